@@ -1,0 +1,115 @@
+"""ChainProblem: a Chain and a Record flattened into the arrays the kernels integrate."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .chain import Chain, ForceSchedule, Record
+
+
+@dataclass(frozen=True, eq=False)
+class ChainProblem:
+    """Bodies from the top: [striker] + beads + [wall as a body of zero inverse mass].
+
+    Arrays are per body (size nb) in SI: mass (kg; 0 for the wall), invm (1/kg), bias
+    (constant acceleration, m/s^2: gravity, plus top force / m on bead 0), load (size nb+1:
+    the constant force carried from above through each slot, N), and per contact
+    slot (slot i joins bodies i-1 and i): A (N/m^1.5), d0 (m), f0 (N), damping (s), d_limit
+    (m, an overlap beyond which the integration is declared unstable). u0, v0 the initial
+    state (m, m/s). ch_slot/ch_weight describe the recorded probes in slot numbering.
+    """
+
+    chain: Chain
+    record: Record
+    offset: int
+    mass: np.ndarray
+    invm: np.ndarray
+    bias: np.ndarray
+    load: np.ndarray
+    A: np.ndarray
+    d0: np.ndarray
+    f0: np.ndarray
+    damping: np.ndarray
+    d_limit: np.ndarray
+    u0: np.ndarray
+    v0: np.ndarray
+    sched_body: int
+    sched_t: np.ndarray
+    sched_f: np.ndarray
+    ch_names: tuple
+    ch_slot: np.ndarray
+    ch_weight: np.ndarray
+    wall_slot: int
+    energy_scale: float
+    momentum_scale: float
+
+    @classmethod
+    def from_chain(cls, chain: Chain, record: Record) -> "ChainProblem":
+        off = 1 if chain.striker is not None else 0
+        n = chain.n_beads
+        nb = off + n + (1 if chain.wall is not None else 0)
+        mass = np.zeros(nb)
+        mass[off:off + n] = chain.masses
+        if off:
+            mass[0] = chain.striker.mass
+        invm = np.zeros(nb)
+        invm[mass > 0] = 1.0 / mass[mass > 0]
+        bias = np.where(mass > 0, chain.gravity, 0.0)
+        bias[off] += chain.initial_top_force / mass[off]
+        load = np.concatenate(([0.0], np.cumsum(mass * bias)))
+
+        A_c, F_c, d_c = chain.contact_constants(), chain.static_forces(), chain.static_overlaps()
+        A = np.zeros(nb)
+        d0 = np.zeros(nb)
+        f0 = np.zeros(nb)
+        d_limit = np.full(nb, math.inf)
+        radii = [b.radius for b in chain.beads]
+        for k in range(n + 1):
+            slot = k + off
+            if np.isfinite(A_c[k]) and 0 < slot < nb:
+                A[slot], d0[slot], f0[slot] = A_c[k], d_c[k], F_c[k]
+                near = [radii[j] for j in (k - 1, k) if 0 <= j < n]
+                d_limit[slot] = 0.5 * min(near)
+        damping = np.full(nb, chain.damping_time)
+
+        u0 = np.zeros(nb)
+        v0 = np.zeros(nb)
+        if off:
+            v0[0] = chain.striker.velocity
+
+        if isinstance(chain.top_force, ForceSchedule):
+            sched_t = np.array(chain.top_force.times)
+            sched_f = np.array(chain.top_force.forces) - chain.initial_top_force
+        else:
+            sched_t = np.zeros(0)
+            sched_f = np.zeros(0)
+
+        names = tuple(record.probes)
+        width = max([len(p.contacts) for p in record.probes.values()] + [1])
+        ch_slot = np.zeros((len(names), width), dtype=np.int64)
+        ch_weight = np.zeros((len(names), width))
+        for c, name in enumerate(names):
+            p = record.probes[name]
+            for j, (k, w) in enumerate(zip(p.contacts, p.weights)):
+                ch_slot[c, j] = k + off
+                ch_weight[c, j] = w
+
+        if off:
+            e_scale = 0.5 * chain.striker.mass * chain.striker.velocity**2
+            p_scale = chain.striker.mass * chain.striker.velocity
+        else:  # no impact: the static elastic energy and its momentum scale
+            e_scale = float(np.sum(0.4 * f0 * d0)) or 1.0
+            p_scale = math.sqrt(2.0 * mass.sum() * e_scale)
+        return cls(chain, record, off, mass, invm, bias, load, A, d0, f0, damping, d_limit, u0, v0,
+                   off, sched_t, sched_f, names, ch_slot, ch_weight,
+                   nb - 1 if chain.wall is not None else 0, e_scale, p_scale)
+
+    @property
+    def n_bodies(self) -> int:
+        return self.mass.shape[0]
+
+    @property
+    def moving_bodies(self) -> int:
+        return int(np.count_nonzero(self.invm))

@@ -1,0 +1,66 @@
+"""Solution: what a solve recorded, and how the solve went."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class SolverStats:
+    """Diagnostics of one solve.
+
+    energy_error: max |E(t) - E(0)| / E_ref over the checks (E_ref: the striker's kinetic
+    energy, or the static elastic energy without a striker). momentum_error: max
+    |P(t) - P(0) - external impulse| / P_ref (P_ref: the striker's momentum), external
+    impulse = constant loads x t + scheduled force impulse - wall impulse.
+    """
+
+    method: str
+    dt_s: float
+    steps: int
+    force_evaluations: int
+    wall_s: float
+    energy_error: float
+    momentum_error: float
+    wall_impulse_Ns: float
+    accuracy: float | None
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+@dataclass(frozen=True, eq=False)
+class Solution:
+    """Recorded forces (N) on the grid t = j * sample_interval, j = 0..n-1 (t = 0: impact).
+
+    frames: positions (m, down from bead 0's equilibrium centre) of the striker (if any)
+    and the beads at t = j * frame_interval, only when frames were asked for.
+    final_u, final_v: each body's displacement (m) and velocity (m/s) at the end.
+    """
+
+    forces: dict
+    sample_interval: float
+    frames: np.ndarray | None
+    frame_interval: float | None
+    final_u: np.ndarray
+    final_v: np.ndarray
+    stats: SolverStats
+    problem: object
+
+    @property
+    def time(self) -> np.ndarray:
+        n = len(next(iter(self.forces.values()))) if self.forces else 0
+        return np.arange(n) * self.sample_interval
+
+    @property
+    def frame_times(self) -> np.ndarray | None:
+        if self.frames is None:
+            return None
+        return np.arange(self.frames.shape[0]) * self.frame_interval
+
+    @property
+    def recorded_bytes(self) -> int:
+        """Bytes held by the recorded channels and frames (what 'record only what is asked' buys)."""
+        n = sum(a.nbytes for a in self.forces.values())
+        return n + (self.frames.nbytes if self.frames is not None else 0)

@@ -1,0 +1,92 @@
+"""solve(problem, t_end, method, accuracy | dt) -> Solution."""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from ._kernels.integrators import integrate
+from .errors import RigError, invalid
+from .methods import DEFAULT_METHOD, method as get_method
+from .problem import ChainProblem
+from .solution import Solution, SolverStats
+from .stepsize import DEFAULT_ACCURACY, accuracy_step, stability_limit
+
+MAX_CHECKS = 1000  # energy / momentum / blow-up checks per solve
+
+
+def solve(problem: ChainProblem, t_end: float, *, method: str = DEFAULT_METHOD,
+          accuracy: float | None = None, dt: float | None = None) -> Solution:
+    """Integrate ``problem`` from the impact (t = 0) to ``t_end`` (s).
+
+    The step is ``dt`` (s) when given, else chosen from ``accuracy`` (target relative force
+    error over the whole chain, default 1e-4; see rig/stepsize.py). A dt beyond the
+    method's stability limit for this chain is refused.
+    """
+    m = get_method(method)
+    if not isinstance(t_end, (int, float)) or not math.isfinite(t_end) or t_end <= 0:
+        raise invalid("t_end", t_end, "end time must be a finite number > 0 s")
+    limit = stability_limit(problem, m)
+    if dt is not None:
+        if accuracy is not None:
+            raise invalid("dt", dt, "give either dt or accuracy, not both")
+        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+            raise invalid("dt", dt, "time step must be a finite number > 0 s")
+        if dt > limit:
+            raise RigError(
+                f"dt = {dt:.4g} s is beyond the stability limit of {m.name} for this chain "
+                f"(about {limit:.4g} s at the estimated peak forces); use dt <= {limit:.3g} s "
+                f"or leave dt unset to choose it from the accuracy target")
+        step = float(dt)
+    else:
+        accuracy = DEFAULT_ACCURACY if accuracy is None else accuracy
+        if not (isinstance(accuracy, (int, float)) and 1e-14 <= accuracy <= 0.1):
+            raise invalid("accuracy", accuracy, "relative accuracy target in [1e-14, 0.1]")
+        step = min(accuracy_step(problem, m, accuracy), 0.5 * limit, t_end)
+    n_steps = max(1, math.ceil(t_end / step * (1 - 1e-12)))
+    step = t_end / n_steps
+
+    rec = problem.record
+    n_out = int(math.floor(t_end / rec.sample_interval * (1 + 1e-12))) + 1
+    out = np.zeros((len(problem.ch_names), n_out))
+    if rec.frame_interval is not None:
+        n_frames = int(math.floor(t_end / rec.frame_interval * (1 + 1e-12))) + 1
+        frame_dt = rec.frame_interval
+    else:
+        n_frames, frame_dt = 0, 1.0
+    frames = np.zeros((n_frames, problem.n_bodies))
+    u = problem.u0.copy()
+    v = problem.v0.copy()
+    diag = np.zeros(6)
+    check_every = max(1, n_steps // MAX_CHECKS)
+
+    t0 = time.perf_counter()
+    integrate(u, v, problem.mass, problem.invm, problem.bias, problem.load, problem.A, problem.d0,
+              problem.damping, problem.chain.law.code,
+              np.array(m.drifts), np.array(m.kicks), step, n_steps,
+              problem.sched_body, problem.sched_t, problem.sched_f,
+              problem.ch_slot, problem.ch_weight, rec.sample_interval, out,
+              frame_dt, frames,
+              check_every, problem.d_limit, problem.wall_slot,
+              problem.energy_scale, problem.momentum_scale, diag)
+    wall = time.perf_counter() - t0
+    if diag[3] != 0:
+        raise RigError(
+            f"the integration became unstable near t = {diag[5]:.4g} s (dt = {step:.4g} s, "
+            f"method {m.name}): an overlap grew beyond half a bead radius; use a smaller dt "
+            f"or a tighter accuracy")
+
+    stats = SolverStats(m.name, step, n_steps, n_steps * m.force_evaluations, wall,
+                        float(diag[0]), float(diag[1]), float(diag[2]),
+                        None if dt is not None else float(accuracy))
+    moving = slice(0, problem.n_bodies - (1 if problem.wall_slot else 0))
+    frames_abs = None
+    if n_frames:
+        x_eq = problem.chain.equilibrium_positions()
+        if problem.offset:
+            top = problem.chain.beads[0].radius + problem.chain.striker.length
+            x_eq = np.concatenate(([-top], x_eq))  # the striker's face at the bead's top
+        frames_abs = frames[:, moving] + x_eq
+    return Solution(dict(zip(problem.ch_names, out)), rec.sample_interval, frames_abs,
+                    rec.frame_interval, u[moving].copy(), v[moving].copy(), stats, problem)
