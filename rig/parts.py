@@ -18,7 +18,7 @@ PTFE_GAUGE_CAPS_FRACTION = 0.093 / 0.1226
 PZT_PLATE_MASS = 0.023e-3  # kg, 0.5 mm x 3 mm x 3 mm lead zirconate titanate with electrodes
 
 _UNITS = {"diameter": "m", "mass": "kg", "caps_mass": "kg", "plate_mass": "kg",
-          "velocity": "m/s", "length": "m"}
+          "velocity": "m/s", "gap": "m"}
 
 
 class _Part:
@@ -103,17 +103,24 @@ class GaugeBead(Bead):
 
 @dataclass(frozen=True)
 class Striker(_Part):
-    """A cylinder dropped flat face first on the top bead with ``velocity`` (m/s, > 0)."""
+    """A cylinder dropped flat face first on the top bead with ``velocity`` (m/s, > 0).
+
+    gap (m, >= 0): distance from its face to the top bead at t = 0 (0: impact at t = 0).
+    """
 
     material: Material | str = "alumina"
     mass: float = 0.47e-3
     velocity: float = 0.89
     diameter: float = 4.76e-3
+    gap: float = 0.0
     kind = "striker"
 
     def __post_init__(self):
         self._convert("striker")
         self._positive("striker", "mass", "velocity", "diameter")
+        if not self.gap >= 0:
+            raise invalid("striker.gap", self.gap,
+                          "the striker would overlap the top bead; allowed: gap >= 0 m")
 
     @property
     def length(self) -> float:

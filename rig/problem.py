@@ -72,6 +72,8 @@ class ChainProblem:
                 A[slot], d0[slot], f0[slot] = A_c[k], d_c[k], F_c[k]
                 near = [radii[j] for j in (k - 1, k) if 0 <= j < n]
                 d_limit[slot] = 0.5 * min(near)
+        if off:
+            d0[1] = -chain.striker.gap
         damping = np.full(nb, chain.damping_time)
 
         u0 = np.zeros(nb)

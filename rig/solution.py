@@ -59,6 +59,19 @@ class Solution:
             return None
         return np.arange(self.frames.shape[0]) * self.frame_interval
 
+    def final_body_energies(self) -> np.ndarray:
+        """Energy (J) of each moving body at the end: kinetic plus half of the elastic
+        energy of each of its contacts (constant-load potentials excluded)."""
+        p = self.problem
+        n = self.final_u.shape[0]
+        u = np.zeros(p.n_bodies)
+        u[:n] = self.final_u
+        d = np.maximum(p.d0[1:] + u[:-1] - u[1:], 0.0)
+        contact = np.concatenate(([0.0], 0.4 * p.A[1:] * d**2.5, [0.0]))
+        e = 0.5 * p.mass * np.pad(self.final_v, (0, p.n_bodies - n)) ** 2
+        e += 0.5 * (contact[:-1] + contact[1:])
+        return e[:n]
+
     @property
     def recorded_bytes(self) -> int:
         """Bytes held by the recorded channels and frames (what 'record only what is asked' buys)."""

@@ -1,0 +1,38 @@
+"""Energy and momentum of conservative shots."""
+import numpy as np
+import pytest
+
+from rig import METHODS, solve
+from conftest import ptfe_rig, record_contacts
+
+
+def _shot(**kw):
+    chain = ptfe_rig(n=30)
+    return solve(chain.problem(record_contacts(chain, 10)), 0.6e-3, **kw)
+
+
+@pytest.mark.parametrize("name", ["verlet", "srkn6b"])
+def test_energy_error_falls_at_the_method_order(name):
+    sols = [_shot(method=name, accuracy=a) for a in (1e-3, 1e-4, 1e-5, 1e-6)]
+    dt = np.array([s.stats.dt_s for s in sols])
+    err = np.array([s.stats.energy_error for s in sols])
+    assert np.all(np.diff(err) < 0)
+    slope = np.polyfit(np.log(dt), np.log(err), 1)[0]
+    assert slope > METHODS[name].contact_order - 0.3, (slope, err)
+    for s in sols:  # the momentum balance closes at every setting
+        assert s.stats.momentum_error < 1e-10
+
+
+def test_published_energy_figure_is_reachable():
+    # the published numerics conserved energy to 1e-10: accuracy=1e-10 gets there
+    # (the accuracy target is calibrated on force error, which is the looser figure)
+    sol = _shot(accuracy=1e-10)
+    assert sol.stats.energy_error < 1e-10
+    assert sol.stats.momentum_error < 1e-10
+
+
+def test_default_accuracy_figures():
+    sol = _shot()
+    assert sol.stats.accuracy == 1e-4
+    assert sol.stats.energy_error < sol.stats.accuracy  # energy is the tighter figure
+    assert sol.stats.momentum_error < 1e-10
