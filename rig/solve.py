@@ -13,7 +13,7 @@ from .problem import ChainProblem
 from .solution import Solution, SolverStats
 from .stepsize import DEFAULT_ACCURACY, accuracy_step, stability_limit
 
-MAX_CHECKS = 1000  # energy / momentum / blow-up checks per solve
+MAX_CHECKS = 200  # energy / momentum / blow-up checks per solve (each one O(N))
 
 
 def solve(problem: ChainProblem, t_end: float, *, method: str = DEFAULT_METHOD,

@@ -36,6 +36,9 @@ def solitary_wave_speed(E, nu, rho, a, F0, Fm):
     V_s = 0.9314 (4 E^2 F0 / (a^2 rho^3 (1-nu^2)^2))^(1/6) / (f_r^(2/3) - 1)
           * sqrt((4/15) (3 + 2 f_r^(5/3) - 5 f_r^(2/3))),  f_r = Fm / F0.
     Tends to Eq (2) as f_r -> 1 and to Eq (4) as f_r -> infinity. Requires Fm > F0 > 0.
+    Evaluated in the cancellation-free form with x = f_r^(1/3), using
+    3 + 2x^5 - 5x^2 = (x-1)^2 (2x^3 + 4x^2 + 6x + 3) and x^2 - 1 = (x-1)(x+1):
+    V_s = pre * sqrt((4/15) (2x^3 + 4x^2 + 6x + 3)) / (x + 1).
     """
     F0 = np.asarray(F0, dtype=float)
     Fm = np.asarray(Fm, dtype=float)
@@ -45,5 +48,5 @@ def solitary_wave_speed(E, nu, rho, a, F0, Fm):
         raise invalid("Fm", Fm, "the maximum force must exceed the precompression F0")
     fr = Fm / F0
     pre = 0.9314 * (4.0 * E**2 * F0 / (a**2 * rho**3 * (1.0 - nu**2) ** 2)) ** (1.0 / 6.0)
-    x = fr ** (2.0 / 3.0)
-    return pre / (x - 1.0) * np.sqrt(4.0 / 15.0 * (3.0 + 2.0 * fr ** (5.0 / 3.0) - 5.0 * x))
+    x = np.cbrt(fr)
+    return pre * np.sqrt(4.0 / 15.0 * (((2.0 * x + 4.0) * x + 6.0) * x + 3.0)) / (x + 1.0)

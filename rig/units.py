@@ -23,7 +23,8 @@ def quantity(value, unit: str, field: str, *, bare_ok: bool = False) -> float:
     """Return ``value`` expressed in ``unit`` (an SI unit such as "m", "kg", "Pa").
 
     ``value`` is a string with a unit ("0.47 g", "1.46 GPa"), or a plain number when
-    ``bare_ok`` is true, in which case it is taken to be in ``unit`` already. Raises
+    ``bare_ok`` is true, in which case it is taken to be in ``unit`` already (a string
+    always needs its unit: "4.76" is refused, 4.76 is not). Raises
     RigError naming ``field`` when the text does not parse, has no unit where one is
     required, or has the wrong dimension.
     """
@@ -34,7 +35,7 @@ def quantity(value, unit: str, field: str, *, bare_ok: bool = False) -> float:
             raise invalid(field, value, f"a unit is required, e.g. '{value} {unit}'")
         out = float(value)
     elif isinstance(value, str):
-        out = _parse(value, unit, field, bare_ok)
+        out = _parse(value, unit, field)
     else:
         raise invalid(field, value, f"expected a quantity in {unit}, e.g. '1 {unit}'")
     if not math.isfinite(out):
@@ -42,7 +43,7 @@ def quantity(value, unit: str, field: str, *, bare_ok: bool = False) -> float:
     return out
 
 
-def _parse(text: str, unit: str, field: str, bare_ok: bool) -> float:
+def _parse(text: str, unit: str, field: str) -> float:
     import pint
 
     ureg = _registry()
@@ -51,8 +52,6 @@ def _parse(text: str, unit: str, field: str, bare_ok: bool) -> float:
     except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError) as exc:
         raise invalid(field, text, f"not a quantity in {unit} ({exc})") from None
     if q.unitless:
-        if bare_ok:
-            return float(q.magnitude)
         raise invalid(field, text, f"a unit is required, e.g. '{text.strip()} {unit}'")
     try:
         si = float(q.to(unit).magnitude)

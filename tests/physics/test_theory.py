@@ -1,0 +1,53 @@
+"""Long-wave theory against the published values, and the discrete wave's limits."""
+import math
+
+import pytest
+
+from rig import hertz_constant, material
+from rig.solitary import solitary_wave
+from rig.theory import solitary_wave_speed, sonic_vacuum_speed, sound_speed
+
+D = 4.76e-3
+
+
+@pytest.mark.parametrize("name,F0,published", [
+    ("ptfe", 0.017, 92.6), ("ptfe", 2.397, 211.2), ("steel316", 0.062, 292.6), ("steel316", 2.44, 539.6)])
+def test_sound_speed_reproduces_published_values(name, F0, published):
+    m = material(name)
+    assert sound_speed(m.E, m.nu, m.rho, D, F0) == pytest.approx(published, rel=1e-3)
+
+
+def test_eq1_limits():
+    m = material("ptfe")
+    c0 = sound_speed(m.E, m.nu, m.rho, D, 2.397)
+    assert solitary_wave_speed(m.E, m.nu, m.rho, D, 2.397, 2.397 * (1 + 1e-6)) == pytest.approx(c0, rel=1e-5)
+    sv = sonic_vacuum_speed(m.E, m.nu, m.rho, D, 10.0)
+    assert solitary_wave_speed(m.E, m.nu, m.rho, D, 1e-9, 10.0) == pytest.approx(sv, rel=1e-3)
+
+
+def _steel_chain():
+    m = material("steel316")
+    return m, m.rho * math.pi * D**3 / 6, hertz_constant(m.E, m.nu, D / 2, m.E, m.nu, D / 2)
+
+
+def test_discrete_sonic_vacuum_wave_is_about_one_percent_faster_than_eq4():
+    m, mass, A = _steel_chain()
+    for Fm in (1.0, 10.0, 100.0):
+        w = solitary_wave(mass, A, D, Fm)
+        ratio = w.speed / sonic_vacuum_speed(m.E, m.nu, m.rho, D, Fm)
+        assert ratio == pytest.approx(1.01246, abs=2e-5)  # the same constant at every amplitude
+        assert 3.0 < w.width_beads < 5.0  # compact: about five diameters, as theory says
+    assert w.beta == pytest.approx(1.414, abs=2e-3)
+
+
+@pytest.mark.parametrize("F0", [0.062, 2.44])
+def test_precompressed_discrete_wave_approaches_eq1_and_beta_depends_on_fr_only(F0):
+    m, mass, A = _steel_chain()
+    weak = solitary_wave(mass, A, D, 1.1 * F0, F0)
+    assert weak.speed == pytest.approx(solitary_wave_speed(m.E, m.nu, m.rho, D, F0, 1.1 * F0), rel=2e-4)
+    strong = solitary_wave(mass, A, D, 50 * F0, F0)
+    assert 1.0 < strong.speed / solitary_wave_speed(m.E, m.nu, m.rho, D, F0, 50 * F0) < 1.012
+    # beta = F_d / F_m,e grows from 1 (long waves) towards the sonic-vacuum value
+    assert 1.0 < weak.beta < strong.beta < solitary_wave(mass, A, D, 10.0).beta
+    assert solitary_wave(mass, A * 0.01, D, 5 * F0 * 0.01, F0 * 0.01).beta == pytest.approx(
+        solitary_wave(mass, A, D, 5 * F0, F0).beta, rel=1e-6)  # independent of the modulus

@@ -1,0 +1,56 @@
+"""The rig command line: public JSON keys, readable output, clean errors."""
+import json
+
+import pytest
+
+from rig.cli import main
+from benchmarks.solver import matched
+
+
+def _json(capsys, *argv):
+    assert main(list(argv)) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_theory_json_keys_and_values(capsys):
+    out = _json(capsys, "theory", "--material", "ptfe", "--diameter", "4.76mm", "--f0", "0.017",
+                "--fm", "5", "--json")
+    assert out["sound_speed_m_per_s"] == pytest.approx(92.6, rel=1e-3)
+    for key in ("speed_m_per_s", "sonic_vacuum_speed_m_per_s", "discrete_speed_m_per_s"):
+        assert out[key] > out["sound_speed_m_per_s"]
+    assert out["discrete_speed_m_per_s"] == pytest.approx(out["speed_m_per_s"], rel=0.02)
+
+
+def test_theory_without_fm_prints_only_the_sound_speed(capsys):
+    out = _json(capsys, "theory", "--material", "steel316", "--f0", "2.44 N", "--json")
+    assert out["sound_speed_m_per_s"] == pytest.approx(539.6, rel=1e-3)
+    assert out["speed_m_per_s"] is None and out["discrete_speed_m_per_s"] is None
+
+
+@pytest.mark.parametrize("argv,field", [
+    (["theory", "--material", "wood", "--f0", "1"], "material"),
+    (["theory", "--f0", "-1"], "--f0"),
+    (["theory", "--f0", "1", "--fm", "0.5"], "--fm"),
+    (["theory", "--f0", "1", "--diameter", "4.76 kg"], "--diameter"),
+    (["demo", "--velocity", "-1"], "striker.velocity"),
+])
+def test_bad_input_is_one_line_and_exit_2(capsys, argv, field):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert field in err and "\n" not in err and "Traceback" not in err
+
+
+def test_demo_shot(capsys):
+    out = _json(capsys, "demo", "--beads", "30", "--json")
+    lead = out["leading_pulse"]
+    assert lead["speed_m_per_s"] > lead["sound_speed_m_per_s"]  # a supersonic solitary wave
+    assert out["solver"]["momentum_error"] < 1e-10
+
+
+def test_matched_error_comparison():
+    rows = [dict(scenario="s", method="srkn6b", setting="a", wall_s=0.1, error=1e-5),
+            dict(scenario="s", method="srkn6b", setting="b", wall_s=0.05, error=1e-3),
+            dict(scenario="s", method="scipy-DOP853", setting="c", wall_s=5.0, error=1e-4)]
+    best = {r["method"]: r for r in matched(rows)}
+    assert best["srkn6b"]["setting"] == "a"  # the cheaper run misses the error target
+    assert best["srkn6b"]["speedup_vs_dop853"] == pytest.approx(50.0)

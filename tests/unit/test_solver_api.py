@@ -1,0 +1,81 @@
+"""What a solve records and refuses."""
+import numpy as np
+import pytest
+
+from rig import Chain, ForceSchedule, Record, RigError, solve
+from conftest import ptfe_rig, steel_sonic_vacuum
+
+
+def test_only_the_asked_channels_are_recorded():
+    chain = ptfe_rig(n=52)
+    rec = Record({"g20": chain.gauge_probe(19), "g29": chain.gauge_probe(28), "wall": chain.wall_probe()})
+    sol = solve(chain.problem(rec), 1e-3)
+    n = int(round(1e-3 / rec.sample_interval)) + 1
+    assert set(sol.forces) == {"g20", "g29", "wall"}
+    assert all(f.shape == (n,) for f in sol.forces.values())
+    assert sol.frames is None
+    assert sol.recorded_bytes == 3 * n * 8  # three force channels, not the whole chain
+
+
+def test_frames_only_when_asked():
+    chain = ptfe_rig(n=10)
+    sol = solve(chain.problem(Record({}, frame_interval=1e-5)), 1e-4)
+    assert sol.frames.shape == (11, 12)  # striker + magnetic bead + 10 beads
+    assert np.all(np.diff(sol.frames[0]) > 0)  # ordered down the tube
+
+
+def test_gauge_reads_the_mean_of_its_two_contacts():
+    chain = ptfe_rig(n=20)
+    rec = Record({"g": chain.gauge_probe(8), "a": chain.contact_probe(8), "b": chain.contact_probe(9)})
+    sol = solve(chain.problem(rec), 3e-4)
+    assert np.allclose(sol.forces["g"], 0.5 * (sol.forces["a"] + sol.forces["b"]), rtol=1e-13, atol=1e-15)
+
+
+def test_no_magnet_no_magnet_term():
+    p = ptfe_rig(n=5, top_force=0.0).problem()
+    assert p.sched_t.size == 0
+    assert np.allclose(p.bias[1:-1], 9.80665)  # gravity alone, on the magnetic bead too
+
+
+def test_scheduled_magnet_force_balances_energy_and_momentum():
+    sched = ForceSchedule((0.0, 2e-4, 4e-4), (2.38, 4.25, 4.25))
+    chain = ptfe_rig(n=20, top_force=sched, striker=False)
+    p = chain.problem(Record({"wall": chain.wall_probe()}))
+    coarse, fine = (solve(p, 6e-4, dt=dt) for dt in (4e-7, 1e-7))
+    for sol in (coarse, fine):
+        assert sol.stats.momentum_error < 1e-10  # the schedule's impulse is exact
+    # the magnet's work is summed by the trapezoidal rule: the balance closes as O(dt^2)
+    assert fine.stats.energy_error < coarse.stats.energy_error / 16 * 1.5
+    assert fine.stats.energy_error < 1e-6
+    assert fine.forces["wall"][-1] > fine.forces["wall"][0] + 1.0  # the extra load arrives
+
+
+def test_dissipative_law_loses_energy_and_is_off_by_default():
+    assert steel_sonic_vacuum(n=5).law.name == "hertz"
+    from conftest import STEEL
+    from rig import Bead, Striker
+    lossy = Chain([Bead(**STEEL)] * 30, striker=Striker("steel316", "0.4501 g", "0.44 m/s"),
+                  gravity=0, contact_law="kuwabara-kono", damping_time=1e-7)
+    sol = solve(lossy.problem(), 2e-4)
+    kept = sol.final_body_energies().sum() / (0.5 * 0.4501e-3 * 0.44**2)
+    assert 0.5 < kept < 0.999
+
+
+@pytest.mark.parametrize("t_end", [0.0, -1e-3, float("nan")])
+def test_end_time_must_be_positive(t_end):
+    with pytest.raises(RigError, match="t_end"):
+        solve(ptfe_rig(n=3).problem(), t_end)
+
+
+def test_bad_chain_inputs():
+    from rig import Bead
+    with pytest.raises(RigError, match="chain.beads"):
+        Chain([])
+    with pytest.raises(RigError, match="chain.wall"):
+        Chain([Bead("ptfe", "4.76 mm")])  # gravity but nothing to rest on
+    with pytest.raises(RigError, match="probe.contact"):
+        steel_sonic_vacuum(n=5).contact_probe(5)  # no wall, so no contact 5
+    with pytest.raises(RigError, match="method"):
+        solve(ptfe_rig(n=3).problem(), 1e-4, method="rk4")
+    with pytest.raises(RigError, match="accuracy"):
+        solve(ptfe_rig(n=3).problem(), 1e-4, accuracy=2.0)
