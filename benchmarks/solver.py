@@ -17,7 +17,7 @@ import numpy as np
 
 from numba import njit
 
-from rig import Bead, Chain, METHODS, Record, Striker, Wall, solve
+from rig import Bead, Chain, Record, Striker, Wall, solve
 from rig._kernels.forces import contact_forces
 from rig.stepsize import DEFAULT_ACCURACY, contact_time_scale
 

@@ -13,13 +13,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .contact import contact_constant, contact_law as lookup_law, static_overlaps
-from .errors import RigError, invalid
+from .errors import invalid
 from .parts import Bead, Striker, Wall
 from .units import quantity
+
+if TYPE_CHECKING:
+    from .problem import ChainProblem
 
 STANDARD_GRAVITY = 9.80665  # m/s^2
 

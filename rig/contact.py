@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import invalid
+from .errors import invalid, lookup
 from .materials import Material
 
 
@@ -82,8 +82,4 @@ CONTACT_LAWS: dict[str, ContactLaw] = {
 
 def contact_law(name) -> ContactLaw:
     """Look a contact law up by name."""
-    if isinstance(name, ContactLaw):
-        return name
-    if name not in CONTACT_LAWS:
-        raise invalid("contact_law", name, f"known laws: {', '.join(CONTACT_LAWS)}")
-    return CONTACT_LAWS[name]
+    return lookup(CONTACT_LAWS, name, "contact_law", ContactLaw)

@@ -8,3 +8,13 @@ class RigError(ValueError):
 def invalid(field: str, value, allowed: str) -> RigError:
     """Build the standard message: ``field = value: allowed``."""
     return RigError(f"{field} = {value!r}: {allowed}")
+
+
+def lookup(registry: dict, name, field: str, kind: type):
+    """registry[name], passing a ``kind`` instance through; a clear error otherwise."""
+    if isinstance(name, kind):
+        return name
+    key = str(name).strip().lower()
+    if key not in registry:
+        raise invalid(field, name, f"known {field.split('.')[-1]}s: {', '.join(sorted(registry))}")
+    return registry[key]

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .errors import invalid
+from .errors import invalid, lookup
 
 
 @dataclass(frozen=True)
@@ -50,9 +50,4 @@ MATERIALS: dict[str, Material] = {
 
 def material(name) -> Material:
     """Look a material up by name (or pass a Material through)."""
-    if isinstance(name, Material):
-        return name
-    key = str(name).strip().lower()
-    if key not in MATERIALS:
-        raise invalid("material", name, f"known materials: {', '.join(sorted(MATERIALS))}")
-    return MATERIALS[key]
+    return lookup(MATERIALS, name, "material", Material)

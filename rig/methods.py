@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import invalid
+from .errors import lookup
 
 
 @dataclass(frozen=True)
@@ -75,8 +75,4 @@ DEFAULT_METHOD = "srkn6b"
 
 def method(name) -> Method:
     """Look a method up by name."""
-    if isinstance(name, Method):
-        return name
-    if name not in METHODS:
-        raise invalid("method", name, f"known methods: {', '.join(METHODS)}")
-    return METHODS[name]
+    return lookup(METHODS, name, "method", Method)

@@ -7,7 +7,7 @@ and every field is validated there (a RigError names the field and the allowed r
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 
 from .errors import invalid
 from .materials import Material, material

@@ -115,3 +115,17 @@ def solitary_wave(mass: float, A: float, diameter: float, Fm: float, F0: float =
     c = math.sqrt(mu * A / mass)
     return SolitaryWave(c * (diameter - r0), c, xi, A * np.maximum(r0 + w, 0.0) ** 1.5, F0, Fm,
                         diameter - r0)
+
+
+def beta(force_ratio: float) -> float:
+    """beta(F_m/F_0) = F_d / F_m,e of a uniform chain from its exact solitary wave.
+
+    The ratio of the maximum dynamic contact force to the maximum dynamic mean of two
+    neighbouring contacts (what a rigid gauge bead reads) depends on F_m/F_0 alone, not on
+    the material (Daraio et al. 2006); ``force_ratio = inf`` gives the sonic-vacuum value.
+    """
+    if not force_ratio >= MIN_FORCE_RATIO:
+        raise invalid("force_ratio", force_ratio, f"F_m/F_0 must be >= {MIN_FORCE_RATIO}")
+    if math.isinf(force_ratio):
+        return solitary_wave(1.0, 1.0, 1.0, 1.0).beta
+    return solitary_wave(1.0, 1.0, 1.0, force_ratio, 1.0).beta

@@ -61,16 +61,4 @@ def _parse(text: str, unit: str, field: str) -> float:
     return float(f"{si:.15g}")
 
 
-def check_range(field: str, value: float, *, lo=None, hi=None, lo_open=True, hi_open=True,
-                unit: str = "") -> float:
-    """Check ``lo < value < hi`` (or <= where the bound is closed); return value."""
-    bad = (lo is not None and (value <= lo if lo_open else value < lo)) or (
-        hi is not None and (value >= hi if hi_open else value > hi))
-    if bad:
-        left = "" if lo is None else f"{lo} {'<' if lo_open else '<='} "
-        right = "" if hi is None else f" {'<' if hi_open else '<='} {hi}"
-        raise invalid(field, value, f"allowed: {left}{field}{right}{' ' + unit if unit else ''}".rstrip())
-    return value
-
-
-__all__ = ["quantity", "check_range", "RigError"]
+__all__ = ["quantity", "RigError"]

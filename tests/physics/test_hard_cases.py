@@ -4,7 +4,7 @@ import importlib
 import numpy as np
 import pytest
 
-from rig import Bead, Chain, MagneticBead, Record, RigError, Striker, Wall, solve
+from rig import Bead, Chain, Record, RigError, Striker, Wall, solve
 from rig.stepsize import stability_limit
 from rig.methods import METHODS
 from conftest import PTFE, STEEL, ptfe_rig, record_contacts, steel_sonic_vacuum

@@ -51,3 +51,11 @@ def test_precompressed_discrete_wave_approaches_eq1_and_beta_depends_on_fr_only(
     assert 1.0 < weak.beta < strong.beta < solitary_wave(mass, A, D, 10.0).beta
     assert solitary_wave(mass, A * 0.01, D, 5 * F0 * 0.01, F0 * 0.01).beta == pytest.approx(
         solitary_wave(mass, A, D, 5 * F0, F0).beta, rel=1e-6)  # independent of the modulus
+
+
+def test_beta_curve_from_the_discrete_chain():
+    from rig.solitary import beta
+    curve = [beta(fr) for fr in (1.1, 2.0, 5.0, 50.0, float("inf"))]
+    assert all(b2 > b1 for b1, b2 in zip(curve, curve[1:]))  # grows with F_m/F_0
+    assert curve[0] == pytest.approx(1.008, abs=1e-3)  # long waves: gauge reads the contact
+    assert curve[-1] == pytest.approx(1.414, abs=2e-3)  # sonic vacuum

@@ -1,7 +1,6 @@
 """Materials, parts, units and contact laws."""
 import math
 
-import numpy as np
 import pytest
 
 from rig import (Bead, GaugeBead, MagneticBead, RigError, Striker, Wall, hertz_constant,
