@@ -6,6 +6,8 @@ import json
 import math
 import sys
 
+from instruments.errors import InstrumentError
+
 from .errors import RigError
 
 
@@ -59,55 +61,84 @@ def cmd_theory(args) -> dict:
     return out
 
 
-def cmd_demo(args) -> dict:
-    """A virtual shot of the published PTFE chain, solver only (instruments come later)."""
-    import numpy as np
+def cmd_shot(args) -> dict:
+    """Fire one virtual shot of a scene; print a summary or JSON; export scope files."""
+    from pathlib import Path
 
-    from . import Bead, Chain, MagneticBead, Record, Striker, Wall, solve
-    from .theory import sound_speed
+    from instruments.formats import WRITERS
 
-    v = _q(args.velocity, "m/s", "--velocity")
-    F = _q(args.force, "N", "--force")
-    beads = [MagneticBead()] + [Bead("ptfe", "4.76 mm", "0.1226 g")] * args.beads
-    chain = Chain(beads, striker=Striker("alumina", "0.47 g", v), wall=Wall(), top_force=F)
-    upper, lower = 20, 29  # published gauges: 20th and 29th PTFE beads from the top
-    if lower > args.beads:
-        raise RigError(f"--beads = {args.beads}: the demo's gauges sit in beads 20 and 29; use >= 29")
-    rec = Record({"upper": chain.gauge_probe(upper), "lower": chain.gauge_probe(lower),
-                  "wall": chain.wall_probe()})
-    sol = solve(chain.problem(rec), args.t_end * 1e-3)
-    x = chain.equilibrium_positions()
-    t = sol.time
+    from .shot import Rig
 
-    def first_peak(y):  # leading pulse: first maximum above half the record's peak
-        dyn = y - y[0]
-        i = int(np.argmax(dyn > 0.5 * dyn.max()))
-        while i + 1 < len(y) and y[i + 1] >= y[i]:
-            i += 1
-        return t[i], dyn[i]
-
-    t1, f1 = first_peak(sol.forces["upper"])
-    t2, f2 = first_peak(sol.forces["lower"])
-    speed = (x[lower] - x[upper]) / (t2 - t1)
-    F0 = chain.static_forces()[(upper + lower) // 2 + 1]
-    m = beads[1].material
-    out = {"beads": args.beads + 1, "striker_velocity_m_per_s": v, "magnet_force_N": F,
-           "solver": sol.stats.as_dict(), "leading_pulse": {
-               "speed_m_per_s": speed, "averaged_amplitude_N": 0.5 * (f1 + f2),
-               "sound_speed_m_per_s": float(sound_speed(m.E, m.nu, m.rho, 4.76e-3, F0))},
-           "wall_peak_N": float(sol.forces["wall"].max())}
+    rig = Rig.from_scene(args.scene, args.set or ())
+    shot = rig.fire(seed=args.seed)
+    out = shot_summary(rig, shot)
+    if args.export:
+        if not shot.scope.triggered:
+            raise RigError(f"--export: nothing to export, the scope did not trigger ({shot.scope.reason})")
+        folder = Path(args.export)
+        folder.mkdir(parents=True, exist_ok=True)
+        paths = WRITERS[args.format](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
+        out["exported"] = [str(p) for p in paths]
     if not args.json:
-        s = sol.stats
-        print(f"PTFE chain: magnetic bead + {args.beads} beads, striker 0.47 g at {v:g} m/s, magnet {F:g} N")
-        print(f"  solver {s.method}: dt = {s.dt_s * 1e9:.1f} ns, {s.steps} steps, {s.wall_s * 1e3:.1f} ms, "
-              f"energy error {s.energy_error:.1e}, momentum error {s.momentum_error:.1e}")
-        print(f"  leading pulse between gauges 20 and 29: {speed:.1f} m/s, averaged amplitude "
-              f"{0.5 * (f1 + f2):.3f} N (sound speed c0 = {out['leading_pulse']['sound_speed_m_per_s']:.1f} m/s)")
-        print(f"  wall force peak {out['wall_peak_N']:.3f} N")
+        print_shot(out)
     return out
 
 
+def shot_summary(rig, shot) -> dict:
+    """The JSON-ready summary of a shot (the keys of `rig shot --json`)."""
+    st = shot.solver
+    wiring = {ch: f"gauges.{n}" for n, (_, ch, _) in rig.gauges.items()}
+    if rig.wall_sensor is not None:
+        wiring[rig.wall_channel] = "wall_sensor"
+    tr = rig.scope.trigger
+    channels = {}
+    for ch, w in shot.scope.waveforms.items():
+        v = w.volts()
+        p = w.preamble
+        channels[ch] = {"connected": wiring.get(ch), "samples": p.points,
+                        "sample_interval_s": p.x_increment, "trigger_index": p.trigger_index,
+                        "first_sample_s": p.x_zero, "volts_per_div": p.extra["volts_per_div"],
+                        "y_multiplier_V": p.y_multiplier, "min_V": float(v.min()),
+                        "max_V": float(v.max()), "clipped": w.overrange}
+    return {"scenario": shot.scene, "seed": shot.seed, "overrides": list(shot.overrides),
+            "solver": {"method": st.method, "dt_s": st.dt_s, "steps": st.steps,
+                       "wall_s": st.wall_s, "energy_error": st.energy_error,
+                       "momentum_error": st.momentum_error},
+            "triggered": shot.scope.triggered, "no_trigger_reason": shot.scope.reason,
+            "trigger": {"source": tr.source, "level_V": tr.level, "slope": tr.slope,
+                        "time_after_impact_s": shot.scope.trigger_time},
+            "channels": channels}
+
+
+def print_shot(out: dict):
+    s = out["solver"]
+    print(f"{out['scenario']} (seed {out['seed']})")
+    print(f"  solver {s['method']}: dt = {s['dt_s'] * 1e9:.1f} ns, {s['steps']} steps, "
+          f"{s['wall_s'] * 1e3:.1f} ms, energy error {s['energy_error']:.1e}, "
+          f"momentum error {s['momentum_error']:.1e}")
+    tr = out["trigger"]
+    if not out["triggered"]:
+        print(f"  scope: NO TRIGGER ({out['no_trigger_reason']})")
+        return
+    print(f"  scope: triggered on {tr['source']} ({tr['slope']}, {tr['level_V'] * 1e3:g} mV) "
+          f"{tr['time_after_impact_s'] * 1e3:.3f} ms after impact")
+    for ch, c in out["channels"].items():
+        print(f"  {ch} {c['connected'] or 'unconnected':14s} {c['samples']} samples at "
+              f"{c['sample_interval_s'] * 1e6:g} us, trigger at sample {c['trigger_index']}, "
+              f"{c['volts_per_div'] * 1e3:g} mV/div, {c['min_V']:+.3f} .. {c['max_V']:+.3f} V"
+              f"{'  CLIPPED' if c['clipped'] else ''}")
+    for path in out.get("exported", []):
+        print(f"  wrote {path}")
+
+
 def cmd_bench(args) -> dict:
+    if args.what == "shot":
+        from benchmarks import shot as bench_shot
+
+        result = bench_shot.run()
+        if not args.json:
+            print(bench_shot.table(result))
+        return result
     from benchmarks import solver as bench
 
     progress = None if args.json else (lambda msg: print(f"  running {msg}", file=sys.stderr, flush=True))
@@ -131,16 +162,18 @@ def build_parser() -> argparse.ArgumentParser:
     th.add_argument("--json", action="store_true", help="print JSON")
     th.set_defaults(func=cmd_theory)
 
-    de = sub.add_parser("demo", help="a solver-only shot of the published PTFE chain")
-    de.add_argument("--beads", type=int, default=52, help="PTFE beads under the magnetic bead (default 52)")
-    de.add_argument("--velocity", default="0.89", help="striker velocity (plain number: m/s)")
-    de.add_argument("--force", default="2.38", help="magnet force (plain number: N)")
-    de.add_argument("--t-end", type=float, default=1.5, help="simulated time in ms (default 1.5)")
-    de.add_argument("--json", action="store_true", help="print JSON")
-    de.set_defaults(func=cmd_demo)
+    sh = sub.add_parser("shot", help="fire one virtual shot of a scene")
+    sh.add_argument("scene", help="a scene file, or a published scene's name (e.g. ptfe52_magnetic)")
+    sh.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="override a scene key, e.g. striker.velocity=1.2 (plain numbers in SI)")
+    sh.add_argument("--seed", type=int, help="seed of every random draw (default: a fresh one, printed)")
+    sh.add_argument("--export", metavar="DIR", help="write the scope records to DIR")
+    sh.add_argument("--format", choices=["isf", "csv"], default="isf", help="scope file format (default isf)")
+    sh.add_argument("--json", action="store_true", help="print JSON")
+    sh.set_defaults(func=cmd_shot)
 
     be = sub.add_parser("bench", help="benchmarks")
-    be.add_argument("what", choices=["solver"], help="what to benchmark")
+    be.add_argument("what", choices=["solver", "shot"], help="what to benchmark")
     be.add_argument("--quick", action="store_true", help="fewer settings, one repeat")
     be.add_argument("--json", action="store_true", help="print JSON")
     be.set_defaults(func=cmd_bench)
@@ -151,7 +184,7 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
         out = args.func(args)
-    except RigError as exc:
+    except (RigError, InstrumentError) as exc:
         print(f"rig {args.command}: error: {exc}", file=sys.stderr)
         return 2
     if args.json:

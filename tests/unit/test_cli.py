@@ -32,19 +32,14 @@ def test_theory_without_fm_prints_only_the_sound_speed(capsys):
     (["theory", "--f0", "-1"], "--f0"),
     (["theory", "--f0", "1", "--fm", "0.5"], "--fm"),
     (["theory", "--f0", "1", "--diameter", "4.76 kg"], "--diameter"),
-    (["demo", "--velocity", "-1"], "striker.velocity"),
+    (["shot", "ptfe52_magnetic", "--set", "striker.velocity=-1"], "striker.velocity"),
+    (["shot", "ptfe52_magnetic", "--set", "chain.colour=red"], "chain.colour"),
+    (["shot", "no_such_scene"], "scene"),
 ])
 def test_bad_input_is_one_line_and_exit_2(capsys, argv, field):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert field in err and "\n" not in err and "Traceback" not in err
-
-
-def test_demo_shot(capsys):
-    out = _json(capsys, "demo", "--beads", "30", "--json")
-    lead = out["leading_pulse"]
-    assert lead["speed_m_per_s"] > lead["sound_speed_m_per_s"]  # a supersonic solitary wave
-    assert out["solver"]["momentum_error"] < 1e-10
 
 
 def test_matched_error_comparison():

@@ -1,0 +1,236 @@
+"""The virtual shot: parts and instruments assembled around the solver.
+
+``Rig.from_scene("ptfe52_magnetic").fire(seed=1)`` solves the chain once (the solution is
+reused by later fires: instruments draw their randomness per shot, the chain does not),
+records only the contacts of the gauge beads and the wall, runs every connected
+instrument and the oscilloscope, and returns a ShotRecord. Same seed, same bits.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from instruments.gauges import GaugeDraw, GaugeSettings, PiezoGauge
+from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
+from instruments.records import ScopeRecord
+
+from . import scene as scene_io
+from .apparatus import Holder, RingMagnet
+from .chain import Chain, Record
+from .errors import RigError, invalid
+from .parts import Bead, GaugeBead, MagneticBead, Striker, Wall
+from .solution import SolverStats
+from .solve import solve
+
+
+@dataclass(frozen=True, eq=False)
+class GaugeTruth:
+    """Noise-free truth at one gauge bead (chain index ``bead``, 0 = top bead)."""
+
+    bead: int
+    channel: str
+    position_m: float          # equilibrium centre, down from bead 0's centre
+    average_force: np.ndarray  # N, what the rigid gauge bead's plate feels
+    contact_above: np.ndarray  # N
+    contact_below: np.ndarray  # N
+    static_above_N: float
+    static_below_N: float
+
+
+@dataclass(frozen=True, eq=False)
+class Truth:
+    """Ground truth on the solver's output grid t = n * sample_interval (s, 0 = impact)."""
+
+    sample_interval: float
+    gauges: dict
+    wall_force: np.ndarray | None
+    wave_speed_m_per_s: float | None
+
+
+@dataclass(frozen=True, eq=False)
+class ShotRecord:
+    """One virtual shot: scope records, every part's settings, the seed and the truth."""
+
+    scene: str
+    scene_text: str
+    overrides: tuple
+    seed: int
+    settings: dict
+    scope: ScopeRecord
+    truth: Truth
+    solver: SolverStats
+    draws: dict
+
+
+class Rig:
+    """Parts and instruments of one scene (see rig/scene.py for the file format)."""
+
+    def __init__(self, values: dict, scene_text: str = "", overrides: tuple = ()):
+        self.values = values
+        self.scene_text = scene_text
+        self.overrides = tuple(overrides)
+        self.name = values.get("scene", {}).get("name", "scene")
+        self._build()
+        self._solution = None
+
+    @classmethod
+    def from_scene(cls, name_or_path, overrides=()) -> "Rig":
+        values, text = scene_io.load(name_or_path, overrides)
+        return cls(values, text, tuple(overrides))
+
+    # --- assembly -------------------------------------------------------------------
+    def _build(self):
+        v = self.values
+        for table in ("chain", "striker", "holder", "wall", "scope", "solver"):
+            if table not in v:
+                raise invalid(f"scene [{table}]", None, "this table is required")
+        self.holder = Holder(**v["holder"])
+        c = dict(v["chain"])
+        n = c.pop("beads", None)
+        if not isinstance(n, int) or n < 1:
+            raise invalid("chain.beads", n, "a whole number of beads >= 1")
+        magnetic = c.pop("magnetic_bead", False)
+        law = c.pop("contact_law", "hertz")
+        damping = c.pop("damping_time", 0.0)
+        plain = Bead(c.get("material"), c.get("diameter"), c.get("mass"))
+        beads = ([MagneticBead()] if magnetic else []) + [plain] * n
+        first = 1 if magnetic else 0
+        self.gauges = {}
+        for name, g in sorted(v.get("gauges", {}).items()):
+            g = dict(g)
+            index = self._gauge_index(name, g.pop("bead", None), g.pop("from_wall", None), first, len(beads))
+            channel = g.pop("channel", None)
+            beads[index] = GaugeBead.like(plain)
+            self.gauges[name] = (index, channel, GaugeSettings(**g))
+        self.striker = Striker(**v["striker"])
+        self.holder.check(beads, self.striker)
+        self.magnet = RingMagnet(**v["magnet"]) if "magnet" in v else None
+        if self.magnet is not None and not magnetic:
+            raise invalid("magnet", "set", "a ring magnet needs chain.magnetic_bead = true")
+        self.chain = Chain(beads, striker=self.striker, wall=Wall(**v["wall"]),
+                           gravity=self.holder.gravity,
+                           top_force=self.magnet.top_force() if self.magnet else 0.0,
+                           contact_law=law, damping_time=damping)
+        ws = dict(v.get("wall_sensor", {}))
+        self.wall_channel = ws.pop("channel", None)
+        self.wall_sensor = GaugeSettings(misalignment_sd=0.0, **ws) if "wall_sensor" in v else None
+        self.scope = self._scope(v["scope"])
+        self._check_connections()
+        s = v["solver"]
+        self.solver = {"method": s.get("method", "srkn6b"), "accuracy": s.get("accuracy"),
+                       "duration": s.get("duration"), "sample_interval": s.get("sample_interval", 1e-7)}
+        if not self.solver["duration"] or self.solver["duration"] <= 0:
+            raise invalid("solver.duration", self.solver["duration"], "simulated time > 0 s, e.g. '4 ms'")
+
+    @staticmethod
+    def _gauge_index(name, bead, from_wall, first, total):
+        field = f"gauges.{name}"
+        if (bead is None) == (from_wall is None):
+            raise invalid(field, None, "give exactly one of bead (from the top) or from_wall")
+        plain = total - first
+        count = bead if bead is not None else from_wall
+        if not 1 <= count <= plain:
+            key = "bead" if bead is not None else "from_wall"
+            raise invalid(f"{field}.{key}", count, f"the chain has beads 1..{plain} (magnetic bead not counted)")
+        return first + bead - 1 if bead is not None else total - from_wall
+
+    @staticmethod
+    def _scope(s: dict) -> Oscilloscope:
+        s = dict(s)
+        channels = {ch: ChannelSettings(**cs) for ch, cs in s.pop("channels", {}).items()}
+        trigger = Trigger(**s.pop("trigger", {}))
+        timebase = Timebase(s.pop("sample_interval", 1e-7), s.pop("record_length", 20000))
+        return Oscilloscope(channels=channels, timebase=timebase, trigger=trigger, **s)
+
+    def _check_connections(self):
+        used = {}
+        wiring = [(f"gauges.{n}.channel", ch) for n, (_, ch, _) in self.gauges.items()]
+        if self.wall_sensor is not None:
+            wiring.append(("wall_sensor.channel", self.wall_channel))
+        for field, ch in wiring:
+            if ch not in self.scope.channels:
+                raise invalid(field, ch, f"not set up on the scope (channels: {', '.join(self.scope.channels)})")
+            if ch in used:
+                raise invalid(field, ch, f"already taken by {used[ch]}")
+            used[ch] = field
+        src = self.scope.trigger.source
+        if src not in used:
+            raise invalid("scope.trigger.source", src,
+                          f"triggers on an unconnected channel (connected: {', '.join(used) or 'none'})")
+
+    # --- the shot ---------------------------------------------------------------------
+    def record(self) -> Record:
+        """Only the contacts the instruments need: each gauge bead's two, and the wall's."""
+        probes = {}
+        for index, _, _ in self.gauges.values():
+            for k in (index, index + 1):
+                probes[f"contact{k}"] = self.chain.contact_probe(k)
+        if self.wall_sensor is not None:
+            probes["wall"] = self.chain.wall_probe()
+        return Record(probes, sample_interval=self.solver["sample_interval"])
+
+    def solution(self):
+        if self._solution is None:
+            self._solution = solve(self.chain.problem(self.record()), self.solver["duration"],
+                                   method=self.solver["method"], accuracy=self.solver["accuracy"])
+        return self._solution
+
+    def truth(self) -> Truth:
+        sol = self.solution()
+        x = self.chain.equilibrium_positions()
+        F0 = self.chain.static_forces()
+        gauges = {}
+        for name, (j, ch, _) in self.gauges.items():
+            above, below = sol.forces[f"contact{j}"], sol.forces[f"contact{j + 1}"]
+            gauges[name] = GaugeTruth(j, ch, float(x[j]), 0.5 * (above + below), above, below,
+                                      float(F0[j]), float(F0[j + 1]))
+        return Truth(sol.sample_interval, gauges, sol.forces.get("wall"), _wave_speed(gauges, sol.sample_interval))
+
+    def fire(self, seed: int | None = None) -> ShotRecord:
+        """One shot. ``seed`` (int) fixes every random draw; None draws a fresh one (recorded)."""
+        if seed is None:  # fresh, 63 bits so that it fits a signed 64-bit integer anywhere
+            seed = int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(1))
+        if not isinstance(seed, (int, np.integer)) or seed < 0:
+            raise invalid("seed", seed, "a whole number >= 0")
+        rng = np.random.default_rng(int(seed))
+        truth = self.truth()
+        h = truth.sample_interval
+        inputs, draws = {}, {}
+        for name, (_, ch, settings) in self.gauges.items():
+            draw = GaugeDraw.draw(settings, rng)
+            draws[name] = {"gain": draw.gain, "misalignment_m": draw.misalignment}
+            inputs[ch] = PiezoGauge(settings).read(truth.gauges[name].average_force, h, draw, rng,
+                                                   truth.wave_speed_m_per_s)
+        if self.wall_sensor is not None:
+            draw = GaugeDraw.draw(self.wall_sensor, rng)
+            draws["wall_sensor"] = {"gain": draw.gain}
+            inputs[self.wall_channel] = PiezoGauge(self.wall_sensor).read(truth.wall_force, h, draw, rng)
+        try:
+            record = self.scope.acquire(inputs, h, rng)
+        except ValueError as exc:
+            raise RigError(f"{exc} (solver.duration = {self.solver['duration']:g} s)") from None
+        return ShotRecord(self.name, self.scene_text, self.overrides, int(seed), self.values, record,
+                          truth, self.solution().stats, draws)
+
+
+def _wave_speed(gauges: dict, h: float) -> float | None:
+    """Leading-pulse speed (m/s) between the outermost gauges, from the truth's peaks."""
+    if len(gauges) < 2:
+        return None
+    g = sorted(gauges.values(), key=lambda t: t.position_m)
+    t_top, t_bottom = _first_peak_time(g[0].average_force, h), _first_peak_time(g[-1].average_force, h)
+    if t_top is None or t_bottom is None or t_bottom <= t_top:
+        return None
+    return (g[-1].position_m - g[0].position_m) / (t_bottom - t_top)
+
+
+def _first_peak_time(f: np.ndarray, h: float) -> float | None:
+    """Time (s) of the first local maximum of the dynamic force above half its peak."""
+    dyn = f - f[0]
+    if dyn.max() <= 0:
+        return None
+    i = int(np.argmax(dyn > 0.5 * dyn.max()))
+    while i + 1 < dyn.size and dyn[i + 1] >= dyn[i]:
+        i += 1
+    return i * h

@@ -1,0 +1,89 @@
+"""The emulated Tektronix scope: quantisation, clipping, trigger, noise, no-trigger."""
+import numpy as np
+import pytest
+
+from instruments.errors import InstrumentError
+from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
+
+H = 1e-7
+
+
+def _pulse(n=30000, at=1e-3, width=5e-5, amp=0.2):
+    t = np.arange(n) * H
+    return amp * np.exp(-(((t - at) / width) ** 2))
+
+
+def _scope(**kw):
+    ch = kw.pop("channels", {"CH1": ChannelSettings(volts_per_div=0.05, bandwidth=None)})
+    return Oscilloscope(channels=ch, timebase=kw.pop("timebase", Timebase(2e-7, 5000)),
+                        trigger=kw.pop("trigger", Trigger("CH1", 0.05, "rising", 0.2)), **kw)
+
+
+def test_quantisation_step_is_v_per_div_over_25():
+    rec = _scope(noise_floor=0.0).acquire({"CH1": _pulse()}, H, np.random.default_rng(1))
+    w = rec["CH1"]
+    assert w.preamble.y_multiplier == 0.05 / 25
+    v = w.volts()
+    steps = np.unique(np.round(np.diff(np.unique(v)) / w.preamble.y_multiplier, 9))
+    assert steps.min() == 1.0  # every level is a whole number of 2 mV codes
+    assert w.codes.dtype == np.int8
+
+
+def test_clipping_sets_the_over_range_flag():
+    small = _scope(noise_floor=0.0).acquire({"CH1": _pulse(amp=0.2)}, H, np.random.default_rng(1))
+    big = _scope(noise_floor=0.0).acquire({"CH1": _pulse(amp=0.5)}, H, np.random.default_rng(1))
+    assert not small["CH1"].overrange
+    assert big["CH1"].overrange and big["CH1"].codes.max() == 127
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_trigger_lands_within_one_sample_of_the_crossing(seed):
+    x = _pulse()
+    rec = _scope(noise_floor=0.0).acquire({"CH1": x}, H, np.random.default_rng(seed))
+    w = rec["CH1"]
+    t = np.arange(x.size) * H
+    i = np.argmax(x >= 0.05)
+    t_cross = t[i - 1] + (0.05 - x[i - 1]) / (x[i] - x[i - 1]) * H
+    assert abs(rec.trigger_time - t_cross) < 1e-12
+    k = w.preamble.trigger_index
+    assert k == 1000  # 20% of 5000 points before the trigger
+    sample_t = rec.trigger_time + w.time()
+    assert sample_t[k - 1] < t_cross <= sample_t[k]
+    assert 0 <= sample_t[k] - t_cross < w.preamble.x_increment
+
+
+def test_unconnected_channel_reads_the_noise_floor():
+    chans = {"CH1": ChannelSettings(volts_per_div=0.05), "CH4": ChannelSettings(volts_per_div=1e-3)}
+    rec = _scope(channels=chans, noise_floor=2e-4).acquire({"CH1": _pulse()}, H, np.random.default_rng(2))
+    assert np.std(rec["CH4"].volts()) == pytest.approx(2e-4, rel=0.05)  # 5000 samples, 0.04 mV steps
+
+
+def test_averaging_reduces_the_scope_noise():
+    chans = {"CH1": ChannelSettings(volts_per_div=0.05), "CH4": ChannelSettings(volts_per_div=1e-3)}
+    rec = _scope(channels=chans, noise_floor=4e-4, mode="average", averages=16).acquire(
+        {"CH1": _pulse()}, H, np.random.default_rng(2))
+    assert np.std(rec["CH4"].volts()) == pytest.approx(1e-4, rel=0.06)
+
+
+def test_no_trigger_is_an_outcome_not_an_exception():
+    rec = _scope().acquire({"CH1": _pulse(amp=0.01)}, H, np.random.default_rng(0))
+    assert not rec.triggered and rec.waveforms == {} and "no rising crossing" in rec.reason
+
+
+def test_same_seed_same_bits():
+    a = _scope().acquire({"CH1": _pulse()}, H, np.random.default_rng(7))["CH1"]
+    b = _scope().acquire({"CH1": _pulse()}, H, np.random.default_rng(7))["CH1"]
+    assert np.array_equal(a.codes, b.codes) and a.preamble == b.preamble
+
+
+@pytest.mark.parametrize("make,field", [
+    (lambda: ChannelSettings(volts_per_div=0), "volts_per_div"),
+    (lambda: ChannelSettings(volts_per_div=-0.1), "volts_per_div"),
+    (lambda: ChannelSettings(coupling="XY"), "coupling"),
+    (lambda: Timebase(1e-7, 0), "record_length"),
+    (lambda: Trigger(slope="up"), "slope"),
+    (lambda: _scope(trigger=Trigger("CH2")), "trigger.source"),
+])
+def test_bad_settings_name_the_field(make, field):
+    with pytest.raises(InstrumentError, match=field):
+        make()
