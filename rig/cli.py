@@ -79,6 +79,10 @@ def cmd_shot(args) -> dict:
         folder.mkdir(parents=True, exist_ok=True)
         paths = WRITERS[args.format](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
         out["exported"] = [str(p) for p in paths]
+    if args.out:
+        from instruments.archive import Archive
+
+        out["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot.to_entry()])[0]}
     if not args.json:
         print_shot(out)
     return out
@@ -129,15 +133,79 @@ def print_shot(out: dict):
               f"{'  CLIPPED' if c['clipped'] else ''}")
     for path in out.get("exported", []):
         print(f"  wrote {path}")
+    if "archived" in out:
+        print(f"  appended to {out['archived']['archive']} as shot {out['archived']['shot']}")
+
+
+def cmd_verify(args) -> dict:
+    from instruments.archive import Archive
+
+    report = Archive(args.archive).verify()
+    if not args.json:
+        print(f"{args.archive}: {report['shots']} shots, {report['ok']} ok, {len(report['bad'])} bad")
+        for b in report["bad"]:
+            print(f"  shot {b['shot']}: {b['reason']}")
+    args.exit_code = 1 if report["bad"] else 0
+    return report
+
+
+def cmd_import(args) -> dict:
+    """Real scope files into an archive, in the same layout as virtual shots (simulated = false)."""
+    from datetime import datetime, timezone
+    from pathlib import Path
+
+    from instruments.archive import Archive, Entry
+    from instruments.formats import READERS
+    from instruments.records import ScopeRecord
+
+    groups = [args.files] if args.together else [[f] for f in args.files]
+    entries = []
+    for files in groups:
+        waves = {}
+        for name in files:
+            path = Path(name)
+            reader = READERS.get(path.suffix.lower())
+            if reader is None:
+                raise RigError(f"{path}: cannot import {path.suffix or 'extensionless'} files "
+                               f"(known: {', '.join(READERS)})")
+            for w in reader(path):
+                key = w.channel if w.channel not in waves else f"{w.channel}@{path.stem}"
+                waves[key] = w
+        mtime = min(Path(f).stat().st_mtime for f in files)
+        entries.append(Entry(ScopeRecord(waves, True), False, scene="",
+                             settings={"source_files": [str(Path(f).resolve().name) for f in files]},
+                             start_time=datetime.fromtimestamp(mtime, timezone.utc).isoformat()))
+    ids = Archive(args.into).append(entries)
+    out = {"archive": args.into, "shots": ids}
+    if not args.json:
+        print(f"imported {len(args.files)} file(s) into {args.into} as shot(s) {', '.join(map(str, ids))}")
+    return out
+
+
+def cmd_ls(args) -> list:
+    from instruments.archive import Archive
+
+    rows = Archive(args.archive).summary()
+    if not args.json:
+        print(f"{'shot':>5s}  {'start (UTC)':19s}  {'kind':7s}  {'scene':22s}  {'seed':>20s}  channels")
+        for r in rows:
+            s = r["settings"]
+            extra = f"  v={s['velocity']:g} m/s" if "velocity" in s else ""
+            what = r["scene"] or ",".join(r["sources"]) or "-"
+            print(f"{r['shot']:5d}  {r['start_time'][:19]:19s}  {'virtual' if r['simulated'] else 'real':7s}  "
+                  f"{what:22s}  {'' if r['seed'] is None else r['seed']:>20}  "
+                  f"{','.join(r['channels'])}{'' if r['triggered'] else '  NO TRIGGER'}{extra}")
+    return rows
 
 
 def cmd_bench(args) -> dict:
-    if args.what == "shot":
-        from benchmarks import shot as bench_shot
+    if args.what in ("shot", "archive"):
+        import importlib
 
-        result = bench_shot.run()
+        module = importlib.import_module(f"benchmarks.{args.what}")
+        result = module.run()
         if not args.json:
-            print(bench_shot.table(result))
+            print(module.table(result))
         return result
     from benchmarks import solver as bench
 
@@ -169,11 +237,29 @@ def build_parser() -> argparse.ArgumentParser:
     sh.add_argument("--seed", type=int, help="seed of every random draw (default: a fresh one, printed)")
     sh.add_argument("--export", metavar="DIR", help="write the scope records to DIR")
     sh.add_argument("--format", choices=["isf", "csv"], default="isf", help="scope file format (default isf)")
+    sh.add_argument("--out", metavar="ARCHIVE.h5", help="append the shot to an HDF5 archive")
     sh.add_argument("--json", action="store_true", help="print JSON")
     sh.set_defaults(func=cmd_shot)
 
+    ve = sub.add_parser("verify", help="check every shot of an archive (exit 1 if any is bad)")
+    ve.add_argument("archive")
+    ve.add_argument("--json", action="store_true", help="print JSON")
+    ve.set_defaults(func=cmd_verify)
+
+    im = sub.add_parser("import", help="import real scope files into an archive")
+    im.add_argument("files", nargs="+", metavar="FILE")
+    im.add_argument("--into", required=True, metavar="ARCHIVE.h5")
+    im.add_argument("--together", action="store_true", help="the files are the channels of one shot")
+    im.add_argument("--json", action="store_true", help="print JSON")
+    im.set_defaults(func=cmd_import)
+
+    ls = sub.add_parser("ls", help="list the shots of an archive")
+    ls.add_argument("archive")
+    ls.add_argument("--json", action="store_true", help="print JSON")
+    ls.set_defaults(func=cmd_ls)
+
     be = sub.add_parser("bench", help="benchmarks")
-    be.add_argument("what", choices=["solver", "shot"], help="what to benchmark")
+    be.add_argument("what", choices=["solver", "shot", "archive"], help="what to benchmark")
     be.add_argument("--quick", action="store_true", help="fewer settings, one repeat")
     be.add_argument("--json", action="store_true", help="print JSON")
     be.set_defaults(func=cmd_bench)
@@ -189,7 +275,7 @@ def main(argv=None) -> int:
         return 2
     if args.json:
         print(json.dumps(out, indent=2))
-    return 0
+    return getattr(args, "exit_code", 0)
 
 
 if __name__ == "__main__":

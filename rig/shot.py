@@ -7,15 +7,17 @@ instrument and the oscilloscope, and returns a ShotRecord. Same seed, same bits.
 """
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
 
+from instruments.archive import Entry
 from instruments.gauges import GaugeDraw, GaugeSettings, PiezoGauge
 from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from instruments.records import ScopeRecord
 
-from . import scene as scene_io
+from . import __version__, scene as scene_io
 from .apparatus import Holder, RingMagnet
 from .chain import Chain, Record
 from .errors import RigError, invalid
@@ -61,6 +63,26 @@ class ShotRecord:
     truth: Truth
     solver: SolverStats
     draws: dict
+
+    def to_entry(self) -> Entry:
+        """The archive's plain form of this shot (instruments never see rig objects)."""
+        arrays, gauges = {}, {}
+        for name, g in self.truth.gauges.items():
+            arrays[f"{name}.average_force"] = g.average_force
+            arrays[f"{name}.contact_above"] = g.contact_above
+            arrays[f"{name}.contact_below"] = g.contact_below
+            gauges[name] = {"bead": g.bead, "channel": g.channel, "position_m": g.position_m,
+                            "static_above_N": g.static_above_N, "static_below_N": g.static_below_N}
+        if self.truth.wall_force is not None:
+            arrays["wall_force"] = self.truth.wall_force
+        facts = {"sample_interval_s": self.truth.sample_interval, "gauges": gauges,
+                 "wave_speed_m_per_s": self.truth.wave_speed_m_per_s, "draws": self.draws,
+                 "trigger_time_after_impact_s": self.scope.trigger_time,
+                 "solver": self.solver.as_dict(), "overrides": list(self.overrides)}
+        key = hashlib.sha256((self.scene_text + "\n".join(self.overrides) + __version__).encode())
+        return Entry(self.scope, True, self.seed, self.scene, self.scene_text,
+                     {**self.settings, "overrides": list(self.overrides)}, arrays, facts,
+                     key.hexdigest()[:16], project_version=__version__)
 
 
 class Rig:

@@ -1,5 +1,6 @@
 """Scope file formats: Tektronix ISF (binary) and Tektronix CSV, by file extension."""
-from .isf import write_isf
+from .isf import read_isf, write_isf
 from .tek_csv import write_csv
 
 WRITERS = {"isf": write_isf, "csv": write_csv}
+READERS = {".isf": read_isf}

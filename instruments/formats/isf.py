@@ -5,14 +5,33 @@ Header (full keywords, as DPO/TDS scopes write them):
   XUNIT "s";XINCR dt;XZERO t0;PT_OFF 0;YUNIT "V";YMULT m;YOFF o;YZERO z;:CURVE #<d><len><bytes>
 PT_OFF is written 0 with XZERO the first sample's time, so readers that use
 t = XZERO + XINCR (n - PT_OFF) and readers that ignore PT_OFF agree.
+
+The reader takes what real scopes write: full (":WFMPRE:BYT_NR") or abbreviated
+(":WFMP:BYT_N") keywords, 8- or 16-bit, either byte order, sample (Y) or envelope (ENV)
+records, and several header+curve records back to back in one file (each is returned).
 """
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
 
-from ..records import Waveform
+from ..errors import InstrumentError
+from ..records import Preamble, Waveform
+
+# every spelling real scopes use, long and short, to one canonical key
+_ALIASES = {"BYT_NR": "BYT_NR", "BYT_N": "BYT_NR", "BIT_NR": "BIT_NR", "BIT_N": "BIT_NR",
+            "ENCDG": "ENCDG", "ENC": "ENCDG", "BN_FMT": "BN_FMT", "BN_F": "BN_FMT",
+            "BYT_OR": "BYT_OR", "BYT_O": "BYT_OR", "WFID": "WFID", "WFI": "WFID",
+            "NR_PT": "NR_PT", "NR_P": "NR_PT", "PT_FMT": "PT_FMT", "PT_F": "PT_FMT",
+            "XUNIT": "XUNIT", "XUN": "XUNIT", "XINCR": "XINCR", "XIN": "XINCR",
+            "XZERO": "XZERO", "XZE": "XZERO", "PT_OFF": "PT_OFF", "PT_O": "PT_OFF",
+            "YUNIT": "YUNIT", "YUN": "YUNIT", "YMULT": "YMULT", "YMU": "YMULT",
+            "YOFF": "YOFF", "YOF": "YOFF", "YZERO": "YZERO", "YZE": "YZERO"}
+_REQUIRED = ("BYT_NR", "NR_PT", "XINCR", "XZERO", "YMULT", "YOFF", "YZERO")
+_CURVE = re.compile(rb":CURV(?:E)?\s+#")
+_CHANNEL = re.compile(r"^\s*(ch|math|ref)\s*(\d)", re.IGNORECASE)
 
 
 def _num(x: float) -> str:
@@ -42,3 +61,100 @@ def write_isf(waveforms: dict, directory, stem: str) -> list:
         path.write_bytes(isf_bytes(w))
         out.append(path)
     return out
+
+
+def read_isf(path) -> list:
+    """Every record in a Tektronix ISF file, as Waveforms (volts = YZERO + YMULT (code - YOFF)).
+
+    Raises InstrumentError naming the file for a missing header field, a non-numeric
+    value, a byte count that disagrees with the header, or a truncated curve block.
+    """
+    path = Path(path)
+    data = path.read_bytes()
+    out, pos = [], 0
+    while pos < len(data) and data[pos:].strip():
+        m = _CURVE.search(data, pos)
+        if m is None:
+            raise InstrumentError(f"{path}: no :CURVE block after byte {pos} (not an ISF file?)")
+        header = _parse_header(data[pos:m.start()], path)
+        codes, pos = _read_curve(data, m.end(), header, path)
+        out.append(_waveform(header, codes, path, len(out)))
+        while pos < len(data) and data[pos:pos + 1] in (b"\n", b"\r", b" "):
+            pos += 1
+    if not out:
+        raise InstrumentError(f"{path}: empty file")
+    return out
+
+
+def _parse_header(raw: bytes, path) -> dict:
+    try:
+        text = raw.decode("ascii")
+    except UnicodeDecodeError:
+        raise InstrumentError(f"{path}: the header is not ASCII text (not an ISF file?)") from None
+    fields = {}
+    for item in text.split(";"):
+        item = re.sub(r"^(:?[A-Z]+:)+", "", item.strip())  # drop :WFMPRE: / :WFMP:
+        if not item:
+            continue
+        key, _, value = item.partition(" ")
+        canon = _ALIASES.get(key.upper())
+        if canon:
+            fields[canon] = value.strip().strip('"')
+    missing = [k for k in _REQUIRED if k not in fields]
+    if missing:
+        raise InstrumentError(f"{path}: header field(s) missing: {', '.join(missing)}")
+    return fields
+
+
+def _number(header, key, path, kind=float):
+    try:
+        return kind(float(header[key])) if kind is int else float(header[key])
+    except ValueError:
+        raise InstrumentError(f"{path}: header field {key} = {header[key]!r} is not a number") from None
+
+
+def _read_curve(data: bytes, at: int, header: dict, path):
+    ndig = data[at:at + 1]
+    if not ndig.isdigit() or ndig == b"0":
+        raise InstrumentError(f"{path}: malformed curve block length at byte {at}")
+    n = int(ndig)
+    count_text = data[at + 1:at + 1 + n]
+    if len(count_text) < n or not count_text.isdigit():
+        raise InstrumentError(f"{path}: malformed curve block length at byte {at}")
+    count = int(count_text)
+    start = at + 1 + n
+    nbytes = _number(header, "BYT_NR", path, int)
+    points = _number(header, "NR_PT", path, int)
+    if nbytes not in (1, 2):
+        raise InstrumentError(f"{path}: BYT_NR = {nbytes}: only 1 or 2 bytes per point are defined")
+    if count != points * nbytes:
+        raise InstrumentError(f"{path}: the curve block holds {count} bytes but the header says "
+                              f"{points} points x {nbytes} bytes = {points * nbytes}")
+    if len(data) - start < count:
+        raise InstrumentError(f"{path}: truncated curve block: {len(data) - start} of {count} bytes present")
+    order = ">" if header.get("BYT_OR", "MSB").upper() == "MSB" else "<"
+    signed = header.get("BN_FMT", "RI").upper() == "RI"
+    dtype = np.dtype(f"{order}{'i' if signed else 'u'}{nbytes}")
+    codes = np.frombuffer(data, dtype=dtype, count=points, offset=start).astype(dtype.newbyteorder("="))
+    return codes, start + count
+
+
+def _waveform(h: dict, codes, path, index) -> Waveform:
+    dx = _number(h, "XINCR", path)
+    x0 = _number(h, "XZERO", path)
+    pt_off = _number(h, "PT_OFF", path, int) if "PT_OFF" in h else 0
+    first = x0 - dx * pt_off  # t = XZERO + XINCR (n - PT_OFF)
+    trigger = pt_off if pt_off else int(np.clip(round(-first / dx), 0, codes.size - 1))
+    wfid = h.get("WFID", "")
+    m = _CHANNEL.match(wfid)
+    name = f"{m.group(1).upper()}{m.group(2)}" if m else Path(path).stem
+    envelope = h.get("PT_FMT", "Y").upper() == "ENV"
+    if index:
+        name = f"{name}#{index + 1}"
+    pre = Preamble(points=codes.size, x_increment=dx, x_zero=first, trigger_index=trigger,
+                   y_multiplier=_number(h, "YMULT", path), y_offset=_number(h, "YOFF", path),
+                   y_zero=_number(h, "YZERO", path), byte_count=codes.dtype.itemsize,
+                   x_unit=h.get("XUNIT", "s"), y_unit=h.get("YUNIT", "V"), waveform_id=wfid,
+                   extra={"source": str(path), "record": index + 1,
+                          "point_format": "ENV" if envelope else "Y"})
+    return Waveform(name, pre, codes=codes)

@@ -1,0 +1,385 @@
+"""HDF5 shot archive (NeXus-style) that never loses a committed shot.
+
+Layout, one NXentry per shot (``/shot_000001``, ...)::
+
+    shot_000001/            NXentry; attribute "shot": shot_id, seed (-1: none), simulated,
+                            triggered, scene, start_time (UTC), project_version, sha256 (of
+                            the raw codes and their scaling), no_trigger_reason
+      scene_text, settings  the scene as fired (TOML) and every part's settings (JSON, SI)
+      instrument/oscilloscope/
+                            NXcollection; CHn: raw ADC codes (int8/int16) with CF units,
+                            scale_factor, add_offset (-> V); attribute "preamble": a table of
+                            each channel's Tektronix scaling, trigger index, over-range flag
+      data/                 NXdata, the default plot: the same CHn (hard links) and time
+                            (int32 sample index, CF-scaled to s from the trigger), attached
+                            as a dimension scale: opens with xarray's h5netcdf engine
+      truth/                ground truth (virtual shots): per-shot draws in the attribute
+                            "facts"; forces/ is a hard link to the noise-free force arrays (N)
+      analysis/             results, added by the analysis when there are some
+    shared/<key>/           what all shots of one scene share, stored once: scene_text,
+                            settings, forces/
+
+Datasets are chunked, gzip-compressed (level 1, shuffle) and carry the fletcher32 checksum;
+each entry's sha256 is checked again on read.
+
+Appends are transactions. Under an exclusive lock (``ARCHIVE.h5.lock``) the archive is
+copied to a temporary file beside it, the new shots are written there, the copy is flushed
+to disk (fsync), and ``os.replace`` puts it in place atomically; then the directory is
+synced. A writer killed at any moment, a power loss or a full disk leaves either the old
+archive or the new one, never a mix, and a stale temporary file is removed by the next
+append. Readers open the path and see one complete version: this is what SWMR would give,
+without SWMR's ban on creating groups. The price is a file copy per transaction; append
+many shots in one call where that matters.
+"""
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import hashlib
+import json
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from .errors import InstrumentError
+from .records import Preamble, ScopeRecord, Waveform
+
+LAYOUT = """One NXentry per shot (shot_NNNNNN). Its attribute 'shot' holds shot_id, seed
+(-1: none), simulated, triggered, scene, start_time (UTC, ISO 8601), project_version and the
+sha256 of the raw codes with their scaling. scene_text: the scene file as fired; settings:
+JSON of every part's settings in SI units. instrument/oscilloscope/CHn: raw ADC codes; the
+group attribute 'preamble' is a table of each channel's Tektronix scaling: volts = y_zero +
+y_multiplier * (codes - y_offset), time = x_zero + x_increment * n (s from the trigger,
+x_zero is the first sample's time). data/: the default plot: the same codes (hard links)
+with CF scale_factor/add_offset giving volts, and time (int32 sample index, CF-scaled to s).
+truth/: per-shot draws as JSON in the attribute 'facts', and forces/: noise-free forces (N)
+on the solver grid, stored once per scene under shared/. All datasets but the time index
+are gzip-compressed with the fletcher32 checksum."""
+COMPRESSION = dict(compression="gzip", compression_opts=1, shuffle=True, fletcher32=True)
+_PREAMBLE_FLOATS = ("x_increment", "x_zero", "y_multiplier", "y_offset", "y_zero")
+
+
+@dataclass(eq=False)
+class Entry:
+    """One shot as the archive stores it: plain data, real or virtual.
+
+    truth: name -> array (N) of ground-truth forces; truth_attrs: small JSON-able facts
+    (per-shot draws, positions); truth_key: shots with equal keys share the truth arrays.
+    """
+
+    record: ScopeRecord
+    simulated: bool
+    seed: int | None = None
+    scene: str = ""
+    scene_text: str = ""
+    settings: dict = field(default_factory=dict)
+    truth: dict | None = None
+    truth_attrs: dict = field(default_factory=dict)
+    truth_key: str | None = None
+    start_time: str = ""
+    project_version: str = ""
+    shot_id: int | None = None  # set when read back
+
+
+def raw_digest(record: ScopeRecord) -> str:
+    """SHA-256 over each channel's name, scaling and raw codes, in channel order."""
+    h = hashlib.sha256()
+    for ch in sorted(record.waveforms):
+        w = record.waveforms[ch]
+        p = w.preamble
+        h.update(ch.encode())
+        h.update(json.dumps([p.points, p.trigger_index] + [getattr(p, k) for k in _PREAMBLE_FLOATS]).encode())
+        h.update(np.ascontiguousarray(w.codes).tobytes())
+    return h.hexdigest()
+
+
+class Archive:
+    """A shot archive at ``path`` (created on the first append)."""
+
+    def __init__(self, path):
+        self.path = Path(path)
+
+    # --- writing --------------------------------------------------------------------
+    def append(self, entries) -> list:
+        """Append shots in one transaction; returns their ids. All or nothing."""
+        entries = list(entries)
+        with self._lock():
+            self._drop_stale_temporaries()
+            fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp", dir=self.path.parent)
+            os.close(fd)
+            try:
+                if self.path.exists():
+                    self._open(self.path).close()  # refuse to build on a broken archive
+                    shutil.copyfile(self.path, tmp)
+                    shutil.copymode(self.path, tmp)
+                else:
+                    umask = os.umask(0)
+                    os.umask(umask)
+                    os.chmod(tmp, 0o666 & ~umask)
+                with h5py.File(tmp, "a", libver=("v110", "latest")) as f:
+                    if "NX_class" not in f.attrs:
+                        f.attrs.update({"NX_class": "NXroot", "creator": "sonic-rig", "layout": LAYOUT})
+                    start = max([_shot_id(n) for n in f if n.startswith("shot_")] + [0]) + 1
+                    ids = [start + i for i in range(len(entries))]
+                    checked = set()
+                    for shot_id, e in zip(ids, entries):
+                        _write_entry(f, shot_id, e, checked)
+                    f.attrs["default"] = f"shot_{ids[-1]:06d}" if ids else f.attrs.get("default", "")
+                _fsync(tmp)
+                os.replace(tmp, self.path)
+                _fsync_dir(self.path.parent)
+            except BaseException:
+                with contextlib.suppress(OSError):
+                    os.unlink(tmp)
+                raise
+        return ids
+
+    @contextlib.contextmanager
+    def _lock(self):
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        with open(self.path.with_name(self.path.name + ".lock"), "a") as fh:
+            fcntl.flock(fh, fcntl.LOCK_EX)
+            try:
+                yield
+            finally:
+                fcntl.flock(fh, fcntl.LOCK_UN)
+
+    def _drop_stale_temporaries(self):
+        for stale in self.path.parent.glob(f".{self.path.name}.*.tmp"):
+            with contextlib.suppress(OSError):
+                stale.unlink()  # we hold the lock: no live writer owns it
+
+    # --- reading --------------------------------------------------------------------
+    def _open(self, path=None) -> h5py.File:
+        path = Path(path or self.path)
+        if not path.exists():
+            raise InstrumentError(f"{path}: no such archive")
+        if not h5py.is_hdf5(path):
+            raise InstrumentError(f"{path}: not an HDF5 file")
+        try:
+            return h5py.File(path, "r")
+        except OSError as exc:
+            raise InstrumentError(f"{path}: cannot be opened as HDF5 (truncated or damaged?): {exc}") from None
+
+    def ids(self) -> list:
+        with self._open() as f:
+            return sorted(_shot_id(n) for n in f if n.startswith("shot_"))
+
+    def read(self, shot_id: int, verify: bool = True, with_truth: bool = True) -> Entry:
+        """The stored shot as the same record objects the scope produces."""
+        with self._open() as f:
+            name = f"shot_{shot_id:06d}"
+            if name not in f:
+                raise InstrumentError(f"{self.path}: no shot {shot_id} (shots: {_id_range(f)})")
+            return _read_entry(f[name], verify, self.path, with_truth)
+
+    def verify(self) -> dict:
+        """Check every shot (fletcher32 on every chunk, then the sha256)."""
+        try:
+            f = self._open()
+        except InstrumentError as exc:
+            return {"shots": 0, "ok": 0, "bad": [{"shot": None, "reason": str(exc)}]}
+        bad, n = [], 0
+        with f:
+            checked = set()  # shared datasets (hard links) are read once
+            for name in sorted(k for k in f if k.startswith("shot_")):
+                n += 1
+                try:
+                    _read_entry(f[name], True, self.path, with_truth=False)
+                    for obj in _datasets(f[name]):
+                        key = h5py.h5o.get_info(obj.id).token if hasattr(h5py.h5o.get_info(obj.id), "token") \
+                            else h5py.h5o.get_info(obj.id).addr
+                        if key not in checked:
+                            obj[()]  # fletcher32 is checked chunk by chunk as it is read
+                            checked.add(key)
+                except (OSError, InstrumentError, KeyError, ValueError) as exc:
+                    bad.append({"shot": _shot_id(name), "reason": str(exc).splitlines()[0]})
+        return {"shots": n, "ok": n - len(bad), "bad": bad}
+
+    def summary(self) -> list:
+        """One row per shot: id, time, simulated, scene, seed, channels, triggered."""
+        rows = []
+        with self._open() as f:
+            for name in sorted(k for k in f if k.startswith("shot_")):
+                g = f[name]
+                a = g.attrs["shot"]
+                settings = json.loads(g["settings"][()])
+                rows.append({"shot": int(a["shot_id"]), "start_time": a["start_time"].decode(),
+                             "simulated": bool(a["simulated"]), "scene": a["scene"].decode(),
+                             "seed": int(a["seed"]) if a["seed"] >= 0 else None,
+                             "triggered": bool(a["triggered"]),
+                             "channels": sorted(g["instrument/oscilloscope"]),
+                             "sources": settings.get("source_files", []),
+                             "settings": settings.get("striker", {})})
+        return rows
+
+
+# --- layout -------------------------------------------------------------------------
+def _write_entry(f: h5py.File, shot_id: int, e: Entry, checked: set):
+    """Write one NXentry; ``checked`` holds the shared keys already verified this transaction."""
+    g = f.create_group(f"shot_{shot_id:06d}")
+    g.attrs.update({"NX_class": "NXentry", "default": "data", "shot": _shot_attr(shot_id, e)})
+    key = e.truth_key or f"shot_{shot_id:06d}"
+    shared = f.require_group("shared").require_group(key)
+    if key not in checked:
+        for name, text in (("scene_text", e.scene_text),
+                           ("settings", json.dumps(e.settings, default=_jsonable, sort_keys=True))):
+            if name not in shared:
+                shared.create_dataset(name, data=text)
+            elif shared[name][()].decode() != text:
+                raise InstrumentError(f"shared key {key!r}: {name} differs between shots")
+        checked.add(key)
+    g["scene_text"] = shared["scene_text"]
+    g["settings"] = shared["settings"]
+    instrument = g.create_group("instrument")
+    instrument.attrs["NX_class"] = "NXinstrument"
+    scope = instrument.create_group("oscilloscope")
+    scope.attrs["NX_class"] = "NXcollection"
+    data = g.create_group("data")
+    chans = sorted(e.record.waveforms)
+    data.attrs.update({"NX_class": "NXdata", "signal": chans[0] if chans else "", "axes": ["time"]})
+    scope.attrs["preamble"] = _preamble_table(e.record)
+    for ch in chans:
+        w = e.record.waveforms[ch]
+        p = w.preamble
+        d = scope.create_dataset(ch, data=w.codes, **_chunks(w.codes))
+        d.attrs.update({"units": p.y_unit, "scale_factor": p.y_multiplier,
+                        "add_offset": p.y_zero - p.y_multiplier * p.y_offset})
+        data[ch] = d  # hard link: the plottable data are the raw codes
+        d.dims[0].attach_scale(_time_axis(data, p))
+    if e.truth is not None:
+        tg = g.create_group("truth")
+        tg.attrs.update({"NX_class": "NXcollection", "facts": json.dumps(e.truth_attrs, default=_jsonable)})
+        if "forces" not in shared:
+            forces = shared.create_group("forces")
+            for name, arr in e.truth.items():
+                forces.create_dataset(name, data=np.asarray(arr), **_chunks(arr)).attrs["units"] = "N"
+        tg["forces"] = shared["forces"]  # one hard link to the arrays stored once per key
+
+
+def _shot_attr(shot_id: int, e: Entry) -> np.ndarray:
+    """The shot's facts as one self-describing compound attribute."""
+    start = e.start_time or datetime.now(timezone.utc).isoformat()
+    reason = e.record.reason or ""
+    fields = [("shot_id", "<i8", shot_id), ("seed", "<i8", -1 if e.seed is None else int(e.seed)),
+              ("simulated", "u1", int(e.simulated)), ("triggered", "u1", int(e.record.triggered)),
+              ("scene", f"S{max(1, len(e.scene.encode()))}", e.scene.encode()),
+              ("start_time", f"S{len(start)}", start.encode()),
+              ("project_version", f"S{max(1, len(e.project_version))}", e.project_version.encode()),
+              ("sha256", "S64", raw_digest(e.record).encode()),
+              ("no_trigger_reason", f"S{max(1, len(reason.encode()))}", reason.encode())]
+    return np.array(tuple(v for _, _, v in fields), dtype=[(n, t) for n, t, _ in fields])
+
+
+def _preamble_table(record: ScopeRecord) -> np.ndarray:
+    """Every channel's Tektronix scaling in one compound table, a row per channel."""
+    chans = sorted(record.waveforms)
+    rows = []
+    for ch in chans:
+        w = record.waveforms[ch]
+        p = w.preamble
+        rows.append((ch.encode(), p.points, p.trigger_index, p.byte_count, p.x_increment, p.x_zero,
+                     p.y_multiplier, p.y_offset, p.y_zero, p.x_unit.encode(), p.y_unit.encode(),
+                     int(w.overrange), p.waveform_id.encode(),
+                     json.dumps(p.extra, default=_jsonable).encode()))
+    width = [max([len(r[i]) for r in rows] + [1]) for i in (0, 12, 13)]
+    dtype = np.dtype([("channel", f"S{width[0]}")] + _PREAMBLE_FIELDS +
+                     [("waveform_id", f"S{width[1]}"), ("extra", f"S{width[2]}")])
+    return np.array(rows, dtype=dtype)
+
+
+_PREAMBLE_FIELDS = [("points", "<i8"), ("trigger_index", "<i8"), ("byte_count", "<i4"),
+                    ("x_increment", "<f8"), ("x_zero", "<f8"), ("y_multiplier", "<f8"),
+                    ("y_offset", "<f8"), ("y_zero", "<f8"), ("x_unit", "S8"), ("y_unit", "S8"),
+                    ("overrange", "u1")]
+
+
+def _time_axis(data: h5py.Group, p: Preamble) -> h5py.Dataset:
+    """The time axis for a channel's time base: "time" for the first, "time_2"... after."""
+    n = 1
+    while True:
+        name = "time" if n == 1 else f"time_{n}"
+        if name not in data:
+            t = data.create_dataset(name, data=np.arange(p.points, dtype=np.int32))  # an index
+            t.attrs.update({"units": "s", "scale_factor": p.x_increment, "add_offset": p.x_zero})
+            t.make_scale(name)
+            return t
+        t = data[name]
+        if (t.shape[0], t.attrs["scale_factor"], t.attrs["add_offset"]) == (p.points, p.x_increment, p.x_zero):
+            return t
+        n += 1
+
+
+def _chunks(arr) -> dict:
+    n = int(np.asarray(arr).size)
+    return dict(chunks=(max(1, min(n, 65536)),), **COMPRESSION) if n else {}
+
+
+def _read_entry(g: h5py.Group, verify: bool, path, with_truth: bool = True) -> Entry:
+    shot = g.attrs["shot"]
+    waves = {}
+    scope = g["instrument/oscilloscope"]
+    table = scope.attrs["preamble"] if len(scope) else []
+    for pa in table:
+        ch = pa["channel"].decode()
+        d = scope[ch]
+        pre = Preamble(points=int(pa["points"]), trigger_index=int(pa["trigger_index"]),
+                       byte_count=int(pa["byte_count"]), x_unit=pa["x_unit"].decode(),
+                       y_unit=pa["y_unit"].decode(), waveform_id=pa["waveform_id"].decode(),
+                       extra=json.loads(pa["extra"].decode()),
+                       **{k: float(pa[k]) for k in _PREAMBLE_FLOATS})
+        waves[ch] = Waveform(ch, pre, codes=d[()], overrange=bool(pa["overrange"]))
+    record = ScopeRecord(waves, bool(shot["triggered"]), shot["no_trigger_reason"].decode() or None)
+    if verify and raw_digest(record) != shot["sha256"].decode():
+        raise InstrumentError(f"{path}: shot {int(shot['shot_id'])}: sha256 of the raw data does not match")
+    truth, facts = None, {}
+    if "truth" in g:
+        facts = json.loads(g["truth"].attrs["facts"])
+        if with_truth:
+            truth = {k: v[()] for k, v in g["truth/forces"].items()}
+    seed = int(shot["seed"])
+    return Entry(record, bool(shot["simulated"]), None if seed < 0 else seed, shot["scene"].decode(),
+                 g["scene_text"][()].decode(), json.loads(g["settings"][()]), truth, facts, None,
+                 shot["start_time"].decode(), shot["project_version"].decode(), int(shot["shot_id"]))
+
+
+def _datasets(group):
+    out = []
+    group.visititems(lambda name, obj: out.append(obj) if isinstance(obj, h5py.Dataset) else None)
+    return out
+
+
+def _shot_id(name: str) -> int:
+    return int(name.split("_", 1)[1])
+
+
+def _id_range(f) -> str:
+    ids = sorted(_shot_id(n) for n in f if n.startswith("shot_"))
+    return f"{ids[0]}..{ids[-1]}" if ids else "none"
+
+
+def _jsonable(x):
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, (tuple, set)):
+        return list(x)
+    return str(x)
+
+
+def _fsync(path):
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _fsync_dir(path):
+    with contextlib.suppress(OSError):
+        _fsync(path)

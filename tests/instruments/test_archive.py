@@ -1,0 +1,175 @@
+"""The HDF5 archive: round trip, crash safety, corruption, concurrent reading, openness.
+
+Synthetic scope records (the emulated oscilloscope on a Gaussian pulse) keep these tests
+on the measurement side: no rig import.
+"""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from instruments.archive import Archive, Entry
+from instruments.errors import InstrumentError
+from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
+
+SCOPE = Oscilloscope(channels={c: ChannelSettings(volts_per_div=0.05) for c in ("CH1", "CH2", "CH3")},
+                     timebase=Timebase(2e-7, 10000), trigger=Trigger("CH1", 0.05, "rising", 0.1))
+_T = np.arange(40000) * 1e-7
+
+
+def entry(seed: int, truth=True) -> Entry:
+    rng = np.random.default_rng(seed)
+    x = 0.2 * np.exp(-(((_T - 1e-3) / 5e-5) ** 2))
+    rec = SCOPE.acquire({"CH1": x, "CH2": 0.8 * x, "CH3": 0.5 * x}, 1e-7, rng)
+    return Entry(rec, True, seed, "synthetic", "[scene]\nname = 'synthetic'\n", {"probe": "synthetic"},
+                 {"wall_force": np.sin(_T[:5000])} if truth else None, {"draw": seed}, "shared")
+
+
+WRITER = r"""
+import sys
+sys.path[:0] = {paths!r}
+from test_archive import entry
+from instruments.archive import Archive
+a = Archive(sys.argv[1])
+i = int(sys.argv[2])
+while True:
+    ids = a.append([entry(i)])
+    print(ids[0], flush=True)
+    i += 1
+"""
+
+
+def _writer(path, start):
+    code = WRITER.format(paths=[os.path.dirname(__file__), os.getcwd()])
+    return subprocess.Popen([sys.executable, "-c", code, str(path), str(start)],
+                            stdout=subprocess.PIPE, text=True)
+
+
+def test_round_trip_is_bit_identical(tmp_path):
+    a = Archive(tmp_path / "a.h5")
+    shots = [entry(s) for s in range(30)]
+    ids = a.append(shots[:10]) + a.append(shots[10:])
+    assert ids == list(range(1, 31))
+    for i, e in zip(ids, shots):
+        back = a.read(i)
+        assert back.seed == e.seed and back.settings == e.settings and back.scene_text == e.scene_text
+        for ch, w in e.record.waveforms.items():
+            r = back.record[ch]
+            assert r.codes.dtype == w.codes.dtype and np.array_equal(r.codes, w.codes)
+            assert r.preamble == w.preamble and r.overrange == w.overrange
+        assert np.array_equal(back.truth["wall_force"], e.truth["wall_force"])
+    with h5py.File(tmp_path / "a.h5") as f:  # the shared truth is stored once
+        assert len(f["shared"]) == 1
+        assert f["shot_000001/data/CH1"].id == f["shot_000001/instrument/oscilloscope/CH1"].id
+        assert f["shot_000001/truth/forces"].id == f["shot_000030/truth/forces"].id
+
+
+@pytest.mark.slow
+def test_sigkill_during_appends_never_loses_a_committed_shot(tmp_path):
+    path = tmp_path / "crash.h5"
+    rng = np.random.default_rng(2024)
+    committed = []
+    start = 1
+    for _ in range(20):
+        proc = _writer(path, start)
+        time.sleep(rng.uniform(0.6, 1.6))  # python start-up is about 0.5 s: kills land mid-append
+        proc.send_signal(signal.SIGKILL)
+        out, _ = proc.communicate()
+        lines = [int(x) for x in out.split()]
+        committed += lines
+        start += len(lines) + 1
+        a = Archive(path)
+        if committed:
+            ids = a.ids()
+            assert set(committed) <= set(ids)  # every shot reported committed is there
+            report = a.verify()
+            assert report["bad"] == [] and report["shots"] == len(ids)
+    assert len(committed) > 20
+    n = len(Archive(path).ids())
+    assert Archive(path).append([entry(99999)]) == [n + 1]  # the next append works
+    assert not list(tmp_path.glob(".crash.h5.*.tmp"))  # stale temporaries were cleaned
+
+
+def test_flipped_byte_in_a_data_chunk_is_reported_with_the_shot(tmp_path):
+    path = tmp_path / "c.h5"
+    a = Archive(path)
+    a.append([entry(s, truth=False) for s in range(3)])
+    with h5py.File(path) as f:
+        offset = f["shot_000002/instrument/oscilloscope/CH2"].id.get_chunk_info(0).byte_offset
+    with open(path, "r+b") as fh:
+        fh.seek(offset + 100)
+        b = fh.read(1)
+        fh.seek(offset + 100)
+        fh.write(bytes([b[0] ^ 0xFF]))
+    report = a.verify()
+    assert report["shots"] == 3 and report["ok"] == 2
+    assert [b["shot"] for b in report["bad"]] == [2]
+    with pytest.raises((OSError, InstrumentError)):
+        a.read(2)
+
+
+def test_truncated_and_foreign_files_give_clear_errors(tmp_path):
+    path = tmp_path / "t.h5"
+    Archive(path).append([entry(1)])
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    with pytest.raises(InstrumentError, match="truncated or damaged"):
+        Archive(path).ids()
+    assert Archive(path).verify()["bad"][0]["shot"] is None
+    junk = tmp_path / "junk.h5"
+    junk.write_text("not hdf5")
+    with pytest.raises(InstrumentError, match="not an HDF5 file"):
+        Archive(junk).read(1)
+    with pytest.raises(InstrumentError, match="not an HDF5 file"):
+        Archive(junk).append([entry(1)])  # never builds on a broken archive
+    assert junk.read_text() == "not hdf5"
+
+
+def test_reader_sees_only_complete_shots_while_a_writer_appends(tmp_path):
+    path = tmp_path / "live.h5"
+    Archive(path).append([entry(0)])
+    proc = _writer(path, 1)
+    try:
+        seen, t_end = [], time.time() + 4.0
+        while time.time() < t_end:
+            a = Archive(path)
+            ids = a.ids()
+            last = a.read(ids[-1])  # sha256 checked: complete, consistent data
+            assert last.shot_id == ids[-1]
+            seen.append(len(ids))
+    finally:
+        proc.kill()
+        proc.communicate()
+    assert seen[-1] > seen[0]  # the archive grew while we read it
+    assert Archive(path).verify()["bad"] == []
+
+
+def test_files_open_with_plain_h5py_and_xarray(tmp_path):
+    xr = pytest.importorskip("xarray")
+    path = tmp_path / "x.h5"
+    e = entry(5)
+    Archive(path).append([e])
+    with h5py.File(path, "r") as f:
+        g = f["shot_000001"]
+        assert g.attrs["NX_class"] == "NXentry" and g["data"].attrs["signal"] == "CH1"
+        assert g.attrs["shot"]["seed"] == 5 and "volts = y_zero" in f.attrs["layout"]
+        for name, obj in _all_datasets(g):
+            assert "units" in obj.attrs or name in ("scene_text", "settings"), name
+        json.loads(g["settings"][()])
+    ds = xr.open_dataset(path, group="shot_000001/data", engine="h5netcdf")
+    w = e.record["CH1"]
+    assert np.allclose(ds["CH1"].values, w.volts(), rtol=0, atol=1e-12)
+    assert np.allclose(ds["time"].values, w.time(), rtol=0, atol=1e-15)
+    assert ds["CH1"].attrs["units"] == "V"
+
+
+def _all_datasets(group):
+    out = []
+    group.visititems(lambda n, o: out.append((n, o)) if isinstance(o, h5py.Dataset) else None)
+    return out

@@ -1,0 +1,72 @@
+"""Virtual shots and real files in the archive, through the rig's commands."""
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from instruments.archive import Archive
+from rig.cli import main
+from rig.shot import Rig
+
+REAL = Path(__file__).resolve().parents[2].parent / "shared" / "realdata"
+
+
+def test_thousand_virtual_shots_round_trip_bit_identical(tmp_path):
+    rig = Rig.from_scene("ptfe52_magnetic")
+    shots = [rig.fire(seed=s) for s in range(1000)]
+    archive = Archive(tmp_path / "mc.h5")
+    ids = []
+    for k in range(0, 1000, 250):  # four transactions
+        ids += archive.append([s.to_entry() for s in shots[k:k + 250]])
+    assert ids == list(range(1, 1001))
+    assert archive.verify() == {"shots": 1000, "ok": 1000, "bad": []}
+    for i, s in zip(ids, shots):
+        back = archive.read(i)
+        assert back.seed == s.seed and back.simulated and back.scene == "ptfe52_magnetic"
+        assert back.scene_text == s.scene_text and back.truth_attrs["draws"] == s.draws
+        for ch, w in s.scope.waveforms.items():
+            assert np.array_equal(back.record[ch].codes, w.codes)
+            assert back.record[ch].preamble == w.preamble
+    first = archive.read(1)
+    assert np.array_equal(first.truth["upper.average_force"], shots[0].truth.gauges["upper"].average_force)
+
+
+def test_rig_shot_out_then_ls_and_verify(tmp_path, capsys):
+    path = str(tmp_path / "a.h5")
+    assert main(["shot", "steel21_magnetic", "--seed", "4", "--out", path, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["archived"] == {"archive": path, "shot": 1}
+    assert main(["shot", "ptfe52_gravity", "--seed", "5", "--out", path]) == 0
+    capsys.readouterr()
+    assert main(["ls", path, "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [(r["shot"], r["scene"], r["seed"]) for r in rows] == [(1, "steel21_magnetic", 4), (2, "ptfe52_gravity", 5)]
+    assert main(["verify", path, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out) == {"shots": 2, "ok": 2, "bad": []}
+
+
+def test_real_files_import_into_the_same_layout(tmp_path, capsys):
+    path = str(tmp_path / "real.h5")
+    files = [str(REAL / "tek_16bit_dpo.isf"), str(REAL / "tek_8bit_two_records.isf")]
+    assert main(["import", *files, "--into", path]) == 0
+    a = Archive(path)
+    dpo, eight = a.read(1), a.read(2)
+    assert not dpo.simulated and dpo.seed is None
+    v = dpo.record["CH2"].volts()
+    assert (v.min(), v.max()) == (pytest.approx(-7.3), pytest.approx(17.1))
+    assert set(eight.record.waveforms) == {"CH1", "CH1#2"}  # the second record is kept
+    v1 = eight.record["CH1"].volts()
+    assert (v1.min(), v1.max(), v1[0]) == (pytest.approx(0.3), pytest.approx(4.9), pytest.approx(0.9))
+
+
+@pytest.mark.parametrize("make", ["truncated", "junk", "missing"])
+def test_bad_archives_are_one_line_errors(tmp_path, capsys, make):
+    path = tmp_path / "bad.h5"
+    if make != "missing":
+        Archive(path).append([Rig.from_scene("steel21_gravity").fire(seed=1).to_entry()])
+        data = path.read_bytes()
+        path.write_bytes(data[: len(data) // 3] if make == "truncated" else b"hello")
+    assert main(["ls", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert str(path) in err and "Traceback" not in err
+    assert main(["verify", str(path)]) == 1
