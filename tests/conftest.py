@@ -27,3 +27,19 @@ def record_contacts(chain, *contacts, **kw):
 @pytest.fixture
 def sonic_vacuum():
     return steel_sonic_vacuum
+
+
+@pytest.fixture
+def realdata():
+    """The real Tektronix files in ../shared/realdata (beside the checkout). CI must have
+    them; elsewhere their absence skips the test with the reason."""
+    import os
+    from pathlib import Path
+
+    here = Path(__file__).resolve().parents[1]
+    for base in (here.parent / "shared" / "realdata", here / "shared" / "realdata"):
+        if (base / "tek_16bit_dpo.isf").is_file():
+            return base
+    if os.environ.get("CI"):
+        pytest.fail("../shared/realdata is missing: the real scope files are required in CI")
+    pytest.skip("real scope files not found beside the checkout (../shared/realdata)")

@@ -1,16 +1,11 @@
 """Virtual shots and real files in the archive, through the rig's commands."""
 import json
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from instruments.archive import Archive
 from rig.cli import main
 from rig.shot import Rig
-
-REAL = Path(__file__).resolve().parents[2].parent / "shared" / "realdata"
-
 
 def test_thousand_virtual_shots_round_trip_bit_identical(tmp_path):
     rig = Rig.from_scene("ptfe52_magnetic")
@@ -45,9 +40,9 @@ def test_rig_shot_out_then_ls_and_verify(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out) == {"shots": 2, "ok": 2, "bad": []}
 
 
-def test_real_files_import_into_the_same_layout(tmp_path, capsys):
+def test_real_files_import_into_the_same_layout(tmp_path, capsys, realdata):
     path = str(tmp_path / "real.h5")
-    files = [str(REAL / "tek_16bit_dpo.isf"), str(REAL / "tek_8bit_two_records.isf")]
+    files = [str(realdata / "tek_16bit_dpo.isf"), str(realdata / "tek_8bit_two_records.isf")]
     assert main(["import", *files, "--into", path]) == 0
     a = Archive(path)
     dpo, eight = a.read(1), a.read(2)
