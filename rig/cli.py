@@ -69,9 +69,12 @@ def cmd_shot(args) -> dict:
 
     from .shot import Rig
 
+    from .measure import shot_blocks
+
     rig = Rig.from_scene(args.scene, args.set or ())
     shot = rig.fire(seed=args.seed)
     out = shot_summary(rig, shot)
+    out.update(shot_blocks(rig, shot))
     if args.export:
         if not shot.scope.triggered:
             raise RigError(f"--export: nothing to export, the scope did not trigger ({shot.scope.reason})")
@@ -131,6 +134,16 @@ def print_shot(out: dict):
               f"{c['sample_interval_s'] * 1e6:g} us, trigger at sample {c['trigger_index']}, "
               f"{c['volts_per_div'] * 1e3:g} mV/div, {c['min_V']:+.3f} .. {c['max_V']:+.3f} V"
               f"{'  CLIPPED' if c['clipped'] else ''}")
+    t, m, th = out["truth"], out["measured"], out["theory"]
+    fmt = lambda v, scale=1.0, spec=".1f": "-" if v is None else format(v * scale, spec)  # noqa: E731
+    print(f"  {'':10s} {'speed m/s':>10s} {'F_d N':>8s} {'F_m,e N':>8s} {'beta':>6s} {'pulses':>6s} {'FWHM us':>8s}")
+    for label, r in (("truth", t), ("measured", m)):
+        print(f"  {label:10s} {fmt(r['speed_m_per_s']):>10s} {fmt(r['amplitude_N'], 1, '.3f'):>8s} "
+              f"{fmt(r['averaged_amplitude_N'], 1, '.3f'):>8s} {fmt(r['beta'], 1, '.3f'):>6s} "
+              f"{fmt(r['pulses'], 1, '.0f'):>6s} {fmt(r['duration_s'], 1e6):>8s}")
+    print(f"  theory     c0 = {fmt(th['sound_speed_m_per_s'])} m/s (Eq 2), "
+          f"Eq (1) at the truth amplitude: {fmt(th['speed_m_per_s'])} m/s; "
+          f"cross-correlation speed {fmt(m['speed_xcorr_m_per_s'])} m/s")
     for path in out.get("exported", []):
         print(f"  wrote {path}")
     if "archived" in out:
@@ -182,6 +195,23 @@ def cmd_import(args) -> dict:
     return out
 
 
+def cmd_analyze(args) -> list:
+    from .analyze import analyze_paths
+
+    results = analyze_paths(args)
+    if not args.json:
+        fmt = lambda v, spec=".2f": "-" if v is None else format(v, spec)  # noqa: E731
+        print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d N':>8s} {'F_m,e N':>8s} "
+              f"{'pulses':>6s} {'FWHM us':>8s} {'Eq1 m/s':>8s}")
+        for r in results:
+            fwhm = None if r["duration_s"] is None else r["duration_s"] * 1e6
+            print(f"{r['source'][-40:]:40s} {fmt(r['speed_m_per_s'], '.1f'):>8s} "
+                  f"{fmt(r['speed_xcorr_m_per_s'], '.1f'):>8s} {fmt(r['amplitude_N'], '.3f'):>8s} "
+                  f"{fmt(r['averaged_amplitude_N'], '.3f'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
+                  f"{fmt(fwhm, '.1f'):>8s} {fmt(r['theory_speed_m_per_s'], '.1f'):>8s}")
+    return results
+
+
 def cmd_ls(args) -> list:
     from instruments.archive import Archive
 
@@ -199,7 +229,7 @@ def cmd_ls(args) -> list:
 
 
 def cmd_bench(args) -> dict:
-    if args.what in ("shot", "archive"):
+    if args.what in ("shot", "archive", "pipeline"):
         import importlib
 
         module = importlib.import_module(f"benchmarks.{args.what}")
@@ -253,13 +283,30 @@ def build_parser() -> argparse.ArgumentParser:
     im.add_argument("--json", action="store_true", help="print JSON")
     im.set_defaults(func=cmd_import)
 
+    an = sub.add_parser("analyze", help="speeds and amplitudes from scope files or an archive")
+    an.add_argument("files", nargs="+", metavar="FILE", help=".isf, .csv or .h5 (an archive)")
+    an.add_argument("--shot", type=int, help="one shot of an archive (default: every shot)")
+    an.add_argument("--gauge-distance", type=lambda s: _q(s, "m", "--gauge-distance"),
+                    help="distance between the two gauges (plain number: m), for real files")
+    an.add_argument("--channels", help="UPPER,LOWER[,WALL] channel names (default: file order)")
+    an.add_argument("--wall", action="store_true", help="the third channel is the wall sensor")
+    an.add_argument("--sensitivity", type=float, default=1.0, help="gauge sensitivity V/N (default 1: volts)")
+    an.add_argument("--tau", type=lambda s: _q(s, "s", "--tau"), help="gauge RC time constant to invert (s)")
+    an.add_argument("--beta", type=float, default=1.0, help="beta = F_d / F_m,e (default 1)")
+    an.add_argument("--f0", type=lambda s: _q(s, "N", "--f0"), default=0.0, help="precompression F_0 (N)")
+    an.add_argument("--diameter", type=lambda s: _q(s, "m", "--diameter"), default=4.76e-3,
+                    help="bead diameter (plain number: m; default 4.76 mm)")
+    an.add_argument("--material", help="bead material, to add the Eq (1) speed")
+    an.add_argument("--json", action="store_true", help="print JSON")
+    an.set_defaults(func=cmd_analyze)
+
     ls = sub.add_parser("ls", help="list the shots of an archive")
     ls.add_argument("archive")
     ls.add_argument("--json", action="store_true", help="print JSON")
     ls.set_defaults(func=cmd_ls)
 
     be = sub.add_parser("bench", help="benchmarks")
-    be.add_argument("what", choices=["solver", "shot", "archive"], help="what to benchmark")
+    be.add_argument("what", choices=["solver", "shot", "archive", "pipeline"], help="what to benchmark")
     be.add_argument("--quick", action="store_true", help="fewer settings, one repeat")
     be.add_argument("--json", action="store_true", help="print JSON")
     be.set_defaults(func=cmd_bench)

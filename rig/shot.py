@@ -63,6 +63,7 @@ class ShotRecord:
     truth: Truth
     solver: SolverStats
     draws: dict
+    analysis_truth: dict | None = None  # the truth block of rig/measure.py, when computed
 
     def to_entry(self) -> Entry:
         """The archive's plain form of this shot (instruments never see rig objects)."""
@@ -76,6 +77,7 @@ class ShotRecord:
         if self.truth.wall_force is not None:
             arrays["wall_force"] = self.truth.wall_force
         facts = {"sample_interval_s": self.truth.sample_interval, "gauges": gauges,
+                 "analysis": self.analysis_truth,
                  "wave_speed_m_per_s": self.truth.wave_speed_m_per_s, "draws": self.draws,
                  "trigger_time_after_impact_s": self.scope.trigger_time,
                  "solver": self.solver.as_dict(), "overrides": list(self.overrides)}
@@ -209,6 +211,14 @@ class Rig:
                                       float(F0[j]), float(F0[j + 1]))
         return Truth(sol.sample_interval, gauges, sol.forces.get("wall"), _wave_speed(gauges, sol.sample_interval))
 
+    def truth_analysis(self):
+        """The pipeline on the noise-free truth (computed once per rig; see rig/measure.py)."""
+        if getattr(self, "_truth_report", None) is None:
+            from .measure import truth_report
+
+            self._truth_report = truth_report(self, self.truth())
+        return self._truth_report
+
     def fire(self, seed: int | None = None) -> ShotRecord:
         """One shot. ``seed`` (int) fixes every random draw; None draws a fresh one (recorded)."""
         if seed is None:  # fresh, 63 bits so that it fits a signed 64-bit integer anywhere
@@ -232,8 +242,9 @@ class Rig:
             record = self.scope.acquire(inputs, h, rng)
         except ValueError as exc:
             raise RigError(f"{exc} (solver.duration = {self.solver['duration']:g} s)") from None
+        truth_analysis = self.truth_analysis().as_dict() if len(self.gauges) >= 2 else None
         return ShotRecord(self.name, self.scene_text, self.overrides, int(seed), self.values, record,
-                          truth, self.solution().stats, draws)
+                          truth, self.solution().stats, draws, truth_analysis)
 
 
 def _wave_speed(gauges: dict, h: float) -> float | None:

@@ -9,6 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import InstrumentError
+from ..records import Preamble, Waveform
+
 
 def write_csv(waveforms: dict, directory, stem: str) -> list:
     """Write ``<stem>.csv`` with every channel; returns [path]."""
@@ -40,3 +43,100 @@ def write_csv(waveforms: dict, directory, stem: str) -> list:
         fh.write("\nTIME," + ",".join(chans) + "\n")
         np.savetxt(fh, data, delimiter=",", fmt="%.10g")
     return [path]
+
+
+def read_csv(path) -> list:
+    """Waveforms from a Tektronix CSV file, either layout:
+
+    - DPO/MSO: "name,value" header rows, then a "TIME,CH1,..." row and the data columns;
+    - TDS1000/2000: six columns per row, the header cells (Record Length, Sample Interval,
+      Trigger Point, Source, Vertical Units, ...) in the first two beside time and volts
+      in the fourth and fifth; one channel per file.
+    """
+    path = Path(path)
+    try:
+        lines = path.read_text(errors="strict").splitlines()
+    except UnicodeDecodeError:
+        raise InstrumentError(f"{path}: not a text file (not a Tektronix CSV?)") from None
+    rows = [line.split(",") for line in lines]
+    start = next((i for i, r in enumerate(rows) if r and r[0].strip().upper() == "TIME"), None)
+    if start is not None:
+        return _read_dpo(path, rows, start)
+    if rows and len(rows[0]) >= 5:
+        return [_read_tds(path, rows)]
+    raise InstrumentError(f"{path}: neither Tektronix CSV layout (no TIME column header, "
+                          f"and not the six-column TDS layout)")
+
+
+def _floats(path, cells, row_no):
+    try:
+        return [float(c) for c in cells]
+    except ValueError:
+        bad = next(c for c in cells if not _is_float(c))
+        raise InstrumentError(f"{path}: row {row_no + 1}: non-numeric value {bad.strip()!r}") from None
+
+
+def _is_float(c):
+    try:
+        float(c)
+        return True
+    except ValueError:
+        return False
+
+
+def _read_dpo(path, rows, start) -> list:
+    header = {r[0].strip(): [c.strip() for c in r[1:]] for r in rows[:start] if r and r[0].strip()}
+    names = [c.strip() for c in rows[start][1:] if c.strip()]
+    if not names:
+        raise InstrumentError(f"{path}: the TIME row names no channel")
+    data = [_floats(path, r[:1 + len(names)], start + 1 + i)
+            for i, r in enumerate(rows[start + 1:]) if any(c.strip() for c in r)]
+    if len(data) < 2:
+        raise InstrumentError(f"{path}: fewer than two data rows")
+    if any(len(r) != 1 + len(names) for r in data):
+        raise InstrumentError(f"{path}: a data row has fewer columns than the TIME row")
+    table = np.array(data)
+    t = table[:, 0]
+    zero = header.get("Zero Index", [None])[0]
+    units = header.get("Vertical Units", [])
+    interval = header.get("Sample Interval", [None])[0]
+    return [_waveform(path, name, t, table[:, 1 + k], zero, units[k] if k < len(units) else "V", interval)
+            for k, name in enumerate(names)]
+
+
+def _read_tds(path, rows) -> Waveform:
+    header, t, v = {}, [], []
+    for i, r in enumerate(rows):
+        if len(r) < 5:
+            if any(c.strip() for c in r):
+                raise InstrumentError(f"{path}: row {i + 1}: expected six columns (TDS layout)")
+            continue
+        if r[0].strip():
+            header[r[0].strip()] = r[1].strip()
+        tv = _floats(path, [r[3], r[4]], i)
+        t.append(tv[0])
+        v.append(tv[1])
+    for key in ("Record Length", "Sample Interval"):
+        if key not in header:
+            raise InstrumentError(f"{path}: header field {key!r} missing (TDS layout)")
+    n = int(float(header["Record Length"]))
+    if n != len(t):
+        raise InstrumentError(f"{path}: Record Length says {n} points but the file holds {len(t)}")
+    name = header.get("Source", Path(path).stem).upper()
+    return _waveform(path, name, np.array(t), np.array(v), header.get("Trigger Point"),
+                     header.get("Vertical Units", "V"), header["Sample Interval"])
+
+
+def _waveform(path, name, t, v, trigger, unit, interval=None) -> Waveform:
+    """A volts-only Waveform; the sample interval from the header where it is given."""
+    try:
+        dt = float(interval) if interval not in (None, "") else float(np.median(np.diff(t)))
+    except ValueError:
+        raise InstrumentError(f"{path}: Sample Interval = {interval!r} is not a number") from None
+    if not dt > 0 or not np.all(np.diff(t) > 0):
+        raise InstrumentError(f"{path}: the time column does not increase")
+    idx = int(float(trigger)) if trigger not in (None, "") else int(np.clip(round(-t[0] / dt), 0, t.size - 1))
+    pre = Preamble(points=t.size, x_increment=dt, x_zero=float(t[0]), trigger_index=idx,
+                   y_multiplier=1.0, y_offset=0.0, y_zero=0.0, byte_count=0, y_unit=unit or "V",
+                   extra={"source": str(path)})
+    return Waveform(name, pre, samples=v)

@@ -1,0 +1,159 @@
+"""Analysis of gauge signals as in Daraio et al., Phys. Rev. E 73, 026610 (2006).
+
+Conditioning: baseline from the pre-trigger samples; inversion of the one-pole RC
+high-pass, x = y + (1/tau) * integral of y dt (trapezoid rule); volts to force with the
+gauge's sensitivity. Pulses: scipy.signal.find_peaks with height/prominence/distance rules;
+the peak time and amplitude of each pulse come from a least-squares parabola through the
+samples within ``top`` of its maximum, which stays accurate on 8-bit records whose tops are
+plateaus of equal codes; widths are where the pulse crosses 50% (FWHM) and 1% (base) of its
+amplitude, interpolated linearly. Time of flight: between leading-pulse maxima, and by
+cross-correlating the leading pulses with a parabola through the correlation peak.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import cumulative_trapezoid
+from scipy.signal import find_peaks, peak_widths
+
+from .errors import check
+
+
+def remove_baseline(y: np.ndarray, n_pre: int) -> np.ndarray:
+    """y minus the mean of its first n_pre samples (at least 10, the pre-trigger part)."""
+    return y - np.mean(y[:max(int(n_pre), 10)])
+
+
+def invert_rc(y: np.ndarray, h: float, tau: float) -> np.ndarray:
+    """Undo a one-pole RC high-pass of time constant tau (s): x = y + (1/tau) int y dt."""
+    return y + cumulative_trapezoid(y, dx=h, initial=0.0) / tau
+
+
+@dataclass(frozen=True)
+class PeakRules:
+    """Which maxima are pulses. height, prominence: fractions of the record's maximum;
+    distance: least spacing of pulses (s); width: least width of a pulse at half its
+    prominence (s; rejects noise spikes, which are a sample or two wide); top: fraction of a
+    pulse's amplitude over which its parabola is fitted; lead: the leading pulse is the
+    first one above this fraction of the record's largest pulse."""
+
+    height: float = 0.1
+    prominence: float = 0.05
+    distance: float = 0.0
+    width: float = 2e-6
+    top: float = 0.05
+    lead: float = 0.3
+
+    def __post_init__(self):
+        for name in ("height", "prominence", "top", "lead"):
+            check(f"peaks.{name}", getattr(self, name), lo=0, hi=1)
+        check("peaks.distance", self.distance, lo=0, lo_closed=True, unit="s")
+        check("peaks.width", self.width, lo=0, lo_closed=True, unit="s")
+
+
+@dataclass(frozen=True)
+class Pulse:
+    """One pulse: time of its maximum (s), amplitude (same unit as the signal), full width
+    at half maximum and at 1% of the amplitude (s, nan where the signal never falls there)."""
+
+    time: float
+    amplitude: float
+    fwhm: float
+    base_width: float
+
+
+def find_pulses(t: np.ndarray, f: np.ndarray, rules: PeakRules = PeakRules(),
+                floor: float | None = None, refine: bool = True) -> list:
+    """Every pulse of f (a dynamic signal, baseline 0), in time order. ``floor`` replaces
+    the relative height rule by an absolute one. refine=False gives each pulse's highest
+    sample only (no parabola, widths nan): enough to count and choose pulses."""
+    peak = float(np.max(f)) if f.size else 0.0
+    if peak <= 0:
+        return []
+    h = t[1] - t[0]
+    spacing = int(round(rules.distance / h))
+    idx, props = find_peaks(f, height=rules.height * peak if floor is None else floor,
+                            prominence=rules.prominence * peak,
+                            distance=spacing if spacing > 1 else None)
+    if rules.width > 0 and idx.size:  # widths only for the candidates left (noise makes many maxima)
+        widths = peak_widths(f, idx, rel_height=0.5,
+                             prominence_data=(props["prominences"], props["left_bases"], props["right_bases"]))[0]
+        idx = idx[widths >= rules.width / h]
+    coarse = [Pulse(float(t[i]), float(f[i]), math.nan, math.nan) for i in idx]
+    return [refined(t, f, p, rules) for p in coarse] if refine else coarse
+
+
+def refined(t: np.ndarray, f: np.ndarray, pulse: Pulse, rules: PeakRules = PeakRules()) -> Pulse:
+    """The pulse's time and amplitude from its parabola, and its FWHM and 1% base width."""
+    i = int(round((pulse.time - t[0]) / (t[1] - t[0])))
+    time, amp = _vertex(t, f, i, rules.top)
+    return Pulse(time, amp, _width(t, f, i, 0.5 * amp), _width(t, f, i, 0.01 * amp))
+
+
+def leading(pulses: list, rules: PeakRules = PeakRules()):
+    """The first pulse above ``rules.lead`` of the largest one (None if there is none)."""
+    if not pulses:
+        return None
+    big = max(p.amplitude for p in pulses)
+    return next(p for p in pulses if p.amplitude >= rules.lead * big)
+
+
+def _vertex(t, f, i, top):
+    """Least-squares parabola through the contiguous samples within ``top`` of f[i]."""
+    level = f[i] * (1.0 - top)
+    lo, hi = i, i
+    while lo > 0 and f[lo - 1] >= level:
+        lo -= 1
+    while hi < f.size - 1 and f[hi + 1] >= level:
+        hi += 1
+    lo, hi = min(lo, i - 1), max(hi, i + 1)
+    if lo < 0 or hi >= f.size:
+        return float(t[i]), float(f[i])
+    x = t[lo:hi + 1] - t[i]
+    a, b, c = np.polyfit(x, f[lo:hi + 1], 2)
+    if a >= 0:
+        return float(t[i]), float(f[i])
+    xv = -b / (2 * a)
+    if not x[0] <= xv <= x[-1]:
+        return float(t[i]), float(f[i])
+    return float(t[i] + xv), float(c - b * b / (4 * a))
+
+
+def _width(t, f, i, level):
+    """Time between the crossings of ``level`` on either side of sample i (linear)."""
+    below_left = f[i::-1] <= level
+    below_right = f[i:] <= level
+    if not below_left.any() or not below_right.any():
+        return math.nan
+    left = i - int(np.argmax(below_left))
+    right = i + int(np.argmax(below_right))
+    tl = t[left] + (level - f[left]) / (f[left + 1] - f[left]) * (t[left + 1] - t[left])
+    tr = t[right - 1] + (f[right - 1] - level) / (f[right - 1] - f[right]) * (t[right] - t[right - 1])
+    return float(tr - tl)
+
+
+def xcorr_delay(t, fa, pa: Pulse, fb, pb: Pulse) -> float:
+    """Delay (s) of pulse b after pulse a by cross-correlation of the leading pulses.
+
+    The window of a spans one FWHM either side of its maximum (the main lobe, clear of the
+    next pulse of a train); b is searched within a window twice as wide around its own
+    maximum; parabola through the correlation peak.
+    """
+    h = t[1] - t[0]
+    half = pa.fwhm
+    if not math.isfinite(half) or half <= 0:
+        return math.nan
+    ia0, ia1 = np.searchsorted(t, [pa.time - half, pa.time + half])
+    ib0, ib1 = np.searchsorted(t, [pb.time - 2 * half, pb.time + 2 * half])
+    a, b = fa[ia0:ia1], fb[ib0:ib1]
+    if a.size < 3 or b.size <= a.size:
+        return math.nan
+    c = np.correlate(b, a, mode="valid")
+    k = int(np.argmax(c))
+    shift = 0.0
+    if 0 < k < c.size - 1:
+        den = c[k - 1] - 2 * c[k] + c[k + 1]
+        shift = 0.5 * (c[k - 1] - c[k + 1]) / den if den != 0 else 0.0
+    return float((ib0 + k + shift - ia0) * h)
