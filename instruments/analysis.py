@@ -56,12 +56,15 @@ class PeakRules:
 @dataclass(frozen=True)
 class Pulse:
     """One pulse: time of its maximum (s), amplitude (same unit as the signal), full width
-    at half maximum and at 1% of the amplitude (s, nan where the signal never falls there)."""
+    at half maximum and at 1% of the amplitude, and rise from 1% to the maximum (s, nan
+    where the signal never falls there). In a train the 1% width runs into the next pulse;
+    twice the rise is then the pulse's own width."""
 
     time: float
     amplitude: float
     fwhm: float
     base_width: float
+    rise: float = math.nan
 
 
 def find_pulses(t: np.ndarray, f: np.ndarray, rules: PeakRules = PeakRules(),
@@ -89,7 +92,8 @@ def refined(t: np.ndarray, f: np.ndarray, pulse: Pulse, rules: PeakRules = PeakR
     """The pulse's time and amplitude from its parabola, and its FWHM and 1% base width."""
     i = int(round((pulse.time - t[0]) / (t[1] - t[0])))
     time, amp = _vertex(t, f, i, rules.top)
-    return Pulse(time, amp, _width(t, f, i, 0.5 * amp), _width(t, f, i, 0.01 * amp))
+    half, base = _crossings(t, f, i, 0.5 * amp), _crossings(t, f, i, 0.01 * amp)
+    return Pulse(time, amp, half[1] - half[0], base[1] - base[0], time - base[0])
 
 
 def leading(pulses: list, rules: PeakRules = PeakRules()):
@@ -121,17 +125,16 @@ def _vertex(t, f, i, top):
     return float(t[i] + xv), float(c - b * b / (4 * a))
 
 
-def _width(t, f, i, level):
-    """Time between the crossings of ``level`` on either side of sample i (linear)."""
+def _crossings(t, f, i, level):
+    """Times (s) where f crosses ``level`` before and after sample i (linear; nan if never)."""
     below_left = f[i::-1] <= level
     below_right = f[i:] <= level
-    if not below_left.any() or not below_right.any():
-        return math.nan
-    left = i - int(np.argmax(below_left))
-    right = i + int(np.argmax(below_right))
-    tl = t[left] + (level - f[left]) / (f[left + 1] - f[left]) * (t[left + 1] - t[left])
-    tr = t[right - 1] + (f[right - 1] - level) / (f[right - 1] - f[right]) * (t[right] - t[right - 1])
-    return float(tr - tl)
+    left = i - int(np.argmax(below_left)) if below_left.any() else -1
+    right = i + int(np.argmax(below_right)) if below_right.any() else -1
+    tl = math.nan if left < 0 else t[left] + (level - f[left]) / (f[left + 1] - f[left]) * (t[left + 1] - t[left])
+    tr = math.nan if right < 0 else \
+        t[right - 1] + (f[right - 1] - level) / (f[right - 1] - f[right]) * (t[right] - t[right - 1])
+    return float(tl), float(tr)
 
 
 def xcorr_delay(t, fa, pa: Pulse, fb, pb: Pulse) -> float:

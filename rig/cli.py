@@ -5,6 +5,7 @@ import argparse
 import json
 import math
 import sys
+from pathlib import Path
 
 from instruments.errors import InstrumentError
 
@@ -212,6 +213,62 @@ def cmd_analyze(args) -> list:
     return results
 
 
+def cmd_sweep(args) -> dict:
+    from tqdm import tqdm
+
+    from .shot import Rig
+    from .sweep import Vary, run_sweep
+
+    vary = Vary.parse(args.vary)
+    Rig.from_scene(args.scene, args.set or ())  # the base scene itself must be valid
+    with tqdm(total=len(vary.values), desc=f"sweep {vary.key}", unit="shot", file=sys.stderr,
+              disable=args.quiet) as bar:
+        points = run_sweep(args.scene, vary, args.set or (), args.seed, bar.update, args.out)
+    out = {"points": []}
+    for p in points:
+        one = shot_summary(p.rig, p.shot)
+        one.update(p.blocks)
+        one["value"] = p.value
+        out["points"].append(one)
+    if not args.json:
+        fmt = lambda v, spec: "-" if v is None else format(v, spec)  # noqa: E731
+        print(f"{vary.key:>18s} | {'truth F_d N':>11s} {'V_s m/s':>8s} | {'measured F_d N':>14s} "
+              f"{'V_s m/s':>8s} | {'Eq (1) m/s':>10s}")
+        clipped = []
+        for p in out["points"]:
+            t, m = p["truth"], p["measured"]
+            print(f"{p['value']:18.6g} | {fmt(t['amplitude_N'], '11.3f')} {fmt(t['speed_m_per_s'], '8.1f')} | "
+                  f"{fmt(m['amplitude_N'], '14.3f')} {fmt(m['speed_m_per_s'], '8.1f')} | "
+                  f"{fmt(p['theory']['speed_m_per_s'], '10.1f')}"
+                  f"{'  CLIPPED: ' + ','.join(c) if (c := [k for k, v in p['channels'].items() if v['clipped']]) else ''}")
+            clipped += [p["value"]] if any(v["clipped"] for v in p["channels"].values()) else []
+        if clipped:
+            print(f"clipped scope channels at {vary.key} = {', '.join(f'{v:g}' for v in clipped)}: "
+                  f"those measurements read low; raise scope.channels.CHn.volts_per_div")
+        if args.out:
+            print(f"appended {len(points)} shots to {args.out}")
+    return out
+
+
+def cmd_reproduce(args) -> dict:
+    from tqdm import tqdm
+
+    from .reproduce import CONFIGS, MASS_RATIOS, OTHER_SCENES, VELOCITY_FACTORS, reproduce
+
+    total = len(CONFIGS) + len(OTHER_SCENES) + len(CONFIGS) * len(VELOCITY_FACTORS) + len(MASS_RATIOS) + 1
+    with tqdm(total=total, desc=f"reproduce {args.study}", unit="step", file=sys.stderr,
+              disable=args.quiet) as bar:
+        def progress(what):
+            bar.set_postfix_str(what[:40])
+            bar.update()
+
+        results = reproduce(args.study, args.out, progress)
+    if not args.json:
+        print((Path(args.out) / "table1.md").read_text())
+        print(f"wrote {args.out}/: table1.md, table1.csv, summary.md, results.json and the figures")
+    return {"out": args.out, "table1": results["table1"], "summary": results["summary"]}
+
+
 def cmd_ls(args) -> list:
     from instruments.archive import Archive
 
@@ -282,6 +339,24 @@ def build_parser() -> argparse.ArgumentParser:
     im.add_argument("--together", action="store_true", help="the files are the channels of one shot")
     im.add_argument("--json", action="store_true", help="print JSON")
     im.set_defaults(func=cmd_import)
+
+    sw = sub.add_parser("sweep", help="one shot per value of a scene key")
+    sw.add_argument("scene")
+    sw.add_argument("--vary", required=True, metavar="KEY=START:STOP:COUNT",
+                    help="e.g. striker.velocity=0.3:1.5:7 (plain numbers in the key's SI unit)")
+    sw.add_argument("--set", action="append", metavar="KEY=VALUE", help="other overrides")
+    sw.add_argument("--seed", type=int, default=0, help="the sweep's seed (default 0)")
+    sw.add_argument("--out", metavar="ARCHIVE.h5", help="append every shot to an archive")
+    sw.add_argument("--quiet", action="store_true", help="no progress bar")
+    sw.add_argument("--json", action="store_true", help="print JSON")
+    sw.set_defaults(func=cmd_sweep)
+
+    rp = sub.add_parser("reproduce", help="re-run a published study (daraio2006)")
+    rp.add_argument("study", help="daraio2006")
+    rp.add_argument("--out", required=True, metavar="DIR", help="folder for tables and figures")
+    rp.add_argument("--quiet", action="store_true", help="no progress bar")
+    rp.add_argument("--json", action="store_true", help="print JSON")
+    rp.set_defaults(func=cmd_reproduce)
 
     an = sub.add_parser("analyze", help="speeds and amplitudes from scope files or an archive")
     an.add_argument("files", nargs="+", metavar="FILE", help=".isf, .csv or .h5 (an archive)")
