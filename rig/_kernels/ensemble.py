@@ -1,0 +1,194 @@
+"""Many shots of one chain topology at once (numba): shots are the innermost index.
+
+Arrays are (chunks, bodies, width): each chunk is a C-contiguous block whose inner index
+runs over ``width`` shots from 0, so every loop over the shots of a chunk vectorises;
+``integrate_ensemble`` runs the chunks on numba's threads. Every shot
+performs exactly the operations of the single-shot kernel (integrators.integrate) in the
+same order with the same step, so the two agree to the last bit. Conservative Hertz
+contacts and constant loads only (no force schedule, no dissipation).
+"""
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .integrators import _hermite
+
+
+@njit(cache=True, fastmath=False)
+def _forces(u, A, d0, load, f):
+    nb = u.shape[0]
+    for i in range(1, nb):
+        for s in range(u.shape[1]):
+            d = d0[i, s] + u[i - 1, s] - u[i, s]
+            d = d if d > 0.0 else 0.0
+            f[i, s] = A[i, s] * d * math.sqrt(d) - load[i, s]
+
+
+@njit(cache=True, fastmath=False)
+def _kick_drift(u, v, invm, f, hb, ha):
+    for i in range(v.shape[0]):
+        for s in range(u.shape[1]):
+            vi = v[i, s] + hb * (f[i, s] - f[i + 1, s]) * invm[i, s]
+            v[i, s] = vi
+            u[i, s] += ha * vi
+
+
+@njit(cache=True, fastmath=False)
+def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha):
+    """_kick_drift then _forces in one pass over the rows: row i is kicked and drifted
+    (reading f[i], f[i+1], not yet renewed), then contact i is renewed from rows i-1 and i
+    (both moved). The same operations as the two passes, so the same bits."""
+    for i in range(v.shape[0]):
+        for s in range(u.shape[1]):
+            vi = v[i, s] + hb * (f[i, s] - f[i + 1, s]) * invm[i, s]
+            v[i, s] = vi
+            u[i, s] += ha * vi
+        if i >= 1:
+            for s in range(u.shape[1]):
+                d = d0[i, s] + u[i - 1, s] - u[i, s]
+                d = d if d > 0.0 else 0.0
+                f[i, s] = A[i, s] * d * math.sqrt(d) - load[i, s]
+
+
+@njit(cache=True, fastmath=False)
+def _synced(j, s, v, invm, f, pending):
+    return v[j, s] + pending * (f[j, s] - f[j + 1, s]) * invm[j, s]
+
+
+@njit(cache=True, fastmath=False)
+def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, y, r):
+    for c in range(ch_slot.shape[0]):
+        for s in range(u.shape[1]):
+            yc = 0.0
+            rc = 0.0
+            for k in range(ch_slot.shape[1]):
+                w = ch_weight[c, k]
+                if w != 0.0:
+                    i = ch_slot[c, k]
+                    yc += w * (f[i, s] + load[i, s])
+                    d = d0[i, s] + u[i - 1, s] - u[i, s]
+                    if d > 0.0:
+                        va = _synced(i - 1, s, v, invm, f, pending)
+                        vb = _synced(i, s, v, invm, f, pending)
+                        rc += w * (1.5 * A[i, s] * math.sqrt(d) * (va - vb))
+            y[c, s] = yc
+            r[c, s] = rc
+
+
+@njit(cache=True, fastmath=False)
+def _energy(u, v, mass, bias, A, d0, s):
+    nb = u.shape[0]
+    e = 0.0
+    for i in range(nb):
+        e += 0.5 * mass[i, s] * v[i, s] * v[i, s] - mass[i, s] * bias[i, s] * u[i, s]
+    for i in range(1, nb):
+        d = d0[i, s] + u[i - 1, s] - u[i, s]
+        if d > 0.0:
+            e += 0.4 * A[i, s] * d * d * math.sqrt(d)
+    return e
+
+
+@njit(cache=True, fastmath=False)
+def _momentum(v, mass, s):
+    p = 0.0
+    for i in range(v.shape[0]):
+        p += mass[i, s] * v[i, s]
+    return p
+
+
+@njit(cache=True, fastmath=False)
+def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps,
+           ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
+           e_ref, p_ref, diag, f, y_old, r_old, y_new, r_new):
+    nb = u.shape[0]
+    W = u.shape[1]
+    n_drift = a_coef.shape[0]
+    n_ch = ch_slot.shape[0]
+    n_out = out.shape[1]
+    for s in range(u.shape[1]):
+        f[0, s] = 0.0
+        f[nb, s] = -load[nb, s]
+    _forces(u, A, d0, load, f)
+    e0 = np.empty(W)
+    p0 = np.empty(W)
+    net = np.empty(W)
+    j_wall = np.zeros(W)
+    for s in range(u.shape[1]):
+        e0[s] = _energy(u, v, mass, bias, A, d0, s)
+        p0[s] = _momentum(v, mass, s)
+        net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
+    _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, 0.0, y_old, r_old)
+    if n_out > 0:
+        for c in range(n_ch):
+            for s in range(u.shape[1]):
+                out[c, 0, s] = y_old[c, s]
+    j_out = 1
+    pending = 0.0
+    for n in range(n_steps):
+        t = n * dt
+        for st in range(n_drift):
+            hb = b_coef[st] * dt
+            if st == 0:
+                hb += pending
+            if wall_slot > 0:
+                for s in range(u.shape[1]):
+                    j_wall[s] += hb * f[wall_slot, s]
+            h = a_coef[st] * dt
+            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h)
+        t_new = (n + 1) * dt
+        pending = b_coef[n_drift] * dt
+        check = (n + 1) % check_every == 0 or n == n_steps - 1
+        if check:
+            if wall_slot > 0:
+                for s in range(u.shape[1]):
+                    j_wall[s] += pending * f[wall_slot, s]
+            _kick_drift(u, v, invm, f, pending, 0.0)
+            pending = 0.0
+        _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, y_new, r_new)
+        while j_out < n_out and j_out * sample_dt <= t_new * (1.0 + 1e-12):
+            x = (j_out * sample_dt - t) / dt
+            for c in range(n_ch):
+                for s in range(u.shape[1]):
+                    out[c, j_out, s] = _hermite(x, dt, y_old[c, s], r_old[c, s], y_new[c, s], r_new[c, s])
+            j_out += 1
+        for c in range(n_ch):
+            for s in range(u.shape[1]):
+                y_old[c, s] = y_new[c, s]
+                r_old[c, s] = r_new[c, s]
+        if check:
+            for s in range(u.shape[1]):
+                e = _energy(u, v, mass, bias, A, d0, s)
+                err = abs(e - e0[s]) / e_ref[s]
+                pe = abs(_momentum(v, mass, s) - p0[s] - (t_new * net[s] - j_wall[s])) / p_ref[s]
+                worst = 0.0
+                for i in range(1, nb):
+                    q = (d0[i, s] + u[i - 1, s] - u[i, s]) / d_limit[i, s]
+                    worst = max(worst, q) if q == q else math.inf
+                if not (err < 1e300) or not (worst <= 1.0):
+                    diag[3, s] = 1.0
+                diag[0, s] = max(diag[0, s], err)
+                diag[1, s] = max(diag[1, s], pe)
+    for s in range(u.shape[1]):
+        diag[2, s] = j_wall[s] + (load[wall_slot, s] if wall_slot > 0 else 0.0) * n_steps * dt
+        diag[4, s] = n_steps
+        diag[5, s] = n_steps * dt
+
+
+@njit(cache=True, fastmath=False, parallel=True)
+def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps,
+                       ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
+                       e_ref, p_ref, diag):
+    """Integrate every shot of the (chunks, bodies, width) arrays in place; out is
+    (chunks, channels, samples, width), diag (chunks, 6, width) as in the single-shot kernel."""
+    n_chunks, nb, W = u.shape
+    n_ch = ch_slot.shape[0]
+    for k in prange(n_chunks):
+        f = np.zeros((nb + 1, W))
+        y_old = np.zeros((n_ch, W))
+        r_old = np.zeros((n_ch, W))
+        y_new = np.zeros((n_ch, W))
+        r_new = np.zeros((n_ch, W))
+        _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], a_coef, b_coef, dt, n_steps,
+               ch_slot, ch_weight, sample_dt, out[k], check_every, d_limit[k], wall_slot,
+               e_ref[k], p_ref[k], diag[k], f, y_old, r_old, y_new, r_new)

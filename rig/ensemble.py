@@ -1,0 +1,93 @@
+"""Many shots of one chain topology in one call of the batched kernel.
+
+The step is the smallest that any shot's accuracy target (or stability) asks for, so a
+shot's result never depends on which other shots share its batch: a shot solved alone with
+``solve(problem, t_end, dt=step)`` gives the same numbers to the last bit.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._kernels.ensemble import integrate_ensemble
+from .errors import RigError, invalid
+from .methods import DEFAULT_METHOD, method as get_method
+from .solve import MAX_CHECKS
+from .stepsize import DEFAULT_ACCURACY, accuracy_step, stability_limit
+
+
+@dataclass(frozen=True, eq=False)
+class EnsembleSolution:
+    """forces: {probe: (samples, shots) array (N)}; diag: (6, shots) as SolverStats fields
+    (energy error, momentum error, wall impulse, status, steps, end time)."""
+
+    forces: dict
+    sample_interval: float
+    dt: float
+    steps: int
+    wall_s: float
+    diag: np.ndarray
+
+    @property
+    def shots(self) -> int:
+        return self.diag.shape[1]
+
+
+def ensemble_step(problems, t_end: float, method=DEFAULT_METHOD, accuracy=None) -> float:
+    """The common step (s) for a batch: the smallest any of its shots needs."""
+    m = get_method(method)
+    acc = DEFAULT_ACCURACY if accuracy is None else accuracy
+    if not problems:
+        raise invalid("problems", [], "at least one shot")
+    return min(min(accuracy_step(p, m, acc), 0.5 * stability_limit(p, m)) for p in problems)
+
+
+def solve_ensemble(problems: list, t_end: float, *, dt: float, method: str = DEFAULT_METHOD,
+                   width: int = 32) -> EnsembleSolution:
+    """Integrate every problem with the same step ``dt`` (s) to ``t_end`` (s)."""
+    if not problems:
+        raise invalid("problems", [], "at least one shot")
+    m = get_method(method)
+    p0 = problems[0]
+    for p in problems:
+        if (p.n_bodies, p.wall_slot, p.offset, p.ch_names) != (p0.n_bodies, p0.wall_slot, p0.offset, p0.ch_names) \
+                or not np.array_equal(p.ch_slot, p0.ch_slot) or not np.array_equal(p.ch_weight, p0.ch_weight):
+            raise RigError("an ensemble needs shots of one chain topology and one set of probes")
+        if p.sched_t.size or p.chain.law.dissipative:
+            raise RigError("the batched kernel takes conservative chains with constant loads only")
+    if not (t_end > 0 and dt > 0):
+        raise invalid("t_end/dt", (t_end, dt), "both > 0 s")
+    n_steps = max(1, math.ceil(t_end / dt * (1 - 1e-12)))
+    step = t_end / n_steps
+    n = len(problems)
+    n_chunks = -(-n // width)
+    padded = problems + [problems[-1]] * (n_chunks * width - n)  # the last chunk filled up
+
+    def blocks(values):  # -> (chunks, ..., width), each chunk C-contiguous
+        a = np.stack(values, axis=-1)
+        return np.ascontiguousarray(np.moveaxis(a.reshape(a.shape[:-1] + (n_chunks, width)), -2, 0))
+
+    stack = lambda name: blocks([getattr(p, name) for p in padded])  # noqa: E731
+    rec = p0.record
+    n_out = int(math.floor(t_end / rec.sample_interval * (1 + 1e-12))) + 1
+    out = np.zeros((n_chunks, len(p0.ch_names), n_out, width))
+    diag = np.zeros((n_chunks, 6, width))
+    u, v = stack("u0"), stack("v0")
+    t0 = time.perf_counter()
+    integrate_ensemble(u, v, stack("mass"), stack("invm"), stack("bias"), stack("load"), stack("A"),
+                       stack("d0"), np.array(m.drifts), np.array(m.kicks), step, n_steps,
+                       p0.ch_slot, p0.ch_weight, rec.sample_interval, out,
+                       max(1, n_steps // MAX_CHECKS), stack("d_limit"), p0.wall_slot,
+                       blocks([p.energy_scale for p in padded]), blocks([p.momentum_scale for p in padded]),
+                       diag)
+    wall = time.perf_counter() - t0
+    out = np.moveaxis(out, 0, -2).reshape(out.shape[1], n_out, n_chunks * width)[..., :n]
+    diag = np.moveaxis(diag, 0, -2).reshape(6, n_chunks * width)[:, :n]
+    if np.any(diag[3] != 0):
+        bad = np.flatnonzero(diag[3] != 0)
+        raise RigError(f"the integration became unstable for shot(s) {bad.tolist()[:10]} "
+                       f"(dt = {step:.4g} s): use a tighter accuracy")
+    return EnsembleSolution(dict(zip(p0.ch_names, out)), rec.sample_interval, step, n_steps, wall, diag)
