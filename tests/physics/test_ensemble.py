@@ -4,7 +4,7 @@ import pytest
 
 from rig import RigError, solve
 from rig.ensemble import ensemble_step, solve_ensemble
-from conftest import PTFE, ptfe_rig, record_contacts
+from conftest import ptfe_rig, record_contacts
 
 
 def _problems(n):
