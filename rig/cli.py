@@ -269,6 +269,81 @@ def cmd_reproduce(args) -> dict:
     return {"out": args.out, "table1": results["table1"], "summary": results["summary"]}
 
 
+def cmd_mc(args) -> dict:
+    import time
+
+    import numpy as np
+    from tqdm import tqdm
+
+    from .distributions import parse_vary
+    from .executors import run_study
+    from .mc import Store, Study, _base
+    from .mc_report import figures, jcgm101, sobol_indices
+    from .theory import solitary_wave_speed
+
+    study = Study(args.scene, tuple(parse_vary(args.vary or [])), args.shots, args.seed,
+                  tuple(args.set or ()), args.batch, args.accuracy, args.sobol)
+    if not study.dists:
+        raise RigError("--vary: give at least one uncertain input, e.g. striker.velocity=\"normal(0.89 m/s, 0.01 m/s)\"")
+    _, _, base = _base(study.scene, study.overrides)  # the scene must be valid before any shot
+    for d in study.dists:
+        parts = d.key.split(".")
+        if parts[0] == "gauges" and parts[1] not in base.gauges:
+            raise RigError(f"--vary {d.key}: the scene has no gauge {parts[1]!r} (gauges: {', '.join(base.gauges)})")
+    if study.sobol:
+        from .mc import sobol_matrix
+
+        sobol_matrix(study)
+    store = Store(args.out, study).open()
+    done = sum(min(study.shots, (b + 1) * study.batch) - b * study.batch for b in store.done())
+    t0 = time.perf_counter()
+    with tqdm(total=study.shots, initial=done, desc="mc", unit="shot", file=sys.stderr,
+              disable=args.quiet) as bar:
+        try:
+            run_study(study, store, args.workers, args.scheduler, bar.update)
+        except KeyboardInterrupt:
+            kept = sum(min(study.shots, (b + 1) * study.batch) - b * study.batch for b in store.done())
+            raise RigError(f"interrupted: {kept} of {study.shots} shots are kept in {args.out}; "
+                           f"run the same command again to resume") from None
+    ran = study.shots - done
+    elapsed = time.perf_counter() - t0
+    results = store.collect()
+    out = results["outputs"]
+    report = {"shots": int(results["index"].size), "shots_per_s": ran / elapsed if ran else None,
+              "speed_m_per_s": jcgm101(out["speed_m_per_s"]),
+              "speed_xcorr_m_per_s": jcgm101(out["speed_xcorr_m_per_s"]),
+              "amplitude_N": jcgm101(out["amplitude_N"]),
+              "truth_speed_m_per_s": jcgm101(out["truth_speed_m_per_s"]),
+              "truth_amplitude_N": jcgm101(out["truth_amplitude_N"]),
+              "inputs": {d.key: d.text() for d in study.dists}}
+    if study.sobol:
+        report["sobol"] = {k: sobol_indices(study, results["inputs"], out[k]) for k in ("speed_m_per_s", "amplitude_N")}
+    from .measure import midway_static_force
+
+    F0 = midway_static_force(base)
+    m = base.chain.beads[-1].material
+    F = np.linspace(max(np.nanmin(out["amplitude_N"]) * 0.8, 1e-3), np.nanmax(out["amplitude_N"]) * 1.2, 100)
+    figures(Path(args.out), results, study.keys,
+            (F, solitary_wave_speed(m.E, m.nu, m.rho, base.chain.beads[-1].diameter, F0, F0 + F),
+             f"Eq (1), F_0 = {F0:.3g} N"))
+    store.consolidate(results, report)
+    (Path(args.out) / "report.json").write_text(json.dumps(report, indent=1))
+    if not args.json:
+        print(f"{report['shots']} shots ({ran} run now"
+              + (f", {report['shots_per_s']:.0f} shots/s" if ran else "") + f") in {args.out}")
+        for key, label in (("speed_m_per_s", "speed V_s (m/s)"), ("amplitude_N", "amplitude F_d (N)")):
+            r = report[key]
+            if r["estimate"] is not None:
+                print(f"  {label:20s} {r['estimate']:.4g} +- {r['std']:.3g}  95%: [{r['ci95'][0]:.4g}, "
+                      f"{r['ci95'][1]:.4g}]  {'stable' if r['converged'] else 'not yet stable'} "
+                      f"(JCGM 101, tolerance {r['tolerance']:.2g})")
+        for key, s in report.get("sobol", {}).items():
+            print(f"  Sobol {key}: dominant input {s['dominant']}; total "
+                  + ", ".join(f"{k} {v:.2f}" for k, v in s["total"].items()))
+        print(f"  wrote study.h5, report.json, histograms.png, speed_vs_amplitude.png")
+    return report
+
+
 def cmd_ls(args) -> list:
     from instruments.archive import Archive
 
@@ -357,6 +432,24 @@ def build_parser() -> argparse.ArgumentParser:
     rp.add_argument("--quiet", action="store_true", help="no progress bar")
     rp.add_argument("--json", action="store_true", help="print JSON")
     rp.set_defaults(func=cmd_reproduce)
+
+    mc = sub.add_parser("mc", help="Monte Carlo study over many virtual shots")
+    mc.add_argument("scene")
+    mc.add_argument("--shots", type=int, required=True)
+    mc.add_argument("--vary", action="append", metavar="KEY=DIST",
+                    help='e.g. striker.velocity="normal(0.89 m/s, 0.01 m/s)"; also chain.bead_mass, '
+                         'gauges.NAME.gain, gauges.NAME.misalignment')
+    mc.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides")
+    mc.add_argument("--seed", type=int, default=0, help="the study's seed (default 0)")
+    mc.add_argument("--batch", type=int, default=64, help="shots per batch (default 64)")
+    mc.add_argument("--accuracy", type=float, help="solver accuracy (default: the scene's)")
+    mc.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
+    mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")
+    mc.add_argument("--sobol", action="store_true", help="Sobol design and indices (needs SALib)")
+    mc.add_argument("--out", required=True, metavar="DIR")
+    mc.add_argument("--quiet", action="store_true", help="no progress bar")
+    mc.add_argument("--json", action="store_true", help="print JSON")
+    mc.set_defaults(func=cmd_mc)
 
     an = sub.add_parser("analyze", help="speeds and amplitudes from scope files or an archive")
     an.add_argument("files", nargs="+", metavar="FILE", help=".isf, .csv or .h5 (an archive)")

@@ -28,7 +28,8 @@ CHANNEL_KEYS = {"volts_per_div": "V", "position": float, "offset": "V", "couplin
 SCHEMA = {
     "scene": {"name": str, "description": str, "reference": str},
     "chain": {"material": str, "diameter": "m", "mass": "kg", "beads": int,
-              "magnetic_bead": bool, "contact_law": str, "damping_time": "s"},
+              "magnetic_bead": bool, "contact_law": str, "damping_time": "s",
+              "youngs_modulus": "Pa", "poisson_ratio": float},
     "striker": {"material": str, "mass": "kg", "velocity": "m/s", "diameter": "m", "gap": "m"},
     "magnet": {"force": "N", "position": "m", "peak_force": "N", "schedule": list},
     "holder": {"bore": "m", "outer_diameter": "m", "length": "m", "vertical": bool},

@@ -21,6 +21,7 @@ from . import __version__, scene as scene_io
 from .apparatus import Holder, RingMagnet
 from .chain import Chain, Record
 from .errors import RigError, invalid
+from .materials import Material, material
 from .parts import Bead, GaugeBead, MagneticBead, Striker, Wall
 from .solution import SolverStats
 from .solve import solve
@@ -90,10 +91,13 @@ class ShotRecord:
 class Rig:
     """Parts and instruments of one scene (see rig/scene.py for the file format)."""
 
-    def __init__(self, values: dict, scene_text: str = "", overrides: tuple = ()):
+    def __init__(self, values: dict, scene_text: str = "", overrides: tuple = (), bead_masses=None):
+        """values: a validated scene in SI (rig.scene.load); bead_masses (kg): one mass per
+        plain bead, top to bottom, for studies of the bead-to-bead scatter."""
         self.values = values
         self.scene_text = scene_text
         self.overrides = tuple(overrides)
+        self.bead_masses = None if bead_masses is None else [float(m) for m in bead_masses]
         self.name = values.get("scene", {}).get("name", "scene")
         self._build()
         self._solution = None
@@ -117,15 +121,25 @@ class Rig:
         magnetic = c.pop("magnetic_bead", False)
         law = c.pop("contact_law", "hertz")
         damping = c.pop("damping_time", 0.0)
-        plain = Bead(c.get("material"), c.get("diameter"), c.get("mass"))
-        beads = ([MagneticBead()] if magnetic else []) + [plain] * n
+        mat = material(c.get("material"))
+        if "youngs_modulus" in c or "poisson_ratio" in c:
+            mat = Material(mat.name, c.get("youngs_modulus", mat.E), c.get("poisson_ratio", mat.nu), mat.rho,
+                           mat.source + "; elastic constants set by the scene")
+        plain = Bead(mat, c.get("diameter"), c.get("mass"))
         first = 1 if magnetic else 0
+        if self.bead_masses is None:
+            plain_beads = [plain] * n
+        else:
+            if len(self.bead_masses) != n:
+                raise invalid("bead_masses", len(self.bead_masses), f"one mass per plain bead ({n})")
+            plain_beads = [Bead(mat, plain.diameter, m) for m in self.bead_masses]
+        beads = ([MagneticBead()] if magnetic else []) + plain_beads
         self.gauges = {}
         for name, g in sorted(v.get("gauges", {}).items()):
             g = dict(g)
             index = self._gauge_index(name, g.pop("bead", None), g.pop("from_wall", None), first, len(beads))
             channel = g.pop("channel", None)
-            beads[index] = GaugeBead.like(plain)
+            beads[index] = GaugeBead.like(beads[index])
             self.gauges[name] = (index, channel, GaugeSettings(**g))
         self.striker = Striker(**v["striker"])
         self.holder.check(beads, self.striker)
@@ -219,8 +233,14 @@ class Rig:
             self._truth_report = truth_report(self, self.truth())
         return self._truth_report
 
-    def fire(self, seed: int | None = None) -> ShotRecord:
-        """One shot. ``seed`` (int) fixes every random draw; None draws a fresh one (recorded)."""
+    def use_solution(self, solution):
+        """Take the chain's solution from elsewhere (a batched solve of many shots)."""
+        self._solution = solution
+        self._truth_report = None
+
+    def fire(self, seed: int | None = None, draws: dict | None = None) -> ShotRecord:
+        """One shot. ``seed`` (int) fixes every random draw; None draws a fresh one (recorded).
+        draws: {gauge name: {"gain": g, "misalignment": m}} replaces those draws (studies)."""
         if seed is None:  # fresh, 63 bits so that it fits a signed 64-bit integer anywhere
             seed = int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(1))
         if not isinstance(seed, (int, np.integer)) or seed < 0:
@@ -231,6 +251,8 @@ class Rig:
         inputs, draws = {}, {}
         for name, (_, ch, settings) in self.gauges.items():
             draw = GaugeDraw.draw(settings, rng)
+            if draws and name in draws:
+                draw = GaugeDraw(draws[name].get("gain", draw.gain), draws[name].get("misalignment", draw.misalignment))
             draws[name] = {"gain": draw.gain, "misalignment_m": draw.misalignment}
             inputs[ch] = PiezoGauge(settings).read(truth.gauges[name].average_force, h, draw, rng,
                                                    truth.wave_speed_m_per_s)

@@ -1,0 +1,238 @@
+"""Monte Carlo studies over many virtual shots (`rig mc`).
+
+A Study is data: a scene, overrides, the uncertain inputs, the number of shots, one seed.
+Shot i always belongs to batch i // batch_size and draws its inputs from child i of the
+study's numpy SeedSequence, so results do not depend on the executor or the number of
+workers, and any shot can be fired again alone (``refire``). A batch is solved by the
+batched kernel (one step for its shots, stored per shot), then each shot goes through
+the instruments and the analysis. Every finished batch is written to its own file at once
+(atomically), so an interrupted study keeps what it finished and a re-run resumes.
+"""
+from __future__ import annotations
+
+import copy
+import functools
+import hashlib
+import json
+import math
+import os
+import tempfile
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from . import scene as scene_io
+from .distributions import Distribution
+from .ensemble import ensemble_step, solve_ensemble
+from .errors import RigError, invalid
+from .measure import shot_blocks
+from .shot import Rig
+from .solution import Solution, SolverStats
+
+OUTPUTS = ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_amplitude_N",
+           "truth_speed_m_per_s", "truth_amplitude_N", "energy_error", "dt_s")
+
+
+@dataclass(frozen=True)
+class Study:
+    scene: str
+    dists: tuple
+    shots: int
+    seed: int = 0
+    overrides: tuple = ()
+    batch: int = 64
+    accuracy: float | None = None
+    sobol: bool = False
+
+    def __post_init__(self):
+        if not isinstance(self.shots, int) or self.shots < 1:
+            raise invalid("--shots", self.shots, "a whole number >= 1")
+        if self.batch < 1:
+            raise invalid("--batch", self.batch, "a whole number >= 1")
+
+    @property
+    def keys(self) -> list:
+        return [d.key for d in self.dists]
+
+    def spec(self) -> dict:
+        return {"scene": str(self.scene), "dists": [asdict(d) for d in self.dists], "shots": self.shots,
+                "seed": self.seed, "overrides": list(self.overrides), "batch": self.batch,
+                "accuracy": self.accuracy, "sobol": self.sobol}
+
+    def digest(self) -> str:
+        return hashlib.sha256(json.dumps(self.spec(), sort_keys=True).encode()).hexdigest()[:16]
+
+    @property
+    def n_batches(self) -> int:
+        return -(-self.shots // self.batch)
+
+
+@functools.lru_cache(maxsize=4)
+def _base(scene: str, overrides: tuple):
+    values, text = scene_io.load(scene, overrides)
+    rig = Rig(values, text, overrides)  # validates
+    return values, text, rig
+
+
+def sobol_matrix(study: Study):
+    """SALib's Sobol design for the study's inputs: (shots, K) and the SALib problem."""
+    try:
+        from SALib.sample import sobol as sobol_sample
+    except ImportError:
+        raise RigError("--sobol needs SALib: pip install \".[sobol]\"") from None
+    problem = {"num_vars": len(study.dists), "names": study.keys,
+               "dists": [d.salib()[0] for d in study.dists], "bounds": [d.salib()[1] for d in study.dists]}
+    base = max(1, study.shots // (len(study.dists) + 2))
+    X = sobol_sample.sample(problem, base, calc_second_order=False, seed=study.seed)
+    return X, problem
+
+
+def shot_inputs(study: Study, i: int, n_plain: int, design=None):
+    """Shot i's inputs {key: value}, bead masses (or None) and instrument seed."""
+    child = np.random.SeedSequence(study.seed, spawn_key=(i,))
+    rng = np.random.default_rng(child)
+    x, masses = {}, None
+    for k, d in enumerate(study.dists):
+        if d.key == "chain.bead_mass":
+            masses = d.draw(rng, n_plain)
+            x[d.key] = float(np.mean(masses))
+        else:
+            x[d.key] = float(d.draw(rng)) if design is None else float(design[i, k])
+    seed = int(child.generate_state(1, np.uint64)[0] >> np.uint64(1))
+    return x, masses, seed
+
+
+def _rig_for(study: Study, x: dict, masses) -> tuple:
+    values, text, base = _base(study.scene, tuple(study.overrides))
+    v = copy.deepcopy(values)
+    draws = {}
+    for key, val in x.items():
+        parts = key.split(".")
+        if parts[0] == "gauges" and parts[-1] in ("gain", "misalignment"):
+            draws.setdefault(parts[1], {})[parts[-1]] = val
+            continue
+        if key == "chain.bead_mass":
+            continue
+        node = v
+        for p in parts[:-1]:
+            node = node.setdefault(p, {})
+        node[parts[-1]] = val
+    return Rig(v, text, tuple(study.overrides), bead_masses=masses), draws
+
+
+def run_batch(study: Study, b: int) -> dict:
+    """Batch b of the study: inputs, outputs and seeds of its shots (plain arrays)."""
+    lo, hi = b * study.batch, min(study.shots, (b + 1) * study.batch)
+    _, _, base = _base(study.scene, tuple(study.overrides))
+    n_plain = base.values["chain"]["beads"]
+    design = sobol_matrix(study)[0] if study.sobol else None
+    rigs, draws, seeds, xs = [], [], [], []
+    for i in range(lo, hi):
+        x, masses, seed = shot_inputs(study, i, n_plain, design)
+        try:
+            rig, d = _rig_for(study, x, masses)
+        except ValueError as exc:
+            raise RigError(f"shot {i}: inputs {x} give an impossible rig: {exc}") from None
+        rigs.append(rig)
+        draws.append(d)
+        seeds.append(seed)
+        xs.append([x[k] for k in study.keys])
+    problems = [r.chain.problem(r.record()) for r in rigs]
+    t_end = base.solver["duration"]
+    dt = ensemble_step(problems, t_end, base.solver["method"], study.accuracy or base.solver["accuracy"])
+    ens = solve_ensemble(problems, t_end, dt=dt, method=base.solver["method"])
+    out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
+    for j, (rig, p) in enumerate(zip(rigs, problems)):
+        stats = SolverStats(base.solver["method"], ens.dt, ens.steps, ens.steps * 6, ens.wall_s / len(rigs),
+                            float(ens.diag[0, j]), float(ens.diag[1, j]), float(ens.diag[2, j]), study.accuracy)
+        forces = {name: np.ascontiguousarray(a[:, j]) for name, a in ens.forces.items()}
+        rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))
+        blocks = shot_blocks(rig, rig.fire(seed=seeds[j], draws=draws[j]))
+        m, t = blocks["measured"], blocks["truth"]
+        for key, val in (("speed_m_per_s", m["speed_m_per_s"]), ("speed_xcorr_m_per_s", m["speed_xcorr_m_per_s"]),
+                         ("amplitude_N", m["amplitude_N"]), ("averaged_amplitude_N", m["averaged_amplitude_N"]),
+                         ("truth_speed_m_per_s", t["speed_m_per_s"]), ("truth_amplitude_N", t["amplitude_N"]),
+                         ("energy_error", stats.energy_error), ("dt_s", ens.dt)):
+            out[key][j] = np.nan if val is None else val
+    return {"batch": b, "index": np.arange(lo, hi), "inputs": np.array(xs, dtype=float).reshape(hi - lo, len(study.keys)),
+            "seeds": np.array(seeds, dtype=np.int64), "outputs": out}
+
+
+class Store:
+    """DIR/study.json (the study), DIR/batches/batch_NNNNNN.h5 (one per finished batch)."""
+
+    def __init__(self, folder, study: Study):
+        self.folder = Path(folder)
+        self.study = study
+        self.batches = self.folder / "batches"
+
+    def open(self):
+        self.batches.mkdir(parents=True, exist_ok=True)
+        meta = self.folder / "study.json"
+        spec = {"digest": self.study.digest(), **self.study.spec()}
+        if meta.exists():
+            old = json.loads(meta.read_text())
+            if old.get("digest") != spec["digest"]:
+                raise RigError(f"{self.folder} holds another study (scene {old.get('scene')}, "
+                               f"{old.get('shots')} shots); give another --out or remove it")
+        else:
+            meta.write_text(json.dumps(spec, indent=1))
+        return self
+
+    def done(self) -> set:
+        return {int(p.stem.split("_")[1]) for p in self.batches.glob("batch_*.h5")}
+
+    def write(self, result: dict):
+        fd, tmp = tempfile.mkstemp(dir=self.batches, suffix=".tmp")
+        os.close(fd)
+        try:
+            with h5py.File(tmp, "w") as f:
+                f["index"] = result["index"]
+                f["inputs"] = result["inputs"]
+                f["seeds"] = result["seeds"]
+                for k, v in result["outputs"].items():
+                    f[f"outputs/{k}"] = v
+            os.replace(tmp, self.batches / f"batch_{result['batch']:06d}.h5")
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+
+    def collect(self) -> dict:
+        """Every finished shot, in shot order."""
+        parts = []
+        for p in sorted(self.batches.glob("batch_*.h5")):
+            with h5py.File(p, "r") as f:
+                parts.append({"index": f["index"][()], "inputs": f["inputs"][()], "seeds": f["seeds"][()],
+                              "outputs": {k: f[f"outputs/{k}"][()] for k in f["outputs"]}})
+        if not parts:
+            return {"index": np.zeros(0, int), "inputs": np.zeros((0, len(self.study.keys))),
+                    "seeds": np.zeros(0, np.int64), "outputs": {k: np.zeros(0) for k in OUTPUTS}}
+        order = np.argsort(np.concatenate([q["index"] for q in parts]))
+        cat = lambda key: np.concatenate([q[key] for q in parts])[order]  # noqa: E731
+        return {"index": cat("index"), "inputs": cat("inputs"), "seeds": cat("seeds"),
+                "outputs": {k: np.concatenate([q["outputs"][k] for q in parts])[order] for k in OUTPUTS}}
+
+    def consolidate(self, results: dict, report: dict):
+        """DIR/study.h5: every shot's inputs, outputs and seed, and the report."""
+        path = self.folder / "study.h5"
+        fd, tmp = tempfile.mkstemp(dir=self.folder, suffix=".tmp")
+        os.close(fd)
+        with h5py.File(tmp, "w") as f:
+            f.attrs["study"] = json.dumps(self.study.spec())
+            f.attrs["report"] = json.dumps(report, default=float)
+            f["shot"] = results["index"]
+            f["seed"] = results["seeds"]
+            f["seed"].attrs["description"] = "instrument seed; inputs come from SeedSequence(study seed, spawn_key=(shot,))"
+            for k, key in enumerate(self.study.keys):
+                f[f"inputs/{key}"] = results["inputs"][:, k]
+            for k, v in results["outputs"].items():
+                f[f"outputs/{k}"] = v
+        os.replace(tmp, path)
+        return path
+
+
+def refire(study: Study, i: int) -> dict:
+    """Shot i alone, with its stored step: the same outputs as in the study."""
+    return {k: v[i - (i // study.batch) * study.batch] for k, v in run_batch(study, i // study.batch)["outputs"].items()}
