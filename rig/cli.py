@@ -340,7 +340,7 @@ def cmd_mc(args) -> dict:
         for key, s in report.get("sobol", {}).items():
             print(f"  Sobol {key}: dominant input {s['dominant']}; total "
                   + ", ".join(f"{k} {v:.2f}" for k, v in s["total"].items()))
-        print(f"  wrote study.h5, report.json, histograms.png, speed_vs_amplitude.png")
+        print("  wrote study.h5, report.json, histograms.png, speed_vs_amplitude.png")
     return report
 
 

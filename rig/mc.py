@@ -14,17 +14,15 @@ import copy
 import functools
 import hashlib
 import json
-import math
 import os
 import tempfile
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import h5py
 import numpy as np
 
 from . import scene as scene_io
-from .distributions import Distribution
 from .ensemble import ensemble_step, solve_ensemble
 from .errors import RigError, invalid
 from .measure import shot_blocks

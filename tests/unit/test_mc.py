@@ -1,0 +1,113 @@
+"""Monte Carlo studies: inputs, seeds, executors, resume, report, Sobol."""
+import json
+
+import h5py
+import numpy as np
+import pytest
+
+from rig.cli import main
+from rig.distributions import parse_vary
+from rig.executors import run_study
+from rig.mc import Store, Study, refire, run_batch
+from rig.mc_report import jcgm101
+
+VARY = ["striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)",
+        "gauges.upper.misalignment=normal(0 mm, 1 mm)", "gauges.lower.gain=normal(1, 0.05)"]
+
+
+def _study(shots=48, **kw):
+    return Study("ptfe52_magnetic", tuple(parse_vary(VARY)), shots, seed=kw.pop("seed", 3), batch=16, **kw)
+
+
+def _outputs(folder):
+    with h5py.File(folder / "study.h5") as f:
+        return {k: f["outputs"][k][()] for k in f["outputs"]}
+
+
+@pytest.mark.parametrize("spec,message", [
+    ("striker.velocity=normal(0.89 m/s, -0.01 m/s)", "standard deviation must be > 0"),
+    ("magnet.force=uniform(3 N, 2 N)", "LO < HI"),
+    ("striker.colour=normal(1, 2)", "unknown key"),
+    ("striker.mass=normal(0.47 g, 0.3 g)", "outside the allowed range"),
+    ("gauges.middle.gain=normal(1, 0.05)", "no gauge 'middle'"),
+    ("striker.velocity=normal(0.89, 0.01)", "unit is required"),
+])
+def test_bad_distributions_fail_before_any_shot(tmp_path, capsys, spec, message):
+    out = tmp_path / "study"
+    assert main(["mc", "ptfe52_magnetic", "--shots", "10", "--vary", spec, "--out", str(out), "--quiet"]) == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_identical_results_with_one_two_workers_and_dask(tmp_path):
+    pytest.importorskip("dask.distributed")
+    runs = {}
+    for name, kw in (("one", {}), ("two", {"workers": 2}), ("dask", {"scheduler": "local", "workers": 2})):
+        store = Store(tmp_path / name, _study()).open()
+        run_study(_study(), store, **kw)
+        runs[name] = store.collect()
+    for name in ("two", "dask"):
+        assert np.array_equal(runs[name]["inputs"], runs["one"]["inputs"])
+        assert np.array_equal(runs[name]["seeds"], runs["one"]["seeds"])
+        for k, v in runs["one"]["outputs"].items():
+            assert np.array_equal(runs[name]["outputs"][k], v, equal_nan=True), k
+
+
+def test_interrupted_study_keeps_finished_shots_and_resumes(tmp_path):
+    study = _study()
+    store = Store(tmp_path / "s", study).open()
+    seen = []
+
+    def interrupt(n):
+        seen.append(n)
+        if len(seen) == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_study(study, store, progress=interrupt)
+    assert store.done() == {0, 1}  # the two finished batches are on disk
+    assert run_study(study, store) == 1  # the re-run does only what is missing
+    whole = Store(tmp_path / "w", study).open()
+    run_study(study, whole)
+    for k, v in whole.collect()["outputs"].items():
+        assert np.array_equal(store.collect()["outputs"][k], v, equal_nan=True)
+
+
+def test_any_shot_refires_alone_with_the_same_result():
+    study = _study(shots=32)
+    batch = run_batch(study, 1)
+    again = refire(study, 21)
+    for k, v in again.items():
+        assert v == batch["outputs"][k][5] or (np.isnan(v) and np.isnan(batch["outputs"][k][5]))
+
+
+def test_study_inputs_follow_their_distributions():
+    study = _study(shots=64)
+    x = np.concatenate([run_batch(study, b)["inputs"] for b in range(4)])
+    v = x[:, 0]
+    assert abs(np.mean(v) - 0.89) < 4 * 0.01 / 8 and 0.006 < np.std(v) < 0.014
+
+
+def test_jcgm101_summary():
+    y = np.random.default_rng(1).normal(10.0, 2.0, 200_000)
+    r = jcgm101(y)
+    assert r["estimate"] == pytest.approx(10.0, abs=0.02) and r["std"] == pytest.approx(2.0, rel=0.01)
+    assert r["ci95"] == pytest.approx([10 - 1.96 * 2, 10 + 1.96 * 2], abs=0.05)
+    assert r["trials"] == 200_000 and r["converged"]
+    assert not jcgm101(y[:200])["converged"]  # too few trials for two significant digits
+
+
+def test_mc_command_json_and_sobol(tmp_path, capsys):
+    pytest.importorskip("SALib")
+    out = tmp_path / "sobol"
+    assert main(["mc", "ptfe52_magnetic", "--shots", "256", "--batch", "64", "--sobol",
+                 "--vary", "gauges.lower.misalignment=normal(0 mm, 1 mm)",
+                 "--vary", "gauges.upper.gain=normal(1, 0.1)", "--out", str(out), "--json", "--quiet"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["shots"] == 256 and r["shots_per_s"] > 0
+    assert set(r["speed_m_per_s"]) >= {"estimate", "std", "ci95"} and len(r["amplitude_N"]["ci95"]) == 2
+    assert r["sobol"]["speed_m_per_s"]["dominant"] == "gauges.lower.misalignment"
+    assert r["sobol"]["amplitude_N"]["dominant"] == "gauges.upper.gain"
+    for name in ("study.h5", "report.json", "histograms.png", "speed_vs_amplitude.png"):
+        assert (out / name).stat().st_size > 0
