@@ -136,8 +136,21 @@ class Chain:
         tf = self.top_force
         return isinstance(tf, ForceSchedule) or tf != 0.0
 
+    def _cached(self, name, compute):
+        """A chain does not change after construction: its static geometry is computed once
+        (a read-only array is handed out)."""
+        cache = self.__dict__.setdefault("_cache", {})
+        if name not in cache:
+            value = compute()
+            value.setflags(write=False)
+            cache[name] = value
+        return cache[name]
+
     def contact_constants(self) -> np.ndarray:
         """Hertz constants (N/m^1.5) of contacts 0..n_beads (nan where there is no partner)."""
+        return self._cached("A", self._contact_constants)
+
+    def _contact_constants(self) -> np.ndarray:
         b = self.beads
         A = np.full(self.n_beads + 1, np.nan)
         if self.striker is not None:
@@ -150,12 +163,18 @@ class Chain:
 
     def static_forces(self) -> np.ndarray:
         """Static contact forces (N) of contacts 0..n_beads: weight above plus top force."""
+        return self._cached("F0", self._static_forces)
+
+    def _static_forces(self) -> np.ndarray:
         F = np.zeros(self.n_beads + 1)
         F[1:] = self.gravity * np.cumsum(self.masses) + self.initial_top_force
         return F
 
     def static_overlaps(self) -> np.ndarray:
         """Static overlaps (m), d0 = (F/A)^(2/3); 0 where a contact carries nothing."""
+        return self._cached("d0", self._static_overlaps)
+
+    def _static_overlaps(self) -> np.ndarray:
         A = self.contact_constants()
         F = self.static_forces()
         d0 = np.zeros_like(F)
@@ -165,6 +184,9 @@ class Chain:
 
     def equilibrium_positions(self) -> np.ndarray:
         """Bead centres at equilibrium (m, down from bead 0's centre)."""
+        return self._cached("x", self._equilibrium_positions)
+
+    def _equilibrium_positions(self) -> np.ndarray:
         b = self.beads
         d0 = self.static_overlaps()
         x = np.zeros(self.n_beads)

@@ -361,7 +361,7 @@ def cmd_ls(args) -> list:
 
 
 def cmd_bench(args) -> dict:
-    if args.what in ("shot", "archive", "pipeline"):
+    if args.what in ("shot", "archive", "pipeline", "mc"):
         import importlib
 
         module = importlib.import_module(f"benchmarks.{args.what}")
@@ -441,7 +441,7 @@ def build_parser() -> argparse.ArgumentParser:
                          'gauges.NAME.gain, gauges.NAME.misalignment')
     mc.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides")
     mc.add_argument("--seed", type=int, default=0, help="the study's seed (default 0)")
-    mc.add_argument("--batch", type=int, default=64, help="shots per batch (default 64)")
+    mc.add_argument("--batch", type=int, default=128, help="shots per batch (default 128)")
     mc.add_argument("--accuracy", type=float, help="solver accuracy (default: the scene's)")
     mc.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
     mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")
@@ -474,7 +474,7 @@ def build_parser() -> argparse.ArgumentParser:
     ls.set_defaults(func=cmd_ls)
 
     be = sub.add_parser("bench", help="benchmarks")
-    be.add_argument("what", choices=["solver", "shot", "archive", "pipeline"], help="what to benchmark")
+    be.add_argument("what", choices=["solver", "shot", "archive", "pipeline", "mc"], help="what to benchmark")
     be.add_argument("--quick", action="store_true", help="fewer settings, one repeat")
     be.add_argument("--json", action="store_true", help="print JSON")
     be.set_defaults(func=cmd_bench)

@@ -46,8 +46,9 @@ def ensemble_step(problems, t_end: float, method=DEFAULT_METHOD, accuracy=None) 
 
 
 def solve_ensemble(problems: list, t_end: float, *, dt: float, method: str = DEFAULT_METHOD,
-                   width: int = 32) -> EnsembleSolution:
-    """Integrate every problem with the same step ``dt`` (s) to ``t_end`` (s)."""
+                   width: int | None = None) -> EnsembleSolution:
+    """Integrate every problem with the same step ``dt`` (s) to ``t_end`` (s). ``width``:
+    shots per chunk (default: the batch shared out over numba's threads, 8 to 64)."""
     if not problems:
         raise invalid("problems", [], "at least one shot")
     m = get_method(method)
@@ -63,6 +64,10 @@ def solve_ensemble(problems: list, t_end: float, *, dt: float, method: str = DEF
     n_steps = max(1, math.ceil(t_end / dt * (1 - 1e-12)))
     step = t_end / n_steps
     n = len(problems)
+    if width is None:
+        import numba
+
+        width = int(min(64, max(8, -(-n // numba.get_num_threads()))))
     n_chunks = -(-n // width)
     padded = problems + [problems[-1]] * (n_chunks * width - n)  # the last chunk filled up
 

@@ -40,7 +40,7 @@ class Study:
     shots: int
     seed: int = 0
     overrides: tuple = ()
-    batch: int = 64
+    batch: int = 128
     accuracy: float | None = None
     sobol: bool = False
 
