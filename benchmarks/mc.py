@@ -16,7 +16,7 @@ from rig.mc import Study, _rig_for, run_batch, shot_inputs
 VARY = ("striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)")
 
 
-def run(shots: int = 512, batch: int = 256) -> dict:
+def run(shots: int = 512, batch: int = 128) -> dict:
     study = Study("ptfe52_magnetic", tuple(parse_vary(VARY)), shots, batch=batch)
     rigs = [_rig_for(study, *shot_inputs(study, i, 52)[:2])[0] for i in range(shots)]
     problems = [r.chain.problem(r.record()) for r in rigs]
