@@ -281,8 +281,17 @@ def cmd_mc(args) -> dict:
     from .mc_report import figures, jcgm101, sobol_indices
     from .theory import solitary_wave_speed
 
-    study = Study(args.scene, tuple(parse_vary(args.vary or [])), args.shots, args.seed,
-                  tuple(args.set or ()), args.batch, args.accuracy, args.sobol)
+    dists = tuple(parse_vary(args.vary or []))
+    shots = args.shots
+    if args.sobol:
+        from .mc import sobol_shots
+
+        shots = sobol_shots(args.shots, len(dists))
+        if shots != args.shots and not args.json:
+            print(f"Sobol design over {len(dists)} inputs: {shots} shots "
+                  f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
+    study = Study(args.scene, dists, shots, args.seed, tuple(args.set or ()), args.batch, args.accuracy,
+                  args.sobol)
     if not study.dists:
         raise RigError("--vary: give at least one uncertain input, e.g. striker.velocity=\"normal(0.89 m/s, 0.01 m/s)\"")
     _, _, base = _base(study.scene, study.overrides)  # the scene must be valid before any shot
@@ -338,8 +347,8 @@ def cmd_mc(args) -> dict:
                       f"{r['ci95'][1]:.4g}]  {'stable' if r['converged'] else 'not yet stable'} "
                       f"(JCGM 101, tolerance {r['tolerance']:.2g})")
         for key, s in report.get("sobol", {}).items():
-            print(f"  Sobol {key}: dominant input {s['dominant']}; total "
-                  + ", ".join(f"{k} {v:.2f}" for k, v in s["total"].items()))
+            print(f"  Sobol {key} ({s['base_samples']} base samples): dominant input {s['dominant']}; total "
+                  + ", ".join(f"{k} {v:.2f}+-{s['total_conf95'][k]:.2f}" for k, v in s["total"].items()))
         print("  wrote study.h5, report.json, histograms.png, speed_vs_amplitude.png")
     return report
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import copy
 import functools
+import math
 import hashlib
 import json
 import os
@@ -74,6 +75,15 @@ def _base(scene: str, overrides: tuple):
     return values, text, rig
 
 
+def sobol_shots(requested: int, n_inputs: int) -> int:
+    """Shots of a Sobol design: base x (K + 2), the base the largest power of 2 that fits."""
+    base = 2 ** int(math.floor(math.log2(max(1, requested // (n_inputs + 2)))))
+    if base < 8:
+        raise invalid("--shots", requested, f"a Sobol design over {n_inputs} inputs needs at least "
+                                            f"{8 * (n_inputs + 2)} shots")
+    return base * (n_inputs + 2)
+
+
 def sobol_matrix(study: Study):
     """SALib's Sobol design for the study's inputs: (shots, K) and the SALib problem."""
     try:
@@ -82,8 +92,10 @@ def sobol_matrix(study: Study):
         raise RigError("--sobol needs SALib: pip install \".[sobol]\"") from None
     problem = {"num_vars": len(study.dists), "names": study.keys,
                "dists": [d.salib()[0] for d in study.dists], "bounds": [d.salib()[1] for d in study.dists]}
-    base = max(1, study.shots // (len(study.dists) + 2))
+    base = study.shots // (len(study.dists) + 2)
     X = sobol_sample.sample(problem, base, calc_second_order=False, seed=study.seed)
+    if X.shape[0] != study.shots:
+        raise RigError(f"a Sobol study needs base x (K + 2) shots; use {sobol_shots(study.shots, len(study.dists))}")
     return X, problem
 
 
@@ -147,7 +159,7 @@ def run_batch(study: Study, b: int) -> dict:
                             float(ens.diag[0, j]), float(ens.diag[1, j]), float(ens.diag[2, j]), study.accuracy)
         forces = {name: np.ascontiguousarray(a[:, j]) for name, a in ens.forces.items()}
         rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))
-        blocks = shot_blocks(rig, rig.fire(seed=seeds[j], draws=draws[j]))
+        blocks = shot_blocks(rig, rig.fire(seed=seeds[j], fixed=draws[j]))
         m, t = blocks["measured"], blocks["truth"]
         for key, val in (("speed_m_per_s", m["speed_m_per_s"]), ("speed_xcorr_m_per_s", m["speed_xcorr_m_per_s"]),
                          ("amplitude_N", m["amplitude_N"]), ("averaged_amplitude_N", m["averaged_amplitude_N"]),

@@ -46,9 +46,13 @@ def sobol_indices(study, X, Y) -> dict:
         Y = np.where(np.isfinite(Y), Y, np.nanmean(Y))
     s = sobol.analyze(problem, Y[: X.shape[0]], calc_second_order=False, seed=study.seed)
     names = problem["names"]
-    first = {n: float(v) for n, v in zip(names, s["S1"])}
-    total = {n: float(v) for n, v in zip(names, s["ST"])}
-    return {"first_order": first, "total": total, "dominant": max(total, key=total.get)}
+    pick = lambda key: {n: float(v) for n, v in zip(names, s[key])}  # noqa: E731
+    total = pick("ST")
+    return {"first_order": pick("S1"), "first_order_conf95": pick("S1_conf"), "total": total,
+            "total_conf95": pick("ST_conf"), "dominant": max(total, key=total.get),
+            "base_samples": int(X.shape[0] // (len(names) + 2)),
+            "note": "the instruments' own noise is not in the design and adds to every index; "
+                    "indices are trustworthy where their 95% half-widths are small"}
 
 
 def figures(folder, results, keys, theory_curve=None):

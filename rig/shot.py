@@ -238,9 +238,9 @@ class Rig:
         self._solution = solution
         self._truth_report = None
 
-    def fire(self, seed: int | None = None, draws: dict | None = None) -> ShotRecord:
+    def fire(self, seed: int | None = None, fixed: dict | None = None) -> ShotRecord:
         """One shot. ``seed`` (int) fixes every random draw; None draws a fresh one (recorded).
-        draws: {gauge name: {"gain": g, "misalignment": m}} replaces those draws (studies)."""
+        fixed: {gauge name: {"gain": g, "misalignment": m}} replaces those draws (studies)."""
         if seed is None:  # fresh, 63 bits so that it fits a signed 64-bit integer anywhere
             seed = int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(1))
         if not isinstance(seed, (int, np.integer)) or seed < 0:
@@ -251,8 +251,8 @@ class Rig:
         inputs, draws = {}, {}
         for name, (_, ch, settings) in self.gauges.items():
             draw = GaugeDraw.draw(settings, rng)
-            if draws and name in draws:
-                draw = GaugeDraw(draws[name].get("gain", draw.gain), draws[name].get("misalignment", draw.misalignment))
+            if fixed and name in fixed:
+                draw = GaugeDraw(fixed[name].get("gain", draw.gain), fixed[name].get("misalignment", draw.misalignment))
             draws[name] = {"gain": draw.gain, "misalignment_m": draw.misalignment}
             inputs[ch] = PiezoGauge(settings).read(truth.gauges[name].average_force, h, draw, rng,
                                                    truth.wave_speed_m_per_s)

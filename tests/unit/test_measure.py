@@ -74,3 +74,15 @@ def test_analyze_archive_and_a_pair_of_isf_files(tmp_path, capsys):
     (pair,) = json.loads(capsys.readouterr().out)
     assert pair["speed_m_per_s"] == pytest.approx(shot["measured"]["speed_m_per_s"], rel=1e-9)
     assert pair["averaged_amplitude_N"] == pytest.approx(shot["measured"]["averaged_amplitude_N"], rel=1e-9)
+
+
+def test_fixed_gauge_draws_take_effect():
+    # a known position error of the lower gauge changes the measured speed by distance/speed
+    rig = Rig.from_scene("ptfe52_magnetic", INSTRUMENT_ERRORS_OFF)
+    speeds = [shot_blocks(rig, rig.fire(seed=1, fixed={"lower": {"misalignment": m}}))["measured"]["speed_m_per_s"]
+              for m in (-1e-3, 0.0, 1e-3)]
+    d = rig.chain.equilibrium_positions()[29] - rig.chain.equilibrium_positions()[20]
+    assert speeds[0] > speeds[1] > speeds[2]  # a later arrival reads as a slower wave
+    assert speeds[1] / speeds[2] - 1 == pytest.approx(1e-3 / d, rel=0.05)
+    shot = rig.fire(seed=1, fixed={"upper": {"gain": 1.2}})
+    assert shot.draws["upper"]["gain"] == 1.2
