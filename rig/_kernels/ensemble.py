@@ -16,13 +16,18 @@ from .integrators import _hermite
 
 
 @njit(cache=True, fastmath=False)
+def _contact_row(u, A, d0, load, f, i):
+    """Dynamic force of contact slot i for every shot: A d^(3/2) - load (integrators.py)."""
+    for s in range(u.shape[1]):
+        d = d0[i, s] + u[i - 1, s] - u[i, s]
+        d = d if d > 0.0 else 0.0
+        f[i, s] = A[i, s] * d * math.sqrt(d) - load[i, s]
+
+
+@njit(cache=True, fastmath=False)
 def _forces(u, A, d0, load, f):
-    nb = u.shape[0]
-    for i in range(1, nb):
-        for s in range(u.shape[1]):
-            d = d0[i, s] + u[i - 1, s] - u[i, s]
-            d = d if d > 0.0 else 0.0
-            f[i, s] = A[i, s] * d * math.sqrt(d) - load[i, s]
+    for i in range(1, u.shape[0]):
+        _contact_row(u, A, d0, load, f, i)
 
 
 @njit(cache=True, fastmath=False)
@@ -45,10 +50,7 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha):
             v[i, s] = vi
             u[i, s] += ha * vi
         if i >= 1:
-            for s in range(u.shape[1]):
-                d = d0[i, s] + u[i - 1, s] - u[i, s]
-                d = d if d > 0.0 else 0.0
-                f[i, s] = A[i, s] * d * math.sqrt(d) - load[i, s]
+            _contact_row(u, A, d0, load, f, i)
 
 
 @njit(cache=True, fastmath=False)

@@ -1,0 +1,1 @@
+"""The implementations of the `rig` subcommands (rig/cli.py parses the arguments)."""
