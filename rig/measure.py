@@ -17,6 +17,7 @@ import numpy as np
 from instruments.analysis import PeakRules
 from instruments.pipeline import GaugeSetup, Report, Setup, analyze_forces, analyze_record
 
+from .errors import RigError
 from .theory import solitary_wave_speed, sound_speed
 
 
@@ -24,7 +25,7 @@ def setup_for(rig, beta: float = 1.0, static_force: float = 0.0, nominal: bool =
     """The analysis Setup of a rig's gauges (upper = the higher of the first two)."""
     gauges = sorted(rig.gauges.items(), key=lambda kv: kv[1][0])
     if len(gauges) < 2:
-        raise ValueError("the analysis needs two gauge beads")
+        raise RigError("the analysis needs two gauge beads in the scene")
     x = rig.chain.equilibrium_positions()
     (_, (j1, ch1, s1)), (_, (j2, ch2, s2)) = gauges[0], gauges[1]
     wall = None
@@ -89,7 +90,9 @@ def theory_block(rig, truth: Report) -> dict:
 
 
 def shot_blocks(rig, shot) -> dict:
-    """{"truth", "measured", "theory"} for `rig shot --json`."""
+    """{"truth", "measured", "theory"} for `rig shot --json` (None without two gauges)."""
+    if len(rig.gauges) < 2:
+        return {"truth": None, "measured": None, "theory": None}
     truth = rig.truth_analysis()
     measured = measured_report(rig, shot, truth)
     keys = ("speed_m_per_s", "amplitude_N", "averaged_amplitude_N", "beta", "static_force_N",

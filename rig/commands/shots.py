@@ -82,15 +82,10 @@ def print_shot(out: dict):
               f"{c['volts_per_div'] * 1e3:g} mV/div, {c['min_V']:+.3f} .. {c['max_V']:+.3f} V"
               f"{'  CLIPPED' if c['clipped'] else ''}")
     t, m, th = out["truth"], out["measured"], out["theory"]
-    fmt = lambda v, scale=1.0, spec=".1f": "-" if v is None else format(v * scale, spec)  # noqa: E731
-    print(f"  {'':10s} {'speed m/s':>10s} {'F_d N':>8s} {'F_m,e N':>8s} {'beta':>6s} {'pulses':>6s} {'FWHM us':>8s}")
-    for label, r in (("truth", t), ("measured", m)):
-        print(f"  {label:10s} {fmt(r['speed_m_per_s']):>10s} {fmt(r['amplitude_N'], 1, '.3f'):>8s} "
-              f"{fmt(r['averaged_amplitude_N'], 1, '.3f'):>8s} {fmt(r['beta'], 1, '.3f'):>6s} "
-              f"{fmt(r['pulses'], 1, '.0f'):>6s} {fmt(r['duration_s'], 1e6):>8s}")
-    print(f"  theory     c0 = {fmt(th['sound_speed_m_per_s'])} m/s (Eq 2), "
-          f"Eq (1) at the truth amplitude: {fmt(th['speed_m_per_s'])} m/s; "
-          f"cross-correlation speed {fmt(m['speed_xcorr_m_per_s'])} m/s")
+    if t is None:
+        print("  (speeds and amplitudes need two gauge beads)")
+    else:
+        _print_blocks(t, m, th)
     for path in out.get("exported", []):
         print(f"  wrote {path}")
     if "archived" in out:
@@ -237,3 +232,16 @@ def cmd_mc(args) -> dict:
     return report
 
 
+
+
+def _print_blocks(t, m, th):
+    """The truth / measured / theory rows of a shot's summary."""
+    fmt = lambda v, scale=1.0, spec=".1f": "-" if v is None else format(v * scale, spec)  # noqa: E731
+    print(f"  {'':10s} {'speed m/s':>10s} {'F_d N':>8s} {'F_m,e N':>8s} {'beta':>6s} {'pulses':>6s} {'FWHM us':>8s}")
+    for label, r in (("truth", t), ("measured", m)):
+        print(f"  {label:10s} {fmt(r['speed_m_per_s']):>10s} {fmt(r['amplitude_N'], 1, '.3f'):>8s} "
+              f"{fmt(r['averaged_amplitude_N'], 1, '.3f'):>8s} {fmt(r['beta'], 1, '.3f'):>6s} "
+              f"{fmt(r['pulses'], 1, '.0f'):>6s} {fmt(r['duration_s'], 1e6):>8s}")
+    print(f"  theory     c0 = {fmt(th['sound_speed_m_per_s'])} m/s (Eq 2), "
+          f"Eq (1) at the truth amplitude: {fmt(th['speed_m_per_s'])} m/s; "
+          f"cross-correlation speed {fmt(m['speed_xcorr_m_per_s'])} m/s")

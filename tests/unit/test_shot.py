@@ -138,3 +138,16 @@ def test_quantity_without_unit_in_a_scene_file(tmp_path):
     bad.write_text(text.replace('diameter = "4.76 mm"', "diameter = 4.76"))
     with pytest.raises(ValueError, match=r"chain\.diameter.*unit is required"):
         Rig.from_scene(bad)
+
+
+def test_a_scene_with_the_wall_sensor_alone(tmp_path, capsys):
+    text = (SCENARIO_ROOT / "daraio2006" / "steel21_gravity.toml").read_text()
+    head, _, rest = text.partition("[gauges.upper]")
+    scope = rest[rest.index("[scope]"):]
+    scene = tmp_path / "wall_only.toml"
+    scene.write_text(head + scope.replace('source = "CH1"', 'source = "CH3"'))
+    assert main(["shot", str(scene), "--seed", "1", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["triggered"] and out["truth"] is None and out["channels"]["CH3"]["connected"] == "wall_sensor"
+    assert main(["shot", str(scene), "--seed", "1"]) == 0
+    assert "two gauge beads" in capsys.readouterr().out
