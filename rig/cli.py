@@ -75,6 +75,7 @@ def build_parser() -> argparse.ArgumentParser:
     mc.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
     mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")
     mc.add_argument("--sobol", action="store_true", help="Sobol design and indices (needs SALib)")
+    mc.add_argument("--truth", action="store_true", help="also analyse each shot's noise-free truth (slower)")
     mc.add_argument("--out", required=True, metavar="DIR")
     mc.add_argument("--quiet", action="store_true", help="no progress bar")
 

@@ -26,7 +26,9 @@ import numpy as np
 from . import scene as scene_io
 from .ensemble import ensemble_step, solve_ensemble
 from .errors import RigError, invalid
-from .measure import shot_blocks
+from instruments.pipeline import analyze_record
+
+from .measure import midway_static_force, setup_for
 from .shot import Rig
 from .solution import Solution, SolverStats
 
@@ -44,6 +46,7 @@ class Study:
     batch: int = 128
     accuracy: float | None = None
     sobol: bool = False
+    truth: bool = False  # also analyse each shot's noise-free truth (slower)
 
     def __post_init__(self):
         if not isinstance(self.shots, int) or self.shots < 1:
@@ -58,7 +61,7 @@ class Study:
     def spec(self) -> dict:
         return {"scene": str(self.scene), "dists": [asdict(d) for d in self.dists], "shots": self.shots,
                 "seed": self.seed, "overrides": list(self.overrides), "batch": self.batch,
-                "accuracy": self.accuracy, "sobol": self.sobol}
+                "accuracy": self.accuracy, "sobol": self.sobol, "truth": self.truth}
 
     def digest(self) -> str:
         return hashlib.sha256(json.dumps(self.spec(), sort_keys=True).encode()).hexdigest()[:16]
@@ -73,6 +76,14 @@ def _base(scene: str, overrides: tuple):
     values, text = scene_io.load(scene, overrides)
     rig = Rig(values, text, overrides)  # validates
     return values, text, rig
+
+
+@functools.lru_cache(maxsize=4)
+def nominal_calibration(scene: str, overrides: tuple) -> tuple:
+    """(beta, F_0 in N) of the nominal scene's numerics: what an experimenter applies to
+    every shot of a study (each shot's own truth is unknown to the analysis)."""
+    _, _, rig = _base(scene, overrides)
+    return rig.truth_analysis().beta, midway_static_force(rig)
 
 
 def sobol_shots(requested: int, n_inputs: int) -> int:
@@ -154,16 +165,18 @@ def run_batch(study: Study, b: int) -> dict:
     dt = ensemble_step(problems, t_end, base.solver["method"], study.accuracy or base.solver["accuracy"])
     ens = solve_ensemble(problems, t_end, dt=dt, method=base.solver["method"])
     out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
+    beta, F0 = nominal_calibration(study.scene, tuple(study.overrides))
     for j, (rig, p) in enumerate(zip(rigs, problems)):
         stats = SolverStats(base.solver["method"], ens.dt, ens.steps, ens.steps * 6, ens.wall_s / len(rigs),
                             float(ens.diag[0, j]), float(ens.diag[1, j]), float(ens.diag[2, j]), study.accuracy)
         forces = {name: np.ascontiguousarray(a[:, j]) for name, a in ens.forces.items()}
         rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))
-        blocks = shot_blocks(rig, rig.fire(seed=seeds[j], fixed=draws[j]))
-        m, t = blocks["measured"], blocks["truth"]
-        for key, val in (("speed_m_per_s", m["speed_m_per_s"]), ("speed_xcorr_m_per_s", m["speed_xcorr_m_per_s"]),
-                         ("amplitude_N", m["amplitude_N"]), ("averaged_amplitude_N", m["averaged_amplitude_N"]),
-                         ("truth_speed_m_per_s", t["speed_m_per_s"]), ("truth_amplitude_N", t["amplitude_N"]),
+        shot = rig.fire(seed=seeds[j], fixed=draws[j], truth=False)
+        m = analyze_record(shot.scope, setup_for(rig, beta, F0))
+        t = rig.truth_analysis() if study.truth else None
+        for key, val in (("speed_m_per_s", m.speed_m_per_s), ("speed_xcorr_m_per_s", m.speed_xcorr_m_per_s),
+                         ("amplitude_N", m.amplitude_N), ("averaged_amplitude_N", m.averaged_amplitude_N),
+                         ("truth_speed_m_per_s", t and t.speed_m_per_s), ("truth_amplitude_N", t and t.amplitude_N),
                          ("energy_error", stats.energy_error), ("dt_s", ens.dt)):
             out[key][j] = np.nan if val is None else val
     return {"batch": b, "index": np.arange(lo, hi), "inputs": np.array(xs, dtype=float).reshape(hi - lo, len(study.keys)),

@@ -238,35 +238,36 @@ class Rig:
         self._solution = solution
         self._truth_report = None
 
-    def fire(self, seed: int | None = None, fixed: dict | None = None) -> ShotRecord:
+    def fire(self, seed: int | None = None, fixed: dict | None = None, truth: bool = True) -> ShotRecord:
         """One shot. ``seed`` (int) fixes every random draw; None draws a fresh one (recorded).
-        fixed: {gauge name: {"gain": g, "misalignment": m}} replaces those draws (studies)."""
+        fixed: {gauge name: {"gain": g, "misalignment": m}} replaces those draws (studies);
+        truth=False skips the analysis of the noise-free truth (studies that do not need it)."""
         if seed is None:  # fresh, 63 bits so that it fits a signed 64-bit integer anywhere
             seed = int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(1))
         if not isinstance(seed, (int, np.integer)) or seed < 0:
             raise invalid("seed", seed, "a whole number >= 0")
         rng = np.random.default_rng(int(seed))
-        truth = self.truth()
-        h = truth.sample_interval
+        forces = self.truth()
+        h = forces.sample_interval
         inputs, draws = {}, {}
         for name, (_, ch, settings) in self.gauges.items():
             draw = GaugeDraw.draw(settings, rng)
             if fixed and name in fixed:
                 draw = GaugeDraw(fixed[name].get("gain", draw.gain), fixed[name].get("misalignment", draw.misalignment))
             draws[name] = {"gain": draw.gain, "misalignment_m": draw.misalignment}
-            inputs[ch] = PiezoGauge(settings).read(truth.gauges[name].average_force, h, draw, rng,
-                                                   truth.wave_speed_m_per_s)
+            inputs[ch] = PiezoGauge(settings).read(forces.gauges[name].average_force, h, draw, rng,
+                                                   forces.wave_speed_m_per_s)
         if self.wall_sensor is not None:
             draw = GaugeDraw.draw(self.wall_sensor, rng)
             draws["wall_sensor"] = {"gain": draw.gain}
-            inputs[self.wall_channel] = PiezoGauge(self.wall_sensor).read(truth.wall_force, h, draw, rng)
+            inputs[self.wall_channel] = PiezoGauge(self.wall_sensor).read(forces.wall_force, h, draw, rng)
         try:
             record = self.scope.acquire(inputs, h, rng)
         except ValueError as exc:
             raise RigError(f"{exc} (solver.duration = {self.solver['duration']:g} s)") from None
-        truth_analysis = self.truth_analysis().as_dict() if len(self.gauges) >= 2 else None
+        truth_analysis = self.truth_analysis().as_dict() if truth and len(self.gauges) >= 2 else None
         return ShotRecord(self.name, self.scene_text, self.overrides, int(seed), self.values, record,
-                          truth, self.solution().stats, draws, truth_analysis)
+                          forces, self.solution().stats, draws, truth_analysis)
 
 
 def _wave_speed(gauges: dict, h: float) -> float | None:
