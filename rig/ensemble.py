@@ -21,8 +21,8 @@ from .stepsize import DEFAULT_ACCURACY, accuracy_step, stability_limit
 
 @dataclass(frozen=True, eq=False)
 class EnsembleSolution:
-    """forces: {probe: (samples, shots) array (N)}; diag: (6, shots) as SolverStats fields
-    (energy error, momentum error, wall impulse, status, steps, end time)."""
+    """forces: {probe: (shots, samples) array (N), each shot's row contiguous}; diag: (6, shots)
+    as SolverStats fields (energy error, momentum error, wall impulse, status, steps, end time)."""
 
     forces: dict
     sample_interval: float
@@ -78,7 +78,7 @@ def solve_ensemble(problems: list, t_end: float, *, dt: float, method: str = DEF
     stack = lambda name: blocks([getattr(p, name) for p in padded])  # noqa: E731
     rec = p0.record
     n_out = int(math.floor(t_end / rec.sample_interval * (1 + 1e-12))) + 1
-    out = np.zeros((n_chunks, len(p0.ch_names), n_out, width))
+    out = np.zeros((n_chunks, width, len(p0.ch_names), n_out))
     diag = np.zeros((n_chunks, 6, width))
     u, v = stack("u0"), stack("v0")
     t0 = time.perf_counter()
@@ -89,10 +89,11 @@ def solve_ensemble(problems: list, t_end: float, *, dt: float, method: str = DEF
                        blocks([p.energy_scale for p in padded]), blocks([p.momentum_scale for p in padded]),
                        diag)
     wall = time.perf_counter() - t0
-    out = np.moveaxis(out, 0, -2).reshape(out.shape[1], n_out, n_chunks * width)[..., :n]
+    out = out.reshape(n_chunks * width, len(p0.ch_names), n_out)[:n]  # a view: (shots, channels, samples)
     diag = np.moveaxis(diag, 0, -2).reshape(6, n_chunks * width)[:, :n]
     if np.any(diag[3] != 0):
         bad = np.flatnonzero(diag[3] != 0)
         raise RigError(f"the integration became unstable for shot(s) {bad.tolist()[:10]} "
                        f"(dt = {step:.4g} s): use a tighter accuracy")
-    return EnsembleSolution(dict(zip(p0.ch_names, out)), rec.sample_interval, step, n_steps, wall, diag)
+    return EnsembleSolution({name: out[:, c] for c, name in enumerate(p0.ch_names)}, rec.sample_interval,
+                            step, n_steps, wall, diag)

@@ -169,7 +169,7 @@ def run_batch(study: Study, b: int) -> dict:
     for j, (rig, p) in enumerate(zip(rigs, problems)):
         stats = SolverStats(base.solver["method"], ens.dt, ens.steps, ens.steps * 6, ens.wall_s / len(rigs),
                             float(ens.diag[0, j]), float(ens.diag[1, j]), float(ens.diag[2, j]), study.accuracy)
-        forces = {name: np.ascontiguousarray(a[:, j]) for name, a in ens.forces.items()}
+        forces = {name: a[j] for name, a in ens.forces.items()}
         rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))
         shot = rig.fire(seed=seeds[j], fixed=draws[j], truth=False)
         m = analyze_record(shot.scope, setup_for(rig, beta, F0))

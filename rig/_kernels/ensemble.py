@@ -107,7 +107,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps,
     W = u.shape[1]
     n_drift = a_coef.shape[0]
     n_ch = ch_slot.shape[0]
-    n_out = out.shape[1]
+    n_out = out.shape[2]
     for s in range(u.shape[1]):
         f[0, s] = 0.0
         f[nb, s] = -load[nb, s]
@@ -124,7 +124,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps,
     if n_out > 0:
         for c in range(n_ch):
             for s in range(u.shape[1]):
-                out[c, 0, s] = y_old[c, s]
+                out[s, c, 0] = y_old[c, s]
     j_out = 1
     pending = 0.0
     for n in range(n_steps):
@@ -152,7 +152,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps,
             x = (j_out * sample_dt - t) / dt
             for c in range(n_ch):
                 for s in range(u.shape[1]):
-                    out[c, j_out, s] = _hermite(x, dt, y_old[c, s], r_old[c, s], y_new[c, s], r_new[c, s])
+                    out[s, c, j_out] = _hermite(x, dt, y_old[c, s], r_old[c, s], y_new[c, s], r_new[c, s])
             j_out += 1
         for c in range(n_ch):
             for s in range(u.shape[1]):
@@ -182,7 +182,8 @@ def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, 
                        ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
                        e_ref, p_ref, diag):
     """Integrate every shot of the (chunks, bodies, width) arrays in place; out is
-    (chunks, channels, samples, width), diag (chunks, 6, width) as in the single-shot kernel."""
+    (chunks, width, channels, samples) so that each shot's record is contiguous; diag is
+    (chunks, 6, width) as in the single-shot kernel."""
     n_chunks, nb, W = u.shape
     n_ch = ch_slot.shape[0]
     for k in prange(n_chunks):
