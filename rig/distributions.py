@@ -20,7 +20,7 @@ import numpy as np
 from scipy import stats
 
 from .errors import invalid
-from .scene import SCHEMA
+from .scene import schema_node
 from .units import quantity
 
 EXTRA_KEYS = {"chain.bead_mass": "kg", "chain.youngs_modulus": "Pa", "chain.poisson_ratio": float}
@@ -38,11 +38,10 @@ def key_unit(key: str):
     parts = key.split(".")
     if len(parts) == 3 and parts[0] == "gauges" and parts[2] in GAUGE_KEYS:
         return GAUGE_KEYS[parts[2]]
-    node = SCHEMA
-    for p in parts:
-        if not isinstance(node, dict) or (p not in node and "*" not in node):
-            raise invalid("--vary", key, "unknown key")
-        node = node.get(p, node.get("*"))
+    try:
+        node = schema_node(key)
+    except KeyError:
+        raise invalid("--vary", key, "unknown key") from None
     if node not in (float, int) and not isinstance(node, str):
         raise invalid("--vary", key, "only numeric keys can be uncertain")
     return float if node in (float, int) else node

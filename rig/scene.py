@@ -88,19 +88,28 @@ def _override(raw: dict, item: str):
     node[parts[-1]] = _typed(value, spec, key)
 
 
-def _spec_for(parts):
+def schema_node(key: str):
+    """The SCHEMA entry of a dotted key: a type, a unit string, or a table (dict).
+    KeyError(i) names the first part of the key that the schema does not know."""
     node = SCHEMA
-    for i, p in enumerate(parts):
-        if not isinstance(node, dict):
-            break
-        sub = node.get(p, node.get("*"))
-        if sub is None:
-            where = ".".join(parts[:i]) or "the scene"
-            raise invalid("scene key", ".".join(parts),
-                          f"unknown key; known in {where}: {', '.join(k for k in node if k != '*')}")
-        node = sub
+    for i, p in enumerate(key.split(".")):
+        if not isinstance(node, dict) or (p not in node and "*" not in node):
+            raise KeyError(i)
+        node = node.get(p, node.get("*"))
+    return node
+
+
+def _spec_for(parts):
+    key = ".".join(parts)
+    try:
+        node = schema_node(key)
+    except KeyError as exc:
+        where = ".".join(parts[:exc.args[0]])
+        parent = schema_node(where) if where else SCHEMA
+        known = ", ".join(k for k in parent if k != "*") if isinstance(parent, dict) else "none"
+        raise invalid("scene key", key, f"unknown key; known in {where or 'the scene'}: {known}") from None
     if isinstance(node, dict):
-        raise invalid("scene key", ".".join(parts), "is a table; set one of its keys")
+        raise invalid("scene key", key, "is a table; set one of its keys")
     return node
 
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from .errors import RigError, invalid
 from .measure import shot_blocks
-from .scene import SCHEMA
+from .scene import schema_node
 from .shot import Rig, ShotRecord
 
 
@@ -52,11 +52,10 @@ class Vary:
 
 
 def _unit_of(key: str):
-    node = SCHEMA
-    for p in key.split("."):
-        if not isinstance(node, dict) or (p not in node and "*" not in node):
-            raise invalid("--vary", key, "unknown scene key")
-        node = node.get(p, node.get("*"))
+    try:
+        node = schema_node(key)
+    except KeyError:
+        raise invalid("--vary", key, "unknown scene key") from None
     if isinstance(node, dict):
         raise invalid("--vary", key, "is a table; vary one of its keys")
     if node in (float, int):
