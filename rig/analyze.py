@@ -12,7 +12,7 @@ from pathlib import Path
 
 from instruments.analysis import PeakRules
 from instruments.archive import Archive
-from instruments.formats import READERS
+from instruments.formats import read_record
 from instruments.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.records import ScopeRecord
 
@@ -34,21 +34,9 @@ def analyze_paths(args) -> list:
             setup = _setup_from_entry(entry) if entry.simulated else _setup_from_flags(args, entry.record)
             results.append(_result(f"{a}#{i}", entry.record, setup, args, entry))
     if files:
-        record = _read_files(files)
+        record = read_record(files)
         results.append(_result(", ".join(map(str, files)), record, _setup_from_flags(args, record), args))
     return results
-
-
-def _read_files(files) -> ScopeRecord:
-    waves = {}
-    for path in files:
-        reader = READERS.get(path.suffix.lower())
-        if reader is None:
-            raise RigError(f"{path}: cannot analyze {path.suffix or 'extensionless'} files "
-                           f"(known: .isf, .csv, .h5)")
-        for w in reader(path):
-            waves[w.channel if w.channel not in waves else f"{w.channel}@{path.stem}"] = w
-    return ScopeRecord(waves, True)
 
 
 def _setup_from_entry(entry) -> Setup:

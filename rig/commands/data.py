@@ -1,7 +1,6 @@
 """`rig verify`, `rig import`, `rig analyze` and `rig ls`."""
 from __future__ import annotations
 
-from ..errors import RigError
 
 
 def cmd_verify(args) -> dict:
@@ -22,24 +21,13 @@ def cmd_import(args) -> dict:
     from pathlib import Path
 
     from instruments.archive import Archive, Entry
-    from instruments.formats import READERS
-    from instruments.records import ScopeRecord
+    from instruments.formats import read_record
 
     groups = [args.files] if args.together else [[f] for f in args.files]
     entries = []
     for files in groups:
-        waves = {}
-        for name in files:
-            path = Path(name)
-            reader = READERS.get(path.suffix.lower())
-            if reader is None:
-                raise RigError(f"{path}: cannot import {path.suffix or 'extensionless'} files "
-                               f"(known: {', '.join(READERS)})")
-            for w in reader(path):
-                key = w.channel if w.channel not in waves else f"{w.channel}@{path.stem}"
-                waves[key] = w
         mtime = min(Path(f).stat().st_mtime for f in files)
-        entries.append(Entry(ScopeRecord(waves, True), False, scene="",
+        entries.append(Entry(read_record(files), False, scene="",
                              settings={"source_files": [str(Path(f).resolve().name) for f in files]},
                              start_time=datetime.fromtimestamp(mtime, timezone.utc).isoformat()))
     ids = Archive(args.into).append(entries)
