@@ -125,15 +125,22 @@ def analyze_forces(t: np.ndarray, forces: dict, setup: Setup) -> Report:
     rep.duration_s = up.fwhm
     rep.base_duration_s = up.base_width
     rep.width_diameters = up.fwhm * rep.speed_m_per_s / setup.bead_diameter_m
-    cut = _reflection_time(t, forces, setup, low, rep.speed_m_per_s)
-    train = find_pulses(t, forces["lower"], rules, floor=0.05 * low.amplitude, refine=False)
-    rep.pulses = sum(1 for p in train if low.time - 0.5 * low.fwhm <= p.time < cut)
+    cut = reflection_time(t, forces, setup, low, rep.speed_m_per_s)
+    rep.pulses = len(solitary_train(t, forces["lower"], low, cut, rules))
     rep.leading = {"upper": asdict(up), "lower": asdict(low)}
     return rep
 
 
-def _reflection_time(t, forces, setup: Setup, low, speed) -> float:
-    """When the wall's reflection of the leading pulse reaches the lower gauge, less one FWHM."""
+def solitary_train(t, f, lead, cut: float, rules: PeakRules = PeakRules(), refine: bool = False) -> list:
+    """The solitary waves of a train at one gauge: pulses above 5% of the leading one, from
+    the leading one until ``cut`` (s; when the wall's reflection arrives)."""
+    train = find_pulses(t, f, rules, floor=0.05 * lead.amplitude, refine=refine)
+    return [p for p in train if lead.time - 0.5 * lead.fwhm <= p.time < cut]
+
+
+def reflection_time(t, forces, setup: Setup, low, speed) -> float:
+    """When the wall's reflection of the leading pulse ``low`` reaches its gauge, less one
+    FWHM (from the wall channel if there is one, else from the wall distance)."""
     if "wall" in forces:
         wall = leading(find_pulses(t, forces["wall"], setup.rules, refine=False), setup.rules)
         if wall is not None and wall.time > low.time:

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from instruments.analysis import PeakRules, find_pulses, leading
-from instruments.pipeline import record_forces
+from instruments.pipeline import record_forces, reflection_time, solitary_train
 
 from . import figures
 from .errors import invalid
@@ -152,10 +152,8 @@ def _counts(rig: Rig, role: str) -> tuple:
     f = g.average_force - g.average_force[0]
     t = np.arange(f.size) * truth.sample_interval
     lead = leading(find_pulses(t, f, PeakRules()))
-    wall = truth.wall_force - truth.wall_force[0]
-    t_wall = leading(find_pulses(t, wall, PeakRules())).time
-    cut = 2 * t_wall - lead.time - lead.fwhm
-    train = [p for p in find_pulses(t, f, PeakRules(), floor=0.05 * lead.amplitude) if lead.time <= p.time < cut]
+    cut = reflection_time(t, {"wall": truth.wall_force - truth.wall_force[0]}, setup, lead, math.nan)
+    train = solitary_train(t, f, lead, cut, PeakRules(), refine=True)
     gap = train[1].time - train[0].time if len(train) > 1 else math.nan
     return len(train), gap
 
