@@ -6,7 +6,6 @@ shot's result never depends on which other shots share its batch: a shot solved 
 """
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass
 
@@ -15,8 +14,8 @@ import numpy as np
 from ._kernels.ensemble import integrate_ensemble
 from .errors import RigError, invalid
 from .methods import DEFAULT_METHOD, method as get_method
-from .solve import MAX_CHECKS
-from .stepsize import DEFAULT_ACCURACY, accuracy_step, stability_limit
+from .solve import MAX_CHECKS, time_grid
+from .stepsize import DEFAULT_ACCURACY, default_step
 
 
 @dataclass(frozen=True, eq=False)
@@ -42,7 +41,7 @@ def ensemble_step(problems, t_end: float, method=DEFAULT_METHOD, accuracy=None) 
     acc = DEFAULT_ACCURACY if accuracy is None else accuracy
     if not problems:
         raise invalid("problems", [], "at least one shot")
-    return min(min(accuracy_step(p, m, acc), 0.5 * stability_limit(p, m)) for p in problems)
+    return min(default_step(p, m, acc) for p in problems)
 
 
 def solve_ensemble(problems: list, t_end: float, *, dt: float, method: str = DEFAULT_METHOD,
@@ -61,8 +60,8 @@ def solve_ensemble(problems: list, t_end: float, *, dt: float, method: str = DEF
             raise RigError("the batched kernel takes conservative chains with constant loads only")
     if not (t_end > 0 and dt > 0):
         raise invalid("t_end/dt", (t_end, dt), "both > 0 s")
-    n_steps = max(1, math.ceil(t_end / dt * (1 - 1e-12)))
-    step = t_end / n_steps
+    rec = p0.record
+    n_steps, step, n_out = time_grid(t_end, dt, rec.sample_interval)
     n = len(problems)
     if width is None:
         import numba
@@ -76,8 +75,6 @@ def solve_ensemble(problems: list, t_end: float, *, dt: float, method: str = DEF
         return np.ascontiguousarray(np.moveaxis(a.reshape(a.shape[:-1] + (n_chunks, width)), -2, 0))
 
     stack = lambda name: blocks([getattr(p, name) for p in padded])  # noqa: E731
-    rec = p0.record
-    n_out = int(math.floor(t_end / rec.sample_interval * (1 + 1e-12))) + 1
     out = np.zeros((n_chunks, width, len(p0.ch_names), n_out))
     diag = np.zeros((n_chunks, 6, width))
     u, v = stack("u0"), stack("v0")

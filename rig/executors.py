@@ -20,14 +20,13 @@ def run_study(study: Study, store: Store, workers: int = 1, scheduler: str | Non
               progress=None) -> int:
     """Run the batches not yet stored; returns how many batches ran."""
     todo = [b for b in range(study.n_batches) if b not in store.done()]
-    size = lambda b: min(study.shots, (b + 1) * study.batch) - b * study.batch  # noqa: E731
     tick = progress or (lambda n: None)
     if scheduler:
-        return _dask(study, store, todo, scheduler, workers, tick, size)
+        return _dask(study, store, todo, scheduler, workers, tick)
     if workers <= 1:
         for b in todo:
             store.write(run_batch(study, b))
-            tick(size(b))
+            tick(len(study.shots_of(b)))
         return len(todo)
     ctx = multiprocessing.get_context("spawn")  # numba's threads and fork do not mix
     with cf.ProcessPoolExecutor(workers, mp_context=ctx, initializer=_one_thread) as pool:
@@ -35,7 +34,7 @@ def run_study(study: Study, store: Store, workers: int = 1, scheduler: str | Non
         try:
             for fut in cf.as_completed(futures):
                 store.write(fut.result())
-                tick(size(futures[fut]))
+                tick(len(study.shots_of(futures[fut])))
         except BaseException:
             for fut in futures:
                 fut.cancel()
@@ -43,7 +42,7 @@ def run_study(study: Study, store: Store, workers: int = 1, scheduler: str | Non
     return len(todo)
 
 
-def _dask(study, store, todo, scheduler, workers, tick, size):
+def _dask(study, store, todo, scheduler, workers, tick):
     try:
         from dask.distributed import Client, LocalCluster, as_completed
     except ImportError:

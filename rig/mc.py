@@ -26,6 +26,7 @@ import numpy as np
 from . import scene as scene_io
 from .ensemble import ensemble_step, solve_ensemble
 from .errors import RigError, invalid
+from .methods import method as get_method
 from instruments.pipeline import analyze_record
 
 from .measure import midway_static_force, setup_for
@@ -70,6 +71,10 @@ class Study:
     def n_batches(self) -> int:
         return -(-self.shots // self.batch)
 
+    def shots_of(self, b: int) -> range:
+        """The shots of batch b: shot i always belongs to batch i // batch."""
+        return range(b * self.batch, min(self.shots, (b + 1) * self.batch))
+
 
 @functools.lru_cache(maxsize=4)
 def _base(scene: str, overrides: tuple):
@@ -95,6 +100,7 @@ def sobol_shots(requested: int, n_inputs: int) -> int:
     return base * (n_inputs + 2)
 
 
+@functools.lru_cache(maxsize=4)
 def sobol_matrix(study: Study):
     """SALib's Sobol design for the study's inputs: (shots, K) and the SALib problem."""
     try:
@@ -145,7 +151,8 @@ def _rig_for(study: Study, x: dict, masses) -> tuple:
 
 def run_batch(study: Study, b: int) -> dict:
     """Batch b of the study: inputs, outputs and seeds of its shots (plain arrays)."""
-    lo, hi = b * study.batch, min(study.shots, (b + 1) * study.batch)
+    shots = study.shots_of(b)
+    lo, hi = shots.start, shots.stop
     _, _, base = _base(study.scene, tuple(study.overrides))
     n_plain = base.values["chain"]["beads"]
     design = sobol_matrix(study)[0] if study.sobol else None
@@ -167,7 +174,8 @@ def run_batch(study: Study, b: int) -> dict:
     out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
     beta, F0 = nominal_calibration(study.scene, tuple(study.overrides))
     for j, (rig, p) in enumerate(zip(rigs, problems)):
-        stats = SolverStats(base.solver["method"], ens.dt, ens.steps, ens.steps * 6, ens.wall_s / len(rigs),
+        stats = SolverStats(base.solver["method"], ens.dt, ens.steps,
+                            ens.steps * get_method(base.solver["method"]).force_evaluations, ens.wall_s / len(rigs),
                             float(ens.diag[0, j]), float(ens.diag[1, j]), float(ens.diag[2, j]), study.accuracy)
         forces = {name: a[j] for name, a in ens.forces.items()}
         rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))

@@ -11,9 +11,16 @@ from .errors import RigError, invalid
 from .methods import DEFAULT_METHOD, method as get_method
 from .problem import ChainProblem
 from .solution import Solution, SolverStats
-from .stepsize import DEFAULT_ACCURACY, accuracy_step, stability_limit
+from .stepsize import DEFAULT_ACCURACY, default_step, stability_limit
 
 MAX_CHECKS = 200  # energy / momentum / blow-up checks per solve (each one O(N))
+
+
+def time_grid(t_end: float, dt: float, sample_interval: float) -> tuple:
+    """(steps, step, output samples): whole steps of at most dt (s) that end exactly at t_end,
+    and the output grid t = j * sample_interval up to t_end."""
+    n_steps = max(1, math.ceil(t_end / dt * (1 - 1e-12)))
+    return n_steps, t_end / n_steps, int(math.floor(t_end / sample_interval * (1 + 1e-12))) + 1
 
 
 def solve(problem: ChainProblem, t_end: float, *, method: str = DEFAULT_METHOD,
@@ -43,12 +50,9 @@ def solve(problem: ChainProblem, t_end: float, *, method: str = DEFAULT_METHOD,
         accuracy = DEFAULT_ACCURACY if accuracy is None else accuracy
         if not (isinstance(accuracy, (int, float)) and 1e-14 <= accuracy <= 0.1):
             raise invalid("accuracy", accuracy, "relative accuracy target in [1e-14, 0.1]")
-        step = min(accuracy_step(problem, m, accuracy), 0.5 * limit, t_end)
-    n_steps = max(1, math.ceil(t_end / step * (1 - 1e-12)))
-    step = t_end / n_steps
-
+        step = min(default_step(problem, m, accuracy, limit), t_end)
     rec = problem.record
-    n_out = int(math.floor(t_end / rec.sample_interval * (1 + 1e-12))) + 1
+    n_steps, step, n_out = time_grid(t_end, step, rec.sample_interval)
     out = np.zeros((len(problem.ch_names), n_out))
     if rec.frame_interval is not None:
         n_frames = int(math.floor(t_end / rec.frame_interval * (1 + 1e-12))) + 1

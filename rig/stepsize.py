@@ -29,11 +29,8 @@ DEFAULT_ACCURACY = 1e-4
 
 def _reduced_masses(p) -> np.ndarray:
     """Reduced mass (kg) of each contact slot's two bodies (the wall is infinitely heavy)."""
-    m_above, m_below = p.mass[:-1], p.mass[1:]
-    inv = np.where(m_above > 0, 1 / np.where(m_above > 0, m_above, 1), 0.0) + \
-        np.where(m_below > 0, 1 / np.where(m_below > 0, m_below, 1), 0.0)
     out = np.full(p.n_bodies, np.nan)
-    out[1:] = 1.0 / inv
+    out[1:] = 1.0 / (p.invm[:-1] + p.invm[1:])
     return out
 
 
@@ -84,3 +81,10 @@ def accuracy_step(p, method: Method, accuracy: float) -> float:
     """Step (s) meeting ``accuracy`` over a pulse crossing every moving body."""
     tau = contact_time_scale(p)
     return tau * (accuracy / (method.error_constant * max(p.moving_bodies, 1))) ** (1.0 / method.contact_order)
+
+
+def default_step(p, method: Method, accuracy: float, limit: float | None = None) -> float:
+    """The step (s) a solve takes by itself: the accuracy step, at most half the stability
+    limit (``limit``, computed here when not given)."""
+    limit = stability_limit(p, method) if limit is None else limit
+    return min(accuracy_step(p, method, accuracy), 0.5 * limit)

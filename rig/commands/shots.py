@@ -183,14 +183,14 @@ def cmd_mc(args) -> dict:
 
         sobol_matrix(study)
     store = Store(args.out, study).open()
-    done = sum(min(study.shots, (b + 1) * study.batch) - b * study.batch for b in store.done())
+    done = sum(len(study.shots_of(b)) for b in store.done())
     t0 = time.perf_counter()
     with tqdm(total=study.shots, initial=done, desc="mc", unit="shot", file=sys.stderr,
               disable=args.quiet) as bar:
         try:
             run_study(study, store, args.workers, args.scheduler, bar.update)
         except KeyboardInterrupt:
-            kept = sum(min(study.shots, (b + 1) * study.batch) - b * study.batch for b in store.done())
+            kept = sum(len(study.shots_of(b)) for b in store.done())
             raise RigError(f"interrupted: {kept} of {study.shots} shots are kept in {args.out}; "
                            f"run the same command again to resume") from None
     ran = study.shots - done
