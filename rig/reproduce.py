@@ -44,10 +44,10 @@ def autoscaled(scene: str, overrides=()) -> Rig:
     rig = Rig.from_scene(scene, overrides)
     truth = rig.truth()
     extra = []
-    peaks = {}
-    for g in truth.gauges.values():
-        peaks[g.channel] = rig.gauges[[n for n, v in rig.gauges.items() if v[1] == g.channel][0]][2].sensitivity \
-            * float(np.max(g.average_force - g.average_force[0]))
+    peaks = {}  # expected peak volts per channel
+    for name, (_, ch, settings) in rig.gauges.items():
+        g = truth.gauges[name]
+        peaks[ch] = settings.sensitivity * float(np.max(g.average_force - g.average_force[0]))
     if rig.wall_sensor is not None:
         peaks[rig.wall_channel] = rig.wall_sensor.sensitivity * float(np.max(truth.wall_force - truth.wall_force[0]))
     for ch, v in peaks.items():
