@@ -193,8 +193,8 @@ class Archive:
                 try:
                     _read_entry(f[name], True, self.path, with_truth=False)
                     for obj in _datasets(f[name]):
-                        key = h5py.h5o.get_info(obj.id).token if hasattr(h5py.h5o.get_info(obj.id), "token") \
-                            else h5py.h5o.get_info(obj.id).addr
+                        info = h5py.h5o.get_info(obj.id)
+                        key = info.token if hasattr(info, "token") else info.addr
                         if key not in checked:
                             obj[()]  # fletcher32 is checked chunk by chunk as it is read
                             checked.add(key)
