@@ -57,6 +57,16 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("--out", metavar="ARCHIVE.h5", help="append every shot to an archive")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
 
+    an = _command(sub, "animate", "render a virtual shot to a movie or still, off-screen", shots.cmd_animate)
+    an.add_argument("scene")
+    an.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene key")
+    an.add_argument("--seed", type=int, help="seed of the instruments' draws (default: a fresh one, printed)")
+    an.add_argument("--out", required=True, metavar="FILE", help="FILE.mp4, FILE.gif or FILE.png (one still)")
+    an.add_argument("--frames", type=int, default=100, help="frames over the scene's duration (default 100)")
+    an.add_argument("--exaggerate", type=float,
+                    help="displacement factor (default: the largest displacement shown as 1/3 diameter)")
+    an.add_argument("--quiet", action="store_true", help="no progress bar")
+
     rp = _command(sub, "reproduce", "re-run a published study (daraio2006)", shots.cmd_reproduce)
     rp.add_argument("study", help="daraio2006")
     rp.add_argument("--out", required=True, metavar="DIR", help="folder for tables and figures")
@@ -76,6 +86,9 @@ def build_parser() -> argparse.ArgumentParser:
     mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")
     mc.add_argument("--sobol", action="store_true", help="Sobol design and indices (needs SALib)")
     mc.add_argument("--truth", action="store_true", help="also analyse each shot's noise-free truth (slower)")
+    mc.add_argument("--window", choices=["leading", "record"], default="leading",
+                    help="simulate until the leading pulse has passed the last gauge (default), "
+                         "or the scene's whole record")
     mc.add_argument("--out", required=True, metavar="DIR")
     mc.add_argument("--quiet", action="store_true", help="no progress bar")
 

@@ -15,7 +15,7 @@ from ._kernels.ensemble import integrate_ensemble
 from .errors import RigError, invalid
 from .methods import DEFAULT_METHOD, method as get_method
 from .solve import MAX_CHECKS, time_grid
-from .stepsize import DEFAULT_ACCURACY, default_step
+from .stepsize import DEFAULT_ACCURACY, Stepping, default_step
 
 
 @dataclass(frozen=True, eq=False)
@@ -35,19 +35,25 @@ class EnsembleSolution:
         return self.diag.shape[1]
 
 
-def ensemble_step(problems, t_end: float, method=DEFAULT_METHOD, accuracy=None) -> float:
-    """The common step (s) for a batch: the smallest any of its shots needs."""
+def ensemble_step(problems, t_end: float, method=DEFAULT_METHOD, accuracy=None) -> Stepping:
+    """The common stepping of a batch: the smallest step (and substep) any of its shots
+    needs; multirate only when every shot has the same head, else the single-rate step."""
     m = get_method(method)
     acc = DEFAULT_ACCURACY if accuracy is None else accuracy
     if not problems:
         raise invalid("problems", [], "at least one shot")
-    return min(default_step(p, m, acc) for p in problems)
+    own = [default_step(p, m, acc) for p in problems]
+    heads = {s.head for s in own}
+    if len(heads) == 1 and own[0].head:
+        return Stepping(min(s.dt for s in own), own[0].head, min(s.inner_dt for s in own))
+    return Stepping(min(s.inner_dt if s.head else s.dt for s in own))
 
 
-def solve_ensemble(problems: list, t_end: float, *, dt: float, method: str = DEFAULT_METHOD,
+def solve_ensemble(problems: list, t_end: float, *, dt: float | Stepping, method: str = DEFAULT_METHOD,
                    width: int | None = None) -> EnsembleSolution:
-    """Integrate every problem with the same step ``dt`` (s) to ``t_end`` (s). ``width``:
-    shots per chunk (default: the batch shared out over numba's threads, 8 to 64)."""
+    """Integrate every problem with the same stepping ``dt`` (a step in s, or a Stepping)
+    to ``t_end`` (s). ``width``: shots per chunk (default: the batch shared out over
+    numba's threads, 8 to 64)."""
     if not problems:
         raise invalid("problems", [], "at least one shot")
     m = get_method(method)
@@ -58,10 +64,12 @@ def solve_ensemble(problems: list, t_end: float, *, dt: float, method: str = DEF
             raise RigError("an ensemble needs shots of one chain topology and one set of probes")
         if p.sched_t.size or p.chain.law.dissipative:
             raise RigError("the batched kernel takes conservative chains with constant loads only")
-    if not (t_end > 0 and dt > 0):
-        raise invalid("t_end/dt", (t_end, dt), "both > 0 s")
+    stepping = dt if isinstance(dt, Stepping) else Stepping(dt)
+    if not (t_end > 0 and stepping.dt > 0):
+        raise invalid("t_end/dt", (t_end, stepping.dt), "both > 0 s")
     rec = p0.record
-    n_steps, step, n_out = time_grid(t_end, dt, rec.sample_interval)
+    n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), rec.sample_interval)
+    sub = stepping.substeps(step, m.drifts)
     n = len(problems)
     if width is None:
         import numba
@@ -80,7 +88,7 @@ def solve_ensemble(problems: list, t_end: float, *, dt: float, method: str = DEF
     u, v = stack("u0"), stack("v0")
     t0 = time.perf_counter()
     integrate_ensemble(u, v, stack("mass"), stack("invm"), stack("bias"), stack("load"), stack("A"),
-                       stack("d0"), np.array(m.drifts), np.array(m.kicks), step, n_steps,
+                       stack("d0"), np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head, sub,
                        p0.ch_slot, p0.ch_weight, rec.sample_interval, out,
                        max(1, n_steps // MAX_CHECKS), stack("d_limit"), p0.wall_slot,
                        blocks([p.energy_scale for p in padded]), blocks([p.momentum_scale for p in padded]),

@@ -33,6 +33,7 @@ from .measure import midway_static_force, setup_for
 from .shot import Rig
 from .solution import Solution, SolverStats
 
+WINDOWS = ("leading", "record")
 OUTPUTS = ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_amplitude_N",
            "truth_speed_m_per_s", "truth_amplitude_N", "energy_error", "dt_s")
 
@@ -48,8 +49,11 @@ class Study:
     accuracy: float | None = None
     sobol: bool = False
     truth: bool = False  # also analyse each shot's noise-free truth (slower)
+    window: str = "leading"  # "leading": simulate until the leading pulse is past the last gauge; "record": the scene's
 
     def __post_init__(self):
+        if self.window not in WINDOWS:
+            raise invalid("--window", self.window, f"one of {', '.join(WINDOWS)}")
         if not isinstance(self.shots, int) or self.shots < 1:
             raise invalid("--shots", self.shots, "a whole number >= 1")
         if self.batch < 1:
@@ -62,7 +66,7 @@ class Study:
     def spec(self) -> dict:
         return {"scene": str(self.scene), "dists": [asdict(d) for d in self.dists], "shots": self.shots,
                 "seed": self.seed, "overrides": list(self.overrides), "batch": self.batch,
-                "accuracy": self.accuracy, "sobol": self.sobol, "truth": self.truth}
+                "accuracy": self.accuracy, "sobol": self.sobol, "truth": self.truth, "window": self.window}
 
     def digest(self) -> str:
         return hashlib.sha256(json.dumps(self.spec(), sort_keys=True).encode()).hexdigest()[:16]
@@ -89,6 +93,28 @@ def nominal_calibration(scene: str, overrides: tuple) -> tuple:
     every shot of a study (each shot's own truth is unknown to the analysis)."""
     _, _, rig = _base(scene, overrides)
     return rig.truth_analysis().beta, midway_static_force(rig)
+
+
+@functools.lru_cache(maxsize=4)
+def leading_window(scene: str, overrides: tuple) -> tuple:
+    """(duration in s, scope record length, pre-trigger fraction) of a study that needs
+    only the leading pulse: simulated until the nominal shot's leading pulse at the last
+    gauge is past (peak time + base width); the scope keeps the scene's pre-trigger
+    samples (the baseline comes from them) and records after the trigger only as long as
+    the simulation lasts, the trigger taken at the nominal time + 5% (shot-to-shot spread)."""
+    _, _, rig = _base(scene, overrides)
+    lead = rig.truth_analysis().leading
+    last = lead.get("lower") or lead.get("upper")
+    shot = rig.fire(seed=0, truth=False)
+    tb, pre = rig.scope.timebase, rig.scope.trigger.pre_trigger
+    if not last or not last.get("base_width") or not shot.scope.triggered:
+        return rig.solver["duration"], tb.record_length, pre
+    duration = min(rig.solver["duration"], last["time"] + last["base_width"])
+    n_pre = int(round(pre * tb.record_length))
+    n_post = int((duration - 1.05 * shot.scope.trigger_time) / tb.sample_interval)
+    if n_post <= 0 or n_pre + n_post >= tb.record_length:
+        return rig.solver["duration"], tb.record_length, pre
+    return duration, n_pre + n_post, n_pre / (n_pre + n_post)
 
 
 def sobol_shots(requested: int, n_inputs: int) -> int:
@@ -131,9 +157,24 @@ def shot_inputs(study: Study, i: int, n_plain: int, design=None):
     return x, masses, seed
 
 
+def study_duration(study: Study) -> float:
+    """Simulated time (s) of each shot of the study."""
+    if study.window == "leading":
+        return leading_window(study.scene, tuple(study.overrides))[0]
+    return _base(study.scene, tuple(study.overrides))[2].solver["duration"]
+
+
 def _rig_for(study: Study, x: dict, masses) -> tuple:
     values, text, base = _base(study.scene, tuple(study.overrides))
     v = copy.deepcopy(values)
+    # the solver records at the scope's sampling rate (the scope reads nothing finer)
+    scope_dt = v.get("scope", {}).get("sample_interval")
+    if scope_dt and scope_dt > v["solver"].get("sample_interval", 1e-7):
+        v["solver"]["sample_interval"] = scope_dt
+    if study.window == "leading":
+        duration, length, pre = leading_window(study.scene, tuple(study.overrides))
+        v["solver"]["duration"], v["scope"]["record_length"] = duration, length
+        v["scope"].setdefault("trigger", {})["pre_trigger"] = pre
     draws = {}
     for key, val in x.items():
         parts = key.split(".")
@@ -168,7 +209,7 @@ def run_batch(study: Study, b: int) -> dict:
         seeds.append(seed)
         xs.append([x[k] for k in study.keys])
     problems = [r.chain.problem(r.record()) for r in rigs]
-    t_end = base.solver["duration"]
+    t_end = study_duration(study)
     dt = ensemble_step(problems, t_end, base.solver["method"], study.accuracy or base.solver["accuracy"])
     ens = solve_ensemble(problems, t_end, dt=dt, method=base.solver["method"])
     out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}

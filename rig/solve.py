@@ -11,9 +11,9 @@ from .errors import RigError, invalid
 from .methods import DEFAULT_METHOD, method as get_method
 from .problem import ChainProblem
 from .solution import Solution, SolverStats
-from .stepsize import DEFAULT_ACCURACY, default_step, stability_limit
+from .stepsize import DEFAULT_ACCURACY, Stepping, default_step, stability_limit
 
-MAX_CHECKS = 200  # energy / momentum / blow-up checks per solve (each one O(N))
+MAX_CHECKS = 50  # energy / momentum / blow-up checks per solve (each one O(N))
 
 
 def time_grid(t_end: float, dt: float, sample_interval: float) -> tuple:
@@ -23,36 +23,50 @@ def time_grid(t_end: float, dt: float, sample_interval: float) -> tuple:
     return n_steps, t_end / n_steps, int(math.floor(t_end / sample_interval * (1 + 1e-12))) + 1
 
 
+def frame_origin(chain) -> np.ndarray:
+    """Where each moving body's frame position is measured from (m, down from bead 0's
+    equilibrium centre): the striker's far end at impact, then each bead's equilibrium."""
+    x_eq = chain.equilibrium_positions()
+    if chain.striker is None:
+        return x_eq
+    top = chain.beads[0].radius + chain.striker.gap + chain.striker.length
+    return np.concatenate(([-top], x_eq))
+
+
 def solve(problem: ChainProblem, t_end: float, *, method: str = DEFAULT_METHOD,
-          accuracy: float | None = None, dt: float | None = None) -> Solution:
+          accuracy: float | None = None, dt: float | Stepping | None = None) -> Solution:
     """Integrate ``problem`` from the impact (t = 0) to ``t_end`` (s).
 
-    The step is ``dt`` (s) when given, else chosen from ``accuracy`` (target relative force
-    error over the whole chain, default 1e-4; see rig/stepsize.py). A dt beyond the
-    method's stability limit for this chain is refused.
+    The step is ``dt`` (s, single rate; or a Stepping, possibly multirate) when given,
+    else chosen from ``accuracy`` (target relative force error over the whole chain,
+    default 1e-4; see rig/stepsize.py). A dt beyond the method's stability limit for this
+    chain is refused.
     """
     m = get_method(method)
     if not isinstance(t_end, (int, float)) or not math.isfinite(t_end) or t_end <= 0:
         raise invalid("t_end", t_end, "end time must be a finite number > 0 s")
-    limit = stability_limit(problem, m)
     if dt is not None:
         if accuracy is not None:
             raise invalid("dt", dt, "give either dt or accuracy, not both")
-        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+        stepping = dt if isinstance(dt, Stepping) else Stepping(dt)
+        if not (isinstance(stepping.dt, (int, float)) and math.isfinite(stepping.dt) and stepping.dt > 0):
             raise invalid("dt", dt, "time step must be a finite number > 0 s")
-        if dt > limit:
+        limit = stability_limit(problem, m, stepping.head)
+        if stepping.dt > limit:
             raise RigError(
-                f"dt = {dt:.4g} s is beyond the stability limit of {m.name} for this chain "
+                f"dt = {stepping.dt:.4g} s is beyond the stability limit of {m.name} for this chain "
                 f"(about {limit:.4g} s at the estimated peak forces); use dt <= {limit:.3g} s "
                 f"or leave dt unset to choose it from the accuracy target")
-        step = float(dt)
     else:
         accuracy = DEFAULT_ACCURACY if accuracy is None else accuracy
         if not (isinstance(accuracy, (int, float)) and 1e-14 <= accuracy <= 0.1):
             raise invalid("accuracy", accuracy, "relative accuracy target in [1e-14, 0.1]")
-        step = min(default_step(problem, m, accuracy, limit), t_end)
+        stepping = default_step(problem, m, accuracy)
+    if stepping.head and (problem.chain.law.dissipative or stepping.head >= problem.n_bodies - 2):
+        raise invalid("dt.head", stepping.head, "a multirate head needs a conservative chain longer than the head")
     rec = problem.record
-    n_steps, step, n_out = time_grid(t_end, step, rec.sample_interval)
+    n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), rec.sample_interval)
+    sub = stepping.substeps(step, m.drifts)
     out = np.zeros((len(problem.ch_names), n_out))
     if rec.frame_interval is not None:
         n_frames = int(math.floor(t_end / rec.frame_interval * (1 + 1e-12))) + 1
@@ -67,13 +81,14 @@ def solve(problem: ChainProblem, t_end: float, *, method: str = DEFAULT_METHOD,
 
     args = (problem.mass, problem.invm, problem.bias, problem.load, problem.A, problem.d0,
             problem.damping, problem.chain.law.code, np.array(m.drifts), np.array(m.kicks), step)
+    mid = (stepping.head, sub)
     tail = (problem.sched_body, problem.sched_t, problem.sched_f,
             problem.ch_slot, problem.ch_weight, rec.sample_interval, out, frame_dt, frames,
             check_every, problem.d_limit, problem.wall_slot,
             problem.energy_scale, problem.momentum_scale, diag)
-    integrate(u.copy(), v.copy(), *args, 0, *tail)  # load the compiled kernel before timing
+    integrate(u.copy(), v.copy(), *args, 0, *mid, *tail)  # load the compiled kernel before timing
     t0 = time.perf_counter()
-    integrate(u, v, *args, n_steps, *tail)
+    integrate(u, v, *args, n_steps, *mid, *tail)
     wall = time.perf_counter() - t0
     if diag[3] != 0:
         raise RigError(
@@ -85,13 +100,6 @@ def solve(problem: ChainProblem, t_end: float, *, method: str = DEFAULT_METHOD,
                         float(diag[0]), float(diag[1]), float(diag[2]),
                         None if dt is not None else float(accuracy))
     moving = slice(0, problem.n_bodies - (1 if problem.wall_slot else 0))
-    frames_abs = None
-    if n_frames:
-        x_eq = problem.chain.equilibrium_positions()
-        if problem.offset:
-            striker = problem.chain.striker
-            top = problem.chain.beads[0].radius + striker.gap + striker.length
-            x_eq = np.concatenate(([-top], x_eq))  # the striker's far end
-        frames_abs = frames[:, moving] + x_eq
+    frames_abs = frames[:, moving] + frame_origin(problem.chain) if n_frames else None
     return Solution(dict(zip(problem.ch_names, out)), rec.sample_interval, frames_abs,
                     rec.frame_interval, u[moving].copy(), v[moving].copy(), stats, problem)

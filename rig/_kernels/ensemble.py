@@ -4,8 +4,9 @@ Arrays are (chunks, bodies, width): each chunk is a C-contiguous block whose inn
 runs over ``width`` shots from 0, so every loop over the shots of a chunk vectorises;
 ``integrate_ensemble`` runs the chunks on numba's threads. Every shot
 performs exactly the operations of the single-shot kernel (integrators.integrate) in the
-same order with the same step, so the two agree to the last bit. Conservative Hertz
-contacts and constant loads only (no force schedule, no dissipation).
+same order with the same step, so the two agree to the last bit (the multirate head
+runs the same multirate.head_flow in both). Conservative Hertz contacts and constant
+loads only (no force schedule, no dissipation).
 """
 import math
 
@@ -13,6 +14,7 @@ import numpy as np
 from numba import njit, prange
 
 from .integrators import _hermite
+from .multirate import head_flow, slow_net
 
 
 @njit(cache=True, fastmath=False)
@@ -31,8 +33,19 @@ def _forces(u, A, d0, load, f):
 
 
 @njit(cache=True, fastmath=False)
-def _kick_drift(u, v, invm, f, hb, ha):
-    for i in range(v.shape[0]):
+def _head_kick(v, invm, f, hb, head):
+    """The method's kick of the head's last body (slot head + 1 only)."""
+    for s in range(v.shape[1]):
+        v[head, s] += hb * (0.0 - f[head + 1, s]) * invm[head, s]
+
+
+@njit(cache=True, fastmath=False)
+def _kick_drift(u, v, invm, f, hb, ha, head):
+    start = 0
+    if head > 0:
+        _head_kick(v, invm, f, hb, head)
+        start = head + 1
+    for i in range(start, v.shape[0]):
         for s in range(u.shape[1]):
             vi = v[i, s] + hb * (f[i, s] - f[i + 1, s]) * invm[i, s]
             v[i, s] = vi
@@ -40,11 +53,17 @@ def _kick_drift(u, v, invm, f, hb, ha):
 
 
 @njit(cache=True, fastmath=False)
-def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha):
-    """_kick_drift then _forces in one pass over the rows: row i is kicked and drifted
-    (reading f[i], f[i+1], not yet renewed), then contact i is renewed from rows i-1 and i
-    (both moved). The same operations as the two passes, so the same bits."""
-    for i in range(v.shape[0]):
+def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub):
+    """_kick_drift (and the head's flow) then _forces in one pass over the rows: row i is
+    kicked and drifted (reading f[i], f[i+1], not yet renewed), then contact i is renewed
+    from rows i-1 and i (both moved). The same operations as the two passes, so the same
+    bits."""
+    start = 0
+    if head > 0:
+        _head_kick(v, invm, f, hb, head)
+        head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub)
+        start = head + 1
+    for i in range(start, v.shape[0]):
         for s in range(u.shape[1]):
             vi = v[i, s] + hb * (f[i, s] - f[i + 1, s]) * invm[i, s]
             v[i, s] = vi
@@ -54,12 +73,12 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha):
 
 
 @njit(cache=True, fastmath=False)
-def _synced(j, s, v, invm, f, pending):
-    return v[j, s] + pending * (f[j, s] - f[j + 1, s]) * invm[j, s]
+def _synced(j, s, v, invm, f, pending, head):
+    return v[j, s] + pending * slow_net(f, j, head, s) * invm[j, s]
 
 
 @njit(cache=True, fastmath=False)
-def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, y, r):
+def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, head, y, r):
     for c in range(ch_slot.shape[0]):
         for s in range(u.shape[1]):
             yc = 0.0
@@ -71,36 +90,48 @@ def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, y, r):
                     yc += w * (f[i, s] + load[i, s])
                     d = d0[i, s] + u[i - 1, s] - u[i, s]
                     if d > 0.0:
-                        va = _synced(i - 1, s, v, invm, f, pending)
-                        vb = _synced(i, s, v, invm, f, pending)
+                        va = _synced(i - 1, s, v, invm, f, pending, head)
+                        vb = _synced(i, s, v, invm, f, pending, head)
                         rc += w * (1.5 * A[i, s] * math.sqrt(d) * (va - vb))
             y[c, s] = yc
             r[c, s] = rc
 
 
 @njit(cache=True, fastmath=False)
-def _energy(u, v, mass, bias, A, d0, s):
+def _energy(u, v, mass, bias, A, d0, e):
+    """Each shot's energy into e (forces.energy's sums, in its order, over all shots)."""
     nb = u.shape[0]
-    e = 0.0
+    e[:] = 0.0
     for i in range(nb):
-        e += 0.5 * mass[i, s] * v[i, s] * v[i, s] - mass[i, s] * bias[i, s] * u[i, s]
+        for s in range(u.shape[1]):
+            e[s] += 0.5 * mass[i, s] * v[i, s] * v[i, s] - mass[i, s] * bias[i, s] * u[i, s]
     for i in range(1, nb):
-        d = d0[i, s] + u[i - 1, s] - u[i, s]
-        if d > 0.0:
-            e += 0.4 * A[i, s] * d * d * math.sqrt(d)
-    return e
+        for s in range(u.shape[1]):
+            d = d0[i, s] + u[i - 1, s] - u[i, s]
+            if d > 0.0:
+                e[s] += 0.4 * A[i, s] * d * d * math.sqrt(d)
 
 
 @njit(cache=True, fastmath=False)
-def _momentum(v, mass, s):
-    p = 0.0
+def _momentum(v, mass, p):
+    p[:] = 0.0
     for i in range(v.shape[0]):
-        p += mass[i, s] * v[i, s]
-    return p
+        for s in range(v.shape[1]):
+            p[s] += mass[i, s] * v[i, s]
 
 
 @njit(cache=True, fastmath=False)
-def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps,
+def _worst_overlap(u, d0, d_limit, w):
+    """Each shot's largest d / d_limit (inf for nan), as forces.max_overlap_excess."""
+    w[:] = 0.0
+    for i in range(1, u.shape[0]):
+        for s in range(u.shape[1]):
+            q = (d0[i, s] + u[i - 1, s] - u[i, s]) / d_limit[i, s]
+            w[s] = max(w[s], q) if q == q else math.inf
+
+
+@njit(cache=True, fastmath=False)
+def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, head, sub,
            ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
            e_ref, p_ref, diag, f, y_old, r_old, y_new, r_new):
     nb = u.shape[0]
@@ -114,13 +145,16 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps,
     _forces(u, A, d0, load, f)
     e0 = np.empty(W)
     p0 = np.empty(W)
+    e = np.empty(W)
+    pn = np.empty(W)
+    worst = np.empty(W)
     net = np.empty(W)
     j_wall = np.zeros(W)
+    _energy(u, v, mass, bias, A, d0, e0)
+    _momentum(v, mass, p0)
     for s in range(u.shape[1]):
-        e0[s] = _energy(u, v, mass, bias, A, d0, s)
-        p0[s] = _momentum(v, mass, s)
         net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
-    _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, 0.0, y_old, r_old)
+    _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, 0.0, head, y_old, r_old)
     if n_out > 0:
         for c in range(n_ch):
             for s in range(u.shape[1]):
@@ -137,7 +171,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps,
                 for s in range(u.shape[1]):
                     j_wall[s] += hb * f[wall_slot, s]
             h = a_coef[st] * dt
-            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h)
+            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st])
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1
@@ -145,29 +179,30 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps,
             if wall_slot > 0:
                 for s in range(u.shape[1]):
                     j_wall[s] += pending * f[wall_slot, s]
-            _kick_drift(u, v, invm, f, pending, 0.0)
+            _kick_drift(u, v, invm, f, pending, 0.0, head)
             pending = 0.0
-        _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, y_new, r_new)
-        while j_out < n_out and j_out * sample_dt <= t_new * (1.0 + 1e-12):
-            x = (j_out * sample_dt - t) / dt
+        _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, head, y_new, r_new)
+        j_end = j_out
+        while j_end < n_out and j_end * sample_dt <= t_new * (1.0 + 1e-12):
+            j_end += 1
+        for s in range(u.shape[1]):  # each shot's samples are contiguous: write them in runs
             for c in range(n_ch):
-                for s in range(u.shape[1]):
-                    out[s, c, j_out] = _hermite(x, dt, y_old[c, s], r_old[c, s], y_new[c, s], r_new[c, s])
-            j_out += 1
+                for j in range(j_out, j_end):
+                    x = (j * sample_dt - t) / dt
+                    out[s, c, j] = _hermite(x, dt, y_old[c, s], r_old[c, s], y_new[c, s], r_new[c, s])
+        j_out = j_end
         for c in range(n_ch):
             for s in range(u.shape[1]):
                 y_old[c, s] = y_new[c, s]
                 r_old[c, s] = r_new[c, s]
         if check:
+            _energy(u, v, mass, bias, A, d0, e)
+            _momentum(v, mass, pn)
+            _worst_overlap(u, d0, d_limit, worst)
             for s in range(u.shape[1]):
-                e = _energy(u, v, mass, bias, A, d0, s)
-                err = abs(e - e0[s]) / e_ref[s]
-                pe = abs(_momentum(v, mass, s) - p0[s] - (t_new * net[s] - j_wall[s])) / p_ref[s]
-                worst = 0.0
-                for i in range(1, nb):
-                    q = (d0[i, s] + u[i - 1, s] - u[i, s]) / d_limit[i, s]
-                    worst = max(worst, q) if q == q else math.inf
-                if not (err < 1e300) or not (worst <= 1.0):
+                err = abs(e[s] - e0[s]) / e_ref[s]
+                pe = abs(pn[s] - p0[s] - (t_new * net[s] - j_wall[s])) / p_ref[s]
+                if not (err < 1e300) or not (worst[s] <= 1.0):
                     diag[3, s] = 1.0
                 diag[0, s] = max(diag[0, s], err)
                 diag[1, s] = max(diag[1, s], pe)
@@ -178,7 +213,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps,
 
 
 @njit(cache=True, fastmath=False, parallel=True)
-def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps,
+def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, head, sub,
                        ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
                        e_ref, p_ref, diag):
     """Integrate every shot of the (chunks, bodies, width) arrays in place; out is
@@ -192,6 +227,6 @@ def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, 
         r_old = np.zeros((n_ch, W))
         y_new = np.zeros((n_ch, W))
         r_new = np.zeros((n_ch, W))
-        _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], a_coef, b_coef, dt, n_steps,
+        _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], a_coef, b_coef, dt, n_steps, head, sub,
                ch_slot, ch_weight, sample_dt, out[k], check_every, d_limit[k], wall_slot,
                e_ref[k], p_ref[k], diag[k], f, y_old, r_old, y_new, r_new)

@@ -13,11 +13,16 @@ body at checks, frames and the end). Velocity Verlet is a = [1], b = [1/2, 1/2].
 Recorded channels are linear combinations of contact forces, interpolated onto a uniform
 output grid by cubic Hermite interpolation between step ends (force and its rate
 dF/dt = (3/2) A d^(1/2) d(d)/dt), so the output grid may be finer than the step.
+
+With a multirate head (head > 0, see rig/stepsize.py) the kicks carry every contact but
+the first ``head`` ones, and each drift moves bodies 0..head by multirate.head_flow
+(``sub[s]`` substeps of the same method in drift s) instead of a plain drift.
 """
 import numpy as np
 from numba import njit
 
 from .forces import contact_forces, energy, force_rate, max_overlap_excess, momentum
+from .multirate import head_flow, slow_net
 
 
 @njit(cache=True, fastmath=False)
@@ -53,25 +58,31 @@ def _external_kick(v, invm, f, h, t, wall_slot, sched_body, sched_t, sched_f):
 
 
 @njit(cache=True, fastmath=False)
-def _kick_drift(u, v, invm, f, hb, ha):
-    """One pass: v += hb (f_above - f_below)/m, then u += ha v (ha = 0: kick only)."""
-    for i in range(v.shape[0]):
+def _kick_drift(u, v, invm, f, hb, ha, head):
+    """One pass: v += hb (f_above - f_below)/m, then u += ha v (ha = 0: kick only). With a
+    head, bodies 0..head get only the kick of slot head + 1 and are not drifted here."""
+    start = 0
+    if head > 0:
+        v[head] += hb * (0.0 - f[head + 1]) * invm[head]
+        start = head + 1
+    for i in range(start, v.shape[0]):
         vi = v[i] + hb * (f[i] - f[i + 1]) * invm[i]
         v[i] = vi
         u[i] += ha * vi
 
 
 @njit(cache=True, fastmath=False)
-def _synced_velocity(j, v, invm, f, pending, sched_body, f_sched):
-    """Velocity of body j once the owed closing kick of ``pending`` seconds is applied."""
-    vj = v[j] + pending * (f[j] - f[j + 1]) * invm[j]
+def _synced_velocity(j, v, invm, f2, pending, sched_body, f_sched, head):
+    """Velocity of body j once the owed closing kick of ``pending`` seconds is applied
+    (f2: the forces as a (slots, 1) view)."""
+    vj = v[j] + pending * slow_net(f2, j, head, 0) * invm[j]
     if j == sched_body:
         vj += pending * f_sched * invm[j]
     return vj
 
 
 @njit(cache=True, fastmath=False)
-def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, sched_body, f_sched, y, r):
+def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, sched_body, f_sched, head, y, r):
     """Channel values y (N, whole contact forces) and rates r (N/s) at a step end."""
     for c in range(ch_slot.shape[0]):
         y[c] = 0.0
@@ -81,8 +92,9 @@ def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, sched_body, 
             if w != 0.0:
                 s = ch_slot[c, k]
                 y[c] += w * (f[s] + load[s])
-                va = _synced_velocity(s - 1, v, invm, f, pending, sched_body, f_sched)
-                vb = _synced_velocity(s, v, invm, f, pending, sched_body, f_sched)
+                f2 = f.reshape((f.shape[0], 1))
+                va = _synced_velocity(s - 1, v, invm, f2, pending, sched_body, f_sched, head)
+                vb = _synced_velocity(s, v, invm, f2, pending, sched_body, f_sched, head)
                 r[c] += w * force_rate(s, u, va, vb, A, d0)
 
 
@@ -97,7 +109,7 @@ def _hermite(s, h, y0, r0, y1, r1):
 
 @njit(cache=True, fastmath=False)
 def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
-              a_coef, b_coef, dt, n_steps,
+              a_coef, b_coef, dt, n_steps, head, sub,
               sched_body, sched_t, sched_f,
               ch_slot, ch_weight, sample_dt, out,
               frame_dt, frames,
@@ -120,6 +132,9 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
     has_sched = sched_t.shape[0] > 0
 
     contact_forces(u, v, A, d0, damping, law, load, f)
+    # (bodies, 1) views for the multirate head (shared with the batched kernel)
+    u2, v2, im2, f2 = u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1))
+    A2, d02, load2 = A.reshape((nb, 1)), d0.reshape((nb, 1)), load.reshape((nb + 1, 1))
     # sum of constant loads, less the part the wall's slot carries (j_wall is dynamic)
     wall_load = load[wall_slot] if wall_slot > 0 else 0.0
     net_const = load[nb] - wall_load
@@ -133,7 +148,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
     r_old = np.empty(n_ch)
     y_new = np.empty(n_ch)
     r_new = np.empty(n_ch)
-    _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, 0.0, sched_body, 0.0, y_old, r_old)
+    _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, 0.0, sched_body, 0.0, head, y_old, r_old)
     if n_out > 0:
         for c in range(n_ch):
             out[c, 0] = y_old[c]
@@ -169,7 +184,9 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
             j_wall += jw
             j_sched += js
             h = a_coef[s] * dt
-            _kick_drift(u, v, invm, f, hb, h)
+            _kick_drift(u, v, invm, f, hb, h, head)
+            if head > 0:
+                head_flow(u2, v2, im2, f2, A2, d02, load2, head, a_coef, b_coef, h, sub[s])
             ts += h
             contact_forces(u, v, A, d0, damping, law, load, f)
         t_new = (n + 1) * dt
@@ -180,7 +197,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
                                     sched_body, sched_t, sched_f)
             j_wall += jw
             j_sched += js
-            _kick_drift(u, v, invm, f, pending, 0.0)
+            _kick_drift(u, v, invm, f, pending, 0.0, head)
             pending = 0.0
         if has_sched:
             fe_new = schedule_force(t_new, sched_t, sched_f)
@@ -189,7 +206,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
             fe_new = 0.0
         steps_done = n + 1
 
-        _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, sched_body, fe_new,
+        _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, sched_body, fe_new, head,
                y_new, r_new)
         while j_out < n_out and j_out * sample_dt <= t_new * (1.0 + 1e-12):
             s = (j_out * sample_dt - t) / dt

@@ -170,7 +170,7 @@ def cmd_mc(args) -> dict:
             print(f"Sobol design over {len(dists)} inputs: {shots} shots "
                   f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
     study = Study(args.scene, dists, shots, args.seed, tuple(args.set or ()), args.batch, args.accuracy,
-                  args.sobol, args.truth)
+                  args.sobol, args.truth, args.window)
     if not study.dists:
         raise RigError("--vary: give at least one uncertain input, e.g. striker.velocity=\"normal(0.89 m/s, 0.01 m/s)\"")
     _, _, base = _base(study.scene, study.overrides)  # the scene must be valid before any shot
@@ -245,3 +245,24 @@ def _print_blocks(t, m, th):
     print(f"  theory     c0 = {fmt(th['sound_speed_m_per_s'])} m/s (Eq 2), "
           f"Eq (1) at the truth amplitude: {fmt(th['speed_m_per_s'])} m/s; "
           f"cross-correlation speed {fmt(m['speed_xcorr_m_per_s'])} m/s")
+
+
+def cmd_animate(args) -> dict:
+    """Render a virtual shot to a movie or a still, off-screen (pyvista)."""
+    from tqdm import tqdm
+
+    from ..animate import animate, check_output, require_renderer
+    from ..shot import Rig
+
+    check_output(args.out)  # before anything is computed
+    require_renderer()
+    rig = Rig.from_scene(args.scene, args.set or ())
+    still = args.out.lower().endswith(".png")
+    with tqdm(total=None if still else args.frames, desc="animate", unit="frame", file=sys.stderr,
+              disable=args.quiet or still) as bar:
+        out = animate(rig, args.out, frames=args.frames, exaggerate=args.exaggerate, seed=args.seed,
+                      progress=bar.update)
+    if not args.json:
+        print(f"wrote {out['out']}: {out['frames']} frame(s), displacements x {out['exaggerate']:.3g}, "
+              f"seed {out['seed']}, {out['seconds']:.1f} s")
+    return out

@@ -1,0 +1,50 @@
+"""The multirate head: a stiff striker contact substepped, the chain at its own step."""
+import numpy as np
+
+from rig import solve
+from rig.methods import method
+from rig.stepsize import (HEAD_SUBSTEP, Stepping, accuracy_step, contact_time_scale, default_step, fast_head,
+                          stability_limit)
+from conftest import ptfe_rig, record_contacts, steel_sonic_vacuum
+
+SRKN = method("srkn6b")
+
+
+def test_the_alumina_striker_on_the_steel_bead_is_the_head():
+    chain = ptfe_rig(n=30)
+    p = chain.problem(record_contacts(chain, 10))
+    assert fast_head(p) == 1
+    st = default_step(p, SRKN, 1e-4)
+    single = min(accuracy_step(p, SRKN, 1e-4), 0.5 * stability_limit(p, SRKN))  # the single-rate rule
+    assert st.head == 1 and st.dt > 3 * single  # the PTFE contacts allow a step > 3x the striker's
+    assert st.inner_dt == HEAD_SUBSTEP * single
+    uniform = steel_sonic_vacuum(n=40)
+    assert fast_head(uniform.problem(record_contacts(uniform, 10))) == 0  # nothing stiffer: single rate
+
+
+def test_multirate_default_meets_the_accuracy_on_the_first_crossing():
+    # force error of every recorded contact while the pulse crosses the chain, against a
+    # single-rate solve at tau/300; the default target is 1e-4
+    chain = ptfe_rig(n=30)
+    p = chain.problem(record_contacts(chain, 5, 15, 25))
+    ref = solve(p, 0.45e-3, dt=contact_time_scale(p) / 300)
+    for acc in (1e-4, 1e-5):
+        sol = solve(p, 0.45e-3, accuracy=acc)
+        assert sol.stats.dt_s > 6 * default_step(p, SRKN, acc).inner_dt
+        err = max(np.max(np.abs(sol.forces[k] - ref.forces[k])) / np.max(np.abs(ref.forces[k])) for k in ref.forces)
+        assert err < acc, (acc, err)
+        assert sol.stats.energy_error < acc
+        assert sol.stats.momentum_error < 1e-10
+
+
+def test_head_substeps_converge_to_the_exact_head_flow():
+    # the outer step fixed, the head's substep refined: the error falls to the outer step's own
+    chain = ptfe_rig(n=30)
+    p = chain.problem(record_contacts(chain, 10))
+    ref = solve(p, 0.3e-3, dt=contact_time_scale(p) / 300)
+    errs = []
+    for inner in (1e-6, 2.5e-7, 6.25e-8):
+        sol = solve(p, 0.3e-3, dt=Stepping(2e-6, 1, inner))
+        errs.append(np.max(np.abs(sol.forces["c10"] - ref.forces["c10"])) / np.max(np.abs(ref.forces["c10"])))
+    assert errs[0] > errs[1] > errs[2]
+    assert errs[2] < 1e-5
