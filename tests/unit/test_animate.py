@@ -1,0 +1,77 @@
+"""Off-screen animations: the frames themselves, the output checks, the lazy import."""
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from rig.cli import main
+
+SMALL = ["--set", "chain.beads=20", "--set", "gauges.upper.bead=6", "--set", "gauges.lower.bead=12",
+         "--set", "solver.duration=0.5 ms", "--set", "scope.record_length=2000"]
+
+
+def _frames(path):
+    import imageio.v2 as imageio
+
+    return np.stack([np.asarray(f)[..., :3] for f in imageio.mimread(path)])
+
+
+@pytest.fixture(scope="module")
+def movie(tmp_path_factory):
+    pytest.importorskip("pyvista")
+    out = tmp_path_factory.mktemp("anim") / "shot.gif"
+    assert main(["animate", "ptfe52_magnetic", *SMALL, "--seed", "4", "--frames", "12",
+                 "--exaggerate", "20", "--out", str(out), "--quiet"]) == 0
+    return _frames(out)
+
+
+def test_movie_has_the_requested_frames_and_they_are_not_blank(movie):
+    from rig.animate import PANEL_HEIGHT, VIEW_HEIGHT, WIDTH
+
+    assert movie.shape == (12, VIEW_HEIGHT + PANEL_HEIGHT, WIDTH, 3)
+    for frame in movie:
+        assert frame.std() > 10  # beads, tube, text and traces, not a flat background
+
+
+def test_colour_moves_down_the_chain_with_the_wave(movie):
+    # along the chain's row in the 3-D view, the column that warmed most (largest force on
+    # the 'inferno' map) moves right, from the striker towards the wall, as the pulse travels
+    from rig.animate import VIEW_HEIGHT
+
+    view = movie[:, :VIEW_HEIGHT].astype(float)
+    row = view[:, VIEW_HEIGHT // 2 - 3: VIEW_HEIGHT // 2 + 3]  # the chain's axis
+    warm = row[..., 0] - row[..., 2]  # red - blue: 0 on white and grey, high on the orange of a loaded bead
+    warm = warm - warm[0]  # against the first frame: the still parts (wall, magnet, striker) cancel
+    cols = warm.max(axis=1).argmax(axis=1)
+    moving = cols[2:9]  # while the leading pulse crosses (the first frames still show the impact)
+    assert np.all(np.diff(moving) > 0), cols
+    assert not np.array_equal(movie[3], movie[8])  # colours change as the pulse passes
+
+
+def test_still_png(tmp_path):
+    pytest.importorskip("pyvista")
+    import imageio.v2 as imageio
+
+    out = tmp_path / "still.png"
+    assert main(["animate", "ptfe52_magnetic", *SMALL, "--seed", "1", "--frames", "10", "--out", str(out)]) == 0
+    assert np.asarray(imageio.imread(out)).std() > 10
+
+
+@pytest.mark.parametrize("out,message", [("shot.avi", "ending in .mp4, .gif, .png"),
+                                         ("missing/shot.mp4", "does not exist")])
+def test_bad_output_is_refused_before_rendering(tmp_path, capsys, monkeypatch, out, message):
+    import rig.shot
+
+    def no_solving(*a, **k):
+        raise AssertionError("nothing may be computed for a bad --out")
+
+    monkeypatch.setattr(rig.shot.Rig, "from_scene", no_solving)
+    assert main(["animate", "ptfe52_magnetic", "--out", str(tmp_path / out)]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "--out" in err and len(err.strip().splitlines()) == 1
+
+
+def test_the_rig_does_not_import_pyvista():
+    code = "import sys, rig, rig.shot, rig.solve, rig.mc, rig.cli; print('pyvista' in sys.modules or 'vtk' in sys.modules)"
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "False"
