@@ -53,6 +53,7 @@ class Frames:
 def chain_frames(rig, n_frames: int) -> Frames:
     """Solve the rig's shot recording positions at n_frames instants over its duration,
     and install the solution in the rig (its instruments read the same solve)."""
+    from .contact import hertz_force
     from .solve import frame_origin, solve
 
     duration = rig.solver["duration"]
@@ -63,16 +64,12 @@ def chain_frames(rig, n_frames: int) -> Frames:
     rig.use_solution(sol)
     pos = sol.frames[:n_frames]
     u = pos - frame_origin(rig.chain)  # displacements from the static equilibrium (m)
-    off = problem.offset
+    off, beads = problem.offset, len(rig.chain.beads)
     u_all = np.concatenate([u, np.zeros((u.shape[0], 1))], axis=1) if problem.wall_slot else u
-    d = problem.d0[None, 1:] + u_all[:, :-1] - u_all[:, 1:]
-    contact = problem.A[None, 1:] * np.clip(d, 0.0, None) ** 1.5  # whole contact forces, slot 1..
-    beads = len(rig.chain.beads)
-    above = contact[:, off - 1: off - 1 + beads] if off else np.concatenate(
-        [np.zeros((contact.shape[0], 1)), contact[:, :beads - 1]], axis=1)
-    below = contact[:, off: off + beads]
-    if below.shape[1] < beads:  # no wall: the last bead has nothing below
-        below = np.concatenate([below, np.zeros((below.shape[0], 1))], axis=1)
+    # whole contact force of every slot (slot i: bodies i-1 and i; slot 0 and a missing wall: 0)
+    slots = np.zeros((u.shape[0], off + beads + 2))
+    slots[:, 1:u_all.shape[1]] = hertz_force(problem.A[None, 1:], problem.d0[None, 1:] + u_all[:, :-1] - u_all[:, 1:])
+    above, below = slots[:, off: off + beads], slots[:, off + 1: off + 1 + beads]
     return Frames(np.arange(pos.shape[0]) * rec.frame_interval, pos, 0.5 * (above + below), u)
 
 
@@ -82,13 +79,13 @@ class _View:
     def __init__(self, rig, frames: Frames, exaggerate: float):
         import pyvista as pv
 
-        self.pv = pv
         chain, off = rig.chain, int(rig.chain.striker is not None)
         self.off, self.exaggerate = off, exaggerate
         self.x_eq = frames.centres[0]
         radii = np.array([b.radius for b in chain.beads])
         sphere = pv.Sphere(radius=1.0, theta_resolution=18, phi_resolution=12)
         n_pts, tri = sphere.n_points, sphere.faces.reshape(-1, 4)
+        self.n_pts = n_pts
         self.unit = np.tile(sphere.points, (len(radii), 1)) * np.repeat(radii, n_pts)[:, None]
         self.owner = np.repeat(np.arange(len(radii)), n_pts)
         faces = np.concatenate([np.column_stack([tri[:, :1], tri[:, 1:] + k * n_pts]) for k in range(len(radii))])
@@ -152,7 +149,7 @@ class _View:
     def render(self, frames: Frames, k: int) -> np.ndarray:
         x = self.x_eq + self.exaggerate * frames.displacement[k]
         self.beads.points = self._bead_points(x[self.off:])
-        self.beads["average contact force (N)"] = np.repeat(frames.bead_force[k], self.unit.shape[0] // frames.bead_force.shape[1])
+        self.beads["average contact force (N)"] = np.repeat(frames.bead_force[k], self.n_pts)
         if self.striker is not None:
             pts = self.striker_base.copy()
             pts[:, 0] += x[0] - self.x_eq[0]

@@ -15,7 +15,7 @@ from ._kernels.ensemble import integrate_ensemble
 from .errors import RigError, invalid
 from .methods import DEFAULT_METHOD, method as get_method
 from .solve import MAX_CHECKS, time_grid
-from .stepsize import DEFAULT_ACCURACY, Stepping, default_step
+from .stepsize import DEFAULT_ACCURACY, Stepping, default_step, single_rate_step
 
 
 @dataclass(frozen=True, eq=False)
@@ -43,10 +43,9 @@ def ensemble_step(problems, t_end: float, method=DEFAULT_METHOD, accuracy=None) 
     if not problems:
         raise invalid("problems", [], "at least one shot")
     own = [default_step(p, m, acc) for p in problems]
-    heads = {s.head for s in own}
-    if len(heads) == 1 and own[0].head:
+    if own[0].head and all(s.head == own[0].head for s in own):
         return Stepping(min(s.dt for s in own), own[0].head, min(s.inner_dt for s in own))
-    return Stepping(min(s.inner_dt if s.head else s.dt for s in own))
+    return Stepping(min(single_rate_step(p, m, acc) for p in problems))
 
 
 def solve_ensemble(problems: list, t_end: float, *, dt: float | Stepping, method: str = DEFAULT_METHOD,

@@ -136,13 +136,17 @@ def accuracy_step(p, method: Method, accuracy: float, head: int = 0) -> float:
     return tau * (accuracy / (method.error_constant * max(p.moving_bodies, 1))) ** (1.0 / method.contact_order)
 
 
-def default_step(p, method: Method, accuracy: float, limit: float | None = None) -> Stepping:
-    """The stepping a solve takes by itself. Single rate: the accuracy step, at most half
-    the stability limit (``limit``, computed here when not given). With a stiff head
-    (``fast_head``): that same step for the head's substeps, and an outer step from the
-    slow contacts, at most half their stability limit and at most the head's tau."""
-    limit = stability_limit(p, method) if limit is None else limit
-    single = min(accuracy_step(p, method, accuracy), 0.5 * limit)
+def single_rate_step(p, method: Method, accuracy: float) -> float:
+    """The single-rate step (s): the accuracy step, at most half the stability limit."""
+    return min(accuracy_step(p, method, accuracy), 0.5 * stability_limit(p, method))
+
+
+def default_step(p, method: Method, accuracy: float) -> Stepping:
+    """The stepping a solve takes by itself. Single rate: ``single_rate_step``. With a
+    stiff head (``fast_head``): HEAD_SUBSTEP x that step for the head's substeps, and an
+    outer step from the slow contacts, at most half their stability limit and at most the
+    head's tau."""
+    single = single_rate_step(p, method, accuracy)
     head = fast_head(p)
     if head == 0:
         return Stepping(single)

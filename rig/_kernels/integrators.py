@@ -84,6 +84,7 @@ def _synced_velocity(j, v, invm, f2, pending, sched_body, f_sched, head):
 @njit(cache=True, fastmath=False)
 def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, sched_body, f_sched, head, y, r):
     """Channel values y (N, whole contact forces) and rates r (N/s) at a step end."""
+    f2 = f.reshape((f.shape[0], 1))
     for c in range(ch_slot.shape[0]):
         y[c] = 0.0
         r[c] = 0.0
@@ -92,7 +93,6 @@ def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, sched_body, 
             if w != 0.0:
                 s = ch_slot[c, k]
                 y[c] += w * (f[s] + load[s])
-                f2 = f.reshape((f.shape[0], 1))
                 va = _synced_velocity(s - 1, v, invm, f2, pending, sched_body, f_sched, head)
                 vb = _synced_velocity(s, v, invm, f2, pending, sched_body, f_sched, head)
                 r[c] += w * force_rate(s, u, va, vb, A, d0)
