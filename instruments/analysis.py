@@ -18,6 +18,8 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 from scipy.signal import find_peaks, peak_widths
 
+from ._kernels.parabola import parabola
+from ._kernels.prominence import prominence_bases
 from .errors import check
 
 
@@ -79,12 +81,17 @@ def find_pulses(t: np.ndarray, f: np.ndarray, rules: PeakRules = PeakRules(),
     # at least half the least pulse width apart: on 8-bit noisy tops every wiggle is a local
     # maximum, and thinning them before their prominences are computed saves most of the time
     spacing = int(round(max(rules.distance, 0.5 * rules.width) / h))
-    idx, props = find_peaks(f, height=rules.height * peak if floor is None else floor,
-                            prominence=rules.prominence * peak,
-                            distance=spacing if spacing > 1 else None)
+    idx, _ = find_peaks(f, height=rules.height * peak if floor is None else floor,
+                        distance=spacing if spacing > 1 else None)
+    # the prominence rule, applied after the distance rule as find_peaks applies it, with
+    # the same bases found in one pass (find_peaks scans from each candidate: O(n) each)
+    left, right = prominence_bases(np.ascontiguousarray(f, dtype=float))
+    left, right = left[idx], right[idx]
+    prominence = f[idx] - np.maximum(f[left], f[right])
+    keep = prominence >= rules.prominence * peak
+    idx, prominence, left, right = idx[keep], prominence[keep], left[keep], right[keep]
     if rules.width > 0 and idx.size:  # widths only for the candidates left (noise makes many maxima)
-        widths = peak_widths(f, idx, rel_height=0.5,
-                             prominence_data=(props["prominences"], props["left_bases"], props["right_bases"]))[0]
+        widths = peak_widths(f, idx, rel_height=0.5, prominence_data=(prominence, left, right))[0]
         idx = idx[widths >= rules.width / h]
     coarse = [Pulse(float(t[i]), float(f[i]), math.nan, math.nan) for i in idx]
     return [refined(t, f, p, rules) for p in coarse] if refine else coarse
@@ -117,14 +124,14 @@ def _vertex(t, f, i, top):
     lo, hi = min(lo, i - 1), max(hi, i + 1)
     if lo < 0 or hi >= f.size:
         return float(t[i]), float(f[i])
-    x = t[lo:hi + 1] - t[i]
-    a, b, c = np.polyfit(x, f[lo:hi + 1], 2)
-    if a >= 0:
+    x = np.arange(lo - i, hi - i + 1, dtype=float)  # in samples from i
+    a, b, c = parabola(x, np.ascontiguousarray(f[lo:hi + 1], dtype=float))
+    if not a < 0:
         return float(t[i]), float(f[i])
     xv = -b / (2 * a)
     if not x[0] <= xv <= x[-1]:
         return float(t[i]), float(f[i])
-    return float(t[i] + xv), float(c - b * b / (4 * a))
+    return float(t[i] + xv * (t[1] - t[0])), float(c - b * b / (4 * a))
 
 
 def _crossings(t, f, i, level):

@@ -11,7 +11,7 @@ the total F_m = F_d + F_0.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
@@ -104,8 +104,10 @@ def record_forces(record: ScopeRecord, setup: Setup):
     return t, out
 
 
-def analyze_forces(t: np.ndarray, forces: dict, setup: Setup) -> Report:
-    """Speed, amplitudes, pulse count and widths from dynamic forces (baseline 0)."""
+def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True) -> Report:
+    """Speed, amplitudes, pulse count and widths from dynamic forces (baseline 0).
+    train=False leaves the solitary train uncounted (pulses None): studies that need only
+    the leading pulse skip the wall channel and two peak searches."""
     rules = setup.rules
     up = leading(find_pulses(t, forces["upper"], rules, refine=False), rules)
     low = leading(find_pulses(t, forces["lower"], rules, refine=False), rules)
@@ -125,8 +127,9 @@ def analyze_forces(t: np.ndarray, forces: dict, setup: Setup) -> Report:
     rep.duration_s = up.fwhm
     rep.base_duration_s = up.base_width
     rep.width_diameters = up.fwhm * rep.speed_m_per_s / setup.bead_diameter_m
-    cut = reflection_time(t, forces, setup, low, rep.speed_m_per_s)
-    rep.pulses = len(solitary_train(t, forces["lower"], low, cut, rules))
+    if train:
+        cut = reflection_time(t, forces, setup, low, rep.speed_m_per_s)
+        rep.pulses = len(solitary_train(t, forces["lower"], low, cut, rules))
     rep.leading = {"upper": asdict(up), "lower": asdict(low)}
     return rep
 
@@ -150,9 +153,12 @@ def reflection_time(t, forces, setup: Setup, low, speed) -> float:
     return math.inf
 
 
-def analyze_record(record: ScopeRecord, setup: Setup) -> Report:
-    """The full pipeline on one scope record; an untriggered record gives an empty report."""
+def analyze_record(record: ScopeRecord, setup: Setup, train: bool = True) -> Report:
+    """The full pipeline on one scope record; an untriggered record gives an empty report.
+    train=False: the leading pulse only (see analyze_forces; the wall channel is not read)."""
     if not record.triggered:
         return Report(beta=setup.beta, static_force_N=setup.static_force_N)
+    if not train:
+        setup = replace(setup, wall=None)
     t, forces = record_forces(record, setup)
-    return analyze_forces(t, forces, setup)
+    return analyze_forces(t, forces, setup, train)

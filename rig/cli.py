@@ -89,6 +89,8 @@ def build_parser() -> argparse.ArgumentParser:
     mc.add_argument("--window", choices=["leading", "record"], default="leading",
                     help="simulate until the leading pulse has passed the last gauge (default), "
                          "or the scene's whole record")
+    mc.add_argument("--traces", action="store_true",
+                    help="also archive every shot's scope record and truth in DIR/traces/ (one archive per batch)")
     mc.add_argument("--out", required=True, metavar="DIR")
     mc.add_argument("--quiet", action="store_true", help="no progress bar")
 

@@ -10,25 +10,28 @@ the instruments and the analysis. Every finished batch is written to its own fil
 """
 from __future__ import annotations
 
+import contextlib
 import copy
 import functools
+import gc
 import math
 import hashlib
 import json
 import os
 import tempfile
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import h5py
 import numpy as np
 
+from instruments.archive import Archive
+from instruments.pipeline import analyze_record
+
 from . import scene as scene_io
 from .ensemble import ensemble_step, solve_ensemble
 from .errors import RigError, invalid
 from .methods import method as get_method
-from instruments.pipeline import analyze_record
-
 from .measure import midway_static_force, setup_for
 from .shot import Rig
 from .solution import Solution, SolverStats
@@ -50,6 +53,7 @@ class Study:
     sobol: bool = False
     truth: bool = False  # also analyse each shot's noise-free truth (slower)
     window: str = "leading"  # "leading": simulate until the leading pulse is past the last gauge; "record": the scene's
+    traces: bool = False  # also archive every shot's scope record and truth (DIR/traces/)
 
     def __post_init__(self):
         if self.window not in WINDOWS:
@@ -66,7 +70,8 @@ class Study:
     def spec(self) -> dict:
         return {"scene": str(self.scene), "dists": [asdict(d) for d in self.dists], "shots": self.shots,
                 "seed": self.seed, "overrides": list(self.overrides), "batch": self.batch,
-                "accuracy": self.accuracy, "sobol": self.sobol, "truth": self.truth, "window": self.window}
+                "accuracy": self.accuracy, "sobol": self.sobol, "truth": self.truth, "window": self.window,
+                "traces": self.traces}
 
     def digest(self) -> str:
         return hashlib.sha256(json.dumps(self.spec(), sort_keys=True).encode()).hexdigest()[:16]
@@ -190,8 +195,27 @@ def _rig_for(study: Study, x: dict, masses) -> tuple:
     return Rig(v, text, tuple(study.overrides), bead_masses=masses), draws
 
 
+@contextlib.contextmanager
+def _collector_paused():
+    """Python's cycle collector off while a batch builds its rigs: it would walk the many
+    small objects of every rig again and again (a quarter of a batch's time); whatever
+    cycles the batch leaves are collected on the next collection after it."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
+
+
 def run_batch(study: Study, b: int) -> dict:
     """Batch b of the study: inputs, outputs and seeds of its shots (plain arrays)."""
+    with _collector_paused():
+        return _run_batch(study, b)
+
+
+def _run_batch(study: Study, b: int) -> dict:
     shots = study.shots_of(b)
     lo, hi = shots.start, shots.stop
     _, _, base = _base(study.scene, tuple(study.overrides))
@@ -213,6 +237,7 @@ def run_batch(study: Study, b: int) -> dict:
     dt = ensemble_step(problems, t_end, base.solver["method"], study.accuracy or base.solver["accuracy"])
     ens = solve_ensemble(problems, t_end, dt=dt, method=base.solver["method"])
     out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
+    traces = []
     beta, F0 = nominal_calibration(study.scene, tuple(study.overrides))
     for j, (rig, p) in enumerate(zip(rigs, problems)):
         stats = SolverStats(base.solver["method"], ens.dt, ens.steps,
@@ -221,7 +246,11 @@ def run_batch(study: Study, b: int) -> dict:
         forces = {name: a[j] for name, a in ens.forces.items()}
         rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))
         shot = rig.fire(seed=seeds[j], fixed=draws[j], truth=False)
-        m = analyze_record(shot.scope, setup_for(rig, beta, F0))
+        if study.traces:  # each shot has its own scene values and truth: nothing shared between shots
+            e = shot.to_entry()
+            traces.append(replace(e, truth_key=None,
+                                  truth_attrs={**e.truth_attrs, "study_shot": lo + j, "study": study.digest()}))
+        m = analyze_record(shot.scope, setup_for(rig, beta, F0), train=False)  # leading pulse only
         t = rig.truth_analysis() if study.truth else None
         for key, val in (("speed_m_per_s", m.speed_m_per_s), ("speed_xcorr_m_per_s", m.speed_xcorr_m_per_s),
                          ("amplitude_N", m.amplitude_N), ("averaged_amplitude_N", m.averaged_amplitude_N),
@@ -229,16 +258,19 @@ def run_batch(study: Study, b: int) -> dict:
                          ("energy_error", stats.energy_error), ("dt_s", ens.dt)):
             out[key][j] = np.nan if val is None else val
     return {"batch": b, "index": np.arange(lo, hi), "inputs": np.array(xs, dtype=float).reshape(hi - lo, len(study.keys)),
-            "seeds": np.array(seeds, dtype=np.int64), "outputs": out}
+            "seeds": np.array(seeds, dtype=np.int64), "outputs": out, "traces": traces}
 
 
 class Store:
-    """DIR/study.json (the study), DIR/batches/batch_NNNNNN.h5 (one per finished batch)."""
+    """DIR/study.json (the study), DIR/batches/batch_NNNNNN.h5 (one per finished batch) and,
+    for a study with traces, DIR/traces/batch_NNNNNN.h5 (a shot archive per batch, written
+    before the batch counts as finished)."""
 
     def __init__(self, folder, study: Study):
         self.folder = Path(folder)
         self.study = study
         self.batches = self.folder / "batches"
+        self.traces = self.folder / "traces"
 
     def open(self):
         self.batches.mkdir(parents=True, exist_ok=True)
@@ -257,6 +289,11 @@ class Store:
         return {int(p.stem.split("_")[1]) for p in self.batches.glob("batch_*.h5")}
 
     def write(self, result: dict):
+        if result.get("traces"):
+            self.traces.mkdir(exist_ok=True)
+            archive = self.traces / f"batch_{result['batch']:06d}.h5"
+            archive.unlink(missing_ok=True)  # left by an interrupted run: that batch did not finish
+            Archive(archive).append(result["traces"])
         fd, tmp = tempfile.mkstemp(dir=self.batches, suffix=".tmp")
         os.close(fd)
         try:

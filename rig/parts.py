@@ -6,6 +6,7 @@ and every field is validated there (a RigError names the field and the allowed r
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, fields
 
@@ -21,16 +22,25 @@ _UNITS = {"diameter": "m", "mass": "kg", "caps_mass": "kg", "plate_mass": "kg",
           "velocity": "m/s", "gap": "m"}
 
 
+@functools.cache
+def _unit_fields(cls) -> tuple:
+    """The fields of a part class that carry a unit."""
+    return tuple(f.name for f in fields(cls) if f.name in _UNITS)
+
+
 class _Part:
     """Shared construction: look the material up, convert quantities, validate."""
 
     def _convert(self, prefix: str):
-        object.__setattr__(self, "material", material(self.material))
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if f.name in _UNITS and value is not None:
-                object.__setattr__(self, f.name,
-                                   quantity(value, _UNITS[f.name], f"{prefix}.{f.name}", bare_ok=True))
+        if not isinstance(self.material, Material):
+            object.__setattr__(self, "material", material(self.material))
+        for name in _unit_fields(type(self)):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            if type(value) is float and math.isfinite(value):  # SI already (studies build many parts)
+                continue
+            object.__setattr__(self, name, quantity(value, _UNITS[name], f"{prefix}.{name}", bare_ok=True))
 
     def _positive(self, prefix: str, *names):
         for name in names:

@@ -65,13 +65,12 @@ class ChainProblem:
         d0 = np.zeros(nb)
         f0 = np.zeros(nb)
         d_limit = np.full(nb, math.inf)
-        radii = [b.radius for b in chain.beads]
-        for k in range(n + 1):
-            slot = k + off
-            if np.isfinite(A_c[k]) and 0 < slot < nb:
-                A[slot], d0[slot], f0[slot] = A_c[k], d_c[k], F_c[k]
-                near = [radii[j] for j in (k - 1, k) if 0 <= j < n]
-                d_limit[slot] = 0.5 * min(near)
+        radii = np.array([b.radius for b in chain.beads])
+        near = np.minimum(np.append(math.inf, radii), np.append(radii, math.inf))  # contact k: beads k-1, k
+        slot = np.arange(n + 1) + off
+        live = np.isfinite(A_c) & (slot > 0) & (slot < nb)
+        A[slot[live]], d0[slot[live]], f0[slot[live]] = A_c[live], d_c[live], F_c[live]
+        d_limit[slot[live]] = 0.5 * near[live]
         if off:
             d0[1] = -chain.striker.gap
         damping = np.full(nb, chain.damping_time)

@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .integrators import _hermite
+from .integrators import hermite, hermite_weights
 from .multirate import head_flow, slow_net
 
 
@@ -150,6 +150,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
     worst = np.empty(W)
     net = np.empty(W)
     j_wall = np.zeros(W)
+    w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
     _energy(u, v, mass, bias, A, d0, e0)
     _momentum(v, mass, p0)
     for s in range(u.shape[1]):
@@ -185,11 +186,13 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
         j_end = j_out
         while j_end < n_out and j_end * sample_dt <= t_new * (1.0 + 1e-12):
             j_end += 1
+        for j in range(j_out, j_end):  # the weights are the same for every shot and channel
+            hermite_weights((j * sample_dt - t) / dt, dt, w, j - j_out)
         for s in range(u.shape[1]):  # each shot's samples are contiguous: write them in runs
             for c in range(n_ch):
+                y0, r0, y1, r1 = y_old[c, s], r_old[c, s], y_new[c, s], r_new[c, s]
                 for j in range(j_out, j_end):
-                    x = (j * sample_dt - t) / dt
-                    out[s, c, j] = _hermite(x, dt, y_old[c, s], r_old[c, s], y_new[c, s], r_new[c, s])
+                    out[s, c, j] = hermite(w, j - j_out, y0, r0, y1, r1)
         j_out = j_end
         for c in range(n_ch):
             for s in range(u.shape[1]):

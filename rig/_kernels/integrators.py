@@ -99,12 +99,22 @@ def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, sched_body, 
 
 
 @njit(cache=True, fastmath=False)
-def _hermite(s, h, y0, r0, y1, r1):
-    """Cubic Hermite interpolant at fraction s of a step of length h."""
-    s2 = s * s
-    s3 = s2 * s
-    return ((2.0 * s3 - 3.0 * s2 + 1.0) * y0 + (s3 - 2.0 * s2 + s) * h * r0
-            + (3.0 * s2 - 2.0 * s3) * y1 + (s3 - s2) * h * r1)
+def hermite_weights(x, h, w, k):
+    """Column k of w (4, n) gets the weights of the cubic Hermite interpolant at fraction x
+    of a step of h seconds: y(x) = w0 y0 + w1 r0 + w2 y1 + w3 r1 (values y, rates r at the
+    step's ends)."""
+    x2 = x * x
+    x3 = x2 * x
+    w[0, k] = 2.0 * x3 - 3.0 * x2 + 1.0
+    w[1, k] = (x3 - 2.0 * x2 + x) * h
+    w[2, k] = 3.0 * x2 - 2.0 * x3
+    w[3, k] = (x3 - x2) * h
+
+
+@njit(cache=True, fastmath=False)
+def hermite(w, k, y0, r0, y1, r1):
+    """The interpolant with the weights of column k (hermite_weights)."""
+    return w[0, k] * y0 + w[1, k] * r0 + w[2, k] * y1 + w[3, k] * r1
 
 
 @njit(cache=True, fastmath=False)
@@ -148,6 +158,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
     r_old = np.empty(n_ch)
     y_new = np.empty(n_ch)
     r_new = np.empty(n_ch)
+    w = np.empty((4, 1))
     _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, 0.0, sched_body, 0.0, head, y_old, r_old)
     if n_out > 0:
         for c in range(n_ch):
@@ -209,17 +220,17 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
         _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, sched_body, fe_new, head,
                y_new, r_new)
         while j_out < n_out and j_out * sample_dt <= t_new * (1.0 + 1e-12):
-            s = (j_out * sample_dt - t) / dt
+            hermite_weights((j_out * sample_dt - t) / dt, dt, w, 0)
             for c in range(n_ch):
-                out[c, j_out] = _hermite(s, dt, y_old[c], r_old[c], y_new[c], r_new[c])
+                out[c, j_out] = hermite(w, 0, y_old[c], r_old[c], y_new[c], r_new[c])
             j_out += 1
         for c in range(n_ch):
             y_old[c] = y_new[c]
             r_old[c] = r_new[c]
         while j_frame < n_frames and j_frame * frame_dt <= t_new * (1.0 + 1e-12):
-            s = (j_frame * frame_dt - t) / dt
+            hermite_weights((j_frame * frame_dt - t) / dt, dt, w, 0)
             for i in range(nb):
-                frames[j_frame, i] = _hermite(s, dt, u_old[i], v_old[i], u[i], v[i])
+                frames[j_frame, i] = hermite(w, 0, u_old[i], v_old[i], u[i], v[i])
             j_frame += 1
 
         if check:

@@ -170,7 +170,7 @@ def cmd_mc(args) -> dict:
             print(f"Sobol design over {len(dists)} inputs: {shots} shots "
                   f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
     study = Study(args.scene, dists, shots, args.seed, tuple(args.set or ()), args.batch, args.accuracy,
-                  args.sobol, args.truth, args.window)
+                  args.sobol, args.truth, args.window, args.traces)
     if not study.dists:
         raise RigError("--vary: give at least one uncertain input, e.g. striker.velocity=\"normal(0.89 m/s, 0.01 m/s)\"")
     _, _, base = _base(study.scene, study.overrides)  # the scene must be valid before any shot

@@ -128,3 +128,32 @@ def test_leading_window_measures_what_the_whole_record_measures():
     for key in ("speed_m_per_s", "amplitude_N"):
         assert np.all(np.isfinite(a[key]))
         np.testing.assert_allclose(a[key], b[key], rtol=1e-6)
+
+
+def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(tmp_path):
+    # --traces: each batch's shots go to a shot archive of their own (scope codes and truth),
+    # and the pipeline run on an archived record gives the speed the study stored
+    from instruments.archive import Archive
+    from instruments.pipeline import analyze_record
+    from rig.mc import _rig_for, nominal_calibration, shot_inputs
+    from rig.measure import setup_for
+
+    plain = Store(tmp_path / "plain", _study(32)).open()
+    run_study(_study(32), plain)
+    assert not (tmp_path / "plain" / "traces").exists()
+    study = _study(32, traces=True)
+    store = Store(tmp_path / "t", study).open()
+    run_study(study, store)
+    archives = sorted((tmp_path / "t" / "traces").glob("batch_*.h5"))
+    assert [p.name for p in archives] == ["batch_000000.h5", "batch_000001.h5"]
+    entries = [Archive(archives[1]).read(i) for i in Archive(archives[1]).ids()]
+    assert len(entries) == 16
+    e = entries[3]
+    assert e.truth_attrs["study_shot"] == 19 and e.truth is not None
+    beta, F0 = nominal_calibration(study.scene, ())
+    rig = _rig_for(study, *shot_inputs(study, 19, 52)[:2])[0]
+    speed = analyze_record(e.record, setup_for(rig, beta, F0), train=False).speed_m_per_s
+    assert speed == store.collect()["outputs"]["speed_m_per_s"][19]
+    # the traces do not change the results
+    for k, v in plain.collect()["outputs"].items():
+        assert np.array_equal(store.collect()["outputs"][k], v, equal_nan=True)

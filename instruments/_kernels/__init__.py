@@ -1,0 +1,1 @@
+"""Compiled helpers of the analysis (numba)."""
