@@ -15,9 +15,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
 from scipy.signal import find_peaks, peak_widths
 
+from ._kernels.filters import undo_highpass
 from ._kernels.parabola import parabola
 from ._kernels.prominence import prominence_bases
 from .errors import check
@@ -30,7 +30,7 @@ def remove_baseline(y: np.ndarray, n_pre: int) -> np.ndarray:
 
 def invert_rc(y: np.ndarray, h: float, tau: float) -> np.ndarray:
     """Undo a one-pole RC high-pass of time constant tau (s): x = y + (1/tau) int y dt."""
-    return y + cumulative_trapezoid(y, dx=h, initial=0.0) / tau
+    return undo_highpass(np.ascontiguousarray(y, dtype=float), float(h), float(tau))
 
 
 @dataclass(frozen=True)
@@ -81,11 +81,11 @@ def find_pulses(t: np.ndarray, f: np.ndarray, rules: PeakRules = PeakRules(),
     # at least half the least pulse width apart: on 8-bit noisy tops every wiggle is a local
     # maximum, and thinning them before their prominences are computed saves most of the time
     spacing = int(round(max(rules.distance, 0.5 * rules.width) / h))
-    idx, _ = find_peaks(f, height=rules.height * peak if floor is None else floor,
-                        distance=spacing if spacing > 1 else None)
+    height = rules.height * peak if floor is None else floor
+    idx, _ = find_peaks(f, height=height, distance=spacing if spacing > 1 else None)
     # the prominence rule, applied after the distance rule as find_peaks applies it, with
     # the same bases found in one pass (find_peaks scans from each candidate: O(n) each)
-    left, right = prominence_bases(np.ascontiguousarray(f, dtype=float))
+    left, right = prominence_bases(np.ascontiguousarray(f, dtype=float), float(height))
     left, right = left[idx], right[idx]
     prominence = f[idx] - np.maximum(f[left], f[right])
     keep = prominence >= rules.prominence * peak

@@ -16,15 +16,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.signal import lfilter
+
+from ._kernels.filters import one_pole
+from ._kernels.resample import at_positions
 
 
 def rc_highpass(x: np.ndarray, h: float, tau: float) -> np.ndarray:
     """One-pole RC high-pass of time constant tau (s); y = 0 for a constant input."""
     a = math.exp(-h / tau)
     g = tau / h * (1.0 - a)
-    y = lfilter([g, -g], [1.0, -a], x - x[0])
-    return y
+    return one_pole(np.ascontiguousarray(x, dtype=float), g, -g, -a, float(x[0]), False)
 
 
 def lowpass(x: np.ndarray, h: float, bandwidth: float) -> np.ndarray:
@@ -32,12 +33,10 @@ def lowpass(x: np.ndarray, h: float, bandwidth: float) -> np.ndarray:
     tau = 1.0 / (2.0 * math.pi * bandwidth)
     a = math.exp(-h / tau)
     g = tau / h * (1.0 - a)
-    y = lfilter([1.0 - g, g - a], [1.0, -a], x - x[0])
-    return y + x[0]
+    return one_pole(np.ascontiguousarray(x, dtype=float), 1.0 - g, g - a, -a, float(x[0]), True)
 
 
 def delay(x: np.ndarray, h: float, shift: float) -> np.ndarray:
     """x delayed by ``shift`` seconds (may be negative, sub-sample), by linear interpolation;
     the ends are held."""
-    n = np.arange(x.size)
-    return np.interp(n - shift / h, n, x)
+    return at_positions(np.ascontiguousarray(x, dtype=float), np.arange(x.size) - shift / h)

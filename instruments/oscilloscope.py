@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import InstrumentError, check
+from ._kernels.quantiser import quantise
+from ._kernels.resample import at_positions
 from .frontend import lowpass, rc_highpass
 from .records import Preamble, ScopeRecord, Waveform
 
@@ -141,7 +143,7 @@ class Oscilloscope:
                 f"record a longer input or shorten the record")
         waves = {}
         for ch, s in self.channels.items():
-            v = np.interp(t / h, np.arange(n_in), analog[ch])
+            v = at_positions(analog[ch], t / h)  # linear between the input's samples
             waves[ch] = self._digitise(ch, s, v, x_zero, n_pre, rng)
         return ScopeRecord(waves, True, None, t_cross)
 
@@ -156,13 +158,13 @@ class Oscilloscope:
     def _digitise(self, ch, s: ChannelSettings, v, x_zero, n_pre, rng) -> Waveform:
         ymult = s.y_multiplier
         yoff = s.position * CODES_PER_DIV
-        codes_f = (v - s.offset) / ymult + yoff
+        sd, noise = 0.0, np.empty(0)
         if self.noise_floor:  # the mean of N acquisitions' noise: sd / sqrt(N)
             sd = self.noise_floor * s.probe / ymult / math.sqrt(self.averages)
-            codes_f = codes_f + sd * rng.standard_normal(v.size)
-        codes_f = np.rint(codes_f)
-        overrange = bool(np.any(codes_f > CODE_MAX) or np.any(codes_f < CODE_MIN))
-        codes = np.clip(codes_f, CODE_MIN, CODE_MAX).astype(np.int8)
+            noise = rng.standard_normal(v.size)
+        # codes = round((v - offset) / ymult + yoff + sd * noise), clipped to 8 bits
+        codes, overrange = quantise(np.ascontiguousarray(v, dtype=float), float(s.offset), ymult, yoff, sd, noise,
+                                    float(CODE_MIN), float(CODE_MAX))
         pre = Preamble(points=v.size, x_increment=self.timebase.sample_interval, x_zero=x_zero,
                        trigger_index=n_pre, y_multiplier=ymult, y_offset=yoff, y_zero=s.offset,
                        byte_count=1,

@@ -130,7 +130,7 @@ def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True
     if train:
         cut = reflection_time(t, forces, setup, low, rep.speed_m_per_s)
         rep.pulses = len(solitary_train(t, forces["lower"], low, cut, rules))
-    rep.leading = {"upper": asdict(up), "lower": asdict(low)}
+    rep.leading = {"upper": dict(vars(up)), "lower": dict(vars(low))}  # a Pulse holds floats only
     return rep
 
 

@@ -155,8 +155,13 @@ class Chain:
         A = np.full(self.n_beads + 1, np.nan)
         if self.striker is not None:
             A[0] = contact_constant(self.striker.material, math.inf, b[0].material, b[0].radius)
+        pairs = {}  # a chain repeats the same pair of beads many times
         for k in range(1, self.n_beads):
-            A[k] = contact_constant(b[k - 1].material, b[k - 1].radius, b[k].material, b[k].radius)
+            up, down = b[k - 1], b[k]
+            key = (id(up.material), up.diameter, id(down.material), down.diameter)
+            if key not in pairs:
+                pairs[key] = contact_constant(up.material, up.radius, down.material, down.radius)
+            A[k] = pairs[key]
         if self.wall is not None:
             A[-1] = contact_constant(b[-1].material, b[-1].radius, self.wall.material, math.inf)
         return A
@@ -187,11 +192,12 @@ class Chain:
         return self._cached("x", self._equilibrium_positions)
 
     def _equilibrium_positions(self) -> np.ndarray:
-        b = self.beads
-        d0 = self.static_overlaps()
-        x = np.zeros(self.n_beads)
+        r = [bead.radius for bead in self.beads]
+        d0 = self.static_overlaps().tolist()
+        x = [0.0] * self.n_beads
         for k in range(1, self.n_beads):
-            x[k] = x[k - 1] + b[k - 1].radius + b[k].radius - d0[k]
+            x[k] = x[k - 1] + r[k - 1] + r[k] - d0[k]
+        x = np.array(x)
         return x
 
     def wall_position(self) -> float:

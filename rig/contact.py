@@ -10,7 +10,6 @@ A flat face (striker, wall) has R = infinity, so R_eff is the sphere's radius.
 """
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
@@ -30,7 +29,6 @@ def hertz_constant(E1: float, nu1: float, R1: float, E2: float, nu2: float,
     return 4.0 / 3.0 * e_eff * math.sqrt(1.0 / curvature)
 
 
-@functools.lru_cache(maxsize=1024)  # a chain repeats the same pair of beads many times
 def contact_constant(m1: Material, R1: float, m2: Material, R2: float = math.inf) -> float:
     """Hertz constant between two parts made of materials m1, m2 (radii in m, inf = flat)."""
     return hertz_constant(m1.E, m1.nu, R1, m2.E, m2.nu, R2)

@@ -11,7 +11,6 @@ the instruments and the analysis. Every finished batch is written to its own fil
 from __future__ import annotations
 
 import contextlib
-import copy
 import functools
 import gc
 import math
@@ -37,6 +36,7 @@ from .shot import Rig
 from .solution import Solution, SolverStats
 
 WINDOWS = ("leading", "record")
+TAIL_FWHM = 3.0  # the leading window ends this many widths after the last gauge's leading peak
 OUTPUTS = ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_amplitude_N",
            "truth_speed_m_per_s", "truth_amplitude_N", "energy_error", "dt_s")
 
@@ -103,18 +103,20 @@ def nominal_calibration(scene: str, overrides: tuple) -> tuple:
 @functools.lru_cache(maxsize=4)
 def leading_window(scene: str, overrides: tuple) -> tuple:
     """(duration in s, scope record length, pre-trigger fraction) of a study that needs
-    only the leading pulse: simulated until the nominal shot's leading pulse at the last
-    gauge is past (peak time + base width); the scope keeps the scene's pre-trigger
-    samples (the baseline comes from them) and records after the trigger only as long as
-    the simulation lasts, the trigger taken at the nominal time + 5% (shot-to-shot spread)."""
+    only the leading pulse: simulated until TAIL_FWHM full widths after the nominal shot's
+    leading pulse peaks at the last gauge (the cross-correlation searches 2 widths around
+    it; the third covers the shot-to-shot spread of its arrival); the scope keeps the
+    scene's pre-trigger samples (the baseline comes from them) and records after the
+    trigger only as long as the simulation lasts, the trigger taken at the nominal time +
+    5% (shot-to-shot spread)."""
     _, _, rig = _base(scene, overrides)
     lead = rig.truth_analysis().leading
     last = lead.get("lower") or lead.get("upper")
     shot = rig.fire(seed=0, truth=False)
     tb, pre = rig.scope.timebase, rig.scope.trigger.pre_trigger
-    if not last or not last.get("base_width") or not shot.scope.triggered:
+    if not last or not last.get("fwhm") or not shot.scope.triggered:
         return rig.solver["duration"], tb.record_length, pre
-    duration = min(rig.solver["duration"], last["time"] + last["base_width"])
+    duration = min(rig.solver["duration"], last["time"] + TAIL_FWHM * last["fwhm"])
     n_pre = int(round(pre * tb.record_length))
     n_post = int((duration - 1.05 * shot.scope.trigger_time) / tb.sample_interval)
     if n_post <= 0 or n_pre + n_post >= tb.record_length:
@@ -169,17 +171,28 @@ def study_duration(study: Study) -> float:
     return _base(study.scene, tuple(study.overrides))[2].solver["duration"]
 
 
+def _table(v: dict, path) -> dict:
+    """The table at ``path`` in v, after copying every table along it (copy on write: the
+    scene's other tables stay shared with the nominal values, which nothing modifies)."""
+    node = v
+    for p in path:
+        node[p] = dict(node.get(p, {}))
+        node = node[p]
+    return node
+
+
 def _rig_for(study: Study, x: dict, masses) -> tuple:
     values, text, base = _base(study.scene, tuple(study.overrides))
-    v = copy.deepcopy(values)
+    v = dict(values)
+    solver, scope = _table(v, ["solver"]), _table(v, ["scope"])
     # the solver records at the scope's sampling rate (the scope reads nothing finer)
-    scope_dt = v.get("scope", {}).get("sample_interval")
-    if scope_dt and scope_dt > v["solver"].get("sample_interval", 1e-7):
-        v["solver"]["sample_interval"] = scope_dt
+    scope_dt = scope.get("sample_interval")
+    if scope_dt and scope_dt > solver.get("sample_interval", 1e-7):
+        solver["sample_interval"] = scope_dt
     if study.window == "leading":
         duration, length, pre = leading_window(study.scene, tuple(study.overrides))
-        v["solver"]["duration"], v["scope"]["record_length"] = duration, length
-        v["scope"].setdefault("trigger", {})["pre_trigger"] = pre
+        solver["duration"], scope["record_length"] = duration, length
+        _table(v, ["scope", "trigger"])["pre_trigger"] = pre
     draws = {}
     for key, val in x.items():
         parts = key.split(".")
@@ -188,10 +201,7 @@ def _rig_for(study: Study, x: dict, masses) -> tuple:
             continue
         if key == "chain.bead_mass":
             continue
-        node = v
-        for p in parts[:-1]:
-            node = node.setdefault(p, {})
-        node[parts[-1]] = val
+        _table(v, parts[:-1])[parts[-1]] = val
     return Rig(v, text, tuple(study.overrides), bead_masses=masses), draws
 
 

@@ -68,6 +68,16 @@ class Bead(_Part):
     def radius(self) -> float:
         return 0.5 * self.diameter
 
+    def with_mass(self, mass: float) -> "Bead":
+        """This bead with another mass (kg, > 0), its other fields taken as they are (already
+        converted and checked): the bead-to-bead scatter of a study builds many."""
+        if not (isinstance(mass, float) and math.isfinite(mass) and mass > 0):
+            raise invalid("bead.mass", mass, "must be > 0 kg")
+        bead = object.__new__(type(self))
+        bead.__dict__.update(self.__dict__)
+        object.__setattr__(bead, "mass", mass)
+        return bead
+
     kind = "bead"
 
 

@@ -107,6 +107,16 @@ class ChainProblem:
                    off, sched_t, sched_f, names, ch_slot, ch_weight,
                    nb - 1 if chain.wall is not None else 0, e_scale, p_scale)
 
+    def derived(self, name: str, compute):
+        """A quantity derived from the problem (which never changes), computed once; the
+        array handed out is read-only."""
+        memo = self.__dict__.setdefault("_derived", {})
+        if name not in memo:
+            value = compute()
+            value.setflags(write=False)
+            memo[name] = value
+        return memo[name]
+
     @property
     def n_bodies(self) -> int:
         return self.mass.shape[0]

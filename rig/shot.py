@@ -132,7 +132,7 @@ class Rig:
         else:
             if len(self.bead_masses) != n:
                 raise invalid("bead_masses", len(self.bead_masses), f"one mass per plain bead ({n})")
-            plain_beads = [Bead(mat, plain.diameter, m) for m in self.bead_masses]
+            plain_beads = [plain.with_mass(m) for m in self.bead_masses]
         beads = ([MagneticBead()] if magnetic else []) + plain_beads
         self.gauges = {}
         for name, g in sorted(v.get("gauges", {}).items()):
@@ -287,6 +287,5 @@ def _first_peak_time(f: np.ndarray, h: float) -> float | None:
     if dyn.max() <= 0:
         return None
     i = int(np.argmax(dyn > 0.5 * dyn.max()))
-    while i + 1 < dyn.size and dyn[i + 1] >= dyn[i]:
-        i += 1
-    return i * h
+    falls = np.flatnonzero(dyn[i + 1:] < dyn[i:-1])  # climb from i to the first sample that falls
+    return (i + int(falls[0]) if falls.size else dyn.size - 1) * h

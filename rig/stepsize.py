@@ -67,7 +67,12 @@ def _reduced_masses(p) -> np.ndarray:
 
 
 def contact_time_scales(p) -> np.ndarray:
-    """tau (s) of each contact slot (formula in the module doc; inf where no contact)."""
+    """tau (s) of each contact slot (formula in the module doc; inf where no contact);
+    computed once per problem."""
+    return p.derived("contact_time_scales", lambda: _contact_time_scales(p))
+
+
+def _contact_time_scales(p) -> np.ndarray:
     m = _reduced_masses(p)
     live = p.A > 0
     tau = np.full(p.n_bodies, np.inf)

@@ -1,0 +1,114 @@
+"""The compiled helpers of the instruments and the analysis give what scipy and numpy give,
+to the last bit where they replace a library call (compared as raw 64-bit patterns)."""
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import cumulative_trapezoid
+from scipy.signal import find_peaks, lfilter, peak_prominences
+
+from instruments._kernels.filters import one_pole, undo_highpass
+from instruments._kernels.parabola import parabola
+from instruments._kernels.prominence import prominence_bases
+from instruments._kernels.quantiser import quantise
+from instruments._kernels.resample import at_positions
+
+
+def _same_bits(a, b):
+    return a.shape == b.shape and np.array_equal(np.asarray(a, float).view(np.int64), np.asarray(b, float).view(np.int64))
+
+
+def _signals():
+    rng = np.random.default_rng(7)
+    for k in range(240):
+        n = int(rng.integers(3, 600))
+        if k % 3 == 0:
+            yield rng.integers(0, 6, n).astype(float)  # 8-bit-like plateaus and ties
+        elif k % 3 == 1:
+            yield np.round(rng.standard_normal(n).cumsum())
+        else:
+            yield rng.standard_normal(n)
+
+
+@pytest.mark.parametrize("with_floor", [False, True])
+def test_prominence_bases_are_scipys_bit_for_bit(with_floor):
+    # with a floor (find_peaks' height rule) only the samples at or above it have bases
+    rng = np.random.default_rng(11)
+    checked = 0
+    for x in _signals():
+        floor = float(np.quantile(x, rng.uniform(0, 1))) if with_floor else -np.inf
+        peaks = find_peaks(x, height=floor)[0]
+        if not peaks.size:
+            continue
+        prom, left, right = peak_prominences(x, peaks)
+        lb, rb = prominence_bases(x, floor)
+        assert np.array_equal(lb[peaks], left) and np.array_equal(rb[peaks], right)
+        assert np.array_equal(x[peaks] - np.maximum(x[lb[peaks]], x[rb[peaks]]), prom)
+        assert np.all(lb[x < floor] == -1) and np.all(rb[x < floor] == -1)
+        checked += peaks.size
+    assert checked > 2000
+
+
+def test_parabola_is_the_least_squares_fit():
+    rng = np.random.default_rng(3)
+    for _ in range(500):
+        n = int(rng.integers(3, 40))
+        x = np.arange(n, dtype=float) - rng.integers(0, n)
+        y = 2.0 - 0.3 * x**2 + 0.1 * x + rng.standard_normal(n)
+        scale = np.abs(y).max()
+        ref = np.polyfit(x, y, 2)
+        got = np.array(parabola(x, y))
+        # the normal equations in sample units lose at most a few digits against polyfit's QR
+        assert np.allclose(got * np.array([n * n, n, 1.0]), ref * np.array([n * n, n, 1.0]), rtol=0, atol=1e-9 * scale)
+    assert all(np.isnan(parabola(np.array([0.0, 0.0, 1.0]), np.array([1.0, 2.0, 3.0]))))
+
+
+@pytest.mark.parametrize("n", [3, 7])
+def test_parabola_is_exact_on_a_parabola(n):
+    x = np.arange(n, dtype=float) - n // 2
+    a, b, c = parabola(x, -1.5 * x**2 + 0.25 * x + 4.0)
+    assert (a, b, c) == pytest.approx((-1.5, 0.25, 4.0), rel=1e-13, abs=1e-13)
+
+
+def test_one_pole_filters_are_lfilters():
+    rng = np.random.default_rng(1)
+    for _ in range(100):
+        n = int(rng.integers(2, 5000))
+        x = rng.standard_normal(n) * 10 ** rng.uniform(-6, 3) + rng.uniform(-1, 1)
+        a = math.exp(-rng.uniform(1e-4, 30))
+        g = (1.0 / rng.uniform(1e-3, 10)) * (1.0 - a)
+        assert _same_bits(one_pole(x, g, -g, -a, x[0], False), lfilter([g, -g], [1.0, -a], x - x[0]))
+        assert _same_bits(one_pole(x, 1 - g, g - a, -a, x[0], True), lfilter([1 - g, g - a], [1.0, -a], x - x[0]) + x[0])
+
+
+def test_undo_highpass_is_the_trapezoid_inversion():
+    rng = np.random.default_rng(2)
+    for _ in range(100):
+        n = int(rng.integers(1, 5000))
+        y, h, tau = rng.standard_normal(n), 10 ** rng.uniform(-8, -5), 10 ** rng.uniform(-5, -2)
+        assert _same_bits(undo_highpass(y, h, tau), y + cumulative_trapezoid(y, dx=h, initial=0.0) / tau)
+
+
+def test_positions_read_as_np_interp_reads_them():
+    rng = np.random.default_rng(5)
+    for k in range(200):
+        n, m = int(rng.integers(1, 3000)), int(rng.integers(1, 3000))
+        f = rng.standard_normal(n) * 10 ** rng.uniform(-5, 3)
+        pos = np.sort(rng.uniform(-3, n + 3, m)) if k % 2 else np.arange(m) * rng.uniform(0.5, 1.5) + rng.uniform(-5, 5)
+        pos[::5] = np.round(pos[::5])  # exactly on samples too
+        assert _same_bits(at_positions(f, pos), np.interp(pos, np.arange(n), f))
+
+
+@pytest.mark.parametrize("sd", [0.0, 0.4])
+def test_quantiser_is_the_numpy_expression(sd):
+    rng = np.random.default_rng(9)
+    v = rng.uniform(-1.5, 1.5, 20000)
+    noise = rng.standard_normal(v.size) if sd else np.empty(0)
+    codes, clipped = quantise(v, 0.1, 0.01, -25.0, sd, noise, -128.0, 127.0)
+    ref = (v - 0.1) / 0.01 + -25.0
+    if sd:
+        ref = ref + sd * noise
+    ref = np.rint(ref)
+    assert clipped == bool(np.any(ref > 127) or np.any(ref < -128)) and clipped
+    assert codes.dtype == np.int8 and np.array_equal(codes, np.clip(ref, -128, 127).astype(np.int8))
+    assert not quantise(v * 0.1, 0.0, 0.01, 0.0, sd, noise, -128.0, 127.0)[1]
