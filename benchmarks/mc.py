@@ -90,7 +90,7 @@ def table(r: dict) -> str:
         f"  batched solver, kernel only, {r['threads']} threads          {r['solver_kernel_shots_per_s']:8.0f} shots/s",
         f"  batched solver, with set-up, {r['threads']} threads          {r['solver_shots_per_s']:8.0f} shots/s",
         f"  full pipeline, one process                      {r['pipeline_shots_per_s']:8.0f} shots/s",
-        f"  full pipeline, rig mc --workers {r['workers']}, steady        "
-        f"{r['pipeline_workers_steady_shots_per_s']:8.0f} shots/s",
-        f"  full pipeline, rig mc --workers {r['workers']}, {r['study_shots']} shots incl. start-up "
-        f"{r['pipeline_workers_total_shots_per_s']:6.0f} shots/s"])
+        (f"  full pipeline, rig mc --workers {r['workers']}, steady        "
+         f"{r['pipeline_workers_steady_shots_per_s']:8.0f} shots/s"),
+        (f"  full pipeline, rig mc --workers {r['workers']}, {r['study_shots']} shots incl. start-up "
+         f"{r['pipeline_workers_total_shots_per_s']:6.0f} shots/s")])

@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import InstrumentError, check
 from ._kernels.quantiser import quantise
 from ._kernels.resample import at_positions
+from .errors import InstrumentError, check
 from .frontend import lowpass, rc_highpass
 from .records import Preamble, ScopeRecord, Waveform
 

@@ -68,7 +68,7 @@ class Bead(_Part):
     def radius(self) -> float:
         return 0.5 * self.diameter
 
-    def with_mass(self, mass: float) -> "Bead":
+    def with_mass(self, mass: float) -> Bead:
         """This bead with another mass (kg, > 0), its other fields taken as they are (already
         converted and checked): the bead-to-bead scatter of a study builds many."""
         if not (isinstance(mass, float) and math.isfinite(mass) and mass > 0):

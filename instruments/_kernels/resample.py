@@ -14,14 +14,14 @@ def at_positions(f, pos):
     out = np.empty(pos.shape[0])
     for i in range(pos.shape[0]):
         p = pos[i]
-        if p != p:
+        if math.isnan(p):
             out[i] = p
         elif p < 0.0:
             out[i] = f[0]
         elif p >= n - 1:
             out[i] = f[n - 1]
         else:
-            j = int(math.floor(p))
+            j = math.floor(p)
             if p == j:
                 out[i] = f[j]
             else:
