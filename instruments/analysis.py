@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import find_peaks, peak_widths
 
+from ._kernels.crossings import level_bracket
 from ._kernels.filters import undo_highpass
 from ._kernels.parabola import parabola
 from ._kernels.prominence import prominence_bases
@@ -136,10 +137,7 @@ def _vertex(t, f, i, top):
 
 def _crossings(t, f, i, level):
     """Times (s) where f crosses ``level`` before and after sample i (linear; nan if never)."""
-    below_left = f[i::-1] <= level
-    below_right = f[i:] <= level
-    left = i - int(np.argmax(below_left)) if below_left.any() else -1
-    right = i + int(np.argmax(below_right)) if below_right.any() else -1
+    left, right = level_bracket(f, i, float(level))
     tl = math.nan if left < 0 else t[left] + (level - f[left]) / (f[left + 1] - f[left]) * (t[left + 1] - t[left])
     tr = math.nan if right < 0 else \
         t[right - 1] + (f[right - 1] - level) / (f[right - 1] - f[right]) * (t[right] - t[right - 1])

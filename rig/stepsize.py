@@ -119,10 +119,9 @@ def max_frequency(p, first: int = 1) -> float:
     k = np.where(p.A > 0, contact_stiffness(p.A, peak_force_estimate(p)), 0.0)
     k[:first] = 0.0
     k_above = k
-    k_below = np.append(k[1:], 0.0)
+    k_below, im_above, im_below = np.zeros_like(k), np.zeros_like(k), np.zeros_like(k)
     im = p.invm
-    im_above = np.append(0.0, im[:-1])
-    im_below = np.append(im[1:], 0.0)
+    k_below[:-1], im_above[1:], im_below[:-1] = k[1:], im[:-1], im[1:]
     rows = im * (k_above + k_below) + k_above * np.sqrt(im * im_above) + k_below * np.sqrt(im * im_below)
     return float(math.sqrt(rows.max())) if rows.max() > 0 else 0.0
 
