@@ -181,18 +181,29 @@ def _table(v: dict, path) -> dict:
     return node
 
 
-def _rig_for(study: Study, x: dict, masses) -> tuple:
-    values, text, base = _base(study.scene, tuple(study.overrides))
+@functools.lru_cache(maxsize=4)
+def _study_base(scene: str, overrides: tuple, window: str) -> tuple:
+    """What every shot of a study starts from: the scene's values with the solver recording
+    at the scope's sampling rate (the scope reads nothing finer) and, in the leading window,
+    the window's duration and record; and a rig of them, whose parts the shots take over."""
+    values, text, base = _base(scene, overrides)
     v = dict(values)
     solver, scope = _table(v, ["solver"]), _table(v, ["scope"])
-    # the solver records at the scope's sampling rate (the scope reads nothing finer)
     scope_dt = scope.get("sample_interval")
     if scope_dt and scope_dt > solver.get("sample_interval", 1e-7):
         solver["sample_interval"] = scope_dt
-    if study.window == "leading":
-        duration, length, pre = leading_window(study.scene, tuple(study.overrides))
+    if window == "leading":
+        duration, length, pre = leading_window(scene, overrides)
         solver["duration"], scope["record_length"] = duration, length
         _table(v, ["scope", "trigger"])["pre_trigger"] = pre
+    return v, Rig(v, text, overrides, like=base)
+
+
+def _rig_for(study: Study, x: dict, masses) -> tuple:
+    """Shot inputs x (and bead masses) -> (the shot's rig, its instrument draws)."""
+    overrides = tuple(study.overrides)
+    values, template = _study_base(study.scene, overrides, study.window)
+    v = dict(values)
     draws = {}
     for key, val in x.items():
         parts = key.split(".")
@@ -202,7 +213,7 @@ def _rig_for(study: Study, x: dict, masses) -> tuple:
         if key == "chain.bead_mass":
             continue
         _table(v, parts[:-1])[parts[-1]] = val
-    return Rig(v, text, tuple(study.overrides), bead_masses=masses), draws
+    return Rig(v, template.scene_text, overrides, bead_masses=masses, like=template), draws
 
 
 @contextlib.contextmanager

@@ -91,15 +91,18 @@ class ShotRecord:
 class Rig:
     """Parts and instruments of one scene (see rig/scene.py for the file format)."""
 
-    def __init__(self, values: dict, scene_text: str = "", overrides: tuple = (), bead_masses=None):
+    def __init__(self, values: dict, scene_text: str = "", overrides: tuple = (), bead_masses=None,
+                 like: Rig | None = None):
         """values: a validated scene in SI (rig.scene.load); bead_masses (kg): one mass per
-        plain bead, top to bottom, for studies of the bead-to-bead scatter."""
+        plain bead, top to bottom, for studies of the bead-to-bead scatter. like: a rig whose
+        parts and instruments are taken over where this rig's scene table is the very same
+        object as its own (a study's shots share all but the tables their draws change)."""
         self.values = values
         self.scene_text = scene_text
         self.overrides = tuple(overrides)
         self.bead_masses = None if bead_masses is None else [float(m) for m in bead_masses]
         self.name = values.get("scene", {}).get("name", "scene")
-        self._build()
+        self._build(like)
         self._solution = None
 
     @classmethod
@@ -108,12 +111,16 @@ class Rig:
         return cls(values, text, tuple(overrides))
 
     # --- assembly -------------------------------------------------------------------
-    def _build(self):
+    def _build(self, like: Rig | None = None):
         v = self.values
         for table in ("chain", "striker", "holder", "wall", "scope", "solver"):
             if table not in v:
                 raise invalid(f"scene [{table}]", None, "this table is required")
-        self.holder = Holder(**v["holder"])
+
+        def shared(*tables):  # built from the very same tables as like's: take like's
+            return like is not None and all(v.get(t) is like.values.get(t) for t in tables)
+
+        self.holder = like.holder if shared("holder") else Holder(**v["holder"])
         c = dict(v["chain"])
         n = c.pop("beads", None)
         if not isinstance(n, int) or n < 1:
@@ -134,27 +141,37 @@ class Rig:
                 raise invalid("bead_masses", len(self.bead_masses), f"one mass per plain bead ({n})")
             plain_beads = [plain.with_mass(m) for m in self.bead_masses]
         beads = ([MagneticBead()] if magnetic else []) + plain_beads
-        self.gauges = {}
-        for name, g in sorted(v.get("gauges", {}).items()):
-            g = dict(g)
-            index = self._gauge_index(name, g.pop("bead", None), g.pop("from_wall", None), first, len(beads))
-            channel = g.pop("channel", None)
+        if shared("gauges", "chain"):
+            self.gauges = like.gauges
+        else:
+            self.gauges = {}
+            for name, g in sorted(v.get("gauges", {}).items()):
+                g = dict(g)
+                index = self._gauge_index(name, g.pop("bead", None), g.pop("from_wall", None), first, len(beads))
+                self.gauges[name] = (index, g.pop("channel", None), GaugeSettings(**g))
+        for index, _, _ in self.gauges.values():
             beads[index] = GaugeBead.like(beads[index])
-            self.gauges[name] = (index, channel, GaugeSettings(**g))
-        self.striker = Striker(**v["striker"])
+        self.striker = like.striker if shared("striker") else Striker(**v["striker"])
         self.holder.check(beads, self.striker)
-        self.magnet = RingMagnet(**v["magnet"]) if "magnet" in v else None
+        if shared("magnet"):
+            self.magnet = like.magnet
+        else:
+            self.magnet = RingMagnet(**v["magnet"]) if "magnet" in v else None
         if self.magnet is not None and not magnetic:
             raise invalid("magnet", "set", "a ring magnet needs chain.magnetic_bead = true")
-        self.chain = Chain(beads, striker=self.striker, wall=Wall(**v["wall"]),
-                           gravity=self.holder.gravity,
+        wall = like.chain.wall if shared("wall") else Wall(**v["wall"])
+        self.chain = Chain(beads, striker=self.striker, wall=wall, gravity=self.holder.gravity,
                            top_force=self.magnet.top_force() if self.magnet else 0.0,
                            contact_law=law, damping_time=damping)
-        ws = dict(v.get("wall_sensor", {}))
-        self.wall_channel = ws.pop("channel", None)
-        self.wall_sensor = GaugeSettings(misalignment_sd=0.0, **ws) if "wall_sensor" in v else None
-        self.scope = self._scope(v["scope"])
-        self._check_connections()
+        if shared("wall_sensor"):
+            self.wall_channel, self.wall_sensor = like.wall_channel, like.wall_sensor
+        else:
+            ws = dict(v.get("wall_sensor", {}))
+            self.wall_channel = ws.pop("channel", None)
+            self.wall_sensor = GaugeSettings(misalignment_sd=0.0, **ws) if "wall_sensor" in v else None
+        self.scope = like.scope if shared("scope") else self._scope(v["scope"])
+        if not shared("gauges", "chain", "wall_sensor", "scope"):
+            self._check_connections()
         s = v["solver"]
         self.solver = {"method": s.get("method", "srkn6b"), "accuracy": s.get("accuracy"),
                        "duration": s.get("duration"), "sample_interval": s.get("sample_interval", 1e-7)}
