@@ -151,3 +151,21 @@ def test_a_scene_with_the_wall_sensor_alone(tmp_path, capsys):
     assert out["triggered"] and out["truth"] is None and out["channels"]["CH3"]["connected"] == "wall_sensor"
     assert main(["shot", str(scene), "--seed", "1"]) == 0
     assert "two gauge beads" in capsys.readouterr().out
+
+
+def test_a_rig_like_another_takes_over_only_the_parts_of_shared_tables():
+    # studies build each shot's rig "like" a template: parts of the very same scene tables
+    # are taken over, the others built anew, and the shot is the one a fresh rig fires
+    from rig import scene as scene_io
+
+    values, text = scene_io.load("ptfe52_magnetic")
+    template = Rig(values, text)
+    v = dict(values)
+    v["striker"] = {**values["striker"], "velocity": 0.95}
+    masses = [0.1226e-3 * (1 + 0.001 * k) for k in range(52)]
+    alike, fresh = Rig(v, text, bead_masses=masses, like=template), Rig(v, text, bead_masses=masses)
+    assert alike.scope is template.scope and alike.gauges is template.gauges
+    assert alike.striker is not template.striker and alike.striker.velocity == 0.95
+    a, b = alike.fire(seed=5, truth=False), fresh.fire(seed=5, truth=False)
+    for ch, w in b.scope.waveforms.items():
+        assert np.array_equal(a.scope.waveforms[ch].codes, w.codes)
