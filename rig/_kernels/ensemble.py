@@ -53,7 +53,7 @@ def _kick_drift(u, v, invm, f, hb, ha, head):
 
 
 @njit(cache=True, fastmath=False)
-def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub):
+def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_ns, h_work):
     """_kick_drift (and the head's flow) then _forces in one pass over the rows: row i is
     kicked and drifted (reading f[i], f[i+1], not yet renewed), then contact i is renewed
     from rows i-1 and i (both moved). The same operations as the two passes, so the same
@@ -61,7 +61,7 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
     start = 0
     if head > 0:
         _head_kick(v, invm, f, hb, head)
-        head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub)
+        head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub, h_ns, h_work)
         start = head + 1
     for i in range(start, v.shape[0]):
         for s in range(u.shape[1]):
@@ -151,6 +151,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
     net = np.empty(W)
     j_wall = np.zeros(W)
     w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
+    h_ns, h_work = np.empty(W, np.int64), np.empty((3, W))  # the head's work arrays
     _energy(u, v, mass, bias, A, d0, e0)
     _momentum(v, mass, p0)
     for s in range(u.shape[1]):
@@ -172,7 +173,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
                 for s in range(u.shape[1]):
                     j_wall[s] += hb * f[wall_slot, s]
             h = a_coef[st] * dt
-            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st])
+            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_ns, h_work)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1

@@ -145,6 +145,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
     # (bodies, 1) views for the multirate head (shared with the batched kernel)
     u2, v2, im2, f2 = u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1))
     A2, d02, load2 = A.reshape((nb, 1)), d0.reshape((nb, 1)), load.reshape((nb + 1, 1))
+    h_ns, h_work = np.empty(1, np.int64), np.empty((3, 1))  # the head's work arrays
     # sum of constant loads, less the part the wall's slot carries (j_wall is dynamic)
     wall_load = load[wall_slot] if wall_slot > 0 else 0.0
     net_const = load[nb] - wall_load
@@ -197,7 +198,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
             h = a_coef[s] * dt
             _kick_drift(u, v, invm, f, hb, h, head)
             if head > 0:
-                head_flow(u2, v2, im2, f2, A2, d02, load2, head, a_coef, b_coef, h, sub[s])
+                head_flow(u2, v2, im2, f2, A2, d02, load2, head, a_coef, b_coef, h, sub[s], h_ns, h_work)
             ts += h
             contact_forces(u, v, A, d0, damping, law, load, f)
         t_new = (n + 1) * dt
