@@ -98,35 +98,23 @@ def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, head, y, r):
 
 
 @njit(cache=True, fastmath=False)
-def _energy(u, v, mass, bias, A, d0, e):
-    """Each shot's energy into e (forces.energy's sums, in its order, over all shots)."""
+def _state_sums(u, v, mass, bias, A, d0, d_limit, e, p, w):
+    """Each shot's energy e (forces.energy's sums, in its order), momentum p and largest
+    d / d_limit w (inf for nan, as forces.max_overlap_excess), in two passes over the rows."""
     nb = u.shape[0]
     e[:] = 0.0
+    p[:] = 0.0
+    w[:] = 0.0
     for i in range(nb):
         for s in range(u.shape[1]):
             e[s] += 0.5 * mass[i, s] * v[i, s] * v[i, s] - mass[i, s] * bias[i, s] * u[i, s]
+            p[s] += mass[i, s] * v[i, s]
     for i in range(1, nb):
         for s in range(u.shape[1]):
             d = d0[i, s] + u[i - 1, s] - u[i, s]
             if d > 0.0:
                 e[s] += 0.4 * A[i, s] * d * d * math.sqrt(d)
-
-
-@njit(cache=True, fastmath=False)
-def _momentum(v, mass, p):
-    p[:] = 0.0
-    for i in range(v.shape[0]):
-        for s in range(v.shape[1]):
-            p[s] += mass[i, s] * v[i, s]
-
-
-@njit(cache=True, fastmath=False)
-def _worst_overlap(u, d0, d_limit, w):
-    """Each shot's largest d / d_limit (inf for nan), as forces.max_overlap_excess."""
-    w[:] = 0.0
-    for i in range(1, u.shape[0]):
-        for s in range(u.shape[1]):
-            q = (d0[i, s] + u[i - 1, s] - u[i, s]) / d_limit[i, s]
+            q = d / d_limit[i, s]
             w[s] = max(w[s], q) if q == q else math.inf
 
 
@@ -152,8 +140,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
     j_wall = np.zeros(W)
     w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
     h_ns, h_work = np.empty(W, np.int64), np.empty((3, W))  # the head's work arrays
-    _energy(u, v, mass, bias, A, d0, e0)
-    _momentum(v, mass, p0)
+    _state_sums(u, v, mass, bias, A, d0, d_limit, e0, p0, worst)
     for s in range(u.shape[1]):
         net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
     _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, 0.0, head, y_old, r_old)
@@ -200,9 +187,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
                 y_old[c, s] = y_new[c, s]
                 r_old[c, s] = r_new[c, s]
         if check:
-            _energy(u, v, mass, bias, A, d0, e)
-            _momentum(v, mass, pn)
-            _worst_overlap(u, d0, d_limit, worst)
+            _state_sums(u, v, mass, bias, A, d0, d_limit, e, pn, worst)
             for s in range(u.shape[1]):
                 err = abs(e[s] - e0[s]) / e_ref[s]
                 pe = abs(pn[s] - p0[s] - (t_new * net[s] - j_wall[s])) / p_ref[s]
