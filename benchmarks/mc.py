@@ -20,7 +20,7 @@ import numba
 from rig.distributions import parse_vary
 from rig.ensemble import ensemble_step, solve_ensemble
 from rig.executors import run_study
-from rig.mc import Store, Study, _rig_for, run_batch, shot_inputs
+from rig.mc import Store, Study, _rig_for, run_batch, shot_inputs, study_record
 
 VARY = ("striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)")
 BATCH = 128
@@ -28,7 +28,7 @@ BATCH = 128
 
 def _solver(study: Study, shots: int) -> dict:
     rigs = [_rig_for(study, *shot_inputs(study, i, 52)[:2])[0] for i in range(shots)]
-    problems = [r.chain.problem(r.record()) for r in rigs]
+    problems = [r.chain.problem(study_record(study, r)) for r in rigs]
     t_end = rigs[0].solver["duration"]
     dt = ensemble_step(problems, t_end)
     solve_ensemble(problems[:8], t_end, dt=dt)

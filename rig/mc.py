@@ -236,6 +236,13 @@ def run_batch(study: Study, b: int) -> dict:
         return _run_batch(study, b)
 
 
+def study_record(study: Study, rig: Rig):
+    """What a study's solver records: the gauges' averages (what their plates read) and the
+    wall; each gauge's two contacts too where the truth analysis or the traces need them.
+    The averages feed the gauges either way, so traces do not change the results."""
+    return rig.record(contacts=study.truth or study.traces, averages=True)
+
+
 def _run_batch(study: Study, b: int) -> dict:
     shots = study.shots_of(b)
     lo, hi = shots.start, shots.stop
@@ -253,7 +260,7 @@ def _run_batch(study: Study, b: int) -> dict:
         draws.append(d)
         seeds.append(seed)
         xs.append([x[k] for k in study.keys])
-    problems = [r.chain.problem(r.record()) for r in rigs]
+    problems = [r.chain.problem(study_record(study, r)) for r in rigs]
     t_end = study_duration(study)
     dt = ensemble_step(problems, t_end, base.solver["method"], study.accuracy or base.solver["accuracy"])
     ens = solve_ensemble(problems, t_end, dt=dt, method=base.solver["method"])

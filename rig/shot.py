@@ -35,8 +35,8 @@ class GaugeTruth:
     channel: str
     position_m: float          # equilibrium centre, down from bead 0's centre
     average_force: np.ndarray  # N, what the rigid gauge bead's plate feels
-    contact_above: np.ndarray  # N
-    contact_below: np.ndarray  # N
+    contact_above: np.ndarray | None  # N (None where only the average was recorded)
+    contact_below: np.ndarray | None  # N
     static_above_N: float
     static_below_N: float
 
@@ -71,8 +71,9 @@ class ShotRecord:
         arrays, gauges = {}, {}
         for name, g in self.truth.gauges.items():
             arrays[f"{name}.average_force"] = g.average_force
-            arrays[f"{name}.contact_above"] = g.contact_above
-            arrays[f"{name}.contact_below"] = g.contact_below
+            if g.contact_above is not None:
+                arrays[f"{name}.contact_above"] = g.contact_above
+                arrays[f"{name}.contact_below"] = g.contact_below
             gauges[name] = {"bead": g.bead, "channel": g.channel, "position_m": g.position_m,
                             "static_above_N": g.static_above_N, "static_below_N": g.static_below_N}
         if self.truth.wall_force is not None:
@@ -215,12 +216,19 @@ class Rig:
                           f"triggers on an unconnected channel (connected: {', '.join(used) or 'none'})")
 
     # --- the shot ---------------------------------------------------------------------
-    def record(self) -> Record:
-        """Only the contacts the instruments need: each gauge bead's two, and the wall's."""
+    def record(self, contacts: bool = True, averages: bool = False) -> Record:
+        """Only what the instruments need: each gauge bead's two contacts (``contacts``)
+        and/or its plate's average of them as one probe (``averages``: studies that need
+        no contact apart record 2 channels fewer), and the wall's contact."""
+        if not (contacts or averages):
+            raise invalid("record", "nothing", "the contacts, the averages or both")
         probes = {}
-        for index, _, _ in self.gauges.values():
-            for k in (index, index + 1):
-                probes[f"contact{k}"] = self.chain.contact_probe(k)
+        for name, (index, _, _) in self.gauges.items():
+            if contacts:
+                for k in (index, index + 1):
+                    probes[f"contact{k}"] = self.chain.contact_probe(k)
+            if averages:
+                probes[f"gauge_{name}"] = self.chain.gauge_probe(index)
         if self.wall_sensor is not None:
             probes["wall"] = self.chain.wall_probe()
         return Record(probes, sample_interval=self.solver["sample_interval"])
@@ -237,9 +245,10 @@ class Rig:
         F0 = self.chain.static_forces()
         gauges = {}
         for name, (j, ch, _) in self.gauges.items():
-            above, below = sol.forces[f"contact{j}"], sol.forces[f"contact{j + 1}"]
-            gauges[name] = GaugeTruth(j, ch, float(x[j]), 0.5 * (above + below), above, below,
-                                      float(F0[j]), float(F0[j + 1]))
+            above, below = sol.forces.get(f"contact{j}"), sol.forces.get(f"contact{j + 1}")
+            average = sol.forces.get(f"gauge_{name}")
+            gauges[name] = GaugeTruth(j, ch, float(x[j]), 0.5 * (above + below) if average is None else average,
+                                      above, below, float(F0[j]), float(F0[j + 1]))
         return Truth(sol.sample_interval, gauges, sol.forces.get("wall"), _wave_speed(gauges, sol.sample_interval))
 
     def truth_analysis(self):

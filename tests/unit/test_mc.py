@@ -157,3 +157,21 @@ def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(t
     # the traces do not change the results
     for k, v in plain.collect()["outputs"].items():
         assert np.array_equal(store.collect()["outputs"][k], v, equal_nan=True)
+
+
+def test_a_study_records_the_gauge_averages_and_contacts_only_when_needed():
+    # the gauges read their plates' average: a study records it as one probe per gauge
+    # (3 channels with the wall, not 5); the truth analysis and the traces add the contacts
+    from rig.mc import _rig_for, shot_inputs, study_record
+
+    for kw, names in (({}, {"gauge_lower", "gauge_upper", "wall"}),
+                      ({"truth": True}, {"gauge_lower", "gauge_upper", "wall", "contact20", "contact21",
+                                         "contact29", "contact30"})):
+        study = _study(16, **kw)
+        rig = _rig_for(study, *shot_inputs(study, 0, 52)[:2])[0]
+        assert set(study_record(study, rig).probes) == names
+    plain = run_batch(_study(16), 0)["outputs"]
+    with_truth = run_batch(_study(16, truth=True), 0)["outputs"]
+    for k in ("speed_m_per_s", "amplitude_N"):
+        assert np.array_equal(plain[k], with_truth[k])
+    assert np.all(np.isfinite(with_truth["truth_speed_m_per_s"]))
