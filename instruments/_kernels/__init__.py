@@ -1,1 +1,48 @@
-"""Compiled helpers of the analysis (numba)."""
+"""Compiled helpers of the instruments and the analysis (numba), and the guard that keeps
+numba's on-disk cache of a kernel package consistent with its sources."""
+from __future__ import annotations
+
+import hashlib
+import importlib
+import pkgutil
+from pathlib import Path
+
+
+def drop_stale_cache(package: str) -> None:
+    """Drop the cached machine code of every kernel of ``package`` when any of its sources
+    changed since that code was written.
+
+    numba's cache=True keys each compiled function on its own source file only, but a
+    kernel inlines the kernels it calls from the package's other files: after a change to
+    a callee alone, its callers' cached code would still hold the old callee. Keying the
+    whole package on a digest of all its sources closes that gap (numba then compiles
+    afresh, once).
+    """
+    from numba.core.dispatcher import Dispatcher
+
+    root = importlib.import_module(package)
+    folder = Path(root.__file__).parent
+    digest = hashlib.sha256()
+    for path in sorted(folder.glob("*.py")):
+        digest.update(path.name.encode() + b"\0" + path.read_bytes())
+    modules = [importlib.import_module(f"{package}.{m.name}") for m in pkgutil.iter_modules([str(folder)])]
+    caches = {}
+    for module in modules:
+        for obj in vars(module).values():
+            cache = getattr(obj, "_cache", None) if isinstance(obj, Dispatcher) else None
+            if cache is not None and hasattr(cache, "cache_path") and hasattr(cache, "flush"):
+                caches.setdefault(cache.cache_path, []).append(cache)
+    for path, members in caches.items():
+        stamp = Path(path) / f"{package}.sources"
+        try:
+            if stamp.is_file() and stamp.read_text() == digest.hexdigest():
+                continue
+            for cache in members:
+                cache.flush()
+            stamp.parent.mkdir(parents=True, exist_ok=True)
+            stamp.write_text(digest.hexdigest())
+        except OSError:  # a cache folder we cannot write: numba cannot cache there either
+            continue
+
+
+drop_stale_cache(__name__)

@@ -6,3 +6,6 @@ from static equilibrium (m, positive down), ``v`` the velocity (m/s). Force slot
 (size nb + 1) holds the contact between body i-1 and body i; ``f[0]`` and ``f[nb]`` stay 0
 so that every body sees ``f[i] - f[i+1]`` with no special case at the ends.
 """
+from instruments._kernels import drop_stale_cache
+
+drop_stale_cache(__name__)

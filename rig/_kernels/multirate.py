@@ -34,8 +34,8 @@ def _open_acceleration(j, invm, load, head, s):
 
 @njit(cache=True, fastmath=False)
 def _substeps(u, v, invm, d0, load, head, a_coef, b_coef, h, n, ns):
-    """ns[s]: 1 where shot s's head contacts are open and stay open through the drift,
-    else n (bound in the module doc)."""
+    """ns[s]: 0 where shot s's head contacts are open and stay open through the drift (its
+    flow is then taken in closed form), else the n substeps (bound in the module doc)."""
     sum_a = 0.0
     for a in a_coef:
         sum_a += abs(a)
@@ -45,7 +45,7 @@ def _substeps(u, v, invm, d0, load, head, a_coef, b_coef, h, n, ns):
     reach = abs(h) * sum_a
     spread = h * h * sum_a * sum_b
     for s in range(u.shape[1]):
-        ns[s] = 1
+        ns[s] = 0
     for i in range(1, head + 1):
         for s in range(u.shape[1]):  # no branch on the shot: this loop vectorises
             gap = -(d0[i, s] + u[i - 1, s] - u[i, s])
@@ -67,10 +67,10 @@ def head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, h, n, ns, work):
     most = 0
     for s in range(u.shape[1]):
         most = max(most, ns[s])
-        on[s] = 1.0 if ns[s] > 1 else 0.0
-        step[s] = h / ns[s] if ns[s] > 1 else 0.0  # the others idle through the substeps
+        on[s] = 1.0 if ns[s] > 0 else 0.0
+        step[s] = h / ns[s] if ns[s] > 0 else 0.0  # the free ones idle through the substeps
         pending[s] = 0.0
-    if most > 1:
+    if most > 0:
         for _ in range(most):
             for st in range(n_drift):
                 for i in range(head + 1):

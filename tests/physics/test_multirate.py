@@ -73,3 +73,16 @@ def test_a_free_head_flies_exactly_and_still_lands_on_time():
     # the pulse the landing sends down: a landing off in time or speed would show here
     err = np.max(np.abs(landed.forces["c10"] - ref.forces["c10"])) / np.max(ref.forces["c10"])
     assert err < 1e-4, err  # the default accuracy
+
+
+def test_a_drift_of_one_substep_still_feels_the_striker():
+    # at accuracy 1e-3 the shortest drifts of a step fit in one head substep: they must
+    # still integrate the striker's contact (not take it for free flight)
+    chain = ptfe_rig(n=30)
+    p = chain.problem(record_contacts(chain, 5, 15, 25))
+    st = default_step(p, SRKN, 1e-3)
+    assert st.head == 1 and 1 in st.substeps(st.dt, SRKN.drifts)
+    ref = solve(p, 0.45e-3, dt=contact_time_scale(p) / 300)
+    sol = solve(p, 0.45e-3, accuracy=1e-3)
+    err = max(np.max(np.abs(sol.forces[k] - ref.forces[k])) / np.max(np.abs(ref.forces[k])) for k in ref.forces)
+    assert err < 1e-3, err
