@@ -113,7 +113,8 @@ def build_parser() -> argparse.ArgumentParser:
     ls.add_argument("archive")
 
     be = _command(sub, "bench", "benchmarks", tools.cmd_bench)
-    be.add_argument("what", choices=["solver", "shot", "archive", "pipeline", "mc", "animate"], help="what to benchmark")
+    be.add_argument("what", choices=["solver", "accuracy", "shot", "archive", "pipeline", "mc", "animate"],
+                    help="what to benchmark")
     be.add_argument("--quick", action="store_true", help="fewer settings, one repeat")
     return ap
 

@@ -49,7 +49,7 @@ def cmd_theory(args) -> dict:
 
 
 def cmd_bench(args) -> dict:
-    if args.what in ("shot", "archive", "pipeline", "mc", "animate"):
+    if args.what in ("accuracy", "shot", "archive", "pipeline", "mc", "animate"):
         import importlib
 
         module = importlib.import_module(f"benchmarks.{args.what}")
