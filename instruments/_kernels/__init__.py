@@ -30,7 +30,7 @@ def drop_stale_cache(package: str) -> None:
     for module in modules:
         for obj in vars(module).values():
             cache = getattr(obj, "_cache", None) if isinstance(obj, Dispatcher) else None
-            if cache is not None and hasattr(cache, "cache_path") and hasattr(cache, "flush"):
+            if getattr(cache, "cache_path", None) and hasattr(cache, "flush"):  # None: not cached
                 caches.setdefault(cache.cache_path, []).append(cache)
     for path, members in caches.items():
         stamp = Path(path) / f"{package}.sources"
