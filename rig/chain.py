@@ -22,6 +22,17 @@ from .errors import invalid
 from .parts import Bead, Striker, Wall
 from .units import quantity
 
+
+def computed_once(owner, name: str, compute) -> np.ndarray:
+    """The array ``compute()`` for an object that never changes, computed on the first call
+    and kept on it; the array handed out is read-only."""
+    memo = owner.__dict__.setdefault("_computed", {})
+    if name not in memo:
+        value = compute()
+        value.setflags(write=False)
+        memo[name] = value
+    return memo[name]
+
 if TYPE_CHECKING:
     from .problem import ChainProblem
 
@@ -137,14 +148,8 @@ class Chain:
         return isinstance(tf, ForceSchedule) or tf != 0.0
 
     def _cached(self, name, compute):
-        """A chain does not change after construction: its static geometry is computed once
-        (a read-only array is handed out)."""
-        cache = self.__dict__.setdefault("_cache", {})
-        if name not in cache:
-            value = compute()
-            value.setflags(write=False)
-            cache[name] = value
-        return cache[name]
+        """A chain does not change after construction: its static geometry is computed once."""
+        return computed_once(self, name, compute)
 
     def contact_constants(self) -> np.ndarray:
         """Hertz constants (N/m^1.5) of contacts 0..n_beads (nan where there is no partner)."""

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .chain import Chain, ForceSchedule, Record
+from .chain import Chain, ForceSchedule, Record, computed_once
 
 
 @dataclass(frozen=True, eq=False)
@@ -108,14 +108,8 @@ class ChainProblem:
                    nb - 1 if chain.wall is not None else 0, e_scale, p_scale)
 
     def derived(self, name: str, compute):
-        """A quantity derived from the problem (which never changes), computed once; the
-        array handed out is read-only."""
-        memo = self.__dict__.setdefault("_derived", {})
-        if name not in memo:
-            value = compute()
-            value.setflags(write=False)
-            memo[name] = value
-        return memo[name]
+        """An array derived from the problem (which never changes), computed once."""
+        return computed_once(self, name, compute)
 
     @property
     def n_bodies(self) -> int:
