@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .chain import Chain, ForceSchedule, Record, computed_once
+from .chain import Chain, ForceSchedule, Record
 
 
 @dataclass(frozen=True, eq=False)
@@ -106,10 +106,6 @@ class ChainProblem:
         return cls(chain, record, off, mass, invm, bias, load, A, d0, f0, damping, d_limit, u0, v0,
                    off, sched_t, sched_f, names, ch_slot, ch_weight,
                    nb - 1 if chain.wall is not None else 0, e_scale, p_scale)
-
-    def derived(self, name: str, compute):
-        """An array derived from the problem (which never changes), computed once."""
-        return computed_once(self, name, compute)
 
     @property
     def n_bodies(self) -> int:

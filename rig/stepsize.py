@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .chain import computed_once
 from .contact import contact_stiffness
 from .methods import Method
 
@@ -69,7 +70,7 @@ def _reduced_masses(p) -> np.ndarray:
 def contact_time_scales(p) -> np.ndarray:
     """tau (s) of each contact slot (formula in the module doc; inf where no contact);
     computed once per problem."""
-    return p.derived("contact_time_scales", lambda: _contact_time_scales(p))
+    return computed_once(p, "contact_time_scales", lambda: _contact_time_scales(p))
 
 
 def _contact_time_scales(p) -> np.ndarray:

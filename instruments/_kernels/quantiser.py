@@ -7,8 +7,8 @@ from numba import njit
 def quantise(v, offset, ymult, yoff, sd, noise, lo, hi):
     """Codes round((v - offset) / ymult + yoff [+ sd * noise]) clipped to [lo, hi] (int8),
     and whether any was clipped. ``noise``: standard normal draws, one per sample, or an
-    empty array for none. The same operations, in the same order, as the numpy expression
-    in Oscilloscope._digitise."""
+    empty array for none. The same operations, in the same order, as numpy's
+    clip(rint((v - offset) / ymult + yoff + sd * noise), lo, hi).astype(int8), in one pass."""
     n = v.shape[0]
     codes = np.empty(n, np.int8)
     noisy = noise.shape[0] > 0
