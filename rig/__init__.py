@@ -1,27 +1,46 @@
-"""The virtual rig: chain physics, the solver and the long-wave theory.
+"""The virtual rig: chain physics, the solver, the theory, the virtual experiment.
 
 Quick use::
 
-    from rig import Bead, MagneticBead, Striker, Wall, Chain, Record, solve
+    from rig import Bead, MagneticBead, Striker, Wall, Chain, SaveAt, solve
     beads = [MagneticBead()] + [Bead("ptfe", "4.76 mm", "0.1226 g")] * 52
     chain = Chain(beads, striker=Striker("alumina", "0.47 g", "0.89 m/s"), wall=Wall(),
                   top_force="2.38 N")
-    sol = solve(chain.problem(Record({"wall": chain.wall_probe()})), t_end=2e-3)
-"""
-from .chain import Chain, ForceSchedule, Probe, Record, STANDARD_GRAVITY
-from .contact import CONTACT_LAWS, hertz_constant, hertz_energy, hertz_force, static_overlaps
-from .errors import RigError
-from .materials import MATERIALS, Material, material
-from .methods import METHODS, Method
-from .parts import Bead, GaugeBead, MagneticBead, Striker, Wall
-from .problem import ChainProblem
-from .solution import Solution, SolverStats
-from .solve import solve
+    sol = solve(chain, t_end=2e-3, save=SaveAt({"wall": chain.wall_probe()}))
 
-__all__ = [
-    "Bead", "GaugeBead", "MagneticBead", "Striker", "Wall", "Chain", "ForceSchedule",
-    "Probe", "Record", "ChainProblem", "Solution", "SolverStats", "solve", "RigError",
-    "MATERIALS", "Material", "material", "METHODS", "Method", "CONTACT_LAWS",
-    "hertz_constant", "hertz_force", "hertz_energy", "static_overlaps", "STANDARD_GRAVITY",
-]
+The names below are loaded on first use (PEP 562), so that ``import rig`` and the command
+line start without numba, scipy or pint; docs/architecture.md shows the layers.
+"""
+from __future__ import annotations
+
+import importlib
+
 __version__ = "0.1.0"
+
+_PUBLIC = {
+    "rig.model.chain": ("Chain", "ForceSchedule", "Probe", "STANDARD_GRAVITY"),
+    "rig.model.contact": ("CONTACT_LAWS", "hertz_constant", "hertz_energy", "hertz_force",
+                          "static_overlaps"),
+    "rig.model.materials": ("MATERIALS", "Material", "material"),
+    "rig.model.parts": ("Bead", "GaugeBead", "MagneticBead", "Striker", "Wall"),
+    "rig.errors": ("RigError",),
+    "rig.solver.methods": ("METHODS", "Method"),
+    "rig.solver.problem": ("ChainProblem",),
+    "rig.solver.saveat": ("SaveAt",),
+    "rig.solver.solution": ("Solution", "SolverStats", "Status"),
+    "rig.solver.solve": ("solve",),
+}
+_WHERE = {name: module for module, names in _PUBLIC.items() for name in names}
+__all__ = sorted(_WHERE)
+
+
+def __getattr__(name: str):
+    if name not in _WHERE:
+        raise AttributeError(f"module 'rig' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_WHERE[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

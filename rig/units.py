@@ -9,7 +9,7 @@ import functools
 import math
 import numbers
 
-from .errors import RigError, invalid
+from rig.errors import RigError, invalid
 
 
 @functools.lru_cache(maxsize=1)

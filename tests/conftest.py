@@ -1,7 +1,7 @@
 """Shared chain builders for the tests (small chains keep the suite fast)."""
 import pytest
 
-from rig import Bead, Chain, MagneticBead, Record, Striker, Wall
+from rig import Bead, Chain, MagneticBead, SaveAt, Striker, Wall
 
 STEEL = dict(material="steel316", diameter="4.76 mm", mass="0.4501 g")
 PTFE = dict(material="ptfe", diameter="4.76 mm", mass="0.1226 g")
@@ -21,7 +21,7 @@ def ptfe_rig(n=52, top_force=2.38, striker=True, velocity="0.89 m/s"):
 
 
 def record_contacts(chain, *contacts, **kw):
-    return Record({f"c{k}": chain.contact_probe(k) for k in contacts}, **kw)
+    return SaveAt({f"c{k}": chain.contact_probe(k) for k in contacts}, **kw)
 
 
 @pytest.fixture

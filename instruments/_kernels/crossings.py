@@ -1,8 +1,8 @@
 """Where a pulse falls to a level on either side of its maximum (numba)."""
-from numba import njit
+from instruments.jit import jit
 
 
-@njit(cache=True, fastmath=False)
+@jit
 def level_bracket(f, i, level):
     """(left, right): the nearest samples at or below ``level`` at or before sample i, and
     at or after it; -1 where the signal never gets there. Scans outward from i only as far

@@ -1,9 +1,9 @@
 """One-pole recursive filter (numba) for the analog front ends (instruments/frontend.py)."""
 import numpy as np
-from numba import njit
+from instruments.jit import jit
 
 
-@njit(cache=True, fastmath=False)
+@jit
 def one_pole(x, b0, b1, a1, level, restore):
     """y[n] = b0 u[n] + b1 u[n-1] - a1 y[n-1], u = x - level, from rest; plus level again
     when ``restore``. Operation for operation what scipy.signal.lfilter([b0, b1], [1, a1],
@@ -19,7 +19,7 @@ def one_pole(x, b0, b1, a1, level, restore):
     return y
 
 
-@njit(cache=True, fastmath=False)
+@jit
 def undo_highpass(y, h, tau):
     """x[n] = y[n] + (1/tau) sum_{k<=n} h (y[k] + y[k-1]) / 2 (trapezoid rule): the input of
     a one-pole RC high-pass from its output. The same operations as

@@ -2,16 +2,16 @@
 without its set-up cost, for the many short fits of a study."""
 import math
 
-from numba import njit
+from instruments.jit import jit
 
 
-@njit(cache=True, fastmath=False)
+@jit
 def _det3(a, b, c, d, e, f, g, h, i):
     """Determinant of [[a, b, c], [d, e, f], [g, h, i]]."""
     return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
 
 
-@njit(cache=True, fastmath=False)
+@jit
 def parabola(x, y):
     """(a, b, c) of the least-squares fit y = a x^2 + b x + c; nan if x has fewer than
     three distinct values. The normal equations are solved by Cramer's rule: centre x and

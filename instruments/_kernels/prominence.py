@@ -15,10 +15,10 @@ the stack as its lowest sample alone (the last of equal lows, the one closest to
 follows), which keeps the noisy baseline of a record out of the stack.
 """
 import numpy as np
-from numba import njit
+from instruments.jit import jit
 
 
-@njit(cache=True, fastmath=False)
+@jit
 def _left_bases(x, floor, base):
     """base[i]: scipy's left base of sample i (the closest lowest sample before the first
     higher one) for x[i] >= floor; -1 for the samples below the floor."""
@@ -50,7 +50,7 @@ def _left_bases(x, floor, base):
         i += 1
 
 
-@njit(cache=True, fastmath=False)
+@jit
 def prominence_bases(x, floor=-np.inf):
     """(left bases, right bases) of every sample of x at or above ``floor``, as
     scipy.signal.peak_prominences finds them for a peak there (int64 indices; -1 below

@@ -1,9 +1,9 @@
 """The oscilloscope's 8-bit converter (numba): one pass from volts to codes."""
 import numpy as np
-from numba import njit
+from instruments.jit import jit
 
 
-@njit(cache=True, fastmath=False)
+@jit
 def quantise(v, offset, ymult, yoff, sd, noise, lo, hi):
     """Codes round((v - offset) / ymult + yoff [+ sd * noise]) clipped to [lo, hi] (int8),
     and whether any was clipped. ``noise``: standard normal draws, one per sample, or an

@@ -2,10 +2,10 @@
 import math
 
 import numpy as np
-from numba import njit
+from instruments.jit import jit
 
 
-@njit(cache=True, fastmath=False)
+@jit
 def at_positions(f, pos):
     """f (samples 0..n-1) read at fractional sample positions ``pos`` by linear
     interpolation, the ends held: np.interp(pos, np.arange(n), f), operation for

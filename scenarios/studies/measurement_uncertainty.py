@@ -10,8 +10,8 @@ import argparse
 
 import numpy as np
 
-from rig.measure import shot_blocks
-from rig.shot import Rig
+from rig.experiment.measure import shot_blocks
+from rig.experiment.shot import Rig
 
 SCENES = ["ptfe52_gravity", "ptfe52_magnetic", "ptfe52_magnetic_4p25", "ptfe20_gravity",
           "steel21_gravity", "steel21_magnetic"]

@@ -2,13 +2,13 @@
 import numpy as np
 import pytest
 
-from rig import METHODS, solve
+from rig import ChainProblem, METHODS, solve
 from conftest import ptfe_rig, record_contacts
 
 
 def _shot(**kw):
     chain = ptfe_rig(n=30)
-    return solve(chain.problem(record_contacts(chain, 10)), 0.6e-3, **kw)
+    return solve(chain, 0.6e-3, **kw, save=record_contacts(chain, 10))
 
 
 @pytest.mark.parametrize("name", ["verlet", "srkn6b"])
@@ -43,17 +43,17 @@ def test_default_accuracy_figures():
                                                              ("steel21_magnetic", 3e-3, 5e-4)])
 def test_documented_force_error_of_published_records(scene, default_bound, fine_bound):
     # the levels the README states for whole published records (about 2x the measured ones)
-    from rig.shot import Rig
-    from rig.stepsize import contact_time_scale
+    from rig.experiment.shot import Rig
+    from rig.solver.stepsize import contact_time_scale
 
     rig = Rig.from_scene(scene)
-    p = rig.chain.problem(rig.record())
+    p, save = ChainProblem.from_chain(rig.chain), rig.save_at()
     T = rig.solver["duration"]
-    ref = solve(p, T, dt=contact_time_scale(p) / 300)
+    ref = solve(p, T, dt=contact_time_scale(p) / 300, save=save)
 
     def err(sol):
         return max(np.max(np.abs(sol.forces[k] - ref.forces[k])) / np.max(np.abs(ref.forces[k] - ref.forces[k][0]))
                    for k in ref.forces)
 
-    assert err(solve(p, T, accuracy=1e-4)) < default_bound
-    assert err(solve(p, T, accuracy=1e-5)) < fine_bound
+    assert err(solve(p, T, accuracy=1e-4, save=save)) < default_bound
+    assert err(solve(p, T, accuracy=1e-5, save=save)) < fine_bound

@@ -2,16 +2,18 @@
 import numpy as np
 import pytest
 
-from rig import RigError, solve
-from rig.ensemble import ensemble_step, solve_ensemble
+from rig import ChainProblem, RigError, solve
+from rig.solver.ensemble import ensemble_step, solve_ensemble
 from conftest import ptfe_rig, record_contacts
+
+SAVE = record_contacts(ptfe_rig(n=20), 5, 14, 21)
 
 
 def _problems(n):
     out = []
     for k in range(n):
         chain = ptfe_rig(n=20, top_force=2.38 + 0.05 * k, velocity=f"{0.6 + 0.03 * k} m/s")
-        out.append(chain.problem(record_contacts(chain, 5, 14, 21)))
+        out.append(ChainProblem.from_chain(chain))
     return out
 
 
@@ -19,13 +21,13 @@ def _problems(n):
 def test_batched_kernel_agrees_with_single_shots(width):
     probs = _problems(11)  # not a multiple of the width: the last chunk is padded
     dt = ensemble_step(probs, 0.8e-3)
-    ens = solve_ensemble(probs, 0.8e-3, dt=dt, width=width)
+    ens = solve_ensemble(probs, 0.8e-3, save=SAVE, dt=dt, width=width)
     for k, p in enumerate(probs):
-        single = solve(p, 0.8e-3, dt=dt)
+        single = solve(p, 0.8e-3, dt=dt, save=SAVE)
         for name, f in single.forces.items():
             assert np.max(np.abs(ens.forces[name][k] - f)) <= 1e-12 * np.max(np.abs(f))
-        assert ens.diag[0, k] == pytest.approx(single.stats.energy_error, rel=1e-12)
-        assert ens.diag[1, k] <= 1e-10
+        assert ens.reports[k].energy_error == pytest.approx(single.stats.energy_error, rel=1e-12)
+        assert ens.reports[k].momentum_error <= 1e-10
     own = [ensemble_step([p], 0.8e-3) for p in probs]
     assert dt.head == 1  # the alumina striker on the steel bead: the multirate head runs in both kernels
     assert dt.dt == min(s.dt for s in own) and dt.inner_dt == min(s.inner_dt for s in own)  # the strictest shot sets it
@@ -35,9 +37,9 @@ def test_ensemble_refuses_mixed_topologies_and_schedules():
     from rig import ForceSchedule
     a = _problems(1)[0]
     chain = ptfe_rig(n=21)
-    b = chain.problem(record_contacts(chain, 5, 14, 21))
+    b = ChainProblem.from_chain(chain)
     with pytest.raises(RigError, match="one chain topology"):
-        solve_ensemble([a, b], 1e-4, dt=1e-7)
+        solve_ensemble([a, b], 1e-4, save=SAVE, dt=1e-7)
     sched = ptfe_rig(n=20, top_force=ForceSchedule((0, 1e-4), (2.38, 3.0)))
     with pytest.raises(RigError, match="constant loads only"):
-        solve_ensemble([sched.problem(record_contacts(sched, 5, 14, 21))], 1e-4, dt=1e-7)
+        solve_ensemble([ChainProblem.from_chain(sched)], 1e-4, save=SAVE, dt=1e-7)

@@ -2,8 +2,8 @@
 import numpy as np
 
 from rig import solve
-from rig.solitary import solitary_wave
-from rig.theory import sonic_vacuum_speed
+from rig.theory.solitary import solitary_wave
+from rig.theory.longwave import sonic_vacuum_speed
 from conftest import record_contacts, steel_sonic_vacuum
 
 
@@ -17,7 +17,7 @@ def _peak_time(t, y):
 def test_stationary_pulse_matches_discrete_theory():
     chain = steel_sonic_vacuum(n=130)
     a, b = 50, 110
-    sol = solve(chain.problem(record_contacts(chain, a, b)), 1.3e-3, accuracy=1e-6)
+    sol = solve(chain, 1.3e-3, accuracy=1e-6, save=record_contacts(chain, a, b))
     ta, fa = _peak_time(sol.time, sol.forces[f"c{a}"])
     tb, fb = _peak_time(sol.time, sol.forces[f"c{b}"])
     assert abs(fa / fb - 1) < 2e-4  # stationary: the amplitude no longer changes
@@ -38,7 +38,7 @@ def test_stationary_pulse_matches_discrete_theory():
 
 def test_leading_pulse_carries_the_impact_energy():
     chain = steel_sonic_vacuum(n=80)
-    sol = solve(chain.problem(record_contacts(chain, 60)), 0.55e-3, accuracy=1e-6)
+    sol = solve(chain, 0.55e-3, accuracy=1e-6, save=record_contacts(chain, 60))
     e = sol.final_body_energies()
     impact = 0.5 * chain.striker.mass * chain.striker.velocity**2
     assert abs(e.sum() / impact - 1) < 1e-6  # nothing lost overall

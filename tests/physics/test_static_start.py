@@ -1,7 +1,7 @@
 """The rig starts from exact static equilibrium: nothing moves before impact."""
 import numpy as np
 
-from rig import Record, solve
+from rig import ChainProblem, SaveAt, solve
 from conftest import ptfe_rig
 
 
@@ -9,8 +9,8 @@ def test_published_ptfe_chain_at_rest_stays_at_rest():
     # 52 PTFE beads + magnetic bead, gravity and 2.38 N, no striker: after 2 ms no bead
     # moves faster than 1e-9 m/s (acceptance of the static start).
     chain = ptfe_rig(top_force=2.38, striker=False)
-    p = chain.problem(Record({"wall": chain.wall_probe()}))
-    sol = solve(p, 2e-3)
+    p, save = ChainProblem.from_chain(chain), SaveAt({"wall": chain.wall_probe()})
+    sol = solve(p, 2e-3, save=save)
     assert np.max(np.abs(sol.final_v)) < 1e-9
     # the wall carries the weight of everything plus the magnet force, unchanged
     expected = 9.80665 * chain.masses.sum() + 2.38

@@ -4,8 +4,8 @@ import math
 import pytest
 
 from rig import hertz_constant, material
-from rig.solitary import solitary_wave
-from rig.theory import solitary_wave_speed, sonic_vacuum_speed, sound_speed
+from rig.theory.solitary import solitary_wave
+from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed, sound_speed
 
 D = 4.76e-3
 
@@ -54,7 +54,7 @@ def test_precompressed_discrete_wave_approaches_eq1_and_beta_depends_on_fr_only(
 
 
 def test_beta_curve_from_the_discrete_chain():
-    from rig.solitary import beta
+    from rig.theory.solitary import beta
     curve = [beta(fr) for fr in (1.1, 2.0, 5.0, 50.0, float("inf"))]
     assert all(b2 > b1 for b1, b2 in zip(curve, curve[1:]))  # grows with F_m/F_0
     assert curve[0] == pytest.approx(1.008, abs=1e-3)  # long waves: gauge reads the contact

@@ -27,7 +27,7 @@ def movie(tmp_path_factory):
 
 
 def test_movie_has_the_requested_frames_and_they_are_not_blank(movie):
-    from rig.animate import PANEL_HEIGHT, VIEW_HEIGHT, WIDTH
+    from rig.viz.animate import PANEL_HEIGHT, VIEW_HEIGHT, WIDTH
 
     assert movie.shape == (12, VIEW_HEIGHT + PANEL_HEIGHT, WIDTH, 3)
     for frame in movie:
@@ -37,7 +37,7 @@ def test_movie_has_the_requested_frames_and_they_are_not_blank(movie):
 def test_colour_moves_down_the_chain_with_the_wave(movie):
     # along the chain's row in the 3-D view, the column that warmed most (largest force on
     # the 'inferno' map) moves right, from the striker towards the wall, as the pulse travels
-    from rig.animate import VIEW_HEIGHT
+    from rig.viz.animate import VIEW_HEIGHT
 
     view = movie[:, :VIEW_HEIGHT].astype(float)
     row = view[:, VIEW_HEIGHT // 2 - 3: VIEW_HEIGHT // 2 + 3]  # the chain's axis
@@ -61,17 +61,17 @@ def test_still_png(tmp_path):
 @pytest.mark.parametrize("out,message", [("shot.avi", "ending in .mp4, .gif, .png"),
                                          ("missing/shot.mp4", "does not exist")])
 def test_bad_output_is_refused_before_rendering(tmp_path, capsys, monkeypatch, out, message):
-    import rig.shot
+    import rig.experiment.shot
 
     def no_solving(*a, **k):
         raise AssertionError("nothing may be computed for a bad --out")
 
-    monkeypatch.setattr(rig.shot.Rig, "from_scene", no_solving)
+    monkeypatch.setattr(rig.experiment.shot.Rig, "from_scene", no_solving)
     assert main(["animate", "ptfe52_magnetic", "--out", str(tmp_path / out)]) == 2
     err = capsys.readouterr().err
     assert message in err and "--out" in err and len(err.strip().splitlines()) == 1
 
 
 def test_the_rig_does_not_import_pyvista():
-    code = "import sys, rig, rig.shot, rig.solve, rig.mc, rig.cli; print('pyvista' in sys.modules or 'vtk' in sys.modules)"
+    code = "import sys, rig, rig.experiment.shot, rig.solver.solve, rig.study.montecarlo, rig.cli; print('pyvista' in sys.modules or 'vtk' in sys.modules)"
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "False"

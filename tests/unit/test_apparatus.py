@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from rig import Bead, ForceSchedule, RigError, Striker
-from rig.apparatus import Holder, RingMagnet
-from rig.shot import Rig
+from rig.model.apparatus import Holder, RingMagnet
+from rig.experiment.shot import Rig
 
 
 def test_a_hanging_ring_pulls_with_its_weight_the_published_2p38_N():
@@ -22,8 +22,8 @@ def test_sliding_the_ring_changes_the_force():
 
 
 def test_magnet_position_and_schedule_in_a_scene(tmp_path):
-    from rig.scene import SCENARIO_ROOT
-    text = (SCENARIO_ROOT / "daraio2006" / "ptfe52_magnetic.toml").read_text()
+    from rig.experiment.scene import PUBLISHED_SCENES
+    text = (PUBLISHED_SCENES / "daraio2006" / "ptfe52_magnetic.toml").read_text()
     f = tmp_path / "slid.toml"
     f.write_text(text.replace('force = "2.38 N"', 'position = "7 mm"'))
     rig = Rig.from_scene(f)

@@ -5,7 +5,7 @@ import pytest
 
 from instruments.archive import Archive
 from rig.cli import main
-from rig.shot import Rig
+from rig.experiment.shot import Rig
 
 def test_thousand_virtual_shots_round_trip_bit_identical(tmp_path):
     rig = Rig.from_scene("ptfe52_magnetic")

@@ -4,7 +4,7 @@ import json
 import pytest
 
 from rig.cli import main
-from benchmarks.solver import matched
+from rig.bench.solver import matched
 
 
 def _json(capsys, *argv):

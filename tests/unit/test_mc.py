@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from rig.cli import main
-from rig.distributions import parse_vary
-from rig.executors import run_study
-from rig.mc import Store, Study, refire, run_batch
-from rig.mc_report import jcgm101
+from rig.study.distributions import parse_vary
+from rig.study.executors import run_study
+from rig.study.montecarlo import Store, Study, refire, run_batch
+from rig.study.report import jcgm101
 
 VARY = ["striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)",
         "gauges.upper.misalignment=normal(0 mm, 1 mm)", "gauges.lower.gain=normal(1, 0.05)"]
@@ -117,7 +117,7 @@ def test_leading_window_measures_what_the_whole_record_measures():
     # with noise-free instruments the short study window (simulated until the leading pulse
     # has passed the last gauge, the scope's pre-trigger samples kept) gives the same speed
     # and amplitude as the scene's whole record, for a fraction of the simulated time
-    from rig.mc import leading_window
+    from rig.study.montecarlo import leading_window
 
     quiet = ("gauges.upper.noise=0 V", "gauges.lower.noise=0 V", "gauges.upper.calibration_error=0",
              "gauges.lower.calibration_error=0", "wall_sensor.noise=0 V", "wall_sensor.calibration_error=0",
@@ -135,8 +135,8 @@ def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(t
     # and the pipeline run on an archived record gives the speed the study stored
     from instruments.archive import Archive
     from instruments.pipeline import analyze_record
-    from rig.mc import _rig_for, nominal_calibration, shot_inputs
-    from rig.measure import setup_for
+    from rig.study.montecarlo import _rig_for, nominal_calibration, shot_inputs
+    from rig.experiment.measure import setup_for
 
     plain = Store(tmp_path / "plain", _study(32)).open()
     run_study(_study(32), plain)
@@ -162,14 +162,14 @@ def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(t
 def test_a_study_records_the_gauge_averages_and_contacts_only_when_needed():
     # the gauges read their plates' average: a study records it as one probe per gauge
     # (3 channels with the wall, not 5); the truth analysis and the traces add the contacts
-    from rig.mc import _rig_for, shot_inputs, study_record
+    from rig.study.montecarlo import _rig_for, shot_inputs, study_save
 
     for kw, names in (({}, {"gauge_lower", "gauge_upper", "wall"}),
                       ({"truth": True}, {"gauge_lower", "gauge_upper", "wall", "contact20", "contact21",
                                          "contact29", "contact30"})):
         study = _study(16, **kw)
         rig = _rig_for(study, *shot_inputs(study, 0, 52)[:2])[0]
-        assert set(study_record(study, rig).probes) == names
+        assert set(study_save(study, rig).probes) == names
     plain = run_batch(_study(16), 0)["outputs"]
     with_truth = run_batch(_study(16, truth=True), 0)["outputs"]
     for k in ("speed_m_per_s", "amplitude_N"):

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from rig.cli import main
-from rig.measure import shot_blocks
-from rig.shot import Rig
+from rig.experiment.measure import shot_blocks
+from rig.experiment.shot import Rig
 
 PUBLISHED = ["ptfe52_gravity", "ptfe52_magnetic", "ptfe52_magnetic_4p25", "ptfe20_gravity",
              "steel21_gravity", "steel21_magnetic"]

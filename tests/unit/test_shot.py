@@ -5,9 +5,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rig.solver.problem import ChainProblem
+
 from rig.cli import main
-from rig.scene import SCENARIO_ROOT
-from rig.shot import Rig
+from rig.experiment.scene import PUBLISHED_SCENES
+from rig.experiment.shot import Rig
 
 PUBLISHED = ["ptfe52_gravity", "ptfe52_magnetic", "ptfe52_magnetic_4p25", "ptfe20_gravity",
              "steel21_gravity", "steel21_magnetic"]
@@ -15,7 +17,7 @@ PUBLISHED = ["ptfe52_gravity", "ptfe52_magnetic", "ptfe52_magnetic_4p25", "ptfe2
 
 @pytest.mark.parametrize("name", PUBLISHED)
 def test_every_published_scene_fires_cleanly(name):
-    assert (SCENARIO_ROOT / "daraio2006" / f"{name}.toml").is_file()
+    assert (PUBLISHED_SCENES / "daraio2006" / f"{name}.toml").is_file()
     shot = Rig.from_scene(name).fire(seed=11)
     assert shot.scope.triggered
     assert set(shot.scope.waveforms) == {"CH1", "CH2", "CH3"}
@@ -49,8 +51,8 @@ def test_only_the_instruments_contacts_are_recorded():
 
 
 def test_no_magnet_no_magnet_term():
-    gravity = Rig.from_scene("ptfe52_gravity").chain.problem()
-    magnetic = Rig.from_scene("ptfe52_magnetic").chain.problem()
+    gravity = ChainProblem.from_chain(Rig.from_scene("ptfe52_gravity").chain)
+    magnetic = ChainProblem.from_chain(Rig.from_scene("ptfe52_magnetic").chain)
     assert gravity.sched_t.size == 0 and magnetic.sched_t.size == 0  # constant: no per-step term
     assert gravity.bias[1] == pytest.approx(9.80665)  # the magnetic bead feels gravity alone
     assert magnetic.bias[1] == pytest.approx(9.80665 + 2.38 / 0.5e-3)
@@ -133,7 +135,7 @@ def test_trigger_on_an_unconnected_channel(tmp_path):
 
 
 def test_quantity_without_unit_in_a_scene_file(tmp_path):
-    text = (SCENARIO_ROOT / "daraio2006" / "ptfe52_magnetic.toml").read_text()
+    text = (PUBLISHED_SCENES / "daraio2006" / "ptfe52_magnetic.toml").read_text()
     bad = tmp_path / "bad.toml"
     bad.write_text(text.replace('diameter = "4.76 mm"', "diameter = 4.76"))
     with pytest.raises(ValueError, match=r"chain\.diameter.*unit is required"):
@@ -141,7 +143,7 @@ def test_quantity_without_unit_in_a_scene_file(tmp_path):
 
 
 def test_a_scene_with_the_wall_sensor_alone(tmp_path, capsys):
-    text = (SCENARIO_ROOT / "daraio2006" / "steel21_gravity.toml").read_text()
+    text = (PUBLISHED_SCENES / "daraio2006" / "steel21_gravity.toml").read_text()
     head, _, rest = text.partition("[gauges.upper]")
     scope = rest[rest.index("[scope]"):]
     scene = tmp_path / "wall_only.toml"
@@ -156,7 +158,7 @@ def test_a_scene_with_the_wall_sensor_alone(tmp_path, capsys):
 def test_a_rig_like_another_takes_over_only_the_parts_of_shared_tables():
     # studies build each shot's rig "like" a template: parts of the very same scene tables
     # are taken over, the others built anew, and the shot is the one a fresh rig fires
-    from rig import scene as scene_io
+    from rig.experiment import scene as scene_io
 
     values, text = scene_io.load("ptfe52_magnetic")
     template = Rig(values, text)

@@ -2,14 +2,14 @@
 import numpy as np
 import pytest
 
-from rig import Chain, ForceSchedule, Record, RigError, solve
+from rig import ChainProblem, Chain, ForceSchedule, SaveAt, RigError, solve
 from conftest import ptfe_rig, steel_sonic_vacuum
 
 
 def test_only_the_asked_channels_are_recorded():
     chain = ptfe_rig(n=52)
-    rec = Record({"g20": chain.gauge_probe(19), "g29": chain.gauge_probe(28), "wall": chain.wall_probe()})
-    sol = solve(chain.problem(rec), 1e-3)
+    rec = SaveAt({"g20": chain.gauge_probe(19), "g29": chain.gauge_probe(28), "wall": chain.wall_probe()})
+    sol = solve(chain, 1e-3, save=rec)
     n = int(round(1e-3 / rec.sample_interval)) + 1
     assert set(sol.forces) == {"g20", "g29", "wall"}
     assert all(f.shape == (n,) for f in sol.forces.values())
@@ -19,20 +19,20 @@ def test_only_the_asked_channels_are_recorded():
 
 def test_frames_only_when_asked():
     chain = ptfe_rig(n=10)
-    sol = solve(chain.problem(Record({}, frame_interval=1e-5)), 1e-4)
+    sol = solve(chain, 1e-4, save=SaveAt({}, frame_interval=1e-5))
     assert sol.frames.shape == (11, 12)  # striker + magnetic bead + 10 beads
     assert np.all(np.diff(sol.frames[0]) > 0)  # ordered down the tube
 
 
 def test_gauge_reads_the_mean_of_its_two_contacts():
     chain = ptfe_rig(n=20)
-    rec = Record({"g": chain.gauge_probe(8), "a": chain.contact_probe(8), "b": chain.contact_probe(9)})
-    sol = solve(chain.problem(rec), 3e-4)
+    rec = SaveAt({"g": chain.gauge_probe(8), "a": chain.contact_probe(8), "b": chain.contact_probe(9)})
+    sol = solve(chain, 3e-4, save=rec)
     assert np.allclose(sol.forces["g"], 0.5 * (sol.forces["a"] + sol.forces["b"]), rtol=1e-13, atol=1e-15)
 
 
 def test_no_magnet_no_magnet_term():
-    p = ptfe_rig(n=5, top_force=0.0).problem()
+    p = ChainProblem.from_chain(ptfe_rig(n=5, top_force=0.0))
     assert p.sched_t.size == 0
     assert np.allclose(p.bias[1:-1], 9.80665)  # gravity alone, on the magnetic bead too
 
@@ -40,8 +40,8 @@ def test_no_magnet_no_magnet_term():
 def test_scheduled_magnet_force_balances_energy_and_momentum():
     sched = ForceSchedule((0.0, 2e-4, 4e-4), (2.38, 4.25, 4.25))
     chain = ptfe_rig(n=20, top_force=sched, striker=False)
-    p = chain.problem(Record({"wall": chain.wall_probe()}))
-    coarse, fine = (solve(p, 6e-4, dt=dt) for dt in (4e-7, 1e-7))
+    p, save = ChainProblem.from_chain(chain), SaveAt({"wall": chain.wall_probe()})
+    coarse, fine = (solve(p, 6e-4, dt=dt, save=save) for dt in (4e-7, 1e-7))
     for sol in (coarse, fine):
         assert sol.stats.momentum_error < 1e-10  # the schedule's impulse is exact
     # the magnet's work is summed by the trapezoidal rule: the balance closes as O(dt^2)
@@ -56,7 +56,7 @@ def test_dissipative_law_loses_energy_and_is_off_by_default():
     from rig import Bead, Striker
     lossy = Chain([Bead(**STEEL)] * 30, striker=Striker("steel316", "0.4501 g", "0.44 m/s"),
                   gravity=0, contact_law="kuwabara-kono", damping_time=1e-7)
-    sol = solve(lossy.problem(), 2e-4)
+    sol = solve(lossy, 2e-4)
     kept = sol.final_body_energies().sum() / (0.5 * 0.4501e-3 * 0.44**2)
     assert 0.5 < kept < 0.999
 
@@ -64,7 +64,7 @@ def test_dissipative_law_loses_energy_and_is_off_by_default():
 @pytest.mark.parametrize("t_end", [0.0, -1e-3, float("nan")])
 def test_end_time_must_be_positive(t_end):
     with pytest.raises(RigError, match="t_end"):
-        solve(ptfe_rig(n=3).problem(), t_end)
+        solve(ptfe_rig(n=3), t_end)
 
 
 def test_bad_chain_inputs():
@@ -76,6 +76,6 @@ def test_bad_chain_inputs():
     with pytest.raises(RigError, match="probe.contact"):
         steel_sonic_vacuum(n=5).contact_probe(5)  # no wall, so no contact 5
     with pytest.raises(RigError, match="method"):
-        solve(ptfe_rig(n=3).problem(), 1e-4, method="rk4")
+        solve(ptfe_rig(n=3), 1e-4, method="rk4")
     with pytest.raises(RigError, match="accuracy"):
-        solve(ptfe_rig(n=3).problem(), 1e-4, accuracy=2.0)
+        solve(ptfe_rig(n=3), 1e-4, accuracy=2.0)

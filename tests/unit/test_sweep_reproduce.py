@@ -4,7 +4,7 @@ import json
 import pytest
 
 from rig.cli import main
-from rig.sweep import Vary
+from rig.study.sweep import Vary
 
 
 @pytest.mark.parametrize("spec,message", [

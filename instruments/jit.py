@@ -1,0 +1,63 @@
+"""The one numba decorator of the project and the guard that keeps numba's on-disk cache
+of a kernel package consistent with its sources.
+
+Every compiled kernel (the chain integrators in rig/solver/kernels/, the instruments'
+and the analysis' loops in instruments/_kernels/) is declared with ``@jit`` (or
+``@jit(parallel=True)``): numba's ``njit`` with ``cache=True`` (compiled once per machine,
+kept on disk) and ``fastmath=False`` (IEEE arithmetic: results bit-identical to numpy's).
+A kernel package calls ``drop_stale_cache(__name__)`` in its ``__init__``.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib
+import pkgutil
+from pathlib import Path
+
+from numba import njit
+
+OPTIONS = {"cache": True, "fastmath": False}
+
+
+def jit(function=None, **options):
+    """numba's njit with the project's options; ``@jit`` or ``@jit(parallel=True)``."""
+    if function is None:
+        return lambda f: njit(**OPTIONS, **options)(f)
+    return njit(**OPTIONS)(function)
+
+
+def drop_stale_cache(package: str) -> None:
+    """Drop the cached machine code of every kernel of ``package`` when any of its sources
+    changed since that code was written.
+
+    numba's cache=True keys each compiled function on its own source file only, but a
+    kernel inlines the kernels it calls from the package's other files: after a change to
+    a callee alone, its callers' cached code would still hold the old callee. Keying the
+    whole package on a digest of all its sources closes that gap (numba then compiles
+    afresh, once).
+    """
+    from numba.core.dispatcher import Dispatcher
+
+    root = importlib.import_module(package)
+    folder = Path(root.__file__).parent
+    digest = hashlib.sha256()
+    for path in sorted(folder.glob("*.py")):
+        digest.update(path.name.encode() + b"\0" + path.read_bytes())
+    modules = [importlib.import_module(f"{package}.{m.name}") for m in pkgutil.iter_modules([str(folder)])]
+    caches = {}
+    for module in modules:
+        for obj in vars(module).values():
+            cache = getattr(obj, "_cache", None) if isinstance(obj, Dispatcher) else None
+            if getattr(cache, "cache_path", None) and hasattr(cache, "flush"):  # None: not cached
+                caches.setdefault(cache.cache_path, []).append(cache)
+    for path, members in caches.items():
+        stamp = Path(path) / f"{package}.sources"
+        try:
+            if stamp.is_file() and stamp.read_text() == digest.hexdigest():
+                continue
+            for cache in members:
+                cache.flush()
+            stamp.parent.mkdir(parents=True, exist_ok=True)
+            stamp.write_text(digest.hexdigest())
+        except OSError:  # a cache folder we cannot write: numba cannot cache there either
+            continue

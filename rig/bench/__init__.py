@@ -1,0 +1,1 @@
+"""Benchmarks (`rig bench WHAT`): each module has run() -> dict and table(result) -> str."""

@@ -1,0 +1,57 @@
+"""Archive benchmark (``rig bench archive``): virtual shots of 3 channels x 10,000 points
+(ptfe52_magnetic with scope.record_length = 10000), appended in transactions of 100 shots
+and, for comparison, one transaction per shot (what ``rig shot --out`` does). Medians of
+3 runs into fresh files; then verify and read-back rates."""
+from __future__ import annotations
+
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+from instruments.archive import Archive
+from rig.experiment.shot import Rig
+
+
+def run(shots: int = 400, batch: int = 100, single: int = 60) -> dict:
+    rig = Rig.from_scene("ptfe52_magnetic", ["scope.record_length=10000"])
+    entries = [rig.fire(seed=s).to_entry() for s in range(shots)]
+
+    def rate(chunk, n):
+        times = []
+        for _ in range(3):
+            with tempfile.TemporaryDirectory() as d:
+                a = Archive(Path(d) / "bench.h5")
+                t0 = time.perf_counter()
+                for k in range(0, n, chunk):
+                    a.append(entries[k:k + chunk])
+                times.append(time.perf_counter() - t0)
+        return n / statistics.median(times)
+
+    batched = rate(batch, shots)
+    one_by_one = rate(1, single)
+    with tempfile.TemporaryDirectory() as d:
+        a = Archive(Path(d) / "bench.h5")
+        a.append(entries)
+        size = (Path(d) / "bench.h5").stat().st_size
+        t0 = time.perf_counter()
+        a.verify()
+        verify = shots / (time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        for i in a.ids():
+            a.read(i, with_truth=False)
+        read = shots / (time.perf_counter() - t0)
+    return {"points_per_channel": 10000, "channels": 3, "shots": shots,
+            "batched_shots_per_s": batched, "batch": batch,
+            "single_shots_per_s": one_by_one, "verify_shots_per_s": verify,
+            "read_shots_per_s": read, "bytes_per_shot": size / shots}
+
+
+def table(r: dict) -> str:
+    return "\n".join([
+        f"archive: {r['shots']} virtual shots, {r['channels']} channels x {r['points_per_channel']} points, one core",
+        f"  append, {r['batch']} shots per transaction   {r['batched_shots_per_s']:8.0f} shots/s",
+        f"  append, one shot per transaction   {r['single_shots_per_s']:8.0f} shots/s",
+        f"  verify (fletcher32 + sha256)       {r['verify_shots_per_s']:8.0f} shots/s",
+        f"  read back (codes + metadata)       {r['read_shots_per_s']:8.0f} shots/s",
+        f"  file size                          {r['bytes_per_shot'] / 1e3:8.1f} kB/shot"])

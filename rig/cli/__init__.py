@@ -1,0 +1,135 @@
+"""The ``rig`` command line: the parser. The commands themselves live in rig/commands/.
+Every user mistake ends in one clear line (exit 2), never a traceback."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from instruments.errors import InstrumentError
+
+from rig.cli import data, shots, tools
+from rig.cli.common import quantity_arg as _q
+from rig.errors import RigError
+
+
+def _command(sub, name: str, help_text: str, func):
+    """A subcommand with its --json flag, run by ``func(args)``."""
+    parser = sub.add_parser(name, help=help_text)
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    parser.set_defaults(func=func)
+    return parser
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="rig", description="Virtual rig for strongly nonlinear granular chains.")
+    sub = ap.add_subparsers(dest="command", required=True)
+
+    th = _command(sub, "theory", "long-wave and exact discrete solitary wave speeds", tools.cmd_theory)
+    th.add_argument("--material", default="ptfe", help="ptfe | steel316 | ... (default ptfe)")
+    th.add_argument("--diameter", default="4.76 mm", help="bead diameter, e.g. 4.76mm (plain number: m)")
+    th.add_argument("--f0", required=True, help="precompression F0 (plain number: N)")
+    th.add_argument("--fm", help="maximum contact force Fm of the wave (plain number: N)")
+
+    sh = _command(sub, "shot", "fire one virtual shot of a scene", shots.cmd_shot)
+    sh.add_argument("scene", help="a scene file, or a published scene's name (e.g. ptfe52_magnetic)")
+    sh.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="override a scene key, e.g. striker.velocity=1.2 (plain numbers in SI)")
+    sh.add_argument("--seed", type=int, help="seed of every random draw (default: a fresh one, printed)")
+    sh.add_argument("--export", metavar="DIR", help="write the scope records to DIR")
+    sh.add_argument("--format", choices=["isf", "csv"], default="isf", help="scope file format (default isf)")
+    sh.add_argument("--out", metavar="ARCHIVE.h5", help="append the shot to an HDF5 archive")
+
+    ve = _command(sub, "verify", "check every shot of an archive (exit 1 if any is bad)", data.cmd_verify)
+    ve.add_argument("archive")
+
+    im = _command(sub, "import", "import real scope files into an archive", data.cmd_import)
+    im.add_argument("files", nargs="+", metavar="FILE")
+    im.add_argument("--into", required=True, metavar="ARCHIVE.h5")
+    im.add_argument("--together", action="store_true", help="the files are the channels of one shot")
+
+    sw = _command(sub, "sweep", "one shot per value of a scene key", shots.cmd_sweep)
+    sw.add_argument("scene")
+    sw.add_argument("--vary", required=True, metavar="KEY=START:STOP:COUNT",
+                    help="e.g. striker.velocity=0.3:1.5:7 (plain numbers in the key's SI unit)")
+    sw.add_argument("--set", action="append", metavar="KEY=VALUE", help="other overrides")
+    sw.add_argument("--seed", type=int, default=0, help="the sweep's seed (default 0)")
+    sw.add_argument("--out", metavar="ARCHIVE.h5", help="append every shot to an archive")
+    sw.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    an = _command(sub, "animate", "render a virtual shot to a movie or still, off-screen", shots.cmd_animate)
+    an.add_argument("scene")
+    an.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene key")
+    an.add_argument("--seed", type=int, help="seed of the instruments' draws (default: a fresh one, printed)")
+    an.add_argument("--out", required=True, metavar="FILE", help="FILE.mp4, FILE.gif or FILE.png (one still)")
+    an.add_argument("--frames", type=int, default=100, help="frames over the scene's duration (default 100)")
+    an.add_argument("--exaggerate", type=float,
+                    help="displacement factor (default: the largest displacement shown as 1/3 diameter)")
+    an.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    rp = _command(sub, "reproduce", "re-run a published study (daraio2006)", shots.cmd_reproduce)
+    rp.add_argument("study", help="daraio2006")
+    rp.add_argument("--out", required=True, metavar="DIR", help="folder for tables and figures")
+    rp.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    mc = _command(sub, "mc", "Monte Carlo study over many virtual shots", shots.cmd_mc)
+    mc.add_argument("scene")
+    mc.add_argument("--shots", type=int, required=True)
+    mc.add_argument("--vary", action="append", metavar="KEY=DIST",
+                    help='e.g. striker.velocity="normal(0.89 m/s, 0.01 m/s)"; also chain.bead_mass, '
+                         'gauges.NAME.gain, gauges.NAME.misalignment')
+    mc.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides")
+    mc.add_argument("--seed", type=int, default=0, help="the study's seed (default 0)")
+    mc.add_argument("--batch", type=int, default=128, help="shots per batch (default 128)")
+    mc.add_argument("--accuracy", type=float, help="solver accuracy (default: the scene's)")
+    mc.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
+    mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")
+    mc.add_argument("--sobol", action="store_true", help="Sobol design and indices (needs SALib)")
+    mc.add_argument("--truth", action="store_true", help="also analyse each shot's noise-free truth (slower)")
+    mc.add_argument("--window", choices=["leading", "record"], default="leading",
+                    help="simulate until the leading pulse has passed the last gauge (default), "
+                         "or the scene's whole record")
+    mc.add_argument("--traces", action="store_true",
+                    help="also archive every shot's scope record and truth in DIR/traces/ (one archive per batch)")
+    mc.add_argument("--out", required=True, metavar="DIR")
+    mc.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    an = _command(sub, "analyze", "speeds and amplitudes from scope files or an archive", data.cmd_analyze)
+    an.add_argument("files", nargs="+", metavar="FILE", help=".isf, .csv or .h5 (an archive)")
+    an.add_argument("--shot", type=int, help="one shot of an archive (default: every shot)")
+    an.add_argument("--gauge-distance", type=lambda s: _q(s, "m", "--gauge-distance"),
+                    help="distance between the two gauges (plain number: m), for real files")
+    an.add_argument("--channels", help="UPPER,LOWER[,WALL] channel names (default: file order)")
+    an.add_argument("--wall", action="store_true", help="the third channel is the wall sensor")
+    an.add_argument("--sensitivity", type=float, default=1.0, help="gauge sensitivity V/N (default 1: volts)")
+    an.add_argument("--tau", type=lambda s: _q(s, "s", "--tau"), help="gauge RC time constant to invert (s)")
+    an.add_argument("--beta", type=float, default=1.0, help="beta = F_d / F_m,e (default 1)")
+    an.add_argument("--f0", type=lambda s: _q(s, "N", "--f0"), default=0.0, help="precompression F_0 (N)")
+    an.add_argument("--diameter", type=lambda s: _q(s, "m", "--diameter"), default=4.76e-3,
+                    help="bead diameter (plain number: m; default 4.76 mm)")
+    an.add_argument("--material", help="bead material, to add the Eq (1) speed")
+
+    ls = _command(sub, "ls", "list the shots of an archive", data.cmd_ls)
+    ls.add_argument("archive")
+
+    be = _command(sub, "bench", "benchmarks", tools.cmd_bench)
+    be.add_argument("what", choices=["solver", "accuracy", "shot", "archive", "pipeline", "mc", "animate"],
+                    help="what to benchmark")
+    be.add_argument("--quick", action="store_true", help="fewer settings, one repeat")
+    return ap
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        out = args.func(args)
+    except (RigError, InstrumentError) as exc:
+        print(f"rig {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    if args.json:
+        print(json.dumps(out, indent=2))
+    return getattr(args, "exit_code", 0)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,72 @@
+"""`rig verify`, `rig import`, `rig analyze` and `rig ls`."""
+from __future__ import annotations
+
+
+
+def cmd_verify(args) -> dict:
+    from instruments.archive import Archive
+
+    report = Archive(args.archive).verify()
+    if not args.json:
+        print(f"{args.archive}: {report['shots']} shots, {report['ok']} ok, {len(report['bad'])} bad")
+        for b in report["bad"]:
+            print(f"  shot {b['shot']}: {b['reason']}")
+    args.exit_code = 1 if report["bad"] else 0
+    return report
+
+
+def cmd_import(args) -> dict:
+    """Real scope files into an archive, in the same layout as virtual shots (simulated = false)."""
+    from datetime import datetime, timezone
+    from pathlib import Path
+
+    from instruments.archive import Archive, Entry
+    from instruments.formats import read_record
+
+    groups = [args.files] if args.together else [[f] for f in args.files]
+    entries = []
+    for files in groups:
+        mtime = min(Path(f).stat().st_mtime for f in files)
+        entries.append(Entry(read_record(files), False, scene="",
+                             settings={"source_files": [str(Path(f).resolve().name) for f in files]},
+                             start_time=datetime.fromtimestamp(mtime, timezone.utc).isoformat()))
+    ids = Archive(args.into).append(entries)
+    out = {"archive": args.into, "shots": ids}
+    if not args.json:
+        print(f"imported {len(args.files)} file(s) into {args.into} as shot(s) {', '.join(map(str, ids))}")
+    return out
+
+
+def cmd_analyze(args) -> list:
+    from rig.experiment.analyze import analyze_paths
+
+    results = analyze_paths(args)
+    if not args.json:
+        fmt = lambda v, spec=".2f": "-" if v is None else format(v, spec)  # noqa: E731
+        print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d N':>8s} {'F_m,e N':>8s} "
+              f"{'pulses':>6s} {'FWHM us':>8s} {'Eq1 m/s':>8s}")
+        for r in results:
+            fwhm = None if r["duration_s"] is None else r["duration_s"] * 1e6
+            print(f"{r['source'][-40:]:40s} {fmt(r['speed_m_per_s'], '.1f'):>8s} "
+                  f"{fmt(r['speed_xcorr_m_per_s'], '.1f'):>8s} {fmt(r['amplitude_N'], '.3f'):>8s} "
+                  f"{fmt(r['averaged_amplitude_N'], '.3f'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
+                  f"{fmt(fwhm, '.1f'):>8s} {fmt(r['theory_speed_m_per_s'], '.1f'):>8s}")
+    return results
+
+
+def cmd_ls(args) -> list:
+    from instruments.archive import Archive
+
+    rows = Archive(args.archive).summary()
+    if not args.json:
+        print(f"{'shot':>5s}  {'start (UTC)':19s}  {'kind':7s}  {'scene':22s}  {'seed':>20s}  channels")
+        for r in rows:
+            s = r["settings"]
+            extra = f"  v={s['velocity']:g} m/s" if "velocity" in s else ""
+            what = r["scene"] or ",".join(r["sources"]) or "-"
+            print(f"{r['shot']:5d}  {r['start_time'][:19]:19s}  {'virtual' if r['simulated'] else 'real':7s}  "
+                  f"{what:22s}  {'' if r['seed'] is None else r['seed']:>20}  "
+                  f"{','.join(r['channels'])}{'' if r['triggered'] else '  NO TRIGGER'}{extra}")
+    return rows
+
+

@@ -1,0 +1,70 @@
+"""`rig theory` and `rig bench`."""
+from __future__ import annotations
+
+import math
+import sys
+
+from rig.errors import RigError
+from rig.cli.common import quantity_arg as _q
+
+
+def cmd_theory(args) -> dict:
+    from rig.model.contact import hertz_constant
+    from rig.model.materials import material
+    from rig.theory.solitary import MIN_FORCE_RATIO, solitary_wave
+    from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed, sound_speed
+
+    m = material(args.material)
+    a = _q(args.diameter, "m", "--diameter")
+    F0 = _q(args.f0, "N", "--f0")
+    if not a > 0:
+        raise RigError(f"--diameter = {args.diameter!r}: must be > 0 m")
+    if not F0 >= 0:
+        raise RigError(f"--f0 = {args.f0!r}: precompression must be >= 0 N")
+    out = {"material": m.name, "diameter_m": a, "f0_N": F0, "fm_N": None,
+           "sound_speed_m_per_s": float(sound_speed(m.E, m.nu, m.rho, a, F0)),
+           "speed_m_per_s": None, "sonic_vacuum_speed_m_per_s": None,
+           "discrete_speed_m_per_s": None}
+    if args.fm is not None:
+        Fm = _q(args.fm, "N", "--fm")
+        if not Fm > F0:
+            raise RigError(f"--fm = {args.fm!r}: the maximum force must exceed --f0 = {F0} N")
+        out["fm_N"] = Fm
+        out["sonic_vacuum_speed_m_per_s"] = float(sonic_vacuum_speed(m.E, m.nu, m.rho, a, Fm))
+        out["speed_m_per_s"] = (float(solitary_wave_speed(m.E, m.nu, m.rho, a, F0, Fm)) if F0 > 0
+                                else out["sonic_vacuum_speed_m_per_s"])
+        if F0 == 0 or Fm >= MIN_FORCE_RATIO * F0:
+            A = hertz_constant(m.E, m.nu, a / 2, m.E, m.nu, a / 2)
+            mass = m.rho * math.pi * a**3 / 6
+            out["discrete_speed_m_per_s"] = solitary_wave(mass, A, a, Fm, F0).speed
+    if not args.json:
+        print(f"{m.name}, diameter {a * 1e3:g} mm, F0 = {F0:g} N" + (f", Fm = {out['fm_N']:g} N" if args.fm else ""))
+        rows = [("sound speed c0, Eq (2)", out["sound_speed_m_per_s"]),
+                ("solitary wave speed, Eq (1)", out["speed_m_per_s"]),
+                ("sonic-vacuum speed, Eq (4)", out["sonic_vacuum_speed_m_per_s"]),
+                ("exact discrete solitary wave", out["discrete_speed_m_per_s"])]
+        for label, v in rows:
+            print(f"  {label:30s} {'-' if v is None else f'{v:9.2f} m/s'}")
+    return out
+
+
+def cmd_bench(args) -> dict:
+    if args.what in ("accuracy", "shot", "archive", "pipeline", "mc", "animate"):
+        import importlib
+
+        module = importlib.import_module(f"rig.bench.{args.what}")
+        result = module.run()
+        if not args.json:
+            print(module.table(result))
+        return result
+    from rig.bench import solver as bench
+
+    progress = None if args.json else (lambda msg: print(f"  running {msg}", file=sys.stderr, flush=True))
+    result = bench.run(quick=args.quick, progress=progress)
+    if not args.json:
+        print(f"solver work-precision, {bench.N_BEADS} steel beads, force error at contact "
+              f"{bench.PROBE} (machine: {result['machine']})")
+        print(bench.table(result))
+    return result
+
+

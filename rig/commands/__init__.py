@@ -1,1 +1,0 @@
-"""The implementations of the `rig` subcommands (rig/cli.py parses the arguments)."""

@@ -1,0 +1,86 @@
+"""`rig analyze`: the measurement pipeline on scope files and archives.
+
+Virtual shots in an archive carry what the analysis needs (gauge channels and nominal
+positions, sensitivities, RC time constants, beta and F_0 from their numerics). Real files
+need it from the command line: --gauge-distance, and optionally --sensitivity, --tau,
+--beta, --f0, --diameter; --material adds the long-wave Eq (1) speed beside each result.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from instruments.analysis import PeakRules
+from instruments.archive import Archive
+from instruments.formats import read_record
+from instruments.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.records import ScopeRecord
+
+from rig.errors import RigError
+from rig.model.materials import material
+from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed
+
+
+def analyze_paths(args) -> list:
+    paths = [Path(p) for p in args.files]
+    archives = [p for p in paths if p.suffix.lower() in (".h5", ".hdf5", ".nxs")]
+    files = [p for p in paths if p not in archives]
+    results = []
+    for a in archives:
+        archive = Archive(a)
+        ids = [args.shot] if args.shot is not None else archive.ids()
+        for i in ids:
+            entry = archive.read(i, with_truth=False)
+            setup = _setup_from_entry(entry) if entry.simulated else _setup_from_flags(args, entry.record)
+            results.append(_result(f"{a}#{i}", entry.record, setup, args, entry))
+    if files:
+        record = read_record(files)
+        results.append(_result(", ".join(map(str, files)), record, _setup_from_flags(args, record), args))
+    return results
+
+
+def _setup_from_entry(entry) -> Setup:
+    facts, settings = entry.truth_attrs, entry.settings
+    gauges = sorted(facts["gauges"].items(), key=lambda kv: kv[1]["position_m"])
+    roles = []
+    for name, g in gauges[:2]:
+        s = settings["gauges"][name]
+        roles.append(GaugeSetup(g["channel"], g["position_m"], s.get("sensitivity", 0.05), s.get("tau", 1e-3)))
+    wall = None
+    if "wall_sensor" in settings:
+        ws = settings["wall_sensor"]
+        wall = GaugeSetup(ws["channel"], math.inf, ws.get("sensitivity", 0.05), ws.get("tau", 1e-3))
+    truth = facts.get("analysis") or {}
+    return Setup(roles[0], roles[1], wall, settings["chain"]["diameter"], truth.get("beta") or 1.0,
+                 truth.get("static_force_N") or 0.0, PeakRules())
+
+
+def _setup_from_flags(args, record: ScopeRecord) -> Setup:
+    if args.gauge_distance is None:
+        raise RigError("--gauge-distance is required for real scope files (e.g. --gauge-distance '43.1 mm')")
+    names = args.channels.split(",") if args.channels else list(record.waveforms)[:3 if args.wall else 2]
+    if len(names) < 2:
+        raise RigError(f"two gauge channels are needed; the files hold {', '.join(record.waveforms) or 'none'}")
+    for n in names:
+        if n not in record.waveforms:
+            raise RigError(f"--channels: {n!r} is not in the files (channels: {', '.join(record.waveforms)})")
+    g = lambda ch, x: GaugeSetup(ch, x, args.sensitivity, args.tau)  # noqa: E731
+    wall = g(names[2], math.inf) if len(names) > 2 else None
+    return Setup(g(names[0], 0.0), g(names[1], args.gauge_distance), wall, args.diameter,
+                 args.beta, args.f0, PeakRules())
+
+
+def _result(source, record, setup: Setup, args, entry=None) -> dict:
+    rep = analyze_record(record, setup).as_dict()
+    rep.pop("leading", None)
+    out = {"source": source, "channels": [setup.upper.channel, setup.lower.channel], **rep}
+    mat = args.material or (entry.settings["chain"]["material"] if entry is not None and entry.simulated else None)
+    out["theory_speed_m_per_s"] = None
+    if mat and rep["amplitude_N"]:
+        m = material(mat)
+        F0 = setup.static_force_N
+        Fm = rep["amplitude_N"] + F0
+        out["theory_speed_m_per_s"] = float(
+            solitary_wave_speed(m.E, m.nu, m.rho, setup.bead_diameter_m, F0, Fm) if F0 > 0
+            else sonic_vacuum_speed(m.E, m.nu, m.rho, setup.bead_diameter_m, Fm))
+    return out

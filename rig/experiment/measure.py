@@ -1,0 +1,107 @@
+"""What a virtual shot measures, analysed three ways (the blocks of `rig shot --json`).
+
+truth: the pipeline on the noise-free ground truth at the nominal gauge positions, as the
+published numerics were analysed; F_d is the mean over the two gauge beads of the maximum
+dynamic contact force during the leading pulse, and beta = F_d / F_m,n.
+measured: the scope records through the full pipeline, told only what an experimenter
+knows (nominal positions and sensitivities, the RC time constant, beta and F_0 from the
+truth).
+theory: Eq (2) at F_0 and Eq (1) at the truth amplitude.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from instruments.analysis import PeakRules
+from instruments.pipeline import GaugeSetup, Report, Setup, analyze_forces, analyze_record
+
+from rig.errors import RigError
+from rig.theory.longwave import solitary_wave_speed, sound_speed
+
+
+def setup_for(rig, beta: float = 1.0, static_force: float = 0.0, nominal: bool = True) -> Setup:
+    """The analysis Setup of a rig's gauges (upper = the higher of the first two)."""
+    gauges = sorted(rig.gauges.items(), key=lambda kv: kv[1][0])
+    if len(gauges) < 2:
+        raise RigError("the analysis needs two gauge beads in the scene")
+    x = rig.chain.equilibrium_positions()
+    (_, (j1, ch1, s1)), (_, (j2, ch2, s2)) = gauges[0], gauges[1]
+    wall = None
+    if rig.wall_sensor is not None:
+        wall = GaugeSetup(rig.wall_channel, float(rig.chain.wall_position()),
+                          rig.wall_sensor.sensitivity, rig.wall_sensor.tau)
+    return Setup(GaugeSetup(ch1, float(x[j1]), s1.sensitivity, s1.tau),
+                 GaugeSetup(ch2, float(x[j2]), s2.sensitivity, s2.tau), wall,
+                 rig.chain.beads[j1].diameter, beta, static_force, PeakRules(),
+                 float(rig.chain.wall_position() - x[j2]))
+
+
+def midway_static_force(rig) -> float:
+    """F_0 (N) at the contact midway between the two gauge beads."""
+    j1, j2 = sorted(j for j, _, _ in rig.gauges.values())[:2]
+    return float(rig.chain.static_forces()[(j1 + 1 + j2) // 2])
+
+
+def truth_report(rig, truth) -> Report:
+    """The pipeline on the noise-free truth, with F_d from the contact forces."""
+    F0 = midway_static_force(rig)
+    setup = setup_for(rig, 1.0, F0)
+    h = truth.sample_interval
+    by_channel = {g.channel: g for g in truth.gauges.values()}
+    up, low = by_channel[setup.upper.channel], by_channel[setup.lower.channel]
+    forces = {"upper": up.average_force - up.average_force[0],
+              "lower": low.average_force - low.average_force[0]}
+    if truth.wall_force is not None:
+        forces["wall"] = truth.wall_force - truth.wall_force[0]
+    t = np.arange(forces["upper"].size) * h
+    rep = analyze_forces(t, forces, setup)
+    if rep.speed_m_per_s is None:
+        return rep
+    peaks = []
+    for g, lead in ((up, rep.leading["upper"]), (low, rep.leading["lower"])):
+        window = (t >= lead["time"] - lead["fwhm"]) & (t <= lead["time"] + lead["fwhm"])
+        peaks.append(max(np.max(g.contact_above[window] - g.static_above_N),
+                         np.max(g.contact_below[window] - g.static_below_N)))
+    rep.amplitude_N = float(np.mean(peaks))
+    rep.beta = rep.amplitude_N / rep.averaged_amplitude_N
+    rep.total_force_N = rep.amplitude_N + F0
+    return rep
+
+
+def measured_report(rig, shot, truth: Report) -> Report:
+    """The scope records through the pipeline, with beta and F_0 from the truth."""
+    beta = truth.beta if truth.beta is not None else 1.0
+    return analyze_record(shot.scope, setup_for(rig, beta, midway_static_force(rig)))
+
+
+def theory_block(rig, truth: Report) -> dict:
+    """Eq (2) at F_0, and Eq (1) at the truth's total force (m/s)."""
+    bead = rig.chain.beads[sorted(j for j, _, _ in rig.gauges.values())[0]]
+    m = bead.material
+    F0 = midway_static_force(rig)
+    out = {"sound_speed_m_per_s": float(sound_speed(m.E, m.nu, m.rho, bead.diameter, F0)),
+           "speed_m_per_s": None}
+    if truth.amplitude_N and truth.amplitude_N > 0:
+        out["speed_m_per_s"] = float(solitary_wave_speed(m.E, m.nu, m.rho, bead.diameter,
+                                                         F0, F0 + truth.amplitude_N))
+    return out
+
+
+def shot_blocks(rig, shot) -> dict:
+    """{"truth", "measured", "theory"} for `rig shot --json` (None without two gauges)."""
+    if len(rig.gauges) < 2:
+        return {"truth": None, "measured": None, "theory": None}
+    truth = rig.truth_analysis()
+    measured = measured_report(rig, shot, truth)
+    keys = ("speed_m_per_s", "amplitude_N", "averaged_amplitude_N", "beta", "static_force_N",
+            "pulses", "duration_s")
+    pick = lambda r: {k: _clean(getattr(r, k)) for k in keys}  # noqa: E731
+    m = pick(measured)
+    m["speed_xcorr_m_per_s"] = _clean(measured.speed_xcorr_m_per_s)
+    return {"truth": pick(truth), "measured": m, "theory": theory_block(rig, truth)}
+
+
+def _clean(v):
+    return None if v is None or (isinstance(v, float) and not math.isfinite(v)) else v

@@ -1,0 +1,183 @@
+"""Scene files: a TOML description of one shot, every quantity with its unit.
+
+A scene has the tables [scene], [chain], [striker], [magnet] (optional), [holder],
+[wall], [wall_sensor] (optional), [gauges.NAME] (any number), [scope] with
+[scope.trigger] and [scope.channels.CHn], and [solver]. The keys and their units are in
+SCHEMA. Unknown keys, a quantity without its unit, and a value outside its range are
+refused naming the key. Overrides use dotted keys ("striker.velocity=1.2"); a plain number
+is taken in the key's SI unit (m/s here).
+"""
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+from rig.errors import RigError, invalid
+from rig.units import quantity
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+GAUGE_KEYS = {"bead": int, "from_wall": int, "channel": str, "sensitivity": "V/N",
+              "calibration_error": float, "tau": "s", "noise": "V", "misalignment_sd": "m"}
+CHANNEL_KEYS = {"volts_per_div": "V", "position": float, "offset": "V", "coupling": str,
+                "bandwidth": "Hz", "probe": float}
+SCHEMA = {
+    "scene": {"name": str, "description": str, "reference": str},
+    "chain": {"material": str, "diameter": "m", "mass": "kg", "beads": int,
+              "magnetic_bead": bool, "contact_law": str, "damping_time": "s",
+              "youngs_modulus": "Pa", "poisson_ratio": float},
+    "striker": {"material": str, "mass": "kg", "velocity": "m/s", "diameter": "m", "gap": "m"},
+    "magnet": {"force": "N", "position": "m", "peak_force": "N", "schedule": list},
+    "holder": {"bore": "m", "outer_diameter": "m", "length": "m", "vertical": bool},
+    "wall": {"material": str},
+    "wall_sensor": {"channel": str, "sensitivity": "V/N", "calibration_error": float,
+                    "tau": "s", "noise": "V"},
+    "gauges": {"*": GAUGE_KEYS},
+    "scope": {"sample_interval": "s", "record_length": int, "mode": str, "averages": int,
+              "noise_floor": "V", "model": str,
+              "trigger": {"source": str, "level": "V", "slope": str, "pre_trigger": float},
+              "channels": {"*": CHANNEL_KEYS}},
+    "solver": {"method": str, "accuracy": float, "duration": "s", "sample_interval": "s"},
+}
+PUBLISHED_SCENES = Path(__file__).resolve().parent.parent / "scenes"  # package data
+
+
+def find_scene(name_or_path) -> Path:
+    """A path to a .toml file, or the name of a published scene (rig/scenes/, e.g. ptfe52_magnetic)."""
+    p = Path(name_or_path)
+    if p.suffix == ".toml" or p.exists():
+        if not p.is_file():
+            raise invalid("scene", str(name_or_path), "no such scene file")
+        return p
+    hits = sorted(PUBLISHED_SCENES.rglob(f"{p.name}.toml"))
+    if not hits:
+        known = sorted(q.stem for q in PUBLISHED_SCENES.rglob("*.toml"))
+        raise invalid("scene", str(name_or_path), f"not a file; known scenes: {', '.join(known)}")
+    return hits[0]
+
+
+def load(name_or_path, overrides=()) -> tuple[dict, str]:
+    """Parse, override and validate a scene: (values in SI, the scene's TOML text)."""
+    path = find_scene(name_or_path)
+    text = path.read_text()
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise RigError(f"scene {path}: not valid TOML ({exc})") from None
+    raw.setdefault("scene", {}).setdefault("name", path.stem)
+    for item in overrides:
+        _override(raw, item)
+    return convert(raw), text
+
+
+def _override(raw: dict, item: str):
+    if "=" not in item:
+        raise invalid("--set", item, "expected key=value, e.g. striker.velocity=1.2")
+    key, value = (s.strip() for s in item.split("=", 1))
+    parts = key.split(".")
+    spec = _spec_for(parts)
+    node = raw
+    for p in parts[:-1]:
+        node = node.setdefault(p, {})
+        if not isinstance(node, dict):
+            raise invalid("--set", key, "not a table in this scene")
+    node[parts[-1]] = _typed(value, spec, key)
+
+
+def schema_node(key: str):
+    """The SCHEMA entry of a dotted key: a type, a unit string, or a table (dict).
+    KeyError(i) names the first part of the key that the schema does not know."""
+    node = SCHEMA
+    for i, p in enumerate(key.split(".")):
+        if not isinstance(node, dict) or (p not in node and "*" not in node):
+            raise KeyError(i)
+        node = node.get(p, node.get("*"))
+    return node
+
+
+def _spec_for(parts):
+    key = ".".join(parts)
+    try:
+        node = schema_node(key)
+    except KeyError as exc:
+        where = ".".join(parts[:exc.args[0]])
+        parent = schema_node(where) if where else SCHEMA
+        known = ", ".join(k for k in parent if k != "*") if isinstance(parent, dict) else "none"
+        raise invalid("scene key", key, f"unknown key; known in {where or 'the scene'}: {known}") from None
+    if isinstance(node, dict):
+        raise invalid("scene key", key, "is a table; set one of its keys")
+    return node
+
+
+def _typed(value: str, spec, key):
+    if spec is bool:
+        if value.lower() not in ("true", "false"):
+            raise invalid(key, value, "true or false")
+        return value.lower() == "true"
+    if spec is int:
+        try:
+            return int(value)
+        except ValueError:
+            raise invalid(key, value, "a whole number") from None
+    if spec is float:
+        try:
+            return float(value)
+        except ValueError:
+            raise invalid(key, value, "a number") from None
+    if isinstance(spec, str):  # a quantity: a plain number is in SI
+        try:
+            return f"{float(value)!r} {spec}"
+        except ValueError:
+            return value
+    return value
+
+
+def convert(raw: dict) -> dict:
+    """Validate keys against SCHEMA and convert quantities to SI floats."""
+    return _convert(raw, SCHEMA, "")
+
+
+def _convert(node, spec, prefix):
+    if not isinstance(node, dict):
+        raise invalid(prefix.rstrip("."), node, "expected a table")
+    out = {}
+    for key, value in node.items():
+        sub = spec.get(key, spec.get("*"))
+        name = f"{prefix}{key}"
+        if sub is None:
+            raise invalid("scene key", name, f"unknown key; known here: {', '.join(k for k in spec if k != '*')}")
+        if isinstance(sub, dict):
+            out[key] = _convert(value, sub, name + ".")
+        elif isinstance(sub, str):
+            if key == "bandwidth" and value == "full":
+                out[key] = None
+            else:
+                out[key] = quantity(value, sub, name)
+        elif sub is list:
+            out[key] = _schedule(value, name)
+        elif sub is float:
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise invalid(name, value, "a number")
+            out[key] = float(value)
+        elif not isinstance(value, sub) or (sub is int and isinstance(value, bool)):
+            raise invalid(name, value, f"expected {sub.__name__}")
+        else:
+            out[key] = value
+    return out
+
+
+def _schedule(value, name):
+    """[["0 ms", "2.38 N"], ["1 ms", "4.25 N"], ...] -> ((s, N), ...)."""
+    if not isinstance(value, list) or not value:
+        raise invalid(name, value, 'a list of ["time", "force"] pairs, e.g. [["0 ms", "2.38 N"]]')
+    pairs = []
+    for i, pair in enumerate(value):
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise invalid(f"{name}[{i}]", pair, 'a ["time", "force"] pair')
+        pairs.append((quantity(pair[0], "s", f"{name}[{i}].time"),
+                      quantity(pair[1], "N", f"{name}[{i}].force")))
+    return tuple(pairs)

@@ -1,0 +1,159 @@
+"""The chain's parts: beads, gauge beads, the magnetic top bead, the striker, the wall.
+
+Every length, mass and speed may be given as an SI float or as a string with its unit
+("4.76 mm", "0.1226 g", "0.89 m/s"); strings are converted to SI once, on construction,
+and every field is validated there (a RigError names the field and the allowed range).
+"""
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass, fields
+
+from rig.errors import invalid
+from rig.model.materials import Material, material
+from rig.units import quantity
+
+# Published PTFE gauge bead (Daraio et al. 2006): caps 0.093 g, plate 0.023 g, of a 0.1226 g bead.
+PTFE_GAUGE_CAPS_FRACTION = 0.093 / 0.1226
+PZT_PLATE_MASS = 0.023e-3  # kg, 0.5 mm x 3 mm x 3 mm lead zirconate titanate with electrodes
+
+_UNITS = {"diameter": "m", "mass": "kg", "caps_mass": "kg", "plate_mass": "kg",
+          "velocity": "m/s", "gap": "m"}
+
+
+@functools.cache
+def _unit_fields(cls) -> tuple:
+    """The fields of a part class that carry a unit."""
+    return tuple(f.name for f in fields(cls) if f.name in _UNITS)
+
+
+class _Part:
+    """Shared construction: look the material up, convert quantities, validate."""
+
+    def _convert(self, prefix: str):
+        if not isinstance(self.material, Material):
+            object.__setattr__(self, "material", material(self.material))
+        for name in _unit_fields(type(self)):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            if type(value) is float and math.isfinite(value):  # SI already (studies build many parts)
+                continue
+            object.__setattr__(self, name, quantity(value, _UNITS[name], f"{prefix}.{name}", bare_ok=True))
+
+    def _positive(self, prefix: str, *names):
+        for name in names:
+            value = getattr(self, name)
+            if not value > 0:
+                raise invalid(f"{prefix}.{name}", value, f"must be > 0 {_UNITS[name]}")
+
+
+@dataclass(frozen=True)
+class Bead(_Part):
+    """A sphere of ``material``; ``mass`` defaults to density x volume (kg)."""
+
+    material: Material | str
+    diameter: float
+    mass: float | None = None
+
+    def __post_init__(self):
+        self._convert("bead")
+        self._positive("bead", "diameter")
+        if self.mass is None:
+            object.__setattr__(self, "mass", self.material.rho * math.pi * self.diameter**3 / 6.0)
+        self._positive("bead", "mass")
+
+    @property
+    def radius(self) -> float:
+        return 0.5 * self.diameter
+
+    def with_mass(self, mass: float) -> Bead:
+        """This bead with another mass (kg, > 0), its other fields taken as they are (already
+        converted and checked): the bead-to-bead scatter of a study builds many."""
+        if not (isinstance(mass, float) and math.isfinite(mass) and mass > 0):
+            raise invalid("bead.mass", mass, "must be > 0 kg")
+        bead = object.__new__(type(self))
+        bead.__dict__.update(self.__dict__)
+        object.__setattr__(bead, "mass", mass)
+        return bead
+
+    kind = "bead"
+
+
+@dataclass(frozen=True)
+class MagneticBead(Bead):
+    """The magnetic steel ball on top of the chain that the ring magnet pulls (5 mm, 0.5 g)."""
+
+    material: Material | str = "chrome_steel"
+    diameter: float = 5e-3
+    mass: float | None = 0.5e-3
+    kind = "magnetic"
+
+
+@dataclass(frozen=True)
+class GaugeBead(Bead):
+    """A bead cut in two with a piezo plate glued between its caps.
+
+    Treated as rigid: its plate reads the mean of its two contact forces. Its mass is
+    caps + plate. By default the caps keep the published PTFE fraction (0.093 g of a
+    0.1226 g bead) of the plain bead's mass, and the plate weighs 0.023 g; for PTFE that
+    gives the published 0.116 g.
+    """
+
+    caps_mass: float | None = None
+    plate_mass: float | None = PZT_PLATE_MASS
+    kind = "gauge"
+
+    def __post_init__(self):
+        self._convert("gauge_bead")
+        self._positive("gauge_bead", "diameter", "plate_mass")
+        if self.caps_mass is None:
+            plain = self.mass if self.mass is not None else (
+                self.material.rho * math.pi * self.diameter**3 / 6.0)
+            object.__setattr__(self, "caps_mass", PTFE_GAUGE_CAPS_FRACTION * plain)
+        self._positive("gauge_bead", "caps_mass")
+        object.__setattr__(self, "mass", self.caps_mass + self.plate_mass)
+
+    @classmethod
+    def like(cls, bead: Bead, **kw) -> "GaugeBead":
+        """The gauge version of a plain bead (same material, diameter; mass from its mass)."""
+        return cls(bead.material, bead.diameter, mass=bead.mass, **kw)
+
+
+@dataclass(frozen=True)
+class Striker(_Part):
+    """A cylinder dropped flat face first on the top bead with ``velocity`` (m/s, > 0).
+
+    gap (m, >= 0): distance from its face to the top bead at t = 0 (0: impact at t = 0).
+    """
+
+    material: Material | str = "alumina"
+    mass: float = 0.47e-3
+    velocity: float = 0.89
+    diameter: float = 4.76e-3
+    gap: float = 0.0
+    kind = "striker"
+
+    def __post_init__(self):
+        self._convert("striker")
+        self._positive("striker", "mass", "velocity", "diameter")
+        if not self.gap >= 0:
+            raise invalid("striker.gap", self.gap,
+                          "the striker would overlap the top bead; allowed: gap >= 0 m")
+
+    @property
+    def length(self) -> float:
+        """Cylinder length (m) from mass, density and diameter."""
+        return self.mass / (self.material.rho * math.pi * self.diameter**2 / 4.0)
+
+
+@dataclass(frozen=True)
+class Wall(_Part):
+    """The flat bottom wall (the force sensor's top plate)."""
+
+    material: Material | str = "brass"
+    kind = "wall"
+
+    def __post_init__(self):
+        self._convert("wall")

@@ -1,0 +1,223 @@
+"""Many shots of one chain topology at once (numba): shots are the innermost index.
+
+Arrays are (chunks, bodies, width): each chunk is a C-contiguous block whose inner index
+runs over ``width`` shots from 0, so every loop over the shots of a chunk vectorises;
+``integrate_ensemble`` runs the chunks on numba's threads. Every shot
+performs exactly the operations of the single-shot kernel (integrators.integrate) in the
+same order with the same step, so the two agree to the last bit (the multirate head
+runs the same multirate.head_flow in both). Conservative Hertz contacts and constant
+loads only (no force schedule, no dissipation).
+"""
+import math
+
+import numpy as np
+from numba import prange
+
+from instruments.jit import jit
+
+from rig.solver.kernels.integrators import hermite, hermite_weights
+from rig.solver.kernels.multirate import head_flow, slow_net
+
+
+@jit
+def _contact_row(u, A, d0, load, f, i):
+    """Dynamic force of contact slot i for every shot: A d^(3/2) - load (integrators.py)."""
+    for s in range(u.shape[1]):
+        d = d0[i, s] + u[i - 1, s] - u[i, s]
+        d = d if d > 0.0 else 0.0
+        f[i, s] = A[i, s] * d * math.sqrt(d) - load[i, s]
+
+
+@jit
+def _forces(u, A, d0, load, f):
+    for i in range(1, u.shape[0]):
+        _contact_row(u, A, d0, load, f, i)
+
+
+@jit
+def _head_kick(v, invm, f, hb, head):
+    """The method's kick of the head's last body (slot head + 1 only)."""
+    for s in range(v.shape[1]):
+        v[head, s] += hb * (0.0 - f[head + 1, s]) * invm[head, s]
+
+
+@jit
+def _kick_drift(u, v, invm, f, hb, ha, head):
+    start = 0
+    if head > 0:
+        _head_kick(v, invm, f, hb, head)
+        start = head + 1
+    for i in range(start, v.shape[0]):
+        for s in range(u.shape[1]):
+            vi = v[i, s] + hb * (f[i, s] - f[i + 1, s]) * invm[i, s]
+            v[i, s] = vi
+            u[i, s] += ha * vi
+
+
+@jit
+def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_ns, h_work):
+    """_kick_drift (and the head's flow) then _forces in one pass over the rows: row i is
+    kicked and drifted (reading f[i], f[i+1], not yet renewed), then contact i is renewed
+    from rows i-1 and i (both moved). The same operations as the two passes, so the same
+    bits."""
+    start = 0
+    if head > 0:
+        _head_kick(v, invm, f, hb, head)
+        head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub, h_ns, h_work)
+        start = head + 1
+    for i in range(start, v.shape[0]):
+        for s in range(u.shape[1]):
+            vi = v[i, s] + hb * (f[i, s] - f[i + 1, s]) * invm[i, s]
+            v[i, s] = vi
+            u[i, s] += ha * vi
+        if i >= 1:
+            _contact_row(u, A, d0, load, f, i)
+
+
+@jit
+def _synced(j, s, v, invm, f, pending, head):
+    return v[j, s] + pending * slow_net(f, j, head, s) * invm[j, s]
+
+
+@jit
+def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, head, y, r):
+    for c in range(ch_slot.shape[0]):
+        for s in range(u.shape[1]):
+            yc = 0.0
+            rc = 0.0
+            for k in range(ch_slot.shape[1]):
+                w = ch_weight[c, k]
+                if w != 0.0:
+                    i = ch_slot[c, k]
+                    yc += w * (f[i, s] + load[i, s])
+                    d = d0[i, s] + u[i - 1, s] - u[i, s]
+                    if d > 0.0:
+                        va = _synced(i - 1, s, v, invm, f, pending, head)
+                        vb = _synced(i, s, v, invm, f, pending, head)
+                        rc += w * (1.5 * A[i, s] * math.sqrt(d) * (va - vb))
+            y[c, s] = yc
+            r[c, s] = rc
+
+
+@jit
+def _state_sums(u, v, mass, bias, A, d0, d_limit, e, p, w):
+    """Each shot's energy e (forces.energy's sums, in its order), momentum p and largest
+    d / d_limit w (inf for nan, as forces.max_overlap_excess), in two passes over the rows."""
+    nb = u.shape[0]
+    e[:] = 0.0
+    p[:] = 0.0
+    w[:] = 0.0
+    for i in range(nb):
+        for s in range(u.shape[1]):
+            e[s] += 0.5 * mass[i, s] * v[i, s] * v[i, s] - mass[i, s] * bias[i, s] * u[i, s]
+            p[s] += mass[i, s] * v[i, s]
+    for i in range(1, nb):
+        for s in range(u.shape[1]):
+            d = d0[i, s] + u[i - 1, s] - u[i, s]
+            if d > 0.0:
+                e[s] += 0.4 * A[i, s] * d * d * math.sqrt(d)
+            q = d / d_limit[i, s]
+            w[s] = max(w[s], q) if q == q else math.inf
+
+
+@jit
+def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, head, sub,
+           ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
+           e_ref, p_ref, diag, f, y_old, r_old, y_new, r_new):
+    nb = u.shape[0]
+    W = u.shape[1]
+    n_drift = a_coef.shape[0]
+    n_ch = ch_slot.shape[0]
+    n_out = out.shape[2]
+    for s in range(u.shape[1]):
+        f[0, s] = 0.0
+        f[nb, s] = -load[nb, s]
+    _forces(u, A, d0, load, f)
+    e0 = np.empty(W)
+    p0 = np.empty(W)
+    e = np.empty(W)
+    pn = np.empty(W)
+    worst = np.empty(W)
+    net = np.empty(W)
+    j_wall = np.zeros(W)
+    w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
+    h_ns, h_work = np.empty(W, np.int64), np.empty((3, W))  # the head's work arrays
+    _state_sums(u, v, mass, bias, A, d0, d_limit, e0, p0, worst)
+    for s in range(u.shape[1]):
+        net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
+    _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, 0.0, head, y_old, r_old)
+    if n_out > 0:
+        for c in range(n_ch):
+            for s in range(u.shape[1]):
+                out[s, c, 0] = y_old[c, s]
+    j_out = 1
+    pending = 0.0
+    for n in range(n_steps):
+        t = n * dt
+        for st in range(n_drift):
+            hb = b_coef[st] * dt
+            if st == 0:
+                hb += pending
+            if wall_slot > 0:
+                for s in range(u.shape[1]):
+                    j_wall[s] += hb * f[wall_slot, s]
+            h = a_coef[st] * dt
+            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_ns, h_work)
+        t_new = (n + 1) * dt
+        pending = b_coef[n_drift] * dt
+        check = (n + 1) % check_every == 0 or n == n_steps - 1
+        if check:
+            if wall_slot > 0:
+                for s in range(u.shape[1]):
+                    j_wall[s] += pending * f[wall_slot, s]
+            _kick_drift(u, v, invm, f, pending, 0.0, head)
+            pending = 0.0
+        _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, head, y_new, r_new)
+        j_end = j_out
+        while j_end < n_out and j_end * sample_dt <= t_new * (1.0 + 1e-12):
+            j_end += 1
+        for j in range(j_out, j_end):  # the weights are the same for every shot and channel
+            hermite_weights((j * sample_dt - t) / dt, dt, w, j - j_out)
+        for s in range(u.shape[1]):  # each shot's samples are contiguous: write them in runs
+            for c in range(n_ch):
+                y0, r0, y1, r1 = y_old[c, s], r_old[c, s], y_new[c, s], r_new[c, s]
+                for j in range(j_out, j_end):
+                    out[s, c, j] = hermite(w, j - j_out, y0, r0, y1, r1)
+        j_out = j_end
+        for c in range(n_ch):
+            for s in range(u.shape[1]):
+                y_old[c, s] = y_new[c, s]
+                r_old[c, s] = r_new[c, s]
+        if check:
+            _state_sums(u, v, mass, bias, A, d0, d_limit, e, pn, worst)
+            for s in range(u.shape[1]):
+                err = abs(e[s] - e0[s]) / e_ref[s]
+                pe = abs(pn[s] - p0[s] - (t_new * net[s] - j_wall[s])) / p_ref[s]
+                if not (err < 1e300) or not (worst[s] <= 1.0):
+                    diag[3, s] = 1.0
+                diag[0, s] = max(diag[0, s], err)
+                diag[1, s] = max(diag[1, s], pe)
+    for s in range(u.shape[1]):
+        diag[2, s] = j_wall[s] + (load[wall_slot, s] if wall_slot > 0 else 0.0) * n_steps * dt
+        diag[4, s] = n_steps
+        diag[5, s] = n_steps * dt
+
+
+@jit(parallel=True)
+def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, head, sub,
+                       ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
+                       e_ref, p_ref, diag):
+    """Integrate every shot of the (chunks, bodies, width) arrays in place; out is
+    (chunks, width, channels, samples) so that each shot's record is contiguous; diag is
+    (chunks, 6, width) as in the single-shot kernel."""
+    n_chunks, nb, W = u.shape
+    n_ch = ch_slot.shape[0]
+    for k in prange(n_chunks):
+        f = np.zeros((nb + 1, W))
+        y_old = np.zeros((n_ch, W))
+        r_old = np.zeros((n_ch, W))
+        y_new = np.zeros((n_ch, W))
+        r_new = np.zeros((n_ch, W))
+        _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], a_coef, b_coef, dt, n_steps, head, sub,
+               ch_slot, ch_weight, sample_dt, out[k], check_every, d_limit[k], wall_slot,
+               e_ref[k], p_ref[k], diag[k], f, y_old, r_old, y_new, r_new)

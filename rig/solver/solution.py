@@ -1,0 +1,115 @@
+"""Solution: what a solve recorded, and how the solve went."""
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+import numpy as np
+
+
+class Status(enum.IntEnum):
+    """How a solve ended, as the kernels report it (like scipy's OdeResult.status)."""
+
+    SUCCESS = 0
+    UNSTABLE = 1  # an overlap grew beyond half a bead radius: the step is too large
+
+    @property
+    def message(self) -> str:
+        return {Status.SUCCESS: "the integration reached the end time",
+                Status.UNSTABLE: "the integration became unstable (an overlap grew beyond half a "
+                                 "bead radius); use a smaller dt or a tighter accuracy"}[self]
+
+
+@dataclass(frozen=True)
+class KernelReport:
+    """What an integration kernel reports in its float64[6] diagnostics array, by name."""
+
+    energy_error: float
+    momentum_error: float
+    wall_impulse_Ns: float
+    status: Status
+    steps: int
+    end_time_s: float
+
+    @classmethod
+    def of(cls, diag) -> "KernelReport":
+        return cls(float(diag[0]), float(diag[1]), float(diag[2]), Status(int(diag[3])),
+                   int(diag[4]), float(diag[5]))
+
+
+@dataclass(frozen=True)
+class SolverStats:
+    """Diagnostics of one solve.
+
+    energy_error: max |E(t) - E(0)| / E_ref over the checks (E_ref: the striker's kinetic
+    energy, or the static elastic energy without a striker). momentum_error: max
+    |P(t) - P(0) - external impulse| / P_ref (P_ref: the striker's momentum), external
+    impulse = constant loads x t + scheduled force impulse - wall impulse.
+    """
+
+    method: str
+    dt_s: float
+    steps: int
+    force_evaluations: int
+    wall_s: float
+    energy_error: float
+    momentum_error: float
+    wall_impulse_Ns: float
+    accuracy: float | None
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+@dataclass(frozen=True, eq=False)
+class Solution:
+    """Recorded forces (N) on the grid t = j * sample_interval, j = 0..n-1 (t = 0: impact).
+
+    frames: positions (m, down from bead 0's equilibrium centre) of the striker (if any)
+    and the beads at t = j * frame_interval, only when frames were asked for.
+    final_u, final_v: each body's displacement (m) and velocity (m/s) at the end.
+    """
+
+    forces: dict
+    sample_interval: float
+    frames: np.ndarray | None
+    frame_interval: float | None
+    final_u: np.ndarray
+    final_v: np.ndarray
+    stats: SolverStats
+    problem: object
+    status: Status = Status.SUCCESS
+
+    @property
+    def message(self) -> str:
+        return self.status.message
+
+    @property
+    def time(self) -> np.ndarray:
+        n = len(next(iter(self.forces.values()))) if self.forces else 0
+        return np.arange(n) * self.sample_interval
+
+    @property
+    def frame_times(self) -> np.ndarray | None:
+        if self.frames is None:
+            return None
+        return np.arange(self.frames.shape[0]) * self.frame_interval
+
+    def final_body_energies(self) -> np.ndarray:
+        """Energy (J) of each moving body at the end: kinetic plus half of the elastic
+        energy of each of its contacts (constant-load potentials excluded)."""
+        p = self.problem
+        n = self.final_u.shape[0]
+        u = np.zeros(p.n_bodies)
+        u[:n] = self.final_u
+        d = np.maximum(p.d0[1:] + u[:-1] - u[1:], 0.0)
+        contact = np.concatenate(([0.0], 0.4 * p.A[1:] * d**2.5, [0.0]))
+        e = 0.5 * p.mass * np.pad(self.final_v, (0, p.n_bodies - n)) ** 2
+        e += 0.5 * (contact[:-1] + contact[1:])
+        return e[:n]
+
+    @property
+    def recorded_bytes(self) -> int:
+        """Bytes held by the recorded channels and frames (what 'record only what is asked' buys)."""
+        n = sum(a.nbytes for a in self.forces.values())
+        return n + (self.frames.nbytes if self.frames is not None else 0)

@@ -1,0 +1,1 @@
+"""Pictures: figures (matplotlib) and off-screen animations (pyvista, an optional extra)."""
