@@ -30,7 +30,7 @@ def run(scenes=SCENES) -> dict:
         rig = Rig.from_scene(scene)
         p = ChainProblem.from_chain(rig.chain)
         save = rig.save_at()
-        t_end = rig.solver["duration"]
+        t_end = rig.solver.duration
         ref = solve(p, t_end, save=save, dt=contact_time_scale(p) / 300)
         first = _first_wall_peak(ref.forces["wall"])
         rows[scene] = []

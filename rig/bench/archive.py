@@ -10,12 +10,13 @@ import time
 from pathlib import Path
 
 from instruments.archive import Archive
+from rig.experiment.entry import shot_entry
 from rig.experiment.shot import Rig
 
 
 def run(shots: int = 400, batch: int = 100, single: int = 60) -> dict:
     rig = Rig.from_scene("ptfe52_magnetic", ["scope.record_length=10000"])
-    entries = [rig.fire(seed=s).to_entry() for s in range(shots)]
+    entries = [shot_entry(rig.fire(seed=s)) for s in range(shots)]
 
     def rate(chunk, n):
         times = []

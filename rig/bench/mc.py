@@ -21,17 +21,17 @@ from rig.study.distributions import parse_vary
 from rig.solver.ensemble import ensemble_step, solve_ensemble
 from rig.solver.problem import ChainProblem
 from rig.study.executors import run_study
-from rig.study.montecarlo import Store, Study, _rig_for, run_batch, shot_inputs, study_save
+from rig.study.montecarlo import Store, Study, shot_rig, run_batch, shot_inputs, study_save
 
 VARY = ("striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)")
 BATCH = 128
 
 
 def _solver(study: Study, shots: int) -> dict:
-    rigs = [_rig_for(study, *shot_inputs(study, i, 52)[:2])[0] for i in range(shots)]
+    rigs = [shot_rig(study, *shot_inputs(study, i, 52)[:2])[0] for i in range(shots)]
     problems = [ChainProblem.from_chain(r.chain) for r in rigs]
     save = study_save(study, rigs[0])
-    t_end = rigs[0].solver["duration"]
+    t_end = rigs[0].solver.duration
     dt = ensemble_step(problems, t_end)
     solve_ensemble(problems[:8], t_end, save=save, dt=dt)
     kernel, total = [], []

@@ -32,7 +32,9 @@ def cmd_shot(args) -> dict:
     if args.out:
         from instruments.archive import Archive
 
-        out["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot.to_entry()])[0]}
+        from rig.experiment.entry import shot_entry
+
+        out["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot_entry(shot)])[0]}
     if not args.json:
         print_shot(out)
     return out
@@ -41,9 +43,7 @@ def cmd_shot(args) -> dict:
 def shot_summary(rig, shot) -> dict:
     """The JSON-ready summary of a shot (the keys of `rig shot --json`)."""
     st = shot.solver
-    wiring = {ch: f"gauges.{n}" for n, (_, ch, _) in rig.gauges.items()}
-    if rig.wall_sensor is not None:
-        wiring[rig.wall_channel] = "wall_sensor"
+    wiring = rig.wiring()
     tr = rig.scope.trigger
     channels = {}
     for ch, w in shot.scope.waveforms.items():
@@ -156,7 +156,7 @@ def cmd_mc(args) -> dict:
 
     from rig.study.distributions import parse_vary
     from rig.study.executors import run_study
-    from rig.study.montecarlo import Store, Study, _base
+    from rig.study.montecarlo import Store, Study, nominal_rig
     from rig.study.report import figures, jcgm101, sobol_indices
     from rig.theory.longwave import solitary_wave_speed
 
@@ -173,11 +173,12 @@ def cmd_mc(args) -> dict:
                   args.sobol, args.truth, args.window, args.traces)
     if not study.dists:
         raise RigError("--vary: give at least one uncertain input, e.g. striker.velocity=\"normal(0.89 m/s, 0.01 m/s)\"")
-    _, _, base = _base(study.scene, study.overrides)  # the scene must be valid before any shot
+    base = nominal_rig(study.scene, study.overrides)  # the scene must be valid before any shot
     for d in study.dists:
         parts = d.key.split(".")
-        if parts[0] == "gauges" and parts[1] not in base.gauges:
-            raise RigError(f"--vary {d.key}: the scene has no gauge {parts[1]!r} (gauges: {', '.join(base.gauges)})")
+        names = [g.name for g in base.gauges]
+        if parts[0] == "gauges" and parts[1] not in names:
+            raise RigError(f"--vary {d.key}: the scene has no gauge {parts[1]!r} (gauges: {', '.join(names)})")
     if study.sobol:
         from rig.study.montecarlo import sobol_matrix
 

@@ -23,24 +23,24 @@ from rig.theory.longwave import solitary_wave_speed, sound_speed
 
 def setup_for(rig, beta: float = 1.0, static_force: float = 0.0, nominal: bool = True) -> Setup:
     """The analysis Setup of a rig's gauges (upper = the higher of the first two)."""
-    gauges = sorted(rig.gauges.items(), key=lambda kv: kv[1][0])
+    gauges = sorted(rig.gauges, key=lambda g: g.bead)
     if len(gauges) < 2:
         raise RigError("the analysis needs two gauge beads in the scene")
     x = rig.chain.equilibrium_positions()
-    (_, (j1, ch1, s1)), (_, (j2, ch2, s2)) = gauges[0], gauges[1]
+    up, low = gauges[0], gauges[1]
     wall = None
     if rig.wall_sensor is not None:
-        wall = GaugeSetup(rig.wall_channel, float(rig.chain.wall_position()),
-                          rig.wall_sensor.sensitivity, rig.wall_sensor.tau)
-    return Setup(GaugeSetup(ch1, float(x[j1]), s1.sensitivity, s1.tau),
-                 GaugeSetup(ch2, float(x[j2]), s2.sensitivity, s2.tau), wall,
-                 rig.chain.beads[j1].diameter, beta, static_force, PeakRules(),
-                 float(rig.chain.wall_position() - x[j2]))
+        ws = rig.wall_sensor
+        wall = GaugeSetup(ws.channel, float(rig.chain.wall_position()), ws.settings.sensitivity, ws.settings.tau)
+    return Setup(GaugeSetup(up.channel, float(x[up.bead]), up.settings.sensitivity, up.settings.tau),
+                 GaugeSetup(low.channel, float(x[low.bead]), low.settings.sensitivity, low.settings.tau), wall,
+                 rig.chain.beads[up.bead].diameter, beta, static_force, PeakRules(),
+                 float(rig.chain.wall_position() - x[low.bead]))
 
 
 def midway_static_force(rig) -> float:
     """F_0 (N) at the contact midway between the two gauge beads."""
-    j1, j2 = sorted(j for j, _, _ in rig.gauges.values())[:2]
+    j1, j2 = sorted(g.bead for g in rig.gauges)[:2]
     return float(rig.chain.static_forces()[(j1 + 1 + j2) // 2])
 
 
@@ -78,7 +78,7 @@ def measured_report(rig, shot, truth: Report) -> Report:
 
 def theory_block(rig, truth: Report) -> dict:
     """Eq (2) at F_0, and Eq (1) at the truth's total force (m/s)."""
-    bead = rig.chain.beads[sorted(j for j, _, _ in rig.gauges.values())[0]]
+    bead = rig.chain.beads[min(g.bead for g in rig.gauges)]
     m = bead.material
     F0 = midway_static_force(rig)
     out = {"sound_speed_m_per_s": float(sound_speed(m.E, m.nu, m.rho, bead.diameter, F0)),

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import sys
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from rig.errors import RigError, invalid
@@ -60,8 +61,23 @@ def find_scene(name_or_path) -> Path:
     return hits[0]
 
 
-def load(name_or_path, overrides=()) -> tuple[dict, str]:
-    """Parse, override and validate a scene: (values in SI, the scene's TOML text)."""
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A scene as fired: its name, the TOML text as written, the overrides applied
+    ("key=value" items) and the validated values (nested tables, quantities in SI)."""
+
+    name: str
+    text: str
+    overrides: tuple = ()
+    values: dict = field(default_factory=dict)
+
+    def with_values(self, values: dict) -> "Scene":
+        """The same scene with other values (a study's shot: the same text and overrides)."""
+        return Scene(self.name, self.text, self.overrides, values)
+
+
+def load(name_or_path, overrides=()) -> Scene:
+    """Parse, override and validate a scene file (a path, or a published scene's name)."""
     path = find_scene(name_or_path)
     text = path.read_text()
     try:
@@ -69,9 +85,11 @@ def load(name_or_path, overrides=()) -> tuple[dict, str]:
     except tomllib.TOMLDecodeError as exc:
         raise RigError(f"scene {path}: not valid TOML ({exc})") from None
     raw.setdefault("scene", {}).setdefault("name", path.stem)
+    overrides = tuple(overrides)
     for item in overrides:
         _override(raw, item)
-    return convert(raw), text
+    values = convert(raw)
+    return Scene(values["scene"]["name"], text, overrides, values)
 
 
 def _override(raw: dict, item: str):

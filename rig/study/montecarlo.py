@@ -27,6 +27,7 @@ import numpy as np
 from instruments.archive import Archive
 from instruments.pipeline import analyze_record
 
+from rig.experiment.entry import shot_entry
 from rig.experiment import scene as scene_io
 from rig.solver.ensemble import ensemble_step, solve_ensemble
 from rig.errors import RigError, invalid
@@ -87,17 +88,16 @@ class Study:
 
 
 @functools.lru_cache(maxsize=4)
-def _base(scene: str, overrides: tuple):
-    values, text = scene_io.load(scene, overrides)
-    rig = Rig(values, text, overrides)  # validates
-    return values, text, rig
+def nominal_rig(scene: str, overrides: tuple) -> Rig:
+    """The study's nominal rig: the scene with its fixed overrides (validated)."""
+    return Rig(scene_io.load(scene, overrides))
 
 
 @functools.lru_cache(maxsize=4)
 def nominal_calibration(scene: str, overrides: tuple) -> tuple:
     """(beta, F_0 in N) of the nominal scene's numerics: what an experimenter applies to
     every shot of a study (each shot's own truth is unknown to the analysis)."""
-    _, _, rig = _base(scene, overrides)
+    rig = nominal_rig(scene, overrides)
     return rig.truth_analysis().beta, midway_static_force(rig)
 
 
@@ -110,18 +110,18 @@ def leading_window(scene: str, overrides: tuple) -> tuple:
     scene's pre-trigger samples (the baseline comes from them) and records after the
     trigger only as long as the simulation lasts, the trigger taken at the nominal time +
     5% (shot-to-shot spread)."""
-    _, _, rig = _base(scene, overrides)
+    rig = nominal_rig(scene, overrides)
     lead = rig.truth_analysis().leading
     last = lead.get("lower") or lead.get("upper")
     shot = rig.fire(seed=0, truth=False)
     tb, pre = rig.scope.timebase, rig.scope.trigger.pre_trigger
     if not last or not last.get("fwhm") or not shot.scope.triggered:
-        return rig.solver["duration"], tb.record_length, pre
-    duration = min(rig.solver["duration"], last["time"] + TAIL_FWHM * last["fwhm"])
+        return rig.solver.duration, tb.record_length, pre
+    duration = min(rig.solver.duration, last["time"] + TAIL_FWHM * last["fwhm"])
     n_pre = int(round(pre * tb.record_length))
     n_post = int((duration - 1.05 * shot.scope.trigger_time) / tb.sample_interval)
     if n_post <= 0 or n_pre + n_post >= tb.record_length:
-        return rig.solver["duration"], tb.record_length, pre
+        return rig.solver.duration, tb.record_length, pre
     return duration, n_pre + n_post, n_pre / (n_pre + n_post)
 
 
@@ -169,7 +169,7 @@ def study_duration(study: Study) -> float:
     """Simulated time (s) of each shot of the study."""
     if study.window == "leading":
         return leading_window(study.scene, tuple(study.overrides))[0]
-    return _base(study.scene, tuple(study.overrides))[2].solver["duration"]
+    return nominal_rig(study.scene, tuple(study.overrides)).solver.duration
 
 
 def _table(v: dict, path) -> dict:
@@ -183,12 +183,12 @@ def _table(v: dict, path) -> dict:
 
 
 @functools.lru_cache(maxsize=4)
-def _study_base(scene: str, overrides: tuple, window: str) -> tuple:
+def study_template(scene: str, overrides: tuple, window: str) -> Rig:
     """What every shot of a study starts from: the scene's values with the solver recording
     at the scope's sampling rate (the scope reads nothing finer) and, in the leading window,
-    the window's duration and record; and a rig of them, whose parts the shots take over."""
-    values, text, base = _base(scene, overrides)
-    v = dict(values)
+    the window's duration and record: a rig of them, whose parts the shots take over."""
+    base = nominal_rig(scene, overrides)
+    v = dict(base.values)
     solver, scope = _table(v, ["solver"]), _table(v, ["scope"])
     scope_dt = scope.get("sample_interval")
     if scope_dt and scope_dt > solver.get("sample_interval", 1e-7):
@@ -197,14 +197,13 @@ def _study_base(scene: str, overrides: tuple, window: str) -> tuple:
         duration, length, pre = leading_window(scene, overrides)
         solver["duration"], scope["record_length"] = duration, length
         _table(v, ["scope", "trigger"])["pre_trigger"] = pre
-    return v, Rig(v, text, overrides, like=base)
+    return Rig(base.scene.with_values(v), like=base)
 
 
-def _rig_for(study: Study, x: dict, masses) -> tuple:
+def shot_rig(study: Study, x: dict, masses) -> tuple:
     """Shot inputs x (and bead masses) -> (the shot's rig, its instrument draws)."""
-    overrides = tuple(study.overrides)
-    values, template = _study_base(study.scene, overrides, study.window)
-    v = dict(values)
+    template = study_template(study.scene, tuple(study.overrides), study.window)
+    v = dict(template.values)
     draws = {}
     for key, val in x.items():
         parts = key.split(".")
@@ -214,7 +213,7 @@ def _rig_for(study: Study, x: dict, masses) -> tuple:
         if key == "chain.bead_mass":
             continue
         _table(v, parts[:-1])[parts[-1]] = val
-    return Rig(v, template.scene_text, overrides, bead_masses=masses, like=template), draws
+    return Rig(template.scene.with_values(v), bead_masses=masses, like=template), draws
 
 
 @contextlib.contextmanager
@@ -247,14 +246,14 @@ def study_save(study: Study, rig: Rig) -> SaveAt:
 def _run_batch(study: Study, b: int) -> dict:
     shots = study.shots_of(b)
     lo, hi = shots.start, shots.stop
-    _, _, base = _base(study.scene, tuple(study.overrides))
+    base = nominal_rig(study.scene, tuple(study.overrides))
     n_plain = base.values["chain"]["beads"]
     design = sobol_matrix(study)[0] if study.sobol else None
     rigs, draws, seeds, xs = [], [], [], []
     for i in range(lo, hi):
         x, masses, seed = shot_inputs(study, i, n_plain, design)
         try:
-            rig, d = _rig_for(study, x, masses)
+            rig, d = shot_rig(study, x, masses)
         except ValueError as exc:
             raise RigError(f"shot {i}: inputs {x} give an impossible rig: {exc}") from None
         rigs.append(rig)
@@ -264,8 +263,8 @@ def _run_batch(study: Study, b: int) -> dict:
     problems = [ChainProblem.from_chain(r.chain) for r in rigs]
     save = study_save(study, rigs[0])
     t_end = study_duration(study)
-    dt = ensemble_step(problems, t_end, base.solver["method"], study.accuracy or base.solver["accuracy"])
-    ens = solve_ensemble(problems, t_end, save=save, dt=dt, method=base.solver["method"])
+    dt = ensemble_step(problems, t_end, base.solver.method, study.accuracy or base.solver.accuracy)
+    ens = solve_ensemble(problems, t_end, save=save, dt=dt, method=base.solver.method)
     out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
     traces = []
     beta, F0 = nominal_calibration(study.scene, tuple(study.overrides))
@@ -275,7 +274,7 @@ def _run_batch(study: Study, b: int) -> dict:
         rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))
         shot = rig.fire(seed=seeds[j], fixed=draws[j], truth=False)
         if study.traces:  # each shot has its own scene values and truth: nothing shared between shots
-            e = shot.to_entry()
+            e = shot_entry(shot)
             traces.append(replace(e, truth_key=None,
                                   truth_attrs={**e.truth_attrs, "study_shot": lo + j, "study": study.digest()}))
         m = analyze_record(shot.scope, setup_for(rig, beta, F0), train=False)  # leading pulse only

@@ -45,11 +45,12 @@ def autoscaled(scene: str, overrides=()) -> Rig:
     truth = rig.truth()
     extra = []
     peaks = {}  # expected peak volts per channel
-    for name, (_, ch, settings) in rig.gauges.items():
-        g = truth.gauges[name]
-        peaks[ch] = settings.sensitivity * float(np.max(g.average_force - g.average_force[0]))
+    for gauge in rig.gauges:
+        g = truth.gauges[gauge.name]
+        peaks[gauge.channel] = gauge.settings.sensitivity * float(np.max(g.average_force - g.average_force[0]))
     if rig.wall_sensor is not None:
-        peaks[rig.wall_channel] = rig.wall_sensor.sensitivity * float(np.max(truth.wall_force - truth.wall_force[0]))
+        ws = rig.wall_sensor
+        peaks[ws.channel] = ws.settings.sensitivity * float(np.max(truth.wall_force - truth.wall_force[0]))
     for ch, v in peaks.items():
         extra.append(f"scope.channels.{ch}.volts_per_div={_step_125(v / 5.0)!r}")
     extra.append(f"scope.trigger.level={0.15 * peaks[rig.scope.trigger.source]!r}")

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rig.experiment.entry import shot_entry
 from rig.errors import RigError, invalid
 from rig.experiment.measure import shot_blocks
 from rig.experiment.scene import schema_node
@@ -103,7 +104,7 @@ def run_sweep(scene, vary: Vary, overrides=(), seed: int = 0, progress=None, arc
         for v, rig, s in zip(vary.values, rigs, seeds_for(seed, len(rigs))):
             shot = rig.fire(seed=s)
             points.append(SweepPoint(v, rig, shot, shot_blocks(rig, shot)))
-            entries.append(shot.to_entry())
+            entries.append(shot_entry(shot))
             if progress:
                 progress()
     finally:

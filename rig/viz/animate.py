@@ -57,11 +57,11 @@ def chain_frames(rig, n_frames: int) -> Frames:
     from rig.solver.problem import ChainProblem
     from rig.solver.solve import frame_origin, solve
 
-    duration = rig.solver["duration"]
+    duration = rig.solver.duration
     rec = rig.save_at()
     rec = replace(rec, frame_interval=duration / max(n_frames - 1, 1))
     problem = ChainProblem.from_chain(rig.chain)
-    sol = solve(problem, duration, save=rec, method=rig.solver["method"], accuracy=rig.solver["accuracy"])
+    sol = solve(problem, duration, save=rec, method=rig.solver.method, accuracy=rig.solver.accuracy)
     rig.use_solution(sol)
     pos = sol.frames[:n_frames]
     u = pos - frame_origin(rig.chain)  # displacements from the static equilibrium (m)
@@ -130,8 +130,8 @@ class _View:
         self.p.add_text(f"displacements x {exaggerate:.3g}   (tube vertical in the rig: striker on top)",
                         position="upper_left", font_size=10, color="black")
         self.clock = self.p.add_text("t = 0.000 ms", position="upper_right", font_size=12, color="black")
-        for name, (index, channel, _) in rig.gauges.items():  # mark the gauge beads with their channels
-            self.p.add_point_labels([(self.x_eq[off + index], 0, 3.0 * radii[0])], [f"{channel} ({name})"],
+        for g in rig.gauges:  # mark the gauge beads with their channels
+            self.p.add_point_labels([(self.x_eq[off + g.bead], 0, 3.0 * radii[0])], [f"{g.channel} ({g.name})"],
                                     font_size=11, point_size=1, shape_opacity=0.0, text_color="black")
         self.p.view_xz()
         self.p.enable_parallel_projection()
@@ -223,7 +223,7 @@ def animate(rig, out, frames: int = 100, exaggerate: float | None = None, seed: 
     shot = rig.fire(seed=seed, truth=False)
     x = default_exaggeration(fr, rig) if exaggerate is None else float(exaggerate)
     view = _View(rig, fr, x)
-    traces = _Traces(shot.scope, rig.solver["duration"])
+    traces = _Traces(shot.scope, rig.solver.duration)
     still = out.suffix.lower() == ".png"
     order = [_still_frame(rig, fr)] if still else range(len(fr.times))
     try:
@@ -245,7 +245,7 @@ def animate(rig, out, frames: int = 100, exaggerate: float | None = None, seed: 
     finally:
         view.close()
     return {"out": str(out), "frames": 1 if still else len(fr.times), "exaggerate": x, "seed": shot.seed,
-            "duration_s": rig.solver["duration"], "seconds": time.perf_counter() - t_start}
+            "duration_s": rig.solver.duration, "seconds": time.perf_counter() - t_start}
 
 
 def _still_frame(rig, fr: Frames) -> int:

@@ -48,7 +48,7 @@ def test_documented_force_error_of_published_records(scene, default_bound, fine_
 
     rig = Rig.from_scene(scene)
     p, save = ChainProblem.from_chain(rig.chain), rig.save_at()
-    T = rig.solver["duration"]
+    T = rig.solver.duration
     ref = solve(p, T, dt=contact_time_scale(p) / 300, save=save)
 
     def err(sol):

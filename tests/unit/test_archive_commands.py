@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from instruments.archive import Archive
+from rig.experiment.entry import shot_entry
 from rig.cli import main
 from rig.experiment.shot import Rig
 
@@ -13,7 +14,7 @@ def test_thousand_virtual_shots_round_trip_bit_identical(tmp_path):
     archive = Archive(tmp_path / "mc.h5")
     ids = []
     for k in range(0, 1000, 250):  # four transactions
-        ids += archive.append([s.to_entry() for s in shots[k:k + 250]])
+        ids += archive.append([shot_entry(s) for s in shots[k:k + 250]])
     assert ids == list(range(1, 1001))
     assert archive.verify() == {"shots": 1000, "ok": 1000, "bad": []}
     for i, s in zip(ids, shots):
@@ -58,7 +59,7 @@ def test_real_files_import_into_the_same_layout(tmp_path, capsys, realdata):
 def test_bad_archives_are_one_line_errors(tmp_path, capsys, make):
     path = tmp_path / "bad.h5"
     if make != "missing":
-        Archive(path).append([Rig.from_scene("steel21_gravity").fire(seed=1).to_entry()])
+        Archive(path).append([shot_entry(Rig.from_scene("steel21_gravity").fire(seed=1))])
         data = path.read_bytes()
         path.write_bytes(data[: len(data) // 3] if make == "truncated" else b"hello")
     assert main(["ls", str(path)]) == 2

@@ -135,7 +135,7 @@ def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(t
     # and the pipeline run on an archived record gives the speed the study stored
     from instruments.archive import Archive
     from instruments.pipeline import analyze_record
-    from rig.study.montecarlo import _rig_for, nominal_calibration, shot_inputs
+    from rig.study.montecarlo import shot_rig, nominal_calibration, shot_inputs
     from rig.experiment.measure import setup_for
 
     plain = Store(tmp_path / "plain", _study(32)).open()
@@ -151,7 +151,7 @@ def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(t
     e = entries[3]
     assert e.truth_attrs["study_shot"] == 19 and e.truth is not None
     beta, F0 = nominal_calibration(study.scene, ())
-    rig = _rig_for(study, *shot_inputs(study, 19, 52)[:2])[0]
+    rig = shot_rig(study, *shot_inputs(study, 19, 52)[:2])[0]
     speed = analyze_record(e.record, setup_for(rig, beta, F0), train=False).speed_m_per_s
     assert speed == store.collect()["outputs"]["speed_m_per_s"][19]
     # the traces do not change the results
@@ -162,13 +162,13 @@ def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(t
 def test_a_study_records_the_gauge_averages_and_contacts_only_when_needed():
     # the gauges read their plates' average: a study records it as one probe per gauge
     # (3 channels with the wall, not 5); the truth analysis and the traces add the contacts
-    from rig.study.montecarlo import _rig_for, shot_inputs, study_save
+    from rig.study.montecarlo import shot_rig, shot_inputs, study_save
 
     for kw, names in (({}, {"gauge_lower", "gauge_upper", "wall"}),
                       ({"truth": True}, {"gauge_lower", "gauge_upper", "wall", "contact20", "contact21",
                                          "contact29", "contact30"})):
         study = _study(16, **kw)
-        rig = _rig_for(study, *shot_inputs(study, 0, 52)[:2])[0]
+        rig = shot_rig(study, *shot_inputs(study, 0, 52)[:2])[0]
         assert set(study_save(study, rig).probes) == names
     plain = run_batch(_study(16), 0)["outputs"]
     with_truth = run_batch(_study(16, truth=True), 0)["outputs"]

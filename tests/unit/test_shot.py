@@ -160,12 +160,13 @@ def test_a_rig_like_another_takes_over_only_the_parts_of_shared_tables():
     # are taken over, the others built anew, and the shot is the one a fresh rig fires
     from rig.experiment import scene as scene_io
 
-    values, text = scene_io.load("ptfe52_magnetic")
-    template = Rig(values, text)
-    v = dict(values)
-    v["striker"] = {**values["striker"], "velocity": 0.95}
+    scene = scene_io.load("ptfe52_magnetic")
+    template = Rig(scene)
+    v = dict(scene.values)
+    v["striker"] = {**scene.values["striker"], "velocity": 0.95}
     masses = [0.1226e-3 * (1 + 0.001 * k) for k in range(52)]
-    alike, fresh = Rig(v, text, bead_masses=masses, like=template), Rig(v, text, bead_masses=masses)
+    shot_scene = scene.with_values(v)
+    alike, fresh = Rig(shot_scene, bead_masses=masses, like=template), Rig(shot_scene, bead_masses=masses)
     assert alike.scope is template.scope and alike.gauges is template.gauges
     assert alike.striker is not template.striker and alike.striker.velocity == 0.95
     a, b = alike.fire(seed=5, truth=False), fresh.fire(seed=5, truth=False)

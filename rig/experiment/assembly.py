@@ -1,0 +1,156 @@
+"""The rig on the bench: parts and instruments assembled from a scene, with the wiring
+checked (every gauge and the wall sensor on a channel of the scope, no channel taken
+twice, a trigger on a connected channel)."""
+from __future__ import annotations
+
+from instruments.gauges import GaugeSettings
+from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
+
+from rig.errors import invalid
+from rig.experiment.scene import Scene
+from rig.experiment.settings import GaugeWiring, SolverSettings, WallWiring
+from rig.model.apparatus import Holder, RingMagnet
+from rig.model.chain import Chain
+from rig.model.materials import Material, material
+from rig.model.parts import Bead, GaugeBead, MagneticBead, Striker, Wall
+
+REQUIRED_TABLES = ("chain", "striker", "holder", "wall", "scope", "solver")
+
+
+class Assembly:
+    """Parts (holder, striker, chain, ring magnet), instruments (gauges, wall sensor,
+    oscilloscope) and solver settings of one scene (see rig/experiment/scene.py).
+
+    scene: a validated Scene. bead_masses (kg): one mass per plain bead, top to bottom, for
+    studies of the bead-to-bead scatter. like: an assembly whose parts and instruments are
+    taken over where this scene's table is the very same object as its own (a study's
+    shots share all but the tables their draws change).
+    """
+
+    def __init__(self, scene: Scene, bead_masses=None, like: Assembly | None = None):
+        self.scene = scene
+        self.bead_masses = None if bead_masses is None else [float(m) for m in bead_masses]
+        self._build(like)
+
+    @property
+    def name(self) -> str:
+        return self.scene.name
+
+    @property
+    def values(self) -> dict:
+        return self.scene.values
+
+    def _build(self, like: Assembly | None):
+        v = self.values
+        for table in REQUIRED_TABLES:
+            if table not in v:
+                raise invalid(f"scene [{table}]", None, "this table is required")
+
+        def shared(*tables):  # built from the very same tables as like's: take like's
+            return like is not None and all(v.get(t) is like.values.get(t) for t in tables)
+
+        self.holder = like.holder if shared("holder") else Holder(**v["holder"])
+        beads, first = self._beads(v["chain"])
+        if shared("gauges", "chain"):
+            self.gauges = like.gauges
+        else:
+            self.gauges = tuple(self._gauge(name, dict(g), first, len(beads))
+                                for name, g in sorted(v.get("gauges", {}).items()))
+        for g in self.gauges:
+            beads[g.bead] = GaugeBead.like(beads[g.bead])
+        self.striker = like.striker if shared("striker") else Striker(**v["striker"])
+        self.holder.check(beads, self.striker)
+        if shared("magnet"):
+            self.magnet = like.magnet
+        else:
+            self.magnet = RingMagnet(**v["magnet"]) if "magnet" in v else None
+        if self.magnet is not None and not first:
+            raise invalid("magnet", "set", "a ring magnet needs chain.magnetic_bead = true")
+        wall = like.chain.wall if shared("wall") else Wall(**v["wall"])
+        self.chain = Chain(beads, striker=self.striker, wall=wall, gravity=self.holder.gravity,
+                           top_force=self.magnet.top_force() if self.magnet else 0.0,
+                           contact_law=v["chain"].get("contact_law", "hertz"),
+                           damping_time=v["chain"].get("damping_time", 0.0))
+        if shared("wall_sensor"):
+            self.wall_sensor = like.wall_sensor
+        elif "wall_sensor" in v:
+            ws = dict(v["wall_sensor"])
+            self.wall_sensor = WallWiring(ws.pop("channel", None), GaugeSettings(misalignment_sd=0.0, **ws))
+        else:
+            self.wall_sensor = None
+        self.scope = like.scope if shared("scope") else self._scope(v["scope"])
+        if not shared("gauges", "chain", "wall_sensor", "scope"):
+            self._check_connections()
+        self.solver = like.solver if shared("solver") else SolverSettings.from_table(v["solver"])
+
+    def _beads(self, table: dict) -> tuple:
+        """(the chain's beads, 1 if the top one is the magnetic bead else 0)."""
+        c = dict(table)
+        n = c.pop("beads", None)
+        if not isinstance(n, int) or n < 1:
+            raise invalid("chain.beads", n, "a whole number of beads >= 1")
+        first = 1 if c.pop("magnetic_bead", False) else 0
+        mat = material(c.get("material"))
+        if "youngs_modulus" in c or "poisson_ratio" in c:
+            mat = Material(mat.name, c.get("youngs_modulus", mat.E), c.get("poisson_ratio", mat.nu), mat.rho,
+                           mat.source + "; elastic constants set by the scene")
+        plain = Bead(mat, c.get("diameter"), c.get("mass"))
+        if self.bead_masses is None:
+            plain_beads = [plain] * n
+        else:
+            if len(self.bead_masses) != n:
+                raise invalid("bead_masses", len(self.bead_masses), f"one mass per plain bead ({n})")
+            plain_beads = [plain.with_mass(m) for m in self.bead_masses]
+        return ([MagneticBead()] if first else []) + plain_beads, first
+
+    @staticmethod
+    def _gauge(name: str, g: dict, first: int, total: int) -> GaugeWiring:
+        field = f"gauges.{name}"
+        bead, from_wall = g.pop("bead", None), g.pop("from_wall", None)
+        if (bead is None) == (from_wall is None):
+            raise invalid(field, None, "give exactly one of bead (from the top) or from_wall")
+        plain = total - first
+        count = bead if bead is not None else from_wall
+        if not 1 <= count <= plain:
+            key = "bead" if bead is not None else "from_wall"
+            raise invalid(f"{field}.{key}", count, f"the chain has beads 1..{plain} (magnetic bead not counted)")
+        index = first + bead - 1 if bead is not None else total - from_wall
+        return GaugeWiring(name, index, g.pop("channel", None), GaugeSettings(**g))
+
+    @staticmethod
+    def _scope(s: dict) -> Oscilloscope:
+        s = dict(s)
+        channels = {ch: ChannelSettings(**cs) for ch, cs in s.pop("channels", {}).items()}
+        trigger = Trigger(**s.pop("trigger", {}))
+        timebase = Timebase(s.pop("sample_interval", 1e-7), s.pop("record_length", 20000))
+        return Oscilloscope(channels=channels, timebase=timebase, trigger=trigger, **s)
+
+    def _check_connections(self):
+        used = {}
+        wiring = [(f"gauges.{g.name}.channel", g.channel) for g in self.gauges]
+        if self.wall_sensor is not None:
+            wiring.append(("wall_sensor.channel", self.wall_sensor.channel))
+        for field, ch in wiring:
+            if ch not in self.scope.channels:
+                raise invalid(field, ch, f"not set up on the scope (channels: {', '.join(self.scope.channels)})")
+            if ch in used:
+                raise invalid(field, ch, f"already taken by {used[ch]}")
+            used[ch] = field
+        src = self.scope.trigger.source
+        if src not in used:
+            raise invalid("scope.trigger.source", src,
+                          f"triggers on an unconnected channel (connected: {', '.join(used) or 'none'})")
+
+    def gauge(self, name: str) -> GaugeWiring:
+        """The gauge wired under ``name``."""
+        for g in self.gauges:
+            if g.name == name:
+                return g
+        raise invalid("gauge", name, f"the scene's gauges: {', '.join(g.name for g in self.gauges) or 'none'}")
+
+    def wiring(self) -> dict:
+        """{scope channel: what is connected to it ("gauges.NAME" or "wall_sensor")}."""
+        out = {g.channel: f"gauges.{g.name}" for g in self.gauges}
+        if self.wall_sensor is not None:
+            out[self.wall_sensor.channel] = "wall_sensor"
+        return out

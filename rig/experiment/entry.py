@@ -1,0 +1,34 @@
+"""A virtual shot in the archive's plain form (instruments never see rig objects)."""
+from __future__ import annotations
+
+import hashlib
+
+from instruments.archive import Entry
+
+from rig import __version__
+from rig.experiment.shot import ShotRecord
+
+
+def shot_entry(shot: ShotRecord) -> Entry:
+    """The archive Entry of a shot: scope record, scene, settings, truth arrays and facts.
+    The truth key (one truth stored per scene text, overrides and version) lets shots of
+    the same scene share their noise-free truth."""
+    arrays, gauges = {}, {}
+    for name, g in shot.truth.gauges.items():
+        arrays[f"{name}.average_force"] = g.average_force
+        if g.contact_above is not None:
+            arrays[f"{name}.contact_above"] = g.contact_above
+            arrays[f"{name}.contact_below"] = g.contact_below
+        gauges[name] = {"bead": g.bead, "channel": g.channel, "position_m": g.position_m,
+                        "static_above_N": g.static_above_N, "static_below_N": g.static_below_N}
+    if shot.truth.wall_force is not None:
+        arrays["wall_force"] = shot.truth.wall_force
+    facts = {"sample_interval_s": shot.truth.sample_interval, "gauges": gauges,
+             "analysis": shot.analysis_truth,
+             "wave_speed_m_per_s": shot.truth.wave_speed_m_per_s, "draws": shot.draws,
+             "trigger_time_after_impact_s": shot.scope.trigger_time,
+             "solver": shot.solver.as_dict(), "overrides": list(shot.overrides)}
+    key = hashlib.sha256((shot.scene_text + "\n".join(shot.overrides) + __version__).encode())
+    return Entry(shot.scope, True, shot.seed, shot.scene, shot.scene_text,
+                 {**shot.settings, "overrides": list(shot.overrides)}, arrays, facts,
+                 key.hexdigest()[:16], project_version=__version__)

@@ -1,0 +1,50 @@
+"""How the parts of a scene are wired and solved: small frozen records that cross module
+boundaries instead of tuples and dicts."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from instruments.gauges import GaugeSettings
+
+from rig.errors import invalid
+
+
+@dataclass(frozen=True)
+class GaugeWiring:
+    """A gauge bead: its name in the scene, its chain index (0 = top bead, the magnetic
+    bead included), the scope channel it is wired to and its signal chain's settings."""
+
+    name: str
+    bead: int
+    channel: str
+    settings: GaugeSettings
+
+
+@dataclass(frozen=True)
+class WallWiring:
+    """The wall sensor: the scope channel it is wired to and its signal chain's settings."""
+
+    channel: str
+    settings: GaugeSettings
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """The [solver] table: method name, accuracy target (None: the method's default),
+    simulated duration (s) and the output grid's sample interval (s)."""
+
+    method: str = "srkn6b"
+    accuracy: float | None = None
+    duration: float | None = None
+    sample_interval: float = 1e-7
+
+    def __post_init__(self):
+        d = self.duration
+        if d is None or not (isinstance(d, (int, float)) and math.isfinite(d) and d > 0):
+            raise invalid("solver.duration", d, "simulated time > 0 s, e.g. '4 ms'")
+
+    @classmethod
+    def from_table(cls, table: dict) -> "SolverSettings":
+        return cls(table.get("method", "srkn6b"), table.get("accuracy"), table.get("duration"),
+                   table.get("sample_interval", 1e-7))

@@ -1,0 +1,68 @@
+"""The noise-free ground truth of a shot: what each gauge bead and the wall felt, from the
+solver's recorded forces, and the leading pulse's speed between the outermost gauges."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class GaugeTruth:
+    """Noise-free truth at one gauge bead (chain index ``bead``, 0 = top bead)."""
+
+    bead: int
+    channel: str
+    position_m: float          # equilibrium centre, down from bead 0's centre
+    average_force: np.ndarray  # N, what the rigid gauge bead's plate feels
+    contact_above: np.ndarray | None  # N (None where only the average was recorded)
+    contact_below: np.ndarray | None  # N
+    static_above_N: float
+    static_below_N: float
+
+
+@dataclass(frozen=True, eq=False)
+class Truth:
+    """Ground truth on the solver's output grid t = n * sample_interval (s, 0 = impact)."""
+
+    sample_interval: float
+    gauges: dict
+    wall_force: np.ndarray | None
+    wave_speed_m_per_s: float | None
+
+
+def truth_of(assembly, solution) -> Truth:
+    """The Truth of an assembly's solution (recorded with its ``save_at``: each gauge's two
+    contacts "contact{k}" and/or its average "gauge_{name}", and the "wall")."""
+    x = assembly.chain.equilibrium_positions()
+    F0 = assembly.chain.static_forces()
+    gauges = {}
+    for g in assembly.gauges:
+        j = g.bead
+        above, below = solution.forces.get(f"contact{j}"), solution.forces.get(f"contact{j + 1}")
+        average = solution.forces.get(f"gauge_{g.name}")
+        gauges[g.name] = GaugeTruth(j, g.channel, float(x[j]), 0.5 * (above + below) if average is None else average,
+                                    above, below, float(F0[j]), float(F0[j + 1]))
+    h = solution.sample_interval
+    return Truth(h, gauges, solution.forces.get("wall"), wave_speed(gauges, h))
+
+
+def wave_speed(gauges: dict, h: float) -> float | None:
+    """Leading-pulse speed (m/s) between the outermost gauges, from the truth's peaks."""
+    if len(gauges) < 2:
+        return None
+    g = sorted(gauges.values(), key=lambda t: t.position_m)
+    t_top, t_bottom = first_peak_time(g[0].average_force, h), first_peak_time(g[-1].average_force, h)
+    if t_top is None or t_bottom is None or t_bottom <= t_top:
+        return None
+    return (g[-1].position_m - g[0].position_m) / (t_bottom - t_top)
+
+
+def first_peak_time(f: np.ndarray, h: float) -> float | None:
+    """Time (s) of the first local maximum of the dynamic force above half its peak."""
+    dyn = f - f[0]
+    if dyn.max() <= 0:
+        return None
+    i = int(np.argmax(dyn > 0.5 * dyn.max()))
+    falls = np.flatnonzero(dyn[i + 1:] < dyn[i:-1])  # climb from i to the first sample that falls
+    return (i + int(falls[0]) if falls.size else dyn.size - 1) * h
