@@ -8,7 +8,7 @@ import sys
 
 from instruments.errors import InstrumentError
 
-from rig.cli import data, shots, tools
+from rig.cli import data, shots, study, sweeps, tools
 from rig.cli.common import quantity_arg as _q
 from rig.errors import RigError
 
@@ -48,7 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
     im.add_argument("--into", required=True, metavar="ARCHIVE.h5")
     im.add_argument("--together", action="store_true", help="the files are the channels of one shot")
 
-    sw = _command(sub, "sweep", "one shot per value of a scene key", shots.cmd_sweep)
+    sw = _command(sub, "sweep", "one shot per value of a scene key", sweeps.cmd_sweep)
     sw.add_argument("scene")
     sw.add_argument("--vary", required=True, metavar="KEY=START:STOP:COUNT",
                     help="e.g. striker.velocity=0.3:1.5:7 (plain numbers in the key's SI unit)")
@@ -67,12 +67,12 @@ def build_parser() -> argparse.ArgumentParser:
                     help="displacement factor (default: the largest displacement shown as 1/3 diameter)")
     an.add_argument("--quiet", action="store_true", help="no progress bar")
 
-    rp = _command(sub, "reproduce", "re-run a published study (daraio2006)", shots.cmd_reproduce)
+    rp = _command(sub, "reproduce", "re-run a published study (daraio2006)", sweeps.cmd_reproduce)
     rp.add_argument("study", help="daraio2006")
     rp.add_argument("--out", required=True, metavar="DIR", help="folder for tables and figures")
     rp.add_argument("--quiet", action="store_true", help="no progress bar")
 
-    mc = _command(sub, "mc", "Monte Carlo study over many virtual shots", shots.cmd_mc)
+    mc = _command(sub, "mc", "Monte Carlo study over many virtual shots", study.cmd_mc)
     mc.add_argument("scene")
     mc.add_argument("--shots", type=int, required=True)
     mc.add_argument("--vary", action="append", metavar="KEY=DIST",

@@ -12,7 +12,7 @@ d0 = (F/A)^(2/3), so nothing moves before impact.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 

@@ -13,7 +13,7 @@ SRKN = method("srkn6b")
 
 def test_the_alumina_striker_on_the_steel_bead_is_the_head():
     chain = ptfe_rig(n=30)
-    p, save = ChainProblem.from_chain(chain), record_contacts(chain, 10)
+    p = ChainProblem.from_chain(chain)
     assert fast_head(p) == 1
     st = default_step(p, SRKN, 1e-4)
     single = min(accuracy_step(p, SRKN, 1e-4), 0.5 * stability_limit(p, SRKN))  # the single-rate rule

@@ -1,0 +1,63 @@
+"""`rig sweep` and `rig reproduce`: one shot per value of a key, and the published study."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from rig.cli.shots import shot_summary
+
+
+def cmd_sweep(args) -> dict:
+    from tqdm import tqdm
+
+    from rig.experiment.shot import Rig
+    from rig.study.sweep import Vary, run_sweep
+
+    vary = Vary.parse(args.vary)
+    Rig.from_scene(args.scene, args.set or ())  # the base scene itself must be valid
+    with tqdm(total=len(vary.values), desc=f"sweep {vary.key}", unit="shot", file=sys.stderr,
+              disable=args.quiet) as bar:
+        points = run_sweep(args.scene, vary, args.set or (), args.seed, bar.update, args.out)
+    out = {"points": []}
+    for p in points:
+        one = shot_summary(p.rig, p.shot)
+        one.update(p.blocks)
+        one["value"] = p.value
+        out["points"].append(one)
+    if not args.json:
+        fmt = lambda v, spec: "-" if v is None else format(v, spec)  # noqa: E731
+        print(f"{vary.key:>18s} | {'truth F_d N':>11s} {'V_s m/s':>8s} | {'measured F_d N':>14s} "
+              f"{'V_s m/s':>8s} | {'Eq (1) m/s':>10s}")
+        clipped = []
+        for p in out["points"]:
+            t, m = p["truth"], p["measured"]
+            print(f"{p['value']:18.6g} | {fmt(t['amplitude_N'], '11.3f')} {fmt(t['speed_m_per_s'], '8.1f')} | "
+                  f"{fmt(m['amplitude_N'], '14.3f')} {fmt(m['speed_m_per_s'], '8.1f')} | "
+                  f"{fmt(p['theory']['speed_m_per_s'], '10.1f')}"
+                  f"{'  CLIPPED: ' + ','.join(c) if (c := [k for k, v in p['channels'].items() if v['clipped']]) else ''}")
+            clipped += [p["value"]] if any(v["clipped"] for v in p["channels"].values()) else []
+        if clipped:
+            print(f"clipped scope channels at {vary.key} = {', '.join(f'{v:g}' for v in clipped)}: "
+                  f"those measurements read low; raise scope.channels.CHn.volts_per_div")
+        if args.out:
+            print(f"appended {len(points)} shots to {args.out}")
+    return out
+
+
+def cmd_reproduce(args) -> dict:
+    from tqdm import tqdm
+
+    from rig.study.reproduce import CONFIGS, MASS_RATIOS, OTHER_SCENES, VELOCITY_FACTORS, reproduce
+
+    total = len(CONFIGS) + len(OTHER_SCENES) + len(CONFIGS) * len(VELOCITY_FACTORS) + len(MASS_RATIOS) + 1
+    with tqdm(total=total, desc=f"reproduce {args.study}", unit="step", file=sys.stderr,
+              disable=args.quiet) as bar:
+        def progress(what):
+            bar.set_postfix_str(what[:40])
+            bar.update()
+
+        results = reproduce(args.study, args.out, progress)
+    if not args.json:
+        print((Path(args.out) / "table1.md").read_text())
+        print(f"wrote {args.out}/: table1.md, table1.csv, summary.md, results.json and the figures")
+    return {"out": args.out, "table1": results["table1"], "summary": results["summary"]}
