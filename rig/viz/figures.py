@@ -1,7 +1,29 @@
 """Figures of the reproduction (matplotlib, Agg backend, PNG; imported only when drawn)."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+from pathlib import Path
+
 import numpy as np
+
+
+@dataclass(frozen=True)
+class FigureSpec:
+    """A figure as data: the drawing function's name in this module, the PNG's file name
+    and the function's arguments after the path."""
+
+    kind: str
+    filename: str
+    args: tuple
+
+
+def draw(folder, spec: FigureSpec) -> Path:
+    """Draw ``spec`` into folder/spec.filename (PNG)."""
+    kinds = {"speed_vs_force": speed_vs_force, "traces": traces, "beta_curve": beta_curve,
+             "pulse_vs_solitary": pulse_vs_solitary}
+    path = Path(folder) / spec.filename
+    kinds[spec.kind](path, *spec.args)
+    return path
 
 
 def _plt():
