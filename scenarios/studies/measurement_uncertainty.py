@@ -4,7 +4,7 @@ instrument errors (gauge position sd 1 mm, gain sd 5%, gauge noise 1 mV, scope n
 
     python scenarios/studies/measurement_uncertainty.py [--seeds 200] [--set KEY=VALUE ...]
 
-Public API only: rig.shot.Rig and rig.measure.shot_blocks.
+Public API only: rig.experiment.shot.Rig and rig.experiment.measure.shot_blocks.
 """
 import argparse
 
