@@ -26,7 +26,7 @@ def jit(function=None, **options):
     return njit(**OPTIONS)(function)
 
 
-def drop_stale_cache(package: str) -> None:
+def drop_stale_cache(package: str, constants: tuple = ()) -> None:
     """Drop the cached machine code of every kernel of ``package`` when any of its sources
     changed since that code was written.
 
@@ -34,14 +34,17 @@ def drop_stale_cache(package: str) -> None:
     kernel inlines the kernels it calls from the package's other files: after a change to
     a callee alone, its callers' cached code would still hold the old callee. Keying the
     whole package on a digest of all its sources closes that gap (numba then compiles
-    afresh, once).
+    afresh, once). ``constants``: modules outside the package whose globals the kernels
+    read as compile-time constants (e.g. the contact-law codes); their sources join the
+    digest.
     """
     from numba.core.dispatcher import Dispatcher
 
     root = importlib.import_module(package)
     folder = Path(root.__file__).parent
     digest = hashlib.sha256()
-    for path in sorted(folder.glob("*.py")):
+    sources = sorted(folder.glob("*.py")) + [Path(importlib.import_module(m).__file__) for m in constants]
+    for path in sources:
         digest.update(path.name.encode() + b"\0" + path.read_bytes())
     modules = [importlib.import_module(f"{package}.{m.name}") for m in pkgutil.iter_modules([str(folder)])]
     caches = {}

@@ -56,6 +56,10 @@ def contact_stiffness(A, force):
     return 1.5 * np.cbrt(A**2 * np.asarray(force, dtype=float))
 
 
+HERTZ = 0          # the kernels' code of each law: the one source (rig/solver/kernels/forces.py)
+KUWABARA_KONO = 1
+
+
 @dataclass(frozen=True)
 class ContactLaw:
     """A contact law the kernels know by ``code``; ``damping_time`` (s) only where used."""
@@ -69,9 +73,9 @@ class ContactLaw:
 CONTACT_LAWS: dict[str, ContactLaw] = {
     law.name: law
     for law in (
-        ContactLaw("hertz", 0, "elastic Hertz law F = A delta^(3/2) (conservative)", False),
+        ContactLaw("hertz", HERTZ, "elastic Hertz law F = A delta^(3/2) (conservative)", False),
         ContactLaw(
-            "kuwabara-kono", 1,
+            "kuwabara-kono", KUWABARA_KONO,
             "viscoelastic Hertz law F = A delta^(1/2) (delta + tau_d d(delta)/dt), never "
             "attractive (Kuwabara & Kono, Jpn. J. Appl. Phys. 26, 1230 (1987); Brilliantov "
             "et al., Phys. Rev. E 53, 5382 (1996)); tau_d is the material's damping time",

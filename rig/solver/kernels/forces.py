@@ -3,8 +3,7 @@ import math
 
 from instruments.jit import jit
 
-HERTZ = 0
-KUWABARA_KONO = 1
+from rig.model.contact import HERTZ
 
 
 @jit
