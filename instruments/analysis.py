@@ -2,7 +2,8 @@
 
 Conditioning: baseline from the pre-trigger samples; inversion of the one-pole RC
 high-pass, x = y + (1/tau) * integral of y dt (trapezoid rule); volts to force with the
-gauge's sensitivity. Pulses: scipy.signal.find_peaks with height/prominence/distance rules;
+gauge's sensitivity. Pulses: the rules of scipy.signal.find_peaks (height, distance,
+prominence, width; compiled in _kernels/, the same results bit for bit);
 the peak time and amplitude of each pulse come from a least-squares parabola through the
 samples within ``top`` of its maximum, which stays accurate on 8-bit records whose tops are
 plateaus of equal codes; widths are where the pulse crosses 50% (FWHM) and 1% (base) of its
@@ -15,11 +16,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import find_peaks, peak_widths
 
 from ._kernels.crossings import level_bracket
 from ._kernels.filters import undo_highpass
 from ._kernels.parabola import parabola
+from ._kernels.peaks import local_maxima, thin_by_distance, widths_at
 from ._kernels.prominence import prominence_bases
 from .errors import check
 
@@ -83,16 +84,20 @@ def find_pulses(t: np.ndarray, f: np.ndarray, rules: PeakRules = PeakRules(),
     # maximum, and thinning them before their prominences are computed saves most of the time
     spacing = int(round(max(rules.distance, 0.5 * rules.width) / h))
     height = rules.height * peak if floor is None else floor
-    idx, _ = find_peaks(f, height=height, distance=spacing if spacing > 1 else None)
+    f = np.ascontiguousarray(f, dtype=float)
+    idx = local_maxima(f)  # find_peaks(f, height, distance): its steps in its order
+    idx = idx[height <= f[idx]]
+    if spacing > 1 and idx.size:
+        idx = idx[thin_by_distance(idx, np.argsort(f[idx]), float(spacing))]
     # the prominence rule, applied after the distance rule as find_peaks applies it, with
     # the same bases found in one pass (find_peaks scans from each candidate: O(n) each)
-    left, right = prominence_bases(np.ascontiguousarray(f, dtype=float), float(height))
+    left, right = prominence_bases(f, float(height))
     left, right = left[idx], right[idx]
     prominence = f[idx] - np.maximum(f[left], f[right])
     keep = prominence >= rules.prominence * peak
     idx, prominence, left, right = idx[keep], prominence[keep], left[keep], right[keep]
     if rules.width > 0 and idx.size:  # widths only for the candidates left (noise makes many maxima)
-        widths = peak_widths(f, idx, rel_height=0.5, prominence_data=(prominence, left, right))[0]
+        widths = widths_at(f, idx, 0.5, prominence, left, right)
         idx = idx[widths >= rules.width / h]
     coarse = [Pulse(float(t[i]), float(f[i]), math.nan, math.nan) for i in idx]
     return [refined(t, f, p, rules) for p in coarse] if refine else coarse

@@ -1,13 +1,18 @@
 """Quantities with units, converted to SI floats once, at the boundary.
 
-``quantity("4.76 mm", "m", field="bead.diameter")`` returns ``0.00476``. Parsing uses
-pint; the registry is built lazily (first use) so that importing the rig stays cheap.
+``quantity("4.76 mm", "m", field="bead.diameter")`` returns ``0.00476``. pint is the
+authority on units; the plain forms of scene files ("NUMBER UNIT" or "NUMBER UNIT/UNIT",
+SI units with SI prefixes, integer powers) are converted by a small table first, since
+loading pint and its registry costs about a quarter of a second; anything else goes to
+pint. Both round to 15 significant digits, which drops the conversion's last-bit noise, so
+they give the same floats (tests/model/test_units.py compares them).
 """
 from __future__ import annotations
 
 import functools
 import math
 import numbers
+import re
 
 from rig.errors import RigError, invalid
 
@@ -43,7 +48,54 @@ def quantity(value, unit: str, field: str, *, bare_ok: bool = False) -> float:
     return out
 
 
+# SI units by symbol: (factor to SI, dimension exponents of kg, m, s, A)
+_UNITS = {"m": (1.0, (0, 1, 0, 0)), "g": (1e-3, (1, 0, 0, 0)), "s": (1.0, (0, 0, 1, 0)),
+          "N": (1.0, (1, 1, -2, 0)), "Pa": (1.0, (1, -1, -2, 0)), "V": (1.0, (1, 2, -3, -1)),
+          "Hz": (1.0, (0, 0, -1, 0)), "A": (1.0, (0, 0, 0, 1)), "J": (1.0, (1, 2, -2, 0))}
+_PREFIXES = {"": 1.0, "G": 1e9, "M": 1e6, "k": 1e3, "c": 1e-2, "m": 1e-3, "u": 1e-6, "µ": 1e-6,
+             "μ": 1e-6, "n": 1e-9, "p": 1e-12}
+_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)\s*$")
+_FACTOR = re.compile(r"([A-Za-zµμ]+)(?:(?:\^|\*\*)(-?\d+))?$")
+
+
+def _si(unit: str):
+    """(factor to SI, dimension) of a unit written as factors joined by '*' and at most one
+    '/' (e.g. "mm", "m/s^2", "V/N"); None where the table does not know it."""
+    num, _, den = unit.partition("/")
+    factor, dims = 1.0, [0, 0, 0, 0]
+    for part, sign in ((num, 1), (den, -1)):
+        if sign < 0 and not den:
+            break
+        for token in part.split("*") if "**" not in part else [part]:
+            m = _FACTOR.match(token.strip())
+            if not m:
+                return None
+            symbol, power = m.group(1), sign * int(m.group(2) or 1)
+            known = [(p, symbol[len(p):]) for p in _PREFIXES if symbol.startswith(p) and symbol[len(p):] in _UNITS]
+            if not known:
+                return None
+            prefix, base = min(known, key=lambda k: len(k[0]))  # "m" is metre, not milli-nothing
+            f, d = _UNITS[base]
+            factor *= (_PREFIXES[prefix] * f) ** power
+            dims = [a + power * b for a, b in zip(dims, d)]
+    return factor, tuple(dims)
+
+
+def _fast(text: str, unit: str):
+    """The SI value of ``text`` by the table, or None where pint must decide."""
+    m = _NUMBER.match(text)
+    if not m:
+        return None
+    have, want = _si(m.group(2)), _si(unit)
+    if have is None or want is None or have[1] != want[1]:
+        return None
+    return float(f"{float(m.group(1)) * have[0] / want[0]:.15g}")
+
+
 def _parse(text: str, unit: str, field: str) -> float:
+    fast = _fast(text, unit)
+    if fast is not None:
+        return fast
     import pint
 
     ureg = _registry()

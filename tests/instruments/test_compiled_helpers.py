@@ -5,10 +5,11 @@ import math
 import numpy as np
 import pytest
 from scipy.integrate import cumulative_trapezoid
-from scipy.signal import find_peaks, lfilter, peak_prominences
+from scipy.signal import find_peaks, lfilter, peak_prominences, peak_widths
 
 from instruments._kernels.filters import one_pole, undo_highpass
 from instruments._kernels.parabola import parabola
+from instruments._kernels.peaks import local_maxima, thin_by_distance, widths_at
 from instruments._kernels.prominence import prominence_bases
 from instruments._kernels.quantiser import quantise
 from instruments._kernels.resample import at_positions
@@ -45,6 +46,37 @@ def test_prominence_bases_are_scipys_bit_for_bit(with_floor):
         assert np.array_equal(lb[peaks], left) and np.array_equal(rb[peaks], right)
         assert np.array_equal(x[peaks] - np.maximum(x[lb[peaks]], x[rb[peaks]]), prom)
         assert np.all(lb[x < floor] == -1) and np.all(rb[x < floor] == -1)
+        checked += peaks.size
+    assert checked > 2000
+
+
+@pytest.mark.parametrize("distance", [None, 2, 5, 17.5])
+def test_candidate_maxima_are_find_peaks_bit_for_bit(distance):
+    # plateaus, ties and the height and distance rules, in find_peaks' order
+    rng = np.random.default_rng(5)
+    checked = 0
+    for x in _signals():
+        height = float(np.quantile(x, rng.uniform(0, 1)))
+        ref = find_peaks(x, height=height, distance=distance)[0]
+        idx = local_maxima(x)
+        idx = idx[height <= x[idx]]
+        if distance is not None and idx.size:
+            idx = idx[thin_by_distance(idx, np.argsort(x[idx]), float(distance))]
+        assert np.array_equal(idx, ref)
+        checked += ref.size
+    assert checked > 1000
+
+
+@pytest.mark.parametrize("rel_height", [0.5, 0.01, 1.0])
+def test_widths_are_peak_widths_bit_for_bit(rel_height):
+    checked = 0
+    for x in _signals():
+        peaks = find_peaks(x)[0]
+        if not peaks.size:
+            continue
+        prom, left, right = peak_prominences(x, peaks)
+        ref = peak_widths(x, peaks, rel_height=rel_height, prominence_data=(prom, left, right))[0]
+        assert _same_bits(widths_at(x, peaks, rel_height, prom, left, right), ref)
         checked += peaks.size
     assert checked > 2000
 

@@ -1,0 +1,77 @@
+"""Candidate maxima and widths of pulses, the loops of scipy.signal.find_peaks and
+peak_widths (numba), so that analysing a record does not load scipy.signal (about 1 s of
+import time). Each reproduces scipy's algorithm step for step, in the same arithmetic:
+tests/instruments/test_compiled_helpers.py compares them with scipy bit for bit.
+"""
+import numpy as np
+
+from instruments.jit import jit
+
+
+@jit
+def local_maxima(x):
+    """Indices of the local maxima of x: samples higher than their left neighbour and
+    than the first different sample on their right; a flat top counts once, at its middle
+    ((first + last) // 2), as scipy.signal's _local_maxima_1d."""
+    out = np.empty(x.shape[0] // 2 + 1, np.int64)
+    m = 0
+    i = 1
+    last = x.shape[0] - 1
+    while i < last:
+        if x[i - 1] < x[i]:
+            ahead = i + 1
+            while ahead < last and x[ahead] == x[i]:
+                ahead += 1
+            if x[ahead] < x[i]:
+                out[m] = (i + ahead - 1) // 2
+                m += 1
+                i = ahead
+        i += 1
+    return out[:m]
+
+
+@jit
+def thin_by_distance(peaks, order, distance):
+    """keep[k] for peaks[k]: from the highest peak down (``order``: np.argsort of their
+    heights, as scipy computes it), every lower peak closer than ceil(distance) samples to a
+    kept one is dropped (scipy.signal's _select_by_peak_distance)."""
+    n = peaks.shape[0]
+    span = np.ceil(distance)
+    keep = np.ones(n, np.bool_)
+    for r in range(n - 1, -1, -1):
+        j = order[r]
+        if not keep[j]:
+            continue
+        k = j - 1
+        while k >= 0 and peaks[j] - peaks[k] < span:
+            keep[k] = False
+            k -= 1
+        k = j + 1
+        while k < n and peaks[k] - peaks[j] < span:
+            keep[k] = False
+            k += 1
+    return keep
+
+
+@jit
+def widths_at(x, peaks, rel_height, prominences, left_bases, right_bases):
+    """Width (samples) of each peak where it crosses x[peak] - rel_height * prominence,
+    interpolated linearly, searched between its bases (scipy.signal's _peak_widths)."""
+    out = np.empty(peaks.shape[0])
+    for p in range(peaks.shape[0]):
+        lo, hi, peak = left_bases[p], right_bases[p], peaks[p]
+        height = x[peak] - prominences[p] * rel_height
+        i = peak
+        while lo < i and height < x[i]:
+            i -= 1
+        left = float(i)
+        if x[i] < height:
+            left += (height - x[i]) / (x[i + 1] - x[i])
+        i = peak
+        while i < hi and height < x[i]:
+            i += 1
+        right = float(i)
+        if x[i] < height:
+            right -= (height - x[i]) / (x[i - 1] - x[i])
+        out[p] = right - left
+    return out
