@@ -50,10 +50,10 @@ PUBLISHED_SCENES = Path(__file__).resolve().parent.parent / "scenes"  # package 
 def find_scene(name_or_path) -> Path:
     """A path to a .toml file, or the name of a published scene (rig/scenes/, e.g. ptfe52_magnetic)."""
     p = Path(name_or_path)
-    if p.suffix == ".toml" or p.exists():
-        if not p.is_file():
-            raise invalid("scene", str(name_or_path), "no such scene file")
+    if p.is_file():
         return p
+    if p.suffix == ".toml" or len(p.parts) > 1:
+        raise invalid("scene", str(name_or_path), "no such scene file")
     hits = sorted(PUBLISHED_SCENES.rglob(f"{p.name}.toml"))
     if not hits:
         known = sorted(q.stem for q in PUBLISHED_SCENES.rglob("*.toml"))
