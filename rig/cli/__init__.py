@@ -10,6 +10,7 @@ from instruments.errors import InstrumentError
 
 from rig.cli import data, shots, study, sweeps, tools
 from rig.cli.common import quantity_arg as _q
+from rig import __version__
 from rig.errors import RigError
 
 
@@ -23,6 +24,7 @@ def _command(sub, name: str, help_text: str, func):
 
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="rig", description="Virtual rig for strongly nonlinear granular chains.")
+    ap.add_argument("--version", action="version", version=f"rig {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
 
     th = _command(sub, "theory", "long-wave and exact discrete solitary wave speeds", tools.cmd_theory)
@@ -113,7 +115,7 @@ def build_parser() -> argparse.ArgumentParser:
     ls.add_argument("archive")
 
     be = _command(sub, "bench", "benchmarks", tools.cmd_bench)
-    be.add_argument("what", choices=["solver", "accuracy", "shot", "archive", "pipeline", "mc", "animate"],
+    be.add_argument("what", choices=["solver", "accuracy", "shot", "archive", "pipeline", "mc", "animate", "startup"],
                     help="what to benchmark")
     be.add_argument("--quick", action="store_true", help="fewer settings, one repeat")
     return ap

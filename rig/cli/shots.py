@@ -8,15 +8,17 @@ from rig.errors import RigError
 
 def cmd_shot(args) -> dict:
     """Fire one virtual shot of a scene; print a summary or JSON; export scope files."""
+    from rig.experiment.scene import load
+
+    scene = load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
     from pathlib import Path
 
     from instruments.formats import WRITERS
 
+    from rig.experiment.measure import shot_blocks
     from rig.experiment.shot import Rig
 
-    from rig.experiment.measure import shot_blocks
-
-    rig = Rig.from_scene(args.scene, args.set or ())
+    rig = Rig(scene)
     shot = rig.fire(seed=args.seed)
     out = shot_summary(rig, shot)
     out.update(shot_blocks(rig, shot))
@@ -107,12 +109,13 @@ def cmd_animate(args) -> dict:
     """Render a virtual shot to a movie or a still, off-screen (pyvista)."""
     from tqdm import tqdm
 
+    from rig.experiment.scene import load
     from rig.viz.animate import animate, check_output, require_renderer
     from rig.experiment.shot import Rig
 
     check_output(args.out)  # before anything is computed
     require_renderer()
-    rig = Rig.from_scene(args.scene, args.set or ())
+    rig = Rig(load(args.scene, args.set or ()))
     still = args.out.lower().endswith(".png")
     with tqdm(total=None if still else args.frames, desc="animate", unit="frame", file=sys.stderr,
               disable=args.quiet or still) as bar:

@@ -9,6 +9,9 @@ from rig.errors import RigError
 
 
 def cmd_mc(args) -> dict:
+    from rig.experiment.scene import load
+
+    load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
     import time
 
     import numpy as np

@@ -10,11 +10,12 @@ from rig.cli.shots import shot_summary
 def cmd_sweep(args) -> dict:
     from tqdm import tqdm
 
+    from rig.experiment.scene import load
     from rig.experiment.shot import Rig
     from rig.study.sweep import Vary, run_sweep
 
     vary = Vary.parse(args.vary)
-    Rig.from_scene(args.scene, args.set or ())  # the base scene itself must be valid
+    Rig(load(args.scene, args.set or ()))  # the base scene itself must be valid
     with tqdm(total=len(vary.values), desc=f"sweep {vary.key}", unit="shot", file=sys.stderr,
               disable=args.quiet) as bar:
         points = run_sweep(args.scene, vary, args.set or (), args.seed, bar.update, args.out)

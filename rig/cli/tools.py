@@ -49,7 +49,7 @@ def cmd_theory(args) -> dict:
 
 
 def cmd_bench(args) -> dict:
-    if args.what in ("accuracy", "shot", "archive", "pipeline", "mc", "animate"):
+    if args.what in ("accuracy", "shot", "archive", "pipeline", "mc", "animate", "startup"):
         import importlib
 
         module = importlib.import_module(f"rig.bench.{args.what}")

@@ -261,5 +261,5 @@ def require_renderer():
         import imageio  # noqa: F401
         import pyvista  # noqa: F401
     except ImportError as exc:
-        raise RigError(f"rig animate needs pyvista and imageio ({exc.name} is missing): "
-                       f"pip install pyvista imageio imageio-ffmpeg") from None
+        raise RigError(f"rig animate needs the animate extra ({exc.name} is missing): "
+                       f"pip install \"sonic-rig[animate]\"") from None

@@ -61,12 +61,12 @@ def test_still_png(tmp_path):
 @pytest.mark.parametrize("out,message", [("shot.avi", "ending in .mp4, .gif, .png"),
                                          ("missing/shot.mp4", "does not exist")])
 def test_bad_output_is_refused_before_rendering(tmp_path, capsys, monkeypatch, out, message):
-    import rig.experiment.shot
+    import rig.experiment.scene
 
     def no_solving(*a, **k):
         raise AssertionError("nothing may be computed for a bad --out")
 
-    monkeypatch.setattr(rig.experiment.shot.Rig, "from_scene", no_solving)
+    monkeypatch.setattr(rig.experiment.scene, "load", no_solving)
     assert main(["animate", "ptfe52_magnetic", "--out", str(tmp_path / out)]) == 2
     err = capsys.readouterr().err
     assert message in err and "--out" in err and len(err.strip().splitlines()) == 1

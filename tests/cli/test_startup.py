@@ -1,0 +1,38 @@
+"""The command line starts light: help, the version and a scene error load none of the
+heavy libraries (checked in a fresh interpreter); the shot path loads no scipy.signal."""
+import json
+import subprocess
+import sys
+
+import pytest
+
+import rig
+
+HEAVY = ("numba", "scipy", "pint", "pyvista", "vtk", "matplotlib", "dask", "h5py")
+PROBE = ("import json, sys\nfrom rig.cli import main\ntry:\n    code = main({argv!r})\nexcept SystemExit as e:\n"
+         "    code = e.code\nprint(json.dumps([code, sorted(m for m in {heavy!r} if m in sys.modules)]))")
+
+
+def _run(argv, heavy=HEAVY):
+    out = subprocess.run([sys.executable, "-c", PROBE.format(argv=argv, heavy=heavy)],
+                         capture_output=True, text=True, check=True)
+    return out, json.loads(out.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.parametrize("argv,code", [(["--help"], 0), (["shot", "--help"], 0), (["--version"], 0),
+                                       (["shot", "nosuchscene"], 2), (["mc", "nosuchscene", "--shots", "4",
+                                                                       "--out", "x"], 2)])
+def test_help_version_and_scene_errors_load_nothing_heavy(argv, code):
+    out, (got, loaded) = _run(argv)
+    assert got == code and loaded == [], (out.stderr, loaded)
+
+
+def test_version():
+    out, _ = _run(["--version"])
+    assert out.stdout.startswith(f"rig {rig.__version__}")
+
+
+def test_a_shot_loads_no_scipy_signal_nor_pint():
+    _, (code, loaded) = _run(["shot", "ptfe52_magnetic", "--seed", "1"], ("scipy.signal", "scipy.stats", "pint",
+                                                                          "matplotlib", "h5py", "dask"))
+    assert code == 0 and loaded == []
