@@ -21,7 +21,9 @@ from rig.study.distributions import parse_vary
 from rig.solver.ensemble import ensemble_step, solve_ensemble
 from rig.solver.problem import ChainProblem
 from rig.study.executors import run_study
-from rig.study.montecarlo import Store, Study, shot_rig, run_batch, shot_inputs, study_save
+from rig.study.batch import run_batch, shot_inputs, shot_rig, study_save
+from rig.study.mc_spec import Study
+from rig.study.store import Store
 
 VARY = ("striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)")
 BATCH = 128

@@ -7,7 +7,9 @@ import concurrent.futures as cf
 import multiprocessing
 
 from rig.errors import RigError
-from rig.study.montecarlo import Store, Study, run_batch
+from rig.study.batch import run_batch
+from rig.study.mc_spec import Study
+from rig.study.store import Store
 
 
 def _one_thread():
@@ -62,7 +64,7 @@ def _dask(study, store, todo, scheduler, workers, tick):
         for fut in as_completed(futures):
             result = fut.result()
             store.write(result)
-            tick(len(result["index"]))
+            tick(len(result.index))
     finally:
         client.close()
         if cluster is not None:

@@ -1,4 +1,5 @@
-"""The study's report: JCGM 101 (GUM Supplement 1) summaries, Sobol indices, figures."""
+"""The study's report: JCGM 101 (GUM Supplement 1) summaries and figures (Sobol indices:
+rig/study/sobol.py)."""
 from __future__ import annotations
 
 import math
@@ -34,34 +35,13 @@ def jcgm101(y: np.ndarray, n_dig: int = 2, blocks: int = 10) -> dict:
             "stabilisation": 2 * worst}
 
 
-def sobol_indices(study, X, Y) -> dict:
-    """First-order and total Sobol indices (SALib) of one output for each input."""
-    from SALib.analyze import sobol
-
-    from rig.study.montecarlo import sobol_matrix
-
-    _, problem = sobol_matrix(study)
-    Y = np.asarray(Y, float)
-    if not np.all(np.isfinite(Y)):
-        Y = np.where(np.isfinite(Y), Y, np.nanmean(Y))
-    s = sobol.analyze(problem, Y[: X.shape[0]], calc_second_order=False, seed=study.seed)
-    names = problem["names"]
-    pick = lambda key: {n: float(v) for n, v in zip(names, s[key])}  # noqa: E731
-    total = pick("ST")
-    return {"first_order": pick("S1"), "first_order_conf95": pick("S1_conf"), "total": total,
-            "total_conf95": pick("ST_conf"), "dominant": max(total, key=total.get),
-            "base_samples": int(X.shape[0] // (len(names) + 2)),
-            "note": "the instruments' own noise is not in the design and adds to every index; "
-                    "indices are trustworthy where their 95% half-widths are small"}
-
-
 def figures(folder, results, keys, theory_curve=None):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    out = results["outputs"]
+    out = results.outputs
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
     for ax, key, label in ((axes[0], "speed_m_per_s", "measured speed V_s (m/s)"),
                            (axes[1], "amplitude_N", "measured amplitude F_d (N)")):

@@ -8,7 +8,9 @@ import pytest
 from rig.cli import main
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
-from rig.study.montecarlo import Store, Study, refire, run_batch
+from rig.study.batch import refire, run_batch
+from rig.study.mc_spec import Study
+from rig.study.store import Store
 from rig.study.report import jcgm101
 
 VARY = ["striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)",
@@ -48,10 +50,10 @@ def test_identical_results_with_one_two_workers_and_dask(tmp_path):
         run_study(_study(), store, **kw)
         runs[name] = store.collect()
     for name in ("two", "dask"):
-        assert np.array_equal(runs[name]["inputs"], runs["one"]["inputs"])
-        assert np.array_equal(runs[name]["seeds"], runs["one"]["seeds"])
-        for k, v in runs["one"]["outputs"].items():
-            assert np.array_equal(runs[name]["outputs"][k], v, equal_nan=True), k
+        assert np.array_equal(runs[name].inputs, runs["one"].inputs)
+        assert np.array_equal(runs[name].seeds, runs["one"].seeds)
+        for k, v in runs["one"].outputs.items():
+            assert np.array_equal(runs[name].outputs[k], v, equal_nan=True), k
 
 
 def test_interrupted_study_keeps_finished_shots_and_resumes(tmp_path):
@@ -70,8 +72,8 @@ def test_interrupted_study_keeps_finished_shots_and_resumes(tmp_path):
     assert run_study(study, store) == 1  # the re-run does only what is missing
     whole = Store(tmp_path / "w", study).open()
     run_study(study, whole)
-    for k, v in whole.collect()["outputs"].items():
-        assert np.array_equal(store.collect()["outputs"][k], v, equal_nan=True)
+    for k, v in whole.collect().outputs.items():
+        assert np.array_equal(store.collect().outputs[k], v, equal_nan=True)
 
 
 def test_any_shot_refires_alone_with_the_same_result():
@@ -79,12 +81,12 @@ def test_any_shot_refires_alone_with_the_same_result():
     batch = run_batch(study, 1)
     again = refire(study, 21)
     for k, v in again.items():
-        assert v == batch["outputs"][k][5] or (np.isnan(v) and np.isnan(batch["outputs"][k][5]))
+        assert v == batch.outputs[k][5] or (np.isnan(v) and np.isnan(batch.outputs[k][5]))
 
 
 def test_study_inputs_follow_their_distributions():
     study = _study(shots=64)
-    x = np.concatenate([run_batch(study, b)["inputs"] for b in range(4)])
+    x = np.concatenate([run_batch(study, b).inputs for b in range(4)])
     v = x[:, 0]
     assert abs(np.mean(v) - 0.89) < 4 * 0.01 / 8 and 0.006 < np.std(v) < 0.014
 
@@ -117,14 +119,15 @@ def test_leading_window_measures_what_the_whole_record_measures():
     # with noise-free instruments the short study window (simulated until the leading pulse
     # has passed the last gauge, the scope's pre-trigger samples kept) gives the same speed
     # and amplitude as the scene's whole record, for a fraction of the simulated time
-    from rig.study.montecarlo import leading_window
+    from rig.study.nominal import nominal
 
     quiet = ("gauges.upper.noise=0 V", "gauges.lower.noise=0 V", "gauges.upper.calibration_error=0",
              "gauges.lower.calibration_error=0", "wall_sensor.noise=0 V", "wall_sensor.calibration_error=0",
              "scope.noise_floor=0 V")
-    duration, length, pre = leading_window("ptfe52_magnetic", quiet)
+    w = nominal("ptfe52_magnetic", quiet).leading_window
+    duration, length, pre = w.duration, w.record_length, w.pre_trigger
     assert duration < 0.4 * 3e-3 and length < 12500 and round(pre * length) == 1250
-    a, b = (run_batch(_study(8, overrides=quiet, window=w), 0)["outputs"] for w in ("leading", "record"))
+    a, b = (run_batch(_study(8, overrides=quiet, window=w), 0).outputs for w in ("leading", "record"))
     for key in ("speed_m_per_s", "amplitude_N"):
         assert np.all(np.isfinite(a[key]))
         np.testing.assert_allclose(a[key], b[key], rtol=1e-6)
@@ -135,7 +138,8 @@ def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(t
     # and the pipeline run on an archived record gives the speed the study stored
     from instruments.archive import Archive
     from instruments.pipeline import analyze_record
-    from rig.study.montecarlo import shot_rig, nominal_calibration, shot_inputs
+    from rig.study.batch import shot_inputs, shot_rig
+    from rig.study.nominal import nominal
     from rig.experiment.measure import setup_for
 
     plain = Store(tmp_path / "plain", _study(32)).open()
@@ -150,19 +154,19 @@ def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(t
     assert len(entries) == 16
     e = entries[3]
     assert e.truth_attrs["study_shot"] == 19 and e.truth is not None
-    beta, F0 = nominal_calibration(study.scene, ())
+    beta, F0 = nominal(study.scene, ()).calibration
     rig = shot_rig(study, *shot_inputs(study, 19, 52)[:2])[0]
     speed = analyze_record(e.record, setup_for(rig, beta, F0), train=False).speed_m_per_s
-    assert speed == store.collect()["outputs"]["speed_m_per_s"][19]
+    assert speed == store.collect().outputs["speed_m_per_s"][19]
     # the traces do not change the results
-    for k, v in plain.collect()["outputs"].items():
-        assert np.array_equal(store.collect()["outputs"][k], v, equal_nan=True)
+    for k, v in plain.collect().outputs.items():
+        assert np.array_equal(store.collect().outputs[k], v, equal_nan=True)
 
 
 def test_a_study_records_the_gauge_averages_and_contacts_only_when_needed():
     # the gauges read their plates' average: a study records it as one probe per gauge
     # (3 channels with the wall, not 5); the truth analysis and the traces add the contacts
-    from rig.study.montecarlo import shot_rig, shot_inputs, study_save
+    from rig.study.batch import shot_inputs, shot_rig, study_save
 
     for kw, names in (({}, {"gauge_lower", "gauge_upper", "wall"}),
                       ({"truth": True}, {"gauge_lower", "gauge_upper", "wall", "contact20", "contact21",
@@ -170,8 +174,8 @@ def test_a_study_records_the_gauge_averages_and_contacts_only_when_needed():
         study = _study(16, **kw)
         rig = shot_rig(study, *shot_inputs(study, 0, 52)[:2])[0]
         assert set(study_save(study, rig).probes) == names
-    plain = run_batch(_study(16), 0)["outputs"]
-    with_truth = run_batch(_study(16, truth=True), 0)["outputs"]
+    plain = run_batch(_study(16), 0).outputs
+    with_truth = run_batch(_study(16, truth=True), 0).outputs
     for k in ("speed_m_per_s", "amplitude_N"):
         assert np.array_equal(plain[k], with_truth[k])
     assert np.all(np.isfinite(with_truth["truth_speed_m_per_s"]))

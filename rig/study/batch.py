@@ -1,0 +1,146 @@
+"""One batch of a Monte Carlo study: each shot's inputs (from its own SeedSequence child),
+its rig, one batched solve of all the shots, then per shot the instruments and the
+analysis of the leading pulse. ``refire`` runs one shot again alone, with the same numbers."""
+from __future__ import annotations
+
+import contextlib
+import gc
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from instruments.pipeline import analyze_record
+
+from rig.errors import RigError
+from rig.experiment.entry import shot_entry
+from rig.experiment.measure import setup_for
+from rig.experiment.shot import Rig
+from rig.solver.ensemble import ensemble_step, solve_ensemble
+from rig.solver.problem import ChainProblem
+from rig.solver.saveat import SaveAt
+from rig.solver.solution import Solution
+from rig.study.mc_spec import OUTPUTS, Study
+from rig.study.nominal import copied_table, nominal
+from rig.study.sobol import sobol_matrix
+
+
+@dataclass(frozen=True, eq=False)
+class BatchResult:
+    """What batch ``batch`` gives: the shots' indices, inputs (shots, K) in the study's key
+    order, instrument seeds, outputs {name: (shots,)} (OUTPUTS; nan where nothing was
+    measured) and, for a study with traces, each shot's archive Entry."""
+
+    batch: int
+    index: np.ndarray
+    inputs: np.ndarray
+    seeds: np.ndarray
+    outputs: dict
+    traces: tuple = ()
+
+
+def shot_inputs(study: Study, i: int, n_plain: int, design=None):
+    """Shot i's inputs {key: value}, bead masses (or None) and instrument seed."""
+    child = np.random.SeedSequence(study.seed, spawn_key=(i,))
+    rng = np.random.default_rng(child)
+    x, masses = {}, None
+    for k, d in enumerate(study.dists):
+        if d.key == "chain.bead_mass":
+            masses = d.draw(rng, n_plain)
+            x[d.key] = float(np.mean(masses))
+        else:
+            x[d.key] = float(d.draw(rng)) if design is None else float(design[i, k])
+    seed = int(child.generate_state(1, np.uint64)[0] >> np.uint64(1))
+    return x, masses, seed
+
+
+def shot_rig(study: Study, x: dict, masses) -> tuple:
+    """Shot inputs x (and bead masses) -> (the shot's rig, its instrument draws)."""
+    template = nominal(study.scene, tuple(study.overrides)).template(study.window)
+    v = dict(template.values)
+    draws = {}
+    for key, val in x.items():
+        parts = key.split(".")
+        if parts[0] == "gauges" and parts[-1] in ("gain", "misalignment"):
+            draws.setdefault(parts[1], {})[parts[-1]] = val
+            continue
+        if key == "chain.bead_mass":
+            continue
+        copied_table(v, parts[:-1])[parts[-1]] = val
+    return Rig(template.scene.with_values(v), bead_masses=masses, like=template), draws
+
+
+def study_save(study: Study, rig: Rig) -> SaveAt:
+    """What a study's solver records: the gauges' averages (what their plates read) and the
+    wall; each gauge's two contacts too where the truth analysis or the traces need them.
+    The averages feed the gauges either way, so traces do not change the results."""
+    return rig.save_at(contacts=study.truth or study.traces, averages=True)
+
+
+@contextlib.contextmanager
+def collector_paused():
+    """Python's cycle collector off while a batch builds its rigs: it would walk the many
+    small objects of every rig again and again (a quarter of a batch's time); whatever
+    cycles the batch leaves are collected on the next collection after it."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
+
+
+def run_batch(study: Study, b: int) -> BatchResult:
+    """Batch b of the study."""
+    with collector_paused():
+        return _batch(study, b)
+
+
+def _batch(study: Study, b: int) -> BatchResult:
+    shots = study.shots_of(b)
+    lo, hi = shots.start, shots.stop
+    nom = nominal(study.scene, tuple(study.overrides))
+    base = nom.rig
+    design = sobol_matrix(study)[0] if study.sobol else None
+    rigs, draws, seeds, xs = [], [], [], []
+    for i in range(lo, hi):
+        x, masses, seed = shot_inputs(study, i, base.values["chain"]["beads"], design)
+        try:
+            rig, d = shot_rig(study, x, masses)
+        except ValueError as exc:
+            raise RigError(f"shot {i}: inputs {x} give an impossible rig: {exc}") from None
+        rigs.append(rig)
+        draws.append(d)
+        seeds.append(seed)
+        xs.append([x[k] for k in study.keys])
+    problems = [ChainProblem.from_chain(r.chain) for r in rigs]
+    t_end = nom.window(study.window).duration
+    dt = ensemble_step(problems, t_end, base.solver.method, study.accuracy or base.solver.accuracy)
+    ens = solve_ensemble(problems, t_end, save=study_save(study, rigs[0]), dt=dt, method=base.solver.method)
+    out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
+    traces = []
+    beta, F0 = nom.calibration
+    for j, (rig, p) in enumerate(zip(rigs, problems)):
+        stats = ens.stats(j, study.accuracy)
+        forces = {name: a[j] for name, a in ens.forces.items()}
+        rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))
+        shot = rig.fire(seed=seeds[j], fixed=draws[j], truth=False)
+        if study.traces:  # each shot has its own scene values and truth: nothing shared between shots
+            e = shot_entry(shot)
+            traces.append(replace(e, truth_key=None,
+                                  truth_attrs={**e.truth_attrs, "study_shot": lo + j, "study": study.digest()}))
+        m = analyze_record(shot.scope, setup_for(rig, beta, F0), train=False)  # leading pulse only
+        t = rig.truth_analysis() if study.truth else None
+        for key, val in (("speed_m_per_s", m.speed_m_per_s), ("speed_xcorr_m_per_s", m.speed_xcorr_m_per_s),
+                         ("amplitude_N", m.amplitude_N), ("averaged_amplitude_N", m.averaged_amplitude_N),
+                         ("truth_speed_m_per_s", t and t.speed_m_per_s), ("truth_amplitude_N", t and t.amplitude_N),
+                         ("energy_error", stats.energy_error), ("dt_s", ens.dt)):
+            out[key][j] = np.nan if val is None else val
+    return BatchResult(b, np.arange(lo, hi), np.array(xs, dtype=float).reshape(hi - lo, len(study.keys)),
+                       np.array(seeds, dtype=np.int64), out, tuple(traces))
+
+
+def refire(study: Study, i: int) -> dict:
+    """Shot i alone, with its stored step: the same outputs as in the study."""
+    r = run_batch(study, i // study.batch)
+    return {k: v[i - r.index[0]] for k, v in r.outputs.items()}

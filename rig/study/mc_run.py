@@ -1,0 +1,96 @@
+"""Run a Monte Carlo study to its folder (`rig mc`): check it, open or resume its store,
+run the batches not yet stored (progress per batch), collect every shot and write the
+report (JCGM 101 summaries, Sobol indices, figures, study.h5, report.json)."""
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rig.errors import RigError
+from rig.experiment.measure import midway_static_force
+from rig.study.executors import run_study
+from rig.study.mc_spec import Study
+from rig.study.nominal import nominal
+from rig.study.report import figures, jcgm101
+from rig.study.sobol import sobol_indices, sobol_matrix
+from rig.study.store import StudyResults, Store, atomic_write
+from rig.theory.longwave import solitary_wave_speed
+
+
+def check(study: Study):
+    """Refuse a study that cannot run, before any shot: no uncertain input, a varied gauge
+    the scene does not have, a Sobol design that SALib cannot build."""
+    if not study.dists:
+        raise RigError("--vary: give at least one uncertain input, e.g. striker.velocity=\"normal(0.89 m/s, 0.01 m/s)\"")
+    names = [g.name for g in nominal(study.scene, study.overrides).rig.gauges]
+    for d in study.dists:
+        parts = d.key.split(".")
+        if parts[0] == "gauges" and parts[1] not in names:
+            raise RigError(f"--vary {d.key}: the scene has no gauge {parts[1]!r} (gauges: {', '.join(names)})")
+    if study.sobol:
+        sobol_matrix(study)
+
+
+@dataclass(frozen=True)
+class StudyRun:
+    """A finished study: its report (the keys of `rig mc --json`) and how many shots ran now."""
+
+    report: dict
+    ran_now: int
+
+
+def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None, progress=None,
+           on_start=None) -> StudyRun:
+    """Run (or resume) ``study`` in ``folder``. ``progress(n)`` is told each finished
+    batch's shots; ``on_start(done)`` how many shots were already stored."""
+    check(study)
+    store = Store(folder, study).open()
+    done = sum(len(study.shots_of(b)) for b in store.done())
+    if on_start:
+        on_start(done)
+    t0 = time.perf_counter()
+    try:
+        run_study(study, store, workers, scheduler, progress)
+    except KeyboardInterrupt:
+        kept = sum(len(study.shots_of(b)) for b in store.done())
+        raise RigError(f"interrupted: {kept} of {study.shots} shots are kept in {folder}; "
+                       f"run the same command again to resume") from None
+    ran = study.shots - done
+    elapsed = time.perf_counter() - t0
+    results = store.collect()
+    report = summarise(study, results, ran / elapsed if ran else None)
+    write_report(Path(folder), study, store, results, report)
+    return StudyRun(report, ran)
+
+
+def summarise(study: Study, results: StudyResults, shots_per_s) -> dict:
+    """The JCGM 101 summary of each output, the inputs, and the Sobol indices if asked."""
+    out = results.outputs
+    report = {"shots": int(results.index.size), "shots_per_s": shots_per_s,
+              "speed_m_per_s": jcgm101(out["speed_m_per_s"]),
+              "speed_xcorr_m_per_s": jcgm101(out["speed_xcorr_m_per_s"]),
+              "amplitude_N": jcgm101(out["amplitude_N"]),
+              "truth_speed_m_per_s": jcgm101(out["truth_speed_m_per_s"]),
+              "truth_amplitude_N": jcgm101(out["truth_amplitude_N"]),
+              "inputs": {d.key: d.text() for d in study.dists}}
+    if study.sobol:
+        report["sobol"] = {k: sobol_indices(study, results.inputs, out[k]) for k in ("speed_m_per_s", "amplitude_N")}
+    return report
+
+
+def write_report(folder: Path, study: Study, store: Store, results: StudyResults, report: dict):
+    """The figures (with the Eq (1) curve at the nominal F_0), study.h5 and report.json."""
+    base = nominal(study.scene, study.overrides).rig
+    F0 = midway_static_force(base)
+    bead = base.chain.beads[-1]
+    m = bead.material
+    amp = results.outputs["amplitude_N"]
+    F = np.linspace(max(np.nanmin(amp) * 0.8, 1e-3), np.nanmax(amp) * 1.2, 100)
+    figures(folder, results, study.keys,
+            (F, solitary_wave_speed(m.E, m.nu, m.rho, bead.diameter, F0, F0 + F), f"Eq (1), F_0 = {F0:.3g} N"))
+    store.consolidate(results, report)
+    atomic_write(folder / "report.json", lambda tmp: Path(tmp).write_text(json.dumps(report, indent=1)))

@@ -1,0 +1,59 @@
+"""What a Monte Carlo study is (`rig mc`): a scene, its fixed overrides, the uncertain
+inputs, the number of shots, one seed, the batch size and what to record. Shot i always
+belongs to batch i // batch and draws its inputs from child i of the study's numpy
+SeedSequence, so results depend on none of the executor, the workers or the order."""
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import asdict, dataclass
+
+from rig.errors import invalid
+
+WINDOWS = ("leading", "record")
+OUTPUTS = ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_amplitude_N",
+           "truth_speed_m_per_s", "truth_amplitude_N", "energy_error", "dt_s")
+
+
+@dataclass(frozen=True)
+class Study:
+    scene: str
+    dists: tuple
+    shots: int
+    seed: int = 0
+    overrides: tuple = ()
+    batch: int = 128
+    accuracy: float | None = None
+    sobol: bool = False
+    truth: bool = False  # also analyse each shot's noise-free truth (slower)
+    window: str = "leading"  # "leading": until the leading pulse is past the last gauge; "record": the scene's
+    traces: bool = False  # also archive every shot's scope record and truth (DIR/traces/)
+
+    def __post_init__(self):
+        if self.window not in WINDOWS:
+            raise invalid("--window", self.window, f"one of {', '.join(WINDOWS)}")
+        if not isinstance(self.shots, int) or self.shots < 1:
+            raise invalid("--shots", self.shots, "a whole number >= 1")
+        if self.batch < 1:
+            raise invalid("--batch", self.batch, "a whole number >= 1")
+
+    @property
+    def keys(self) -> list:
+        return [d.key for d in self.dists]
+
+    def spec(self) -> dict:
+        return {"scene": str(self.scene), "dists": [asdict(d) for d in self.dists], "shots": self.shots,
+                "seed": self.seed, "overrides": list(self.overrides), "batch": self.batch,
+                "accuracy": self.accuracy, "sobol": self.sobol, "truth": self.truth, "window": self.window,
+                "traces": self.traces}
+
+    def digest(self) -> str:
+        return hashlib.sha256(json.dumps(self.spec(), sort_keys=True).encode()).hexdigest()[:16]
+
+    @property
+    def n_batches(self) -> int:
+        return -(-self.shots // self.batch)
+
+    def shots_of(self, b: int) -> range:
+        """The shots of batch b: shot i always belongs to batch i // batch."""
+        return range(b * self.batch, min(self.shots, (b + 1) * self.batch))

@@ -1,0 +1,131 @@
+"""Where a Monte Carlo study keeps its work: DIR/study.json (the study), DIR/batches/
+batch_NNNNNN.h5 (one per finished batch), for a study with traces DIR/traces/
+batch_NNNNNN.h5 (a shot archive per batch, written before the batch counts as finished),
+and at the end DIR/study.h5. Every file appears whole or not at all (written beside, then
+renamed), so a killed or failed run can always be resumed by running it again."""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rig.errors import RigError
+from rig.study.batch import BatchResult
+from rig.study.mc_spec import OUTPUTS, Study
+
+
+@dataclass(frozen=True, eq=False)
+class StudyResults:
+    """Every finished shot, in shot order: index, inputs (shots, K), seeds, outputs."""
+
+    index: np.ndarray
+    inputs: np.ndarray
+    seeds: np.ndarray
+    outputs: dict
+
+
+def atomic_write(path: Path, write) -> Path:
+    """``write(temporary path)``, flushed to disk, then renamed to ``path`` (atomic); the
+    temporary file is removed when anything fails."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        write(tmp)
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+class Store:
+    """The study's folder (see the module's docstring)."""
+
+    def __init__(self, folder, study: Study):
+        self.folder = Path(folder)
+        self.study = study
+        self.batches = self.folder / "batches"
+        self.traces = self.folder / "traces"
+
+    def open(self) -> "Store":
+        """Create the folder, or check that it holds this very study (to resume it)."""
+        self.batches.mkdir(parents=True, exist_ok=True)
+        meta = self.folder / "study.json"
+        spec = {"digest": self.study.digest(), **self.study.spec()}
+        if meta.exists():
+            try:
+                old = json.loads(meta.read_text())
+            except (ValueError, OSError) as exc:
+                raise RigError(f"{meta}: not a study file ({exc}); give another --out or remove it") from None
+            if old.get("digest") != spec["digest"]:
+                raise RigError(f"{self.folder} holds another study (scene {old.get('scene')}, "
+                               f"{old.get('shots')} shots); give another --out or remove it")
+        else:
+            atomic_write(meta, lambda tmp: Path(tmp).write_text(json.dumps(spec, indent=1)))
+        return self
+
+    def done(self) -> set:
+        return {int(p.stem.split("_")[1]) for p in self.batches.glob("batch_*.h5")}
+
+    def write(self, result: BatchResult):
+        import h5py
+
+        if result.traces:
+            from instruments.archive import Archive
+
+            self.traces.mkdir(exist_ok=True)
+            archive = self.traces / f"batch_{result.batch:06d}.h5"
+            archive.unlink(missing_ok=True)  # left by an interrupted run: that batch did not finish
+            Archive(archive).append(list(result.traces))
+
+        def write(tmp):
+            with h5py.File(tmp, "w") as f:
+                f["index"] = result.index
+                f["inputs"] = result.inputs
+                f["seeds"] = result.seeds
+                for k, v in result.outputs.items():
+                    f[f"outputs/{k}"] = v
+
+        atomic_write(self.batches / f"batch_{result.batch:06d}.h5", write)
+
+    def collect(self) -> StudyResults:
+        """Every finished shot, in shot order."""
+        import h5py
+
+        parts = []
+        for p in sorted(self.batches.glob("batch_*.h5")):
+            with h5py.File(p, "r") as f:
+                parts.append({"index": f["index"][()], "inputs": f["inputs"][()], "seeds": f["seeds"][()],
+                              "outputs": {k: f[f"outputs/{k}"][()] for k in f["outputs"]}})
+        if not parts:
+            return StudyResults(np.zeros(0, int), np.zeros((0, len(self.study.keys))), np.zeros(0, np.int64),
+                                {k: np.zeros(0) for k in OUTPUTS})
+        order = np.argsort(np.concatenate([q["index"] for q in parts]))
+        cat = lambda key: np.concatenate([q[key] for q in parts])[order]  # noqa: E731
+        return StudyResults(cat("index"), cat("inputs"), cat("seeds"),
+                            {k: np.concatenate([q["outputs"][k] for q in parts])[order] for k in OUTPUTS})
+
+    def consolidate(self, results: StudyResults, report: dict) -> Path:
+        """DIR/study.h5: every shot's inputs, outputs and seed, and the report."""
+        import h5py
+
+        def write(tmp):
+            with h5py.File(tmp, "w") as f:
+                f.attrs["study"] = json.dumps(self.study.spec())
+                f.attrs["report"] = json.dumps(report, default=float)
+                f["shot"] = results.index
+                f["seed"] = results.seeds
+                f["seed"].attrs["description"] = ("instrument seed; inputs come from SeedSequence(study seed, "
+                                                  "spawn_key=(shot,))")
+                for k, key in enumerate(self.study.keys):
+                    f[f"inputs/{key}"] = results.inputs[:, k]
+                for k, v in results.outputs.items():
+                    f[f"outputs/{k}"] = v
+
+        return atomic_write(self.folder / "study.h5", write)
