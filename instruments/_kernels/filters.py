@@ -1,5 +1,6 @@
 """One-pole recursive filter (numba) for the analog front ends (instruments/frontend.py)."""
 import numpy as np
+
 from instruments.jit import jit
 
 

@@ -15,6 +15,7 @@ the stack as its lowest sample alone (the last of equal lows, the one closest to
 follows), which keeps the noisy baseline of a record out of the stack.
 """
 import numpy as np
+
 from instruments.jit import jit
 
 

@@ -1,5 +1,6 @@
 """The oscilloscope's 8-bit converter (numba): one pass from volts to codes."""
 import numpy as np
+
 from instruments.jit import jit
 
 

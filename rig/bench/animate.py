@@ -11,8 +11,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from rig.viz.animate import animate
 from rig.experiment.shot import Rig
+from rig.viz.animate import animate
 
 FRAMES = 100
 

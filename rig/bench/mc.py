@@ -17,11 +17,11 @@ import time
 
 import numba
 
-from rig.study.distributions import parse_vary
 from rig.solver.ensemble import ensemble_step, solve_ensemble
 from rig.solver.problem import ChainProblem
-from rig.study.executors import run_study
 from rig.study.batch import run_batch, shot_inputs, shot_rig, study_save
+from rig.study.distributions import parse_vary
+from rig.study.executors import run_study
 from rig.study.mc_spec import Study
 from rig.study.store import Store
 

@@ -16,9 +16,12 @@ import time
 import numpy as np
 
 from instruments.jit import jit
-
-from rig import Bead, Chain, ChainProblem, SaveAt, Striker, Wall, solve
+from rig.model.chain import Chain
+from rig.model.parts import Bead, Striker, Wall
 from rig.solver.kernels.forces import contact_forces
+from rig.solver.problem import ChainProblem
+from rig.solver.saveat import SaveAt
+from rig.solver.solve import solve
 from rig.solver.stepsize import DEFAULT_ACCURACY, contact_time_scale
 
 N_BEADS = 1000

@@ -7,10 +7,9 @@ import json
 import sys
 
 from instruments.errors import InstrumentError
-
+from rig import __version__
 from rig.cli import data, shots, study, sweeps, tools
 from rig.cli.common import quantity_arg as _q
-from rig import __version__
 from rig.errors import RigError
 
 

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 
-
 def cmd_verify(args) -> dict:
     from instruments.archive import Archive
 

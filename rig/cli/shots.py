@@ -14,7 +14,6 @@ def cmd_shot(args) -> dict:
     from pathlib import Path
 
     from instruments.formats import WRITERS
-
     from rig.experiment.measure import shot_blocks
     from rig.experiment.shot import Rig
 
@@ -31,7 +30,6 @@ def cmd_shot(args) -> dict:
         out["exported"] = [str(p) for p in paths]
     if args.out:
         from instruments.archive import Archive
-
         from rig.experiment.entry import shot_entry
 
         out["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot_entry(shot)])[0]}
@@ -110,8 +108,8 @@ def cmd_animate(args) -> dict:
     from tqdm import tqdm
 
     from rig.experiment.scene import load
-    from rig.viz.animate import animate, check_output, require_renderer
     from rig.experiment.shot import Rig
+    from rig.viz.animate import animate, check_output, require_renderer
 
     check_output(args.out)  # before anything is computed
     require_renderer()

@@ -4,15 +4,15 @@ from __future__ import annotations
 import math
 import sys
 
-from rig.errors import RigError
 from rig.cli.common import quantity_arg as _q
+from rig.errors import RigError
 
 
 def cmd_theory(args) -> dict:
     from rig.model.contact import hertz_constant
     from rig.model.materials import material
-    from rig.theory.solitary import MIN_FORCE_RATIO, solitary_wave
     from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed, sound_speed
+    from rig.theory.solitary import MIN_FORCE_RATIO, solitary_wave
 
     m = material(args.material)
     a = _q(args.diameter, "m", "--diameter")

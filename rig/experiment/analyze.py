@@ -15,7 +15,6 @@ from instruments.archive import Archive
 from instruments.formats import read_record
 from instruments.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.records import ScopeRecord
-
 from rig.errors import RigError
 from rig.model.materials import material
 from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed

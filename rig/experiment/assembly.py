@@ -5,7 +5,6 @@ from __future__ import annotations
 
 from instruments.gauges import GaugeSettings
 from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
-
 from rig.errors import invalid
 from rig.experiment.scene import Scene
 from rig.experiment.settings import GaugeWiring, SolverSettings, WallWiring

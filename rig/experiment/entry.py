@@ -4,7 +4,6 @@ from __future__ import annotations
 import hashlib
 
 from instruments.archive import Entry
-
 from rig import __version__
 from rig.experiment.shot import ShotRecord
 

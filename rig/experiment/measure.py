@@ -16,7 +16,6 @@ import numpy as np
 
 from instruments.analysis import PeakRules
 from instruments.pipeline import GaugeSetup, Report, Setup, analyze_forces, analyze_record
-
 from rig.errors import RigError
 from rig.theory.longwave import solitary_wave_speed, sound_speed
 

@@ -6,7 +6,6 @@ import math
 from dataclasses import dataclass
 
 from instruments.gauges import GaugeSettings
-
 from rig.errors import invalid
 
 

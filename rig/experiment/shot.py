@@ -13,7 +13,6 @@ import numpy as np
 
 from instruments.gauges import GaugeDraw, PiezoGauge
 from instruments.records import ScopeRecord
-
 from rig.errors import RigError, invalid
 from rig.experiment import scene as scene_io
 from rig.experiment.assembly import Assembly

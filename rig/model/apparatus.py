@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rig.model.chain import ForceSchedule, STANDARD_GRAVITY
 from rig.errors import invalid
+from rig.model.chain import STANDARD_GRAVITY, ForceSchedule
 
 
 @dataclass(frozen=True)

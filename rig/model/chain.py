@@ -16,12 +16,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rig.memo import computed_once
-from rig.model.contact import contact_constant, contact_law as lookup_law, static_overlaps
 from rig.errors import invalid
+from rig.memo import computed_once
+from rig.model.contact import contact_constant, static_overlaps
+from rig.model.contact import contact_law as lookup_law
 from rig.model.parts import Bead, Striker, Wall
 from rig.units import quantity
-
 
 STANDARD_GRAVITY = 9.80665  # m/s^2
 

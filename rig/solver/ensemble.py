@@ -11,9 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rig.solver.kernels.ensemble import integrate_ensemble
 from rig.errors import RigError, invalid
-from rig.solver.methods import DEFAULT_METHOD, method as get_method
+from rig.solver.kernels.ensemble import integrate_ensemble
+from rig.solver.methods import DEFAULT_METHOD
+from rig.solver.methods import method as get_method
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import KernelReport, SolverStats, Status
 from rig.solver.solve import MAX_CHECKS, time_grid

@@ -6,10 +6,11 @@ import time
 
 import numpy as np
 
-from rig.solver.kernels.integrators import integrate
 from rig.errors import RigError, invalid
-from rig.solver.methods import DEFAULT_METHOD, method as get_method
 from rig.model.chain import Chain
+from rig.solver.kernels.integrators import integrate
+from rig.solver.methods import DEFAULT_METHOD
+from rig.solver.methods import method as get_method
 from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import KernelReport, Solution, SolverStats, Status

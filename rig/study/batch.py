@@ -10,7 +10,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from instruments.pipeline import analyze_record
-
 from rig.errors import RigError
 from rig.experiment.entry import shot_entry
 from rig.experiment.measure import setup_for

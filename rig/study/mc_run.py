@@ -17,7 +17,7 @@ from rig.study.mc_spec import Study
 from rig.study.nominal import nominal
 from rig.study.report import figures, jcgm101
 from rig.study.sobol import sobol_indices, sobol_matrix
-from rig.study.store import StudyResults, Store, atomic_write
+from rig.study.store import Store, StudyResults, atomic_write
 from rig.theory.longwave import solitary_wave_speed
 
 

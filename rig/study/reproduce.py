@@ -18,14 +18,13 @@ import numpy as np
 
 from instruments.analysis import PeakRules, find_pulses, leading
 from instruments.pipeline import reflection_time, solitary_train
-
-from rig.study.reproduce_figures import figure_specs
-from rig.viz import figures
 from rig.errors import invalid
 from rig.experiment.measure import midway_static_force, setup_for, shot_blocks
 from rig.experiment.shot import Rig
+from rig.study.reproduce_figures import figure_specs
 from rig.study.sweep import seeds_for
 from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed, sound_speed
+from rig.viz import figures
 
 CONFIGS = [  # (material, precompression label, scene)
     ("PTFE", "gravity", "ptfe52_gravity"), ("PTFE", "2.38 N", "ptfe52_magnetic"),

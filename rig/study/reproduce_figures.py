@@ -7,11 +7,11 @@ import math
 import numpy as np
 
 from instruments.pipeline import record_forces
-
 from rig.experiment.measure import setup_for
 from rig.study.sweep import seeds_for
 from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed, sound_speed
-from rig.theory.solitary import beta as beta_of, solitary_wave
+from rig.theory.solitary import beta as beta_of
+from rig.theory.solitary import solitary_wave
 from rig.viz.figures import FigureSpec
 
 

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rig.experiment.entry import shot_entry
 from rig.errors import RigError, invalid
+from rig.experiment.entry import shot_entry
 from rig.experiment.measure import shot_blocks
 from rig.experiment.scene import schema_node
 from rig.experiment.shot import Rig, ShotRecord

@@ -170,8 +170,8 @@ class _Traces:
         import matplotlib
 
         matplotlib.use("Agg", force=False)
-        from matplotlib.figure import Figure
         from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
 
         self.fig = Figure(figsize=(WIDTH / 100, PANEL_HEIGHT / 100), dpi=100)
         self.canvas = FigureCanvasAgg(self.fig)

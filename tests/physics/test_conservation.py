@@ -1,9 +1,9 @@
 """Energy and momentum of conservative shots."""
 import numpy as np
 import pytest
-
-from rig import ChainProblem, METHODS, solve
 from conftest import ptfe_rig, record_contacts
+
+from rig import METHODS, ChainProblem, solve
 
 
 def _shot(**kw):

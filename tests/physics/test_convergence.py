@@ -7,10 +7,10 @@ where each method must still reach its declared ``contact_order``.
 """
 import numpy as np
 import pytest
+from conftest import STEEL, record_contacts, steel_sonic_vacuum
 
 from rig import METHODS, Bead, Chain, ChainProblem, Wall, solve
 from rig.solver.stepsize import contact_time_scale
-from conftest import STEEL, record_contacts, steel_sonic_vacuum
 
 SLOPE_TOL = 0.25  # the least-squares slope over a factor 8 in dt
 

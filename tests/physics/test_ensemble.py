@@ -1,10 +1,10 @@
 """The batched kernel against single shots: same step, same numbers."""
 import numpy as np
 import pytest
+from conftest import ptfe_rig, record_contacts
 
 from rig import ChainProblem, RigError, solve
 from rig.solver.ensemble import ensemble_step, solve_ensemble
-from conftest import ptfe_rig, record_contacts
 
 SAVE = record_contacts(ptfe_rig(n=20), 5, 14, 21)
 

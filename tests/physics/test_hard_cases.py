@@ -3,11 +3,11 @@ import importlib
 
 import numpy as np
 import pytest
-
-from rig import ChainProblem, Bead, Chain, SaveAt, RigError, Striker, Wall, solve
-from rig.solver.stepsize import stability_limit
-from rig.solver.methods import METHODS
 from conftest import PTFE, STEEL, ptfe_rig, record_contacts, steel_sonic_vacuum
+
+from rig import Bead, Chain, ChainProblem, RigError, SaveAt, Striker, Wall, solve
+from rig.solver.methods import METHODS
+from rig.solver.stepsize import stability_limit
 
 
 def _finite(sol):

@@ -1,12 +1,19 @@
 """The multirate head: a stiff striker contact substepped, the chain at its own step."""
 import numpy as np
 import pytest
+from conftest import ptfe_rig, record_contacts, steel_sonic_vacuum
 
 from rig import ChainProblem, solve
 from rig.solver.methods import method
-from rig.solver.stepsize import (HEAD_SUBSTEP, Stepping, accuracy_step, contact_time_scale, default_step, fast_head,
-                          stability_limit)
-from conftest import ptfe_rig, record_contacts, steel_sonic_vacuum
+from rig.solver.stepsize import (
+    HEAD_SUBSTEP,
+    Stepping,
+    accuracy_step,
+    contact_time_scale,
+    default_step,
+    fast_head,
+    stability_limit,
+)
 
 SRKN = method("srkn6b")
 

@@ -1,10 +1,10 @@
 """A struck sonic-vacuum chain forms the exact discrete solitary wave, not Eq (4)'s."""
 import numpy as np
+from conftest import record_contacts, steel_sonic_vacuum
 
 from rig import solve
-from rig.theory.solitary import solitary_wave
 from rig.theory.longwave import sonic_vacuum_speed
-from conftest import record_contacts, steel_sonic_vacuum
+from rig.theory.solitary import solitary_wave
 
 
 def _peak_time(t, y):

@@ -1,8 +1,8 @@
 """The rig starts from exact static equilibrium: nothing moves before impact."""
 import numpy as np
+from conftest import ptfe_rig
 
 from rig import ChainProblem, SaveAt, solve
-from conftest import ptfe_rig
 
 
 def test_published_ptfe_chain_at_rest_stays_at_rest():

@@ -4,8 +4,8 @@ import math
 import pytest
 
 from rig import hertz_constant, material
-from rig.theory.solitary import solitary_wave
 from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed, sound_speed
+from rig.theory.solitary import solitary_wave
 
 D = 4.76e-3
 

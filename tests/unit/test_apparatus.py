@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from rig import Bead, ForceSchedule, RigError, Striker
-from rig.model.apparatus import Holder, RingMagnet
 from rig.experiment.shot import Rig
+from rig.model.apparatus import Holder, RingMagnet
 
 
 def test_a_hanging_ring_pulls_with_its_weight_the_published_2p38_N():

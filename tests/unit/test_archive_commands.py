@@ -1,12 +1,14 @@
 """Virtual shots and real files in the archive, through the rig's commands."""
 import json
+
 import numpy as np
 import pytest
 
 from instruments.archive import Archive
-from rig.experiment.entry import shot_entry
 from rig.cli import main
+from rig.experiment.entry import shot_entry
 from rig.experiment.shot import Rig
+
 
 def test_thousand_virtual_shots_round_trip_bit_identical(tmp_path):
     rig = Rig.from_scene("ptfe52_magnetic")

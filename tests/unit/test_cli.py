@@ -3,8 +3,8 @@ import json
 
 import pytest
 
-from rig.cli import main
 from rig.bench.solver import matched
+from rig.cli import main
 
 
 def _json(capsys, *argv):

@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 
 from rig.cli import main
+from rig.study.batch import refire, run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
-from rig.study.batch import refire, run_batch
 from rig.study.mc_spec import Study
-from rig.study.store import Store
 from rig.study.report import jcgm101
+from rig.study.store import Store
 
 VARY = ["striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)",
         "gauges.upper.misalignment=normal(0 mm, 1 mm)", "gauges.lower.gain=normal(1, 0.05)"]
@@ -138,9 +138,9 @@ def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(t
     # and the pipeline run on an archived record gives the speed the study stored
     from instruments.archive import Archive
     from instruments.pipeline import analyze_record
+    from rig.experiment.measure import setup_for
     from rig.study.batch import shot_inputs, shot_rig
     from rig.study.nominal import nominal
-    from rig.experiment.measure import setup_for
 
     plain = Store(tmp_path / "plain", _study(32)).open()
     run_study(_study(32), plain)

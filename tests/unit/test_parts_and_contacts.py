@@ -3,8 +3,19 @@ import math
 
 import pytest
 
-from rig import (Bead, GaugeBead, MagneticBead, RigError, Striker, Wall, hertz_constant,
-                 hertz_energy, hertz_force, material, static_overlaps)
+from rig import (
+    Bead,
+    GaugeBead,
+    MagneticBead,
+    RigError,
+    Striker,
+    Wall,
+    hertz_constant,
+    hertz_energy,
+    hertz_force,
+    material,
+    static_overlaps,
+)
 from rig.units import quantity
 
 

@@ -5,11 +5,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rig.solver.problem import ChainProblem
-
 from rig.cli import main
 from rig.experiment.scene import PUBLISHED_SCENES
 from rig.experiment.shot import Rig
+from rig.solver.problem import ChainProblem
 
 PUBLISHED = ["ptfe52_gravity", "ptfe52_magnetic", "ptfe52_magnetic_4p25", "ptfe20_gravity",
              "steel21_gravity", "steel21_magnetic"]

@@ -1,9 +1,9 @@
 """What a solve records and refuses."""
 import numpy as np
 import pytest
-
-from rig import ChainProblem, Chain, ForceSchedule, SaveAt, RigError, solve
 from conftest import ptfe_rig, steel_sonic_vacuum
+
+from rig import Chain, ChainProblem, ForceSchedule, RigError, SaveAt, solve
 
 
 def test_only_the_asked_channels_are_recorded():
@@ -53,6 +53,7 @@ def test_scheduled_magnet_force_balances_energy_and_momentum():
 def test_dissipative_law_loses_energy_and_is_off_by_default():
     assert steel_sonic_vacuum(n=5).law.name == "hertz"
     from conftest import STEEL
+
     from rig import Bead, Striker
     lossy = Chain([Bead(**STEEL)] * 30, striker=Striker("steel316", "0.4501 g", "0.44 m/s"),
                   gravity=0, contact_law="kuwabara-kono", damping_time=1e-7)

@@ -14,7 +14,6 @@ import numpy as np
 from numba import prange
 
 from instruments.jit import jit
-
 from rig.solver.kernels.integrators import hermite, hermite_weights
 from rig.solver.kernels.multirate import head_flow, slow_net
 

@@ -2,7 +2,6 @@
 import math
 
 from instruments.jit import jit
-
 from rig.model.contact import HERTZ
 
 

@@ -19,8 +19,8 @@ the first ``head`` ones, and each drift moves bodies 0..head by multirate.head_f
 (``sub[s]`` substeps of the same method in drift s) instead of a plain drift.
 """
 import numpy as np
-from instruments.jit import jit
 
+from instruments.jit import jit
 from rig.solver.kernels.forces import contact_forces, energy, force_rate, max_overlap_excess, momentum
 from rig.solver.kernels.multirate import head_flow, slow_net
 
