@@ -29,17 +29,20 @@ def sonic_vacuum():
     return steel_sonic_vacuum
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def realdata():
-    """The real Tektronix files in ../shared/realdata (beside the checkout). CI must have
-    them; elsewhere their absence skips the test with the reason."""
+    """The folder of real scope files (each with its .source.txt): $RIG_REALDATA, else
+    ../shared/realdata beside the checkout. CI (CI=true) must have them: missing there,
+    the test fails; elsewhere it is skipped, saying how to provide them."""
     import os
     from pathlib import Path
 
-    here = Path(__file__).resolve().parents[1]
-    for base in (here.parent / "shared" / "realdata", here / "shared" / "realdata"):
-        if (base / "tek_16bit_dpo.isf").is_file():
-            return base
-    if os.environ.get("CI"):
-        pytest.fail("../shared/realdata is missing: the real scope files are required in CI")
-    pytest.skip("real scope files not found beside the checkout (../shared/realdata)")
+    env = os.environ.get("RIG_REALDATA")
+    base = Path(env) if env else Path(__file__).resolve().parents[2] / "shared" / "realdata"
+    if base.is_dir() and any(base.glob("*.source.txt")):
+        return base
+    how = (f"real scope files not found in {base}: set RIG_REALDATA=/path/to/realdata "
+           f"or place them at ../shared/realdata beside the checkout")
+    if os.environ.get("CI", "").lower() in ("1", "true", "yes"):
+        pytest.fail(how + " (CI must run the real-data tests)")
+    pytest.skip(how)

@@ -8,7 +8,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 
 import h5py
 import numpy as np
@@ -31,16 +30,38 @@ def entry(seed: int, truth=True) -> Entry:
                  {"wall_force": np.sin(_T[:5000])} if truth else None, {"draw": seed}, "shared")
 
 
+# a writer appending one shot at a time, which stops at each point of a transaction (it
+# prints the point's name) until it reads "go", and prints "commit ID" after each append
 WRITER = r"""
-import sys
+import os, shutil, sys
 sys.path[:0] = {paths!r}
 from test_archive import entry
+import instruments.archive as archive
 from instruments.archive import Archive
+
+def pause(event):
+    print(event, flush=True)
+    if sys.stdin.readline().strip() != "go":
+        sys.exit(0)
+
+def after(event, function, when=lambda *a: True):
+    def hooked(*args, **kw):
+        out = function(*args, **kw)
+        if when(*args):
+            pause(event)
+        return out
+    return hooked
+
+archive.shutil.copyfile = after("copied", shutil.copyfile)
+archive._fsync = after("written", archive._fsync, lambda p: str(p).endswith(".tmp"))
+archive.os.replace = after("replaced", os.replace)
+append = Archive.append
+Archive.append = lambda self, entries: (pause("idle"), append(self, entries))[1]
 a = Archive(sys.argv[1])
 i = int(sys.argv[2])
 while True:
     ids = a.append([entry(i)])
-    print(ids[0], flush=True)
+    print("commit", ids[0], flush=True)
     i += 1
 """
 
@@ -48,7 +69,7 @@ while True:
 def _writer(path, start):
     code = WRITER.format(paths=[os.path.dirname(__file__), os.getcwd()])
     return subprocess.Popen([sys.executable, "-c", code, str(path), str(start)],
-                            stdout=subprocess.PIPE, text=True)
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
 
 
 def test_round_trip_is_bit_identical(tmp_path):
@@ -70,27 +91,42 @@ def test_round_trip_is_bit_identical(tmp_path):
         assert f["shot_000001/truth/forces"].id == f["shot_000030/truth/forces"].id
 
 
+KILL_POINTS = ("idle", "copied", "written", "replaced")  # between appends, then inside one
+
+
 @pytest.mark.slow
-def test_sigkill_during_appends_never_loses_a_committed_shot(tmp_path):
+def test_sigkill_at_every_point_of_an_append_never_loses_a_committed_shot(tmp_path):
+    # the writer stops at each point of its transaction until told to go on; the test kills
+    # it at a chosen point after a chosen number of commits: events, not wall-clock windows
     path = tmp_path / "crash.h5"
-    rng = np.random.default_rng(2024)
-    committed = []
-    start = 1
-    for _ in range(20):
-        proc = _writer(path, start)
-        time.sleep(rng.uniform(0.6, 1.6))  # python start-up is about 0.5 s: kills land mid-append
-        proc.send_signal(signal.SIGKILL)
-        out, _ = proc.communicate()
-        lines = [int(x) for x in out.split()]
-        committed += lines
-        start += len(lines) + 1
+    Archive(path).append([entry(0)])  # every append copies the archive: each point is reached
+    plan = [(int(n), KILL_POINTS[k % len(KILL_POINTS)])
+            for k, n in enumerate(np.random.default_rng(2024).integers(0, 3, 20))]
+    committed, start, mid_transaction = [1], 1, 0
+    for n_commits, point in plan:
+        proc = _writer(path, start + 1)
+        done = []
+        for line in proc.stdout:
+            event = line.split()
+            if event[0] == "commit":
+                done.append(int(event[1]))
+            elif len(done) == n_commits and event[0] == point:
+                proc.send_signal(signal.SIGKILL)
+                mid_transaction += point != "idle"
+                break
+            else:
+                proc.stdin.write("go\n")
+                proc.stdin.flush()
+        proc.communicate()
+        assert proc.returncode == -signal.SIGKILL and len(done) == n_commits
+        committed += done
+        start += len(done) + 1
         a = Archive(path)
-        if committed:
-            ids = a.ids()
-            assert set(committed) <= set(ids)  # every shot reported committed is there
-            report = a.verify()
-            assert report["bad"] == [] and report["shots"] == len(ids)
-    assert len(committed) > 20
+        ids = a.ids()
+        assert set(committed) <= set(ids)  # every shot reported committed is there
+        report = a.verify()
+        assert report["bad"] == [] and report["shots"] == len(ids)
+    assert len(committed) == 1 + sum(n for n, _ in plan) and mid_transaction == 15
     n = len(Archive(path).ids())
     assert Archive(path).append([entry(99999)]) == [n + 1]  # the next append works
     assert not list(tmp_path.glob(".crash.h5.*.tmp"))  # stale temporaries were cleaned
@@ -132,21 +168,26 @@ def test_truncated_and_foreign_files_give_clear_errors(tmp_path):
 
 
 def test_reader_sees_only_complete_shots_while_a_writer_appends(tmp_path):
+    # the reader opens the archive at every point of the writer's transactions
     path = tmp_path / "live.h5"
     Archive(path).append([entry(0)])
     proc = _writer(path, 1)
+    seen = []
     try:
-        seen, t_end = [], time.time() + 4.0
-        while time.time() < t_end:
+        for line in proc.stdout:
             a = Archive(path)
             ids = a.ids()
-            last = a.read(ids[-1])  # sha256 checked: complete, consistent data
-            assert last.shot_id == ids[-1]
+            assert a.read(ids[-1]).shot_id == ids[-1]  # sha256 checked: complete, consistent data
             seen.append(len(ids))
+            if len(ids) == 6:
+                break
+            if not line.startswith("commit"):
+                proc.stdin.write("go\n")
+                proc.stdin.flush()
     finally:
         proc.kill()
         proc.communicate()
-    assert seen[-1] > seen[0]  # the archive grew while we read it
+    assert seen[0] == 1 and seen[-1] == 6 and len(seen) > 5 * 4  # read before, inside and after appends
     assert Archive(path).verify()["bad"] == []
 
 
