@@ -8,6 +8,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 
 import h5py
 import numpy as np
@@ -105,6 +106,8 @@ def test_sigkill_at_every_point_of_an_append_never_loses_a_committed_shot(tmp_pa
     committed, start, mid_transaction = [1], 1, 0
     for n_commits, point in plan:
         proc = _writer(path, start + 1)
+        watchdog = threading.Timer(120, proc.kill)  # a safety net only: a hung writer fails, not hangs
+        watchdog.start()
         done = []
         for line in proc.stdout:
             event = line.split()
@@ -118,6 +121,7 @@ def test_sigkill_at_every_point_of_an_append_never_loses_a_committed_shot(tmp_pa
                 proc.stdin.write("go\n")
                 proc.stdin.flush()
         proc.communicate()
+        watchdog.cancel()
         assert proc.returncode == -signal.SIGKILL and len(done) == n_commits
         committed += done
         start += len(done) + 1
