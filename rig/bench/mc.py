@@ -15,8 +15,6 @@ import statistics
 import tempfile
 import time
 
-import numba
-
 from rig.solver.ensemble import ensemble_step, solve_ensemble
 from rig.solver.problem import ChainProblem
 from rig.study.batch import run_batch, shot_inputs, shot_rig, study_save
@@ -76,6 +74,8 @@ def _workers(study: Study, workers: int) -> dict:
 
 
 def run(shots: int = 512, study_shots: int = 8192) -> dict:
+    import numba
+
     study = Study("ptfe52_magnetic", tuple(parse_vary(VARY)), shots, batch=BATCH)
     workers = os.cpu_count() or 1
     out = {"scene": "ptfe52_magnetic", "shots": shots, "threads": numba.get_num_threads(), "workers": workers,

@@ -11,7 +11,6 @@ import numpy as np
 
 from instruments.pipeline import analyze_record
 from rig.errors import RigError
-from rig.experiment.entry import shot_entry
 from rig.experiment.measure import setup_for
 from rig.experiment.shot import Rig
 from rig.solver.ensemble import ensemble_step, solve_ensemble
@@ -125,6 +124,8 @@ def _batch(study: Study, b: int) -> BatchResult:
         rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))
         shot = rig.fire(seed=seeds[j], fixed=draws[j], truth=False)
         if study.traces:  # each shot has its own scene values and truth: nothing shared between shots
+            from rig.experiment.entry import shot_entry  # the archive's Entry (h5py): only with traces
+
             e = shot_entry(shot)
             traces.append(replace(e, truth_key=None,
                                   truth_attrs={**e.truth_attrs, "study_shot": lo + j, "study": study.digest()}))

@@ -25,7 +25,8 @@ def check(study: Study):
     """Refuse a study that cannot run, before any shot: no uncertain input, a varied gauge
     the scene does not have, a Sobol design that SALib cannot build."""
     if not study.dists:
-        raise RigError("--vary: give at least one uncertain input, e.g. striker.velocity=\"normal(0.89 m/s, 0.01 m/s)\"")
+        raise RigError("--vary: give at least one uncertain input, "
+                       "e.g. striker.velocity=\"normal(0.89 m/s, 0.01 m/s)\"")
     names = [g.name for g in nominal(study.scene, study.overrides).rig.gauges]
     for d in study.dists:
         parts = d.key.split(".")

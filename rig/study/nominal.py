@@ -2,8 +2,10 @@
 the nominal rig, the calibration an experimenter applies to every shot, the leading window
 and the template rig whose parts the shots take over.
 
-One cache (``nominal``) keeps these per (scene, overrides); the values are computed on
-first use, from the nominal scene and its nominal shot (instrument seed NOMINAL_SEED).
+One cache (``nominal``) keeps these per (scene, overrides) in a process; the values are
+computed on first use, from the nominal scene's noise-free solution and from its nominal
+shot (``nominal_trigger_time``: the one shot a study fires outside its design, with the
+instrument draws of NOMINAL_SEED).
 """
 from __future__ import annotations
 
@@ -14,8 +16,11 @@ from rig.experiment import scene as scene_io
 from rig.experiment.measure import midway_static_force
 from rig.experiment.shot import Rig
 
-TAIL_FWHM = 3.0    # the leading window ends this many widths after the last gauge's leading peak
-NOMINAL_SEED = 0   # the instrument draws of the nominal shot that times the trigger
+TAIL_FWHM = 3.0  # the leading window ends this many widths after the last gauge's leading peak
+NOMINAL_SEED = 0
+"""The seed of the nominal shot's instrument draws (gains, misalignments, noise, the scope's
+noise floor): the shot that times the scope's trigger for the leading window. Every study's
+window, hence every result, depends on it."""
 
 
 @dataclass(frozen=True)
@@ -41,6 +46,12 @@ class Nominal:
         shot (each shot's own truth is unknown to the analysis)."""
         return self.rig.truth_analysis().beta, midway_static_force(self.rig)
 
+    @property
+    def record_window(self) -> Window:
+        """The scene's own window."""
+        rig = self.rig
+        return Window(rig.solver.duration, rig.scope.timebase.record_length, rig.scope.trigger.pre_trigger)
+
     @functools.cached_property
     def leading_window(self) -> Window:
         """Simulated until TAIL_FWHM full widths after the nominal leading pulse peaks at the
@@ -51,25 +62,21 @@ class Nominal:
         scene's own window where the nominal shot shows no leading pulse or no trigger."""
         rig = self.rig
         tb, pre = rig.scope.timebase, rig.scope.trigger.pre_trigger
-        whole = Window(rig.solver.duration, tb.record_length, pre)
         lead = rig.truth_analysis().leading
         last = lead.get("lower") or lead.get("upper")
-        shot = rig.fire(seed=NOMINAL_SEED, truth=False)
-        if not last or not last.get("fwhm") or not shot.scope.triggered:
-            return whole
+        trigger = nominal_trigger_time(rig)
+        if not last or not last.get("fwhm") or trigger is None:
+            return self.record_window
         duration = min(rig.solver.duration, last["time"] + TAIL_FWHM * last["fwhm"])
         n_pre = int(round(pre * tb.record_length))
-        n_post = int((duration - 1.05 * shot.scope.trigger_time) / tb.sample_interval)
+        n_post = int((duration - 1.05 * trigger) / tb.sample_interval)
         if n_post <= 0 or n_pre + n_post >= tb.record_length:
-            return whole
+            return self.record_window
         return Window(duration, n_pre + n_post, n_pre / (n_pre + n_post))
 
     def window(self, kind: str) -> Window:
         """The study's window: "leading" or "record" (the scene's own)."""
-        if kind == "leading":
-            return self.leading_window
-        tb = self.rig.scope.timebase
-        return Window(self.rig.solver.duration, tb.record_length, self.rig.scope.trigger.pre_trigger)
+        return self.leading_window if kind == "leading" else self.record_window
 
     def template(self, kind: str) -> Rig:
         """The rig every shot starts from: the solver recording at the scope's sampling rate
@@ -89,9 +96,19 @@ class Nominal:
         return self._templates[kind]
 
 
+def nominal_trigger_time(rig: Rig) -> float | None:
+    """When the scope triggers (s) in the nominal shot of ``rig``, None where it does not.
+    The nominal shot is the rig's noise-free solution read by instruments whose draws come
+    from NOMINAL_SEED: the trigger fires on what the instruments read, so their draws take
+    part. The truth analysis is skipped (the shot is only timed)."""
+    shot = rig.fire(seed=NOMINAL_SEED, truth=False)
+    return shot.scope.trigger_time if shot.scope.triggered else None
+
+
 @functools.lru_cache(maxsize=4)
 def nominal(scene: str, overrides: tuple) -> Nominal:
-    """The Nominal of a study's scene (one per scene and overrides in a process)."""
+    """The Nominal of a study's scene: the one cache of what the shots start from, one
+    Nominal per (scene, overrides) in a process (each worker process builds its own)."""
     return Nominal(scene, tuple(overrides))
 
 

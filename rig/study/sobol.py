@@ -20,15 +20,22 @@ def sobol_shots(requested: int, n_inputs: int) -> int:
     return base * (n_inputs + 2)
 
 
+def sobol_problem(study: Study) -> dict:
+    """The SALib problem of the study's inputs: their names, distributions and bounds."""
+    return {"num_vars": len(study.dists), "names": study.keys,
+            "dists": [d.salib()[0] for d in study.dists], "bounds": [d.salib()[1] for d in study.dists]}
+
+
 @functools.lru_cache(maxsize=4)
 def sobol_matrix(study: Study):
-    """SALib's Sobol design for the study's inputs: (shots, K) and the SALib problem."""
+    """SALib's Sobol design for the study's inputs: (shots, K) and the SALib problem.
+    Kept per study in a process: every batch takes its rows from it (drawing it costs as
+    much as a few shots)."""
     try:
         from SALib.sample import sobol as sobol_sample
     except ImportError:
         raise RigError("--sobol needs SALib: pip install \".[sobol]\"") from None
-    problem = {"num_vars": len(study.dists), "names": study.keys,
-               "dists": [d.salib()[0] for d in study.dists], "bounds": [d.salib()[1] for d in study.dists]}
+    problem = sobol_problem(study)
     base = study.shots // (len(study.dists) + 2)
     X = sobol_sample.sample(problem, base, calc_second_order=False, seed=study.seed)
     if X.shape[0] != study.shots:
@@ -40,7 +47,7 @@ def sobol_indices(study, X, Y) -> dict:
     """First-order and total Sobol indices (SALib) of one output for each input."""
     from SALib.analyze import sobol
 
-    _, problem = sobol_matrix(study)
+    problem = sobol_problem(study)
     Y = np.asarray(Y, float)
     if not np.all(np.isfinite(Y)):
         Y = np.where(np.isfinite(Y), Y, np.nanmean(Y))

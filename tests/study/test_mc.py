@@ -76,6 +76,27 @@ def test_interrupted_study_keeps_finished_shots_and_resumes(tmp_path):
         assert np.array_equal(store.collect().outputs[k], v, equal_nan=True)
 
 
+def test_study_json_appears_whole_or_not_at_all(tmp_path, monkeypatch):
+    # a full disk (or a kill) while study.json is written leaves no study.json behind, so
+    # running the same command again starts the study instead of stopping at a broken file
+    import errno
+    from pathlib import Path
+
+    real = Path.write_text
+
+    def disk_full(self, *args, **kw):
+        real(self, '{"dig')
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Path, "write_text", disk_full)
+    with pytest.raises(OSError):
+        Store(tmp_path / "s", _study()).open()
+    monkeypatch.undo()
+    assert sorted(p.name for p in (tmp_path / "s").iterdir()) == ["batches"]
+    Store(tmp_path / "s", _study()).open()
+    assert json.loads((tmp_path / "s" / "study.json").read_text())["digest"] == _study().digest()
+
+
 def test_any_shot_refires_alone_with_the_same_result():
     study = _study(shots=32)
     batch = run_batch(study, 1)
