@@ -84,7 +84,7 @@ def _si(unit: str):
 def _fast(text: str, unit: str):
     """The SI value of ``text`` by the table, or None where pint must decide."""
     m = _NUMBER.match(text)
-    if not m:
+    if not m or (m.end(1) == m.start(2) and m.group(2)[0] in "jJ"):  # pint reads "5J" as Python's 5j
         return None
     have, want = _si(m.group(2)), _si(unit)
     if have is None or want is None or have[1] != want[1]:
@@ -113,4 +113,4 @@ def _parse(text: str, unit: str, field: str) -> float:
     return float(f"{si:.15g}")
 
 
-__all__ = ["quantity", "RigError"]
+__all__ = ["RigError", "quantity"]

@@ -1,4 +1,6 @@
-"""The ``rig`` command line: the parser. The commands themselves live in rig/commands/.
+"""The ``rig`` command line: the parser. The commands themselves live in rig/cli/ (one module
+per group), and import what they need inside each command, so that the parser, ``--help``
+and ``--version`` load no numba, scipy, pint, h5py or matplotlib (tests/cli/test_startup.py).
 Every user mistake ends in one clear line (exit 2), never a traceback."""
 from __future__ import annotations
 
@@ -69,7 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
     an.add_argument("--quiet", action="store_true", help="no progress bar")
 
     rp = _command(sub, "reproduce", "re-run a published study (daraio2006)", sweeps.cmd_reproduce)
-    rp.add_argument("study", help="daraio2006")
+    rp.add_argument("study", choices=["daraio2006"], help="the published study to re-run")
     rp.add_argument("--out", required=True, metavar="DIR", help="folder for tables and figures")
     rp.add_argument("--quiet", action="store_true", help="no progress bar")
 
@@ -127,10 +129,12 @@ def main(argv=None) -> int:
     except (RigError, InstrumentError) as exc:
         print(f"rig {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:  # a file named on the command line that is missing, unreadable, ...
+        if exc.filename is None:
+            raise
+        print(f"rig {args.command}: error: {exc.filename}: {exc.strerror or exc}", file=sys.stderr)
+        return 2
     if args.json:
         print(json.dumps(out, indent=2))
     return getattr(args, "exit_code", 0)
 
-
-if __name__ == "__main__":
-    sys.exit(main())

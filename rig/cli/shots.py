@@ -105,15 +105,18 @@ def print_blocks(t, m, th):
 
 def cmd_animate(args) -> dict:
     """Render a virtual shot to a movie or a still, off-screen (pyvista)."""
-    from tqdm import tqdm
-
     from rig.experiment.scene import load
-    from rig.experiment.shot import Rig
-    from rig.viz.animate import animate, check_output, require_renderer
+    from rig.viz.animate import check_output, require_renderer
 
     check_output(args.out)  # before anything is computed
-    require_renderer()
-    rig = Rig(load(args.scene, args.set or ()))
+    scene = load(args.scene, args.set or ())
+    require_renderer(args.out)
+    from tqdm import tqdm
+
+    from rig.experiment.shot import Rig
+    from rig.viz.animate import animate
+
+    rig = Rig(scene)
     still = args.out.lower().endswith(".png")
     with tqdm(total=None if still else args.frames, desc="animate", unit="frame", file=sys.stderr,
               disable=args.quiet or still) as bar:

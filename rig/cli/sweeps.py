@@ -8,14 +8,16 @@ from rig.cli.shots import shot_summary
 
 
 def cmd_sweep(args) -> dict:
+    from rig.experiment.scene import load
+
+    scene = load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
     from tqdm import tqdm
 
-    from rig.experiment.scene import load
     from rig.experiment.shot import Rig
     from rig.study.sweep import Vary, run_sweep
 
     vary = Vary.parse(args.vary)
-    Rig(load(args.scene, args.set or ()))  # the base scene itself must be valid
+    Rig(scene)  # the base scene itself must be valid
     with tqdm(total=len(vary.values), desc=f"sweep {vary.key}", unit="shot", file=sys.stderr,
               disable=args.quiet) as bar:
         points = run_sweep(args.scene, vary, args.set or (), args.seed, bar.update, args.out)

@@ -255,11 +255,15 @@ def _still_frame(rig, fr: Frames) -> int:
     return int(np.argmin(np.abs(fr.times - t)))
 
 
-def require_renderer():
-    """pyvista and imageio, or a one-line error saying how to get them."""
+def require_renderer(out: str | None = None):
+    """pyvista and imageio (and imageio-ffmpeg for an ``out`` movie .mp4), or a one-line
+    error saying how to get them (the ``animate`` extra)."""
     try:
         import imageio  # noqa: F401
         import pyvista  # noqa: F401
+
+        if out is not None and str(out).lower().endswith(".mp4"):
+            import imageio_ffmpeg  # noqa: F401
     except ImportError as exc:
         raise RigError(f"rig animate needs the animate extra ({exc.name} is missing): "
                        f"pip install \"sonic-rig[animate]\"") from None

@@ -49,3 +49,12 @@ def test_matched_error_comparison():
     best = {r["method"]: r for r in matched(rows)}
     assert best["srkn6b"]["setting"] == "a"  # the cheaper run misses the error target
     assert best["srkn6b"]["speedup_vs_dop853"] == pytest.approx(50.0)
+
+
+@pytest.mark.parametrize("argv", [["analyze", "nosuch.isf", "--gauge-distance", "43 mm"],
+                                  ["import", "nosuch.isf", "--into", "a.h5"]])
+def test_a_missing_file_is_one_line_and_exit_2(tmp_path, monkeypatch, capsys, argv):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "nosuch.isf" in err[0] and "Traceback" not in err[0]

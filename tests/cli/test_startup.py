@@ -36,3 +36,15 @@ def test_a_shot_loads_no_scipy_signal_nor_pint():
     _, (code, loaded) = _run(["shot", "ptfe52_magnetic", "--seed", "1"], ("scipy.signal", "scipy.stats", "pint",
                                                                           "matplotlib", "h5py", "dask"))
     assert code == 0 and loaded == []
+
+
+@pytest.mark.parametrize("argv", [["sweep", "nosuchscene", "--vary", "striker.velocity=1:2:2"],
+                                  ["animate", "nosuchscene", "--out", "x.mp4"]])
+def test_other_commands_check_the_scene_first(argv):
+    _, (code, loaded) = _run(argv)
+    assert code == 2 and loaded == []
+
+
+def test_python_m_rig_cli_is_the_command():
+    out = subprocess.run([sys.executable, "-m", "rig.cli", "--version"], capture_output=True, text=True)
+    assert out.returncode == 0 and out.stdout.startswith("rig ")

@@ -42,3 +42,9 @@ def test_published_scenes_load_without_pint():
             "print('pint' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize("text", ["1e3J", "5e0J"])
+def test_what_pint_reads_as_a_complex_number_is_refused_as_pint_refuses_it(text):
+    with pytest.raises(RigError, match="not a quantity"):
+        quantity(text, "J", "x")

@@ -75,3 +75,14 @@ def test_bad_output_is_refused_before_rendering(tmp_path, capsys, monkeypatch, o
 def test_the_rig_does_not_import_pyvista():
     code = "import sys, rig, rig.experiment.shot, rig.solver.solve, rig.study.mc_run, rig.cli; print('pyvista' in sys.modules or 'vtk' in sys.modules)"
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "False"
+
+
+def test_a_movie_without_the_animate_extra_is_refused_in_one_line(monkeypatch):
+    import sys
+
+    from rig.errors import RigError
+    from rig.viz.animate import require_renderer
+
+    monkeypatch.setitem(sys.modules, "imageio_ffmpeg", None)  # as if not installed
+    with pytest.raises(RigError, match=r'imageio_ffmpeg is missing\): pip install "sonic-rig\[animate\]"'):
+        require_renderer("shot.mp4")
