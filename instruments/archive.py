@@ -48,6 +48,7 @@ import h5py
 import numpy as np
 
 from .errors import InstrumentError
+from .facts import ShotFacts
 from .records import Preamble, ScopeRecord, Waveform
 
 LAYOUT = """One NXentry per shot (shot_NNNNNN). Its attribute 'shot' holds shot_id, seed
@@ -69,8 +70,9 @@ _PREAMBLE_FLOATS = ("x_increment", "x_zero", "y_multiplier", "y_offset", "y_zero
 class Entry:
     """One shot as the archive stores it: plain data, real or virtual.
 
-    truth: name -> array (N) of ground-truth forces; truth_attrs: small JSON-able facts
-    (per-shot draws, positions); truth_key: shots with equal keys share the truth arrays.
+    truth: name -> array (N) of ground-truth forces; facts: the virtual shot's ShotFacts
+    (draws, gauge positions, ...; None for a real shot); truth_key: shots with equal keys
+    share the truth arrays.
     """
 
     record: ScopeRecord
@@ -80,7 +82,7 @@ class Entry:
     scene_text: str = ""
     settings: dict = field(default_factory=dict)
     truth: dict | None = None
-    truth_attrs: dict = field(default_factory=dict)
+    facts: ShotFacts | None = None
     truth_key: str | None = None
     start_time: str = ""
     project_version: str = ""
@@ -255,7 +257,8 @@ def _write_entry(f: h5py.File, shot_id: int, e: Entry, checked: set):
         d.dims[0].attach_scale(_time_axis(data, p))
     if e.truth is not None:
         tg = g.create_group("truth")
-        tg.attrs.update({"NX_class": "NXcollection", "facts": json.dumps(e.truth_attrs, default=_jsonable)})
+        tg.attrs.update({"NX_class": "NXcollection",
+                         "facts": json.dumps(e.facts.to_dict() if e.facts else {}, default=_jsonable)})
         if "forces" not in shared:
             forces = shared.create_group("forces")
             for name, arr in e.truth.items():
@@ -338,9 +341,10 @@ def _read_entry(g: h5py.Group, verify: bool, path, with_truth: bool = True) -> E
     record = ScopeRecord(waves, bool(shot["triggered"]), shot["no_trigger_reason"].decode() or None)
     if verify and raw_digest(record) != shot["sha256"].decode():
         raise InstrumentError(f"{path}: shot {int(shot['shot_id'])}: sha256 of the raw data does not match")
-    truth, facts = None, {}
+    truth, facts = None, None
     if "truth" in g:
-        facts = json.loads(g["truth"].attrs["facts"])
+        stored = json.loads(g["truth"].attrs["facts"])
+        facts = ShotFacts.from_dict(stored, f"{path}: shot {int(shot['shot_id'])}: facts") if stored else None
         if with_truth:
             truth = {k: v[()] for k, v in g["truth/forces"].items()}
     seed = int(shot["seed"])

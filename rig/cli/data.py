@@ -37,9 +37,11 @@ def cmd_import(args) -> dict:
 
 
 def cmd_analyze(args) -> list:
-    from rig.experiment.analyze import analyze_paths
+    from rig.experiment.analyze import AnalyzeOptions, analyze_paths
 
-    results = analyze_paths(args)
+    options = AnalyzeOptions(tuple(args.files), args.shot, args.gauge_distance, args.channels, args.wall,
+                             args.sensitivity, args.tau, args.beta, args.f0, args.diameter, args.material)
+    results = analyze_paths(options)
     if not args.json:
         fmt = lambda v, spec=".2f": "-" if v is None else format(v, spec)  # noqa: E731
         print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d N':>8s} {'F_m,e N':>8s} "

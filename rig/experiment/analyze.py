@@ -8,6 +8,7 @@ need it from the command line: --gauge-distance, and optionally --sensitivity, -
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 from instruments.analysis import PeakRules
@@ -20,7 +21,29 @@ from rig.model.materials import material
 from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed
 
 
-def analyze_paths(args) -> list:
+@dataclass(frozen=True)
+class AnalyzeOptions:
+    """What `rig analyze` is told. files: scope files and/or archives (.h5); shot: one shot
+    of an archive (None: all). For real files: gauge_distance (m) between the two gauges,
+    channels "UPPER,LOWER[,WALL]" (None: file order), wall (the third channel is the wall
+    sensor), sensitivity (V/N), tau (s, the gauge RC to invert; None: none), beta
+    (F_d / F_m,e), f0 (N, precompression), diameter (m), material (adds the Eq (1) speed)."""
+
+    files: tuple
+    shot: int | None = None
+    gauge_distance: float | None = None
+    channels: str | None = None
+    wall: bool = False
+    sensitivity: float = 1.0
+    tau: float | None = None
+    beta: float = 1.0
+    f0: float = 0.0
+    diameter: float = 4.76e-3
+    material: str | None = None
+
+
+def analyze_paths(args: AnalyzeOptions) -> list:
+    """One result per archive shot and one for the scope files together (JSON-ready dicts)."""
     paths = [Path(p) for p in args.files]
     archives = [p for p in paths if p.suffix.lower() in (".h5", ".hdf5", ".nxs")]
     files = [p for p in paths if p not in archives]
@@ -39,22 +62,24 @@ def analyze_paths(args) -> list:
 
 
 def _setup_from_entry(entry) -> Setup:
-    facts, settings = entry.truth_attrs, entry.settings
-    gauges = sorted(facts["gauges"].items(), key=lambda kv: kv[1]["position_m"])
+    facts, settings = entry.facts, entry.settings
+    if facts is None:
+        raise RigError(f"shot {entry.shot_id}: a virtual shot without its facts (gauge positions) cannot be analysed")
+    gauges = sorted(facts.gauges.items(), key=lambda kv: kv[1].position_m)
     roles = []
     for name, g in gauges[:2]:
         s = settings["gauges"][name]
-        roles.append(GaugeSetup(g["channel"], g["position_m"], s.get("sensitivity", 0.05), s.get("tau", 1e-3)))
+        roles.append(GaugeSetup(g.channel, g.position_m, s.get("sensitivity", 0.05), s.get("tau", 1e-3)))
     wall = None
     if "wall_sensor" in settings:
         ws = settings["wall_sensor"]
         wall = GaugeSetup(ws["channel"], math.inf, ws.get("sensitivity", 0.05), ws.get("tau", 1e-3))
-    truth = facts.get("analysis") or {}
+    truth = facts.analysis or {}
     return Setup(roles[0], roles[1], wall, settings["chain"]["diameter"], truth.get("beta") or 1.0,
                  truth.get("static_force_N") or 0.0, PeakRules())
 
 
-def _setup_from_flags(args, record: ScopeRecord) -> Setup:
+def _setup_from_flags(args: AnalyzeOptions, record: ScopeRecord) -> Setup:
     if args.gauge_distance is None:
         raise RigError("--gauge-distance is required for real scope files (e.g. --gauge-distance '43.1 mm')")
     names = args.channels.split(",") if args.channels else list(record.waveforms)[:3 if args.wall else 2]
@@ -69,7 +94,7 @@ def _setup_from_flags(args, record: ScopeRecord) -> Setup:
                  args.beta, args.f0, PeakRules())
 
 
-def _result(source, record, setup: Setup, args, entry=None) -> dict:
+def _result(source, record, setup: Setup, args: AnalyzeOptions, entry=None) -> dict:
     rep = analyze_record(record, setup).as_dict()
     rep.pop("leading", None)
     out = {"source": source, "channels": [setup.upper.channel, setup.lower.channel], **rep}

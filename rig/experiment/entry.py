@@ -4,6 +4,7 @@ from __future__ import annotations
 import hashlib
 
 from instruments.archive import Entry
+from instruments.facts import GaugeFact, ShotFacts
 from rig import __version__
 from rig.experiment.shot import ShotRecord
 
@@ -18,15 +19,11 @@ def shot_entry(shot: ShotRecord) -> Entry:
         if g.contact_above is not None:
             arrays[f"{name}.contact_above"] = g.contact_above
             arrays[f"{name}.contact_below"] = g.contact_below
-        gauges[name] = {"bead": g.bead, "channel": g.channel, "position_m": g.position_m,
-                        "static_above_N": g.static_above_N, "static_below_N": g.static_below_N}
+        gauges[name] = GaugeFact(g.bead, g.channel, g.position_m, g.static_above_N, g.static_below_N)
     if shot.truth.wall_force is not None:
         arrays["wall_force"] = shot.truth.wall_force
-    facts = {"sample_interval_s": shot.truth.sample_interval, "gauges": gauges,
-             "analysis": shot.analysis_truth,
-             "wave_speed_m_per_s": shot.truth.wave_speed_m_per_s, "draws": shot.draws,
-             "trigger_time_after_impact_s": shot.scope.trigger_time,
-             "solver": shot.solver.as_dict(), "overrides": list(shot.overrides)}
+    facts = ShotFacts(shot.truth.sample_interval, gauges, shot.analysis_truth, shot.truth.wave_speed_m_per_s,
+                      shot.draws, shot.scope.trigger_time, shot.solver.as_dict(), tuple(shot.overrides))
     key = hashlib.sha256((shot.scene_text + "\n".join(shot.overrides) + __version__).encode())
     return Entry(shot.scope, True, shot.seed, shot.scene, shot.scene_text,
                  {**shot.settings, "overrides": list(shot.overrides)}, arrays, facts,

@@ -127,8 +127,7 @@ def _batch(study: Study, b: int) -> BatchResult:
             from rig.experiment.entry import shot_entry  # the archive's Entry (h5py): only with traces
 
             e = shot_entry(shot)
-            traces.append(replace(e, truth_key=None,
-                                  truth_attrs={**e.truth_attrs, "study_shot": lo + j, "study": study.digest()}))
+            traces.append(replace(e, truth_key=None, facts=replace(e.facts, study_shot=lo + j, study=study.digest())))
         m = analyze_record(shot.scope, setup_for(rig, beta, F0), train=False)  # leading pulse only
         t = rig.truth_analysis() if study.truth else None
         for key, val in (("speed_m_per_s", m.speed_m_per_s), ("speed_xcorr_m_per_s", m.speed_xcorr_m_per_s),

@@ -22,7 +22,7 @@ def test_thousand_virtual_shots_round_trip_bit_identical(tmp_path):
     for i, s in zip(ids, shots):
         back = archive.read(i)
         assert back.seed == s.seed and back.simulated and back.scene == "ptfe52_magnetic"
-        assert back.scene_text == s.scene_text and back.truth_attrs["draws"] == s.draws
+        assert back.scene_text == s.scene_text and back.facts.draws == s.draws
         for ch, w in s.scope.waveforms.items():
             assert np.array_equal(back.record[ch].codes, w.codes)
             assert back.record[ch].preamble == w.preamble

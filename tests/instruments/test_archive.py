@@ -16,6 +16,7 @@ import pytest
 
 from instruments.archive import Archive, Entry
 from instruments.errors import InstrumentError
+from instruments.facts import GaugeFact, ShotFacts
 from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 
 SCOPE = Oscilloscope(channels={c: ChannelSettings(volts_per_div=0.05) for c in ("CH1", "CH2", "CH3")},
@@ -27,8 +28,10 @@ def entry(seed: int, truth=True) -> Entry:
     rng = np.random.default_rng(seed)
     x = 0.2 * np.exp(-(((_T - 1e-3) / 5e-5) ** 2))
     rec = SCOPE.acquire({"CH1": x, "CH2": 0.8 * x, "CH3": 0.5 * x}, 1e-7, rng)
+    facts = ShotFacts(1e-7, {"upper": GaugeFact(3, "CH1", 0.01, 0.1, 0.2)}, None, None, {"draw": {"seed": seed}},
+                      1e-3, {"method": "synthetic"})
     return Entry(rec, True, seed, "synthetic", "[scene]\nname = 'synthetic'\n", {"probe": "synthetic"},
-                 {"wall_force": np.sin(_T[:5000])} if truth else None, {"draw": seed}, "shared")
+                 {"wall_force": np.sin(_T[:5000])} if truth else None, facts, "shared")
 
 
 # a writer appending one shot at a time, which stops at each point of a transaction (it
@@ -81,6 +84,7 @@ def test_round_trip_is_bit_identical(tmp_path):
     for i, e in zip(ids, shots):
         back = a.read(i)
         assert back.seed == e.seed and back.settings == e.settings and back.scene_text == e.scene_text
+        assert back.facts == e.facts  # the declared facts, checked on read
         for ch, w in e.record.waveforms.items():
             r = back.record[ch]
             assert r.codes.dtype == w.codes.dtype and np.array_equal(r.codes, w.codes)

@@ -174,7 +174,7 @@ def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(t
     entries = [Archive(archives[1]).read(i) for i in Archive(archives[1]).ids()]
     assert len(entries) == 16
     e = entries[3]
-    assert e.truth_attrs["study_shot"] == 19 and e.truth is not None
+    assert e.facts.study_shot == 19 and e.facts.study == study.digest() and e.truth is not None
     beta, F0 = nominal(study.scene, ()).calibration
     rig = shot_rig(study, *shot_inputs(study, 19, 52)[:2])[0]
     speed = analyze_record(e.record, setup_for(rig, beta, F0), train=False).speed_m_per_s
