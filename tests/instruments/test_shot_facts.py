@@ -3,11 +3,11 @@ import json
 
 import h5py
 import pytest
+from test_archive import entry
 
 from instruments.archive import Archive
 from instruments.errors import InstrumentError
 from instruments.facts import FACTS_VERSION, GaugeFact, ShotFacts
-from test_archive import entry
 
 FACTS = ShotFacts(1e-7, {"upper": GaugeFact(20, "CH1", 0.0901, 0.95, 0.96),
                          "lower": GaugeFact(29, "CH2", 0.1328, 0.96, 0.97)},
