@@ -89,15 +89,21 @@ class Entry:
     shot_id: int | None = None  # set when read back
 
 
+def raw_values(w: Waveform) -> np.ndarray:
+    """What a channel stores: its raw codes, or its volts (float64) where a file held
+    volts only (CSV)."""
+    return w.codes if w.codes is not None else np.asarray(w.samples, dtype=np.float64)
+
+
 def raw_digest(record: ScopeRecord) -> str:
-    """SHA-256 over each channel's name, scaling and raw codes, in channel order."""
+    """SHA-256 over each channel's name, scaling and raw codes (or volts), in channel order."""
     h = hashlib.sha256()
     for ch in sorted(record.waveforms):
         w = record.waveforms[ch]
         p = w.preamble
         h.update(ch.encode())
         h.update(json.dumps([p.points, p.trigger_index] + [getattr(p, k) for k in _PREAMBLE_FLOATS]).encode())
-        h.update(np.ascontiguousarray(w.codes).tobytes())
+        h.update(np.ascontiguousarray(raw_values(w)).tobytes())
     return h.hexdigest()
 
 
@@ -250,9 +256,11 @@ def _write_entry(f: h5py.File, shot_id: int, e: Entry, checked: set):
     for ch in chans:
         w = e.record.waveforms[ch]
         p = w.preamble
-        d = scope.create_dataset(ch, data=w.codes, **_chunks(w.codes))
-        d.attrs.update({"units": p.y_unit, "scale_factor": p.y_multiplier,
-                        "add_offset": p.y_zero - p.y_multiplier * p.y_offset})
+        values = raw_values(w)
+        d = scope.create_dataset(ch, data=values, **_chunks(values))
+        d.attrs["units"] = p.y_unit
+        if w.codes is not None:  # CF scaling of the codes to volts
+            d.attrs.update({"scale_factor": p.y_multiplier, "add_offset": p.y_zero - p.y_multiplier * p.y_offset})
         data[ch] = d  # hard link: the plottable data are the raw codes
         d.dims[0].attach_scale(_time_axis(data, p))
     if e.truth is not None:
@@ -337,7 +345,11 @@ def _read_entry(g: h5py.Group, verify: bool, path, with_truth: bool = True) -> E
                        y_unit=pa["y_unit"].decode(), waveform_id=pa["waveform_id"].decode(),
                        extra=json.loads(pa["extra"].decode()),
                        **{k: float(pa[k]) for k in _PREAMBLE_FLOATS})
-        waves[ch] = Waveform(ch, pre, codes=d[()], overrange=bool(pa["overrange"]))
+        values = d[()]
+        if values.dtype.kind == "f":  # volts from a file that held volts only
+            waves[ch] = Waveform(ch, pre, samples=values, overrange=bool(pa["overrange"]))
+        else:
+            waves[ch] = Waveform(ch, pre, codes=values, overrange=bool(pa["overrange"]))
     record = ScopeRecord(waves, bool(shot["triggered"]), shot["no_trigger_reason"].decode() or None)
     if verify and raw_digest(record) != shot["sha256"].decode():
         raise InstrumentError(f"{path}: shot {int(shot['shot_id'])}: sha256 of the raw data does not match")
