@@ -11,6 +11,7 @@ import sys
 from instruments.errors import InstrumentError
 from rig import __version__
 from rig.cli import data, shots, study, sweeps, tools
+from rig.cli.common import OneLineParser, seed_arg
 from rig.cli.common import quantity_arg as _q
 from rig.errors import RigError
 
@@ -24,7 +25,7 @@ def _command(sub, name: str, help_text: str, func):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="rig", description="Virtual rig for strongly nonlinear granular chains.")
+    ap = OneLineParser(prog="rig", description="Virtual rig for strongly nonlinear granular chains.")
     ap.add_argument("--version", action="version", version=f"rig {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
 
@@ -38,7 +39,7 @@ def build_parser() -> argparse.ArgumentParser:
     sh.add_argument("scene", help="a scene file, or a published scene's name (e.g. ptfe52_magnetic)")
     sh.add_argument("--set", action="append", metavar="KEY=VALUE",
                     help="override a scene key, e.g. striker.velocity=1.2 (plain numbers in SI)")
-    sh.add_argument("--seed", type=int, help="seed of every random draw (default: a fresh one, printed)")
+    sh.add_argument("--seed", type=seed_arg, help="seed of every random draw (default: a fresh one, printed)")
     sh.add_argument("--export", metavar="DIR", help="write the scope records to DIR")
     sh.add_argument("--format", choices=["isf", "csv"], default="isf", help="scope file format (default isf)")
     sh.add_argument("--out", metavar="ARCHIVE.h5", help="append the shot to an HDF5 archive")
@@ -56,14 +57,14 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("--vary", required=True, metavar="KEY=START:STOP:COUNT",
                     help="e.g. striker.velocity=0.3:1.5:7 (plain numbers in the key's SI unit)")
     sw.add_argument("--set", action="append", metavar="KEY=VALUE", help="other overrides")
-    sw.add_argument("--seed", type=int, default=0, help="the sweep's seed (default 0)")
+    sw.add_argument("--seed", type=seed_arg, default=0, help="the sweep's seed (default 0)")
     sw.add_argument("--out", metavar="ARCHIVE.h5", help="append every shot to an archive")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
 
     an = _command(sub, "animate", "render a virtual shot to a movie or still, off-screen", shots.cmd_animate)
     an.add_argument("scene")
     an.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene key")
-    an.add_argument("--seed", type=int, help="seed of the instruments' draws (default: a fresh one, printed)")
+    an.add_argument("--seed", type=seed_arg, help="seed of the instruments' draws (default: a fresh one, printed)")
     an.add_argument("--out", required=True, metavar="FILE", help="FILE.mp4, FILE.gif or FILE.png (one still)")
     an.add_argument("--frames", type=int, default=100, help="frames over the scene's duration (default 100)")
     an.add_argument("--exaggerate", type=float,
@@ -82,7 +83,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help='e.g. striker.velocity="normal(0.89 m/s, 0.01 m/s)"; also chain.bead_mass, '
                          'gauges.NAME.gain, gauges.NAME.misalignment')
     mc.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides")
-    mc.add_argument("--seed", type=int, default=0, help="the study's seed (default 0)")
+    mc.add_argument("--seed", type=seed_arg, default=0, help="the study's seed (default 0)")
     mc.add_argument("--batch", type=int, default=128, help="shots per batch (default 128)")
     mc.add_argument("--accuracy", type=float, help="solver accuracy (default: the scene's)")
     mc.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")

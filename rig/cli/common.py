@@ -1,6 +1,30 @@
 """Helpers shared by the commands."""
 from __future__ import annotations
 
+import argparse
+import sys
+
+MAX_SEED = 2**63 - 1  # seeds are stored as signed 64-bit integers
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """argparse with the project's error policy: a mistake is one line, exit 2."""
+
+    def error(self, message):
+        print(f"{self.prog}: error: {message}", file=sys.stderr)
+        sys.exit(2)
+
+
+def seed_arg(text: str) -> int:
+    """A seed: a whole number from 0 to 2^63 - 1."""
+    try:
+        seed = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: a whole number from 0 to {MAX_SEED}") from None
+    if not 0 <= seed <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"{text!r}: a whole number from 0 to {MAX_SEED}")
+    return seed
+
 
 def quantity_arg(text: str, unit: str, field: str) -> float:
     """A command-line quantity: a plain number is taken in ``unit``; else text with a unit."""

@@ -58,3 +58,25 @@ def test_a_missing_file_is_one_line_and_exit_2(tmp_path, monkeypatch, capsys, ar
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "nosuch.isf" in err[0] and "Traceback" not in err[0]
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["mc", "ptfe52_magnetic", "--shots", "4", "--seed", "-1", "--vary", "striker.velocity=normal(0.89 m/s, 0.01 m/s)",
+      "--out", "s"], "argument --seed: '-1': a whole number from 0 to 9223372036854775807"),
+    (["sweep", "ptfe52_magnetic", "--seed", "-1", "--vary", "striker.velocity=1:2:2"], "argument --seed: '-1'"),
+    (["shot", "ptfe52_magnetic", "--seed", str(2**63), "--out", "a.h5"], f"argument --seed: '{2**63}'"),
+    (["mc", "ptfe52_magnetic", "--shots", "4", "--accuracy", "-1", "--vary",
+      "striker.velocity=normal(0.89 m/s, 0.01 m/s)", "--out", "s"], "--accuracy = -1.0: relative accuracy target"),
+    (["mc", "ptfe52_magnetic", "--shots", "4", "--accuracy", "0", "--vary",
+      "striker.velocity=normal(0.89 m/s, 0.01 m/s)", "--out", "s"], "--accuracy = 0.0: relative accuracy target"),
+    (["shot"], "the following arguments are required: scene"),
+])
+def test_bad_arguments_are_one_line_and_exit_2(tmp_path, monkeypatch, capsys, argv, message):
+    monkeypatch.chdir(tmp_path)
+    try:
+        code = main(argv)
+    except SystemExit as exc:  # argparse's own checks
+        code = exc.code
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and message in err[0], err
+    assert not (tmp_path / "s").exists() and not (tmp_path / "a.h5").exists()  # nothing was run
