@@ -171,9 +171,13 @@ class Archive:
         if not h5py.is_hdf5(path):
             raise InstrumentError(f"{path}: not an HDF5 file")
         try:
-            return h5py.File(path, "r")
+            f = h5py.File(path, "r")
         except OSError as exc:
             raise InstrumentError(f"{path}: cannot be opened as HDF5 (truncated or damaged?): {exc}") from None
+        if f.attrs.get("creator") != "sonic-rig":
+            f.close()
+            raise InstrumentError(f"{path}: not a rig archive (an HDF5 file that this project did not write)")
+        return f
 
     def ids(self) -> list:
         with self._open() as f:

@@ -141,6 +141,8 @@ def _read_curve(data: bytes, at: int, header: dict, path):
 
 def _waveform(h: dict, codes, path, index) -> Waveform:
     dx = _number(h, "XINCR", path)
+    if not (np.isfinite(dx) and dx > 0):
+        raise InstrumentError(f"{path}: XINCR = {dx!r}: the sample interval must be a finite number > 0 s")
     x0 = _number(h, "XZERO", path)
     pt_off = _number(h, "PT_OFF", path, int) if "PT_OFF" in h else 0
     first = x0 - dx * pt_off  # t = XZERO + XINCR (n - PT_OFF)

@@ -133,7 +133,9 @@ def _waveform(path, name, t, v, trigger, unit, interval=None) -> Waveform:
         dt = float(interval) if interval not in (None, "") else float(np.median(np.diff(t)))
     except ValueError:
         raise InstrumentError(f"{path}: Sample Interval = {interval!r} is not a number") from None
-    if not dt > 0 or not np.all(np.diff(t) > 0):
+    if not (np.isfinite(dt) and dt > 0):
+        raise InstrumentError(f"{path}: Sample Interval = {interval!r}: must be a finite number > 0 s")
+    if not np.all(np.diff(t) > 0):
         raise InstrumentError(f"{path}: the time column does not increase")
     idx = int(float(trigger)) if trigger not in (None, "") else int(np.clip(round(-t[0] / dt), 0, t.size - 1))
     pre = Preamble(points=t.size, x_increment=dt, x_zero=float(t[0]), trigger_index=idx,

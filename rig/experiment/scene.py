@@ -79,7 +79,10 @@ class Scene:
 def load(name_or_path, overrides=()) -> Scene:
     """Parse, override and validate a scene file (a path, or a published scene's name)."""
     path = find_scene(name_or_path)
-    text = path.read_text()
+    try:
+        text = path.read_text()
+    except UnicodeDecodeError:
+        raise invalid("scene", str(path), "not a text (TOML) scene file") from None
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

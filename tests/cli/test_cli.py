@@ -80,3 +80,33 @@ def test_bad_arguments_are_one_line_and_exit_2(tmp_path, monkeypatch, capsys, ar
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and message in err[0], err
     assert not (tmp_path / "s").exists() and not (tmp_path / "a.h5").exists()  # nothing was run
+
+
+def _bad_files(tmp_path, realdata):
+    import h5py
+
+    with h5py.File(tmp_path / "foreign.h5", "w") as f:
+        f["x"] = [1, 2, 3]
+    (tmp_path / "binary.toml").write_bytes(bytes(range(256)))
+    isf = (realdata / "tek_16bit_dpo.isf").read_bytes()
+    (tmp_path / "xincr0.isf").write_bytes(isf.replace(b"XINCR 400.0000E-12", b"XINCR 0.0000E-12 "))
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["import", "{real}", "--into", "foreign.h5"], "foreign.h5: not a rig archive"),
+    (["shot", "binary.toml"], "not a text (TOML) scene file"),
+    (["analyze", "xincr0.isf", "--gauge-distance", "43 mm"], "XINCR = 0.0: the sample interval must be"),
+])
+def test_bad_files_are_one_line_and_exit_2(tmp_path, monkeypatch, capsys, realdata, argv, message):
+    _bad_files(tmp_path, realdata)
+    monkeypatch.chdir(tmp_path)
+    argv = [a.replace("{real}", str(realdata / "tek_16bit_dpo.isf")) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0], err
+
+
+def test_verify_of_a_foreign_hdf5_file_says_so(tmp_path, capsys, realdata):
+    _bad_files(tmp_path, realdata)
+    assert main(["verify", str(tmp_path / "foreign.h5"), "--json"]) == 1
+    assert "not a rig archive" in json.loads(capsys.readouterr().out)["bad"][0]["reason"]
