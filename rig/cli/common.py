@@ -34,3 +34,18 @@ def quantity_arg(text: str, unit: str, field: str) -> float:
         return float(text)
     except ValueError:
         return quantity(text, unit, field)
+
+
+def quantity_type(unit: str, field: str):
+    """An argparse type for a quantity in ``unit`` (a plain number is taken in ``unit``);
+    a mistake is reported as the field, the value and what is allowed."""
+    def parse(text: str) -> float:
+        from rig.errors import RigError
+
+        try:
+            return quantity_arg(text, unit, field)
+        except RigError as exc:
+            raise argparse.ArgumentTypeError(str(exc).removeprefix(f"{field} = ")) from None
+
+    parse.__name__ = f"quantity in {unit}"
+    return parse

@@ -110,3 +110,22 @@ def test_verify_of_a_foreign_hdf5_file_says_so(tmp_path, capsys, realdata):
     _bad_files(tmp_path, realdata)
     assert main(["verify", str(tmp_path / "foreign.h5"), "--json"]) == 1
     assert "not a rig archive" in json.loads(capsys.readouterr().out)["bad"][0]["reason"]
+
+
+@pytest.mark.parametrize("flag,value,message", [
+    ("--gauge-distance", "4 kg", "argument --gauge-distance: '4 kg': expected a quantity convertible to m"),
+    ("--sensitivity", "0.05 V", "argument --sensitivity: '0.05 V': expected a quantity convertible to V/N"),
+])
+def test_analysis_flags_take_units_and_name_a_wrong_one(capsys, realdata, flag, value, message):
+    argv = ["analyze", str(realdata / "tek_8bit_two_records.isf"), "--gauge-distance", "43 mm", flag, value]
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert exc.value.code == 2 and len(err) == 1 and message in err[0], err
+
+
+def test_sensitivity_with_its_unit_equals_the_plain_number(capsys, realdata):
+    files = [str(realdata / "tek_8bit_two_records.isf"), "--gauge-distance", "43 mm", "--json"]
+    with_unit = _json(capsys, "analyze", *files, "--sensitivity", "0.05 V/N")
+    plain = _json(capsys, "analyze", *files, "--sensitivity", "0.05")
+    assert with_unit == plain
