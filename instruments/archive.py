@@ -43,13 +43,16 @@ import tempfile
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import h5py
 import numpy as np
 
 from .errors import InstrumentError
 from .facts import ShotFacts
 from .records import Preamble, ScopeRecord, Waveform
+
+if TYPE_CHECKING:  # h5py itself is imported where a file is opened: Entry alone does not need it
+    import h5py
 
 LAYOUT = """One NXentry per shot (shot_NNNNNN). Its attribute 'shot' holds shot_id, seed
 (-1: none), simulated, triggered, scene, start_time (UTC, ISO 8601), project_version and the
@@ -116,6 +119,8 @@ class Archive:
     # --- writing --------------------------------------------------------------------
     def append(self, entries) -> list:
         """Append shots in one transaction; returns their ids. All or nothing."""
+        import h5py
+
         entries = list(entries)
         with self._lock():
             self._drop_stale_temporaries()
@@ -165,6 +170,8 @@ class Archive:
 
     # --- reading --------------------------------------------------------------------
     def _open(self, path=None) -> h5py.File:
+        import h5py
+
         path = Path(path or self.path)
         if not path.exists():
             raise InstrumentError(f"{path}: no such archive")
@@ -193,6 +200,8 @@ class Archive:
 
     def verify(self) -> dict:
         """Check every shot (fletcher32 on every chunk, then the sha256)."""
+        import h5py
+
         try:
             f = self._open()
         except InstrumentError as exc:
@@ -235,6 +244,7 @@ class Archive:
 # --- layout -------------------------------------------------------------------------
 def _write_entry(f: h5py.File, shot_id: int, e: Entry, checked: set):
     """Write one NXentry; ``checked`` holds the shared keys already verified this transaction."""
+    facts = _facts_json(e, f"shot {shot_id}: facts") if e.truth is not None else None
     g = f.create_group(f"shot_{shot_id:06d}")
     g.attrs.update({"NX_class": "NXentry", "default": "data", "shot": _shot_attr(shot_id, e)})
     key = e.truth_key or f"shot_{shot_id:06d}"
@@ -270,12 +280,24 @@ def _write_entry(f: h5py.File, shot_id: int, e: Entry, checked: set):
     if e.truth is not None:
         tg = g.create_group("truth")
         tg.attrs.update({"NX_class": "NXcollection",
-                         "facts": json.dumps(e.facts.to_dict() if e.facts else {}, default=_jsonable)})
+                         "facts": facts})
         if "forces" not in shared:
             forces = shared.create_group("forces")
             for name, arr in e.truth.items():
                 forces.create_dataset(name, data=np.asarray(arr), **_chunks(arr)).attrs["units"] = "N"
         tg["forces"] = shared["forces"]  # one hard link to the arrays stored once per key
+
+
+def _facts_json(e: Entry, where: str) -> str:
+    """The facts as stored (JSON with their version; "{}": none), checked as a reader will
+    check them: the archive refuses to write facts it would refuse to read."""
+    if e.facts is None:
+        return "{}"
+    if not isinstance(e.facts, ShotFacts):
+        raise InstrumentError(f"{where} = {type(e.facts).__name__}: expected ShotFacts (instruments.facts) or None")
+    text = json.dumps(e.facts.to_dict(), default=_jsonable)
+    ShotFacts.from_dict(json.loads(text), where)
+    return text
 
 
 def _shot_attr(shot_id: int, e: Entry) -> np.ndarray:
@@ -370,6 +392,8 @@ def _read_entry(g: h5py.Group, verify: bool, path, with_truth: bool = True) -> E
 
 
 def _datasets(group):
+    import h5py
+
     out = []
     group.visititems(lambda name, obj: out.append(obj) if isinstance(obj, h5py.Dataset) else None)
     return out

@@ -50,13 +50,13 @@ class ShotFacts:
         return out
 
     @classmethod
-    def from_dict(cls, d, where: str = "facts") -> "ShotFacts":
+    def from_dict(cls, d, where: str = "facts") -> ShotFacts:
         """Check and read stored facts; InstrumentError naming the field otherwise."""
         if not isinstance(d, dict):
             raise InstrumentError(f"{where} = {d!r}: expected a table of shot facts")
         d = dict(d)
-        version = d.pop("version", 1)
-        if version != FACTS_VERSION:
+        version = d.pop("version", 1)  # unversioned: the layout of version 1
+        if type(version) is not int or version != FACTS_VERSION:
             raise InstrumentError(f"{where}.version = {version!r}: this version reads version {FACTS_VERSION}")
         names = {f.name for f in fields(cls)} - {"version"}
         required = {f.name for f in fields(cls) if f.name not in ("overrides", "study_shot", "study", "version")}
@@ -69,16 +69,23 @@ class ShotFacts:
         for key in ("wave_speed_m_per_s", "trigger_time_after_impact_s"):
             _typed(where, d, key, (int, float, type(None)))
         for key in ("draws", "solver", "gauges"):
-            _typed(where, d, key, dict)
+            _typed(where, d, key, (dict,))
         _typed(where, d, "analysis", (dict, type(None)))
         _typed(where, d, "study_shot", (int, type(None)))
         _typed(where, d, "study", (str, type(None)))
         _typed(where, d, "overrides", (list, tuple))
+        for i, o in enumerate(d.get("overrides", ())):
+            _typed(where, {f"overrides[{i}]": o}, f"overrides[{i}]", (str,))
         gauges = {}
+        keys = [f.name for f in fields(GaugeFact)]
         for name, g in d["gauges"].items():
-            keys = [f.name for f in fields(GaugeFact)]
-            if not isinstance(g, dict) or sorted(g) != sorted(keys):
-                raise InstrumentError(f"{where}.gauges.{name} = {g!r}: expected the keys {', '.join(keys)}")
+            if not isinstance(g, dict):
+                raise InstrumentError(f"{where}.gauges.{name} = {g!r}: expected a table of {', '.join(keys)}")
+            unknown, missing = sorted(set(g) - set(keys)), [k for k in keys if k not in g]
+            if unknown:
+                raise InstrumentError(f"{where}.gauges.{name}.{unknown[0]}: unknown key (known: {', '.join(keys)})")
+            if missing:
+                raise InstrumentError(f"{where}.gauges.{name}.{missing[0]}: missing")
             for key, types in (("bead", (int,)), ("channel", (str,)), ("position_m", (int, float)),
                                ("static_above_N", (int, float)), ("static_below_N", (int, float))):
                 _typed(f"{where}.gauges.{name}", g, key, types)

@@ -39,8 +39,9 @@ def cmd_import(args) -> dict:
 def cmd_analyze(args) -> list:
     from rig.experiment.analyze import AnalyzeOptions, analyze_paths
 
-    options = AnalyzeOptions(tuple(args.files), args.shot, args.gauge_distance, args.channels, args.wall,
-                             args.sensitivity, args.tau, args.beta, args.f0, args.diameter, args.material)
+    options = AnalyzeOptions(files=tuple(args.files), shot=args.shot, gauge_distance=args.gauge_distance,
+                             channels=args.channels, wall=args.wall, sensitivity=args.sensitivity, tau=args.tau,
+                             beta=args.beta, f0=args.f0, diameter=args.diameter, material=args.material)
     results = analyze_paths(options)
     if not args.json:
         fmt = lambda v, spec=".2f": "-" if v is None else format(v, spec)  # noqa: E731

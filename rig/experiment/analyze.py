@@ -42,22 +42,22 @@ class AnalyzeOptions:
     material: str | None = None
 
 
-def analyze_paths(args: AnalyzeOptions) -> list:
+def analyze_paths(options: AnalyzeOptions) -> list:
     """One result per archive shot and one for the scope files together (JSON-ready dicts)."""
-    paths = [Path(p) for p in args.files]
+    paths = [Path(p) for p in options.files]
     archives = [p for p in paths if p.suffix.lower() in (".h5", ".hdf5", ".nxs")]
     files = [p for p in paths if p not in archives]
     results = []
     for a in archives:
         archive = Archive(a)
-        ids = [args.shot] if args.shot is not None else archive.ids()
+        ids = [options.shot] if options.shot is not None else archive.ids()
         for i in ids:
             entry = archive.read(i, with_truth=False)
-            setup = _setup_from_entry(entry) if entry.simulated else _setup_from_flags(args, entry.record)
-            results.append(_result(f"{a}#{i}", entry.record, setup, args, entry))
+            setup = _setup_from_entry(entry) if entry.simulated else _setup_from_flags(options, entry.record)
+            results.append(_result(f"{a}#{i}", entry.record, setup, options, entry))
     if files:
         record = read_record(files)
-        results.append(_result(", ".join(map(str, files)), record, _setup_from_flags(args, record), args))
+        results.append(_result(", ".join(map(str, files)), record, _setup_from_flags(options, record), options))
     return results
 
 
@@ -79,26 +79,26 @@ def _setup_from_entry(entry) -> Setup:
                  truth.get("static_force_N") or 0.0, PeakRules())
 
 
-def _setup_from_flags(args: AnalyzeOptions, record: ScopeRecord) -> Setup:
-    if args.gauge_distance is None:
+def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
+    if options.gauge_distance is None:
         raise RigError("--gauge-distance is required for real scope files (e.g. --gauge-distance '43.1 mm')")
-    names = args.channels.split(",") if args.channels else list(record.waveforms)[:3 if args.wall else 2]
+    names = options.channels.split(",") if options.channels else list(record.waveforms)[:3 if options.wall else 2]
     if len(names) < 2:
         raise RigError(f"two gauge channels are needed; the files hold {', '.join(record.waveforms) or 'none'}")
     for n in names:
         if n not in record.waveforms:
             raise RigError(f"--channels: {n!r} is not in the files (channels: {', '.join(record.waveforms)})")
-    g = lambda ch, x: GaugeSetup(ch, x, args.sensitivity, args.tau)  # noqa: E731
+    g = lambda ch, x: GaugeSetup(ch, x, options.sensitivity, options.tau)  # noqa: E731
     wall = g(names[2], math.inf) if len(names) > 2 else None
-    return Setup(g(names[0], 0.0), g(names[1], args.gauge_distance), wall, args.diameter,
-                 args.beta, args.f0, PeakRules())
+    return Setup(g(names[0], 0.0), g(names[1], options.gauge_distance), wall, options.diameter,
+                 options.beta, options.f0, PeakRules())
 
 
-def _result(source, record, setup: Setup, args: AnalyzeOptions, entry=None) -> dict:
+def _result(source, record, setup: Setup, options: AnalyzeOptions, entry=None) -> dict:
     rep = analyze_record(record, setup).as_dict()
     rep.pop("leading", None)
     out = {"source": source, "channels": [setup.upper.channel, setup.lower.channel], **rep}
-    mat = args.material or (entry.settings["chain"]["material"] if entry is not None and entry.simulated else None)
+    mat = options.material or (entry.settings["chain"]["material"] if entry is not None and entry.simulated else None)
     out["theory_speed_m_per_s"] = None
     if mat and rep["amplitude_N"]:
         m = material(mat)
