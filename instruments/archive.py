@@ -223,6 +223,11 @@ class Archive:
                     bad.append({"shot": _shot_id(name), "reason": str(exc).splitlines()[0]})
         return {"shots": n, "ok": n - len(bad), "bad": bad}
 
+    def digests(self) -> dict:
+        """{shot id: the SHA-256 of its raw data}, as stored (no shot read)."""
+        with self._open() as f:
+            return {_shot_id(n): f[n].attrs["shot"]["sha256"].decode() for n in f if n.startswith("shot_")}
+
     def summary(self) -> list:
         """One row per shot: id, time, simulated, scene, seed, channels, triggered."""
         rows = []

@@ -1,19 +1,24 @@
-"""The layers of docs/architecture.md hold: every import points down (function-level
-imports included), module-level imports form no cycle, instruments never import rig, and
-no private name is imported across modules. The checker is tested on a planted tree too."""
+"""The layers of docs/architecture.md hold, read with ``ast`` from every .py file under rig/
+and instruments/: imports point down (function-level and literal ``import_module`` ones too),
+module-level imports form no cycle, instruments never import rig, the facade is lazy and gives
+rig only ``__version__``, no private name crosses modules. The checker is tested on a planted tree."""
 import ast
+import subprocess
+import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
-# rank of each layer: a module may import its own layer or a lower one; model and theory
-# share a rank but may not import each other
-RANKS = {"instruments": 0, "rig.errors": 1, "rig.units": 1, "rig.memo": 1, "rig.model": 2, "rig.theory": 2,
-         "rig.solver": 3, "rig.experiment": 4, "rig.viz": 5, "rig.study": 6, "rig.bench": 7, "rig.cli": 8}
-APART = {("rig.model", "rig.theory"), ("rig.theory", "rig.model")}
+# a module may import its own layer or a lower one; model and theory share a rank but stay apart
+RANKS = {"instruments": 0, "rig.errors": 1, "rig.units": 2, "rig.memo": 2, "rig.model": 3, "rig.theory": 3,
+         "rig.solver": 4, "rig.experiment": 5, "rig.viz": 6, "rig.study": 7, "rig.bench": 8, "rig.cli": 9}
+APART = {frozenset({"rig.model", "rig.theory"})}
+HEAVY = {"numba", "scipy", "pint", "pyvista", "vtk", "vtkmodules", "matplotlib", "dask", "h5py"}
 
 
 def layer(module: str):
-    """The layer of a project module (the longest prefix in RANKS), or None (not ours)."""
+    """The layer of a project module (its longest prefix in RANKS), or None."""
     hits = [k for k in RANKS if module == k or module.startswith(k + ".")]
     return max(hits, key=len) if hits else None
 
@@ -24,119 +29,171 @@ def modules(root: Path) -> dict:
     for pkg in ("rig", "instruments"):
         for path in sorted((root / pkg).rglob("*.py")):
             parts = list(path.relative_to(root).with_suffix("").parts)
-            if parts[-1] == "__init__":
-                parts = parts[:-1]
-            out[".".join(parts)] = path
+            out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
     return out
 
 
+def _literal_module(call: ast.Call):
+    """The module named by a literal ``import_module("x")`` or ``__import__("x")`` (for an
+    f-string, the package its literal head names), or None."""
+    func, arg = call.func, call.args[0] if call.args else None
+    if getattr(func, "attr", getattr(func, "id", None)) not in ("import_module", "__import__"):
+        return None
+    if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
+        return arg.value
+    if isinstance(arg, ast.JoinedStr) and arg.values and isinstance(arg.values[0], ast.Constant):
+        return arg.values[0].value.rpartition(".")[0] or None
+    return None
+
+
 def imports(name: str, path: Path):
-    """(imported module, imported name or None, line, at module level) of one file."""
-    tree = ast.parse(path.read_text())
+    """Yield (module, imported name or None, line, runs at import time) for one file."""
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-    top = {id(n) for n in tree.body}
-    top |= {id(c) for n in tree.body if isinstance(n, (ast.If, ast.Try)) for c in ast.walk(n)}
-    for node in ast.walk(tree):
-        level = id(node) in top
-        if isinstance(node, ast.Import):
-            for alias in node.names:
-                yield alias.name, None, node.lineno, level
-        elif isinstance(node, ast.ImportFrom):
-            base = node.module or ""
-            if node.level:
-                parts = package.split(".")[: len(package.split(".")) - node.level + 1]
-                base = ".".join(parts + ([node.module] if node.module else []))
-            for alias in node.names:
-                yield base, alias.name, node.lineno, level
-        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
-              and node.func.attr == "import_module" and node.args and isinstance(node.args[0], ast.Constant)
-              and isinstance(node.args[0].value, str)):
-            yield node.args[0].value, None, node.lineno, False
+
+    def visit(node, top):
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.Import):
+                for alias in child.names:
+                    yield alias.name, None, child.lineno, top
+            elif isinstance(child, ast.ImportFrom):
+                base = child.module or ""
+                if child.level:  # relative: resolve against this module's package
+                    parts = package.split(".")[: len(package.split(".")) - child.level + 1]
+                    base = ".".join(parts + ([child.module] if child.module else []))
+                for alias in child.names:
+                    yield base, alias.name, child.lineno, top
+            elif isinstance(child, ast.Call) and _literal_module(child):
+                yield _literal_module(child), None, child.lineno, top
+            lazy = isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)) or (
+                isinstance(child, ast.If) and "TYPE_CHECKING" in ast.unparse(child.test))  # not run
+            yield from visit(child, top and not lazy)
+
+    yield from visit(ast.parse(path.read_text(), str(path)), True)
+
+
+def _private(part: str) -> bool:  # dunders (__version__, __main__) are public
+    return part.startswith("_") and not part.startswith("__")
 
 
 def check_layers(root: Path) -> list:
-    """Every violation found under root, one line each."""
+    """Every violation under root, one line each: 'file:line: edge: why'."""
     mods = modules(root)
     problems, graph = [], {m: set() for m in mods}
     for name, path in mods.items():
-        here = layer(name)
+        here, rel = layer(name), path.relative_to(root).as_posix()
+        if here is None and name != "rig":
+            problems.append(f"{rel}: {name} is in no layer (add it to RANKS and docs/architecture.md)")
         for target, item, line, top in imports(name, path):
             full = f"{target}.{item}" if item and f"{target}.{item}" in mods else target
-            there = layer(full)
-            where = f"{path.relative_to(root)}:{line}"
-            if name == "rig":  # the facade names its layers as strings, loaded lazily
-                if there is not None and item != "annotations":
-                    problems.append(f"{where}: rig/__init__ imports {full} (use the lazy _PUBLIC table)")
+            if full.split(".")[0] not in ("rig", "instruments") or full == name:
                 continue
-            if here == "instruments" and full.split(".")[0] == "rig":
-                problems.append(f"{where}: {name} imports {full}: instruments never import rig")
-            if full == "rig" and item not in (None, "__version__"):
-                problems.append(f"{where}: {name} imports {item} from the rig facade (name its module)")
-            if there is None or here is None:
-                continue
-            if RANKS[there] > RANKS[here] or (here, there) in APART:
-                problems.append(f"{where}: {name} imports {full}: {here} may not import {there}")
-            private = [p for p in full.split(".") if p.startswith("_") and not p.startswith("__")]
-            if item and item.startswith("_") and not item.startswith("__") and full == target:
-                private.append(item)
-            if private and not name.startswith(full.split("._")[0]):
-                problems.append(f"{where}: {name} imports the private {'.'.join(private)} of {full}")
-            if top and full in mods and full != name:
+            there, edge = layer(full), f"{rel}:{line}: {name} imports {full}"
+            if name == "rig":
+                if top and full != "rig":
+                    problems.append(f"{edge}: the facade loads its layers lazily (_PUBLIC), never at import")
+            elif here == "instruments" and full.split(".")[0] == "rig":
+                problems.append(f"{edge}: instruments never import rig")
+            elif full == "rig" and item != "__version__":
+                problems.append(f"{edge}{f' {item}' if item else ''}: only __version__ comes from the rig "
+                                "facade; name the defining module")
+            elif here and there and (RANKS[there] > RANKS[here] or frozenset({here, there}) in APART):
+                down = f"{here.removeprefix('rig.')} may not import {there.removeprefix('rig.')}"
+                problems.append(f"{edge}: {down}")
+            parts = full.split(".")
+            hidden = [i for i, part in enumerate(parts) if _private(part)]
+            owner = ".".join(parts[: hidden[-1]]) if hidden else None
+            if owner is not None and name != owner and not name.startswith(owner + "."):
+                problems.append(f"{edge}: {parts[hidden[-1]]} is private to {owner}")
+            if item and _private(item) and full == target:
+                problems.append(f"{edge}: {item} is private to {full}")
+            if top and full in mods:
                 graph[name].add(full)
     return problems + [f"import cycle: {' -> '.join(c)}" for c in cycles(graph)]
 
 
 def cycles(graph: dict) -> list:
-    """One cycle (as a path) per strongly connected group of more than one module."""
-    index, low, stack, on, found, counter = {}, {}, [], set(), [], [0]
+    """A cycle path (a -> b -> a) per strongly connected group of modules (Tarjan)."""
+    index, low, stack, groups = {}, {}, [], []
 
-    def visit(v):
-        index[v] = low[v] = counter[0]
-        counter[0] += 1
+    def connect(v):
+        index[v] = low[v] = len(index)
         stack.append(v)
-        on.add(v)
-        for w in graph.get(v, ()):
+        for w in sorted(graph[v]):
             if w not in index:
-                visit(w)
+                connect(w)
                 low[v] = min(low[v], low[w])
-            elif w in on:
+            elif w in stack:
                 low[v] = min(low[v], index[w])
         if low[v] == index[v]:
-            group = []
-            while True:
-                w = stack.pop()
-                on.discard(w)
-                group.append(w)
-                if w == v:
-                    break
+            group = set()
+            while not group or v not in group:
+                group.add(stack.pop())
             if len(group) > 1:
-                found.append(sorted(group) + [sorted(group)[0]])
+                groups.append(group)
 
     for v in sorted(graph):
         if v not in index:
-            visit(v)
-    return found
+            connect(v)
+    return sorted(_shortest_cycle(graph, group) for group in groups)
+
+
+def _shortest_cycle(graph: dict, group: set) -> list:
+    """The shortest path from the group's first module back to itself (breadth first)."""
+    start = min(group)
+    paths, queue = {start: [start]}, [start]
+    for v in queue:
+        for w in sorted(graph[v] & group):
+            if w == start:
+                return paths[v] + [start]
+            if w not in paths:
+                paths[w] = paths[v] + [w]
+                queue.append(w)
 
 
 def test_the_tree_keeps_its_layers():
-    assert check_layers(ROOT) == []
+    problems = check_layers(ROOT)
+    assert not problems, "layer violations (docs/architecture.md):\n" + "\n".join(problems)
 
 
 def test_the_checker_finds_planted_violations(tmp_path):
-    files = {"rig/__init__.py": "", "rig/model/__init__.py": "", "rig/solver/__init__.py": "",
-             "rig/model/chain.py": "def f():\n    from rig.solver.solve import solve\n",
-             "rig/solver/solve.py": "from rig.model import chain\n",
-             "rig/solver/a.py": "from rig.solver.b import x\n", "rig/solver/b.py": "from rig.solver import a\nx = 1\n",
-             "rig/theory/__init__.py": "from rig.model.chain import f\n",
-             "rig/experiment/__init__.py": "from instruments._kernels.peaks import local_maxima\n",
-             "instruments/__init__.py": "", "instruments/y.py": "import rig\n",
-             "instruments/_kernels/__init__.py": "", "instruments/_kernels/peaks.py": "local_maxima = 1\n"}
+    files = {
+        "rig/__init__.py": "from rig.model import x\n", "rig/errors.py": "from rig.units import q\n",
+        "rig/memo.py": "from rig.units import q\n", "rig/cli/ok.py": "from rig import __version__, errors\n",
+        "rig/model/x.py": "from rig.solver.solve import solve\n", "rig/theory/t.py": "from ..model import x\n",
+        "rig/model/lazy.py": "import importlib\ndef f():\n    importlib.import_module('rig.viz.figures')\n",
+        "rig/solver/solve.py": "def solve():\n    from . import c\n",
+        "rig/solver/a.py": "from rig.solver.b import y\ndef _helper(): pass\n", "rig/solver/b.py": "from . import a\n",
+        "rig/solver/c.py": "def f():\n    from rig.solver import solve\n",  # lazy: c <-> solve is no cycle
+        "rig/experiment/e.py": "from instruments._kernels.peaks import p\nfrom rig.solver.a import _helper\n"
+                               "from rig import Chain\n",
+        "rig/extra/z.py": "", "rig/viz/figures.py": "", "instruments/_kernels/peaks.py": "p = 1\n",
+        "instruments/y.py": "import rig\nfrom instruments._kernels import peaks\n",
+    }
     for rel, text in files.items():
         (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
         (tmp_path / rel).write_text(text)
-    found = "\n".join(check_layers(tmp_path))
-    assert "rig.model.chain imports rig.solver.solve: rig.model may not import rig.solver" in found
-    assert "instruments.y imports rig: instruments never import rig" in found
-    assert "rig.theory imports rig.model.chain: rig.theory may not import rig.model" in found
-    assert "import cycle: rig.solver.a -> rig.solver.b -> rig.solver.a" in found
-    assert "imports the private _kernels" in found
+    expected = [
+        "rig/__init__.py:1: rig imports rig.model.x: the facade loads its layers lazily",
+        "rig/errors.py:1: rig.errors imports rig.units: errors may not import units",
+        "rig/model/x.py:1: rig.model.x imports rig.solver.solve: model may not import solver",
+        "rig/model/lazy.py:3: rig.model.lazy imports rig.viz.figures: model may not import viz",
+        "rig/theory/t.py:1: rig.theory.t imports rig.model.x: theory may not import model",
+        "rig/experiment/e.py:1: rig.experiment.e imports instruments._kernels.peaks: _kernels is private to instruments",
+        "rig/experiment/e.py:2: rig.experiment.e imports rig.solver.a: _helper is private to rig.solver.a",
+        "rig/experiment/e.py:3: rig.experiment.e imports rig Chain: only __version__ comes from the rig facade",
+        "rig/extra/z.py: rig.extra.z is in no layer",
+        "instruments/y.py:1: instruments.y imports rig: instruments never import rig",
+        "import cycle: rig.solver.a -> rig.solver.b -> rig.solver.a",
+    ]
+    found = check_layers(tmp_path)  # each expected line, and nothing else
+    for line in expected:
+        assert any(p.startswith(line) for p in found), f"not reported: {line}\nfound:\n" + "\n".join(found)
+    assert len(found) == len(expected), "\n".join(found)
+
+
+@pytest.mark.xfail(strict=False, reason="start-up imports being trimmed")
+def test_the_command_line_parser_loads_nothing_heavy():
+    code = ("import sys, rig.cli\nrig.cli.build_parser()\n"
+            f"print(' '.join(sorted({{m.split('.')[0] for m in sys.modules}} & set({sorted(HEAVY)!r}))))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert out.stdout.split() == [], f"loaded by import rig.cli + build_parser(): {out.stdout.strip()}"

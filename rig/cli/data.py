@@ -16,10 +16,11 @@ def cmd_verify(args) -> dict:
 
 def cmd_import(args) -> dict:
     """Real scope files into an archive, in the same layout as virtual shots (simulated = false)."""
+    import sys
     from datetime import datetime, timezone
     from pathlib import Path
 
-    from instruments.archive import Archive, Entry
+    from instruments.archive import Archive, Entry, raw_digest
     from instruments.formats import read_record
 
     groups = [args.files] if args.together else [[f] for f in args.files]
@@ -29,8 +30,21 @@ def cmd_import(args) -> dict:
         entries.append(Entry(read_record(files), False, scene="",
                              settings={"source_files": [str(Path(f).resolve().name) for f in files]},
                              start_time=datetime.fromtimestamp(mtime, timezone.utc).isoformat()))
-    ids = Archive(args.into).append(entries)
-    out = {"archive": args.into, "shots": ids}
+    archive = Archive(args.into)
+    stored = {}  # raw-data digest -> the first shot that holds it
+    for i, d in sorted(archive.digests().items() if Path(args.into).exists() else []):
+        stored.setdefault(d, i)
+    duplicates, this_import = [], set()
+    for files, e in zip(groups, entries):
+        digest = raw_digest(e.record)
+        if digest in stored or digest in this_import:
+            same = stored.get(digest)
+            duplicates.append({"files": [str(f) for f in files], "same_as": same})
+            print(f"rig import: warning: {', '.join(map(str, files))}: the same raw data as "
+                  f"{f'shot {same}' if same else 'another file of this import'} (imported again)", file=sys.stderr)
+        this_import.add(digest)
+    ids = archive.append(entries)
+    out = {"archive": args.into, "shots": ids, "duplicates": duplicates}
     if not args.json:
         print(f"imported {len(args.files)} file(s) into {args.into} as shot(s) {', '.join(map(str, ids))}")
     return out

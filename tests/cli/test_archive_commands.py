@@ -91,3 +91,13 @@ def test_every_readable_real_csv_imports_and_reads_back_exactly(tmp_path, capsys
         imported += 1
     capsys.readouterr()
     assert imported >= 3
+
+
+def test_importing_the_same_raw_data_again_warns(tmp_path, capsys, realdata):
+    archive, isf = str(tmp_path / "a.h5"), str(realdata / "tek_16bit_dpo.isf")
+    assert main(["import", isf, "--into", archive, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["duplicates"] == []
+    assert main(["import", isf, "--into", archive, "--json"]) == 0
+    captured = capsys.readouterr()
+    assert json.loads(captured.out)["duplicates"] == [{"files": [isf], "same_as": 1}]
+    assert "the same raw data as shot 1" in captured.err
