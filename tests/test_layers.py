@@ -191,7 +191,6 @@ def test_the_checker_finds_planted_violations(tmp_path):
     assert len(found) == len(expected), "\n".join(found)
 
 
-@pytest.mark.xfail(strict=False, reason="start-up imports being trimmed")
 def test_the_command_line_parser_loads_nothing_heavy():
     code = ("import sys, rig.cli\nrig.cli.build_parser()\n"
             f"print(' '.join(sorted({{m.split('.')[0] for m in sys.modules}} & set({sorted(HEAVY)!r}))))")
