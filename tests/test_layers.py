@@ -7,8 +7,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parents[1]
 # a module may import its own layer or a lower one; model and theory share a rank but stay apart
 RANKS = {"instruments": 0, "rig.errors": 1, "rig.units": 2, "rig.memo": 2, "rig.model": 3, "rig.theory": 3,
