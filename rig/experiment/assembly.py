@@ -140,13 +140,6 @@ class Assembly:
             raise invalid("scope.trigger.source", src,
                           f"triggers on an unconnected channel (connected: {', '.join(used) or 'none'})")
 
-    def gauge(self, name: str) -> GaugeWiring:
-        """The gauge wired under ``name``."""
-        for g in self.gauges:
-            if g.name == name:
-                return g
-        raise invalid("gauge", name, f"the scene's gauges: {', '.join(g.name for g in self.gauges) or 'none'}")
-
     def wiring(self) -> dict:
         """{scope channel: what is connected to it ("gauges.NAME" or "wall_sensor")}."""
         out = {g.channel: f"gauges.{g.name}" for g in self.gauges}

@@ -64,9 +64,10 @@ def ensemble_step(problems, t_end: float, method=DEFAULT_METHOD, accuracy=None) 
 def solve_ensemble(problems: list, t_end: float, *, save: SaveAt, dt: float | Stepping,
                    method: str = DEFAULT_METHOD, width: int | None = None) -> EnsembleSolution:
     """Integrate every problem with the same stepping ``dt`` (a step in s, or a Stepping)
-    to ``t_end`` (s), recording what ``save`` names for each shot. ``width``: shots per chunk (default: the batch shared out over
-    numba's threads, 8 to 128: wider chunks spread each row's loop overhead over more
-    shots, and 128 shots of a 53-body chain still fit the core's L2 cache)."""
+    to ``t_end`` (s), recording what ``save`` names for each shot. ``width``: shots per
+    chunk (default: the batch shared out over numba's threads, 8 to 128: wider chunks
+    spread each row's loop overhead over more shots, and 128 shots of a 53-body chain
+    still fit the core's L2 cache)."""
     if not problems:
         raise invalid("problems", [], "at least one shot")
     m = get_method(method)
@@ -79,9 +80,8 @@ def solve_ensemble(problems: list, t_end: float, *, save: SaveAt, dt: float | St
     stepping = dt if isinstance(dt, Stepping) else Stepping(dt)
     if not (t_end > 0 and stepping.dt > 0):
         raise invalid("t_end/dt", (t_end, stepping.dt), "both > 0 s")
-    rec = save
     ch_slot, ch_weight = save.channels(p0.offset)
-    n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), rec.sample_interval)
+    n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), save.sample_interval)
     sub = stepping.substeps(step, m.drifts)
     n = len(problems)
     if width is None:
@@ -102,7 +102,7 @@ def solve_ensemble(problems: list, t_end: float, *, save: SaveAt, dt: float | St
     t0 = time.perf_counter()
     integrate_ensemble(u, v, stack("mass"), stack("invm"), stack("bias"), stack("load"), stack("A"),
                        stack("d0"), np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head, sub,
-                       ch_slot, ch_weight, rec.sample_interval, out,
+                       ch_slot, ch_weight, save.sample_interval, out,
                        max(1, n_steps // MAX_CHECKS), stack("d_limit"), p0.wall_slot,
                        blocks([p.energy_scale for p in padded]), blocks([p.momentum_scale for p in padded]),
                        diag)
@@ -113,5 +113,5 @@ def solve_ensemble(problems: list, t_end: float, *, save: SaveAt, dt: float | St
     bad = [j for j, r in enumerate(reports) if r.status is not Status.SUCCESS]
     if bad:
         raise RigError(f"shot(s) {bad[:10]}: {reports[bad[0]].status.message} (dt = {step:.4g} s)")
-    return EnsembleSolution({name: out[:, c] for c, name in enumerate(save.names)}, rec.sample_interval,
+    return EnsembleSolution({name: out[:, c] for c, name in enumerate(save.names)}, save.sample_interval,
                             step, n_steps, wall, m.name, reports)

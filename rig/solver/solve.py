@@ -80,14 +80,13 @@ def solve(problem: ChainProblem | Chain, t_end: float, *, save: SaveAt | None = 
         stepping = default_step(problem, m, accuracy)
     if stepping.head and (problem.chain.law.dissipative or stepping.head >= problem.n_bodies - 2):
         raise invalid("dt.head", stepping.head, "a multirate head needs a conservative chain longer than the head")
-    rec = save
     ch_slot, ch_weight = save.channels(problem.offset)
-    n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), rec.sample_interval)
+    n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), save.sample_interval)
     sub = stepping.substeps(step, m.drifts)
     out = np.zeros((len(save.names), n_out))
-    if rec.frame_interval is not None:
-        n_frames = int(math.floor(t_end / rec.frame_interval * (1 + 1e-12))) + 1
-        frame_dt = rec.frame_interval
+    if save.frame_interval is not None:
+        n_frames = int(math.floor(t_end / save.frame_interval * (1 + 1e-12))) + 1
+        frame_dt = save.frame_interval
     else:
         n_frames, frame_dt = 0, 1.0
     frames = np.zeros((n_frames, problem.n_bodies))
@@ -100,7 +99,7 @@ def solve(problem: ChainProblem | Chain, t_end: float, *, save: SaveAt | None = 
             problem.damping, problem.chain.law.code, np.array(m.drifts), np.array(m.kicks), step)
     mid = (stepping.head, sub)
     tail = (problem.sched_body, problem.sched_t, problem.sched_f,
-            ch_slot, ch_weight, rec.sample_interval, out, frame_dt, frames,
+            ch_slot, ch_weight, save.sample_interval, out, frame_dt, frames,
             check_every, problem.d_limit, problem.wall_slot,
             problem.energy_scale, problem.momentum_scale, diag)
     integrate(u.copy(), v.copy(), *args, 0, *mid, *tail)  # load the compiled kernel before timing
@@ -116,6 +115,6 @@ def solve(problem: ChainProblem | Chain, t_end: float, *, save: SaveAt | None = 
                         None if dt is not None else float(accuracy))
     moving = slice(0, problem.n_bodies - (1 if problem.wall_slot else 0))
     frames_abs = frames[:, moving] + frame_origin(problem.chain) if n_frames else None
-    return Solution(dict(zip(save.names, out)), rec.sample_interval, frames_abs,
-                    rec.frame_interval, u[moving].copy(), v[moving].copy(), stats, problem,
+    return Solution(dict(zip(save.names, out)), save.sample_interval, frames_abs,
+                    save.frame_interval, u[moving].copy(), v[moving].copy(), stats, problem,
                     report.status)
