@@ -4,6 +4,8 @@ A Waveform is one channel: integer ADC codes plus the preamble that scales them
 (Tektronix WFMPRE convention), volts = y_zero + y_multiplier * (code - y_offset) and
 t = x_zero + x_increment * n with x_zero the time of the first sample relative to the
 trigger (s). Records read from files that hold volts only (CSV) carry ``codes = None``.
+An envelope (peak-detect) record, ``point_format == "ENV"``, holds (min, max) pairs: its
+samples alternate between the minimum and the maximum of each acquisition interval.
 """
 from __future__ import annotations
 
@@ -27,6 +29,7 @@ class Preamble:
     x_unit: str = "s"
     y_unit: str = "V"
     waveform_id: str = ""
+    point_format: str = "Y"  # "Y": one sample per point; "ENV": envelope, (min, max) pairs
     extra: dict = field(default_factory=dict)
 
 

@@ -150,13 +150,13 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
     wfid = h.get("WFID", "")
     m = _CHANNEL.match(wfid)
     name = f"{m.group(1).upper()}{m.group(2)}" if m else Path(path).stem
-    envelope = h.get("PT_FMT", "Y").upper() == "ENV"
+    envelope = h.get("PT_FMT", "Y").upper() in ("ENV", "ENVELOPE")
     if index:
         name = f"{name}#{index + 1}"
     pre = Preamble(points=codes.size, x_increment=dx, x_zero=first, trigger_index=trigger,
                    y_multiplier=_number(h, "YMULT", path), y_offset=_number(h, "YOFF", path),
                    y_zero=_number(h, "YZERO", path), byte_count=codes.dtype.itemsize,
                    x_unit=h.get("XUNIT", "s"), y_unit=h.get("YUNIT", "V"), waveform_id=wfid,
-                   extra={"source": str(path), "record": index + 1,
-                          "point_format": "ENV" if envelope else "Y"})
+                   point_format="ENV" if envelope else "Y",
+                   extra={"source": str(path), "record": index + 1})
     return Waveform(name, pre, codes=codes)

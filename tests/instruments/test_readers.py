@@ -21,7 +21,7 @@ def test_real_8bit_file_with_two_records_reads_both(realdata):
     v = first.volts()
     assert first.preamble.points == 1_250_000 and first.preamble.x_increment == 8e-9
     assert (v.min(), v.max(), v[0]) == (pytest.approx(0.3), pytest.approx(4.9), pytest.approx(0.9))
-    assert second.channel == "CH1#2" and second.preamble.extra["point_format"] == "ENV"
+    assert second.channel == "CH1#2" and second.preamble.point_format == "ENV"
 
 
 def _isf(tmp_path, data: bytes):
