@@ -87,13 +87,16 @@ def raw_values(w: Waveform) -> np.ndarray:
 
 
 def raw_digest(record: ScopeRecord) -> str:
-    """SHA-256 over each channel's name, scaling and raw codes (or volts), in channel order."""
+    """SHA-256 over each channel's name, scaling, point format (when not plain samples) and
+    raw codes (or volts), in channel order."""
     h = hashlib.sha256()
     for ch in sorted(record.waveforms):
         w = record.waveforms[ch]
         p = w.preamble
         h.update(ch.encode())
         h.update(json.dumps([p.points, p.trigger_index] + [getattr(p, k) for k in _PREAMBLE_FLOATS]).encode())
+        if p.point_format != "Y":  # sample records hash as they always did
+            h.update(p.point_format.encode())
         h.update(np.ascontiguousarray(raw_values(w)).tobytes())
     return h.hexdigest()
 
@@ -179,9 +182,9 @@ def _preamble_table(record: ScopeRecord) -> np.ndarray:
         p = w.preamble
         rows.append((ch.encode(), p.points, p.trigger_index, p.byte_count, p.x_increment, p.x_zero,
                      p.y_multiplier, p.y_offset, p.y_zero, p.x_unit.encode(), p.y_unit.encode(),
-                     int(w.overrange), p.waveform_id.encode(),
+                     int(w.overrange), p.point_format.encode(), p.waveform_id.encode(),
                      json.dumps(p.extra, default=_jsonable).encode()))
-    width = [max([len(r[i]) for r in rows] + [1]) for i in (0, 12, 13)]
+    width = [max([len(r[i]) for r in rows] + [1]) for i in (0, 13, 14)]
     dtype = np.dtype([("channel", f"S{width[0]}")] + _PREAMBLE_FIELDS +
                      [("waveform_id", f"S{width[1]}"), ("extra", f"S{width[2]}")])
     return np.array(rows, dtype=dtype)
@@ -190,7 +193,7 @@ def _preamble_table(record: ScopeRecord) -> np.ndarray:
 _PREAMBLE_FIELDS = [("points", "<i8"), ("trigger_index", "<i8"), ("byte_count", "<i4"),
                     ("x_increment", "<f8"), ("x_zero", "<f8"), ("y_multiplier", "<f8"),
                     ("y_offset", "<f8"), ("y_zero", "<f8"), ("x_unit", "S8"), ("y_unit", "S8"),
-                    ("overrange", "u1")]
+                    ("overrange", "u1"), ("point_format", "S4")]
 
 
 def _time_axis(data: h5py.Group, p: Preamble) -> h5py.Dataset:
@@ -225,6 +228,7 @@ def read_entry(g: h5py.Group, verify: bool, path, with_truth: bool = True) -> En
         pre = Preamble(points=int(pa["points"]), trigger_index=int(pa["trigger_index"]),
                        byte_count=int(pa["byte_count"]), x_unit=pa["x_unit"].decode(),
                        y_unit=pa["y_unit"].decode(), waveform_id=pa["waveform_id"].decode(),
+                       point_format=pa["point_format"].decode() if "point_format" in pa.dtype.names else "Y",
                        extra=json.loads(pa["extra"].decode()),
                        **{k: float(pa[k]) for k in _PREAMBLE_FLOATS})
         values = d[()]

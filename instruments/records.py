@@ -53,6 +53,21 @@ class Waveform:
         p = self.preamble
         return p.x_zero + p.x_increment * np.arange(p.points)
 
+    def envelope(self) -> tuple:
+        """(t, v_min, v_max) of an envelope record (``point_format == "ENV"``), volts.
+
+        Tektronix scopes send an envelope as (min, max) pairs, NR_PT counting values and
+        XINCR the interval between values, so that pair k covers the samples 2k and 2k+1
+        (a 10-division screen holds NR_PT x XINCR). The order within a pair differs
+        between models, so each pair's smaller value is the minimum; t is the middle of
+        the pair's interval (s from the trigger)."""
+        if self.preamble.point_format != "ENV":
+            raise ValueError(f"{self.channel}: not an envelope record (point format {self.preamble.point_format!r})")
+        v = self.volts()
+        pairs = v[: v.size - v.size % 2].reshape(-1, 2)
+        t = self.preamble.x_zero + self.preamble.x_increment * (2 * np.arange(pairs.shape[0]) + 0.5)
+        return t, pairs.min(axis=1), pairs.max(axis=1)
+
 
 @dataclass(frozen=True, eq=False)
 class ScopeRecord:

@@ -31,7 +31,8 @@ _ALIASES = {"BYT_NR": "BYT_NR", "BYT_N": "BYT_NR", "BIT_NR": "BIT_NR", "BIT_N": 
             "YOFF": "YOFF", "YOF": "YOFF", "YZERO": "YZERO", "YZE": "YZERO"}
 _REQUIRED = ("BYT_NR", "NR_PT", "XINCR", "XZERO", "YMULT", "YOFF", "YZERO")
 _CURVE = re.compile(rb":CURV(?:E)?\s+#")
-_CHANNEL = re.compile(r"^\s*(ch|math|ref)\s*(\d)", re.IGNORECASE)
+# the source named at the start of WFID: "Ch2, DC coupling, ...", "Math, ...", "Math1 ...", "Ref3"
+_CHANNEL = re.compile(r"^\s*(ch(?=\s*\d)|math|ref)\s*(\d*)", re.IGNORECASE)
 
 
 def _num(x: float) -> str:
@@ -44,7 +45,7 @@ def isf_bytes(w: Waveform) -> bytes:
     nbytes = p.byte_count
     codes = np.asarray(w.codes).astype(">i1" if nbytes == 1 else ">i2")
     header = (f":WFMPRE:BYT_NR {nbytes};BIT_NR {8 * nbytes};ENCDG BIN;BN_FMT RI;BYT_OR MSB;"
-              f"NR_PT {p.points};WFID \"{p.waveform_id}\";PT_FMT Y;XUNIT \"{p.x_unit}\";"
+              f"NR_PT {p.points};WFID \"{p.waveform_id}\";PT_FMT {p.point_format};XUNIT \"{p.x_unit}\";"
               f"XINCR {_num(p.x_increment)};XZERO {_num(p.x_zero)};PT_OFF 0;"
               f"YUNIT \"{p.y_unit}\";YMULT {_num(p.y_multiplier)};YOFF {_num(p.y_offset)};"
               f"YZERO {_num(p.y_zero)};:CURVE ")
@@ -149,7 +150,7 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
     trigger = pt_off if pt_off else int(np.clip(round(-first / dx), 0, codes.size - 1))
     wfid = h.get("WFID", "")
     m = _CHANNEL.match(wfid)
-    name = f"{m.group(1).upper()}{m.group(2)}" if m else Path(path).stem
+    name = f"{m.group(1).upper()}{m.group(2)}" if m else Path(path).stem  # no source named: the file
     envelope = h.get("PT_FMT", "Y").upper() in ("ENV", "ENVELOPE")
     if index:
         name = f"{name}#{index + 1}"

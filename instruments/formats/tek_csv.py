@@ -21,7 +21,7 @@ def write_csv(waveforms: dict, directory, stem: str) -> list:
     rows = [
         ("Model", p0.extra.get("model", "")),
         ("Waveform Type", "ANALOG"),
-        ("Point Format", "Y"),
+        ("Point Format", p0.point_format),
         ("Horizontal Units", p0.x_unit),
         ("Horizontal Scale", f"{p0.x_increment * p0.points / 10:.6g}"),
         ("Sample Interval", f"{p0.x_increment:.10g}"),
@@ -100,8 +100,9 @@ def _read_dpo(path, rows, start) -> list:
     zero = header.get("Zero Index", [None])[0]
     units = header.get("Vertical Units", [])
     interval = header.get("Sample Interval", [None])[0]
-    return [_waveform(path, name, t, table[:, 1 + k], zero, units[k] if k < len(units) else "V", interval)
-            for k, name in enumerate(names)]
+    fmt = header.get("Point Format", [None])[0]
+    return [_waveform(path, name.upper(), t, table[:, 1 + k], zero, units[k] if k < len(units) else "V",
+                      interval, fmt) for k, name in enumerate(names)]
 
 
 def _read_tds(path, rows) -> Waveform:
@@ -124,11 +125,12 @@ def _read_tds(path, rows) -> Waveform:
         raise InstrumentError(f"{path}: Record Length says {n} points but the file holds {len(t)}")
     name = header.get("Source", Path(path).stem).upper()
     return _waveform(path, name, np.array(t), np.array(v), header.get("Trigger Point"),
-                     header.get("Vertical Units", "V"), header["Sample Interval"])
+                     header.get("Vertical Units", "V"), header["Sample Interval"], header.get("Pt Fmt"))
 
 
-def _waveform(path, name, t, v, trigger, unit, interval=None) -> Waveform:
-    """A volts-only Waveform; the sample interval from the header where it is given."""
+def _waveform(path, name, t, v, trigger, unit, interval=None, point_format=None) -> Waveform:
+    """A volts-only Waveform; the sample interval from the header where it is given; an
+    envelope where the header's point format says ENV or PEAK (detect)."""
     try:
         dt = float(interval) if interval not in (None, "") else float(np.median(np.diff(t)))
     except ValueError:
@@ -140,5 +142,6 @@ def _waveform(path, name, t, v, trigger, unit, interval=None) -> Waveform:
     idx = int(float(trigger)) if trigger not in (None, "") else int(np.clip(round(-t[0] / dt), 0, t.size - 1))
     pre = Preamble(points=t.size, x_increment=dt, x_zero=float(t[0]), trigger_index=idx,
                    y_multiplier=1.0, y_offset=0.0, y_zero=0.0, byte_count=0, y_unit=unit or "V",
+                   point_format="ENV" if (point_format or "Y").strip().upper().startswith(("ENV", "PEAK")) else "Y",
                    extra={"source": str(path)})
     return Waveform(name, pre, samples=v)

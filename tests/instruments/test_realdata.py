@@ -1,0 +1,142 @@
+"""Every file in the real-data folder, whatever it is: read exactly as an independent reader
+reads it, or refused in one line naming its format. The folder is walked (files added later
+are tested by their format, not by name)."""
+import struct
+
+import numpy as np
+import pytest
+
+from instruments.errors import InstrumentError
+from instruments.formats import identify, read_waveforms
+
+FOREIGN = ("LeCroy", "Rigol", "Keysight", "Yokogawa", "Rohde", "HDF5", "no scope format")
+
+
+def _files(realdata):
+    return sorted(p for p in realdata.iterdir() if p.is_file() and not p.name.endswith((".source.txt", ".md")))
+
+
+def _isf_independent(path):
+    """RigolWFM's ISF reader (the first record of a file: it reads no further)."""
+    rigol = pytest.importorskip("RigolWFM.wfm")
+    ch = rigol.Wfm.from_file(str(path), "ISF").channels[0]
+    return np.asarray(ch.times), np.asarray(ch.volts), 1e-6  # it scales in float32
+
+
+def _csv_independent(path):
+    """numpy on the data rows: the DPO/MSO/TBS layout's columns after its TIME row, or the
+    TDS1000/2000 layout's fourth and fifth columns."""
+    lines = path.read_text().splitlines()
+    title = next((i for i, line in enumerate(lines) if line.split(",")[0].strip().upper() == "TIME"), None)
+    if title is None:
+        table = np.loadtxt(lines, delimiter=",", usecols=(3, 4), ndmin=2)
+    else:
+        ncol = len([c for c in lines[title].split(",") if c.strip()])
+        table = np.loadtxt([line for line in lines[title + 1:] if line.strip()], delimiter=",",
+                           usecols=range(ncol), ndmin=2)
+    return table[:, 0], table[:, 1:], 0.0
+
+
+def _wfm_independent(path):
+    """The WFM#003 header fields at their fixed offsets (Tektronix's reference manual for the
+    WFM#002/#003 layout, little-endian files): the explicit dimension's scale and offset (V
+    per code, V) at bytes 168 and 176, the implicit dimension's (s per sample, s) at 488 and
+    496, the curve buffer's byte offset at 16 and the data start / postcharge start offsets
+    within it at 822 and 826."""
+    b = path.read_bytes()
+    assert b[:2] == b"\x0f\x0f" and b[2:10] in (b":WFM#002", b":WFM#003"), "a little-endian WFM#002/3 file"
+    (curve,) = struct.unpack_from("<i", b, 16)
+    (vscale, voff) = struct.unpack_from("<2d", b, 168)
+    (tscale, toff) = struct.unpack_from("<2d", b, 488)
+    start, stop = struct.unpack_from("<2I", b, 822)
+    width = b[15]
+    codes = np.frombuffer(b, dtype={1: "<i1", 2: "<i2"}[width], count=(stop - start) // width, offset=curve + start)
+    return toff + tscale * np.arange(codes.size), codes * vscale + voff, 0.0
+
+
+INDEPENDENT = {"isf": _isf_independent, "csv": _csv_independent, "wfm": _wfm_independent}
+
+
+def test_every_real_file_reads_exactly_or_is_refused_naming_its_format(realdata):
+    read, refused = [], []
+    for path in _files(realdata):
+        try:
+            kind = identify(path)
+        except InstrumentError as exc:
+            msg = str(exc)
+            assert "\n" not in msg and msg.startswith(str(path)) and any(f in msg for f in FOREIGN), msg
+            assert "the rig reads Tektronix ISF, CSV and WFM files" in msg
+            refused.append(path.name)
+            continue
+        waves = read_waveforms(path)
+        t_ref, v_ref, tol = INDEPENDENT[kind](path)
+        v_ref = v_ref.reshape(len(t_ref), -1)
+        for k in range(v_ref.shape[1]):
+            w = waves[k]
+            assert w.preamble.points == t_ref.size, path.name
+            np.testing.assert_allclose(w.time(), t_ref, rtol=0, atol=1e-6 * w.preamble.x_increment + tol * 1e-3,
+                                       err_msg=path.name)
+            scale = np.max(np.abs(v_ref[:, k])) or 1.0
+            np.testing.assert_allclose(w.volts(), v_ref[:, k], rtol=0, atol=tol * scale + 1e-12 * scale,
+                                       err_msg=path.name)
+        read.append(path.name)
+    assert read and refused
+
+
+def test_the_source_channel_comes_from_the_header(realdata):
+    (math,) = read_waveforms(realdata / "jeremitu_data1.isf")  # WFID "Math, AC coupling, ..."
+    (ch2,) = read_waveforms(realdata / "tek_16bit_dpo.isf")  # WFID "Ch2, DC coupling, ..."
+    assert (math.channel, ch2.channel) == ("MATH", "CH2")
+    assert [w.channel for w in read_waveforms(realdata / "bee331_MSO3012_tek0000.csv")] == ["CH1", "CH2"]
+    assert [w.channel for w in read_waveforms(realdata / "pchem_TDS2001C_F0000CH1.CSV")] == ["CH1"]  # "Source,CH1"
+
+
+def test_an_envelope_record_reads_as_min_max_pairs(realdata):
+    (w,) = read_waveforms(realdata / "jeremitu_data1.isf")  # PT_FMT ENVELOPE, Pk Detect mode
+    assert w.preamble.point_format == "ENV"
+    t, lo, hi = w.envelope()
+    v = w.volts()
+    assert t.size == v.size // 2 == 5000
+    assert np.array_equal(lo, np.minimum(v[0::2], v[1::2])) and np.array_equal(hi, np.maximum(v[0::2], v[1::2]))
+    # "1.0E-3 s/div, 10000 points": ten divisions hold NR_PT values at XINCR apart
+    assert w.preamble.points * w.preamble.x_increment == pytest.approx(10 * 1e-3)
+    assert t[1] - t[0] == pytest.approx(2 * w.preamble.x_increment)
+    with pytest.raises(ValueError, match="not an envelope"):
+        read_waveforms(realdata / "tek_16bit_dpo.isf")[0].envelope()
+
+
+def test_tektronix_wfm_reads_as_codes_with_their_scaling(realdata):
+    (w,) = read_waveforms(realdata / "tekpce_sample_1.wfm")  # Tektronix's own sample file
+    assert w.codes.dtype == np.int8 and w.preamble.points == 1000
+    assert w.preamble.x_increment == pytest.approx(20e-12) and w.time()[0] == pytest.approx(-10e-9)
+    assert (w.codes.min(), w.codes.max()) == (-83, 99)  # a sine-like record, not a constant
+    tm = pytest.importorskip("tm_data_types")  # Tektronix's reader, where it is installed
+    theirs = tm.read_file(str(realdata / "tekpce_sample_1.wfm"))
+    assert np.array_equal(np.asarray(theirs.y_axis_values), w.codes)
+    assert float(theirs.y_axis_spacing) == w.preamble.y_multiplier
+
+
+@pytest.mark.parametrize("head, name", [
+    (b"#9000020746WAVEDESC\0\0\0\0\0\0\0\0LECROY_2_3\0", "LeCroy .trc"),
+    (b"AG10" + bytes(40), "Keysight/Agilent .bin"),
+    (b"\xa5\xa5\x00\x00" + bytes(300), "Rigol .wfm"),
+    (b"RG03" + bytes(40), "Rigol .bin"),
+    (b"X,CH1,CH2,Start,Increment,\nSequence,Volt,Volt,-3e-07,5e-10\n0,1,2,\n", "Rigol CSV"),
+    (b"$PublicInfo\nFormatVersion 1.11\n", "Yokogawa"),
+    (b"\x89HDF\r\n\x1a\n" + bytes(100), "HDF5"),
+    (b"just some notes\nabout a shot\n", "a text file in no scope format"),
+    (b"\x00\x01\x02\x03binary junk" * 10, "a binary file in no scope format"),
+])
+@pytest.mark.parametrize("suffix", [".isf", ".csv", ".wfm", ""])
+def test_other_formats_are_refused_by_content_naming_them(tmp_path, head, name, suffix):
+    path = tmp_path / f"record{suffix}"
+    path.write_bytes(head)
+    with pytest.raises(InstrumentError, match=name.replace(".", r"\.").replace("(", r"\(")) as exc:
+        read_waveforms(path)
+    assert "\n" not in str(exc.value)
+
+
+def test_an_empty_file_is_refused(tmp_path):
+    (tmp_path / "empty.csv").write_bytes(b"")
+    with pytest.raises(InstrumentError, match="empty file"):
+        read_waveforms(tmp_path / "empty.csv")
