@@ -41,7 +41,9 @@ class PeakRules:
     distance: least spacing of pulses (s); width: least width of a pulse at half its
     prominence (s; rejects noise spikes, which are a sample or two wide); top: fraction of a
     pulse's amplitude over which its parabola is fitted; lead: the leading pulse is the
-    first one above this fraction of the record's largest pulse."""
+    first one above this fraction of the record's largest pulse; snr: the least amplitude of
+    a measured pulse in units of its record's baseline noise (instruments/quality.py says
+    why 10)."""
 
     height: float = 0.1
     prominence: float = 0.05
@@ -49,12 +51,14 @@ class PeakRules:
     width: float = 2e-6
     top: float = 0.05
     lead: float = 0.3
+    snr: float = 10.0
 
     def __post_init__(self):
         for name in ("height", "prominence", "top", "lead"):
             check(f"peaks.{name}", getattr(self, name), lo=0, hi=1)
         check("peaks.distance", self.distance, lo=0, lo_closed=True, unit="s")
         check("peaks.width", self.width, lo=0, lo_closed=True, unit="s")
+        check("peaks.snr", self.snr, lo=0, lo_closed=True)
 
 
 @dataclass(frozen=True)

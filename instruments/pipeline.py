@@ -7,6 +7,11 @@ Speed: distance between the gauges over the time between their leading-pulse max
 published), and by cross-correlation of the leading pulses. Amplitude: the mean of the two
 gauges' leading-pulse amplitudes, F_m,e; the contact force amplitude F_d = beta F_m,e and
 the total F_m = F_d + F_0.
+
+No figure is left out without a reason: ``Report.reasons`` maps each missing figure to why
+(no pulse, below the signal-to-noise rule, an envelope record, channels swapped or the same
+record twice, non-finite samples, an implausible speed: instruments/quality.py), and
+``Report.snr`` gives each gauge's leading-pulse amplitude over its baseline noise.
 """
 from __future__ import annotations
 
@@ -17,6 +22,7 @@ import numpy as np
 
 from .analysis import PeakRules, find_pulses, invert_rc, leading, refined, remove_baseline, xcorr_delay
 from .errors import InstrumentError, check
+from .quality import MAX_BAR_SPEED_M_PER_S, baseline_noise, speed_problem
 from .records import ScopeRecord
 
 
@@ -51,15 +57,27 @@ class Setup:
     static_force_N: float = 0.0
     rules: PeakRules = field(default_factory=PeakRules)
     wall_distance_m: float | None = None
+    max_speed_m_per_s: float = MAX_BAR_SPEED_M_PER_S
 
     def __post_init__(self):
         check("gauge_distance", self.lower.position_m - self.upper.position_m, lo=0, unit="m")
         check("beta", self.beta, lo=0, hi=10)
+        check("max_speed", self.max_speed_m_per_s, lo=0, unit="m/s")
+
+
+FIGURES = ("speed_m_per_s", "speed_xcorr_m_per_s", "averaged_amplitude_N", "amplitude_N", "total_force_N",
+           "pulses", "duration_s", "base_duration_s", "width_diameters")
+
+
+def _missing(v) -> bool:
+    return v is None or (isinstance(v, float) and not math.isfinite(v))
 
 
 @dataclass
 class Report:
-    """The analysis of one shot (SI units; None where a pulse was not found)."""
+    """The analysis of one shot (SI units; None where a figure could not be measured, and
+    then ``reasons[figure]`` says why; ``snr``: each gauge's leading-pulse amplitude over
+    its baseline noise, where the record has noise)."""
 
     speed_m_per_s: float | None = None
     speed_xcorr_m_per_s: float | None = None
@@ -73,16 +91,36 @@ class Report:
     base_duration_s: float | None = None
     width_diameters: float | None = None
     leading: dict = field(default_factory=dict)
+    snr: dict = field(default_factory=dict)
+    reasons: dict = field(default_factory=dict)
+
+    def refuse(self, why: str, figures=None) -> Report:
+        """Say why ``figures`` (default: every figure still missing) are left out; the first
+        reason given for a figure stays."""
+        for f in figures or [f for f in FIGURES if _missing(getattr(self, f))]:
+            self.reasons.setdefault(f, why)
+        return self
 
     def as_dict(self) -> dict:
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                 for k, v in asdict(self).items()}
 
 
-def record_forces(record: ScopeRecord, setup: Setup):
-    """Calibrated dynamic forces (N) from a scope record: t (s from the trigger) and
-    {"upper", "lower"[, "wall"]}: baseline from the pre-trigger samples, RC inverted."""
-    out, t, base = {}, None, None
+@dataclass(frozen=True)
+class GaugeForces:
+    """Calibrated dynamic forces (N) of a record: t (s from the trigger), forces by role
+    ("upper", "lower"[, "wall"]), each role's baseline noise (N) and, for a role whose
+    record cannot be analysed (an envelope, non-finite samples), why."""
+
+    t: np.ndarray
+    forces: dict
+    noise: dict
+    unusable: dict
+
+
+def record_forces(record: ScopeRecord, setup: Setup) -> GaugeForces:
+    """Baseline from the pre-trigger samples, RC inverted, volts to newtons."""
+    out, noise, unusable, t, base = {}, {}, {}, None, None
     for role in ("upper", "lower", "wall"):
         g = getattr(setup, role)
         if g is None:
@@ -91,36 +129,65 @@ def record_forces(record: ScopeRecord, setup: Setup):
             raise InstrumentError(f"{role} gauge channel {g.channel!r} is not in the record "
                                   f"(channels: {', '.join(record.waveforms) or 'none'})")
         w = record.waveforms[g.channel]
-        h = w.preamble.x_increment
         p = w.preamble
         if t is None:
             t, base = w.time(), (p.points, p.x_increment, p.x_zero)
         elif (p.points, p.x_increment, p.x_zero) != base:
             raise InstrumentError(f"channel {g.channel} has another time base than the first gauge")
-        v = remove_baseline(w.volts(), w.preamble.trigger_index)
+        v = w.volts()
+        if p.point_format == "ENV":
+            unusable[role] = (f"{g.channel} is an envelope (peak-detect) record: (min, max) pairs, not "
+                              f"samples; record in sample or average mode")
+        elif not np.all(np.isfinite(v)):
+            unusable[role] = f"{g.channel} holds non-finite samples (a NaN or infinite scale factor?)"
+        if role in unusable:
+            v = np.zeros_like(v, dtype=float)
+        v = remove_baseline(v, p.trigger_index)
+        noise[role] = baseline_noise(v, p.trigger_index, p.y_multiplier if w.codes is not None else None) \
+            / g.sensitivity_V_per_N
         if g.tau_s is not None:
-            v = invert_rc(v, h, g.tau_s)
+            v = invert_rc(v, p.x_increment, g.tau_s)
         out[role] = v / g.sensitivity_V_per_N
-    return t, out
+    return GaugeForces(t, out, noise, unusable)
 
 
-def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True) -> Report:
+def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True,
+                   noise: dict | None = None) -> Report:
     """Speed, amplitudes, pulse count and widths from dynamic forces (baseline 0).
     train=False leaves the solitary train uncounted (pulses None): studies that need only
-    the leading pulse skip the wall channel and two peak searches."""
+    the leading pulse skip the wall channel and two peak searches. noise: each role's
+    baseline noise (N) for the signal-to-noise rule (None: noise-free forces, no rule)."""
     rules = setup.rules
-    up = leading(find_pulses(t, forces["upper"], rules, refine=False), rules)
-    low = leading(find_pulses(t, forces["lower"], rules, refine=False), rules)
     rep = Report(beta=setup.beta, static_force_N=setup.static_force_N)
-    if up is None or low is None:
-        return rep
-    up, low = refined(t, forces["upper"], up, rules), refined(t, forces["lower"], low, rules)
+    lead = {}
+    for role in ("upper", "lower"):
+        p = leading(find_pulses(t, forces[role], rules, refine=False), rules)
+        channel = getattr(setup, role).channel
+        if p is None:
+            return rep.refuse(f"no pulse above the baseline on the {role} gauge ({channel})")
+        if noise is not None:
+            rep.snr[role] = p.amplitude / noise[role] if noise[role] > 0 else math.inf
+            if rep.snr[role] < rules.snr:
+                return rep.refuse(f"the {role} gauge's largest pulse ({channel}) is only {rep.snr[role]:.3g} x its "
+                                  f"baseline noise; a pulse must stand {rules.snr:g} x above it")
+        lead[role] = p
+    if np.array_equal(forces["upper"], forces["lower"]):
+        return rep.refuse(f"the upper and lower gauges ({setup.upper.channel}, {setup.lower.channel}) hold the "
+                          f"same record: the same file twice?")
+    up, low = refined(t, forces["upper"], lead["upper"], rules), refined(t, forces["lower"], lead["lower"], rules)
     if low.time <= up.time:
-        return rep
+        return rep.refuse(f"the lower gauge's pulse ({setup.lower.channel}, {low.time:.4g} s) comes before the "
+                          f"upper gauge's ({setup.upper.channel}, {up.time:.4g} s): channels swapped?")
     distance = setup.lower.position_m - setup.upper.position_m
+    problem = speed_problem(distance, low.time - up.time, t[1] - t[0], up.fwhm, setup.bead_diameter_m,
+                            setup.max_speed_m_per_s)
+    if problem:
+        return rep.refuse(f"implausible: {problem}")
     rep.speed_m_per_s = distance / (low.time - up.time)
     lag = xcorr_delay(t, forces["upper"], up, forces["lower"], low)
     rep.speed_xcorr_m_per_s = distance / lag if lag > 0 else None
+    if rep.speed_xcorr_m_per_s is None:
+        rep.refuse("the leading pulses do not cross-correlate at a positive delay", ("speed_xcorr_m_per_s",))
     rep.averaged_amplitude_N = 0.5 * (up.amplitude + low.amplitude)
     rep.amplitude_N = setup.beta * rep.averaged_amplitude_N
     rep.total_force_N = rep.amplitude_N + setup.static_force_N
@@ -131,7 +198,9 @@ def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True
         cut = reflection_time(t, forces, setup, low, rep.speed_m_per_s)
         rep.pulses = len(solitary_train(t, forces["lower"], low, cut, rules))
     rep.leading = {"upper": dict(vars(up)), "lower": dict(vars(low))}  # a Pulse holds floats only
-    return rep
+    if not train:
+        rep.refuse("not counted: only the leading pulse was analysed", ("pulses",))
+    return rep.refuse("the leading pulse's half-maximum or 1% crossings lie outside the record")
 
 
 def solitary_train(t, f, lead, cut: float, rules: PeakRules = PeakRules(), refine: bool = False) -> list:
@@ -154,11 +223,18 @@ def reflection_time(t, forces, setup: Setup, low, speed) -> float:
 
 
 def analyze_record(record: ScopeRecord, setup: Setup, train: bool = True) -> Report:
-    """The full pipeline on one scope record; an untriggered record gives an empty report.
-    train=False: the leading pulse only (see analyze_forces; the wall channel is not read)."""
+    """The full pipeline on one scope record; an untriggered or unusable record gives a
+    report whose reasons say why. train=False: the leading pulse only (see analyze_forces;
+    the wall channel is not read)."""
+    rep = Report(beta=setup.beta, static_force_N=setup.static_force_N)
     if not record.triggered:
-        return Report(beta=setup.beta, static_force_N=setup.static_force_N)
+        return rep.refuse(f"the scope did not trigger: {record.reason or 'no reason recorded'}")
     if not train:
         setup = replace(setup, wall=None)
-    t, forces = record_forces(record, setup)
-    return analyze_forces(t, forces, setup, train)
+    g = record_forces(record, setup)
+    bad = [g.unusable[r] for r in ("upper", "lower") if r in g.unusable]
+    if bad:
+        return rep.refuse("; ".join(bad))
+    if "wall" in g.unusable:
+        g.forces.pop("wall")
+    return analyze_forces(g.t, g.forces, setup, train, g.noise)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 MAX_SEED = 2**63 - 1  # seeds are stored as signed 64-bit integers
@@ -36,16 +37,38 @@ def quantity_arg(text: str, unit: str, field: str) -> float:
         return quantity(text, unit, field)
 
 
-def quantity_type(unit: str, field: str):
-    """An argparse type for a quantity in ``unit`` (a plain number is taken in ``unit``);
-    a mistake is reported as the field, the value and what is allowed."""
+def quantity_type(unit: str, field: str, lo: float | None = None, lo_closed: bool = False, hi: float | None = None):
+    """An argparse type for a finite quantity in ``unit`` (a plain number is taken in
+    ``unit``), above ``lo`` (or at it, with lo_closed) and at most ``hi`` where given; a
+    mistake is reported as the field, the value and what is allowed."""
     def parse(text: str) -> float:
         from rig.errors import RigError
 
         try:
-            return quantity_arg(text, unit, field)
+            x = quantity_arg(text, unit, field)
         except RigError as exc:
             raise argparse.ArgumentTypeError(str(exc).removeprefix(f"{field} = ")) from None
+        low = lo is not None and (x < lo if lo_closed else x <= lo)
+        if not math.isfinite(x) or low or (hi is not None and x > hi):
+            rng = " ".join(filter(None, [f"{lo:g} {'<=' if lo_closed else '<'}" if lo is not None else "",
+                                         "value", f"<= {hi:g}" if hi is not None else ""]))
+            raise argparse.ArgumentTypeError(f"{text!r}: allowed a finite {rng}{' (' + unit + ')' if unit else ''}")
+        return x
 
-    parse.__name__ = f"quantity in {unit}"
+    parse.__name__ = f"quantity in {unit}" if unit else "number"
+    return parse
+
+
+def count_type(field: str, lo: int = 1):
+    """An argparse type for a whole number >= lo."""
+    def parse(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r}: allowed a whole number >= {lo}") from None
+        if n < lo:
+            raise argparse.ArgumentTypeError(f"{text!r}: allowed a whole number >= {lo}")
+        return n
+
+    parse.__name__ = field
     return parse

@@ -51,6 +51,10 @@ def cmd_import(args) -> dict:
 
 
 def cmd_analyze(args) -> list:
+    """The pipeline on scope files and archive shots. Every missing figure comes with its
+    reason (printed under the table, and in the JSON's "reasons"); exit 1 when no source
+    gave a speed, so that a script cannot take a row of dashes for a result."""
+    from instruments.pipeline import FIGURES
     from rig.experiment.analyze import AnalyzeOptions, analyze_paths
 
     options = AnalyzeOptions(files=tuple(args.files), shot=args.shot, gauge_distance=args.gauge_distance,
@@ -60,13 +64,22 @@ def cmd_analyze(args) -> list:
     if not args.json:
         fmt = lambda v, spec=".2f": "-" if v is None else format(v, spec)  # noqa: E731
         print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d N':>8s} {'F_m,e N':>8s} "
-              f"{'pulses':>6s} {'FWHM us':>8s} {'Eq1 m/s':>8s}")
+              f"{'pulses':>6s} {'FWHM us':>8s} {'Eq1 m/s':>8s} {'SNR up/low':>11s}")
         for r in results:
             fwhm = None if r["duration_s"] is None else r["duration_s"] * 1e6
+            snr = "/".join(fmt(r["snr"].get(k), ".0f") for k in ("upper", "lower"))
             print(f"{r['source'][-40:]:40s} {fmt(r['speed_m_per_s'], '.1f'):>8s} "
                   f"{fmt(r['speed_xcorr_m_per_s'], '.1f'):>8s} {fmt(r['amplitude_N'], '.3f'):>8s} "
                   f"{fmt(r['averaged_amplitude_N'], '.3f'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
-                  f"{fmt(fwhm, '.1f'):>8s} {fmt(r['theory_speed_m_per_s'], '.1f'):>8s}")
+                  f"{fmt(fwhm, '.1f'):>8s} {fmt(r['theory_speed_m_per_s'], '.1f'):>8s} {snr:>11s}")
+        for r in results:
+            why = {}
+            for figure, reason in r["reasons"].items():
+                why.setdefault(reason, []).append(figure)
+            for reason, figures in why.items():
+                what = "result" if len(figures) >= len(FIGURES) else ", ".join(figures)
+                print(f"  {r['source'][-40:]}: no {what}: {reason}")
+    args.exit_code = 0 if any(r["speed_m_per_s"] is not None for r in results) else 1
     return results
 
 

@@ -8,7 +8,7 @@ need it from the command line: --gauge-distance, and optionally --sensitivity, -
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from instruments.analysis import PeakRules
@@ -19,6 +19,8 @@ from instruments.records import ScopeRecord
 from rig.errors import RigError
 from rig.model.materials import material
 from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed
+
+THEORY_FACTOR = 2.0  # a measured speed within 1/2 to 2 x Eq (1) at its amplitude is plausible
 
 
 @dataclass(frozen=True)
@@ -95,16 +97,35 @@ def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
 
 
 def _result(source, record, setup: Setup, options: AnalyzeOptions, entry=None) -> dict:
-    rep = analyze_record(record, setup).as_dict()
-    rep.pop("leading", None)
-    out = {"source": source, "channels": [setup.upper.channel, setup.lower.channel], **rep}
+    """The pipeline's report as a JSON-ready dict, with the Eq (1) speed where the material
+    is known. With a material, a speed above its bar speed sqrt(E/rho) is implausible (the
+    pipeline refuses it), and so is one off Eq (1) at the measured amplitude by more than
+    THEORY_FACTOR: V ~ F^(1/6), so even a tenfold error in the gauge sensitivity moves Eq
+    (1) by only 1.5x."""
     mat = options.material or (entry.settings["chain"]["material"] if entry is not None and entry.simulated else None)
+    m = material(mat) if mat else None
+    if m is not None:
+        setup = replace(setup, max_speed_m_per_s=math.sqrt(m.E / m.rho))
+    rep = analyze_record(record, setup)
+    out = {"source": source, "channels": [setup.upper.channel, setup.lower.channel], **rep.as_dict()}
+    out.pop("leading", None)
     out["theory_speed_m_per_s"] = None
-    if mat and rep["amplitude_N"]:
-        m = material(mat)
+    if m is None:
+        out["reasons"].setdefault("theory_speed_m_per_s", "no bead material given (--material)")
+    elif not rep.amplitude_N or rep.amplitude_N <= 0:
+        out["reasons"].setdefault("theory_speed_m_per_s", out["reasons"].get("amplitude_N", "no amplitude"))
+    else:
         F0 = setup.static_force_N
-        Fm = rep["amplitude_N"] + F0
-        out["theory_speed_m_per_s"] = float(
-            solitary_wave_speed(m.E, m.nu, m.rho, setup.bead_diameter_m, F0, Fm) if F0 > 0
-            else sonic_vacuum_speed(m.E, m.nu, m.rho, setup.bead_diameter_m, Fm))
+        Fm = rep.amplitude_N + F0
+        v = float(solitary_wave_speed(m.E, m.nu, m.rho, setup.bead_diameter_m, F0, Fm) if F0 > 0
+                  else sonic_vacuum_speed(m.E, m.nu, m.rho, setup.bead_diameter_m, Fm))
+        out["theory_speed_m_per_s"] = v
+        ratio = rep.speed_m_per_s / v
+        if not 1 / THEORY_FACTOR <= ratio <= THEORY_FACTOR:
+            why = (f"implausible: {rep.speed_m_per_s:.4g} m/s is {ratio:.3g} x the Eq (1) speed of {mat} at the "
+                   f"measured amplitude ({v:.4g} m/s; allowed 1/{THEORY_FACTOR:g} to {THEORY_FACTOR:g} x): check "
+                   f"--gauge-distance, --material, --sensitivity")
+            for key in ("speed_m_per_s", "speed_xcorr_m_per_s", "width_diameters"):
+                out[key] = None
+                out["reasons"][key] = why
     return out

@@ -47,7 +47,8 @@ def figure_specs(results, rigs) -> list:
             shot = r.fire(seed=seeds_for(1, 1)[0])
             pre = "gravity only" if "gravity" in scene else "2.38 N magnet"
             setup = setup_for(r, 1.0, 0.0)
-            t, f = record_forces(shot.scope, setup)
+            g = record_forces(shot.scope, setup)
+            t, f = g.t, g.forces
             panels[(pre, "virtual scope (time from trigger)")] = [
                 (f"gauge {g}", t, f[g]) for g in ("upper", "lower")] + [("wall", t, f["wall"])]
             tr = r.truth()
