@@ -42,6 +42,8 @@ def build_parser() -> argparse.ArgumentParser:
     sh.add_argument("--export", metavar="DIR", help="write the scope records to DIR")
     sh.add_argument("--format", choices=["isf", "csv"], default="isf", help="scope file format (default isf)")
     sh.add_argument("--out", metavar="ARCHIVE.h5", help="append the shot to an HDF5 archive")
+    sh.add_argument("--allow-large", action="store_true",
+                    help="run even when the estimate exceeds 2 GiB of memory or 2 min of CPU")
 
     ve = _command(sub, "verify", "check every shot of an archive (exit 1 if any is bad)", data.cmd_verify)
     ve.add_argument("archive")
@@ -59,6 +61,8 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("--seed", type=seed_arg, default=0, help="the sweep's seed (default 0)")
     sw.add_argument("--out", metavar="ARCHIVE.h5", help="append every shot to an archive")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
+    sw.add_argument("--allow-large", action="store_true",
+                    help="run even when the estimate exceeds 2 GiB of memory or 2 min of CPU")
 
     an = _command(sub, "animate", "render a virtual shot to a movie or still, off-screen", shots.cmd_animate)
     an.add_argument("scene")
@@ -69,6 +73,8 @@ def build_parser() -> argparse.ArgumentParser:
     an.add_argument("--exaggerate", type=float,
                     help="displacement factor (default: the largest displacement shown as 1/3 diameter)")
     an.add_argument("--quiet", action="store_true", help="no progress bar")
+    an.add_argument("--allow-large", action="store_true",
+                    help="run even when the estimate exceeds 2 GiB of memory or 2 min of CPU")
 
     rp = _command(sub, "reproduce", "re-run a published study (daraio2006)", sweeps.cmd_reproduce)
     rp.add_argument("study", choices=["daraio2006"], help="the published study to re-run")
@@ -77,15 +83,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     mc = _command(sub, "mc", "Monte Carlo study over many virtual shots", study.cmd_mc)
     mc.add_argument("scene")
-    mc.add_argument("--shots", type=int, required=True)
+    mc.add_argument("--shots", type=count_type("shots"), required=True, help="number of shots (>= 1)")
     mc.add_argument("--vary", action="append", metavar="KEY=DIST",
                     help='e.g. striker.velocity="normal(0.89 m/s, 0.01 m/s)"; also chain.bead_mass, '
                          'gauges.NAME.gain, gauges.NAME.misalignment')
     mc.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides")
     mc.add_argument("--seed", type=seed_arg, default=0, help="the study's seed (default 0)")
-    mc.add_argument("--batch", type=int, default=128, help="shots per batch (default 128)")
+    mc.add_argument("--batch", type=count_type("batch"), default=128, help="shots per batch (default 128)")
     mc.add_argument("--accuracy", type=float, help="solver accuracy (default: the scene's)")
-    mc.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
+    mc.add_argument("--workers", type=count_type("workers"), default=1, help="local worker processes (default 1)")
     mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")
     mc.add_argument("--sobol", action="store_true", help="Sobol design and indices (needs SALib)")
     mc.add_argument("--truth", action="store_true", help="also analyse each shot's noise-free truth (slower)")
@@ -96,6 +102,8 @@ def build_parser() -> argparse.ArgumentParser:
                     help="also archive every shot's scope record and truth in DIR/traces/ (one archive per batch)")
     mc.add_argument("--out", required=True, metavar="DIR")
     mc.add_argument("--quiet", action="store_true", help="no progress bar")
+    mc.add_argument("--allow-large", action="store_true",
+                    help="run even when the estimate exceeds 2 GiB of memory or 2 min of CPU")
 
     an = _command(sub, "analyze", "speeds and amplitudes from scope files or an archive (exit 1: no speed, "
                                   "with the reasons)", data.cmd_analyze)
@@ -134,10 +142,13 @@ def main(argv=None) -> int:
     except (RigError, InstrumentError) as exc:
         print(f"rig {args.command}: error: {exc}", file=sys.stderr)
         return 2
-    except OSError as exc:  # a file named on the command line that is missing, unreadable, ...
-        if exc.filename is None:
-            raise
-        print(f"rig {args.command}: error: {exc.filename}: {exc.strerror or exc}", file=sys.stderr)
+    except OSError as exc:  # a missing or unreadable file, a full disk, a read-only folder, ...
+        where = f"{exc.filename}: " if exc.filename is not None else ""
+        print(f"rig {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f"rig {args.command}: error: out of memory (a smaller scene, a shorter solver.duration or a "
+              f"coarser solver.sample_interval needs less)", file=sys.stderr)
         return 2
     if args.json:
         print(json.dumps(out, indent=2))

@@ -14,10 +14,12 @@ def cmd_shot(args) -> dict:
     from pathlib import Path
 
     from instruments.formats import WRITERS
+    from rig.experiment.budget import shot_budget
     from rig.experiment.measure import shot_blocks
     from rig.experiment.shot import Rig
 
     rig = Rig(scene)
+    announce(shot_budget(rig).check(args.allow_large))
     shot = rig.fire(seed=args.seed)
     out = shot_summary(rig, shot)
     out.update(shot_blocks(rig, shot))
@@ -36,6 +38,12 @@ def cmd_shot(args) -> dict:
     if not args.json:
         print_shot(out)
     return out
+
+
+def announce(budget, over_s: float = 10.0):
+    """Say on stderr, before it starts, what a long run will cost."""
+    if budget.cpu_s > over_s:
+        print(f"rig: this run takes {budget.note()}", file=sys.stderr)
 
 
 def shot_summary(rig, shot) -> dict:
@@ -113,10 +121,12 @@ def cmd_animate(args) -> dict:
     require_renderer(args.out)
     from tqdm import tqdm
 
+    from rig.experiment.budget import shot_budget
     from rig.experiment.shot import Rig
     from rig.viz.animate import animate
 
     rig = Rig(scene)
+    announce(shot_budget(rig).check(args.allow_large))
     still = args.out.lower().endswith(".png")
     with tqdm(total=None if still else args.frames, desc="animate", unit="frame", file=sys.stderr,
               disable=args.quiet or still) as bar:

@@ -12,7 +12,10 @@ def cmd_mc(args) -> dict:
     from tqdm import tqdm
 
     from rig.study.distributions import parse_vary
-    from rig.study.mc_run import run_to
+    from rig.cli.shots import announce
+    from rig.experiment.budget import shot_budget
+    from rig.study.mc_run import check, run_to
+    from rig.study.nominal import nominal
     from rig.study.mc_spec import Study
     from rig.study.sobol import sobol_shots
 
@@ -25,6 +28,9 @@ def cmd_mc(args) -> dict:
                   f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
     study = Study(args.scene, dists, shots, args.seed, tuple(args.set or ()), args.batch, args.accuracy,
                   args.sobol, args.truth, args.window, args.traces)
+    check(study)  # everything a shot would refuse, before the progress bar
+    one = shot_budget(nominal(study.scene, study.overrides).rig)
+    announce(one.times(study.shots, in_memory=min(study.batch, study.shots) * args.workers).check(args.allow_large))
     with tqdm(total=study.shots, desc="mc", unit="shot", file=sys.stderr, disable=args.quiet) as bar:
         def started(done):
             bar.update(done)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from rig.cli.shots import shot_summary
+from rig.cli.shots import announce, shot_summary
 
 
 def cmd_sweep(args) -> dict:
@@ -13,14 +13,17 @@ def cmd_sweep(args) -> dict:
     scene = load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
     from tqdm import tqdm
 
+    from rig.experiment.budget import shot_budget
     from rig.experiment.shot import Rig
-    from rig.study.sweep import Vary, run_sweep
+    from rig.study.sweep import Vary, run_sweep, sweep_rigs
 
     vary = Vary.parse(args.vary)
-    Rig(scene)  # the base scene itself must be valid
-    with tqdm(total=len(vary.values), desc=f"sweep {vary.key}", unit="shot", file=sys.stderr,
+    base = Rig(scene)  # the base scene itself must be valid
+    announce(shot_budget(base).times(vary.count).check(args.allow_large))  # every point is kept
+    rigs = sweep_rigs(args.scene, vary, args.set or ())
+    with tqdm(total=vary.count, desc=f"sweep {vary.key}", unit="shot", file=sys.stderr,
               disable=args.quiet) as bar:
-        points = run_sweep(args.scene, vary, args.set or (), args.seed, bar.update, args.out)
+        points = run_sweep(rigs, vary, args.seed, bar.update, args.out)
     out = {"points": []}
     for p in points:
         one = shot_summary(p.rig, p.shot)

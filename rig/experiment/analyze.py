@@ -55,7 +55,7 @@ def analyze_paths(options: AnalyzeOptions) -> list:
         ids = [options.shot] if options.shot is not None else archive.ids()
         for i in ids:
             entry = archive.read(i, with_truth=False)
-            setup = _setup_from_entry(entry) if entry.simulated else _setup_from_flags(options, entry.record)
+            setup = _setup_from_entry(entry, options) if entry.simulated else _setup_from_flags(options, entry.record)
             results.append(_result(f"{a}#{i}", entry.record, setup, options, entry))
     if files:
         record = read_record(files)
@@ -63,7 +63,19 @@ def analyze_paths(options: AnalyzeOptions) -> list:
     return results
 
 
-def _setup_from_entry(entry) -> Setup:
+def _real_file_flags(options: AnalyzeOptions) -> list:
+    """The flags given that describe a real set-up (a virtual shot carries its own)."""
+    given = {"--gauge-distance": options.gauge_distance is not None, "--channels": options.channels is not None,
+             "--wall": options.wall, "--sensitivity": options.sensitivity != 1.0, "--tau": options.tau is not None,
+             "--beta": options.beta != 1.0, "--f0": options.f0 != 0.0, "--diameter": options.diameter != 4.76e-3}
+    return [flag for flag, on in given.items() if on]
+
+
+def _setup_from_entry(entry, options: AnalyzeOptions) -> Setup:
+    flags = _real_file_flags(options)
+    if flags:
+        raise RigError(f"{', '.join(flags)}: for real scope files only; shot {entry.shot_id} is a virtual shot "
+                       f"and carries its own gauge positions, sensitivities and beta")
     facts, settings = entry.facts, entry.settings
     if facts is None:
         raise RigError(f"shot {entry.shot_id}: a virtual shot without its facts (gauge positions) cannot be analysed")

@@ -23,7 +23,13 @@ class Vary:
     with units)."""
 
     key: str
-    values: tuple
+    start: float
+    stop: float
+    count: int
+
+    @property
+    def values(self) -> tuple:
+        return tuple(float(v) for v in np.linspace(self.start, self.stop, self.count))
 
     @classmethod
     def parse(cls, text: str) -> "Vary":
@@ -45,7 +51,7 @@ class Vary:
             raise invalid(f"--vary {key}", spec, "START must not exceed STOP")
         if count == 1 and start != stop:
             raise invalid(f"--vary {key}", spec, "one point needs START = STOP")
-        return cls(key, tuple(float(v) for v in np.linspace(start, stop, count)))
+        return cls(key, float(start), float(stop), count)
 
     def override(self, value) -> str:
         unit = _unit_of(self.key)
@@ -91,14 +97,20 @@ def seeds_for(seed: int, count: int) -> list:
     return [int(s >> np.uint64(1)) for s in state]
 
 
-def run_sweep(scene, vary: Vary, overrides=(), seed: int = 0, progress=None, archive=None) -> list:
-    """Fire one shot per value; archive them (if given) even when a later point fails."""
+def sweep_rigs(scene, vary: Vary, overrides=()) -> list:
+    """Every point's rig, assembled (and so validated) before any shot is fired."""
     rigs = []
-    for v in vary.values:  # assemble (validate) every point before firing any
+    for v in vary.values:
         try:
             rigs.append(Rig.from_scene(scene, list(overrides) + [vary.override(v)]))
         except ValueError as exc:
             raise RigError(f"--vary {vary.key} = {v:g}: {exc}") from None
+    return rigs
+
+
+def run_sweep(rigs: list, vary: Vary, seed: int = 0, progress=None, archive=None) -> list:
+    """Fire one shot per rig of ``sweep_rigs``; archive them (if given) even when a later
+    point fails."""
     points, entries = [], []
     try:
         for v, rig, s in zip(vary.values, rigs, seeds_for(seed, len(rigs))):
