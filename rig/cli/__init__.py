@@ -99,7 +99,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     an = _command(sub, "analyze", "speeds and amplitudes from scope files or an archive", data.cmd_analyze)
     an.add_argument("files", nargs="+", metavar="FILE", help=".isf, .csv or .h5 (an archive)")
-    an.add_argument("--shot", type=int, help="one shot of an archive (default: every shot)")
+    an.add_argument("--shot", type=int, help="one shot of an archive, a whole number >= 0 (default: every shot)")
     an.add_argument("--gauge-distance", type=quantity_type("m", "--gauge-distance"),
                     help="distance between the two gauges (plain number: m), for real files")
     an.add_argument("--channels", help="UPPER,LOWER[,WALL] channel names (default: file order)")
@@ -107,11 +107,12 @@ def build_parser() -> argparse.ArgumentParser:
     an.add_argument("--sensitivity", type=quantity_type("V/N", "--sensitivity"), default=1.0,
                     help="gauge sensitivity, e.g. '0.05 V/N' (plain number: V/N; default 1: volts)")
     an.add_argument("--tau", type=quantity_type("s", "--tau"), help="gauge RC time constant to invert (s)")
-    an.add_argument("--beta", type=float, default=1.0, help="beta = F_d / F_m,e (default 1)")
+    an.add_argument("--beta", type=float, default=1.0, help="beta = F_d / F_m,e, dimensionless, > 0 (default 1)")
     an.add_argument("--f0", type=quantity_type("N", "--f0"), default=0.0, help="precompression F_0 (N)")
     an.add_argument("--diameter", type=quantity_type("m", "--diameter"), default=4.76e-3,
                     help="bead diameter (plain number: m; default 4.76 mm)")
-    an.add_argument("--material", help="bead material, to add the Eq (1) speed")
+    an.add_argument("--material", help="bead material: adds the Eq (1) speed and checks the measured one "
+                                       "against it and the material's bar speed")
 
     ls = _command(sub, "ls", "list the shots of an archive", data.cmd_ls)
     ls.add_argument("archive")

@@ -51,12 +51,17 @@ def cmd_import(args) -> dict:
 
 
 def cmd_analyze(args) -> list:
+    """The analysis table, each channel's SNR and, under each source, why any figure is
+    missing. Exit 0 when at least one source gave a speed, 1 when none did (as `rig verify`
+    with bad shots); a mistake in the flags or files is exit 2 (main)."""
+    from instruments.report import FIGURES
     from rig.experiment.analyze import AnalyzeOptions, analyze_paths
 
     options = AnalyzeOptions(files=tuple(args.files), shot=args.shot, gauge_distance=args.gauge_distance,
                              channels=args.channels, wall=args.wall, sensitivity=args.sensitivity, tau=args.tau,
                              beta=args.beta, f0=args.f0, diameter=args.diameter, material=args.material)
     results = analyze_paths(options)
+    args.exit_code = 0 if any(r["speed_m_per_s"] is not None for r in results) else 1
     if not args.json:
         fmt = lambda v, spec=".2f": "-" if v is None else format(v, spec)  # noqa: E731
         print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d N':>8s} {'F_m,e N':>8s} "
@@ -67,6 +72,14 @@ def cmd_analyze(args) -> list:
                   f"{fmt(r['speed_xcorr_m_per_s'], '.1f'):>8s} {fmt(r['amplitude_N'], '.3f'):>8s} "
                   f"{fmt(r['averaged_amplitude_N'], '.3f'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
                   f"{fmt(fwhm, '.1f'):>8s} {fmt(r['theory_speed_m_per_s'], '.1f'):>8s}")
+            if r["snr"]:
+                print("  SNR (leading pulse / pre-trigger noise): "
+                      + ", ".join(f"{ch} {fmt(v, '.3g')}" for ch, v in r["snr"].items()))
+            why = {}
+            for figure, reason in r["reasons"].items():
+                why.setdefault(reason, []).append(figure)
+            for reason, figures in why.items():
+                print(f"  no {'result' if set(FIGURES) <= set(figures) else ', '.join(figures)}: {reason}")
     return results
 
 
