@@ -47,5 +47,10 @@ class Report:
             self.refuse(why, (name,))
 
     def as_dict(self) -> dict:
-        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+        """JSON-ready: non-finite floats (at the top and in snr, noise, leading) as None."""
+        return {k: ({kk: _finite(vv) for kk, vv in v.items()} if k in ("snr", "noise") else _finite(v))
                 for k, v in asdict(self).items()}
+
+
+def _finite(v):
+    return None if isinstance(v, float) and not math.isfinite(v) else v

@@ -105,3 +105,10 @@ def test_leading_pulse_only_says_the_train_was_not_counted():
 def test_limits_refuse_nonsense(limits):
     with pytest.raises(InstrumentError, match="limits."):
         Limits(**limits)
+
+
+def test_json_form_has_no_infinity():
+    from instruments.report import Report
+
+    d = Report(snr={"CH1": float("inf")}, noise={"CH1": 0.0}, duration_s=float("nan")).as_dict()
+    assert d["snr"] == {"CH1": None} and d["noise"] == {"CH1": 0.0} and d["duration_s"] is None
