@@ -97,7 +97,9 @@ def build_parser() -> argparse.ArgumentParser:
     mc.add_argument("--out", required=True, metavar="DIR")
     mc.add_argument("--quiet", action="store_true", help="no progress bar")
 
-    an = _command(sub, "analyze", "speeds and amplitudes from scope files or an archive", data.cmd_analyze)
+    an = _command(sub, "analyze", "speeds and amplitudes from scope files or an archive, each channel's SNR, "
+                                  "and why any figure is missing (exit 1 when no source gives a speed)",
+                  data.cmd_analyze)
     an.add_argument("files", nargs="+", metavar="FILE", help=".isf, .csv or .h5 (an archive)")
     an.add_argument("--shot", type=int, help="one shot of an archive, a whole number >= 0 (default: every shot)")
     an.add_argument("--gauge-distance", type=quantity_type("m", "--gauge-distance"),
