@@ -1,6 +1,7 @@
 """Analysis of gauge signals as in Daraio et al., Phys. Rev. E 73, 026610 (2006).
 
-Conditioning: baseline from the pre-trigger samples; inversion of the one-pole RC
+Conditioning: baseline from the pre-trigger samples, and the noise from them too (see
+noise_level); inversion of the one-pole RC
 high-pass, x = y + (1/tau) * integral of y dt (trapezoid rule); volts to force with the
 gauge's sensitivity. Pulses: the rules of scipy.signal.find_peaks (height, distance,
 prominence, width; compiled in _kernels/, the same results bit for bit);
@@ -30,6 +31,23 @@ def remove_baseline(y: np.ndarray, n_pre: int) -> np.ndarray:
     return y - np.mean(y[:max(int(n_pre), 10)])
 
 
+MIN_BASELINE = 16  # pre-trigger samples needed to measure the noise (the MAD to about 1/3)
+
+
+def noise_level(y: np.ndarray, n_pre: int, step: float = 0.0) -> float | None:
+    """The noise of a conditioned signal (its unit) from its first n_pre samples, the
+    pre-trigger baseline: 1.4826 x their median absolute deviation (the standard deviation
+    of Gaussian noise, but robust: a spike or the start of a slow signal in the baseline
+    does not inflate it as it does the standard deviation), never below the quantisation
+    floor step / sqrt(12) (a flat 8-bit baseline has a MAD of 0, yet a code step hides
+    that much). None with fewer than MIN_BASELINE samples: the noise cannot be measured."""
+    if n_pre < MIN_BASELINE:
+        return None
+    pre = y[:n_pre]
+    mad = 1.4826 * float(np.median(np.abs(pre - np.median(pre))))
+    return max(mad, abs(step) / math.sqrt(12.0))
+
+
 def invert_rc(y: np.ndarray, h: float, tau: float) -> np.ndarray:
     """Undo a one-pole RC high-pass of time constant tau (s): x = y + (1/tau) int y dt."""
     return undo_highpass(np.ascontiguousarray(y, dtype=float), float(h), float(tau))
@@ -41,9 +59,11 @@ class PeakRules:
     distance: least spacing of pulses (s); width: least width of a pulse at half its
     prominence (s; rejects noise spikes, which are a sample or two wide); top: fraction of a
     pulse's amplitude over which its parabola is fitted; lead: the leading pulse is the
-    first one above this fraction of the record's largest pulse; snr: the least amplitude of
-    a measured pulse in units of its record's baseline noise (instruments/quality.py says
-    why 10)."""
+    first one above this fraction of the record's largest pulse; snr: where the noise is
+    known, a pulse must stand this many noise levels above the baseline. 8: a record of
+    1e7 Gaussian samples exceeds 6.4 sigma about once in a thousand records
+    (1e7 x Q(6.4) = 8e-4), and the margin to 8 covers the MAD's own scatter on a short
+    baseline and noise tails heavier than Gaussian."""
 
     height: float = 0.1
     prominence: float = 0.05
@@ -51,14 +71,14 @@ class PeakRules:
     width: float = 2e-6
     top: float = 0.05
     lead: float = 0.3
-    snr: float = 10.0
+    snr: float = 8.0
 
     def __post_init__(self):
+        check("peaks.snr", self.snr, lo=0, hi=math.inf, hi_closed=False)
         for name in ("height", "prominence", "top", "lead"):
             check(f"peaks.{name}", getattr(self, name), lo=0, hi=1)
         check("peaks.distance", self.distance, lo=0, lo_closed=True, unit="s")
         check("peaks.width", self.width, lo=0, lo_closed=True, unit="s")
-        check("peaks.snr", self.snr, lo=0, lo_closed=True)
 
 
 @dataclass(frozen=True)

@@ -8,21 +8,23 @@ published), and by cross-correlation of the leading pulses. Amplitude: the mean 
 gauges' leading-pulse amplitudes, F_m,e; the contact force amplitude F_d = beta F_m,e and
 the total F_m = F_d + F_0.
 
-No figure is left out without a reason: ``Report.reasons`` maps each missing figure to why
-(no pulse, below the signal-to-noise rule, an envelope record, channels swapped or the same
-record twice, non-finite samples, an implausible speed: instruments/quality.py), and
-``Report.snr`` gives each gauge's leading-pulse amplitude over its baseline noise.
+No figure without a reason: each one the analysis cannot give is None, and
+``Report.reasons`` says why (an envelope or untriggered record, non-finite samples, no
+pulse standing ``rules.snr`` noise levels above the pre-trigger baseline, the same record
+on both gauges, the lower pulse first, a speed that fails instruments.plausibility). An
+implausible speed is not given: the speed figures are None and the reason quotes the value.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .analysis import PeakRules, find_pulses, invert_rc, leading, refined, remove_baseline, xcorr_delay
+from .analysis import MIN_BASELINE, PeakRules, find_pulses, invert_rc, leading, noise_level, refined, remove_baseline, xcorr_delay
 from .errors import InstrumentError, check
-from .quality import MAX_BAR_SPEED_M_PER_S, baseline_noise, speed_problem
+from .plausibility import Limits, record_doubt, speed_doubt
+from .report import SPEED_FIGURES, Report
 from .records import ScopeRecord
 
 
@@ -46,8 +48,8 @@ class GaugeSetup:
 class Setup:
     """What the analysis is told: the two gauges (upper first), the wall sensor if any, the
     bead diameter (m), beta = F_d / F_m,e and F_0 (N) from the scene's numerics, the peak
-    rules, and the distance from the lower gauge to the wall (m) where no wall sensor says
-    when the reflection arrives."""
+    rules, the distance from the lower gauge to the wall (m) where no wall sensor says
+    when the reflection arrives, and the limits of a plausible speed."""
 
     upper: GaugeSetup
     lower: GaugeSetup
@@ -57,70 +59,17 @@ class Setup:
     static_force_N: float = 0.0
     rules: PeakRules = field(default_factory=PeakRules)
     wall_distance_m: float | None = None
-    max_speed_m_per_s: float = MAX_BAR_SPEED_M_PER_S
+    limits: Limits = field(default_factory=Limits)
 
     def __post_init__(self):
         check("gauge_distance", self.lower.position_m - self.upper.position_m, lo=0, unit="m")
         check("beta", self.beta, lo=0, hi=10)
-        check("max_speed", self.max_speed_m_per_s, lo=0, unit="m/s")
 
 
-FIGURES = ("speed_m_per_s", "speed_xcorr_m_per_s", "averaged_amplitude_N", "amplitude_N", "total_force_N",
-           "pulses", "duration_s", "base_duration_s", "width_diameters")
-
-
-def _missing(v) -> bool:
-    return v is None or (isinstance(v, float) and not math.isfinite(v))
-
-
-@dataclass
-class Report:
-    """The analysis of one shot (SI units; None where a figure could not be measured, and
-    then ``reasons[figure]`` says why; ``snr``: each gauge's leading-pulse amplitude over
-    its baseline noise, where the record has noise)."""
-
-    speed_m_per_s: float | None = None
-    speed_xcorr_m_per_s: float | None = None
-    averaged_amplitude_N: float | None = None
-    amplitude_N: float | None = None
-    total_force_N: float | None = None
-    beta: float | None = None
-    static_force_N: float | None = None
-    pulses: int | None = None
-    duration_s: float | None = None
-    base_duration_s: float | None = None
-    width_diameters: float | None = None
-    leading: dict = field(default_factory=dict)
-    snr: dict = field(default_factory=dict)
-    reasons: dict = field(default_factory=dict)
-
-    def refuse(self, why: str, figures=None) -> Report:
-        """Say why ``figures`` (default: every figure still missing) are left out; the first
-        reason given for a figure stays."""
-        for f in figures or [f for f in FIGURES if _missing(getattr(self, f))]:
-            self.reasons.setdefault(f, why)
-        return self
-
-    def as_dict(self) -> dict:
-        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
-                for k, v in asdict(self).items()}
-
-
-@dataclass(frozen=True)
-class GaugeForces:
-    """Calibrated dynamic forces (N) of a record: t (s from the trigger), forces by role
-    ("upper", "lower"[, "wall"]), each role's baseline noise (N) and, for a role whose
-    record cannot be analysed (an envelope, non-finite samples), why."""
-
-    t: np.ndarray
-    forces: dict
-    noise: dict
-    unusable: dict
-
-
-def record_forces(record: ScopeRecord, setup: Setup) -> GaugeForces:
-    """Baseline from the pre-trigger samples, RC inverted, volts to newtons."""
-    out, noise, unusable, t, base = {}, {}, {}, None, None
+def record_forces(record: ScopeRecord, setup: Setup):
+    """Calibrated dynamic forces (N) from a scope record: t (s from the trigger) and
+    {"upper", "lower"[, "wall"]}: baseline from the pre-trigger samples, RC inverted."""
+    out, t, base = {}, None, None
     for role in ("upper", "lower", "wall"):
         g = getattr(setup, role)
         if g is None:
@@ -129,92 +78,126 @@ def record_forces(record: ScopeRecord, setup: Setup) -> GaugeForces:
             raise InstrumentError(f"{role} gauge channel {g.channel!r} is not in the record "
                                   f"(channels: {', '.join(record.waveforms) or 'none'})")
         w = record.waveforms[g.channel]
+        h = w.preamble.x_increment
         p = w.preamble
         if t is None:
             t, base = w.time(), (p.points, p.x_increment, p.x_zero)
         elif (p.points, p.x_increment, p.x_zero) != base:
             raise InstrumentError(f"channel {g.channel} has another time base than the first gauge")
-        v = w.volts()
-        if p.point_format == "ENV":
-            unusable[role] = (f"{g.channel} is an envelope (peak-detect) record: (min, max) pairs, not "
-                              f"samples; record in sample or average mode")
-        elif not np.all(np.isfinite(v)):
-            unusable[role] = f"{g.channel} holds non-finite samples (a NaN or infinite scale factor?)"
-        if role in unusable:
-            v = np.zeros_like(v, dtype=float)
-        v = remove_baseline(v, p.trigger_index)
-        noise[role] = baseline_noise(v, p.trigger_index, p.y_multiplier if w.codes is not None else None) \
-            / g.sensitivity_V_per_N
+        v = remove_baseline(w.volts(), w.preamble.trigger_index)
         if g.tau_s is not None:
-            v = invert_rc(v, p.x_increment, g.tau_s)
+            v = invert_rc(v, h, g.tau_s)
         out[role] = v / g.sensitivity_V_per_N
-    return GaugeForces(t, out, noise, unusable)
+    return t, out
 
 
-def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True,
-                   noise: dict | None = None) -> Report:
+def record_noise(record: ScopeRecord, setup: Setup, forces: dict) -> dict:
+    """role -> the noise (N) of each conditioned channel of ``forces`` (record_forces), from
+    its pre-trigger samples with the floor of one code step (analysis.noise_level); None
+    where the record has too short a baseline to measure it."""
+    out = {}
+    for role, f in forces.items():
+        g = getattr(setup, role)
+        w = record.waveforms[g.channel]
+        out[role] = noise_level(f, w.preamble.trigger_index, _code_step(w) / g.sensitivity_V_per_N)
+    return out
+
+
+def _code_step(w) -> float:
+    """One code step of a waveform (V): the scale factor, or for volts without codes (CSV)
+    the least difference between two of its distinct values."""
+    if w.codes is not None:
+        return abs(w.preamble.y_multiplier)
+    steps = np.diff(np.unique(w.samples))
+    return float(steps.min()) if steps.size else 0.0
+
+
+def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True, noise: dict | None = None) -> Report:
     """Speed, amplitudes, pulse count and widths from dynamic forces (baseline 0).
     train=False leaves the solitary train uncounted (pulses None): studies that need only
-    the leading pulse skip the wall channel and two peak searches. noise: each role's
-    baseline noise (N) for the signal-to-noise rule (None: noise-free forces, no rule)."""
-    rules = setup.rules
-    rep = Report(beta=setup.beta, static_force_N=setup.static_force_N)
-    lead = {}
-    for role in ("upper", "lower"):
-        p = leading(find_pulses(t, forces[role], rules, refine=False), rules)
-        channel = getattr(setup, role).channel
-        if p is None:
-            return rep.refuse(f"no pulse above the baseline on the {role} gauge ({channel})")
-        if noise is not None:
-            rep.snr[role] = p.amplitude / noise[role] if noise[role] > 0 else math.inf
-            if rep.snr[role] < rules.snr:
-                return rep.refuse(f"the {role} gauge's largest pulse ({channel}) is only {rep.snr[role]:.3g} x its "
-                                  f"baseline noise; a pulse must stand {rules.snr:g} x above it")
-        lead[role] = p
+    the leading pulse skip the wall channel and two peak searches. noise: role -> noise (N;
+    None: unmeasurable, and no pulse is accepted) for the SNR rule; None: noise-free
+    signals (the truth), no SNR rule."""
+    rules, rep = setup.rules, Report(beta=setup.beta, static_force_N=setup.static_force_N)
+    ch = {role: getattr(setup, role).channel for role in ("upper", "lower")}
     if np.array_equal(forces["upper"], forces["lower"]):
-        return rep.refuse(f"the upper and lower gauges ({setup.upper.channel}, {setup.lower.channel}) hold the "
-                          f"same record: the same file twice?")
-    up, low = refined(t, forces["upper"], lead["upper"], rules), refined(t, forces["lower"], lead["lower"], rules)
+        return rep.refuse(f"{ch['upper']} and {ch['lower']} hold the same record (the same file twice?)")
+    problems = []
+    up, low = (_leading_pulse(t, forces[role], rules, ch[role], noise, role, rep, problems) for role in ("upper", "lower"))
+    if problems:
+        return rep.refuse("; ".join(problems))
     if low.time <= up.time:
-        return rep.refuse(f"the lower gauge's pulse ({setup.lower.channel}, {low.time:.4g} s) comes before the "
-                          f"upper gauge's ({setup.upper.channel}, {up.time:.4g} s): channels swapped?")
-    distance = setup.lower.position_m - setup.upper.position_m
-    problem = speed_problem(distance, low.time - up.time, t[1] - t[0], up.fwhm, setup.bead_diameter_m,
-                            setup.max_speed_m_per_s)
-    if problem:
-        return rep.refuse(f"implausible: {problem}")
-    rep.speed_m_per_s = distance / (low.time - up.time)
-    lag = xcorr_delay(t, forces["upper"], up, forces["lower"], low)
-    rep.speed_xcorr_m_per_s = distance / lag if lag > 0 else None
-    if rep.speed_xcorr_m_per_s is None:
-        rep.refuse("the leading pulses do not cross-correlate at a positive delay", ("speed_xcorr_m_per_s",))
+        return rep.refuse(f"the lower gauge's pulse ({ch['lower']}, {low.time * 1e6:.4g} us) comes before or with "
+                          f"the upper gauge's ({ch['upper']}, {up.time * 1e6:.4g} us): channels swapped?")
+    rep.leading = {"upper": dict(vars(up)), "lower": dict(vars(low))}  # a Pulse holds floats only
     rep.averaged_amplitude_N = 0.5 * (up.amplitude + low.amplitude)
     rep.amplitude_N = setup.beta * rep.averaged_amplitude_N
     rep.total_force_N = rep.amplitude_N + setup.static_force_N
-    rep.duration_s = up.fwhm
-    rep.base_duration_s = up.base_width
-    rep.width_diameters = up.fwhm * rep.speed_m_per_s / setup.bead_diameter_m
+    rep.give("duration_s", up.fwhm, f"{ch['upper']}: the leading pulse never falls to half its amplitude")
+    rep.give("base_duration_s", up.base_width, f"{ch['upper']}: the leading pulse never falls to 1% of its amplitude")
+    distance, flight = setup.lower.position_m - setup.upper.position_m, low.time - up.time
+    doubt = (record_doubt(setup.limits, distance, float(t[-1] - t[0]))
+             or speed_doubt(setup.limits, distance, flight, float(t[1] - t[0]), up.fwhm, setup.bead_diameter_m))
+    if doubt:
+        return rep.refuse(f"implausible speed: {doubt}", SPEED_FIGURES)
+    rep.speed_m_per_s = distance / flight
+    lag = xcorr_delay(t, forces["upper"], up, forces["lower"], low)
+    rep.give("speed_xcorr_m_per_s", distance / lag if lag > 0 else math.nan,
+             "the cross-correlation of the leading pulses found no positive delay")
+    rep.give("width_diameters", up.fwhm * rep.speed_m_per_s / setup.bead_diameter_m, rep.reasons.get("duration_s", ""))
     if train:
-        cut = reflection_time(t, forces, setup, low, rep.speed_m_per_s)
-        rep.pulses = len(solitary_train(t, forces["lower"], low, cut, rules))
-    rep.leading = {"upper": dict(vars(up)), "lower": dict(vars(low))}  # a Pulse holds floats only
-    if not train:
-        rep.refuse("not counted: only the leading pulse was analysed", ("pulses",))
-    return rep.refuse("the leading pulse's half-maximum or 1% crossings lie outside the record")
+        sigma = noise and noise.get("lower")
+        cut = reflection_time(t, forces, setup, low, rep.speed_m_per_s, noise)
+        rep.pulses = len(solitary_train(t, forces["lower"], low, cut, rules, noise=sigma))
+    else:
+        rep.refuse("the train was not counted (leading pulse only)", ("pulses",))
+    return rep
 
 
-def solitary_train(t, f, lead, cut: float, rules: PeakRules = PeakRules(), refine: bool = False) -> list:
-    """The solitary waves of a train at one gauge: pulses above 5% of the leading one, from
-    the leading one until ``cut`` (s; when the wall's reflection arrives)."""
-    train = find_pulses(t, f, rules, floor=0.05 * lead.amplitude, refine=refine)
+def _leading_pulse(t, f, rules: PeakRules, channel: str, noise, role: str, rep: Report, problems: list):
+    """The refined leading pulse of one channel, or None with the reason added to problems;
+    its noise and SNR go into rep."""
+    peak = float(np.max(f)) if f.size else 0.0
+    sigma = None if noise is None else noise.get(role)
+    if noise is not None and sigma is None:
+        problems.append(f"{channel}: fewer than {MIN_BASELINE} samples before the trigger: the noise, and so "
+                        f"whether a pulse stands above it, cannot be measured")
+        return None
+    floor = None if sigma is None else max(rules.height * peak, rules.snr * sigma)
+    if sigma is not None:
+        rep.noise[channel], rep.snr[channel] = sigma, (peak / sigma if sigma > 0 else math.inf)
+    coarse = leading(find_pulses(t, f, rules, floor=floor, refine=False), rules)
+    if coarse is None:
+        if sigma is not None and peak < rules.snr * sigma:
+            problems.append(f"{channel}: no pulse stands {rules.snr:g} times above the pre-trigger noise "
+                            f"({sigma:.3g}): its highest excursion is {rep.snr[channel]:.3g} times the noise")
+        else:
+            problems.append(f"{channel}: no pulse passes the peak rules (height, prominence, width)")
+        return None
+    pulse = refined(t, f, coarse, rules)
+    if sigma is not None and sigma > 0:
+        rep.snr[channel] = pulse.amplitude / sigma
+    return pulse
+
+
+def solitary_train(t, f, lead, cut: float, rules: PeakRules = PeakRules(), refine: bool = False,
+                   noise: float | None = None) -> list:
+    """The solitary waves of a train at one gauge: pulses above 5% of the leading one (and
+    ``rules.snr`` times the noise, where known), from the leading one until ``cut`` (s; when
+    the wall's reflection arrives)."""
+    floor = 0.05 * lead.amplitude if noise is None else max(0.05 * lead.amplitude, rules.snr * noise)
+    train = find_pulses(t, f, rules, floor=floor, refine=refine)
     return [p for p in train if lead.time - 0.5 * lead.fwhm <= p.time < cut]
 
 
-def reflection_time(t, forces, setup: Setup, low, speed) -> float:
+def reflection_time(t, forces, setup: Setup, low, speed, noise: dict | None = None) -> float:
     """When the wall's reflection of the leading pulse ``low`` reaches its gauge, less one
-    FWHM (from the wall channel if there is one, else from the wall distance)."""
+    FWHM (from the wall channel's leading pulse, above the SNR rule where its noise is
+    known, if there is one; else from the wall distance)."""
     if "wall" in forces:
-        wall = leading(find_pulses(t, forces["wall"], setup.rules, refine=False), setup.rules)
+        f, sigma = forces["wall"], (noise or {}).get("wall")
+        floor = None if sigma is None else max(setup.rules.height * float(np.max(f)), setup.rules.snr * sigma)
+        wall = leading(find_pulses(t, f, setup.rules, floor=floor, refine=False), setup.rules)
         if wall is not None and wall.time > low.time:
             return 2 * wall.time - low.time - low.fwhm
     if setup.wall_distance_m is not None:
@@ -223,18 +206,24 @@ def reflection_time(t, forces, setup: Setup, low, speed) -> float:
 
 
 def analyze_record(record: ScopeRecord, setup: Setup, train: bool = True) -> Report:
-    """The full pipeline on one scope record; an untriggered or unusable record gives a
-    report whose reasons say why. train=False: the leading pulse only (see analyze_forces;
-    the wall channel is not read)."""
+    """The full pipeline on one scope record, with the SNR rule on each gauge's noise.
+    train=False: the leading pulse only (see analyze_forces; the wall channel is not read).
+    An untriggered or envelope record, or one with non-finite samples, gives a report of
+    reasons only."""
     rep = Report(beta=setup.beta, static_force_N=setup.static_force_N)
     if not record.triggered:
-        return rep.refuse(f"the scope did not trigger: {record.reason or 'no reason recorded'}")
+        return rep.refuse(f"the scope did not trigger ({record.reason or 'no reason recorded'})")
     if not train:
         setup = replace(setup, wall=None)
-    g = record_forces(record, setup)
-    bad = [g.unusable[r] for r in ("upper", "lower") if r in g.unusable]
+    roles = [r for r in ("upper", "lower", "wall") if getattr(setup, r) is not None]
+    for role in roles:
+        w = record.waveforms.get(getattr(setup, role).channel)
+        if w is not None and w.preamble.point_format == "ENV":
+            return rep.refuse(f"{w.channel}: an envelope (peak-detect) record holds min/max pairs, not samples; "
+                              f"record in sample or average mode")
+    t, forces = record_forces(record, setup)
+    bad = [getattr(setup, r).channel for r in roles if not np.all(np.isfinite(forces[r]))]
     if bad:
-        return rep.refuse("; ".join(bad))
-    if "wall" in g.unusable:
-        g.forces.pop("wall")
-    return analyze_forces(g.t, g.forces, setup, train, g.noise)
+        return rep.refuse(f"{', '.join(bad)}: samples that are not finite numbers (a non-finite scale factor "
+                          f"or sample in the file?)")
+    return analyze_forces(t, forces, setup, train, record_noise(record, setup, forces))

@@ -105,25 +105,24 @@ def build_parser() -> argparse.ArgumentParser:
     mc.add_argument("--allow-large", action="store_true",
                     help="run even when the estimate exceeds 2 GiB of memory or 2 min of CPU")
 
-    an = _command(sub, "analyze", "speeds and amplitudes from scope files or an archive (exit 1: no speed, "
-                                  "with the reasons)", data.cmd_analyze)
+    an = _command(sub, "analyze", "speeds and amplitudes from scope files or an archive, each channel's SNR, "
+                                  "and why any figure is missing (exit 1 when no source gives a speed)",
+                  data.cmd_analyze)
     an.add_argument("files", nargs="+", metavar="FILE", help=".isf, .csv, .wfm (Tektronix) or .h5 (an archive)")
-    an.add_argument("--shot", type=count_type("shot", 1), help="one shot of an archive (default: every shot)")
-    an.add_argument("--gauge-distance", type=quantity_type("m", "--gauge-distance", lo=0),
+    an.add_argument("--shot", type=int, help="one shot of an archive, a whole number >= 0 (default: every shot)")
+    an.add_argument("--gauge-distance", type=quantity_type("m", "--gauge-distance"),
                     help="distance between the two gauges (plain number: m), for real files")
     an.add_argument("--channels", help="UPPER,LOWER[,WALL] channel names (default: file order)")
     an.add_argument("--wall", action="store_true", help="the third channel is the wall sensor")
-    an.add_argument("--sensitivity", type=quantity_type("V/N", "--sensitivity", lo=0), default=1.0,
+    an.add_argument("--sensitivity", type=quantity_type("V/N", "--sensitivity"), default=1.0,
                     help="gauge sensitivity, e.g. '0.05 V/N' (plain number: V/N; default 1: volts)")
-    an.add_argument("--tau", type=quantity_type("s", "--tau", lo=0), help="gauge RC time constant to invert (s)")
-    an.add_argument("--beta", type=quantity_type("", "--beta", lo=0, hi=10), default=1.0,
-                    help="beta = F_d / F_m,e, dimensionless (default 1)")
-    an.add_argument("--f0", type=quantity_type("N", "--f0", lo=0, lo_closed=True), default=0.0,
-                    help="precompression F_0 (N)")
-    an.add_argument("--diameter", type=quantity_type("m", "--diameter", lo=0), default=4.76e-3,
+    an.add_argument("--tau", type=quantity_type("s", "--tau"), help="gauge RC time constant to invert (s)")
+    an.add_argument("--beta", type=float, default=1.0, help="beta = F_d / F_m,e, dimensionless, > 0 (default 1)")
+    an.add_argument("--f0", type=quantity_type("N", "--f0"), default=0.0, help="precompression F_0 (N)")
+    an.add_argument("--diameter", type=quantity_type("m", "--diameter"), default=4.76e-3,
                     help="bead diameter (plain number: m; default 4.76 mm)")
-    an.add_argument("--material", help="bead material (ptfe, steel316, ...): adds the Eq (1) speed and its "
-                                       "plausibility check")
+    an.add_argument("--material", help="bead material: adds the Eq (1) speed and checks the measured one "
+                                       "against it and the material's bar speed")
 
     ls = _command(sub, "ls", "list the shots of an archive", data.cmd_ls)
     ls.add_argument("archive")

@@ -38,9 +38,9 @@ def quantity_arg(text: str, unit: str, field: str) -> float:
 
 
 def quantity_type(unit: str, field: str, lo: float | None = None, lo_closed: bool = False, hi: float | None = None):
-    """An argparse type for a finite quantity in ``unit`` (a plain number is taken in
-    ``unit``), above ``lo`` (or at it, with lo_closed) and at most ``hi`` where given; a
-    mistake is reported as the field, the value and what is allowed."""
+    """An argparse type for a quantity in ``unit`` (a plain number is taken in ``unit``);
+    where ``lo`` or ``hi`` is given, a finite one above ``lo`` (or at it, with lo_closed) and
+    at most ``hi``. A mistake is reported as the field, the value and what is allowed."""
     def parse(text: str) -> float:
         from rig.errors import RigError
 
@@ -48,6 +48,8 @@ def quantity_type(unit: str, field: str, lo: float | None = None, lo_closed: boo
             x = quantity_arg(text, unit, field)
         except RigError as exc:
             raise argparse.ArgumentTypeError(str(exc).removeprefix(f"{field} = ")) from None
+        if lo is None and hi is None:
+            return x  # the command checks the value itself
         low = lo is not None and (x < lo if lo_closed else x <= lo)
         if not math.isfinite(x) or low or (hi is not None and x > hi):
             rng = " ".join(filter(None, [f"{lo:g} {'<=' if lo_closed else '<'}" if lo is not None else "",

@@ -51,35 +51,35 @@ def cmd_import(args) -> dict:
 
 
 def cmd_analyze(args) -> list:
-    """The pipeline on scope files and archive shots. Every missing figure comes with its
-    reason (printed under the table, and in the JSON's "reasons"); exit 1 when no source
-    gave a speed, so that a script cannot take a row of dashes for a result."""
-    from instruments.pipeline import FIGURES
+    """The analysis table, each channel's SNR and, under each source, why any figure is
+    missing. Exit 0 when at least one source gave a speed, 1 when none did (as `rig verify`
+    with bad shots); a mistake in the flags or files is exit 2 (main)."""
+    from instruments.report import FIGURES
     from rig.experiment.analyze import AnalyzeOptions, analyze_paths
 
     options = AnalyzeOptions(files=tuple(args.files), shot=args.shot, gauge_distance=args.gauge_distance,
                              channels=args.channels, wall=args.wall, sensitivity=args.sensitivity, tau=args.tau,
                              beta=args.beta, f0=args.f0, diameter=args.diameter, material=args.material)
     results = analyze_paths(options)
+    args.exit_code = 0 if any(r["speed_m_per_s"] is not None for r in results) else 1
     if not args.json:
         fmt = lambda v, spec=".2f": "-" if v is None else format(v, spec)  # noqa: E731
         print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d N':>8s} {'F_m,e N':>8s} "
-              f"{'pulses':>6s} {'FWHM us':>8s} {'Eq1 m/s':>8s} {'SNR up/low':>11s}")
+              f"{'pulses':>6s} {'FWHM us':>8s} {'Eq1 m/s':>8s}")
         for r in results:
             fwhm = None if r["duration_s"] is None else r["duration_s"] * 1e6
-            snr = "/".join(fmt(r["snr"].get(k), ".0f") for k in ("upper", "lower"))
             print(f"{r['source'][-40:]:40s} {fmt(r['speed_m_per_s'], '.1f'):>8s} "
                   f"{fmt(r['speed_xcorr_m_per_s'], '.1f'):>8s} {fmt(r['amplitude_N'], '.3f'):>8s} "
                   f"{fmt(r['averaged_amplitude_N'], '.3f'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
-                  f"{fmt(fwhm, '.1f'):>8s} {fmt(r['theory_speed_m_per_s'], '.1f'):>8s} {snr:>11s}")
-        for r in results:
+                  f"{fmt(fwhm, '.1f'):>8s} {fmt(r['theory_speed_m_per_s'], '.1f'):>8s}")
+            if r["snr"]:
+                print("  SNR (leading pulse / pre-trigger noise): "
+                      + ", ".join(f"{ch} {fmt(v, '.3g')}" for ch, v in r["snr"].items()))
             why = {}
             for figure, reason in r["reasons"].items():
                 why.setdefault(reason, []).append(figure)
             for reason, figures in why.items():
-                what = "result" if len(figures) >= len(FIGURES) else ", ".join(figures)
-                print(f"  {r['source'][-40:]}: no {what}: {reason}")
-    args.exit_code = 0 if any(r["speed_m_per_s"] is not None for r in results) else 1
+                print(f"  no {'result' if set(FIGURES) <= set(figures) else ', '.join(figures)}: {reason}")
     return results
 
 

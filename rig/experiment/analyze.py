@@ -4,6 +4,12 @@ Virtual shots in an archive carry what the analysis needs (gauge channels and no
 positions, sensitivities, RC time constants, beta and F_0 from their numerics). Real files
 need it from the command line: --gauge-distance, and optionally --sensitivity, --tau,
 --beta, --f0, --diameter; --material adds the long-wave Eq (1) speed beside each result.
+
+Plausibility: the speed must be below the bar speed sqrt(E / rho) of the bead material
+(with --material; else of the fastest material in the table), and, with a material known
+(--material or the virtual shot's scene), within a factor THEORY_FACTOR of Eq (1) at the
+measured amplitude; otherwise it is None and its reason quotes it. Every None figure has
+its reason in "reasons" (figure -> why), and "snr" gives each gauge channel's SNR.
 """
 from __future__ import annotations
 
@@ -15,12 +21,12 @@ from instruments.analysis import PeakRules
 from instruments.archive import Archive
 from instruments.formats import read_record
 from instruments.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.plausibility import Limits
 from instruments.records import ScopeRecord
-from rig.errors import RigError
-from rig.model.materials import material
+from instruments.report import SPEED_FIGURES
+from rig.errors import RigError, invalid
+from rig.model.materials import MATERIALS, material
 from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed
-
-THEORY_FACTOR = 2.0  # a measured speed within 1/2 to 2 x Eq (1) at its amplitude is plausible
 
 
 @dataclass(frozen=True)
@@ -42,6 +48,23 @@ class AnalyzeOptions:
     f0: float = 0.0
     diameter: float = 4.76e-3
     material: str | None = None
+
+    def __post_init__(self):
+        if self.shot is not None and (isinstance(self.shot, bool) or not isinstance(self.shot, int) or self.shot < 0):
+            raise invalid("--shot", self.shot, "a shot number is a whole number >= 0")
+        for flag, value, zero_ok, unit in (("--gauge-distance", self.gauge_distance, False, "m"),
+                                           ("--sensitivity", self.sensitivity, False, "V/N"),
+                                           ("--tau", self.tau, False, "s"), ("--beta", self.beta, False, ""),
+                                           ("--f0", self.f0, True, "N"), ("--diameter", self.diameter, False, "m")):
+            if value is not None and not (math.isfinite(value) and (value >= 0 if zero_ok else value > 0)):
+                raise invalid(flag, value, f"a finite number {'>= 0' if zero_ok else '> 0'}{' ' + unit if unit else ''}")
+        if self.material is not None:
+            material(self.material)  # an unknown name is a user mistake: one line naming the known ones
+
+
+THEORY_FACTOR = 2.0  # measured / Eq (1) beyond this (or below its inverse): not a solitary wave
+# (published speeds agree with Eq (1) to about 10%; an amplitude off by 30% moves Eq (1) by 5%;
+# a factor 2 in speed is a factor 64 in force)
 
 
 def analyze_paths(options: AnalyzeOptions) -> list:
@@ -96,48 +119,54 @@ def _setup_from_entry(entry, options: AnalyzeOptions) -> Setup:
 def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
     if options.gauge_distance is None:
         raise RigError("--gauge-distance is required for real scope files (e.g. --gauge-distance '43.1 mm')")
-    names = options.channels.split(",") if options.channels else list(record.waveforms)[:3 if options.wall else 2]
+    held = ", ".join(record.waveforms) or "none"
+    names = [n.strip() for n in options.channels.split(",")] if options.channels else \
+        list(record.waveforms)[:3 if options.wall else 2]
+    if options.channels and not 2 <= len(names) <= 3:
+        raise invalid("--channels", options.channels, f"UPPER,LOWER[,WALL]: two or three of {held}")
     if len(names) < 2:
-        raise RigError(f"two gauge channels are needed; the files hold {', '.join(record.waveforms) or 'none'}")
+        raise RigError(f"two gauge channels are needed; the files hold {held}")
     for n in names:
         if n not in record.waveforms:
-            raise RigError(f"--channels: {n!r} is not in the files (channels: {', '.join(record.waveforms)})")
+            raise invalid("--channels", options.channels, f"{n!r} is not in the files (channels: {held})")
+    if len(set(names)) < len(names):
+        raise invalid("--channels", options.channels, "a channel named twice (each gauge has its own channel)")
     g = lambda ch, x: GaugeSetup(ch, x, options.sensitivity, options.tau)  # noqa: E731
     wall = g(names[2], math.inf) if len(names) > 2 else None
     return Setup(g(names[0], 0.0), g(names[1], options.gauge_distance), wall, options.diameter,
                  options.beta, options.f0, PeakRules())
 
 
+def _limits(name: str | None) -> Limits:
+    """The speed bound: the bar speed sqrt(E / rho) of the bead material, or of the
+    fastest material in the table when it is not known."""
+    mats = [material(name)] if name else list(MATERIALS.values())
+    return Limits(max_speed_m_per_s=max(math.sqrt(m.E / m.rho) for m in mats))
+
+
 def _result(source, record, setup: Setup, options: AnalyzeOptions, entry=None) -> dict:
-    """The pipeline's report as a JSON-ready dict, with the Eq (1) speed where the material
-    is known. With a material, a speed above its bar speed sqrt(E/rho) is implausible (the
-    pipeline refuses it), and so is one off Eq (1) at the measured amplitude by more than
-    THEORY_FACTOR: V ~ F^(1/6), so even a tenfold error in the gauge sensitivity moves Eq
-    (1) by only 1.5x."""
     mat = options.material or (entry.settings["chain"]["material"] if entry is not None and entry.simulated else None)
-    m = material(mat) if mat else None
-    if m is not None:
-        setup = replace(setup, max_speed_m_per_s=math.sqrt(m.E / m.rho))
+    setup = replace(setup, limits=_limits(mat))
     rep = analyze_record(record, setup)
     out = {"source": source, "channels": [setup.upper.channel, setup.lower.channel], **rep.as_dict()}
     out.pop("leading", None)
     out["theory_speed_m_per_s"] = None
-    if m is None:
-        out["reasons"].setdefault("theory_speed_m_per_s", "no bead material given (--material)")
-    elif not rep.amplitude_N or rep.amplitude_N <= 0:
-        out["reasons"].setdefault("theory_speed_m_per_s", out["reasons"].get("amplitude_N", "no amplitude"))
-    else:
-        F0 = setup.static_force_N
-        Fm = rep.amplitude_N + F0
-        v = float(solitary_wave_speed(m.E, m.nu, m.rho, setup.bead_diameter_m, F0, Fm) if F0 > 0
-                  else sonic_vacuum_speed(m.E, m.nu, m.rho, setup.bead_diameter_m, Fm))
-        out["theory_speed_m_per_s"] = v
-        ratio = rep.speed_m_per_s / v
-        if not 1 / THEORY_FACTOR <= ratio <= THEORY_FACTOR:
-            why = (f"implausible: {rep.speed_m_per_s:.4g} m/s is {ratio:.3g} x the Eq (1) speed of {mat} at the "
-                   f"measured amplitude ({v:.4g} m/s; allowed 1/{THEORY_FACTOR:g} to {THEORY_FACTOR:g} x): check "
-                   f"--gauge-distance, --material, --sensitivity")
-            for key in ("speed_m_per_s", "speed_xcorr_m_per_s", "width_diameters"):
-                out[key] = None
-                out["reasons"][key] = why
+    if not mat:
+        out["reasons"]["theory_speed_m_per_s"] = "no bead material given (--material)"
+        return out
+    if rep.amplitude_N is None or rep.amplitude_N + setup.static_force_N <= 0:
+        out["reasons"]["theory_speed_m_per_s"] = "no amplitude measured"
+        return out
+    m = material(mat)
+    F0, Fm = setup.static_force_N, rep.amplitude_N + setup.static_force_N
+    theory = float(solitary_wave_speed(m.E, m.nu, m.rho, setup.bead_diameter_m, F0, Fm) if F0 > 0
+                   else sonic_vacuum_speed(m.E, m.nu, m.rho, setup.bead_diameter_m, Fm))
+    out["theory_speed_m_per_s"] = theory
+    v = out["speed_m_per_s"]
+    if v is not None and not 1 / THEORY_FACTOR <= v / theory <= THEORY_FACTOR:
+        why = (f"implausible speed: {v:.4g} m/s is off Eq (1)'s {theory:.4g} m/s for {m.name} at the measured "
+               f"amplitude by more than a factor {THEORY_FACTOR:g} (are --material, --sensitivity, --f0 right?)")
+        for k in SPEED_FIGURES:
+            out[k] = None
+            out["reasons"].setdefault(k, why)
     return out

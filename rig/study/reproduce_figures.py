@@ -47,8 +47,7 @@ def figure_specs(results, rigs) -> list:
             shot = r.fire(seed=seeds_for(1, 1)[0])
             pre = "gravity only" if "gravity" in scene else "2.38 N magnet"
             setup = setup_for(r, 1.0, 0.0)
-            g = record_forces(shot.scope, setup)
-            t, f = g.t, g.forces
+            t, f = record_forces(shot.scope, setup)
             panels[(pre, "virtual scope (time from trigger)")] = [
                 (f"gauge {g}", t, f[g]) for g in ("upper", "lower")] + [("wall", t, f["wall"])]
             tr = r.truth()

@@ -81,3 +81,8 @@ def test_full_pipeline_on_an_emulated_scope_record():
     assert rep.averaged_amplitude_N == pytest.approx(4.0, rel=1e-2)  # 8-bit: 1 code = 1% of this pulse
     assert rep.amplitude_N == pytest.approx(1.1 * rep.averaged_amplitude_N)
     assert rep.total_force_N == pytest.approx(rep.amplitude_N + 2.4)
+    assert rep.reasons == {}
+    # noise-free inputs: the noise is the 8-bit floor, one code (0.05 V/div / 25 codes per
+    # division / 0.05 V/N = 0.04 N) / sqrt(12), and a 4 N pulse stands about 350 times above it
+    assert rep.noise == {ch: pytest.approx(0.04 / 12 ** 0.5, rel=1e-6) for ch in ("CH1", "CH2")}
+    assert rep.snr["CH1"] == pytest.approx(4.0 / (0.04 / 12 ** 0.5), rel=0.02)
