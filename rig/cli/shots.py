@@ -1,8 +1,7 @@
 """`rig shot` and `rig animate`: one virtual shot, summarised, exported or rendered."""
 from __future__ import annotations
 
-import sys
-
+from rig.cli.common import check_size, progress_bar, writing_to
 from rig.errors import RigError
 
 
@@ -18,6 +17,7 @@ def cmd_shot(args) -> dict:
     from rig.experiment.shot import Rig
 
     rig = Rig(scene)
+    check_size(rig.estimate(), args, "this shot")
     shot = rig.fire(seed=args.seed)
     out = shot_summary(rig, shot)
     out.update(shot_blocks(rig, shot))
@@ -25,14 +25,16 @@ def cmd_shot(args) -> dict:
         if not shot.scope.triggered:
             raise RigError(f"--export: nothing to export, the scope did not trigger ({shot.scope.reason})")
         folder = Path(args.export)
-        folder.mkdir(parents=True, exist_ok=True)
-        paths = WRITERS[args.format](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
+        with writing_to(folder):
+            folder.mkdir(parents=True, exist_ok=True)
+            paths = WRITERS[args.format](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
         out["exported"] = [str(p) for p in paths]
     if args.out:
         from instruments.archive import Archive
         from rig.experiment.entry import shot_entry
 
-        out["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot_entry(shot)])[0]}
+        with writing_to(args.out):
+            out["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot_entry(shot)])[0]}
     if not args.json:
         print_shot(out)
     return out
@@ -111,15 +113,14 @@ def cmd_animate(args) -> dict:
     check_output(args.out)  # before anything is computed
     scene = load(args.scene, args.set or ())
     require_renderer(args.out)
-    from tqdm import tqdm
-
     from rig.experiment.shot import Rig
     from rig.viz.animate import animate
 
     rig = Rig(scene)
+    check_size(rig.estimate(), args, "this movie")
     still = args.out.lower().endswith(".png")
-    with tqdm(total=None if still else args.frames, desc="animate", unit="frame", file=sys.stderr,
-              disable=args.quiet or still) as bar:
+    with progress_bar(args.quiet or still, total=None if still else args.frames, desc="animate",
+                      unit="frame") as bar:
         out = animate(rig, args.out, frames=args.frames, exaggerate=args.exaggerate, seed=args.seed,
                       progress=bar.update)
     if not args.json:

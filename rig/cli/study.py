@@ -3,14 +3,14 @@ from __future__ import annotations
 
 import sys
 
+from rig.cli.common import check_size, progress_bar, writing_to
+
 
 def cmd_mc(args) -> dict:
     """Parse the study, run it with a progress bar, print its summary."""
     from rig.experiment.scene import load
 
     load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
-    from tqdm import tqdm
-
     from rig.study.distributions import parse_vary
     from rig.study.mc_run import run_to
     from rig.study.mc_spec import Study
@@ -25,11 +25,16 @@ def cmd_mc(args) -> dict:
                   f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
     study = Study(args.scene, dists, shots, args.seed, tuple(args.set or ()), args.batch, args.accuracy,
                   args.sobol, args.truth, args.window, args.traces)
-    with tqdm(total=study.shots, desc="mc", unit="shot", file=sys.stderr, disable=args.quiet) as bar:
+    from rig.study.nominal import nominal
+
+    per_batch = nominal(study.scene, study.overrides).rig.estimate().times(study.batch, study.batch)
+    check_size(per_batch, args, f"each batch of {study.batch} shots")
+    with progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot") as bar:
         def started(done):
             bar.update(done)
 
-        run = run_to(args.out, study, args.workers, args.scheduler, bar.update, started)
+        with writing_to(args.out):
+            run = run_to(args.out, study, args.workers, args.scheduler, bar.update, started)
     if not args.json:
         print_study(run.report, run.ran_now, args.out)
     return run.report

@@ -26,7 +26,9 @@ class Vary:
     values: tuple
 
     @classmethod
-    def parse(cls, text: str) -> "Vary":
+    def parse(cls, text: str, max_count: int | None = None) -> "Vary":
+        """Parse KEY=START:STOP:COUNT; more than ``max_count`` points (if given) is refused
+        before any is made."""
         if "=" not in text:
             raise invalid("--vary", text, "expected KEY=START:STOP:COUNT, e.g. striker.velocity=0.3:1.5:7")
         key, spec = (s.strip() for s in text.split("=", 1))
@@ -41,6 +43,8 @@ class Vary:
             raise invalid(f"--vary {key} COUNT", parts[2], "a whole number >= 1") from None
         if count < 1:
             raise invalid(f"--vary {key} COUNT", count, "a whole number >= 1")
+        if max_count is not None and count > max_count:
+            raise invalid(f"--vary {key} COUNT", count, f"at most {max_count} points; add --allow-large for more")
         if start > stop:
             raise invalid(f"--vary {key}", spec, "START must not exceed STOP")
         if count == 1 and start != stop:
