@@ -37,6 +37,12 @@ def cmd_mc(args) -> dict:
             run = run_to(args.out, study, args.workers, args.scheduler, bar.update, started)
     if not args.json:
         print_study(run.report, run.ran_now, args.out)
+    failed = run.report["failed"]
+    if failed["share"] > args.max_failed:
+        print(f"rig mc: error: {failed['count']} of {run.report['shots']} shots failed "
+              f"({failed['share']:.1%}, more than --max-failed {args.max_failed:.1%}): "
+              + "; ".join(f"{n} {why}" for why, n in failed["reasons"].items()), file=sys.stderr)
+        args.exit_code = 1
     return run.report
 
 
@@ -52,4 +58,8 @@ def print_study(report: dict, ran: int, out):
     for key, s in report.get("sobol", {}).items():
         print(f"  Sobol {key} ({s['base_samples']} base samples): dominant input {s['dominant']}; total "
               + ", ".join(f"{k} {v:.2f}+-{s['total_conf95'][k]:.2f}" for k, v in s["total"].items()))
+    failed = report["failed"]
+    if failed["count"]:
+        print(f"  failed: {failed['count']} of {report['shots']} shots ({failed['share']:.1%}), left out of "
+              "the estimates: " + "; ".join(f"{n} {why}" for why, n in failed["reasons"].items()))
     print("  wrote study.h5, report.json, histograms.png, speed_vs_amplitude.png")

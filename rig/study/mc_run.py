@@ -15,7 +15,7 @@ from rig.experiment.measure import midway_static_force
 from rig.study.executors import run_study
 from rig.study.mc_spec import Study
 from rig.study.nominal import nominal
-from rig.study.report import figures, jcgm101
+from rig.study.report import failures, figures, jcgm101
 from rig.study.sobol import sobol_indices, sobol_matrix
 from rig.study.store import Store, StudyResults, atomic_write
 from rig.theory.longwave import solitary_wave_speed
@@ -70,8 +70,10 @@ def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None,
 
 def summarise(study: Study, results: StudyResults, shots_per_s) -> dict:
     """The JCGM 101 summary of each output, the inputs, and the Sobol indices if asked."""
-    out = results.outputs
+    ok = results.outputs["failure"] == 0  # failed shots are counted, and left out of every estimate
+    out = {k: np.where(ok, v, np.nan) for k, v in results.outputs.items()}
     report = {"shots": int(results.index.size), "shots_per_s": shots_per_s,
+              "failed": failures(results.outputs["failure"]),
               "speed_m_per_s": jcgm101(out["speed_m_per_s"]),
               "speed_xcorr_m_per_s": jcgm101(out["speed_xcorr_m_per_s"]),
               "amplitude_N": jcgm101(out["amplitude_N"]),

@@ -109,7 +109,7 @@ class Store:
         order = np.argsort(np.concatenate([q["index"] for q in parts]))
         cat = lambda key: np.concatenate([q[key] for q in parts])[order]  # noqa: E731
         return StudyResults(cat("index"), cat("inputs"), cat("seeds"),
-                            {k: np.concatenate([q["outputs"][k] for q in parts])[order] for k in OUTPUTS})
+                            {k: np.concatenate([_output(q, k) for q in parts])[order] for k in OUTPUTS})
 
     def consolidate(self, results: StudyResults, report: dict) -> Path:
         """DIR/study.h5: every shot's inputs, outputs and seed, and the report."""
@@ -129,3 +129,10 @@ class Store:
                     f[f"outputs/{k}"] = v
 
         return atomic_write(self.folder / "study.h5", write)
+
+
+def _output(part: dict, key: str) -> np.ndarray:
+    """One output of a stored batch; a batch stored before shots could fail has no "failure"."""
+    if key == "failure" and key not in part["outputs"]:
+        return np.zeros(part["index"].size)
+    return part["outputs"][key]
