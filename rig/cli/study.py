@@ -34,7 +34,7 @@ def cmd_mc(args) -> dict:
             bar.update(done)
 
         with writing_to(args.out):
-            run = run_to(args.out, study, args.workers, args.scheduler, bar.update, started)
+            run = run_to(args.out, study, args.workers, args.scheduler, bar.update, started, args.worker_timeout)
     if not args.json:
         print_study(run.report, run.ran_now, args.out)
     failed = run.report["failed"]

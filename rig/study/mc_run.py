@@ -12,7 +12,7 @@ import numpy as np
 
 from rig.errors import RigError
 from rig.experiment.measure import midway_static_force
-from rig.study.executors import run_study
+from rig.study.executors import DEFAULT_WORKER_TIMEOUT, run_study
 from rig.study.mc_spec import Study
 from rig.study.nominal import nominal
 from rig.study.report import failures, figures, jcgm101
@@ -45,9 +45,10 @@ class StudyRun:
 
 
 def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None, progress=None,
-           on_start=None) -> StudyRun:
+           on_start=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> StudyRun:
     """Run (or resume) ``study`` in ``folder``. ``progress(n)`` is told each finished
-    batch's shots; ``on_start(done)`` how many shots were already stored."""
+    batch's shots; ``on_start(done)`` how many shots were already stored; on Dask the study
+    stops after ``worker_timeout`` s without a live worker."""
     check(study)
     store = Store(folder, study).open()
     done = sum(len(study.shots_of(b)) for b in store.done())
@@ -55,7 +56,7 @@ def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None,
         on_start(done)
     t0 = time.perf_counter()
     try:
-        run_study(study, store, workers, scheduler, progress)
+        run_study(study, store, workers, scheduler, progress, worker_timeout)
     except KeyboardInterrupt:
         kept = sum(len(study.shots_of(b)) for b in store.done())
         raise RigError(f"interrupted: {kept} of {study.shots} shots are kept in {folder}; "
