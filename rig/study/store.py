@@ -33,6 +33,9 @@ def atomic_write(path: Path, write) -> Path:
     temporary file is removed when anything fails."""
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     os.close(fd)
+    mask = os.umask(0)
+    os.umask(mask)
+    os.chmod(tmp, 0o666 & ~mask)  # mkstemp's 0600 would make every study file private
     try:
         write(tmp)
         with open(tmp, "rb+") as fh:

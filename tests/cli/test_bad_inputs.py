@@ -5,6 +5,7 @@ Each case is (argv, needle): ``{d}`` in an argument is the case's scratch folder
 the files of ``_files``); the one error line must contain ``needle``."""
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -217,17 +218,25 @@ def test_the_real_entry_point(tmp_path, argv, needle):
 DISK_FULL = """
 import resource, signal, sys
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
-resource.setrlimit(resource.RLIMIT_FSIZE, (1000, 1000))
+limit = int(sys.argv[1])
+resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 from rig.cli import main
-sys.exit(main(sys.argv[1:]))
+sys.exit(main(sys.argv[2:]))
 """
 
 
-def test_a_full_disk_is_one_line_naming_the_path(tmp_path):
-    """A file-size limit makes every write past 1 kB fail (EFBIG), as a full disk does."""
-    out = tmp_path / "shots"
-    r = subprocess.run([sys.executable, "-c", DISK_FULL, "shot", S, "--seed", "1", "--export", str(out)],
+@pytest.mark.parametrize("limit,argv,folder", [
+    (1000, ["shot", S, "--seed", "1", "--export", "{d}/shots"], "shots"),
+    (3000, ["mc", S, "--shots", "8", "--batch", "4", "--vary", VEL, "--out", "{d}/study", "--quiet"], "study"),
+])
+def test_a_full_disk_is_one_line_naming_the_path(tmp_path, limit, argv, folder):
+    """A file-size limit makes every write past ``limit`` bytes fail (EFBIG), as a full disk
+    does; a study's study.json is whole or absent (so the folder can resume)."""
+    r = subprocess.run([sys.executable, "-c", DISK_FULL, str(limit), *_argv(argv, tmp_path)],
                        capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert r.returncode == 2, r.stderr
     line = _one_line(r.stderr)
-    assert str(out) in line and "too large" in line.lower()
+    assert str(tmp_path / folder) in line and "too large" in line.lower()
+    meta = tmp_path / folder / "study.json"
+    if meta.exists():
+        assert json.loads(meta.read_text())["shots"] == 8
