@@ -11,7 +11,8 @@ import sys
 from instruments.errors import InstrumentError
 from rig import __version__
 from rig.cli import data, shots, study, sweeps, tools
-from rig.cli.common import OneLineParser, count_type, quantity_type, seed_arg
+from rig.cli.common import (OneLineParser, allow_large, count_arg, fraction_arg, os_error_line, positive_seconds,
+                            quantity_type, seed_arg)
 from rig.errors import RigError
 
 
@@ -42,8 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
     sh.add_argument("--export", metavar="DIR", help="write the scope records to DIR")
     sh.add_argument("--format", choices=["isf", "csv"], default="isf", help="scope file format (default isf)")
     sh.add_argument("--out", metavar="ARCHIVE.h5", help="append the shot to an HDF5 archive")
-    sh.add_argument("--allow-large", action="store_true",
-                    help="run even when the estimate exceeds 2 GiB of memory or 2 min of CPU")
+    allow_large(sh)
 
     ve = _command(sub, "verify", "check every shot of an archive (exit 1 if any is bad)", data.cmd_verify)
     ve.add_argument("archive")
@@ -61,8 +61,7 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("--seed", type=seed_arg, default=0, help="the sweep's seed (default 0)")
     sw.add_argument("--out", metavar="ARCHIVE.h5", help="append every shot to an archive")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
-    sw.add_argument("--allow-large", action="store_true",
-                    help="run even when the estimate exceeds 2 GiB of memory or 2 min of CPU")
+    allow_large(sw)
 
     an = _command(sub, "animate", "render a virtual shot to a movie or still, off-screen", shots.cmd_animate)
     an.add_argument("scene")
@@ -73,8 +72,7 @@ def build_parser() -> argparse.ArgumentParser:
     an.add_argument("--exaggerate", type=float,
                     help="displacement factor (default: the largest displacement shown as 1/3 diameter)")
     an.add_argument("--quiet", action="store_true", help="no progress bar")
-    an.add_argument("--allow-large", action="store_true",
-                    help="run even when the estimate exceeds 2 GiB of memory or 2 min of CPU")
+    allow_large(an)
 
     rp = _command(sub, "reproduce", "re-run a published study (daraio2006)", sweeps.cmd_reproduce)
     rp.add_argument("study", choices=["daraio2006"], help="the published study to re-run")
@@ -83,15 +81,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     mc = _command(sub, "mc", "Monte Carlo study over many virtual shots", study.cmd_mc)
     mc.add_argument("scene")
-    mc.add_argument("--shots", type=count_type("shots"), required=True, help="number of shots (>= 1)")
+    mc.add_argument("--shots", type=count_arg, required=True, help="number of shots (>= 1)")
     mc.add_argument("--vary", action="append", metavar="KEY=DIST",
                     help='e.g. striker.velocity="normal(0.89 m/s, 0.01 m/s)"; also chain.bead_mass, '
                          'gauges.NAME.gain, gauges.NAME.misalignment')
     mc.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides")
     mc.add_argument("--seed", type=seed_arg, default=0, help="the study's seed (default 0)")
-    mc.add_argument("--batch", type=count_type("batch"), default=128, help="shots per batch (default 128)")
+    mc.add_argument("--batch", type=count_arg, default=128, help="shots per batch (default 128)")
     mc.add_argument("--accuracy", type=float, help="solver accuracy (default: the scene's)")
-    mc.add_argument("--workers", type=count_type("workers"), default=1, help="local worker processes (default 1)")
+    mc.add_argument("--workers", type=count_arg, default=1, help="local worker processes (default 1)")
     mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")
     mc.add_argument("--sobol", action="store_true", help="Sobol design and indices (needs SALib)")
     mc.add_argument("--truth", action="store_true", help="also analyse each shot's noise-free truth (slower)")
@@ -102,8 +100,11 @@ def build_parser() -> argparse.ArgumentParser:
                     help="also archive every shot's scope record and truth in DIR/traces/ (one archive per batch)")
     mc.add_argument("--out", required=True, metavar="DIR")
     mc.add_argument("--quiet", action="store_true", help="no progress bar")
-    mc.add_argument("--allow-large", action="store_true",
-                    help="run even when the estimate exceeds 2 GiB of memory or 2 min of CPU")
+    mc.add_argument("--max-failed", type=fraction_arg, default=0.05, metavar="PERCENT",
+                    help="fail the study (exit 1) when more shots than this fail (default 5%%)")
+    mc.add_argument("--worker-timeout", type=positive_seconds, default=300.0, metavar="SECONDS",
+                    help="with --scheduler: stop when no Dask worker is alive for this long (default 300)")
+    allow_large(mc)
 
     an = _command(sub, "analyze", "speeds and amplitudes from scope files or an archive, each channel's SNR, "
                                   "and why any figure is missing (exit 1 when no source gives a speed)",
@@ -135,21 +136,22 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    """Run one command. A user mistake or an I/O failure (a missing file, a folder, no
+    permission, a full disk, ...) is one line on stderr and exit 2; never a traceback."""
     args = build_parser().parse_args(argv)
     try:
         out = args.func(args)
     except (RigError, InstrumentError) as exc:
-        print(f"rig {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except OSError as exc:  # a missing or unreadable file, a full disk, a read-only folder, ...
-        where = f"{exc.filename}: " if exc.filename is not None else ""
-        print(f"rig {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
-        return 2
+        return _fail(args.command, str(exc))
+    except OSError as exc:
+        return _fail(args.command, os_error_line(exc))
     except MemoryError:
-        print(f"rig {args.command}: error: out of memory (a smaller scene, a shorter solver.duration or a "
-              f"coarser solver.sample_interval needs less)", file=sys.stderr)
-        return 2
+        return _fail(args.command, "out of memory: choose a shorter duration, fewer beads or fewer points")
     if args.json:
         print(json.dumps(out, indent=2))
     return getattr(args, "exit_code", 0)
 
+
+def _fail(command: str, message: str) -> int:
+    print(f"rig {command}: error: {' '.join(message.split())}", file=sys.stderr)
+    return 2

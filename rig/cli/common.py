@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
 
@@ -31,46 +32,109 @@ def quantity_arg(text: str, unit: str, field: str) -> float:
     """A command-line quantity: a plain number is taken in ``unit``; else text with a unit."""
     from rig.units import quantity
 
+    from rig.errors import invalid
+
     try:
-        return float(text)
+        value = float(text)
     except ValueError:
-        return quantity(text, unit, field)
+        value = quantity(text, unit, field)
+    if not math.isfinite(value):
+        raise invalid(field, text, f"a finite number (plain number: {unit})")
+    return value
 
 
-def quantity_type(unit: str, field: str, lo: float | None = None, lo_closed: bool = False, hi: float | None = None):
+def quantity_type(unit: str, field: str):
     """An argparse type for a quantity in ``unit`` (a plain number is taken in ``unit``);
-    where ``lo`` or ``hi`` is given, a finite one above ``lo`` (or at it, with lo_closed) and
-    at most ``hi``. A mistake is reported as the field, the value and what is allowed."""
+    a mistake is reported as the field, the value and what is allowed."""
     def parse(text: str) -> float:
         from rig.errors import RigError
 
         try:
-            x = quantity_arg(text, unit, field)
+            return quantity_arg(text, unit, field)
         except RigError as exc:
             raise argparse.ArgumentTypeError(str(exc).removeprefix(f"{field} = ")) from None
-        if lo is None and hi is None:
-            return x  # the command checks the value itself
-        low = lo is not None and (x < lo if lo_closed else x <= lo)
-        if not math.isfinite(x) or low or (hi is not None and x > hi):
-            rng = " ".join(filter(None, [f"{lo:g} {'<=' if lo_closed else '<'}" if lo is not None else "",
-                                         "value", f"<= {hi:g}" if hi is not None else ""]))
-            raise argparse.ArgumentTypeError(f"{text!r}: allowed a finite {rng}{' (' + unit + ')' if unit else ''}")
-        return x
 
-    parse.__name__ = f"quantity in {unit}" if unit else "number"
+    parse.__name__ = f"quantity in {unit}"
     return parse
 
 
-def count_type(field: str, lo: int = 1):
-    """An argparse type for a whole number >= lo."""
-    def parse(text: str) -> int:
-        try:
-            n = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r}: allowed a whole number >= {lo}") from None
-        if n < lo:
-            raise argparse.ArgumentTypeError(f"{text!r}: allowed a whole number >= {lo}")
-        return n
+@contextlib.contextmanager
+def progress_bar(quiet: bool = False, **kw):
+    """A tqdm bar on stderr that shows itself only after a second (a mistake found at once
+    leaves nothing but its one error line) and clears its line when the command fails."""
+    from tqdm import tqdm
 
-    parse.__name__ = field
-    return parse
+    bar = tqdm(file=sys.stderr, disable=quiet, delay=1.0, **kw)
+    try:
+        yield bar
+    except BaseException:
+        bar.leave = False
+        bar.close()
+        raise
+    bar.close()
+
+
+def os_error_line(exc: OSError) -> str:
+    """An I/O failure as one line: the path(s) and the cause (e.g. 'No space left on device')."""
+    cause = exc.strerror or str(exc) or type(exc).__name__
+    paths = [str(p) for p in (exc.filename, exc.filename2) if p is not None]
+    return f"{' -> '.join(paths)}: {cause}" if paths else cause
+
+
+def allow_large(parser):
+    """The flag that confirms a run beyond the size limits of rig/solver/estimate.py."""
+    parser.add_argument("--allow-large", action="store_true",
+                        help="run even when the estimate passes 2 GB of memory or 2 minutes of solving")
+
+
+def fraction_arg(text: str) -> float:
+    """A share: '5%' or 0.05, from 0 to 1 (100%)."""
+    try:
+        value = float(text[:-1]) / 100 if text.endswith("%") else float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 <= value <= 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: a share from 0% to 100%, e.g. 5% or 0.05")
+    return value
+
+
+def positive_seconds(text: str) -> float:
+    """A time in seconds > 0 (a plain number)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 < value < math.inf:
+        raise argparse.ArgumentTypeError(f"{text!r}: a number of seconds > 0")
+    return value
+
+
+def check_size(estimate, args, what: str):
+    """Refuse a run beyond the size limits unless --allow-large; say what a large one costs."""
+    from rig.solver.estimate import NOTICE_SECONDS
+
+    estimate.refuse_unless(args.allow_large, what)
+    if estimate.large or estimate.seconds > NOTICE_SECONDS:
+        print(f"{what} needs {estimate.describe()}", file=sys.stderr, flush=True)
+
+
+def count_arg(text: str) -> int:
+    """A whole number >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: a whole number >= 1")
+    return value
+
+
+@contextlib.contextmanager
+def writing_to(path):
+    """Name ``path`` in an I/O failure that names no file (a write on a full disk)."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is None:
+            raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
+        raise

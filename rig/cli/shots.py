@@ -1,8 +1,7 @@
 """`rig shot` and `rig animate`: one virtual shot, summarised, exported or rendered."""
 from __future__ import annotations
 
-import sys
-
+from rig.cli.common import check_size, progress_bar, writing_to
 from rig.errors import RigError
 
 
@@ -14,12 +13,11 @@ def cmd_shot(args) -> dict:
     from pathlib import Path
 
     from instruments.formats import WRITERS
-    from rig.experiment.budget import shot_budget
     from rig.experiment.measure import shot_blocks
     from rig.experiment.shot import Rig
 
     rig = Rig(scene)
-    announce(shot_budget(rig).check(args.allow_large))
+    check_size(rig.estimate(), args, "this shot")
     shot = rig.fire(seed=args.seed)
     out = shot_summary(rig, shot)
     out.update(shot_blocks(rig, shot))
@@ -27,23 +25,19 @@ def cmd_shot(args) -> dict:
         if not shot.scope.triggered:
             raise RigError(f"--export: nothing to export, the scope did not trigger ({shot.scope.reason})")
         folder = Path(args.export)
-        folder.mkdir(parents=True, exist_ok=True)
-        paths = WRITERS[args.format](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
+        with writing_to(folder):
+            folder.mkdir(parents=True, exist_ok=True)
+            paths = WRITERS[args.format](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
         out["exported"] = [str(p) for p in paths]
     if args.out:
         from instruments.archive import Archive
         from rig.experiment.entry import shot_entry
 
-        out["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot_entry(shot)])[0]}
+        with writing_to(args.out):
+            out["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot_entry(shot)])[0]}
     if not args.json:
         print_shot(out)
     return out
-
-
-def announce(budget, over_s: float = 10.0):
-    """Say on stderr, before it starts, what a long run will cost."""
-    if budget.cpu_s > over_s:
-        print(f"rig: this run takes {budget.note()}", file=sys.stderr)
 
 
 def shot_summary(rig, shot) -> dict:
@@ -119,17 +113,14 @@ def cmd_animate(args) -> dict:
     check_output(args.out)  # before anything is computed
     scene = load(args.scene, args.set or ())
     require_renderer(args.out)
-    from tqdm import tqdm
-
-    from rig.experiment.budget import shot_budget
     from rig.experiment.shot import Rig
     from rig.viz.animate import animate
 
     rig = Rig(scene)
-    announce(shot_budget(rig).check(args.allow_large))
+    check_size(rig.estimate(), args, "this movie")
     still = args.out.lower().endswith(".png")
-    with tqdm(total=None if still else args.frames, desc="animate", unit="frame", file=sys.stderr,
-              disable=args.quiet or still) as bar:
+    with progress_bar(args.quiet or still, total=None if still else args.frames, desc="animate",
+                      unit="frame") as bar:
         out = animate(rig, args.out, frames=args.frames, exaggerate=args.exaggerate, seed=args.seed,
                       progress=bar.update)
     if not args.json:

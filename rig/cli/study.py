@@ -3,19 +3,16 @@ from __future__ import annotations
 
 import sys
 
+from rig.cli.common import check_size, progress_bar, writing_to
+
 
 def cmd_mc(args) -> dict:
     """Parse the study, run it with a progress bar, print its summary."""
     from rig.experiment.scene import load
 
     load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
-    from tqdm import tqdm
-
     from rig.study.distributions import parse_vary
-    from rig.cli.shots import announce
-    from rig.experiment.budget import shot_budget
-    from rig.study.mc_run import check, run_to
-    from rig.study.nominal import nominal
+    from rig.study.mc_run import run_to
     from rig.study.mc_spec import Study
     from rig.study.sobol import sobol_shots
 
@@ -28,16 +25,24 @@ def cmd_mc(args) -> dict:
                   f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
     study = Study(args.scene, dists, shots, args.seed, tuple(args.set or ()), args.batch, args.accuracy,
                   args.sobol, args.truth, args.window, args.traces)
-    check(study)  # everything a shot would refuse, before the progress bar
-    one = shot_budget(nominal(study.scene, study.overrides).rig)
-    announce(one.times(study.shots, in_memory=min(study.batch, study.shots) * args.workers).check(args.allow_large))
-    with tqdm(total=study.shots, desc="mc", unit="shot", file=sys.stderr, disable=args.quiet) as bar:
+    from rig.study.nominal import nominal
+
+    per_batch = nominal(study.scene, study.overrides).rig.estimate().times(study.batch, study.batch)
+    check_size(per_batch, args, f"each batch of {study.batch} shots")
+    with progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot") as bar:
         def started(done):
             bar.update(done)
 
-        run = run_to(args.out, study, args.workers, args.scheduler, bar.update, started)
+        with writing_to(args.out):
+            run = run_to(args.out, study, args.workers, args.scheduler, bar.update, started, args.worker_timeout)
     if not args.json:
         print_study(run.report, run.ran_now, args.out)
+    failed = run.report["failed"]
+    if failed["share"] > args.max_failed:
+        print(f"rig mc: error: {failed['count']} of {run.report['shots']} shots failed "
+              f"({failed['share']:.1%}, more than --max-failed {args.max_failed:.1%}): "
+              + "; ".join(f"{n} {why}" for why, n in failed["reasons"].items()), file=sys.stderr)
+        args.exit_code = 1
     return run.report
 
 
@@ -53,4 +58,8 @@ def print_study(report: dict, ran: int, out):
     for key, s in report.get("sobol", {}).items():
         print(f"  Sobol {key} ({s['base_samples']} base samples): dominant input {s['dominant']}; total "
               + ", ".join(f"{k} {v:.2f}+-{s['total_conf95'][k]:.2f}" for k, v in s["total"].items()))
+    failed = report["failed"]
+    if failed["count"]:
+        print(f"  failed: {failed['count']} of {report['shots']} shots ({failed['share']:.1%}), left out of "
+              "the estimates: " + "; ".join(f"{n} {why}" for why, n in failed["reasons"].items()))
     print("  wrote study.h5, report.json, histograms.png, speed_vs_amplitude.png")

@@ -1,29 +1,27 @@
 """`rig sweep` and `rig reproduce`: one shot per value of a key, and the published study."""
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
-from rig.cli.shots import announce, shot_summary
+from rig.cli.common import check_size, progress_bar, writing_to
+from rig.cli.shots import shot_summary
+
+MAX_SWEEP_POINTS = 10_000  # more needs --allow-large (each point's shot is kept to the end)
 
 
 def cmd_sweep(args) -> dict:
     from rig.experiment.scene import load
 
     scene = load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
-    from tqdm import tqdm
-
-    from rig.experiment.budget import shot_budget
     from rig.experiment.shot import Rig
-    from rig.study.sweep import Vary, run_sweep, sweep_rigs
+    from rig.study.sweep import Vary, run_sweep
 
-    vary = Vary.parse(args.vary)
-    base = Rig(scene)  # the base scene itself must be valid
-    announce(shot_budget(base).times(vary.count).check(args.allow_large))  # every point is kept
-    rigs = sweep_rigs(args.scene, vary, args.set or ())
-    with tqdm(total=vary.count, desc=f"sweep {vary.key}", unit="shot", file=sys.stderr,
-              disable=args.quiet) as bar:
-        points = run_sweep(rigs, vary, args.seed, bar.update, args.out)
+    vary = Vary.parse(args.vary, None if args.allow_large else MAX_SWEEP_POINTS)
+    n = len(vary.values)
+    check_size(Rig(scene).estimate().times(n, n), args, f"this sweep of {n} points")  # every point is kept
+    with progress_bar(args.quiet, total=len(vary.values), desc=f"sweep {vary.key}", unit="shot") as bar:
+        with writing_to(args.out or "the sweep"):
+            points = run_sweep(args.scene, vary, args.set or (), args.seed, bar.update, args.out)
     out = {"points": []}
     for p in points:
         one = shot_summary(p.rig, p.shot)
@@ -51,18 +49,16 @@ def cmd_sweep(args) -> dict:
 
 
 def cmd_reproduce(args) -> dict:
-    from tqdm import tqdm
-
     from rig.study.reproduce import CONFIGS, MASS_RATIOS, OTHER_SCENES, VELOCITY_FACTORS, reproduce
 
     total = len(CONFIGS) + len(OTHER_SCENES) + len(CONFIGS) * len(VELOCITY_FACTORS) + len(MASS_RATIOS) + 1
-    with tqdm(total=total, desc=f"reproduce {args.study}", unit="step", file=sys.stderr,
-              disable=args.quiet) as bar:
+    with progress_bar(args.quiet, total=total, desc=f"reproduce {args.study}", unit="step") as bar:
         def progress(what):
             bar.set_postfix_str(what[:40])
             bar.update()
 
-        results = reproduce(args.study, args.out, progress)
+        with writing_to(args.out):
+            results = reproduce(args.study, args.out, progress)
     if not args.json:
         print((Path(args.out) / "table1.md").read_text())
         print(f"wrote {args.out}/: table1.md, table1.csv, summary.md, results.json and the figures")

@@ -19,7 +19,7 @@ def cmd_theory(args) -> dict:
     F0 = _q(args.f0, "N", "--f0")
     if not a > 0:
         raise RigError(f"--diameter = {args.diameter!r}: must be > 0 m")
-    if not F0 >= 0:
+    if not 0 <= F0 < math.inf:
         raise RigError(f"--f0 = {args.f0!r}: precompression must be >= 0 N")
     out = {"material": m.name, "diameter_m": a, "f0_N": F0, "fm_N": None,
            "sound_speed_m_per_s": float(sound_speed(m.E, m.nu, m.rho, a, F0)),

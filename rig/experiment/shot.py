@@ -17,6 +17,8 @@ from rig.errors import RigError, invalid
 from rig.experiment import scene as scene_io
 from rig.experiment.assembly import Assembly
 from rig.experiment.truth import Truth, truth_of
+from rig.solver.estimate import RunEstimate, estimate_solve
+from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution, SolverStats
 from rig.solver.solve import solve
@@ -71,6 +73,12 @@ class Rig(Assembly):
         if self.wall_sensor is not None:
             probes["wall"] = self.chain.wall_probe()
         return SaveAt(probes, sample_interval=self.solver.sample_interval)
+
+    def estimate(self) -> RunEstimate:
+        """How big and how long this rig's solve will be (before it runs)."""
+        s = self.solver
+        return estimate_solve(ChainProblem.from_chain(self.chain), s.duration, len(self.save_at().names),
+                              s.sample_interval, s.method, s.accuracy)
 
     def solution(self) -> Solution:
         if self._solution is None:

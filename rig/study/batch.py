@@ -16,17 +16,19 @@ from rig.experiment.shot import Rig
 from rig.solver.ensemble import ensemble_step, solve_ensemble
 from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
-from rig.solver.solution import Solution
-from rig.study.mc_spec import OUTPUTS, Study
+from rig.solver.solution import Solution, Status
+from rig.study.mc_spec import FAILURES, OUTPUTS, Study
 from rig.study.nominal import copied_table, nominal
 from rig.study.sobol import sobol_matrix
+
+IMPOSSIBLE, UNSTABLE, NO_TRIGGER, SHORT_WINDOW, NON_FINITE = range(1, len(FAILURES))
 
 
 @dataclass(frozen=True, eq=False)
 class BatchResult:
     """What batch ``batch`` gives: the shots' indices, inputs (shots, K) in the study's key
     order, instrument seeds, outputs {name: (shots,)} (OUTPUTS; nan where nothing was
-    measured) and, for a study with traces, each shot's archive Entry."""
+    measured; "failure": the index of FAILURES, 0 for a shot that did not fail) and, for a study with traces, each shot's archive Entry."""
 
     batch: int
     index: np.ndarray
@@ -100,34 +102,51 @@ def _batch(study: Study, b: int) -> BatchResult:
     nom = nominal(study.scene, tuple(study.overrides))
     base = nom.rig
     design = sobol_matrix(study)[0] if study.sobol else None
-    rigs, draws, seeds, xs = [], [], [], []
-    for i in range(lo, hi):
+    out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
+    out["failure"][:] = 0
+    rigs, draws, seeds, xs = {}, {}, [], []
+    for j, i in enumerate(range(lo, hi)):
         x, masses, seed = shot_inputs(study, i, base.values["chain"]["beads"], design)
-        try:
-            rig, d = shot_rig(study, x, masses)
-        except ValueError as exc:
-            raise RigError(f"shot {i}: inputs {x} give an impossible rig: {exc}") from None
-        rigs.append(rig)
-        draws.append(d)
         seeds.append(seed)
         xs.append([x[k] for k in study.keys])
-    problems = [ChainProblem.from_chain(r.chain) for r in rigs]
+        try:
+            rigs[j], draws[j] = shot_rig(study, x, masses)
+        except ValueError:  # inputs no rig can have (a negative velocity): counted, not fatal
+            out["failure"][j] = IMPOSSIBLE
+    traces = []
+    if rigs:
+        _fire_all(study, nom, rigs, draws, seeds, out, traces, lo)
+    return BatchResult(b, np.arange(lo, hi), np.array(xs, dtype=float).reshape(hi - lo, len(study.keys)),
+                       np.array(seeds, dtype=np.int64), out, tuple(traces))
+
+
+def _fire_all(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dict, traces: list, lo: int):
+    """Solve the batch's possible rigs together, then read, analyse and judge each shot."""
+    base = nom.rig
+    problems = [ChainProblem.from_chain(r.chain) for r in rigs.values()]
     t_end = nom.window(study.window).duration
     dt = ensemble_step(problems, t_end, base.solver.method, study.accuracy or base.solver.accuracy)
-    ens = solve_ensemble(problems, t_end, save=study_save(study, rigs[0]), dt=dt, method=base.solver.method)
-    out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
-    traces = []
+    first = next(iter(rigs.values()))
+    ens = solve_ensemble(problems, t_end, save=study_save(study, first), dt=dt, method=base.solver.method)
     beta, F0 = nom.calibration
-    for j, (rig, p) in enumerate(zip(rigs, problems)):
-        stats = ens.stats(j, study.accuracy)
-        forces = {name: a[j] for name, a in ens.forces.items()}
+    for e, ((j, rig), p) in enumerate(zip(rigs.items(), problems)):
+        if ens.reports[e].status is not Status.SUCCESS:
+            out["failure"][j] = UNSTABLE
+            continue
+        stats = ens.stats(e, study.accuracy)
+        forces = {name: a[e] for name, a in ens.forces.items()}
         rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))
-        shot = rig.fire(seed=seeds[j], fixed=draws[j], truth=False)
+        try:
+            shot = rig.fire(seed=seeds[j], fixed=draws[j], truth=False)
+        except RigError:  # the scope's record ends after the simulated window
+            out["failure"][j] = SHORT_WINDOW
+            continue
         if study.traces:  # each shot has its own scene values and truth: nothing shared between shots
             from rig.experiment.entry import shot_entry  # the archive's Entry (h5py): only with traces
 
-            e = shot_entry(shot)
-            traces.append(replace(e, truth_key=None, facts=replace(e.facts, study_shot=lo + j, study=study.digest())))
+            entry = shot_entry(shot)
+            traces.append(replace(entry, truth_key=None, facts=replace(entry.facts, study_shot=lo + j,
+                                                                       study=study.digest())))
         m = analyze_record(shot.scope, setup_for(rig, beta, F0), train=False)  # leading pulse only
         t = rig.truth_analysis() if study.truth else None
         for key, val in (("speed_m_per_s", m.speed_m_per_s), ("speed_xcorr_m_per_s", m.speed_xcorr_m_per_s),
@@ -135,8 +154,10 @@ def _batch(study: Study, b: int) -> BatchResult:
                          ("truth_speed_m_per_s", t and t.speed_m_per_s), ("truth_amplitude_N", t and t.amplitude_N),
                          ("energy_error", stats.energy_error), ("dt_s", ens.dt)):
             out[key][j] = np.nan if val is None else val
-    return BatchResult(b, np.arange(lo, hi), np.array(xs, dtype=float).reshape(hi - lo, len(study.keys)),
-                       np.array(seeds, dtype=np.int64), out, tuple(traces))
+        if not shot.scope.triggered:
+            out["failure"][j] = NO_TRIGGER
+        elif not (np.isfinite(out["speed_m_per_s"][j]) and np.isfinite(out["amplitude_N"][j])):
+            out["failure"][j] = NON_FINITE
 
 
 def refire(study: Study, i: int) -> dict:

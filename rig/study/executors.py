@@ -3,8 +3,10 @@ cluster (optional extra: pip install ".[dask]"). Batches are the same whatever r
 so the results are identical; each finished batch is stored at once."""
 from __future__ import annotations
 
+import asyncio
 import concurrent.futures as cf
 import multiprocessing
+import os
 
 from rig.errors import RigError
 from rig.study.batch import run_batch
@@ -12,26 +14,75 @@ from rig.study.mc_spec import Study
 from rig.study.store import Store
 
 
-def _one_thread():
+PR_SET_PDEATHSIG = 1  # linux/prctl.h
+DEFAULT_WORKER_TIMEOUT = 300.0  # s without any live Dask worker before a study stops
+POLL_S = 1.0  # how often a Dask study looks at its workers while it waits (s)
+
+
+def _worker_start(parent: int):
+    """A local worker: one numba thread (the workers share the cores among themselves),
+    and on Linux killed with its parent, so that a killed study leaves no orphan."""
     import numba
 
-    numba.set_num_threads(1)  # the workers share the cores among themselves
+    die_with_parent(parent)
+    numba.set_num_threads(1)
+
+
+def die_with_parent(parent: int):
+    """Ask Linux to SIGKILL this process when its parent dies (prctl PR_SET_PDEATHSIG);
+    exit at once if the parent ``parent`` is already gone. Elsewhere: nothing."""
+    import os
+    import signal
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return
+    import ctypes
+
+    ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+    if os.getppid() != parent:
+        os._exit(1)
+
+
+class WorkerWatch:
+    """Stops a study that has had no live worker for ``timeout`` seconds: ``check(n)`` is
+    told how many workers are alive now; ``clock`` gives seconds (monotonic)."""
+
+    def __init__(self, timeout: float, clock=None):
+        import time
+
+        self.timeout = timeout
+        self.clock = clock or time.monotonic
+        self.since = None
+
+    def check(self, workers: int, kept: int):
+        """RigError when no worker has been alive for the timeout (``kept``: batches stored)."""
+        if workers:
+            self.since = None
+            return
+        now = self.clock()
+        self.since = now if self.since is None else self.since
+        if now - self.since >= self.timeout:
+            raise RigError(f"--scheduler: no Dask worker alive for {self.timeout:g} s (--worker-timeout); "
+                           f"{kept} finished batches are kept: run the same command again to resume")
 
 
 def run_study(study: Study, store: Store, workers: int = 1, scheduler: str | None = None,
-              progress=None) -> int:
-    """Run the batches not yet stored; returns how many batches ran."""
+              progress=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> int:
+    """Run the batches not yet stored; returns how many batches ran. On Dask, a study
+    with no live worker for ``worker_timeout`` seconds stops (RigError)."""
     todo = [b for b in range(study.n_batches) if b not in store.done()]
     tick = progress or (lambda n: None)
     if scheduler:
-        return _dask(study, store, todo, scheduler, workers, tick)
+        return _dask(study, store, todo, scheduler, workers, tick, WorkerWatch(worker_timeout))
     if workers <= 1:
         for b in todo:
             store.write(run_batch(study, b))
             tick(len(study.shots_of(b)))
         return len(todo)
     ctx = multiprocessing.get_context("spawn")  # numba's threads and fork do not mix
-    with cf.ProcessPoolExecutor(workers, mp_context=ctx, initializer=_one_thread) as pool:
+    with cf.ProcessPoolExecutor(workers, mp_context=ctx, initializer=_worker_start,
+                                initargs=(os.getpid(),)) as pool:
         futures = {pool.submit(run_batch, study, b): b for b in todo}
         try:
             for fut in cf.as_completed(futures):
@@ -44,9 +95,9 @@ def run_study(study: Study, store: Store, workers: int = 1, scheduler: str | Non
     return len(todo)
 
 
-def _dask(study, store, todo, scheduler, workers, tick):
+def _dask(study, store, todo, scheduler, workers, tick, watch: WorkerWatch):
     try:
-        from dask.distributed import Client, LocalCluster, as_completed
+        from dask.distributed import Client, LocalCluster, wait
     except ImportError:
         raise RigError('--scheduler needs Dask: pip install ".[dask]"') from None
     if scheduler == "local":
@@ -60,11 +111,19 @@ def _dask(study, store, todo, scheduler, workers, tick):
         except OSError as exc:
             raise RigError(f"--scheduler {scheduler}: no Dask scheduler answers there ({exc})") from None
     try:
-        futures = [client.submit(run_batch, study, b, pure=False) for b in todo]
-        for fut in as_completed(futures):
-            result = fut.result()
-            store.write(result)
-            tick(len(result.index))
+        pending = {client.submit(run_batch, study, b, pure=False) for b in todo}
+        while pending:
+            try:
+                done = wait(pending, timeout=POLL_S, return_when="FIRST_COMPLETED").done
+            except (TimeoutError, asyncio.TimeoutError):  # nothing finished in this poll
+                done = set()
+            pending -= done
+            for fut in done:
+                result = fut.result()
+                store.write(result)
+                tick(len(result.index))
+            if pending:
+                watch.check(len(client.scheduler_info()["workers"]), len(store.done()))
     finally:
         client.close()
         if cluster is not None:

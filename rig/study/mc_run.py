@@ -12,10 +12,10 @@ import numpy as np
 
 from rig.errors import RigError
 from rig.experiment.measure import midway_static_force
-from rig.study.executors import run_study
+from rig.study.executors import DEFAULT_WORKER_TIMEOUT, run_study
 from rig.study.mc_spec import Study
 from rig.study.nominal import nominal
-from rig.study.report import figures, jcgm101
+from rig.study.report import failures, figures, jcgm101
 from rig.study.sobol import sobol_indices, sobol_matrix
 from rig.study.store import Store, StudyResults, atomic_write
 from rig.theory.longwave import solitary_wave_speed
@@ -45,9 +45,10 @@ class StudyRun:
 
 
 def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None, progress=None,
-           on_start=None) -> StudyRun:
+           on_start=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> StudyRun:
     """Run (or resume) ``study`` in ``folder``. ``progress(n)`` is told each finished
-    batch's shots; ``on_start(done)`` how many shots were already stored."""
+    batch's shots; ``on_start(done)`` how many shots were already stored; on Dask the study
+    stops after ``worker_timeout`` s without a live worker."""
     check(study)
     store = Store(folder, study).open()
     done = sum(len(study.shots_of(b)) for b in store.done())
@@ -55,7 +56,7 @@ def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None,
         on_start(done)
     t0 = time.perf_counter()
     try:
-        run_study(study, store, workers, scheduler, progress)
+        run_study(study, store, workers, scheduler, progress, worker_timeout)
     except KeyboardInterrupt:
         kept = sum(len(study.shots_of(b)) for b in store.done())
         raise RigError(f"interrupted: {kept} of {study.shots} shots are kept in {folder}; "
@@ -70,8 +71,10 @@ def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None,
 
 def summarise(study: Study, results: StudyResults, shots_per_s) -> dict:
     """The JCGM 101 summary of each output, the inputs, and the Sobol indices if asked."""
-    out = results.outputs
+    ok = results.outputs["failure"] == 0  # failed shots are counted, and left out of every estimate
+    out = {k: np.where(ok, v, np.nan) for k, v in results.outputs.items()}
     report = {"shots": int(results.index.size), "shots_per_s": shots_per_s,
+              "failed": failures(results.outputs["failure"]),
               "speed_m_per_s": jcgm101(out["speed_m_per_s"]),
               "speed_xcorr_m_per_s": jcgm101(out["speed_xcorr_m_per_s"]),
               "amplitude_N": jcgm101(out["amplitude_N"]),

@@ -12,7 +12,12 @@ from rig.errors import invalid
 
 WINDOWS = ("leading", "record")
 OUTPUTS = ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_amplitude_N",
-           "truth_speed_m_per_s", "truth_amplitude_N", "energy_error", "dt_s")
+           "truth_speed_m_per_s", "truth_amplitude_N", "energy_error", "dt_s", "failure")
+# Why a shot gave no result: its "failure" output is the index in FAILURES (0: it did not fail).
+FAILURES = ("none", "impossible inputs (the rig refuses them)", "solver unstable",
+            "the scope did not trigger",
+            "the scope record ends after the simulated window (--window record simulates the whole record)",
+            "non-finite measured speed or amplitude")
 
 
 @dataclass(frozen=True)

@@ -33,6 +33,9 @@ def atomic_write(path: Path, write) -> Path:
     temporary file is removed when anything fails."""
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     os.close(fd)
+    mask = os.umask(0)
+    os.umask(mask)
+    os.chmod(tmp, 0o666 & ~mask)  # mkstemp's 0600 would make every study file private
     try:
         write(tmp)
         with open(tmp, "rb+") as fh:
@@ -109,7 +112,7 @@ class Store:
         order = np.argsort(np.concatenate([q["index"] for q in parts]))
         cat = lambda key: np.concatenate([q[key] for q in parts])[order]  # noqa: E731
         return StudyResults(cat("index"), cat("inputs"), cat("seeds"),
-                            {k: np.concatenate([q["outputs"][k] for q in parts])[order] for k in OUTPUTS})
+                            {k: np.concatenate([_output(q, k) for q in parts])[order] for k in OUTPUTS})
 
     def consolidate(self, results: StudyResults, report: dict) -> Path:
         """DIR/study.h5: every shot's inputs, outputs and seed, and the report."""
@@ -129,3 +132,10 @@ class Store:
                     f[f"outputs/{k}"] = v
 
         return atomic_write(self.folder / "study.h5", write)
+
+
+def _output(part: dict, key: str) -> np.ndarray:
+    """One output of a stored batch; a batch stored before shots could fail has no "failure"."""
+    if key == "failure" and key not in part["outputs"]:
+        return np.zeros(part["index"].size)
+    return part["outputs"][key]

@@ -23,16 +23,12 @@ class Vary:
     with units)."""
 
     key: str
-    start: float
-    stop: float
-    count: int
-
-    @property
-    def values(self) -> tuple:
-        return tuple(float(v) for v in np.linspace(self.start, self.stop, self.count))
+    values: tuple
 
     @classmethod
-    def parse(cls, text: str) -> "Vary":
+    def parse(cls, text: str, max_count: int | None = None) -> "Vary":
+        """Parse KEY=START:STOP:COUNT; more than ``max_count`` points (if given) is refused
+        before any is made."""
         if "=" not in text:
             raise invalid("--vary", text, "expected KEY=START:STOP:COUNT, e.g. striker.velocity=0.3:1.5:7")
         key, spec = (s.strip() for s in text.split("=", 1))
@@ -47,11 +43,13 @@ class Vary:
             raise invalid(f"--vary {key} COUNT", parts[2], "a whole number >= 1") from None
         if count < 1:
             raise invalid(f"--vary {key} COUNT", count, "a whole number >= 1")
+        if max_count is not None and count > max_count:
+            raise invalid(f"--vary {key} COUNT", count, f"at most {max_count} points; add --allow-large for more")
         if start > stop:
             raise invalid(f"--vary {key}", spec, "START must not exceed STOP")
         if count == 1 and start != stop:
             raise invalid(f"--vary {key}", spec, "one point needs START = STOP")
-        return cls(key, float(start), float(stop), count)
+        return cls(key, tuple(float(v) for v in np.linspace(start, stop, count)))
 
     def override(self, value) -> str:
         unit = _unit_of(self.key)
@@ -97,20 +95,14 @@ def seeds_for(seed: int, count: int) -> list:
     return [int(s >> np.uint64(1)) for s in state]
 
 
-def sweep_rigs(scene, vary: Vary, overrides=()) -> list:
-    """Every point's rig, assembled (and so validated) before any shot is fired."""
+def run_sweep(scene, vary: Vary, overrides=(), seed: int = 0, progress=None, archive=None) -> list:
+    """Fire one shot per value; archive them (if given) even when a later point fails."""
     rigs = []
-    for v in vary.values:
+    for v in vary.values:  # assemble (validate) every point before firing any
         try:
             rigs.append(Rig.from_scene(scene, list(overrides) + [vary.override(v)]))
         except ValueError as exc:
             raise RigError(f"--vary {vary.key} = {v:g}: {exc}") from None
-    return rigs
-
-
-def run_sweep(rigs: list, vary: Vary, seed: int = 0, progress=None, archive=None) -> list:
-    """Fire one shot per rig of ``sweep_rigs``; archive them (if given) even when a later
-    point fails."""
     points, entries = [], []
     try:
         for v, rig, s in zip(vary.values, rigs, seeds_for(seed, len(rigs))):
