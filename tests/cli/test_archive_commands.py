@@ -27,7 +27,7 @@ def test_thousand_virtual_shots_round_trip_bit_identical(tmp_path):
             assert np.array_equal(back.record[ch].codes, w.codes)
             assert back.record[ch].preamble == w.preamble
     first = archive.read(1)
-    assert np.array_equal(first.truth["upper.average_force"], shots[0].truth.gauges["upper"].average_force)
+    assert np.array_equal(first.truth["upper_average_force"], shots[0].truth.gauges["upper"].average_force)
 
 
 def test_rig_shot_out_then_ls_and_verify(tmp_path, capsys):
