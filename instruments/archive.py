@@ -191,7 +191,11 @@ class Archive:
             return {"shots": 0, "ok": 0, "bad": [{"shot": None, "shots": [], "where": str(self.path),
                                                   "reason": str(exc)}]}
         with f:
-            return check(f)
+            try:
+                return check(f)
+            except Exception as exc:  # noqa: BLE001 - a safety net: damage is a finding, never a crash
+                return {"shots": 0, "ok": 0, "bad": [{"shot": None, "shots": [], "where": str(self.path),
+                                                      "reason": f"unreadable ({_cause(exc)})"}]}
 
     def digests(self) -> dict:
         """{shot id: the SHA-256 of its raw data}, as stored (no shot read)."""

@@ -25,8 +25,8 @@ def root_damage(f: h5py.File) -> list:
         stored = json.loads(f.attrs[ROOT_TABLE])
         now = _root_rows(f)
     except Exception as exc:  # noqa: BLE001
-        return [f"attribute /@{ROOT_TABLE}: unreadable ({_line(exc)})"]
-    return [f"attribute /@{k}: damaged" for k in sorted(set(stored) | set(now)) if stored.get(k) != now.get(k)]
+        return [f"attribute @{ROOT_TABLE}: unreadable ({_line(exc)})"]
+    return [f"attribute @{k}: damaged" for k in sorted(set(stored) | set(now)) if stored.get(k) != now.get(k)]
 
 
 def _root_rows(f) -> dict:
@@ -44,13 +44,12 @@ def shot_names(f: h5py.File) -> list:
 
 def check(f: h5py.File) -> dict:
     """{"shots", "ok", "bad"}: bad rows {"shot", "shots", "where", "reason"}."""
-    bad = [_row(None, "/", r) for r in root_damage(f)]
+    bad = [_row(None, "/" + _item(r), r) for r in root_damage(f)]
     try:
         names = shot_names(f)
     except Exception as exc:  # noqa: BLE001
         return {"shots": 0, "ok": 0, "bad": bad + [_row(None, "/", f"the root group is unreadable ({_line(exc)})")]}
-    shared, problems = _shared_groups(f, bad)
-    linked = {a: path for group in shared.values() for a, path in _addresses(group).items()}
+    shared, problems, linked = _shared_groups(f, bad)
     users, shot_bad = {}, set()
     for name in names:
         shot_id = int(name.split("_", 1)[1])
@@ -74,25 +73,25 @@ def check(f: h5py.File) -> dict:
 
 
 def _shared_groups(f, bad) -> tuple:
-    """({key: group} of the readable shared groups, {key: problems} of the damaged ones)."""
-    shared, problems = {}, {}
-    if "shared" not in f:
-        return shared, problems
+    """({key: group} of the readable shared groups, {key: problems} of the damaged ones,
+    {address: path} of every object in them)."""
+    shared, problems, linked = {}, {}, {}
     try:
-        keys = sorted(f["shared"])
+        keys = sorted(f["shared"]) if "shared" in f else []
     except Exception as exc:  # noqa: BLE001
         bad.append(_row(None, "/shared", f"unreadable ({_line(exc)})"))
-        return shared, problems
+        return shared, problems, linked
     for key in keys:
         try:
             group = f["shared"][key]
             found = damage(group, {})
+            linked.update(_addresses(group))
             shared[key] = group
         except Exception as exc:  # noqa: BLE001
             found = [f"unreadable ({_line(exc)})"]
         if found:
             problems[key] = found
-    return shared, problems
+    return shared, problems, linked
 
 
 def _item(problem: str) -> str:
