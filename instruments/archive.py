@@ -28,7 +28,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .archive_digest import address, damage
-from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, read_entry, write_entry
+from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_entry
+from .archive_reader import read_entry
 from .archive_verify import check, root_seal, shot_names
 from .errors import InstrumentError
 
