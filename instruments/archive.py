@@ -27,10 +27,10 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .archive_digest import address, damage
+from .archive_digest import damage, linked_groups
 from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_entry
 from .archive_reader import read_entry
-from .archive_verify import check, root_seal, shot_names
+from .archive_verify import addresses, check, root_seal, shot_names
 from .errors import InstrumentError
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
@@ -43,6 +43,7 @@ class Archive:
 
     def __init__(self, path):
         self.path = Path(path)
+        self._checked_shared = (None, set())  # (the file's identity, shared groups found intact)
 
     # --- writing --------------------------------------------------------------------
     def append(self, entries) -> list:
@@ -151,14 +152,14 @@ class Archive:
 
     def read(self, shot_id: int, verify: bool = True, with_truth: bool = True) -> Entry:
         """The stored shot as the same record objects the scope produces; with ``verify``,
-        its checksums (and, ``with_truth``, those of its shared truth) first."""
+        its checksums and those of what it shares first."""
         with self._open() as f:
             name = f"shot_{shot_id:06d}"
             if name not in f:
                 raise InstrumentError(f"{self.path}: no shot {shot_id} (shots: {_id_range(f)})")
             try:
                 if verify:
-                    self._check_shot(f, f[name], with_truth)
+                    self._check_shot(f, f[name])
                 e = read_entry(f[name], self.path, with_truth)
             except InstrumentError:
                 raise
@@ -168,19 +169,24 @@ class Archive:
                 raise InstrumentError(f"{self.path}: shot {shot_id}: raw_sha256 does not match the raw data")
             return e
 
-    def _check_shot(self, f, g, with_truth: bool):
-        linked = {}
-        for key, s in (f["shared"].items() if "shared" in f else []):
-            objects = [s]
-            s.visititems(lambda n, o: objects.append(o))
-            linked.update({address(o): o.name for o in objects})
-            if with_truth and "truth" in g and "forces" in s and address(s["forces"]) == address(g["truth/forces"]):
-                problems = damage(s, {})
-                if problems:
-                    raise InstrumentError(f"{self.path}: shot {g.name[6:].lstrip('0')}: shared/{key}: {problems[0]}")
+    def _check_shot(self, f, g):
+        """The shot's table, and those of the shared groups it links to (scene text and
+        settings, and the truth's forces, read or not; once per version of the file)."""
+        linked, name = {}, f"{self.path}: shot {int(g.name.rsplit('_', 1)[1])}"
+        st = os.stat(self.path)
+        identity = (st.st_ino, st.st_size, st.st_mtime_ns)  # a new version is a new file (os.replace)
+        if self._checked_shared[0] != identity:
+            self._checked_shared = (identity, set())
+        for key in sorted(linked_groups(g, "/shared/")):
+            s = f["shared"][key]
+            linked.update(addresses(s))
+            problems = [] if key in self._checked_shared[1] else damage(s, {})
+            if problems:
+                raise InstrumentError(f"{name}: shared/{key}/{problems[0]}")
+            self._checked_shared[1].add(key)
         problems = damage(g, linked)
         if problems:
-            raise InstrumentError(f"{self.path}: shot {g.name[6:].lstrip('0')}: {problems[0]}")
+            raise InstrumentError(f"{name}: {problems[0]}")
 
     def verify(self) -> dict:
         """Check the whole archive: {"shots", "ok", "bad"}; each bad row names the shot

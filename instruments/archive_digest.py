@@ -136,6 +136,17 @@ def damage(group: h5py.Group, linked: dict) -> list:
     return out
 
 
+def linked_groups(group: h5py.Group, under: str) -> set:
+    """The groups below ``under`` (e.g. "/shared/") that ``group``'s stored table links to,
+    by name ({"scene_ab12"}); empty when the table is unreadable (its check says why)."""
+    try:
+        rows = json.loads(group[TABLE][()])
+    except Exception:  # noqa: BLE001
+        return set()
+    return {v[len("link:") + len(under):].split("/", 1)[0] for v in rows.values()
+            if isinstance(v, str) and v.startswith("link:" + under)}
+
+
 def _dataset_digest(d) -> str:
     value = d[()]  # fletcher32 is checked chunk by chunk here
     if isinstance(value, (bytes, str)):

@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 from typing import TYPE_CHECKING
 
-from .archive_digest import address, damage, sha
+from .archive_digest import address, damage, linked_groups, sha
 
 if TYPE_CHECKING:
     import h5py
@@ -56,7 +56,7 @@ def check(f: h5py.File) -> dict:
         try:
             g = f[name]
             found = damage(g, linked)
-            for key in _uses(g, shared):
+            for key in linked_groups(g, "/shared/"):
                 users.setdefault(key, []).append(shot_id)
         except Exception as exc:  # noqa: BLE001
             found = [f"unreadable ({_line(exc)})"]
@@ -85,7 +85,7 @@ def _shared_groups(f, bad) -> tuple:
         try:
             group = f["shared"][key]
             found = damage(group, {})
-            linked.update(_addresses(group))
+            linked.update(addresses(group))
             shared[key] = group
         except Exception as exc:  # noqa: BLE001
             found = [f"unreadable ({_line(exc)})"]
@@ -100,7 +100,8 @@ def _item(problem: str) -> str:
     return "" if head.startswith("unreadable") else head
 
 
-def _addresses(group) -> dict:
+def addresses(group) -> dict:
+    """{address: path} of ``group`` and every object below it."""
     out = {}
 
     def visit(name, obj):
@@ -109,14 +110,6 @@ def _addresses(group) -> dict:
     out[address(group)] = group.name
     group.visititems(visit)
     return out
-
-
-def _uses(g, shared) -> list:
-    """The shared groups a shot links to."""
-    mine = {address(g[n]) for n in ("scene_text", "settings") if n in g}
-    if "truth" in g and "forces" in g["truth"]:
-        mine.add(address(g["truth/forces"]))
-    return [key for key, s in shared.items() if any(address(s[n]) in mine for n in s)]
 
 
 def _row(shot, where, reason) -> dict:
