@@ -1,6 +1,9 @@
 """HDF5 shot archive (NeXus-style) that never loses a committed shot.
 
-The layout of one shot: instruments/archive_layout.py.
+The layout of one shot: instruments/archive_layout.py (version 2, NeXus); its checksums:
+instruments/archive_digest.py and archive_verify.py; archives of layout 1 (no version
+attribute) are refused with a line that says to run ``rig upgrade``, which rewrites them
+(``Archive.upgrade``, through instruments/archive_legacy.py).
 
 Appends are transactions. Under an exclusive lock (``ARCHIVE.h5.lock``) the archive is
 copied to a temporary file beside it, the new shots are written there, the copy is flushed
@@ -9,20 +12,25 @@ synced. A writer killed at any moment, a power loss or a full disk leaves either
 archive or the new one, never a mix, and a stale temporary file is removed by the next
 append. Readers open the path and see one complete version: this is what SWMR would give,
 without SWMR's ban on creating groups. The price is a file copy per transaction; append
-many shots in one call where that matters.
+many shots in one call where that matters. An I/O failure (a full disk, no permission) or
+a damaged archive ends an append with one InstrumentError naming the archive and the cause;
+the archive is left as it was.
 """
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
-import json
 import os
 import shutil
 import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .archive_layout import LAYOUT, Entry, raw_digest, read_entry, write_entry
+from .archive_digest import damage, linked_groups
+from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_entry
+from .archive_reader import read_entry
+from .archive_verify import addresses, check, root_seal, shot_names
 from .errors import InstrumentError
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
@@ -35,42 +43,67 @@ class Archive:
 
     def __init__(self, path):
         self.path = Path(path)
+        self._checked_shared = (None, set())  # (the file's identity, shared groups found intact)
 
     # --- writing --------------------------------------------------------------------
     def append(self, entries) -> list:
         """Append shots in one transaction; returns their ids. All or nothing."""
-        import h5py
-
         entries = list(entries)
         with self._lock():
             self._drop_stale_temporaries()
-            fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp", dir=self.path.parent)
-            os.close(fd)
-            try:
-                if self.path.exists():
-                    self._open(self.path).close()  # refuse to build on a broken archive
-                    shutil.copyfile(self.path, tmp)
-                    shutil.copymode(self.path, tmp)
-                else:
-                    umask = os.umask(0)
-                    os.umask(umask)
-                    os.chmod(tmp, 0o666 & ~umask)
-                with h5py.File(tmp, "a", libver=("v110", "latest")) as f:
-                    if "NX_class" not in f.attrs:
-                        f.attrs.update({"NX_class": "NXroot", "creator": "sonic-rig", "layout": LAYOUT})
-                    start = max([_shot_id(n) for n in f if n.startswith("shot_")] + [0]) + 1
-                    ids = [start + i for i in range(len(entries))]
-                    checked = set()
-                    for shot_id, e in zip(ids, entries):
-                        write_entry(f, shot_id, e, checked)
-                    f.attrs["default"] = f"shot_{ids[-1]:06d}" if ids else f.attrs.get("default", "")
-                _fsync(tmp)
-                os.replace(tmp, self.path)
-                _fsync_dir(self.path.parent)
-            except BaseException:
-                with contextlib.suppress(OSError):
-                    os.unlink(tmp)
+            return self._transaction(lambda f: self._write(f, entries), self.path.exists())
+
+    def upgrade(self) -> int:
+        """Rewrite an archive of layout 1 in the current layout (one transaction); returns
+        the number of shots. An archive of the current layout is left as it is (0)."""
+        from .archive_legacy import read_legacy_entry
+
+        with self._lock():
+            with self._open(current=False) as f:
+                if f.attrs.get("layout_version") == LAYOUT_VERSION:
+                    return 0
+                entries = [read_legacy_entry(f[n], self.path) for n in shot_names(f)]
+            self._drop_stale_temporaries()
+            return len(self._transaction(lambda f: self._write(f, entries, [e.shot_id for e in entries]), False))
+
+    def _transaction(self, write, copy: bool) -> list:
+        """Write into a copy of the archive (or a new file), then put it in place."""
+        import h5py
+
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp", dir=self.path.parent)
+        os.close(fd)
+        try:
+            if copy:
+                self._open().close()  # refuse to build on a broken or foreign archive
+                shutil.copyfile(self.path, tmp)
+                shutil.copymode(self.path, tmp)
+            else:
+                umask = os.umask(0)
+                os.umask(umask)
+                os.chmod(tmp, (os.stat(self.path).st_mode if self.path.exists() else 0o666 & ~umask) & 0o7777)
+            with h5py.File(tmp, "a", libver=("v110", "latest")) as f:
+                ids = write(f)
+            _fsync(tmp)
+            os.replace(tmp, self.path)
+            _fsync_dir(self.path.parent)
+        except BaseException as exc:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+            if isinstance(exc, (InstrumentError, KeyboardInterrupt, SystemExit)) or not isinstance(exc, Exception):
                 raise
+            raise InstrumentError(f"{self.path}: cannot append: {_cause(exc)}") from None
+        return ids
+
+    def _write(self, f, entries, ids=None) -> list:
+        start = max([int(n.split("_", 1)[1]) for n in shot_names(f)] + [0]) + 1
+        ids = ids or [start + i for i in range(len(entries))]
+        checked = set()
+        for shot_id, e in zip(ids, entries):
+            write_entry(f, shot_id, e, checked)
+        f.attrs.update({"NX_class": "NXroot", "creator": "sonic-rig", "layout_version": LAYOUT_VERSION,
+                        "layout": LAYOUT, "file_name": self.path.name})
+        f.attrs["default"] = shot_names(f)[-1] if shot_names(f) else ""
+        root_seal(f)
         return ids
 
     @contextlib.contextmanager
@@ -89,7 +122,9 @@ class Archive:
                 stale.unlink()  # we hold the lock: no live writer owns it
 
     # --- reading --------------------------------------------------------------------
-    def _open(self, path=None) -> h5py.File:
+    def _open(self, path=None, current: bool = True) -> h5py.File:
+        """The archive opened for reading; one InstrumentError if it is missing, not HDF5,
+        damaged, foreign, or (``current``) of an older layout."""
         import h5py
 
         path = Path(path or self.path)
@@ -99,87 +134,115 @@ class Archive:
             raise InstrumentError(f"{path}: not an HDF5 file")
         try:
             f = h5py.File(path, "r")
-        except OSError as exc:
-            raise InstrumentError(f"{path}: cannot be opened as HDF5 (truncated or damaged?): {exc}") from None
-        if f.attrs.get("creator") != "sonic-rig":
+            creator, version = f.attrs.get("creator"), f.attrs.get("layout_version")
+        except Exception as exc:  # noqa: BLE001 - any failure of a damaged file
+            raise InstrumentError(f"{path}: cannot be opened as HDF5 (truncated or damaged?): {_cause(exc)}") from None
+        if creator != "sonic-rig":
             f.close()
             raise InstrumentError(f"{path}: not a rig archive (an HDF5 file that this project did not write)")
+        if current and version != LAYOUT_VERSION:
+            f.close()
+            raise InstrumentError(f"{path}: archive layout {version or 1}, this version reads layout "
+                                  f"{LAYOUT_VERSION}: run `rig upgrade {path}` to convert it")
         return f
 
     def ids(self) -> list:
         with self._open() as f:
-            return sorted(_shot_id(n) for n in f if n.startswith("shot_"))
+            return [int(n.split("_", 1)[1]) for n in shot_names(f)]
 
     def read(self, shot_id: int, verify: bool = True, with_truth: bool = True) -> Entry:
-        """The stored shot as the same record objects the scope produces."""
+        """The stored shot as the same record objects the scope produces; with ``verify``,
+        its checksums and those of what it shares first."""
         with self._open() as f:
             name = f"shot_{shot_id:06d}"
             if name not in f:
                 raise InstrumentError(f"{self.path}: no shot {shot_id} (shots: {_id_range(f)})")
-            return read_entry(f[name], verify, self.path, with_truth)
+            try:
+                if verify:
+                    self._check_shot(f, f[name])
+                e = read_entry(f[name], self.path, with_truth)
+            except InstrumentError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - a damaged file, one line
+                raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({_cause(exc)})") from None
+            if verify and raw_digest(e.record) != stored_raw_digest(f[name]):
+                raise InstrumentError(f"{self.path}: shot {shot_id}: raw_sha256 does not match the raw data")
+            return e
+
+    def _check_shot(self, f, g):
+        """The shot's table, and those of the shared groups it links to (scene text and
+        settings, and the truth's forces, read or not; once per version of the file)."""
+        linked, name = {}, f"{self.path}: shot {int(g.name.rsplit('_', 1)[1])}"
+        st = os.stat(self.path)
+        identity = (st.st_ino, st.st_size, st.st_mtime_ns)  # a new version is a new file (os.replace)
+        if self._checked_shared[0] != identity:
+            self._checked_shared = (identity, set())
+        for key in sorted(linked_groups(g, "/shared/")):
+            s = f["shared"][key]
+            linked.update(addresses(s))
+            problems = [] if key in self._checked_shared[1] else damage(s, {})
+            if problems:
+                raise InstrumentError(f"{name}: shared/{key}/{problems[0]}")
+            self._checked_shared[1].add(key)
+        problems = damage(g, linked)
+        if problems:
+            raise InstrumentError(f"{name}: {problems[0]}")
 
     def verify(self) -> dict:
-        """Check every shot (fletcher32 on every chunk, then the sha256)."""
-        import h5py
-
+        """Check the whole archive: {"shots", "ok", "bad"}; each bad row names the shot
+        ("shot"; None for what is shared or the file itself), the shots it touches
+        ("shots"), the dataset or attribute ("where") and the reason. Never raises."""
         try:
             f = self._open()
         except InstrumentError as exc:
-            return {"shots": 0, "ok": 0, "bad": [{"shot": None, "reason": str(exc)}]}
-        bad, n = [], 0
+            return {"shots": 0, "ok": 0, "bad": [{"shot": None, "shots": [], "where": str(self.path),
+                                                  "reason": str(exc)}]}
         with f:
-            checked = set()  # shared datasets (hard links) are read once
-            for name in sorted(k for k in f if k.startswith("shot_")):
-                n += 1
-                try:
-                    read_entry(f[name], True, self.path, with_truth=False)
-                    for obj in _datasets(f[name]):
-                        info = h5py.h5o.get_info(obj.id)
-                        key = info.token if hasattr(info, "token") else info.addr
-                        if key not in checked:
-                            obj[()]  # fletcher32 is checked chunk by chunk as it is read
-                            checked.add(key)
-                except (OSError, InstrumentError, KeyError, ValueError) as exc:
-                    bad.append({"shot": _shot_id(name), "reason": str(exc).splitlines()[0]})
-        return {"shots": n, "ok": n - len(bad), "bad": bad}
+            try:
+                return check(f)
+            except Exception as exc:  # noqa: BLE001 - a safety net: damage is a finding, never a crash
+                return {"shots": 0, "ok": 0, "bad": [{"shot": None, "shots": [], "where": str(self.path),
+                                                      "reason": f"unreadable ({_cause(exc)})"}]}
 
     def digests(self) -> dict:
         """{shot id: the SHA-256 of its raw data}, as stored (no shot read)."""
         with self._open() as f:
-            return {_shot_id(n): f[n].attrs["shot"]["sha256"].decode() for n in f if n.startswith("shot_")}
+            return {int(n.split("_", 1)[1]): stored_raw_digest(f[n]) for n in shot_names(f)}
 
     def summary(self) -> list:
-        """One row per shot: id, time, simulated, scene, seed, channels, triggered."""
+        """One row per shot: id, title, start time (and what it is), simulated, scene, seed,
+        channels, triggered, source files, the striker's settings."""
         rows = []
         with self._open() as f:
-            for name in sorted(k for k in f if k.startswith("shot_")):
-                g = f[name]
-                a = g.attrs["shot"]
-                settings = json.loads(g["settings"][()])
-                rows.append({"shot": int(a["shot_id"]), "start_time": a["start_time"].decode(),
-                             "simulated": bool(a["simulated"]), "scene": a["scene"].decode(),
-                             "seed": int(a["seed"]) if a["seed"] >= 0 else None,
-                             "triggered": bool(a["triggered"]),
-                             "channels": sorted(g["instrument/oscilloscope"]),
-                             "sources": settings.get("source_files", []),
-                             "settings": settings.get("striker", {})})
+            for name in shot_names(f):
+                try:
+                    e = read_entry(f[name], self.path, with_truth=False)
+                except Exception as exc:  # noqa: BLE001 - a damaged file, one line
+                    raise InstrumentError(f"{self.path}: {name}: unreadable ({_cause(exc)}); "
+                                          f"run `rig verify {self.path}`") from None
+                rows.append({"shot": e.shot_id, "title": e.title, "start_time": e.start_time,
+                             "start_time_source": e.start_time_source, "simulated": e.simulated,
+                             "scene": e.scene, "seed": e.seed, "triggered": e.record.triggered,
+                             "channels": sorted(e.record.waveforms), "sources": e.settings.get("source_files", []),
+                             "settings": e.settings.get("striker", {})})
         return rows
 
 
-def _datasets(group):
-    import h5py
-
-    out = []
-    group.visititems(lambda name, obj: out.append(obj) if isinstance(obj, h5py.Dataset) else None)
-    return out
+def stored_raw_digest(g) -> str:
+    """The stored SHA-256 of a shot's raw data."""
+    value = g["raw_sha256"][()]
+    return value.decode() if isinstance(value, bytes) else str(value)
 
 
-def _shot_id(name: str) -> int:
-    return int(name.split("_", 1)[1])
+def _cause(exc) -> str:
+    """An exception as one line: the OS's words for an I/O error (ENOSPC: 'No space left on device')."""
+    if isinstance(exc, OSError) and exc.errno is not None:
+        return os.strerror(exc.errno) if exc.errno in errno.errorcode else str(exc)
+    return (str(exc).splitlines() or [type(exc).__name__])[0] or type(exc).__name__
 
 
 def _id_range(f) -> str:
-    ids = sorted(_shot_id(n) for n in f if n.startswith("shot_"))
+    ids = [int(n.split("_", 1)[1]) for n in shot_names(f)]
     return f"{ids[0]}..{ids[-1]}" if ids else "none"
 
 

@@ -48,6 +48,9 @@ def build_parser() -> argparse.ArgumentParser:
     ve = _command(sub, "verify", "check every shot of an archive (exit 1 if any is bad)", data.cmd_verify)
     ve.add_argument("archive")
 
+    up = _command(sub, "upgrade", "rewrite an archive of an older layout in the current one", data.cmd_upgrade)
+    up.add_argument("archive")
+
     im = _command(sub, "import", "import real scope files into an archive", data.cmd_import)
     im.add_argument("files", nargs="+", metavar="FILE")
     im.add_argument("--into", required=True, metavar="ARCHIVE.h5")

@@ -1,21 +1,47 @@
-"""`rig verify`, `rig import`, `rig analyze` and `rig ls`."""
+"""`rig verify`, `rig upgrade`, `rig import`, `rig analyze` and `rig ls`."""
 from __future__ import annotations
+
+from rig.errors import RigError
 
 
 def cmd_verify(args) -> dict:
+    """Every shot's checksums; a bad row names the shot (or the shots of a shared group) and
+    the dataset or attribute. Exit 1 if any is bad."""
+    from pathlib import Path
+
     from instruments.archive import Archive
 
-    report = Archive(args.archive).verify()
+    path = Path(args.archive)  # a path that holds no file is a mistake (exit 2), a damaged file a finding (1)
+    if not path.exists():
+        raise RigError(f"{path}: no such archive")
+    if path.is_dir():
+        raise RigError(f"{path}: a folder, not an archive file")
+    report = Archive(path).verify()
     if not args.json:
         print(f"{args.archive}: {report['shots']} shots, {report['ok']} ok, {len(report['bad'])} bad")
         for b in report["bad"]:
-            print(f"  shot {b['shot']}: {b['reason']}")
+            who = f"shot {b['shot']}" if b["shot"] is not None else \
+                f"shots {', '.join(map(str, b['shots']))}" if b["shots"] else "archive"
+            print(f"  {who}: {b['where']}: {b['reason']}")
     args.exit_code = 1 if report["bad"] else 0
     return report
 
 
+def cmd_upgrade(args) -> dict:
+    """Rewrite an archive of an older layout in the current one (one transaction)."""
+    from instruments.archive import Archive
+
+    n = Archive(args.archive).upgrade()
+    if not args.json:
+        print(f"{args.archive}: {n} shots rewritten in the current layout" if n else
+              f"{args.archive}: already in the current layout")
+    return {"archive": args.archive, "upgraded": n}
+
+
 def cmd_import(args) -> dict:
-    """Real scope files into an archive, in the same layout as virtual shots (simulated = false)."""
+    """Real scope files into an archive, in the same layout as virtual shots (simulated = false).
+    A file whose raw data (SHA-256) an archived shot already holds is imported with a warning;
+    an archive that is not a rig archive (or of an older layout) is refused in one line."""
     import sys
     from datetime import datetime, timezone
     from pathlib import Path
@@ -26,10 +52,13 @@ def cmd_import(args) -> dict:
     groups = [args.files] if args.together else [[f] for f in args.files]
     entries = []
     for files in groups:
-        mtime = min(Path(f).stat().st_mtime for f in files)
+        # scope files hold no acquisition time: the start time is the oldest file's
+        # modification time, stored as what it is
+        mtime = datetime.fromtimestamp(min(Path(f).stat().st_mtime for f in files), timezone.utc).isoformat()
         entries.append(Entry(read_record(files), False, scene="",
                              settings={"source_files": [str(Path(f).resolve().name) for f in files]},
-                             start_time=datetime.fromtimestamp(mtime, timezone.utc).isoformat()))
+                             start_time=mtime, file_modification_time=mtime,
+                             start_time_source="file modification time (the file holds no acquisition time)"))
     archive = Archive(args.into)
     stored = {}  # raw-data digest -> the first shot that holds it
     for i, d in sorted(archive.digests().items() if Path(args.into).exists() else []):
@@ -88,14 +117,17 @@ def cmd_ls(args) -> list:
 
     rows = Archive(args.archive).summary()
     if not args.json:
-        print(f"{'shot':>5s}  {'start (UTC)':19s}  {'kind':7s}  {'scene':22s}  {'seed':>20s}  channels")
+        print(f"{'shot':>5s}  {'start (UTC)':20s}  {'kind':7s}  {'scene':22s}  {'seed':>20s}  channels")
         for r in rows:
+            mark = "~" if r["start_time_source"].startswith("file modification") else " "
             s = r["settings"]
             extra = f"  v={s['velocity']:g} m/s" if "velocity" in s else ""
             what = r["scene"] or ",".join(r["sources"]) or "-"
-            print(f"{r['shot']:5d}  {r['start_time'][:19]:19s}  {'virtual' if r['simulated'] else 'real':7s}  "
+            print(f"{r['shot']:5d}  {r['start_time'][:19]:19s}{mark}  {'virtual' if r['simulated'] else 'real':7s}  "
                   f"{what:22s}  {'' if r['seed'] is None else r['seed']:>20}  "
                   f"{','.join(r['channels'])}{'' if r['triggered'] else '  NO TRIGGER'}{extra}")
+        if any(r["start_time_source"].startswith("file modification") for r in rows):
+            print("~ the file's modification time (the file holds no acquisition time)")
     return rows
 
 

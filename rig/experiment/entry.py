@@ -12,13 +12,14 @@ from rig.experiment.shot import ShotRecord
 def shot_entry(shot: ShotRecord) -> Entry:
     """The archive Entry of a shot: scope record, scene, settings, truth arrays and facts.
     The truth key (one truth stored per scene text, overrides and version) lets shots of
-    the same scene share their noise-free truth."""
+    the same scene share their noise-free truth. Truth names are NeXus names:
+    ``upper_average_force``, ``upper_contact_above``, ..., ``wall_force``."""
     arrays, gauges = {}, {}
     for name, g in shot.truth.gauges.items():
-        arrays[f"{name}.average_force"] = g.average_force
+        arrays[f"{name}_average_force"] = g.average_force
         if g.contact_above is not None:
-            arrays[f"{name}.contact_above"] = g.contact_above
-            arrays[f"{name}.contact_below"] = g.contact_below
+            arrays[f"{name}_contact_above"] = g.contact_above
+            arrays[f"{name}_contact_below"] = g.contact_below
         gauges[name] = GaugeFact(g.bead, g.channel, g.position_m, g.static_above_N, g.static_below_N)
     if shot.truth.wall_force is not None:
         arrays["wall_force"] = shot.truth.wall_force

@@ -1,5 +1,6 @@
 """Virtual shots and real files in the archive, through the rig's commands."""
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,7 +28,7 @@ def test_thousand_virtual_shots_round_trip_bit_identical(tmp_path):
             assert np.array_equal(back.record[ch].codes, w.codes)
             assert back.record[ch].preamble == w.preamble
     first = archive.read(1)
-    assert np.array_equal(first.truth["upper.average_force"], shots[0].truth.gauges["upper"].average_force)
+    assert np.array_equal(first.truth["upper_average_force"], shots[0].truth.gauges["upper"].average_force)
 
 
 def test_rig_shot_out_then_ls_and_verify(tmp_path, capsys):
@@ -67,7 +68,8 @@ def test_bad_archives_are_one_line_errors(tmp_path, capsys, make):
     assert main(["ls", str(path)]) == 2
     err = capsys.readouterr().err
     assert str(path) in err and "Traceback" not in err
-    assert main(["verify", str(path)]) == 1
+    # a damaged file is a finding of verify (exit 1); a path with no file is a mistake (exit 2)
+    assert main(["verify", str(path)]) == (2 if make == "missing" else 1)
 
 
 def test_every_readable_real_csv_imports_and_reads_back_exactly(tmp_path, capsys, realdata):
@@ -126,3 +128,86 @@ def test_every_readable_real_file_imports_and_reads_back_exactly(tmp_path, capsy
         imported += 1
     capsys.readouterr()
     assert imported >= 6
+
+
+def _flip(path, offset):
+    with open(path, "r+b") as fh:
+        fh.seek(offset)
+        b = fh.read(1)
+        fh.seek(offset)
+        fh.write(bytes([b[0] ^ 0x5A]))
+
+
+def test_verify_names_the_shot_and_the_dataset_of_a_flip(tmp_path, capsys):
+    import h5py
+
+    rig = Rig.from_scene("steel21_gravity")
+    path = tmp_path / "f.h5"
+    Archive(path).append([shot_entry(rig.fire(seed=s)) for s in (1, 2)])
+    pristine = path.read_bytes()
+    with h5py.File(path, "r") as f:
+        time_chunk = f["shot_000002/data/time"].id.get_chunk_info(0).byte_offset
+        shared = f["shot_000001/truth/forces/upper_average_force"]
+        forces_chunk, forces_name = shared.id.get_chunk_info(0).byte_offset, shared.name
+        key = next(k for k in f["shared"] if f["shared"][k]["forces"] == f["shot_000001/truth/forces"])
+    _flip(path, time_chunk + 40)  # the time axis: once unprotected, now fletcher32 and SHA-256
+    assert main(["verify", str(path)]) == 1
+    out = capsys.readouterr().out
+    assert "2 shots, 1 ok, 1 bad" in out and "shot 2: /shot_000002/data/time:" in out
+    path.write_bytes(pristine)
+    _flip(path, forces_chunk + 40)  # the shared truth: named once, with the shots that use it
+    assert main(["verify", str(path), "--json"]) == 1
+    report = json.loads(capsys.readouterr().out)
+    assert report["ok"] == 0 and len(report["bad"]) == 1, report
+    assert report["bad"][0]["where"] == f"/shared/{key}/forces/upper_average_force"
+    assert report["bad"][0]["shots"] == [1, 2] and forces_name.endswith("upper_average_force")
+
+
+def test_a_full_disk_is_one_line_and_loses_nothing(tmp_path, capsys, monkeypatch):
+    import errno
+    import shutil
+
+    import instruments.archive as archive
+
+    path = tmp_path / "a.h5"
+    assert main(["shot", "steel21_gravity", "--seed", "1", "--out", str(path)]) == 0
+    before = path.read_bytes()
+
+    def full(src, dst):
+        shutil.copyfileobj(open(src, "rb"), open(dst, "wb"), length=1000)  # noqa: SIM115 - part of it
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(archive.shutil, "copyfile", lambda src, dst: full(src, dst))
+    capsys.readouterr()
+    assert main(["shot", "steel21_gravity", "--seed", "2", "--out", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err == f"rig shot: error: {path}: cannot append: No space left on device\n"
+    assert path.read_bytes() == before and not list(tmp_path.glob(".a.h5.*.tmp"))
+
+
+def test_import_refuses_a_foreign_or_old_archive_and_upgrade_converts(tmp_path, capsys, realdata):
+    import shutil
+
+    import h5py
+
+    isf = str(realdata / "tek_16bit_dpo.isf")
+    foreign = tmp_path / "foreign.h5"
+    with h5py.File(foreign, "w") as f:
+        f["x"] = [1, 2, 3]
+    assert main(["import", isf, "--into", str(foreign)]) == 2
+    assert "not a rig archive" in capsys.readouterr().err
+    assert main(["verify", str(foreign)]) == 1
+    assert "not a rig archive" in capsys.readouterr().out
+    old = tmp_path / "old.h5"
+    shutil.copyfile(Path(__file__).parents[1] / "instruments" / "data" / "layout1.h5", old)
+    for argv in (["import", isf, "--into", str(old)], ["ls", str(old)], ["analyze", str(old)]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"run `rig upgrade {old}`" in err, err
+    assert main(["upgrade", str(old)]) == 0
+    assert "3 shots rewritten" in capsys.readouterr().out
+    assert main(["import", isf, "--into", str(old), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["shots"] == [4]
+    assert main(["ls", str(old), "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)[3]
+    assert row["title"] == "tek_16bit_dpo.isf" and row["start_time_source"].startswith("file modification time")

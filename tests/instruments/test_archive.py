@@ -92,8 +92,11 @@ def test_round_trip_is_bit_identical(tmp_path):
         assert np.array_equal(back.truth["wall_force"], e.truth["wall_force"])
     with h5py.File(tmp_path / "a.h5") as f:  # the shared truth is stored once
         assert len(f["shared"]) == 1
-        assert f["shot_000001/data/CH1"].id == f["shot_000001/instrument/oscilloscope/CH1"].id
         assert f["shot_000001/truth/forces"].id == f["shot_000030/truth/forces"].id
+        w = shots[0].record["CH1"]  # the plot holds volts and seconds, the instrument the codes
+        assert np.array_equal(f["shot_000001/data/CH1"][()], w.volts())
+        assert np.array_equal(f["shot_000001/data/time"][()], w.time())
+        assert np.array_equal(f["shot_000001/instrument/oscilloscope/CH1"][()], w.codes)
 
 
 KILL_POINTS = ("idle", "copied", "written", "replaced")  # between appends, then inside one
@@ -203,19 +206,26 @@ def test_files_open_with_plain_h5py_and_xarray(tmp_path):
     xr = pytest.importorskip("xarray")
     path = tmp_path / "x.h5"
     e = entry(5)
-    Archive(path).append([e])
+    Archive(path).append([e, entry(6, truth=False)])
     with h5py.File(path, "r") as f:
         g = f["shot_000001"]
         assert g.attrs["NX_class"] == "NXentry" and g["data"].attrs["signal"] == "CH1"
-        assert g.attrs["shot"]["seed"] == 5 and "volts = y_zero" in f.attrs["layout"]
+        assert g["seed"][()] == 5 and "volts = y_zero" in f.attrs["layout"] and f.attrs["layout_version"] == 2
+        assert g["title"][()].decode() == "synthetic seed 5" and g["start_time"][()].decode().startswith("20")
         for name, obj in _all_datasets(g):
-            assert "units" in obj.attrs or name in ("scene_text", "settings"), name
+            assert obj.ndim == 0 or (obj.fletcher32 and obj.chunks), name  # arrays carry fletcher32
+            assert "units" in obj.attrs or obj.ndim == 0 or name.endswith("sample"), name
         json.loads(g["settings"][()])
     ds = xr.open_dataset(path, group="shot_000001/data", engine="h5netcdf")
     w = e.record["CH1"]
-    assert np.allclose(ds["CH1"].values, w.volts(), rtol=0, atol=1e-12)
-    assert np.allclose(ds["time"].values, w.time(), rtol=0, atol=1e-15)
-    assert ds["CH1"].attrs["units"] == "V"
+    assert np.array_equal(ds["CH1"].values, w.volts()) and np.array_equal(ds["time"].values, w.time())
+    assert ds["CH1"].attrs["units"] == "V" and ds["time"].attrs["units"] == "s"
+    tree = xr.open_datatree(path, engine="h5netcdf")  # the whole file
+    forces = tree["shot_000001/truth/forces"]
+    assert np.array_equal(forces["wall_force"].values, e.truth["wall_force"])
+    assert forces["time"].values[1] == pytest.approx(e.facts.sample_interval_s, rel=1e-12)
+    assert forces["wall_force"].attrs["units"] == "N" and forces["time"].attrs["units"] == "s"
+    assert tree["shot_000002"]["seed"].values == 6 and "truth" not in tree["shot_000002"]
 
 
 def _all_datasets(group):

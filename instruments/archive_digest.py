@@ -1,0 +1,186 @@
+"""The archive's checksum tables: a SHA-256 for every value a reader sees.
+
+A group's table (``checksums``, a JSON text dataset in the group) has one row per item of
+its tree, in sorted order: ``path`` -> the SHA-256 of a dataset's dtype, shape and values,
+``path@name`` -> the SHA-256 of an attribute's value, ``path/`` -> that of a group's member
+names. A hard link to an object that another table covers (the truth shared by the shots
+of one scene) is a row ``link:<path>`` instead. Object references (the dimension scales of
+xarray and netCDF) are hashed as the paths they point to. The group's attribute ``sha256``
+is the SHA-256 of the table's text, so a damaged table is found too.
+
+Comparing a table with the file as it now reads names each damaged dataset or attribute.
+HDF5's own fletcher32 checks (every array dataset) raise while the values are read; each
+such error is caught and reported against the item that raised.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    import h5py
+
+TABLE = "checksums"  # the dataset that holds a group's table
+DIGEST = "sha256"  # the group attribute that holds the table's own SHA-256
+_REFERENCE_ATTRS = ("DIMENSION_LIST", "REFERENCE_LIST")
+
+
+def sha(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def address(obj) -> int:
+    """The object's address in the file: equal for every hard link to it."""
+    import h5py
+
+    return h5py.h5o.get_info(obj.id).addr
+
+
+def paths(group: h5py.Group, linked: dict) -> dict:
+    """{address: path inside ``group``} of every object, the first path in sorted order;
+    objects in ``linked`` (address -> the covering table's path) are not entered."""
+    import h5py
+
+    out = {address(group): "."}
+
+    def walk(g, prefix):
+        for name in sorted(g):
+            try:
+                obj = g[name]
+                a = address(obj)
+            except Exception:  # noqa: BLE001 - table() reports it
+                continue
+            if a in out or a in linked:
+                continue
+            out[a] = prefix + name
+            if isinstance(obj, h5py.Group):
+                walk(obj, prefix + name + "/")
+
+    walk(group, "")
+    return out
+
+
+def table(group: h5py.Group, linked: dict) -> dict:
+    """The rows of ``group``'s table as the file reads now. An item that cannot be read
+    gets the row ``unreadable: <cause>`` (never an exception)."""
+    import h5py
+
+    where = paths(group, linked)
+    names = {**where, **linked}
+    rows = {}
+
+    def attrs(obj, path):
+        for key in sorted(obj.attrs):
+            if obj is group and key == DIGEST:
+                continue
+            rows[f"{path}@{key}"] = _guard(lambda: _attr_digest(obj, key, names))
+
+    def walk(g, prefix):
+        members = sorted(n for n in g if n != TABLE or g is not group)
+        rows[prefix or "/"] = sha(json.dumps(members).encode())
+        attrs(g, prefix.rstrip("/"))
+        for name in members:
+            path = prefix + name
+            try:
+                obj = g[name]
+                a = address(obj)
+            except Exception as exc:  # noqa: BLE001 - a damaged link or header is a finding
+                rows[path] = f"unreadable: {_first_line(exc)}"
+                continue
+            if a in linked:
+                rows[path] = "link:" + linked[a]
+            elif where.get(a) != path:
+                rows[path] = "link:./" + where.get(a, "?")
+            elif isinstance(obj, h5py.Group):
+                walk(obj, path + "/")
+            else:
+                rows[path] = _guard(lambda: _dataset_digest(obj))
+                attrs(obj, path)
+
+    walk(group, "")
+    return rows
+
+
+def seal(group: h5py.Group, linked: dict):
+    """Write ``group``'s table and its digest (after everything else in it is written)."""
+    text = json.dumps(table(group, linked), sort_keys=True, indent=0)
+    group.create_dataset(TABLE, data=text)
+    group.attrs[DIGEST] = sha(text.encode())
+
+
+def damage(group: h5py.Group, linked: dict) -> list:
+    """What differs between ``group``'s stored table and the file: a list of
+    "path: what is wrong" lines, empty when every item matches."""
+    try:
+        text = group[TABLE][()]
+        text = text.decode() if isinstance(text, bytes) else str(text)
+        if sha(text.encode()) != str(group.attrs.get(DIGEST, "")):
+            return [f"{TABLE}: the table of checksums (or the attribute {DIGEST}) is damaged"]
+        stored = json.loads(text)
+    except Exception as exc:  # noqa: BLE001
+        return [f"{TABLE}: unreadable ({_first_line(exc)})"]
+    now = table(group, linked)
+    out = []
+    for key in sorted(set(stored) | set(now)):
+        kind = "attribute " if "@" in key else ""
+        if key not in now:
+            out.append(f"{kind}{key}: missing")
+        elif key not in stored:
+            out.append(f"{kind}{key}: not in the table of checksums (added or renamed)")
+        elif now[key] != stored[key]:
+            cause = now[key][len("unreadable: "):] if now[key].startswith("unreadable") else "SHA-256 differs"
+            out.append(f"{kind}{key}: damaged ({cause})")
+    return out
+
+
+def linked_groups(group: h5py.Group, under: str) -> set:
+    """The groups below ``under`` (e.g. "/shared/") that ``group``'s stored table links to,
+    by name ({"scene_ab12"}); empty when the table is unreadable (its check says why)."""
+    try:
+        rows = json.loads(group[TABLE][()])
+    except Exception:  # noqa: BLE001
+        return set()
+    return {v[len("link:") + len(under):].split("/", 1)[0] for v in rows.values()
+            if isinstance(v, str) and v.startswith("link:" + under)}
+
+
+def _dataset_digest(d) -> str:
+    value = d[()]  # fletcher32 is checked chunk by chunk here
+    if isinstance(value, (bytes, str)):
+        return sha(b"s" + (value.encode() if isinstance(value, str) else value))
+    value = np.asarray(value)
+    return sha(f"{value.dtype.str}{value.shape}".encode() + np.ascontiguousarray(value).tobytes())
+
+
+def _attr_digest(obj, key, names) -> str:
+    if key in _REFERENCE_ATTRS:
+        return sha(json.dumps(_references(obj, key, names)).encode())
+    value = obj.attrs[key]
+    if isinstance(value, (bytes, str)):
+        return sha(b"s" + (value.encode() if isinstance(value, str) else value))
+    value = np.asarray(value)
+    if value.dtype.kind == "O":
+        return sha(json.dumps([v.decode() if isinstance(v, bytes) else str(v) for v in value.ravel()]).encode())
+    return sha(f"{value.dtype.str}{value.shape}".encode() + np.ascontiguousarray(value).tobytes())
+
+
+def _references(obj, key, names) -> list:
+    """The paths the references of a dimension-scale attribute point to."""
+    f = obj.file
+    if key == "DIMENSION_LIST":
+        return [[names.get(address(f[r]), "?") for r in row] for row in obj.attrs[key]]
+    return [[names.get(address(f[row[0]]), "?"), int(row[1])] for row in obj.attrs[key]]
+
+
+def _guard(compute) -> str:
+    try:
+        return compute()
+    except Exception as exc:  # noqa: BLE001 - damage is reported, never raised
+        return f"unreadable: {_first_line(exc)}"
+
+
+def _first_line(exc) -> str:
+    return (str(exc).splitlines() or [type(exc).__name__])[0] or type(exc).__name__

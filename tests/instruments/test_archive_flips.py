@@ -1,0 +1,140 @@
+"""Random byte flips over a small archive: every flip that changes what a reader sees
+(h5py, or xarray through h5netcdf) is found by ``Archive.verify`` and named; none makes
+verify raise, and a later append either works or refuses in one line."""
+import numpy as np
+import pytest
+
+from instruments.archive import Archive, Entry
+from instruments.errors import InstrumentError
+from instruments.facts import GaugeFact, ShotFacts
+from instruments.records import Preamble, ScopeRecord, Waveform
+
+FLIPS = 240
+
+
+def tiny_entry(seed: int, truth: bool = True, n: int = 96) -> Entry:
+    """A small shot: two int8 channels and (``truth``) two shared truth arrays."""
+    rng = np.random.default_rng(seed)
+    p = Preamble(points=n, x_increment=1e-6, x_zero=-1e-5, trigger_index=10, y_multiplier=0.01, y_offset=0.0,
+                 y_zero=0.0, point_format="ENV" if seed == 3 else "Y")
+    waves = {c: Waveform(c, p, codes=rng.integers(-100, 100, n).astype(np.int8)) for c in ("CH1", "CH2")}
+    facts = ShotFacts(1e-6, {"upper": GaugeFact(3, "CH1", 0.01, 0.1, 0.2)}, None, None, {"probe": {"gain": 1.0}},
+                      1e-5, {"method": "synthetic"})
+    forces = {"upper_average_force": np.linspace(0, 1, 48), "wall_force": np.linspace(1, 0, 48)}
+    return Entry(ScopeRecord(waves, True), truth, seed if truth else None, "tiny" if truth else "",
+                 "[scene]\nname = 'tiny'\n" if truth else "", {"probe": "tiny"} if truth else {"source_files": ["a.isf"]},
+                 forces if truth else None, facts if truth else None, "tiny" if truth else None,
+                 "2026-01-01T00:00:00+00:00", "0.9")
+
+
+def h5py_view(path) -> dict:
+    """Everything h5py reads from the file: {path or path@attribute: value as bytes}; a
+    read that fails is a value too."""
+    import h5py
+
+    view = {}
+    try:
+        with h5py.File(path, "r") as f:
+            def visit(name, obj):
+                try:
+                    view[f"/{name}"] = _bytes(obj[()]) if isinstance(obj, h5py.Dataset) else b"group"
+                except Exception as exc:  # noqa: BLE001
+                    view[f"/{name}"] = f"error {type(exc).__name__}".encode()
+                try:
+                    for k in obj.attrs:
+                        view[f"/{name}@{k}"] = _bytes(obj.attrs[k]) if k not in ("DIMENSION_LIST", "REFERENCE_LIST") \
+                            else repr([[f[r].name for r in row] if k == "DIMENSION_LIST" else f[row[0]].name
+                                       for row in obj.attrs[k]]).encode()
+                except Exception as exc:  # noqa: BLE001
+                    view[f"/{name}@"] = f"error {type(exc).__name__}".encode()
+            for k in f.attrs:
+                view[f"/@{k}"] = _bytes(f.attrs[k])
+            f.visititems(visit)
+    except Exception as exc:  # noqa: BLE001
+        view["<file>"] = f"error {type(exc).__name__}".encode()
+    return view
+
+
+def xarray_view(path) -> dict:
+    """Everything xarray reads through h5netcdf (CF decoding, dimension scales), unchecked."""
+    import xarray as xr
+
+    view = {}
+    try:
+        tree = xr.open_datatree(path, engine="h5netcdf")
+        for node in tree.subtree:
+            for k, v in node.attrs.items():
+                view[f"xr:{node.path}@{k}"] = _bytes(v)
+            for name, var in node.variables.items():
+                view[f"xr:{node.path}/{name}"] = _bytes(var.values)
+                for k, v in var.attrs.items():
+                    view[f"xr:{node.path}/{name}@{k}"] = _bytes(v)
+    except Exception as exc:  # noqa: BLE001
+        view["xr:<file>"] = f"error {type(exc).__name__}".encode()
+    return view
+
+
+def _bytes(v) -> bytes:
+    if isinstance(v, (bytes, str)):
+        return v.encode() if isinstance(v, str) else v
+    v = np.asarray(v)
+    if v.dtype.kind == "O":
+        return repr(v.tolist()).encode()
+    return v.dtype.str.encode() + repr(v.shape).encode() + v.tobytes()
+
+
+def _named(changed: set, bad: list, path) -> bool:
+    """Does some row of the report name one of the changed items (or a group that holds it)?"""
+    wheres = [b["where"] for b in bad]
+    for c in changed:
+        item = c.removeprefix("xr:")
+        if item.endswith("<file>") and any(w in (str(path), "/") for w in wheres):
+            return True
+        for w in wheres:
+            if w.startswith("/") and (item.startswith(w) or w.startswith(item.split("@")[0])):
+                return True
+    # xarray names a shared group through a shot's link: the shot's truth/forces
+    return any("truth/forces" in c and any("/shared/" in w for w in wheres) for c in changed)
+
+
+@pytest.fixture(scope="module")
+def pristine(tmp_path_factory):
+    path = tmp_path_factory.mktemp("flips") / "a.h5"
+    a = Archive(path)
+    a.append([tiny_entry(1), tiny_entry(2)])
+    a.append([tiny_entry(3), tiny_entry(4, truth=False)])
+    assert a.verify() == {"shots": 4, "ok": 4, "bad": []}
+    return path.read_bytes(), h5py_view(path), xarray_view(path)
+
+
+def test_random_byte_flips_are_found_and_named_and_never_crash(pristine, tmp_path):
+    data, view, xview = pristine
+    rng = np.random.default_rng(20261123)
+    offsets = rng.integers(0, len(data), FLIPS)
+    masks = rng.integers(1, 256, FLIPS)
+    path = tmp_path / "f.h5"
+    seen, unnamed, appended, refused = 0, [], 0, 0
+    assert xview["xr:/shot_000001/data/CH1"]  # xarray opens the whole pristine file
+    for offset, mask in zip(offsets, masks):
+        damaged = bytearray(data)
+        damaged[offset] ^= int(mask)
+        path.write_bytes(bytes(damaged))
+        now = h5py_view(path)
+        changed = {k for k in set(view) | set(now) if view.get(k) != now.get(k)}
+        if not changed:  # xarray reads through h5py: asked where h5py sees no change
+            now = xarray_view(path)
+            changed = {k for k in set(xview) | set(now) if xview.get(k) != now.get(k)}
+        report = Archive(path).verify()  # never raises
+        if changed:
+            seen += 1
+            if not report["bad"] or not _named(changed, report["bad"], path):
+                unnamed.append((int(offset), sorted(changed)[:3], report["bad"][:2]))
+        try:
+            Archive(path).append([tiny_entry(5)])
+            appended += 1
+        except InstrumentError as exc:  # a refusal is one line naming the archive
+            assert str(path) in str(exc) and "\n" not in str(exc)
+            refused += 1
+    print(f"{FLIPS} flips: {seen} changed what a reader sees, {appended} appended after, {refused} refused")
+    assert unnamed == []
+    assert seen >= FLIPS // 4 and appended + refused == FLIPS  # most flips change what readers see
