@@ -61,7 +61,8 @@ def truth_report(rig, truth) -> Report:
         return rep
     peaks = []
     for g, lead in ((up, rep.leading["upper"]), (low, rep.leading["lower"])):
-        window = (t >= lead["time"] - lead["fwhm"]) & (t <= lead["time"] + lead["fwhm"])
+        half = lead["fwhm"] if math.isfinite(lead["fwhm"]) else h  # a pulse cut off by the record's end
+        window = np.abs(t - lead["time"]) <= max(half, h)
         peaks.append(max(np.max(g.contact_above[window] - g.static_above_N),
                          np.max(g.contact_below[window] - g.static_below_N)))
     rep.amplitude_N = float(np.mean(peaks))

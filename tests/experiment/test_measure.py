@@ -86,3 +86,16 @@ def test_fixed_gauge_draws_take_effect():
     assert speeds[1] / speeds[2] - 1 == pytest.approx(1e-3 / d, rel=0.05)
     shot = rig.fire(seed=1, fixed={"upper": {"gain": 1.2}})
     assert shot.draws["upper"]["gain"] == 1.2
+
+
+def test_a_leading_pulse_cut_off_by_the_end_of_the_record_still_has_a_truth():
+    # the lower gauge's pulse peaks just before the solve ends, so its half-maximum fall is
+    # never recorded (FWHM nan): the truth's contact-force window is then one sample wide
+    # (it was empty: "zero-size array", a traceback on long chains with a gauge far down)
+    from rig.experiment.shot import Rig
+
+    rig = Rig.from_scene("ptfe52_magnetic", ["chain.beads=600", "holder.length=4 m", "gauges.lower.bead=450",
+                                             "solver.duration=9.3 ms", "scope.record_length=1000"])
+    t = rig.truth_analysis()
+    assert t.leading["lower"]["fwhm"] != t.leading["lower"]["fwhm"]  # nan: the fall is past the record
+    assert 225 < t.speed_m_per_s < 237 and 4.0 < t.amplitude_N < 5.0
