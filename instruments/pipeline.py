@@ -21,11 +21,21 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .analysis import MIN_BASELINE, PeakRules, find_pulses, invert_rc, leading, noise_level, refined, remove_baseline, xcorr_delay
+from .analysis import (
+    MIN_BASELINE,
+    PeakRules,
+    find_pulses,
+    invert_rc,
+    leading,
+    noise_level,
+    refined,
+    remove_baseline,
+    xcorr_delay,
+)
 from .errors import InstrumentError, check
 from .plausibility import Limits, record_doubt, speed_doubt
-from .report import SPEED_FIGURES, Report
 from .records import ScopeRecord
+from .report import SPEED_FIGURES, Report
 
 
 @dataclass(frozen=True)
@@ -163,7 +173,7 @@ def _leading_pulse(t, f, rules: PeakRules, channel: str, noise, role: str, rep: 
         problems.append(f"{channel}: fewer than {MIN_BASELINE} samples before the trigger: the noise, and so "
                         f"whether a pulse stands above it, cannot be measured")
         return None
-    floor = None if sigma is None else max(rules.height * peak, rules.snr * sigma)
+    floor = _snr_floor(rules, peak, sigma)
     if sigma is not None:
         rep.noise[channel], rep.snr[channel] = sigma, (peak / sigma if sigma > 0 else math.inf)
     coarse = leading(find_pulses(t, f, rules, floor=floor, refine=False), rules)
@@ -178,6 +188,12 @@ def _leading_pulse(t, f, rules: PeakRules, channel: str, noise, role: str, rep: 
     if sigma is not None and sigma > 0:
         rep.snr[channel] = pulse.amplitude / sigma
     return pulse
+
+
+def _snr_floor(rules: PeakRules, peak: float, sigma: float | None) -> float | None:
+    """The least height of a pulse where the noise ``sigma`` is known: the relative height
+    rule or ``rules.snr`` noise levels, whichever is higher (None: the height rule alone)."""
+    return None if sigma is None else max(rules.height * peak, rules.snr * sigma)
 
 
 def solitary_train(t, f, lead, cut: float, rules: PeakRules = PeakRules(), refine: bool = False,
@@ -196,7 +212,7 @@ def reflection_time(t, forces, setup: Setup, low, speed, noise: dict | None = No
     known, if there is one; else from the wall distance)."""
     if "wall" in forces:
         f, sigma = forces["wall"], (noise or {}).get("wall")
-        floor = None if sigma is None else max(setup.rules.height * float(np.max(f)), setup.rules.snr * sigma)
+        floor = _snr_floor(setup.rules, float(np.max(f)), sigma)
         wall = leading(find_pulses(t, f, setup.rules, floor=floor, refine=False), setup.rules)
         if wall is not None and wall.time > low.time:
             return 2 * wall.time - low.time - low.fwhm

@@ -11,8 +11,16 @@ import sys
 from instruments.errors import InstrumentError
 from rig import __version__
 from rig.cli import data, shots, study, sweeps, tools
-from rig.cli.common import (OneLineParser, allow_large, count_arg, fraction_arg, os_error_line, positive_seconds,
-                            quantity_type, seed_arg)
+from rig.cli.common import (
+    OneLineParser,
+    allow_large,
+    count_arg,
+    fraction_arg,
+    os_error_line,
+    positive_seconds,
+    quantity_type,
+    seed_arg,
+)
 from rig.errors import RigError
 
 

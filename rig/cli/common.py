@@ -30,9 +30,8 @@ def seed_arg(text: str) -> int:
 
 def quantity_arg(text: str, unit: str, field: str) -> float:
     """A command-line quantity: a plain number is taken in ``unit``; else text with a unit."""
-    from rig.units import quantity
-
     from rig.errors import invalid
+    from rig.units import quantity
 
     try:
         value = float(text)

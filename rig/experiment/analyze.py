@@ -14,7 +14,7 @@ its reason in "reasons" (figure -> why), and "snr" gives each gauge channel's SN
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 from instruments.analysis import PeakRules
@@ -86,12 +86,14 @@ def analyze_paths(options: AnalyzeOptions) -> list:
     return results
 
 
+REAL_FILE_FLAGS = ("gauge_distance", "channels", "wall", "sensitivity", "tau", "beta", "f0", "diameter")
+
+
 def _real_file_flags(options: AnalyzeOptions) -> list:
-    """The flags given that describe a real set-up (a virtual shot carries its own)."""
-    given = {"--gauge-distance": options.gauge_distance is not None, "--channels": options.channels is not None,
-             "--wall": options.wall, "--sensitivity": options.sensitivity != 1.0, "--tau": options.tau is not None,
-             "--beta": options.beta != 1.0, "--f0": options.f0 != 0.0, "--diameter": options.diameter != 4.76e-3}
-    return [flag for flag, on in given.items() if on]
+    """The flags given (other than their defaults) that describe a real set-up: a virtual
+    shot carries its own."""
+    defaults = {f.name: f.default for f in fields(AnalyzeOptions)}
+    return [f"--{name.replace('_', '-')}" for name in REAL_FILE_FLAGS if getattr(options, name) != defaults[name]]
 
 
 def _setup_from_entry(entry, options: AnalyzeOptions) -> Setup:

@@ -6,10 +6,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from rig.errors import RigError, invalid
+from rig.errors import RigError
 from rig.solver.methods import method as get_method
 from rig.solver.problem import ChainProblem
-from rig.solver.stepsize import DEFAULT_ACCURACY, default_step
+from rig.solver.solve import time_grid
+from rig.solver.stepsize import checked_accuracy, default_step
 
 NS_PER_BODY_STEP = 26.0  # measured: srkn6b, 2003 bodies, 4836 steps in 0.249 s (one core)
 COPIES = 4  # the output grid, the truth, the instruments' inputs and their conditioning
@@ -52,12 +53,8 @@ def estimate_solve(problem: ChainProblem, t_end: float, channels: int, sample_in
                    method: str, accuracy: float | None = None) -> RunEstimate:
     """The estimate of ``solve(problem, t_end, ...)`` recording ``channels`` channels every
     ``sample_interval`` (s), with the step the solver would choose for ``accuracy``."""
-    accuracy = DEFAULT_ACCURACY if accuracy is None else accuracy
-    if not (isinstance(accuracy, (int, float)) and 1e-14 <= accuracy <= 0.1):
-        raise invalid("accuracy", accuracy, "relative accuracy target in [1e-14, 0.1]")
-    stepping = default_step(problem, get_method(method), accuracy)
-    steps = max(1, int(t_end / min(stepping.dt, t_end)))
-    samples = int(t_end / sample_interval) + 1
+    stepping = default_step(problem, get_method(method), checked_accuracy(accuracy))
+    steps, _, samples = time_grid(t_end, min(stepping.dt, t_end), sample_interval)  # the grid solve takes
     bodies = problem.moving_bodies
     return RunEstimate(8.0 * samples * max(channels, 1) * COPIES, steps * bodies * NS_PER_BODY_STEP * 1e-9,
                        steps, bodies, samples)

@@ -14,7 +14,7 @@ from rig.solver.methods import method as get_method
 from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import KernelReport, Solution, SolverStats, Status
-from rig.solver.stepsize import DEFAULT_ACCURACY, Stepping, default_step, stability_limit
+from rig.solver.stepsize import Stepping, checked_accuracy, default_step, stability_limit
 
 MAX_CHECKS = 50  # energy / momentum / blow-up checks per solve (each one O(N))
 
@@ -74,9 +74,7 @@ def solve(problem: ChainProblem | Chain, t_end: float, *, save: SaveAt | None = 
                 f"(about {limit:.4g} s at the estimated peak forces); use dt <= {limit:.3g} s "
                 f"or leave dt unset to choose it from the accuracy target")
     else:
-        accuracy = DEFAULT_ACCURACY if accuracy is None else accuracy
-        if not (isinstance(accuracy, (int, float)) and 1e-14 <= accuracy <= 0.1):
-            raise invalid("accuracy", accuracy, "relative accuracy target in [1e-14, 0.1]")
+        accuracy = checked_accuracy(accuracy)
         stepping = default_step(problem, m, accuracy)
     if stepping.head and (problem.chain.law.dissipative or stepping.head >= problem.n_bodies - 2):
         raise invalid("dt.head", stepping.head, "a multirate head needs a conservative chain longer than the head")

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rig.errors import invalid
 from rig.memo import computed_once
 from rig.model.contact import contact_stiffness
 from rig.solver.methods import Method
@@ -144,6 +145,15 @@ def accuracy_step(p, method: Method, accuracy: float, head: int = 0) -> float:
 def single_rate_step(p, method: Method, accuracy: float) -> float:
     """The single-rate step (s): the accuracy step, at most half the stability limit."""
     return min(accuracy_step(p, method, accuracy), 0.5 * stability_limit(p, method))
+
+
+def checked_accuracy(accuracy: float | None) -> float:
+    """The accuracy target of a solve: DEFAULT_ACCURACY when None; refused outside
+    [1e-14, 0.1] (relative force error)."""
+    accuracy = DEFAULT_ACCURACY if accuracy is None else accuracy
+    if not (isinstance(accuracy, (int, float)) and 1e-14 <= accuracy <= 0.1):
+        raise invalid("accuracy", accuracy, "relative accuracy target in [1e-14, 0.1]")
+    return accuracy
 
 
 def default_step(p, method: Method, accuracy: float) -> Stepping:

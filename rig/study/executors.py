@@ -13,7 +13,6 @@ from rig.study.batch import run_batch
 from rig.study.mc_spec import Study
 from rig.study.store import Store
 
-
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 DEFAULT_WORKER_TIMEOUT = 300.0  # s without any live Dask worker before a study stops
 POLL_S = 1.0  # how often a Dask study looks at its workers while it waits (s)
@@ -31,7 +30,6 @@ def _worker_start(parent: int):
 def die_with_parent(parent: int):
     """Ask Linux to SIGKILL this process when its parent dies (prctl PR_SET_PDEATHSIG);
     exit at once if the parent ``parent`` is already gone. Elsewhere: nothing."""
-    import os
     import signal
     import sys
 

@@ -2,14 +2,13 @@
 and says why; an implausible speed is not given."""
 import numpy as np
 import pytest
+from test_analysis_snr import SETUP, N, record, sech2
 
 from instruments.errors import InstrumentError
 from instruments.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.plausibility import Limits
 from instruments.records import ScopeRecord
 from instruments.report import FIGURES, SPEED_FIGURES
-
-from test_analysis_snr import N, SETUP, record, sech2
 
 
 def clean_pair(t_up=0.5e-3, t_low=0.7e-3):
