@@ -1,0 +1,11 @@
+"""numba kernels of the benchmark's peer solvers: SI floats and flat float64 arrays only.
+
+Body layout and state as in rig/solver/kernels/: ``nb`` bodies from the top (striker,
+beads, wall of zero inverse mass), displacement ``u`` from static equilibrium (m) and
+velocity ``v`` (m/s); a peer that integrates the first-order system holds them as one
+state ``y = [u, v]`` (size 2 nb).
+"""
+from instruments.jit import drop_stale_cache
+
+# the kernels inline contact_forces (rig.solver.kernels.forces) and read HERTZ (rig.model.contact)
+drop_stale_cache(__name__, constants=("rig.model.contact", "rig.solver.kernels.forces"))
