@@ -15,12 +15,14 @@ import statistics
 import tempfile
 import time
 
-from rig.solver.ensemble import ensemble_step, solve_ensemble
+from rig.solver.ensemble import solve_ensemble
 from rig.solver.problem import ChainProblem
+from rig.solver.stepsize import stepping_at
 from rig.study.batch import run_batch, shot_inputs, shot_rig, study_save
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
 from rig.study.mc_spec import Study
+from rig.study.nominal import nominal
 from rig.study.store import Store
 
 VARY = ("striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)")
@@ -32,7 +34,8 @@ def _solver(study: Study, shots: int) -> dict:
     problems = [ChainProblem.from_chain(r.chain) for r in rigs]
     save = study_save(study, rigs[0])
     t_end = rigs[0].solver.duration
-    dt = ensemble_step(problems, t_end)
+    pilot = nominal(study.scene, ()).pilot(study.window, rigs[0].save_at(contacts=False, averages=True), study.accuracy)
+    dt = stepping_at(problems[0], pilot.stats.dt_s)
     solve_ensemble(problems[:8], t_end, save=save, dt=dt)
     kernel, total = [], []
     for _ in range(3):  # in batches, as a study runs them (the recorded forces take memory)

@@ -143,6 +143,10 @@ def build_parser() -> argparse.ArgumentParser:
     be.add_argument("what", choices=["solver", "accuracy", "shot", "archive", "pipeline", "mc", "animate", "startup"],
                     help="what to benchmark")
     be.add_argument("--quick", action="store_true", help="fewer settings, one repeat")
+    be.add_argument("--peers", action="store_true",
+                    help="solver: also scipy's DOP853, a numba-compiled DOP853 and LAMMPS (when installed)")
+    be.add_argument("--baseline", metavar="REV",
+                    help="solver, mc: measure git revision REV of this checkout too, in turns with the current code")
     return ap
 
 

@@ -27,7 +27,7 @@ def cmd_mc(args) -> dict:
                   args.sobol, args.truth, args.window, args.traces)
     from rig.study.nominal import nominal
 
-    per_batch = nominal(study.scene, study.overrides).rig.estimate().times(study.batch, study.batch)
+    per_batch = nominal(study.scene, study.overrides).rig.estimate(controlled=False).times(study.batch, study.batch)
     check_size(per_batch, args, f"each batch of {study.batch} shots")
     with progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot") as bar:
         def started(done):

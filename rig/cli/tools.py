@@ -49,22 +49,25 @@ def cmd_theory(args) -> dict:
 
 
 def cmd_bench(args) -> dict:
-    if args.what in ("accuracy", "shot", "archive", "pipeline", "mc", "animate", "startup"):
-        import importlib
+    import importlib
 
-        module = importlib.import_module(f"rig.bench.{args.what}")
-        result = module.run()
-        if not args.json:
-            print(module.table(result))
-        return result
-    from rig.bench import solver as bench
-
-    progress = None if args.json else (lambda msg: print(f"  running {msg}", file=sys.stderr, flush=True))
-    result = bench.run(quick=args.quick, progress=progress)
+    module = importlib.import_module(f"rig.bench.{args.what}")
+    if args.peers and args.what != "solver":
+        raise RigError(f"--peers: only rig bench solver has peers (not {args.what})")
+    if args.baseline and args.what not in ("solver", "mc"):
+        raise RigError(f"--baseline {args.baseline}: only rig bench solver and rig bench mc measure a baseline")
+    kw = {}
+    if args.what in ("solver", "accuracy"):
+        kw = {"quick": args.quick,
+              "progress": None if args.json else (lambda msg: print(f"  running {msg}", file=sys.stderr, flush=True))}
+    if args.what == "solver":
+        kw.update(peers=args.peers, baseline=args.baseline)
+    if args.what == "mc" and args.baseline:
+        kw["baseline"] = args.baseline
+    result = module.run(**kw)
     if not args.json:
-        print(f"solver work-precision, {bench.N_BEADS} steel beads, force error at contact "
-              f"{bench.PROBE} (machine: {result['machine']})")
-        print(bench.table(result))
+        if args.what == "solver":
+            print(f"solver work-precision, {module.N_BEADS} steel beads, force error at contact "
+                  f"{module.PROBE} (machine: {result['machine']})")
+        print(module.table(result))
     return result
-
-

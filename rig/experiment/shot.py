@@ -74,11 +74,12 @@ class Rig(Assembly):
             probes["wall"] = self.chain.wall_probe()
         return SaveAt(probes, sample_interval=self.solver.sample_interval)
 
-    def estimate(self) -> RunEstimate:
-        """How big and how long this rig's solve will be (before it runs)."""
+    def estimate(self, controlled: bool = True) -> RunEstimate:
+        """How big and how long this rig's solve will be (before it runs); ``controlled``:
+        with the accuracy control's tries (False: one solve at its step, as a study's shots)."""
         s = self.solver
         return estimate_solve(ChainProblem.from_chain(self.chain), s.duration, len(self.save_at().names),
-                              s.sample_interval, s.method, s.accuracy)
+                              s.sample_interval, s.method, s.accuracy, controlled)
 
     def solution(self) -> Solution:
         if self._solution is None:

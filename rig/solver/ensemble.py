@@ -1,8 +1,9 @@
 """Many shots of one chain topology in one call of the batched kernel.
 
-The step is the smallest that any shot's accuracy target (or stability) asks for, so a
-shot's result never depends on which other shots share its batch: a shot solved alone with
-``solve(problem, t_end, dt=step)`` gives the same numbers to the last bit.
+Every shot takes the same stepping, given by the caller (a study calibrates it once on its
+nominal shot, rig/study/nominal.py), so a shot's result never depends on which other shots
+share its batch: a shot solved alone with ``solve(problem, t_end, dt=stepping)`` gives the
+same numbers to the last bit.
 """
 from __future__ import annotations
 
@@ -15,10 +16,10 @@ from rig.errors import RigError, invalid
 from rig.solver.kernels.ensemble import integrate_ensemble
 from rig.solver.methods import DEFAULT_METHOD
 from rig.solver.methods import method as get_method
+from rig.solver.run import MAX_CHECKS, time_grid
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import KernelReport, SolverStats, Status
-from rig.solver.solve import MAX_CHECKS, time_grid
-from rig.solver.stepsize import DEFAULT_ACCURACY, Stepping, default_step, single_rate_step
+from rig.solver.stepsize import Stepping
 
 
 @dataclass(frozen=True, eq=False)
@@ -39,26 +40,14 @@ class EnsembleSolution:
     def shots(self) -> int:
         return len(self.reports)
 
-    def stats(self, j: int, accuracy: float | None = None) -> SolverStats:
-        """Shot j's SolverStats (the batch's wall time shared out evenly)."""
+    def stats(self, j: int, accuracy: float | None = None, estimate: float | None = None) -> SolverStats:
+        """Shot j's SolverStats (the batch's wall time shared out evenly); ``estimate``: the
+        error estimate of the study's pilot, which set the step."""
         r = self.reports[j]
         m = get_method(self.method)
         return SolverStats(m.name, self.dt, self.steps, self.steps * m.force_evaluations,
                            self.wall_s / self.shots, r.energy_error, r.momentum_error,
-                           r.wall_impulse_Ns, accuracy)
-
-
-def ensemble_step(problems, t_end: float, method=DEFAULT_METHOD, accuracy=None) -> Stepping:
-    """The common stepping of a batch: the smallest step (and substep) any of its shots
-    needs; multirate only when every shot has the same head, else the single-rate step."""
-    m = get_method(method)
-    acc = DEFAULT_ACCURACY if accuracy is None else accuracy
-    if not problems:
-        raise invalid("problems", [], "at least one shot")
-    own = [default_step(p, m, acc) for p in problems]
-    if own[0].head and all(s.head == own[0].head for s in own):
-        return Stepping(min(s.dt for s in own), own[0].head, min(s.inner_dt for s in own))
-    return Stepping(min(single_rate_step(p, m, acc) for p in problems))
+                           r.wall_impulse_Ns, accuracy, estimate, "study pilot" if estimate is not None else "none")
 
 
 def solve_ensemble(problems: list, t_end: float, *, save: SaveAt, dt: float | Stepping,

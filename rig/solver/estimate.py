@@ -9,10 +9,11 @@ from dataclasses import dataclass
 from rig.errors import RigError
 from rig.solver.methods import method as get_method
 from rig.solver.problem import ChainProblem
-from rig.solver.solve import time_grid
+from rig.solver.run import time_grid
 from rig.solver.stepsize import checked_accuracy, default_step
 
-NS_PER_BODY_STEP = 26.0  # measured: srkn6b, 2003 bodies, 4836 steps in 0.249 s (one core)
+NS_PER_BODY_STEP = 7.0  # srkn6b's whole step, one core: 6 force evaluations of about 1.2 ns per body
+CONTROL_WORK = 6.0  # a controlled solve in solves at its final step: about 2 tries, each with a companion at dt/2
 COPIES = 4  # the output grid, the truth, the instruments' inputs and their conditioning
 LIMIT_BYTES = 2e9
 LIMIT_SECONDS = 120.0
@@ -50,11 +51,14 @@ class RunEstimate:
 
 
 def estimate_solve(problem: ChainProblem, t_end: float, channels: int, sample_interval: float,
-                   method: str, accuracy: float | None = None) -> RunEstimate:
+                   method: str, accuracy: float | None = None, controlled: bool = True) -> RunEstimate:
     """The estimate of ``solve(problem, t_end, ...)`` recording ``channels`` channels every
-    ``sample_interval`` (s), with the step the solver would choose for ``accuracy``."""
-    stepping = default_step(problem, get_method(method), checked_accuracy(accuracy))
+    ``sample_interval`` (s), with the step the solver would start from for ``accuracy``
+    (the accuracy control's tries and companions counted as CONTROL_WORK solves; one
+    solve where ``controlled`` is False: a study's shots reuse its pilot's step)."""
+    stepping = default_step(problem, get_method(method), checked_accuracy(accuracy), t_end)
     steps, _, samples = time_grid(t_end, min(stepping.dt, t_end), sample_interval)  # the grid solve takes
     bodies = problem.moving_bodies
-    return RunEstimate(8.0 * samples * max(channels, 1) * COPIES, steps * bodies * NS_PER_BODY_STEP * 1e-9,
+    return RunEstimate(8.0 * samples * max(channels, 1) * COPIES,
+                       steps * bodies * NS_PER_BODY_STEP * 1e-9 * (CONTROL_WORK if controlled else 1.0),
                        steps, bodies, samples)

@@ -66,7 +66,7 @@ METHODS: dict[str, Method] = {
     "verlet": Method("verlet", (1.0,), (0.5, 0.5), order=2, contact_order=2.0,
                      error_constant=0.018, reference="velocity Verlet (Stormer-Verlet)"),
     "srkn6b": Method("srkn6b", *_srkn6b(), order=4, contact_order=2.5,
-                     error_constant=1.2e-4,
+                     error_constant=2e-6,
                      reference="Blanes & Moan 2002, SRKN_6^b, 6 force evaluations per step"),
 }
 

@@ -45,6 +45,13 @@ class SolverStats:
     energy, or the static elastic energy without a striker). momentum_error: max
     |P(t) - P(0) - external impulse| / P_ref (P_ref: the striker's momentum), external
     impulse = constant loads x t + scheduled force impulse - wall impulse.
+    error_estimate: the a-posteriori estimate of the largest error of any recorded force,
+    relative to its dynamic peak (``relative_error``), over the whole record; None where
+    nothing was recorded. estimate_basis: how it was obtained ("companion at 2 dt": a
+    second solve at twice the step, Richardson; "study pilot": the nominal shot of a study).
+    attempts: solves the accuracy control ran (rig/solver/control.py). wall_s: the kernel's
+    wall time of the solve returned; cpu_s: the process CPU time of everything solve did,
+    its attempts and companions included.
     """
 
     method: str
@@ -56,9 +63,26 @@ class SolverStats:
     momentum_error: float
     wall_impulse_Ns: float
     accuracy: float | None
+    error_estimate: float | None = None
+    estimate_basis: str = "none"
+    attempts: int = 1
+    cpu_s: float = 0.0
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
+
+
+def relative_error(forces: dict, reference: dict) -> float:
+    """The largest error of any channel of ``forces`` against ``reference`` ({name: array},
+    the same grid), relative to that channel's dynamic peak max |F_ref(t) - F_ref(0)|:
+    what the accuracy setting bounds. A channel whose dynamic peak is below 1e-6 of the
+    largest one (the pulse never reached it) is measured against that largest one."""
+    peaks = {k: float(np.max(np.abs(r - r[0]))) if r.size else 0.0 for k, r in reference.items()}
+    top = max(peaks.values(), default=0.0)
+    if top == 0.0:
+        return 0.0
+    return max(float(np.max(np.abs(forces[k] - r))) / max(peaks[k], 1e-6 * top)
+               for k, r in reference.items() if r.size)
 
 
 @dataclass(frozen=True, eq=False)

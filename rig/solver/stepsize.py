@@ -1,4 +1,4 @@
-"""Choosing the time step: contact time scale, accuracy target, stability limit.
+"""Choosing the time step: contact time scale, the a-priori rule, stability, the head.
 
 Contact time scale (Nesterenko 2001; the duration of a Hertz collision scales with it):
 
@@ -10,21 +10,25 @@ phase error ~ N (dt/tau)^p, so for a target relative force error ``accuracy``
 
     dt = tau * (accuracy / (C N))^(1/p)
 
-with the method's contact order p and error constant C (calibrated on the solver
-benchmark, see docs/solver.md). The step is also kept below half the linear stability
-limit omega_max dt < S (S from the method's coefficients), with omega_max bounded by
-Gershgorin's theorem on the chain linearised at an upper estimate of the peak forces.
+with the method's contact order p and error constant C, N the contacts a pulse crosses in
+the whole record (``crossed_contacts``: the distance it travels, reflections included, not
+the length of the chain). This rule only starts the accuracy control
+(rig/solver/control.py), which measures the error and moves the step: C is set from the
+easiest of the measured problems, so that a first try is cheap (docs/solver.md). The step
+is also kept below half the linear stability limit omega_max dt < S (S from the method's
+coefficients), with omega_max bounded by Gershgorin's theorem on the chain linearised at an
+upper estimate of the peak forces.
 
-Multirate head. A striker much stiffer against its first bead than the chain's own
-contacts (alumina on the steel magnetic bead: tau 3.7 us against 19 us in the PTFE) would
-set the step of the whole chain. When the first ``head`` contacts are that stiff (tau below
-HEAD_RATIO x the median tau), they are split off (r-RESPA / impulse multiple time
-stepping, Tuckerman, Berne & Martyna 1992): each drift of the method becomes the flow of
-kinetic energy + the head's contacts, integrated by substeps of the same method of at
-most ``inner_dt``; the method's kicks carry the other contacts. The substep is the step
-the single-rate rule above gives for the whole chain; the outer step follows the slow
-contacts (accuracy and stability as above, and at most the head's smallest tau, which
-keeps it below half the head's collision time, away from MTS resonances).
+The head. The contacts that close and open at speed (the striker's; behind it, in a chain
+without precompression, the first beads', which fly apart after the pulse) are split off
+(r-RESPA / impulse multiple time stepping, Tuckerman, Berne & Martyna 1992): each drift of
+the method becomes the flow of kinetic energy + the head's contacts, integrated by
+substeps of the same method (rig/solver/kernels/multirate.py), which resolve the instants
+a contact closes or opens; the method's kicks carry the other contacts. A stiff striker
+(alumina on the steel magnetic bead: tau 3.7 us against 16 us in the PTFE) then no longer
+sets the step of the whole chain: the head's substep is HEAD_SUBSTEP x the outer step x
+the ratio of the taus, and the outer step follows the slow contacts, at most MTS_CAP head
+taus (away from the resonances of multiple time stepping).
 """
 from __future__ import annotations
 
@@ -37,11 +41,13 @@ from rig.errors import invalid
 from rig.memo import computed_once
 from rig.model.contact import contact_stiffness
 from rig.solver.methods import Method
+from rig.theory.longwave import sonic_vacuum_speed, sound_speed
 
 DEFAULT_ACCURACY = 1e-4
 HEAD_RATIO = 0.5   # a leading contact with tau < HEAD_RATIO x median tau is integrated apart
 MAX_HEAD = 3       # at most this many leading contacts form the head
-HEAD_SUBSTEP = 0.5  # the head's substep, as a fraction of the single-rate step
+HEAD_SUBSTEP = 0.5  # the head's substep: this fraction of the outer step, in units of tau
+MTS_CAP = 2.0      # the outer step stays below this many head taus
 
 
 @dataclass(frozen=True)
@@ -91,15 +97,19 @@ def contact_time_scale(p, first: int = 1) -> float:
     return float(np.min(contact_time_scales(p)[first:], initial=math.inf))
 
 
-def fast_head(p) -> int:
-    """How many leading contacts are stiff enough to be integrated apart (0: none)."""
+def head_contacts(p) -> int:
+    """How many leading contacts are integrated apart, by the head flow (0: none): the
+    striker's contact, and after it, up to MAX_HEAD in all, each leading contact that is
+    much stiffer than the chain's (tau below HEAD_RATIO x the median tau) or that carries
+    no static load (it opens behind the pulse with the beads flying apart). These are the
+    contacts that close and open at speed, and the head flow resolves those instants."""
     tau = contact_time_scales(p)[1:]
     finite = tau[np.isfinite(tau)]
-    if p.chain.law.dissipative or finite.size < 2 * MAX_HEAD:
+    if p.chain.law.dissipative or not p.offset or finite.size < 2 * MAX_HEAD:
         return 0
     slow = HEAD_RATIO * float(np.median(finite))
-    k = 0
-    while k < MAX_HEAD and tau[k] < slow:
+    k = 1
+    while k < MAX_HEAD and (tau[k] < slow or p.f0[k + 1] == 0.0):
         k += 1
     return k
 
@@ -135,16 +145,44 @@ def stability_limit(p, method: Method, head: int = 0) -> float:
     return method.stability / w if w > 0 else math.inf
 
 
-def accuracy_step(p, method: Method, accuracy: float, head: int = 0) -> float:
-    """Step (s) meeting ``accuracy`` over a pulse crossing every moving body, from the
-    contacts after the head."""
+def crossed_contacts(p, t_end: float) -> float:
+    """How many contacts a pulse crosses in t_end seconds (at least 1): t_end x the pulse
+    speed / the bead spacing, reflections and returns included. The speed is the larger of
+    the long-wave sound speed at the largest static force (Eq 2) and the sonic-vacuum speed
+    of the peak-force estimate (Eq 4), for beads of the chain's median mass, spacing and
+    contact constant (E/(1 - nu^2) = 3 A / sqrt(a), rho = 6 m / (pi a^3))."""
+    live = (p.A > 0) & (np.arange(p.n_bodies) > p.offset)
+    if p.wall_slot:
+        live[p.wall_slot] = False
+    beads = p.chain.beads
+    a = 2.0 * float(np.median([b.radius for b in beads]))
+    if not live.any():
+        return 1.0
+    A = float(np.median(p.A[live]))
+    m = float(np.median(p.chain.masses))
+    modulus, rho = 3.0 * A / math.sqrt(a), 6.0 * m / (math.pi * a**3)
+    speed = max(float(sound_speed(modulus, 0.0, rho, a, float(p.f0[live].max()))),
+                float(sonic_vacuum_speed(modulus, 0.0, rho, a, float(peak_force_estimate(p)[live].max()))))
+    return max(1.0, speed * t_end / a)
+
+
+def accuracy_step(p, method: Method, accuracy: float, t_end: float, head: int = 0) -> float:
+    """Step (s) meeting ``accuracy`` over t_end seconds, from the contacts after the head:
+    dt = tau (accuracy / (C N))^(1/p), N the contacts a pulse crosses (crossed_contacts)."""
     tau = contact_time_scale(p, head + 1)
-    return tau * (accuracy / (method.error_constant * max(p.moving_bodies, 1))) ** (1.0 / method.contact_order)
+    n = crossed_contacts(p, t_end)
+    return tau * (accuracy / (method.error_constant * n)) ** (1.0 / method.contact_order)
 
 
-def single_rate_step(p, method: Method, accuracy: float) -> float:
-    """The single-rate step (s): the accuracy step, at most half the stability limit."""
-    return min(accuracy_step(p, method, accuracy), 0.5 * stability_limit(p, method))
+def stepping_at(p, dt: float, head: int | None = None) -> Stepping:
+    """The stepping of outer step dt (s): the head of ``head_contacts`` (or ``head``), its
+    substep HEAD_SUBSTEP x dt x (the head's tau / the chain's): the head's contacts taken
+    at half the chain's relative step."""
+    head = head_contacts(p) if head is None else head
+    if head == 0:
+        return Stepping(dt)
+    ratio = contact_time_scale(p) / contact_time_scale(p, head + 1)
+    return Stepping(dt, head, HEAD_SUBSTEP * dt * min(ratio, 1.0))
 
 
 def checked_accuracy(accuracy: float | None) -> float:
@@ -156,15 +194,19 @@ def checked_accuracy(accuracy: float | None) -> float:
     return accuracy
 
 
-def default_step(p, method: Method, accuracy: float) -> Stepping:
-    """The stepping a solve takes by itself. Single rate: ``single_rate_step``. With a
-    stiff head (``fast_head``): HEAD_SUBSTEP x that step for the head's substeps, and an
-    outer step from the slow contacts, at most half their stability limit and at most the
-    head's tau."""
-    single = single_rate_step(p, method, accuracy)
-    head = fast_head(p)
-    if head == 0:
-        return Stepping(single)
-    outer = min(accuracy_step(p, method, accuracy, head), 0.5 * stability_limit(p, method, head),
-                contact_time_scale(p))
-    return Stepping(outer, head, HEAD_SUBSTEP * single) if outer > single else Stepping(single)
+def largest_step(p, method: Method, t_end: float) -> float:
+    """The largest outer step (s) a solve of t_end seconds may take: half the stability
+    limit of the contacts after the head (its companion at twice the step stays stable),
+    with a head at most MTS_CAP x the head's tau (multiple time stepping resonates when
+    the outer step nears the period of the fast contacts), and at most t_end."""
+    head = head_contacts(p)
+    dt = min(0.5 * stability_limit(p, method, head), t_end)
+    return min(dt, MTS_CAP * contact_time_scale(p)) if head else dt
+
+
+def default_step(p, method: Method, accuracy: float, t_end: float) -> Stepping:
+    """The stepping a solve of t_end seconds starts from: the outer step of the a-priori
+    rule (accuracy_step) from the contacts after the head, at most ``largest_step``; the
+    head's substep from stepping_at."""
+    head = head_contacts(p)
+    return stepping_at(p, min(accuracy_step(p, method, accuracy, t_end, head), largest_step(p, method, t_end)), head)

@@ -13,10 +13,11 @@ from instruments.pipeline import analyze_record
 from rig.errors import RigError
 from rig.experiment.measure import setup_for
 from rig.experiment.shot import Rig
-from rig.solver.ensemble import ensemble_step, solve_ensemble
+from rig.solver.ensemble import solve_ensemble
 from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution, Status
+from rig.solver.stepsize import stepping_at
 from rig.study.mc_spec import FAILURES, OUTPUTS, Study
 from rig.study.nominal import copied_table, nominal
 from rig.study.sobol import sobol_matrix
@@ -125,15 +126,19 @@ def _fire_all(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dict
     base = nom.rig
     problems = [ChainProblem.from_chain(r.chain) for r in rigs.values()]
     t_end = nom.window(study.window).duration
-    dt = ensemble_step(problems, t_end, base.solver.method, study.accuracy or base.solver.accuracy)
     first = next(iter(rigs.values()))
-    ens = solve_ensemble(problems, t_end, save=study_save(study, first), dt=dt, method=base.solver.method)
+    save = study_save(study, first)
+    # the step is calibrated on what every study measures (the gauges' averages, the wall),
+    # so that recording the contacts too (--truth, --traces) changes no result
+    pilot = nom.pilot(study.window, first.save_at(contacts=False, averages=True), study.accuracy).stats
+    dt = stepping_at(problems[0], pilot.dt_s)
+    ens = solve_ensemble(problems, t_end, save=save, dt=dt, method=base.solver.method)
     beta, F0 = nom.calibration
     for e, ((j, rig), p) in enumerate(zip(rigs.items(), problems)):
         if ens.reports[e].status is not Status.SUCCESS:
             out["failure"][j] = UNSTABLE
             continue
-        stats = ens.stats(e, study.accuracy)
+        stats = ens.stats(e, pilot.accuracy, pilot.error_estimate)
         forces = {name: a[e] for name, a in ens.forces.items()}
         rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))
         try:

@@ -39,6 +39,7 @@ class Nominal:
     def __init__(self, scene: str, overrides: tuple):
         self.rig = Rig(scene_io.load(scene, overrides))  # validates
         self._templates = {}
+        self._pilots = {}
 
     @functools.cached_property
     def calibration(self) -> tuple:
@@ -77,6 +78,21 @@ class Nominal:
     def window(self, kind: str) -> Window:
         """The study's window: "leading" or "record" (the scene's own)."""
         return self.leading_window if kind == "leading" else self.record_window
+
+    def pilot(self, kind: str, save, accuracy: float | None):
+        """The study's step, calibrated once (not per shot): the accuracy control run on the
+        nominal shot over the study's window, recording what the shots record (``save``) at
+        ``accuracy`` (None: the scene's). Its Solution: stats.dt_s is the step every shot
+        takes, stats.error_estimate the estimate the shots carry."""
+        key = (kind, save.names, accuracy)
+        if key not in self._pilots:
+            from rig.solver.problem import ChainProblem
+            from rig.solver.solve import solve
+
+            rig = self.template(kind)
+            self._pilots[key] = solve(ChainProblem.from_chain(rig.chain), rig.solver.duration, save=save,
+                                      method=rig.solver.method, accuracy=accuracy or rig.solver.accuracy)
+        return self._pilots[key]
 
     def template(self, kind: str) -> Rig:
         """The rig every shot starts from: the solver recording at the scope's sampling rate

@@ -55,7 +55,8 @@ def chain_frames(rig, n_frames: int) -> Frames:
     and install the solution in the rig (its instruments read the same solve)."""
     from rig.model.contact import hertz_force
     from rig.solver.problem import ChainProblem
-    from rig.solver.solve import frame_origin, solve
+    from rig.solver.run import frame_origin
+    from rig.solver.solve import solve
 
     duration = rig.solver.duration
     rec = rig.save_at()

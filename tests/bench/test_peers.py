@@ -11,7 +11,7 @@ import pytest
 from conftest import STEEL, ptfe_rig, record_contacts, steel_sonic_vacuum
 
 from rig import Bead, Chain, ChainProblem, RigError, Wall, solve
-from rig.bench import peers
+from rig.bench import lammps, peers
 from rig.bench.kernels import dop853
 from rig.model.contact import HERTZ
 from rig.solver.kernels.forces import contact_forces
@@ -21,8 +21,8 @@ CASES = {  # name: (chain, probe contact, t_end s)
     "sonic-vacuum": (lambda: steel_sonic_vacuum(n=40), 20, 0.3e-3),
     "ptfe": (lambda: ptfe_rig(n=30), 15, 0.6e-3),
 }
-lammps = pytest.mark.skipif(peers.lammps_executable() is None,
-                            reason="LAMMPS not installed (apt-get install lammps)")
+needs_lammps = pytest.mark.skipif(lammps.executable() is None,
+                                  reason="LAMMPS not installed (apt-get install lammps)")
 
 
 def _error(force, ref, scale=None):
@@ -95,7 +95,7 @@ def test_a_peer_records_one_contact_force():
         peers.numba_dop853(p, record_contacts(chain, 5, 10), 1e-5, 1e-6)
 
 
-@lammps
+@needs_lammps
 @pytest.mark.parametrize("slot", [1, 8])
 def test_lammps_force_law_is_the_problems(slot):
     # sonic vacuum (no load, d0 = 0): the body above slot pressed down by d, its contact above
@@ -104,19 +104,19 @@ def test_lammps_force_law_is_the_problems(slot):
     d = 2e-7
     u = np.zeros(p.n_bodies)
     u[slot - 1] = d
-    F = peers.lammps_forces(p, u)
+    F = lammps.lammps_forces(p, u)
     assert F[slot - 1] == pytest.approx(-p.A[slot] * d**1.5, rel=1e-8)
     assert F[slot] == pytest.approx(p.A[slot] * d**1.5, rel=1e-8)
 
 
-@lammps
+@needs_lammps
 @pytest.mark.parametrize("build", [steel_sonic_vacuum, ptfe_rig], ids=["sonic-vacuum", "ptfe"])
 def test_lammps_computes_the_chains_forces(build):
     # any displacement: the project's net force f[i] - f[i+1] (contacts, striker, wall, gravity, top force)
     p = ChainProblem.from_chain(build(n=20))
     moving = p.invm > 0
     u = np.random.default_rng(7).normal(0.0, 1e-7, p.n_bodies) * moving
-    F = peers.lammps_forces(p, u)
+    F = lammps.lammps_forces(p, u)
     f = np.zeros(p.n_bodies + 1)
     contact_forces(u, np.zeros_like(u), p.A, p.d0, p.damping, HERTZ, p.load, f)
     f[-1] = -p.load[-1]
@@ -124,11 +124,11 @@ def test_lammps_computes_the_chains_forces(build):
     assert np.max(np.abs(F[moving] - net)) < 1e-8 * np.max(np.abs(net))
 
 
-@lammps
+@needs_lammps
 def test_lammps_converges_at_order_2(case):
     p, save, t_end, ref = case["sonic-vacuum"]
     tau = contact_time_scale(p)
-    coarse, fine = (peers.lammps_hertz(p, save, t_end, tau / r) for r in (20, 100))
+    coarse, fine = (lammps.lammps_hertz(p, save, t_end, tau / r) for r in (20, 100))
     e_coarse, e_fine = _error(coarse.force, ref), _error(fine.force, ref)
     assert e_fine < 1e-4 and 15 < e_coarse / e_fine < 30, (e_coarse, e_fine)  # (100/20)^2 = 25 at dt' = dt
     assert fine.steps > 4 * coarse.steps and fine.cpu_s > 0

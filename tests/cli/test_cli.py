@@ -3,7 +3,7 @@ import json
 
 import pytest
 
-from rig.bench.solver import matched
+from rig.bench.solver import at_equal_error
 from rig.cli import main
 
 
@@ -42,13 +42,18 @@ def test_bad_input_is_one_line_and_exit_2(capsys, argv, field):
     assert field in err and "\n" not in err and "Traceback" not in err
 
 
-def test_matched_error_comparison():
-    rows = [dict(scenario="s", method="srkn6b", setting="a", wall_s=0.1, error=1e-5),
-            dict(scenario="s", method="srkn6b", setting="b", wall_s=0.05, error=1e-3),
-            dict(scenario="s", method="scipy-DOP853", setting="c", wall_s=5.0, error=1e-4)]
-    best = {r["method"]: r for r in matched(rows)}
-    assert best["srkn6b"]["setting"] == "a"  # the cheaper run misses the error target
-    assert best["srkn6b"]["speedup_vs_dop853"] == pytest.approx(50.0)
+def test_work_precision_at_equal_error():
+    # each method's CPU at an error level, interpolated log-log between its runs around it
+    rows = [dict(scenario="s", method="srkn6b", setting="a", cpu_s=0.05, error=1e-3),
+            dict(scenario="s", method="srkn6b", setting="b", cpu_s=0.1, error=1e-5),
+            dict(scenario="s", method="scipy-DOP853", setting="c", cpu_s=1.0, error=1e-3),
+            dict(scenario="s", method="scipy-DOP853", setting="d", cpu_s=4.0, error=1e-5),
+            dict(scenario="s", method="LAMMPS", setting="e", cpu_s=9.0, error=3e-3)]
+    at = {(r["method"], r["error"]): r for r in at_equal_error(rows, errors=(1e-4, 1e-6))}
+    assert at["srkn6b", 1e-4]["cpu_s"] == pytest.approx((0.05 * 0.1) ** 0.5)
+    assert at["scipy-DOP853", 1e-4]["ratio_to_srkn6b"] == pytest.approx(2.0 / (0.05 * 0.1) ** 0.5)
+    assert at["srkn6b", 1e-6]["cpu_s"] is None  # no run that accurate: nothing extrapolated
+    assert at["LAMMPS", 1e-4]["cpu_s"] is None and at["LAMMPS", 1e-4]["ratio_to_srkn6b"] is None
 
 
 @pytest.mark.parametrize("argv", [["analyze", "nosuch.isf", "--gauge-distance", "43 mm"],

@@ -14,8 +14,9 @@ import numpy as np
 from numba import prange
 
 from instruments.jit import jit
-from rig.solver.kernels.integrators import hermite, hermite_weights
-from rig.solver.kernels.multirate import head_flow, slow_net
+from rig.model.contact import HERTZ
+from rig.solver.kernels.multirate import head_flow
+from rig.solver.kernels.record import hermite_weights, probe_overlaps, recorded_force
 
 
 @jit
@@ -54,7 +55,7 @@ def _kick_drift(u, v, invm, f, hb, ha, head):
 
 
 @jit
-def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_ns, h_work):
+def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_work):
     """_kick_drift (and the head's flow) then _forces in one pass over the rows: row i is
     kicked and drifted (reading f[i], f[i+1], not yet renewed), then contact i is renewed
     from rows i-1 and i (both moved). The same operations as the two passes, so the same
@@ -62,7 +63,7 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
     start = 0
     if head > 0:
         _head_kick(v, invm, f, hb, head)
-        head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub, h_ns, h_work)
+        head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub, h_work)
         start = head + 1
     for i in range(start, v.shape[0]):
         for s in range(u.shape[1]):
@@ -71,31 +72,6 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
             u[i, s] += ha * vi
         if i >= 1:
             _contact_row(u, A, d0, load, f, i)
-
-
-@jit
-def _synced(j, s, v, invm, f, pending, head):
-    return v[j, s] + pending * slow_net(f, j, head, s) * invm[j, s]
-
-
-@jit
-def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, head, y, r):
-    for c in range(ch_slot.shape[0]):
-        for s in range(u.shape[1]):
-            yc = 0.0
-            rc = 0.0
-            for k in range(ch_slot.shape[1]):
-                w = ch_weight[c, k]
-                if w != 0.0:
-                    i = ch_slot[c, k]
-                    yc += w * (f[i, s] + load[i, s])
-                    d = d0[i, s] + u[i - 1, s] - u[i, s]
-                    if d > 0.0:
-                        va = _synced(i - 1, s, v, invm, f, pending, head)
-                        vb = _synced(i, s, v, invm, f, pending, head)
-                        rc += w * (1.5 * A[i, s] * math.sqrt(d) * (va - vb))
-            y[c, s] = yc
-            r[c, s] = rc
 
 
 @jit
@@ -122,7 +98,7 @@ def _state_sums(u, v, mass, bias, A, d0, d_limit, e, p, w):
 @jit
 def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, head, sub,
            ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
-           e_ref, p_ref, diag, f, y_old, r_old, y_new, r_new):
+           e_ref, p_ref, diag, f, d_old, r_old, d_new, r_new):
     nb = u.shape[0]
     W = u.shape[1]
     n_drift = a_coef.shape[0]
@@ -140,15 +116,17 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
     net = np.empty(W)
     j_wall = np.zeros(W)
     w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
-    h_ns, h_work = np.empty(W, np.int64), np.empty((3, W))  # the head's work arrays
+    h_work = np.empty((2, 3, head + 1))  # the head flow's saved states
     _state_sums(u, v, mass, bias, A, d0, d_limit, e0, p0, worst)
     for s in range(u.shape[1]):
         net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
-    _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, 0.0, head, y_old, r_old)
+    probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, 0.0, head, -1, 0.0, d_old, r_old)
     if n_out > 0:
+        hermite_weights(0.0, dt, w, 0)
         for c in range(n_ch):
             for s in range(u.shape[1]):
-                out[s, c, 0] = y_old[c, s]
+                out[s, c, 0] = recorded_force(w, 0, 0.0, c, s, ch_slot, ch_weight, A, A, HERTZ,
+                                              d_old, r_old, d_old, r_old)
     j_out = 1
     pending = 0.0
     for n in range(n_steps):
@@ -161,7 +139,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
                 for s in range(u.shape[1]):
                     j_wall[s] += hb * f[wall_slot, s]
             h = a_coef[st] * dt
-            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_ns, h_work)
+            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_work)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1
@@ -171,7 +149,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
                     j_wall[s] += pending * f[wall_slot, s]
             _kick_drift(u, v, invm, f, pending, 0.0, head)
             pending = 0.0
-        _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, head, y_new, r_new)
+        probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, pending, head, -1, 0.0, d_new, r_new)
         j_end = j_out
         while j_end < n_out and j_end * sample_dt <= t_new * (1.0 + 1e-12):
             j_end += 1
@@ -179,14 +157,12 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
             hermite_weights((j * sample_dt - t) / dt, dt, w, j - j_out)
         for s in range(u.shape[1]):  # each shot's samples are contiguous: write them in runs
             for c in range(n_ch):
-                y0, r0, y1, r1 = y_old[c, s], r_old[c, s], y_new[c, s], r_new[c, s]
                 for j in range(j_out, j_end):
-                    out[s, c, j] = hermite(w, j - j_out, y0, r0, y1, r1)
+                    out[s, c, j] = recorded_force(w, j - j_out, (j * sample_dt - t) / dt, c, s, ch_slot, ch_weight,
+                                                  A, A, HERTZ, d_old, r_old, d_new, r_new)
         j_out = j_end
-        for c in range(n_ch):
-            for s in range(u.shape[1]):
-                y_old[c, s] = y_new[c, s]
-                r_old[c, s] = r_new[c, s]
+        d_old[:, :, :] = d_new
+        r_old[:, :, :] = r_new
         if check:
             _state_sums(u, v, mass, bias, A, d0, d_limit, e, pn, worst)
             for s in range(u.shape[1]):
@@ -213,10 +189,10 @@ def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, 
     n_ch = ch_slot.shape[0]
     for k in prange(n_chunks):
         f = np.zeros((nb + 1, W))
-        y_old = np.zeros((n_ch, W))
-        r_old = np.zeros((n_ch, W))
-        y_new = np.zeros((n_ch, W))
-        r_new = np.zeros((n_ch, W))
+        d_old = np.zeros((n_ch, ch_slot.shape[1], W))
+        r_old = np.zeros((n_ch, ch_slot.shape[1], W))
+        d_new = np.zeros((n_ch, ch_slot.shape[1], W))
+        r_new = np.zeros((n_ch, ch_slot.shape[1], W))
         _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], a_coef, b_coef, dt, n_steps, head, sub,
                ch_slot, ch_weight, sample_dt, out[k], check_every, d_limit[k], wall_slot,
-               e_ref[k], p_ref[k], diag[k], f, y_old, r_old, y_new, r_new)
+               e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)

@@ -31,15 +31,6 @@ def contact_forces(u, v, A, d0, damping, law, load, f):
 
 
 @jit
-def force_rate(i, u, v_above, v_below, A, d0):
-    """d/dt of the elastic force of contact slot i: (3/2) A d^(1/2) (v_above - v_below) (N/s)."""
-    d = d0[i] + u[i - 1] - u[i]
-    if d <= 0.0:
-        return 0.0
-    return 1.5 * A[i] * math.sqrt(d) * (v_above - v_below)
-
-
-@jit
 def energy(u, v, mass, bias, A, d0):
     """Kinetic + Hertz elastic + potential of the constant loads (J).
 

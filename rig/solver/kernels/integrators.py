@@ -18,11 +18,15 @@ With a multirate head (head > 0, see rig/stepsize.py) the kicks carry every cont
 the first ``head`` ones, and each drift moves bodies 0..head by multirate.head_flow
 (``sub[s]`` substeps of the same method in drift s) instead of a plain drift.
 """
+import math
+
 import numpy as np
 
 from instruments.jit import jit
-from rig.solver.kernels.forces import contact_forces, energy, force_rate, max_overlap_excess, momentum
-from rig.solver.kernels.multirate import head_flow, slow_net
+from rig.model.contact import HERTZ
+from rig.solver.kernels.forces import contact_forces, energy, max_overlap_excess, momentum
+from rig.solver.kernels.multirate import head_flow
+from rig.solver.kernels.record import hermite, hermite_weights, probe_overlaps, recorded_force
 
 
 @jit
@@ -46,75 +50,109 @@ def schedule_force(t, times, forces):
 
 
 @jit
-def _external_kick(v, invm, f, h, t, wall_slot, sched_body, sched_t, sched_f):
-    """Kick by the scheduled force; returns (dynamic wall impulse, schedule impulse)."""
-    j_wall = h * f[wall_slot] if wall_slot > 0 else 0.0
-    j_sched = 0.0
-    if sched_t.shape[0] > 0:
-        fe = schedule_force(t, sched_t, sched_f)
-        v[sched_body] += h * fe * invm[sched_body]
-        j_sched = h * fe
-    return j_wall, j_sched
+def _external_kick(v, invm, h, t, sched_body, sched_t, sched_f):
+    """Kick by the scheduled force at time t; returns its impulse (N s)."""
+    if sched_t.shape[0] == 0:
+        return 0.0
+    fe = schedule_force(t, sched_t, sched_f)
+    v[sched_body] += h * fe * invm[sched_body]
+    return h * fe
 
 
 @jit
-def _kick_drift(u, v, invm, f, hb, ha, head):
-    """One pass: v += hb (f_above - f_below)/m, then u += ha v (ha = 0: kick only). With a
-    head, bodies 0..head get only the kick of slot head + 1 and are not drifted here."""
+def _fused_run(u, v, invm, f, A, d0, damping, law, load, hb, ha, lo, hi):
+    """Bodies lo..hi-1 (lo >= 1), in order: kick v += hb (f_above - f_below)/m, drift
+    u += ha v, then renew contact slot i from bodies i-1 and i (both moved; the law of
+    forces.contact_forces, the same operations). Slot i + 1 is still the old force when
+    body i is kicked, so one pass does what a kick-drift pass and a force pass do.
+
+    The index is unsigned: with a signed start known only at run time numba keeps its
+    negative-index wraparound in the loop and LLVM no longer vectorises it
+    (tests/solver/test_vectorised.py guards this)."""
+    one = np.uint64(1)
+    u_prev = u[lo - 1]
+    if law == HERTZ:
+        for i in range(np.uint64(lo), np.uint64(hi)):
+            vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
+            v[i] = vi
+            ui = u[i] + ha * vi
+            u[i] = ui
+            d = d0[i] + u_prev - ui
+            d = d if d > 0.0 else 0.0
+            f[i] = A[i] * d * math.sqrt(d) - load[i]
+            u_prev = ui
+    else:
+        v_prev = v[lo - 1]
+        for i in range(np.uint64(lo), np.uint64(hi)):
+            vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
+            v[i] = vi
+            ui = u[i] + ha * vi
+            u[i] = ui
+            d = d0[i] + u_prev - ui
+            d = d if d > 0.0 else 0.0
+            fi = A[i] * math.sqrt(d) * (d + damping[i] * (v_prev - vi))
+            f[i] = (fi if fi > 0.0 else 0.0) - load[i]
+            u_prev = ui
+            v_prev = vi
+
+
+@jit
+def _kick(v, invm, f, hb, head):
+    """Kick only (the owed closing kick), every body; the head's bodies get only the force
+    of slot head + 1 (their own contacts are the head flow's)."""
     start = 0
     if head > 0:
         v[head] += hb * (0.0 - f[head + 1]) * invm[head]
         start = head + 1
-    for i in range(start, v.shape[0]):
-        vi = v[i] + hb * (f[i] - f[i + 1]) * invm[i]
-        v[i] = vi
-        u[i] += ha * vi
+    for i in range(np.uint64(start), np.uint64(v.shape[0])):
+        v[i] = v[i] + hb * (f[i] - f[i + np.uint64(1)]) * invm[i]
+
+
+BLOCK = 2048  # bodies per block of a step's wavefront (their arrays stay in the core's L2 cache)
 
 
 @jit
-def _synced_velocity(j, v, invm, f2, pending, sched_body, f_sched, head):
-    """Velocity of body j once the owed closing kick of ``pending`` seconds is applied
-    (f2: the forces as a (slots, 1) view)."""
-    vj = v[j] + pending * slow_net(f2, j, head, 0) * invm[j]
-    if j == sched_body:
-        vj += pending * f_sched * invm[j]
-    return vj
+def _step(u, v, invm, f, A, d0, damping, law, load, a_coef, b_coef, dt, t, pending, head, sub,
+          sched_body, sched_t, sched_f, wall_slot, heads, h_work, impulses):
+    """One step of the composition (its closing kick owed), every body and stage.
 
-
-@jit
-def _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, sched_body, f_sched, head, y, r):
-    """Channel values y (N, whole contact forces) and rates r (N/s) at a step end."""
-    f2 = f.reshape((f.shape[0], 1))
-    for c in range(ch_slot.shape[0]):
-        y[c] = 0.0
-        r[c] = 0.0
-        for k in range(ch_slot.shape[1]):
-            w = ch_weight[c, k]
-            if w != 0.0:
-                s = ch_slot[c, k]
-                y[c] += w * (f[s] + load[s])
-                va = _synced_velocity(s - 1, v, invm, f2, pending, sched_body, f_sched, head)
-                vb = _synced_velocity(s, v, invm, f2, pending, sched_body, f_sched, head)
-                r[c] += w * force_rate(s, u, va, vb, A, d0)
-
-
-@jit
-def hermite_weights(x, h, w, k):
-    """Column k of w (4, n) gets the weights of the cubic Hermite interpolant at fraction x
-    of a step of h seconds: y(x) = w0 y0 + w1 r0 + w2 y1 + w3 r1 (values y, rates r at the
-    step's ends)."""
-    x2 = x * x
-    x3 = x2 * x
-    w[0, k] = 2.0 * x3 - 3.0 * x2 + 1.0
-    w[1, k] = (x3 - 2.0 * x2 + x) * h
-    w[2, k] = 3.0 * x2 - 2.0 * x3
-    w[3, k] = (x3 - x2) * h
-
-
-@jit
-def hermite(w, k, y0, r0, y1, r1):
-    """The interpolant with the weights of column k (hermite_weights)."""
-    return w[0, k] * y0 + w[1, k] * r0 + w[2, k] * y1 + w[3, k] * r1
+    Stage s on body i needs slot i + 1 at stage s - 1 and leaves slot i at stage s, so
+    stage s may run one body behind stage s - 1: the chain is swept in blocks of BLOCK
+    bodies, each block taken through every stage (stage s on bodies kB - s .. (k+1)B - s)
+    while it is in cache, instead of every stage streaming the whole chain from memory.
+    Each body sees the same operations in the same order as in stage-by-stage sweeps.
+    With a multirate head, bodies 0..head get the kick of slot head + 1 and the head's
+    flow (multirate.head_flow) instead. ``heads``: the (bodies, 1) views the head flow
+    takes, h_work its saved states; impulses[0] += the wall's dynamic impulse, impulses[1] += the schedule's (N s).
+    """
+    nb = u.shape[0]
+    u2, v2, im2, f2, A2, d02, load2 = heads
+    n_blocks = max(1, (nb + BLOCK - 1) // BLOCK)
+    for k in range(n_blocks):
+        ts = t
+        for s in range(a_coef.shape[0]):
+            hb = b_coef[s] * dt
+            if s == 0:
+                hb += pending
+            h = a_coef[s] * dt
+            lo = max(k * BLOCK - s, 0)
+            hi = nb if k == n_blocks - 1 else (k + 1) * BLOCK - s
+            if k == n_blocks - 1 and wall_slot > 0:
+                impulses[0] += hb * f[wall_slot]
+            if k == 0:
+                impulses[1] += _external_kick(v, invm, hb, ts, sched_body, sched_t, sched_f)
+                if head > 0:
+                    v[head] += hb * (0.0 - f[head + 1]) * invm[head]
+                    head_flow(u2, v2, im2, f2, A2, d02, load2, head, a_coef, b_coef, h, sub[s], h_work)
+                    lo = head + 1
+                else:
+                    v0 = v[0] + hb * (f[0] - f[1]) * invm[0]
+                    v[0] = v0
+                    u[0] += h * v0
+                    lo = 1
+            if hi > lo:
+                _fused_run(u, v, invm, f, A, d0, damping, law, load, hb, h, lo, hi)
+            ts += h
 
 
 @jit
@@ -143,27 +181,29 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
 
     contact_forces(u, v, A, d0, damping, law, load, f)
     # (bodies, 1) views for the multirate head (shared with the batched kernel)
-    u2, v2, im2, f2 = u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1))
-    A2, d02, load2 = A.reshape((nb, 1)), d0.reshape((nb, 1)), load.reshape((nb + 1, 1))
-    h_ns, h_work = np.empty(1, np.int64), np.empty((3, 1))  # the head's work arrays
+    heads = (u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1)),
+             A.reshape((nb, 1)), d0.reshape((nb, 1)), load.reshape((nb + 1, 1)))
+    h_work = np.empty((2, 3, head + 1))  # the head flow's saved states
     # sum of constant loads, less the part the wall's slot carries (j_wall is dynamic)
     wall_load = load[wall_slot] if wall_slot > 0 else 0.0
     net_const = load[nb] - wall_load
     e0 = energy(u, v, mass, bias, A, d0)
     p0 = momentum(v, mass)
-    j_wall = 0.0
-    j_sched = 0.0
+    impulses = np.zeros(2)  # the wall's dynamic impulse, the schedule's (N s)
     w_sched = 0.0
 
-    y_old = np.empty(n_ch)
-    r_old = np.empty(n_ch)
-    y_new = np.empty(n_ch)
-    r_new = np.empty(n_ch)
+    u2, v2, im2, f2, A2, d02, load2 = heads
+    dm2 = damping.reshape((nb, 1))
+    d_old = np.zeros((n_ch, ch_slot.shape[1], 1))  # overlaps (m) and rates (m/s) the channels read
+    r_old = np.zeros_like(d_old)
+    d_new = np.zeros_like(d_old)
+    r_new = np.zeros_like(d_old)
     w = np.empty((4, 1))
-    _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, 0.0, sched_body, 0.0, head, y_old, r_old)
+    probe_overlaps(u2, v2, im2, f2, d02, ch_slot, ch_weight, 0.0, head, sched_body, 0.0, d_old, r_old)
     if n_out > 0:
+        hermite_weights(0.0, dt, w, 0)
         for c in range(n_ch):
-            out[c, 0] = y_old[c]
+            out[c, 0] = recorded_force(w, 0, 0.0, c, 0, ch_slot, ch_weight, A2, dm2, law, d_old, r_old, d_old, r_old)
     j_out = 1
     u_old = np.empty(nb if n_frames > 0 else 0)
     v_old = np.empty(nb if n_frames > 0 else 0)
@@ -186,30 +226,16 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
         if has_sched:
             us_old = u[sched_body]
             fe_old = schedule_force(t, sched_t, sched_f)
-        ts = t
-        for s in range(n_drift):
-            hb = b_coef[s] * dt
-            if s == 0:
-                hb += pending
-            jw, js = _external_kick(v, invm, f, hb, ts, wall_slot,
-                                    sched_body, sched_t, sched_f)
-            j_wall += jw
-            j_sched += js
-            h = a_coef[s] * dt
-            _kick_drift(u, v, invm, f, hb, h, head)
-            if head > 0:
-                head_flow(u2, v2, im2, f2, A2, d02, load2, head, a_coef, b_coef, h, sub[s], h_ns, h_work)
-            ts += h
-            contact_forces(u, v, A, d0, damping, law, load, f)
+        _step(u, v, invm, f, A, d0, damping, law, load, a_coef, b_coef, dt, t, pending, head, sub,
+              sched_body, sched_t, sched_f, wall_slot, heads, h_work, impulses)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1
         if check or n_frames > 0:  # synchronise every velocity
-            jw, js = _external_kick(v, invm, f, pending, t_new, wall_slot,
-                                    sched_body, sched_t, sched_f)
-            j_wall += jw
-            j_sched += js
-            _kick_drift(u, v, invm, f, pending, 0.0, head)
+            if wall_slot > 0:
+                impulses[0] += pending * f[wall_slot]
+            impulses[1] += _external_kick(v, invm, pending, t_new, sched_body, sched_t, sched_f)
+            _kick(v, invm, f, pending, head)
             pending = 0.0
         if has_sched:
             fe_new = schedule_force(t_new, sched_t, sched_f)
@@ -218,16 +244,16 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
             fe_new = 0.0
         steps_done = n + 1
 
-        _probe(f, load, u, v, invm, A, d0, ch_slot, ch_weight, pending, sched_body, fe_new, head,
-               y_new, r_new)
+        probe_overlaps(u2, v2, im2, f2, d02, ch_slot, ch_weight, pending, head, sched_body, fe_new, d_new, r_new)
         while j_out < n_out and j_out * sample_dt <= t_new * (1.0 + 1e-12):
-            hermite_weights((j_out * sample_dt - t) / dt, dt, w, 0)
+            x = (j_out * sample_dt - t) / dt
+            hermite_weights(x, dt, w, 0)
             for c in range(n_ch):
-                out[c, j_out] = hermite(w, 0, y_old[c], r_old[c], y_new[c], r_new[c])
+                out[c, j_out] = recorded_force(w, 0, x, c, 0, ch_slot, ch_weight, A2, dm2, law,
+                                               d_old, r_old, d_new, r_new)
             j_out += 1
-        for c in range(n_ch):
-            y_old[c] = y_new[c]
-            r_old[c] = r_new[c]
+        d_old[:, :, :] = d_new
+        r_old[:, :, :] = r_new
         while j_frame < n_frames and j_frame * frame_dt <= t_new * (1.0 + 1e-12):
             hermite_weights((j_frame * frame_dt - t) / dt, dt, w, 0)
             for i in range(nb):
@@ -237,7 +263,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
         if check:
             e = energy(u, v, mass, bias, A, d0) - w_sched
             err = abs(e - e0) / e_ref
-            pe = abs(momentum(v, mass) - p0 - (t_new * net_const + j_sched - j_wall)) / p_ref
+            pe = abs(momentum(v, mass) - p0 - (t_new * net_const + impulses[1] - impulses[0])) / p_ref
             if not (err < 1e300) or not (max_overlap_excess(u, d0, d_limit) <= 1.0):
                 status = 1
                 break
@@ -246,7 +272,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
 
     diag[0] = e_err
     diag[1] = p_err
-    diag[2] = j_wall + wall_load * steps_done * dt
+    diag[2] = impulses[0] + wall_load * steps_done * dt
     diag[3] = status
     diag[4] = steps_done
     diag[5] = steps_done * dt

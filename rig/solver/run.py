@@ -1,0 +1,88 @@
+"""One integration of a problem at a given stepping: the output grid, the kernel call and
+its report turned into a Solution (the accuracy control of rig/solver/control.py and
+``solve`` are built on it)."""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from rig.errors import RigError
+from rig.solver.kernels.integrators import integrate
+from rig.solver.methods import Method
+from rig.solver.problem import ChainProblem
+from rig.solver.saveat import SaveAt
+from rig.solver.solution import KernelReport, Solution, SolverStats, Status
+from rig.solver.stepsize import Stepping
+
+MAX_CHECKS = 50  # energy / momentum / blow-up checks per solve (each one O(N))
+
+
+def time_grid(t_end: float, dt: float, sample_interval: float) -> tuple:
+    """(steps, step, output samples): whole steps of at most dt (s) that end exactly at t_end,
+    and the output grid t = j * sample_interval up to t_end."""
+    n_steps = max(1, math.ceil(t_end / dt * (1 - 1e-12)))
+    return n_steps, t_end / n_steps, int(math.floor(t_end / sample_interval * (1 + 1e-12))) + 1
+
+
+def frame_origin(chain) -> np.ndarray:
+    """Where each moving body's frame position is measured from (m, down from bead 0's
+    equilibrium centre): the striker's far end at impact, then each bead's equilibrium."""
+    x_eq = chain.equilibrium_positions()
+    if chain.striker is None:
+        return x_eq
+    top = chain.beads[0].radius + chain.striker.gap + chain.striker.length
+    return np.concatenate(([-top], x_eq))
+
+
+class Unstable(RigError):
+    """An integration that blew up (an overlap beyond half a bead radius): the step is too
+    large. Carries the stepping that failed."""
+
+    def __init__(self, message: str, stepping: Stepping):
+        super().__init__(message)
+        self.stepping = stepping
+
+
+def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, stepping: Stepping,
+                 accuracy: float | None = None) -> Solution:
+    """Integrate ``problem`` from the impact to t_end (s) with ``stepping`` (whole steps
+    ending at t_end), recording what ``save`` names. Raises Unstable if it blows up."""
+    ch_slot, ch_weight = save.channels(problem.offset)
+    n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), save.sample_interval)
+    sub = stepping.substeps(step, m.drifts)
+    out = np.zeros((len(save.names), n_out))
+    if save.frame_interval is not None:
+        n_frames = int(math.floor(t_end / save.frame_interval * (1 + 1e-12))) + 1
+        frame_dt = save.frame_interval
+    else:
+        n_frames, frame_dt = 0, 1.0
+    frames = np.zeros((n_frames, problem.n_bodies))
+    u = problem.u0.copy()
+    v = problem.v0.copy()
+    diag = np.zeros(6)
+    check_every = max(1, n_steps // MAX_CHECKS)
+
+    args = (problem.mass, problem.invm, problem.bias, problem.load, problem.A, problem.d0,
+            problem.damping, problem.chain.law.code, np.array(m.drifts), np.array(m.kicks), step)
+    mid = (stepping.head, sub)
+    tail = (problem.sched_body, problem.sched_t, problem.sched_f,
+            ch_slot, ch_weight, save.sample_interval, out, frame_dt, frames,
+            check_every, problem.d_limit, problem.wall_slot,
+            problem.energy_scale, problem.momentum_scale, diag)
+    integrate(u.copy(), v.copy(), *args, 0, *mid, *tail)  # load the compiled kernel before timing
+    t0 = time.perf_counter()
+    integrate(u, v, *args, n_steps, *mid, *tail)
+    wall = time.perf_counter() - t0
+    report = KernelReport.of(diag)
+    if report.status is not Status.SUCCESS:
+        raise Unstable(f"{report.status.message} (near t = {report.end_time_s:.4g} s, "
+                       f"dt = {step:.4g} s, method {m.name})", stepping)
+    stats = SolverStats(m.name, step, n_steps, n_steps * m.force_evaluations, wall,
+                        report.energy_error, report.momentum_error, report.wall_impulse_Ns, accuracy)
+    moving = slice(0, problem.n_bodies - (1 if problem.wall_slot else 0))
+    frames_abs = frames[:, moving] + frame_origin(problem.chain) if n_frames else None
+    return Solution(dict(zip(save.names, out)), save.sample_interval, frames_abs,
+                    save.frame_interval, u[moving].copy(), v[moving].copy(), stats, problem,
+                    report.status)

@@ -1,0 +1,50 @@
+"""The hot loops stay vectorised: LLVM's code for each holds vector square roots and vector
+arithmetic. A change that loses it (a loop start numba can no longer prove non-negative
+brings back its wraparound check, a branch on the data, a call in the loop) fails here,
+not months later in a benchmark. numba does not show the code of a cached kernel, so each
+is compiled afresh, uncached, from its Python source."""
+import re
+
+import numba
+import numpy as np
+import pytest
+
+from rig.model.contact import HERTZ, KUWABARA_KONO
+from rig.solver.kernels import ensemble, integrators
+
+
+def _llvm(kernel, *args) -> str:
+    fresh = numba.njit(cache=False, fastmath=False)(kernel.py_func)
+    fresh(*args)
+    return "\n".join(fresh.inspect_llvm().values())
+
+
+def _vector_ops(ir: str) -> set:
+    return set(re.findall(r"<(\d+) x double>", ir))
+
+
+def _chain(nb=64):
+    rng = np.random.default_rng(0)
+    u = 1e-9 * rng.standard_normal(nb)
+    return u, np.zeros(nb), np.ones(nb), np.zeros(nb + 1), np.full(nb, 1e9), np.full(nb, 1e-7), np.zeros(nb)
+
+
+@pytest.mark.parametrize("law", [HERTZ, KUWABARA_KONO])
+def test_the_fused_kick_drift_force_pass_is_vectorised(law):
+    u, v, invm, f, A, d0, damping = _chain()
+    ir = _llvm(integrators._fused_run, u, v, invm, f, A, d0, damping, law, np.zeros(65), 1e-9, 1e-9, 3, 64)
+    assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the square roots of the force pass are scalar"
+    assert _vector_ops(ir), "no vector arithmetic in the fused pass"
+
+
+def test_the_closing_kick_is_vectorised():
+    u, v, invm, f, *_ = _chain()
+    assert _vector_ops(_llvm(integrators._kick, v, invm, f, 1e-9, 1)), "the closing kick is scalar"
+
+
+def test_the_batched_kernel_vectorises_over_shots():
+    nb, W = 16, 32
+    u = np.zeros((nb, W))
+    ir = _llvm(ensemble._contact_row, u, np.ones((nb, W)), np.full((nb, W), 1e-7), np.zeros((nb + 1, W)),
+               np.zeros((nb + 1, W)), 3)
+    assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the batched force row is scalar"
