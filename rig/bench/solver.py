@@ -52,7 +52,7 @@ SETTINGS = (1e-3, 1e-4, 1e-5, 1e-6)
 PEERS = {"scipy-DOP853": (1e-6, 1e-8, 1e-10), "numba-DOP853": (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12),
          "LAMMPS": (20, 50, 100)}  # rtol, or tau / dt for LAMMPS
 EQUAL_ERRORS = (1e-4, 1e-5, 1e-6)
-KERNEL_SIZES = ((1000, 4000), (1_000_000, 24))  # (beads, steps) of the kernel figure
+KERNEL_SIZES = ((1000, 4000, 5), (1_000_000, 300, 1))  # (beads, steps, repeats) of the kernel figure
 SCALING_SIZES = (1000, 10_000, 100_000, 1_000_000)
 QUICK = dict(divisions={"srkn6b": (3, 6, 12), "verlet": (32, 128)}, settings=(1e-4,), peers={
     "scipy-DOP853": (1e-8,), "numba-DOP853": (1e-8, 1e-10), "LAMMPS": (20,)}, scenarios=("precompressed",))
@@ -64,7 +64,7 @@ from rig import Bead, Chain, ChainProblem, SaveAt, Striker, Wall, solve
 from rig.solver.stepsize import contact_time_scale
 quiet = {"estimate": False} if "estimate" in inspect.signature(solve).parameters else {}
 out = {}
-for n, steps in SIZES:
+for n, steps, repeats in SIZES:
     bead = Bead(material="steel316", diameter="4.76 mm", mass="0.4501 g")
     c = Chain([bead] * n, striker=Striker("steel316", "0.4501 g", "0.44 m/s"), wall=Wall(), gravity=0,
               top_force=2.38)
@@ -73,7 +73,7 @@ for n, steps in SIZES:
     dt = contact_time_scale(p) / 8
     solve(p, 2 * dt, save=save, dt=dt, **quiet)
     ns = []
-    for _ in range(REPEATS):
+    for _ in range(repeats):
         t0 = time.process_time()
         s = solve(p, steps * dt, save=save, dt=dt, **quiet)
         ns.append((time.process_time() - t0) / (s.stats.force_evaluations * (p.n_bodies - 1)) * 1e9)
@@ -197,7 +197,8 @@ def kernel_figures(repeats: int, rounds: int, baseline: str | None, progress=Non
     revision and, with ``baseline``, that revision in turns; medians over the rounds."""
     from rig.bench.baseline import ROOT, checkout, measure
 
-    snippet = f"SIZES = {KERNEL_SIZES!r}\nREPEATS = {repeats}\n" + KERNEL_SNIPPET
+    sizes = tuple((n, steps, min(r, repeats)) for n, steps, r in KERNEL_SIZES)
+    snippet = f"SIZES = {sizes!r}\n" + KERNEL_SNIPPET
     runs = {"current": [], "baseline": []}
     with (checkout(baseline) if baseline else _no_tree()) as tree:
         for k in range(rounds):
@@ -206,13 +207,13 @@ def kernel_figures(repeats: int, rounds: int, baseline: str | None, progress=Non
             runs["current"].append(measure(ROOT, snippet))
             if tree is not None:
                 runs["baseline"].append(measure(tree, snippet))
-    out = {"beads": [n for n, _ in KERNEL_SIZES], "baseline_rev": baseline}
+    out = {"beads": [n for n, *_ in KERNEL_SIZES], "baseline_rev": baseline}
     for who, rs in runs.items():
         if rs:
-            out[who] = {str(n): statistics.median(r[str(n)] for r in rs) for n, _ in KERNEL_SIZES}
+            out[who] = {str(n): statistics.median(r[str(n)] for r in rs) for n, *_ in KERNEL_SIZES}
     if runs["baseline"]:
         pairs = list(zip(runs["current"], runs["baseline"]))
-        out["ratio"] = {str(n): statistics.median(c[str(n)] / b[str(n)] for c, b in pairs) for n, _ in KERNEL_SIZES}
+        out["ratio"] = {str(n): statistics.median(c[str(n)] / b[str(n)] for c, b in pairs) for n, *_ in KERNEL_SIZES}
     gbs = triad_bandwidth()
     out["bounds"] = {"sqrt_ns": sqrt_ns(), "bandwidth_GB_s": gbs,
                      # one pass over the state per evaluation: u, v, f read and written (48 B);
@@ -243,7 +244,7 @@ def scaling(progress=None) -> dict:
         c = chain(2.38, n)
         p = ChainProblem.from_chain(c)
         save = SaveAt({"c500": c.contact_probe(PROBE)}, SAMPLE_INTERVAL)
-        steps = max(20, int(2e7 / n))
+        steps = max(100, int(2e7 / n))
         span = steps * stepping.dt
         solve(p, 2 * stepping.dt, save=save, dt=stepping, estimate=False)
         _, cpu = _median_cpu(lambda: solve(p, span, save=save, dt=stepping, estimate=False), 3)
@@ -271,7 +272,7 @@ def run(quick: bool = False, peers: bool = False, baseline: str | None = None, p
             notes += [n for n in said if n not in notes]
     return dict(rows=rows, at_equal_error=at_equal_error(rows), notes=notes, machine=_machine(),
                 beads=N_BEADS, probe_contact=PROBE,
-                kernel=kernel_figures(1 if quick else 3, 1 if quick else 5, baseline, progress),
+                kernel=kernel_figures(1 if quick else 5, 1 if quick else 3, baseline, progress),
                 scaling=None if quick else scaling(progress))
 
 

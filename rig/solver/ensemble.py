@@ -16,7 +16,7 @@ from rig.errors import RigError, invalid
 from rig.solver.kernels.ensemble import integrate_ensemble
 from rig.solver.methods import DEFAULT_METHOD
 from rig.solver.methods import method as get_method
-from rig.solver.run import MAX_CHECKS, time_grid
+from rig.solver.run import check_interval, time_grid
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import KernelReport, SolverStats, Status
 from rig.solver.stepsize import Stepping
@@ -92,7 +92,7 @@ def solve_ensemble(problems: list, t_end: float, *, save: SaveAt, dt: float | St
     integrate_ensemble(u, v, stack("mass"), stack("invm"), stack("bias"), stack("load"), stack("A"),
                        stack("d0"), np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head, sub,
                        ch_slot, ch_weight, save.sample_interval, out,
-                       max(1, n_steps // MAX_CHECKS), stack("d_limit"), p0.wall_slot,
+                       check_interval(n_steps), stack("d_limit"), p0.wall_slot,
                        blocks([p.energy_scale for p in padded]), blocks([p.momentum_scale for p in padded]),
                        diag)
     wall = time.perf_counter() - t0

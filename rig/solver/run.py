@@ -19,6 +19,11 @@ from rig.solver.stepsize import Stepping
 MAX_CHECKS = 50  # energy / momentum / blow-up checks per solve (each one O(N))
 
 
+def check_interval(n_steps: int) -> int:
+    """Steps between two checks of a solve of n_steps (the last step is always checked)."""
+    return max(1, n_steps // MAX_CHECKS)
+
+
 def time_grid(t_end: float, dt: float, sample_interval: float) -> tuple:
     """(steps, step, output samples): whole steps of at most dt (s) that end exactly at t_end,
     and the output grid t = j * sample_interval up to t_end."""
@@ -62,7 +67,7 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     u = problem.u0.copy()
     v = problem.v0.copy()
     diag = np.zeros(6)
-    check_every = max(1, n_steps // MAX_CHECKS)
+    check_every = check_interval(n_steps)
 
     args = (problem.mass, problem.invm, problem.bias, problem.load, problem.A, problem.d0,
             problem.damping, problem.chain.law.code, np.array(m.drifts), np.array(m.kicks), step)

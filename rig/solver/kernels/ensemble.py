@@ -15,6 +15,7 @@ from numba import prange
 
 from instruments.jit import jit
 from rig.model.contact import HERTZ
+from rig.solver.kernels.forces import state_sums
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps, recorded_force
 
@@ -75,27 +76,6 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
 
 
 @jit
-def _state_sums(u, v, mass, bias, A, d0, d_limit, e, p, w):
-    """Each shot's energy e (forces.energy's sums, in its order), momentum p and largest
-    d / d_limit w (inf for nan, as forces.max_overlap_excess), in two passes over the rows."""
-    nb = u.shape[0]
-    e[:] = 0.0
-    p[:] = 0.0
-    w[:] = 0.0
-    for i in range(nb):
-        for s in range(u.shape[1]):
-            e[s] += 0.5 * mass[i, s] * v[i, s] * v[i, s] - mass[i, s] * bias[i, s] * u[i, s]
-            p[s] += mass[i, s] * v[i, s]
-    for i in range(1, nb):
-        for s in range(u.shape[1]):
-            d = d0[i, s] + u[i - 1, s] - u[i, s]
-            if d > 0.0:
-                e[s] += 0.4 * A[i, s] * d * d * math.sqrt(d)
-            q = d / d_limit[i, s]
-            w[s] = max(w[s], q) if q == q else math.inf
-
-
-@jit
 def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, head, sub,
            ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
            e_ref, p_ref, diag, f, d_old, r_old, d_new, r_new):
@@ -117,7 +97,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
     j_wall = np.zeros(W)
     w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
     h_work = np.empty((2, 3, head + 1))  # the head flow's saved states
-    _state_sums(u, v, mass, bias, A, d0, d_limit, e0, p0, worst)
+    state_sums(u, v, mass, bias, A, d0, d_limit, e0, p0, worst)
     for s in range(u.shape[1]):
         net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
     probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, 0.0, head, -1, 0.0, d_old, r_old)
@@ -164,7 +144,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
         d_old[:, :, :] = d_new
         r_old[:, :, :] = r_new
         if check:
-            _state_sums(u, v, mass, bias, A, d0, d_limit, e, pn, worst)
+            state_sums(u, v, mass, bias, A, d0, d_limit, e, pn, worst)
             for s in range(u.shape[1]):
                 err = abs(e[s] - e0[s]) / e_ref[s]
                 pe = abs(pn[s] - p0[s] - (t_new * net[s] - j_wall[s])) / p_ref[s]

@@ -1,4 +1,4 @@
-"""Contact forces, their time derivatives and the energy of the chain (numba)."""
+"""Contact forces and the chain's energy, momentum and largest overlap (numba)."""
 import math
 
 from instruments.jit import jit
@@ -31,38 +31,26 @@ def contact_forces(u, v, A, d0, damping, law, load, f):
 
 
 @jit
-def energy(u, v, mass, bias, A, d0):
-    """Kinetic + Hertz elastic + potential of the constant loads (J).
+def state_sums(u, v, mass, bias, A, d0, d_limit, e, p, w):
+    """Each shot's energy e (J), momentum p (kg m/s) and largest d / d_limit w (> 1: an
+    overlap no real contact reaches; inf for nan), arrays (bodies, shots), in two passes:
 
-    E = sum m v^2 / 2 + sum (2/5) A d^(5/2) - sum m b u, where m b is each body's constant
-    external force (gravity, the magnet's force at t = 0).
-    """
+        E = sum m v^2 / 2 + sum (2/5) A d^(5/2) - sum m b u,   P = sum m v,
+
+    m b each body's constant external force (gravity, the magnet's force at t = 0); the
+    wall (mass 0 here) counts for neither."""
     nb = u.shape[0]
-    e = 0.0
+    e[:] = 0.0
+    p[:] = 0.0
+    w[:] = 0.0
     for i in range(nb):
-        e += 0.5 * mass[i] * v[i] * v[i] - mass[i] * bias[i] * u[i]
+        for s in range(u.shape[1]):
+            e[s] += 0.5 * mass[i, s] * v[i, s] * v[i, s] - mass[i, s] * bias[i, s] * u[i, s]
+            p[s] += mass[i, s] * v[i, s]
     for i in range(1, nb):
-        d = d0[i] + u[i - 1] - u[i]
-        if d > 0.0:
-            e += 0.4 * A[i] * d * d * math.sqrt(d)
-    return e
-
-
-@jit
-def momentum(v, mass):
-    """Total linear momentum sum m v (kg m/s); the wall (mass 0 here) does not count."""
-    p = 0.0
-    for i in range(v.shape[0]):
-        p += mass[i] * v[i]
-    return p
-
-
-@jit
-def max_overlap_excess(u, d0, d_limit):
-    """Largest d / d_limit over the contacts (> 1 means an overlap no real contact reaches)."""
-    worst = 0.0
-    for i in range(1, u.shape[0]):
-        r = (d0[i] + u[i - 1] - u[i]) / d_limit[i]
-        if r > worst or r != r:
-            worst = r if r == r else math.inf
-    return worst
+        for s in range(u.shape[1]):
+            d = d0[i, s] + u[i - 1, s] - u[i, s]
+            if d > 0.0:
+                e[s] += 0.4 * A[i, s] * d * d * math.sqrt(d)
+            q = d / d_limit[i, s]
+            w[s] = max(w[s], q) if q == q else math.inf

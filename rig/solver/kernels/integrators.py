@@ -24,7 +24,7 @@ import numpy as np
 
 from instruments.jit import jit
 from rig.model.contact import HERTZ
-from rig.solver.kernels.forces import contact_forces, energy, max_overlap_excess, momentum
+from rig.solver.kernels.forces import contact_forces, state_sums
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite, hermite_weights, probe_overlaps, recorded_force
 
@@ -187,8 +187,10 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
     # sum of constant loads, less the part the wall's slot carries (j_wall is dynamic)
     wall_load = load[wall_slot] if wall_slot > 0 else 0.0
     net_const = load[nb] - wall_load
-    e0 = energy(u, v, mass, bias, A, d0)
-    p0 = momentum(v, mass)
+    sums = np.empty(3)  # energy (J), momentum (kg m/s), largest d / d_limit of one state
+    m2, b2, dl2 = mass.reshape((nb, 1)), bias.reshape((nb, 1)), d_limit.reshape((nb, 1))
+    state_sums(heads[0], heads[1], m2, b2, heads[4], heads[5], dl2, sums[0:1], sums[1:2], sums[2:3])
+    e0, p0 = sums[0], sums[1]
     impulses = np.zeros(2)  # the wall's dynamic impulse, the schedule's (N s)
     w_sched = 0.0
 
@@ -261,10 +263,11 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
             j_frame += 1
 
         if check:
-            e = energy(u, v, mass, bias, A, d0) - w_sched
+            state_sums(heads[0], heads[1], m2, b2, heads[4], heads[5], dl2, sums[0:1], sums[1:2], sums[2:3])
+            e = sums[0] - w_sched
             err = abs(e - e0) / e_ref
-            pe = abs(momentum(v, mass) - p0 - (t_new * net_const + impulses[1] - impulses[0])) / p_ref
-            if not (err < 1e300) or not (max_overlap_excess(u, d0, d_limit) <= 1.0):
+            pe = abs(sums[1] - p0 - (t_new * net_const + impulses[1] - impulses[0])) / p_ref
+            if not (err < 1e300) or not (sums[2] <= 1.0):
                 status = 1
                 break
             e_err = max(e_err, err)
