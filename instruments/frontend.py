@@ -18,25 +18,28 @@ import math
 import numpy as np
 
 from ._kernels.filters import one_pole
-from ._kernels.resample import at_positions
+
+
+def highpass_coefficients(h: float, tau: float) -> tuple:
+    """(b0, b1, a1) of the one-pole high-pass of time constant tau (s) at step h (s)."""
+    a = math.exp(-h / tau)
+    g = tau / h * (1.0 - a)
+    return g, -g, -a
+
+
+def lowpass_coefficients(h: float, bandwidth: float) -> tuple:
+    """(b0, b1, a1) of the one-pole low-pass of -3 dB bandwidth (Hz) at step h (s)."""
+    tau = 1.0 / (2.0 * math.pi * bandwidth)
+    a = math.exp(-h / tau)
+    g = tau / h * (1.0 - a)
+    return 1.0 - g, g - a, -a
 
 
 def rc_highpass(x: np.ndarray, h: float, tau: float) -> np.ndarray:
     """One-pole RC high-pass of time constant tau (s); y = 0 for a constant input."""
-    a = math.exp(-h / tau)
-    g = tau / h * (1.0 - a)
-    return one_pole(np.ascontiguousarray(x, dtype=float), g, -g, -a, float(x[0]), False)
+    return one_pole(np.ascontiguousarray(x, dtype=float), *highpass_coefficients(h, tau), float(x[0]), False)
 
 
 def lowpass(x: np.ndarray, h: float, bandwidth: float) -> np.ndarray:
     """One-pole low-pass with -3 dB bandwidth (Hz); 10-90% rise time 0.35/bandwidth."""
-    tau = 1.0 / (2.0 * math.pi * bandwidth)
-    a = math.exp(-h / tau)
-    g = tau / h * (1.0 - a)
-    return one_pole(np.ascontiguousarray(x, dtype=float), 1.0 - g, g - a, -a, float(x[0]), True)
-
-
-def delay(x: np.ndarray, h: float, shift: float) -> np.ndarray:
-    """x delayed by ``shift`` seconds (may be negative, sub-sample), by linear interpolation;
-    the ends are held."""
-    return at_positions(np.ascontiguousarray(x, dtype=float), np.arange(x.size) - shift / h)
+    return one_pole(np.ascontiguousarray(x, dtype=float), *lowpass_coefficients(h, bandwidth), float(x[0]), True)

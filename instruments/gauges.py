@@ -13,8 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._kernels.acquisition import gauge_signal
 from .errors import check
-from .frontend import delay, rc_highpass
+from .frontend import highpass_coefficients
 
 
 @dataclass(frozen=True)
@@ -67,8 +68,8 @@ class PiezoGauge:
         error into a delay; None (the wall sensor) means no misalignment.
         """
         s = self.settings
-        f = force if wave_speed is None else delay(force, h, draw.misalignment / wave_speed)
-        v = rc_highpass(s.sensitivity * draw.gain * f, h, s.tau)
-        if s.noise:
-            v = v + s.noise * rng.standard_normal(v.size)
-        return v
+        force = np.ascontiguousarray(force, dtype=float)
+        shift = 0.0 if wave_speed is None else draw.misalignment / wave_speed
+        noise = rng.standard_normal(force.size) if s.noise else np.empty(0)
+        return gauge_signal(force, float(h), float(shift), s.sensitivity * draw.gain, *highpass_coefficients(h, s.tau),
+                            float(s.noise), noise)

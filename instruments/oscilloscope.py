@@ -15,10 +15,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._kernels.quantiser import quantise
-from ._kernels.resample import at_positions
+from ._kernels.acquisition import NO_TRIGGER, PAST_INPUT, condition, scope_shot
 from .errors import InstrumentError, check
-from .frontend import lowpass, rc_highpass
+from .frontend import highpass_coefficients, lowpass_coefficients
 from .records import Preamble, ScopeRecord, Waveform
 
 CHANNELS = ("CH1", "CH2", "CH3", "CH4")
@@ -122,54 +121,70 @@ class Oscilloscope:
 
         inputs: {channel: volts at the probe tip}, sampled every h seconds from t = 0; before
         t = 0 each input is held at its first value. Displayed channels without an input
-        read noise. Returns a ScopeRecord; a record that does not trigger says so.
+        read noise. Returns a ScopeRecord; a record that does not trigger says so. Draws
+        from rng the clock's phase, then each displayed channel's noise (shot_draws' order).
         """
         n_in = max((len(v) for v in inputs.values()), default=0)
-        analog = {ch: self._condition(np.asarray(inputs.get(ch, np.zeros(n_in)), float), s, h)
-                  for ch, s in self.channels.items()}
-        tb, tr = self.timebase, self.trigger
-        t_cross = _first_crossing(analog[tr.source], h, tr.level, tr.slope)
-        if t_cross is None:
-            return ScopeRecord({}, False, f"no {tr.slope} crossing of {tr.level:g} V on "
-                                          f"{tr.source} in {n_in * h:.4g} s")
-        n_pre = int(round(tr.pre_trigger * tb.record_length))
+        front = self.front_panel(h)
+        analog = np.empty((len(self.channels), n_in))
+        for c, ch in enumerate(self.channels):
+            v = np.ascontiguousarray(inputs[ch], dtype=float) if ch in inputs else np.zeros(n_in)
+            analog[c] = condition(v, front.probe[c], front.ac[c], front.lowpass[c])
+        tb = self.timebase
         phase = rng.uniform(0.0, tb.sample_interval)
-        x_zero = phase - n_pre * tb.sample_interval  # first sample, relative to the trigger
-        t = t_cross + x_zero + tb.sample_interval * np.arange(int(tb.record_length))
-        t_end = (n_in - 1) * h
-        if t[-1] > t_end * (1 + 1e-12):
+        shape = (len(self.channels), int(tb.record_length) if self.noise_floor else 0)
+        noise = rng.standard_normal(shape) if self.noise_floor else np.empty(shape)
+        codes = np.empty((len(self.channels), int(tb.record_length)), np.int8)
+        over = np.empty(len(self.channels), np.bool_)
+        status, t_cross, x_zero = scope_shot(analog, float(h), front.source, front.level, front.rising, phase,
+                                             front.n_pre, tb.sample_interval, front.offset, front.ymult, front.yoff,
+                                             front.sd, noise, float(CODE_MIN), float(CODE_MAX), codes, over)
+        return self.record_of(status, t_cross, x_zero, codes, over, n_in, h)
+
+    def record_of(self, status: int, t_cross: float, x_zero: float, codes, over, n_in: int, h: float) -> ScopeRecord:
+        """The ScopeRecord of one acquisition (acquisition.scope_shot's status and times,
+        codes (channels, samples), over-range flags), or InstrumentError where the record
+        would run past the input of n_in samples every h s."""
+        tb, tr = self.timebase, self.trigger
+        if status == NO_TRIGGER:
+            return ScopeRecord({}, False, f"no {tr.slope} crossing of {tr.level:g} V on {tr.source} in {n_in * h:.4g} s")
+        if status == PAST_INPUT:
+            last = t_cross + x_zero + tb.sample_interval * (int(tb.record_length) - 1)
             raise InstrumentError(
-                f"scope record ends {t[-1]:.4g} s after t = 0 but the input stops at {t_end:.4g} s: "
+                f"scope record ends {last:.4g} s after t = 0 but the input stops at {(n_in - 1) * h:.4g} s: "
                 f"record a longer input or shorten the record")
-        waves = {}
-        for ch, s in self.channels.items():
-            v = at_positions(analog[ch], t / h)  # linear between the input's samples
-            waves[ch] = self._digitise(ch, s, v, x_zero, n_pre, rng)
-        return ScopeRecord(waves, True, None, t_cross)
+        n_pre = int(round(tr.pre_trigger * tb.record_length))
+        waves = {ch: self._waveform(ch, s, codes[c], bool(over[c]), float(x_zero), n_pre)
+                 for c, (ch, s) in enumerate(self.channels.items())}
+        return ScopeRecord(waves, True, None, float(t_cross))
 
-    def _condition(self, v, s: ChannelSettings, h: float):
-        x = v / s.probe  # at the input connector
-        if s.coupling == "AC":
-            x = rc_highpass(x, h, 1.0 / (2 * math.pi * AC_CORNER_HZ))
-        if s.bandwidth is not None:
-            x = lowpass(x, h, s.bandwidth)
-        return x * s.probe  # expressed back at the probe tip, as the scope displays it
+    def front_panel(self, h: float) -> "FrontPanel":
+        """The settings of every displayed channel, the trigger and the converter as the
+        compiled acquisition takes them, for inputs sampled every h s."""
+        chans = list(self.channels.values())
+        ac = np.full((len(chans), 3), np.nan)
+        low = np.full((len(chans), 3), np.nan)
+        for c, s in enumerate(chans):
+            if s.coupling == "AC":
+                ac[c] = highpass_coefficients(h, 1.0 / (2 * math.pi * AC_CORNER_HZ))
+            if s.bandwidth is not None:
+                low[c] = lowpass_coefficients(h, s.bandwidth)
+        tb, tr = self.timebase, self.trigger
+        ymult = np.array([s.y_multiplier for s in chans])
+        probe = np.array([s.probe for s in chans], dtype=float)
+        sd = (self.noise_floor * probe / ymult / math.sqrt(self.averages) if self.noise_floor
+              else np.zeros(len(chans)))
+        return FrontPanel(probe, ac, low, list(self.channels).index(tr.source), float(tr.level), tr.slope == "rising",
+                          int(round(tr.pre_trigger * tb.record_length)),
+                          np.array([float(s.offset) for s in chans]), ymult,
+                          np.array([s.position * CODES_PER_DIV for s in chans]), sd)
 
-    def _digitise(self, ch, s: ChannelSettings, v, x_zero, n_pre, rng) -> Waveform:
-        ymult = s.y_multiplier
-        yoff = s.position * CODES_PER_DIV
-        sd, noise = 0.0, np.empty(0)
-        if self.noise_floor:  # the mean of N acquisitions' noise: sd / sqrt(N)
-            sd = self.noise_floor * s.probe / ymult / math.sqrt(self.averages)
-            noise = rng.standard_normal(v.size)
-        # codes = round((v - offset) / ymult + yoff + sd * noise), clipped to 8 bits
-        codes, overrange = quantise(np.ascontiguousarray(v, dtype=float), float(s.offset), ymult, yoff, sd, noise,
-                                    float(CODE_MIN), float(CODE_MAX))
-        pre = Preamble(points=v.size, x_increment=self.timebase.sample_interval, x_zero=x_zero,
-                       trigger_index=n_pre, y_multiplier=ymult, y_offset=yoff, y_zero=s.offset,
-                       byte_count=1,
+    def _waveform(self, ch, s: ChannelSettings, codes, overrange: bool, x_zero: float, n_pre: int) -> Waveform:
+        pre = Preamble(points=codes.size, x_increment=self.timebase.sample_interval, x_zero=x_zero,
+                       trigger_index=n_pre, y_multiplier=s.y_multiplier, y_offset=s.position * CODES_PER_DIV,
+                       y_zero=s.offset, byte_count=1,
                        waveform_id=(f"{ch}, {s.coupling} coupling, {s.volts_per_div:g}V/div, "
-                                    f"{self.timebase.sample_interval * v.size / 10:.4g}s/div, {v.size} points, "
+                                    f"{self.timebase.sample_interval * codes.size / 10:.4g}s/div, {codes.size} points, "
                                     f"{'Sample' if self.mode == 'sample' else f'Average {self.averages}'} mode"),
                        extra={"volts_per_div": s.volts_per_div, "position_div": s.position,
                               "coupling": s.coupling, "bandwidth_Hz": s.bandwidth, "probe": s.probe,
@@ -177,13 +192,21 @@ class Oscilloscope:
         return Waveform(ch, pre, codes=codes, overrange=overrange)
 
 
-def _first_crossing(x, h, level, slope):
-    """Time (s) of the first crossing of ``level`` with ``slope``, linearly interpolated."""
-    if slope == "rising":
-        idx = np.flatnonzero((x[:-1] < level) & (x[1:] >= level))
-    else:
-        idx = np.flatnonzero((x[:-1] > level) & (x[1:] <= level))
-    if idx.size == 0:
-        return None
-    i = idx[0]
-    return (i + (level - x[i]) / (x[i + 1] - x[i])) * h
+@dataclass(frozen=True, eq=False)
+class FrontPanel:
+    """An oscilloscope's settings as arrays, one row per displayed channel (in display
+    order): probe attenuation, AC coupling and bandwidth limit ((b0, b1, a1) one-pole
+    coefficients, nan: off), the trigger (source channel index, level V, rising, pre-trigger
+    samples) and the converter (offset V, V per code, code offset, noise in codes)."""
+
+    probe: np.ndarray
+    ac: np.ndarray
+    lowpass: np.ndarray
+    source: int
+    level: float
+    rising: bool
+    n_pre: int
+    offset: np.ndarray
+    ymult: np.ndarray
+    yoff: np.ndarray
+    sd: np.ndarray

@@ -21,17 +21,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .analysis import (
-    MIN_BASELINE,
-    PeakRules,
-    find_pulses,
-    invert_rc,
-    leading,
-    noise_level,
-    refined,
-    remove_baseline,
-    xcorr_delay,
-)
+from ._kernels import pulses
+from ._kernels.pulses import AMPLITUDE, BASE_WIDTH, FOUND, FWHM, LAG, PEAK, RISE, STATUS, TIME, index_of
+from .analysis import MIN_BASELINE, PeakRules, Pulse, find_pulses, leading, noise_level
 from .errors import InstrumentError, check
 from .plausibility import Limits, record_doubt, speed_doubt
 from .records import ScopeRecord
@@ -94,10 +86,8 @@ def record_forces(record: ScopeRecord, setup: Setup):
             t, base = w.time(), (p.points, p.x_increment, p.x_zero)
         elif (p.points, p.x_increment, p.x_zero) != base:
             raise InstrumentError(f"channel {g.channel} has another time base than the first gauge")
-        v = remove_baseline(w.volts(), w.preamble.trigger_index)
-        if g.tau_s is not None:
-            v = invert_rc(v, h, g.tau_s)
-        out[role] = v / g.sensitivity_V_per_N
+        out[role] = pulses.conditioned(np.ascontiguousarray(w.volts(), dtype=float), int(w.preamble.trigger_index),
+                                       float(h), float(g.tau_s or 0.0), float(g.sensitivity_V_per_N))
     return t, out
 
 
@@ -127,16 +117,49 @@ def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True
     train=False leaves the solitary train uncounted (pulses None): studies that need only
     the leading pulse skip the wall channel and two peak searches. noise: role -> noise (N;
     None: unmeasurable, and no pulse is accepted) for the SNR rule; None: noise-free
-    signals (the truth), no SNR rule."""
+    signals (the truth), no SNR rule. The leading pulses and their delay come from the
+    compiled _kernels/pulses.leading_pair, as in a study's batched analysis."""
+    sigma = {r: math.nan if noise is None or noise.get(r) is None else float(noise[r]) for r in ("upper", "lower")}
+    answer = np.empty(pulses.ANSWER)
+    c = np.ascontiguousarray
+    pulses.leading_pair(c(t, dtype=float), c(forces["upper"], dtype=float), c(forces["lower"], dtype=float),
+                        sigma["upper"], sigma["lower"], setup.rules.as_tuple(), answer)
+    return report_of(answer, t, forces, setup, train, noise)
+
+
+def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, train: bool,
+              noise: dict | None) -> Report:
+    """The Report of leading_pair's answer (its layout in _kernels/pulses.py): every figure
+    it allows, a reason for each it does not, the plausibility rules, and with ``train``
+    the solitary train counted on ``forces``."""
     rules, rep = setup.rules, Report(beta=setup.beta, static_force_N=setup.static_force_N)
-    ch = {role: getattr(setup, role).channel for role in ("upper", "lower")}
-    if np.array_equal(forces["upper"], forces["lower"]):
+    ch = {r: getattr(setup, r).channel for r in ("upper", "lower")}
+    if answer[STATUS] == pulses.SAME_RECORD:
         return rep.refuse(f"{ch['upper']} and {ch['lower']} hold the same record (the same file twice?)")
-    problems = []
-    up, low = (_leading_pulse(t, forces[role], rules, ch[role], noise, role, rep, problems) for role in ("upper", "lower"))
+    problems, lead = [], {}
+    for k, r in enumerate(("upper", "lower")):
+        sigma = None if noise is None else noise.get(r)
+        if noise is not None and sigma is None:
+            problems.append(f"{ch[r]}: fewer than {MIN_BASELINE} samples before the trigger: the noise, and so "
+                            f"whether a pulse stands above it, cannot be measured")
+            continue
+        peak = float(answer[index_of(k, PEAK)])
+        if sigma is not None:
+            rep.noise[ch[r]], rep.snr[ch[r]] = sigma, (peak / sigma if sigma > 0 else math.inf)
+        if answer[index_of(k, FOUND)] != 1.0:
+            if sigma is not None and peak < rules.snr * sigma:
+                problems.append(f"{ch[r]}: no pulse stands {rules.snr:g} times above the pre-trigger noise "
+                                f"({sigma:.3g}): its highest excursion is {rep.snr[ch[r]]:.3g} times the noise")
+            else:
+                problems.append(f"{ch[r]}: no pulse passes the peak rules (height, prominence, width)")
+            continue
+        lead[r] = Pulse(*(float(answer[index_of(k, x)]) for x in (TIME, AMPLITUDE, FWHM, BASE_WIDTH, RISE)))
+        if sigma is not None and sigma > 0:
+            rep.snr[ch[r]] = lead[r].amplitude / sigma
     if problems:
         return rep.refuse("; ".join(problems))
-    if low.time <= up.time:
+    up, low = lead["upper"], lead["lower"]
+    if answer[STATUS] == pulses.SWAPPED:
         return rep.refuse(f"the lower gauge's pulse ({ch['lower']}, {low.time * 1e6:.4g} us) comes before or with "
                           f"the upper gauge's ({ch['upper']}, {up.time * 1e6:.4g} us): channels swapped?")
     rep.leading = {"upper": dict(vars(up)), "lower": dict(vars(low))}  # a Pulse holds floats only
@@ -151,7 +174,7 @@ def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True
     if doubt:
         return rep.refuse(f"implausible speed: {doubt}", SPEED_FIGURES)
     rep.speed_m_per_s = distance / flight
-    lag = xcorr_delay(t, forces["upper"], up, forces["lower"], low)
+    lag = float(answer[LAG])
     rep.give("speed_xcorr_m_per_s", distance / lag if lag > 0 else math.nan,
              "the cross-correlation of the leading pulses found no positive delay")
     rep.give("width_diameters", up.fwhm * rep.speed_m_per_s / setup.bead_diameter_m, rep.reasons.get("duration_s", ""))
@@ -162,32 +185,6 @@ def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True
     else:
         rep.refuse("the train was not counted (leading pulse only)", ("pulses",))
     return rep
-
-
-def _leading_pulse(t, f, rules: PeakRules, channel: str, noise, role: str, rep: Report, problems: list):
-    """The refined leading pulse of one channel, or None with the reason added to problems;
-    its noise and SNR go into rep."""
-    peak = float(np.max(f)) if f.size else 0.0
-    sigma = None if noise is None else noise.get(role)
-    if noise is not None and sigma is None:
-        problems.append(f"{channel}: fewer than {MIN_BASELINE} samples before the trigger: the noise, and so "
-                        f"whether a pulse stands above it, cannot be measured")
-        return None
-    floor = _snr_floor(rules, peak, sigma)
-    if sigma is not None:
-        rep.noise[channel], rep.snr[channel] = sigma, (peak / sigma if sigma > 0 else math.inf)
-    coarse = leading(find_pulses(t, f, rules, floor=floor, refine=False), rules)
-    if coarse is None:
-        if sigma is not None and peak < rules.snr * sigma:
-            problems.append(f"{channel}: no pulse stands {rules.snr:g} times above the pre-trigger noise "
-                            f"({sigma:.3g}): its highest excursion is {rep.snr[channel]:.3g} times the noise")
-        else:
-            problems.append(f"{channel}: no pulse passes the peak rules (height, prominence, width)")
-        return None
-    pulse = refined(t, f, coarse, rules)
-    if sigma is not None and sigma > 0:
-        rep.snr[channel] = pulse.amplitude / sigma
-    return pulse
 
 
 def _snr_floor(rules: PeakRules, peak: float, sigma: float | None) -> float | None:

@@ -1,0 +1,134 @@
+"""The instruments of one shot, compiled (numba): a gauge's signal chain and the
+oscilloscope's acquisition. PiezoGauge.read and Oscilloscope.acquire run them for one shot;
+the batched instruments (instruments/batch.py) run them for every shot of a study in one
+compiled loop: the same code, so the same bits. Random draws come in as arrays, drawn
+beforehand from each shot's generator in a fixed order (``shot_draws``).
+"""
+import math
+
+import numpy as np
+from numba import prange
+
+from instruments.jit import jit
+
+from .filters import one_pole
+from .quantiser import quantise
+from .resample import at_positions
+
+OK, NO_TRIGGER, PAST_INPUT = 0, 1, 2  # how an acquisition ended
+
+
+@jit
+def gauge_signal(force, h, shift, scale, b0, b1, a1, noise_sd, z):
+    """Volts of a piezo gauge (frontend.rc_highpass, gauges.PiezoGauge): the force (N,
+    sampled every h s) delayed by ``shift`` s, times ``scale`` (V/N), through the one-pole
+    high-pass (b0, b1, a1), plus noise_sd x z (z: standard normal draws, or empty)."""
+    x = scale * at_positions(force, np.arange(force.shape[0]) - shift / h)
+    y = one_pole(x, b0, b1, a1, x[0], False)
+    if z.shape[0]:
+        y = y + noise_sd * z
+    return y
+
+
+@jit
+def condition(v, probe, ac, lowpass):
+    """A scope channel's analog front end on the volts at the probe tip: the input divided
+    by the probe, AC coupling and the bandwidth limit (each a one-pole (b0, b1, a1); a1 nan:
+    off), expressed back at the probe tip."""
+    x = v / probe
+    if not math.isnan(ac[2]):
+        x = one_pole(x, ac[0], ac[1], ac[2], x[0], False)
+    if not math.isnan(lowpass[2]):
+        x = one_pole(x, lowpass[0], lowpass[1], lowpass[2], x[0], True)
+    return x * probe
+
+
+@jit
+def first_crossing(x, h, level, rising):
+    """Time (s) of the first crossing of ``level``, rising or falling, linearly
+    interpolated; nan where there is none."""
+    for i in range(x.shape[0] - 1):
+        if (x[i] < level and x[i + 1] >= level) if rising else (x[i] > level and x[i + 1] <= level):
+            return (i + (level - x[i]) / (x[i + 1] - x[i])) * h
+    return math.nan
+
+
+@jit
+def scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult, yoff, sd, z, lo, hi,
+               codes, over):
+    """One acquisition of conditioned channels ``analog`` (channels, samples every h s):
+    the edge trigger on channel ``source``, the record of codes.shape[1] samples every dt s
+    from n_pre samples before it (plus the clock's phase), read linearly between input
+    samples, through the 8-bit converter (quantise) with the scope's noise sd x z[c]
+    (z[c] empty: none). Fills codes (channels, samples) and over; returns (status, time of
+    the trigger crossing s, time of the first sample after the trigger s)."""
+    t_cross = first_crossing(analog[source], h, level, rising)
+    if math.isnan(t_cross):
+        return NO_TRIGGER, t_cross, math.nan
+    x_zero = phase - n_pre * dt
+    t = t_cross + x_zero + dt * np.arange(codes.shape[1])
+    if t[-1] > (analog.shape[1] - 1) * h * (1 + 1e-12):
+        return PAST_INPUT, t_cross, x_zero
+    for c in range(analog.shape[0]):
+        codes[c], over[c] = quantise(at_positions(analog[c], t / h), offset[c], ymult[c], yoff[c], sd[c], z[c],
+                                     lo, hi)
+    return OK, t_cross, x_zero
+
+
+@jit
+def _one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, wired, probe, ac, lowpass, source, level,
+              rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over):
+    n = force.shape[1]
+    analog = np.empty((wired.shape[0], n))
+    for c in range(wired.shape[0]):
+        g = wired[c]
+        if g >= 0:
+            v = gauge_signal(force[g], h, shift[g], scale[g], gauge_filter[g, 0], gauge_filter[g, 1],
+                             gauge_filter[g, 2], noise_sd[g], z_gauge[g])
+        else:
+            v = np.zeros(n)
+        analog[c] = condition(v, probe[c], ac[c], lowpass[c])
+    return scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi,
+                      codes, over)
+
+
+@jit(parallel=True)
+def shots(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, wired, probe, ac, lowpass, source, level,
+          rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over, status, times):
+    """Every shot s of a batch: gauge g reads force[s, g] (N, every h s) delayed by
+    shift[s, g] s with gain scale[s, g] V/N, its high-pass gauge_filter[g] and noise
+    noise_sd[g] z_gauge[s, g]; scope channel c displays gauge wired[c] (-1: nothing), with
+    probe[c], ac[c] and lowpass[c] (condition), offset, ymult, yoff (the converter) and
+    noise sd[c] z_scope[s, c]; the trigger on channel ``source`` at ``level`` V, the clock's
+    phase[s] s, n_pre pre-trigger samples every dt s. Fills codes (shots, channels,
+    samples), over (shots, channels), status (shots) and times (shots, 2: the trigger
+    crossing and the first sample after it, s)."""
+    for s in prange(force.shape[0]):
+        st, t_cross, x_zero = _one_shot(force[s], h, shift[s], scale[s], gauge_filter, noise_sd, z_gauge[s], wired,
+                                        probe, ac, lowpass, source, level, rising, phase[s], n_pre, dt, offset,
+                                        ymult, yoff, sd, z_scope[s], lo, hi, codes[s], over[s])
+        status[s] = st
+        times[s, 0] = t_cross
+        times[s, 1] = x_zero
+
+
+@jit
+def shot_draws(g, calibration_error, misalignment_sd, noisy, draws, z_gauge, phase_span, scope_noisy, z_scope):
+    """One shot's random draws from its generator g, in the order a shot takes them: for
+    each gauge (the bead gauges by name, then the wall sensor) its gain factor
+    1 + calibration_error z and position error misalignment_sd z (draws[:, 0], draws[:, 1]),
+    then its noise (z_gauge[k], where noisy[k]); then the scope's clock phase
+    uniform(0, phase_span) (returned) and each displayed channel's noise (z_scope, where
+    scope_noisy). numba's Generator gives numpy's numbers, draw for draw."""
+    for k in range(draws.shape[0]):
+        draws[k, 0] = 1.0 + calibration_error[k] * g.standard_normal()
+        draws[k, 1] = misalignment_sd[k] * g.standard_normal()
+        if noisy[k]:
+            for i in range(z_gauge.shape[1]):
+                z_gauge[k, i] = g.standard_normal()
+    phase = g.uniform(0.0, phase_span)
+    if scope_noisy:
+        for c in range(z_scope.shape[0]):
+            for i in range(z_scope.shape[1]):
+                z_scope[c, i] = g.standard_normal()
+    return phase

@@ -1,0 +1,212 @@
+"""The analysis of one pulse pair, compiled (numba): conditioning of a channel, its noise,
+its pulses, the leading pulse's parabola and widths, the cross-correlation delay. The
+pipeline (instruments/pipeline.py) calls these for one record, and the batched analysis
+(instruments/batch.py) for every shot of a study in one compiled loop: the same code, so
+the same bits.
+"""
+import math
+
+import numpy as np
+
+from instruments.jit import jit
+
+from .crossings import level_bracket
+from .filters import undo_highpass
+from .parabola import parabola
+from .peaks import local_maxima, thin_by_distance, widths_at
+from .prominence import prominence_bases
+
+MIN_BASELINE = 16  # pre-trigger samples needed to measure the noise (the MAD to about 1/3)
+MAD_TO_SD = 1.4826  # the standard deviation of Gaussian noise over its median absolute deviation
+
+# the layout of leading_pair's answer
+OK, SAME_RECORD, NO_PULSE, SWAPPED = 0, 1, 2, 3
+STATUS, LAG = 0, 15
+PEAK, FOUND, TIME, AMPLITUDE, FWHM, BASE_WIDTH, RISE = range(7)
+ANSWER = 16
+
+
+@jit
+def index_of(r, field):
+    """Index in leading_pair's answer of ``field`` of role r (0: upper gauge, 1: lower)."""
+    return 1 + 7 * r + field
+
+
+@jit
+def baseline_mean(y, n_pre):
+    """Mean of the first max(n_pre, 10) samples of y (the pre-trigger baseline)."""
+    n = min(max(n_pre, 10), y.shape[0])
+    s = 0.0
+    for k in range(n):
+        s += y[k]
+    return s / n if n else math.nan
+
+
+@jit
+def _median(x):
+    s = np.sort(x)
+    n = s.shape[0]
+    return s[n // 2] if n % 2 else (s[n // 2 - 1] + s[n // 2]) / 2.0
+
+
+@jit
+def noise_level(y, n_pre, step):
+    """1.4826 x the median absolute deviation of the first n_pre samples of y, never below
+    step / sqrt(12); nan with fewer than MIN_BASELINE samples (analysis.noise_level)."""
+    if n_pre < MIN_BASELINE:
+        return math.nan
+    pre = y[:n_pre]
+    centre = _median(pre)
+    mad = MAD_TO_SD * _median(np.abs(pre - centre))
+    return max(mad, abs(step) / math.sqrt(12.0))
+
+
+@jit
+def conditioned(volts, n_pre, h, tau, sensitivity):
+    """Dynamic force (N) of a channel: volts less their pre-trigger mean, the RC high-pass
+    of time constant tau (s; 0: none) undone, over the sensitivity (V/N)."""
+    v = volts - baseline_mean(volts, n_pre)
+    if tau > 0.0:
+        v = undo_highpass(v, h, tau)
+    return v / sensitivity
+
+
+@jit
+def candidates(f, height, min_prominence, spacing, min_width):
+    """Indices of f's pulses by find_peaks' rules, in time order: local maxima at least
+    ``height`` high, thinned to ``spacing`` samples from the highest down (equal heights:
+    the later first), with at least ``min_prominence`` of prominence and ``min_width``
+    samples of width at half prominence. Nothing if f never rises above 0."""
+    if f.shape[0] == 0 or np.max(f) <= 0.0:
+        return np.empty(0, np.int64)
+    idx = local_maxima(f)
+    idx = idx[f[idx] >= height]
+    if spacing > 1 and idx.shape[0]:
+        idx = idx[thin_by_distance(idx, np.argsort(f[idx], kind="mergesort"), float(spacing))]
+    left, right = prominence_bases(f, height)
+    left, right = left[idx], right[idx]
+    prominence = f[idx] - np.maximum(f[left], f[right])
+    keep = prominence >= min_prominence
+    idx, prominence, left, right = idx[keep], prominence[keep], left[keep], right[keep]
+    if min_width > 0.0 and idx.shape[0]:
+        idx = idx[widths_at(f, idx, 0.5, prominence, left, right) >= min_width]
+    return idx
+
+
+@jit
+def _vertex(t, f, i, top):
+    """Time and height of the least-squares parabola through the contiguous samples
+    within ``top`` of f[i]; the sample itself where no parabola opens downwards there."""
+    level = f[i] * (1.0 - top)
+    lo, hi = i, i
+    while lo > 0 and f[lo - 1] >= level:
+        lo -= 1
+    while hi < f.shape[0] - 1 and f[hi + 1] >= level:
+        hi += 1
+    lo, hi = min(lo, i - 1), max(hi, i + 1)
+    if lo < 0 or hi >= f.shape[0]:
+        return t[i], f[i]
+    x = np.arange(lo - i, hi - i + 1).astype(np.float64)
+    a, b, c = parabola(x, f[lo:hi + 1])
+    if not a < 0.0:
+        return t[i], f[i]
+    xv = -b / (2.0 * a)
+    if not x[0] <= xv <= x[-1]:
+        return t[i], f[i]
+    return t[i] + xv * (t[1] - t[0]), c - b * b / (4.0 * a)
+
+
+@jit
+def crossings(t, f, i, level):
+    """Times (s) where f crosses ``level`` before and after sample i (linear; nan if never)."""
+    left, right = level_bracket(f, i, level)
+    tl = math.nan if left < 0 else t[left] + (level - f[left]) / (f[left + 1] - f[left]) * (t[left + 1] - t[left])
+    tr = math.nan if right < 0 else t[right - 1] + (f[right - 1] - level) / (f[right - 1] - f[right]) * (
+        t[right] - t[right - 1])
+    return tl, tr
+
+
+@jit
+def refine(t, f, i, top):
+    """(time, amplitude, FWHM, 1% width, rise from 1%) of the pulse at sample i."""
+    time, amp = _vertex(t, f, i, top)
+    h0, h1 = crossings(t, f, i, 0.5 * amp)
+    b0, b1 = crossings(t, f, i, 0.01 * amp)
+    return time, amp, h1 - h0, b1 - b0, time - b0
+
+
+@jit
+def xcorr_lag(t, fa, time_a, fwhm_a, fb, time_b):
+    """Delay (s) of pulse b after pulse a: a's window one FWHM either side of its maximum,
+    searched in b's window twice as wide, a parabola through the correlation peak."""
+    h = t[1] - t[0]
+    half = fwhm_a
+    if not (math.isfinite(half) and half > 0.0):
+        return math.nan
+    ia0, ia1 = np.searchsorted(t, time_a - half), np.searchsorted(t, time_a + half)
+    ib0, ib1 = np.searchsorted(t, time_b - 2.0 * half), np.searchsorted(t, time_b + 2.0 * half)
+    m, nb = ia1 - ia0, ib1 - ib0
+    if m < 3 or nb <= m:
+        return math.nan
+    c = np.empty(nb - m + 1)
+    for k in range(nb - m + 1):
+        s = 0.0
+        for j in range(m):
+            s += fb[ib0 + k + j] * fa[ia0 + j]
+        c[k] = s
+    k = int(np.argmax(c))
+    shift = 0.0
+    if 0 < k < c.shape[0] - 1:
+        den = c[k - 1] - 2.0 * c[k] + c[k + 1]
+        shift = 0.5 * (c[k - 1] - c[k + 1]) / den if den != 0.0 else 0.0
+    return (ib0 + k + shift - ia0) * h
+
+
+@jit
+def _leading(t, f, sigma, rules, r, out):
+    """Role r's leading pulse into out (leading_pair's layout); True where found."""
+    height_frac, prominence_frac, top, lead, snr, distance, width = rules
+    h = t[1] - t[0]
+    peak = np.max(f) if f.shape[0] else 0.0
+    floor = height_frac * peak if math.isnan(sigma) else max(height_frac * peak, snr * sigma)
+    out[index_of(r, PEAK)] = peak
+    idx = candidates(f, floor, prominence_frac * peak, int(np.rint(max(distance, 0.5 * width) / h)), width / h)
+    out[index_of(r, FOUND)] = 0.0
+    if idx.shape[0] == 0:
+        return False
+    big = np.max(f[idx])
+    first = idx[0]
+    for i in idx:
+        if f[i] >= lead * big:
+            first = i
+            break
+    i = int(np.rint((t[first] - t[0]) / (t[1] - t[0])))
+    time, amp, fwhm, base, rise = refine(t, f, i, top)
+    out[index_of(r, FOUND)] = 1.0
+    out[index_of(r, TIME)], out[index_of(r, AMPLITUDE)], out[index_of(r, FWHM)] = time, amp, fwhm
+    out[index_of(r, BASE_WIDTH)], out[index_of(r, RISE)] = base, rise
+    return True
+
+
+@jit
+def leading_pair(t, up, low, sigma_up, sigma_low, rules, out):
+    """The leading pulses of the upper and lower gauges' forces (time t, s) and their delay
+    by cross-correlation, into out (ANSWER floats: STATUS, each role's PEAK, FOUND, TIME,
+    AMPLITUDE, FWHM, BASE_WIDTH, RISE at index_of(r, field), LAG). sigma: each channel's noise
+    (nan: unknown, no SNR rule). rules: PeakRules' (height, prominence, top, lead, snr,
+    distance, width) as a tuple of floats. STATUS: OK, SAME_RECORD,
+    NO_PULSE (FOUND says which), SWAPPED (the lower pulse first)."""
+    out[:] = math.nan
+    if up.shape[0] == low.shape[0] and np.all(up == low):
+        out[STATUS] = SAME_RECORD
+        return
+    found_up = _leading(t, up, sigma_up, rules, 0, out)
+    found_low = _leading(t, low, sigma_low, rules, 1, out)
+    if not (found_up and found_low):
+        out[STATUS] = NO_PULSE
+        return
+    if out[index_of(1, TIME)] <= out[index_of(0, TIME)]:
+        out[STATUS] = SWAPPED
+        return
+    out[STATUS] = OK
+    out[LAG] = xcorr_lag(t, up, out[index_of(0, TIME)], out[index_of(0, FWHM)], low, out[index_of(1, TIME)])
