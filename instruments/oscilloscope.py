@@ -147,7 +147,8 @@ class Oscilloscope:
         would run past the input of n_in samples every h s."""
         tb, tr = self.timebase, self.trigger
         if status == NO_TRIGGER:
-            return ScopeRecord({}, False, f"no {tr.slope} crossing of {tr.level:g} V on {tr.source} in {n_in * h:.4g} s")
+            return ScopeRecord({}, False,
+                               f"no {tr.slope} crossing of {tr.level:g} V on {tr.source} in {n_in * h:.4g} s")
         if status == PAST_INPUT:
             last = t_cross + x_zero + tb.sample_interval * (int(tb.record_length) - 1)
             raise InstrumentError(
