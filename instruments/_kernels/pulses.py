@@ -43,21 +43,14 @@ def baseline_mean(y, n_pre):
 
 
 @jit
-def _median(x):
-    s = np.sort(x)
-    n = s.shape[0]
-    return s[n // 2] if n % 2 else (s[n // 2 - 1] + s[n // 2]) / 2.0
-
-
-@jit
 def noise_level(y, n_pre, step):
     """1.4826 x the median absolute deviation of the first n_pre samples of y, never below
     step / sqrt(12); nan with fewer than MIN_BASELINE samples (analysis.noise_level)."""
     if n_pre < MIN_BASELINE:
         return math.nan
     pre = y[:n_pre]
-    centre = _median(pre)
-    mad = MAD_TO_SD * _median(np.abs(pre - centre))
+    centre = np.median(pre)
+    mad = MAD_TO_SD * np.median(np.abs(pre - centre))
     return max(mad, abs(step) / math.sqrt(12.0))
 
 
@@ -148,12 +141,12 @@ def xcorr_lag(t, fa, time_a, fwhm_a, fb, time_b):
     m, nb = ia1 - ia0, ib1 - ib0
     if m < 3 or nb <= m:
         return math.nan
-    c = np.empty(nb - m + 1)
-    for k in range(nb - m + 1):
-        s = 0.0
-        for j in range(m):
-            s += fb[ib0 + k + j] * fa[ia0 + j]
-        c[k] = s
+    c = np.zeros(nb - m + 1)
+    for j in range(m):  # every lag at once, each summed over j in order (the loop over lags vectorises)
+        a = fa[ia0 + j]
+        b = fb[ib0 + j:ib0 + j + c.shape[0]]
+        for k in range(c.shape[0]):
+            c[k] += b[k] * a
     k = int(np.argmax(c))
     shift = 0.0
     if 0 < k < c.shape[0] - 1:

@@ -52,10 +52,17 @@ def wave_speed(gauges: dict, h: float) -> float | None:
     if len(gauges) < 2:
         return None
     g = sorted(gauges.values(), key=lambda t: t.position_m)
-    t_top, t_bottom = first_peak_time(g[0].average_force, h), first_peak_time(g[-1].average_force, h)
+    return speed_between(g[0].position_m, g[0].average_force, g[-1].position_m, g[-1].average_force, h)
+
+
+def speed_between(x_top: float, f_top: np.ndarray, x_bottom: float, f_bottom: np.ndarray, h: float) -> float | None:
+    """Leading-pulse speed (m/s) between two beads at x_top and x_bottom (m) from the first
+    peaks of their forces (N, every h s); None where either has none or they come in the
+    wrong order."""
+    t_top, t_bottom = first_peak_time(f_top, h), first_peak_time(f_bottom, h)
     if t_top is None or t_bottom is None or t_bottom <= t_top:
         return None
-    return (g[-1].position_m - g[0].position_m) / (t_bottom - t_top)
+    return (x_bottom - x_top) / (t_bottom - t_top)
 
 
 def first_peak_time(f: np.ndarray, h: float) -> float | None:

@@ -18,12 +18,69 @@ import numpy as np
 
 from rig.errors import invalid
 from rig.memo import computed_once
-from rig.model.contact import contact_constant, static_overlaps
 from rig.model.contact import contact_law as lookup_law
+from rig.model.contact import hertz_constant, static_overlaps
 from rig.model.parts import Bead, Striker, Wall
 from rig.units import quantity
 
 STANDARD_GRAVITY = 9.80665  # m/s^2
+
+
+def contact_constants_of(chain: "Chain", E=None, nu=None) -> np.ndarray:
+    """Hertz constants (N/m^1.5) of contacts 0..n_beads of ``chain`` (last axis; nan where
+    there is no partner); E, nu (Pa, -; arrays of shots, or None): the elastic constants of
+    its beads' material (every bead but a magnetic one) in place of the material's own."""
+    b = chain.beads
+    plain = next((x.material for x in b if x.kind != "magnetic"), None)
+
+    def elastic(m):
+        if m is plain and E is not None:
+            return np.asarray(E, dtype=float), np.asarray(nu, dtype=float)
+        return m.E, m.nu
+
+    shape = () if E is None else np.shape(E)
+    A = np.full(shape + (chain.n_beads + 1,), np.nan)
+    if chain.striker is not None:
+        A[..., 0] = hertz_constant(*elastic(chain.striker.material), math.inf, *elastic(b[0].material), b[0].radius)
+    pairs = {}  # a chain repeats the same pair of beads many times
+    for k in range(1, chain.n_beads):
+        up, down = b[k - 1], b[k]
+        key = (id(up.material), up.diameter, id(down.material), down.diameter)
+        if key not in pairs:
+            pairs[key] = hertz_constant(*elastic(up.material), up.radius, *elastic(down.material), down.radius)
+        A[..., k] = pairs[key]
+    if chain.wall is not None:
+        A[..., -1] = hertz_constant(*elastic(b[-1].material), b[-1].radius, *elastic(chain.wall.material), math.inf)
+    return A
+
+
+def static_forces_of(masses, gravity: float, top_force) -> np.ndarray:
+    """Static contact forces (N) of contacts 0..n (last axis) of chains of bead masses
+    ``masses`` (kg, (..., n)): F_k = gravity x the mass of beads 0..k-1 + the top force;
+    contact 0 (the striker's) carries nothing."""
+    masses = np.asarray(masses, dtype=float)
+    F = np.zeros(masses.shape[:-1] + (masses.shape[-1] + 1,))
+    F[..., 1:] = gravity * np.cumsum(masses, axis=-1) + np.asarray(top_force, dtype=float)[..., None]
+    return F
+
+
+def static_overlaps_of(A, F) -> np.ndarray:
+    """Static overlaps (m) d0 = (F/A)^(2/3) of contacts of constants A carrying F (N);
+    0 where a contact carries nothing or has no partner (A nan)."""
+    d0 = np.zeros_like(F)
+    ok = np.isfinite(A) & (F > 0)
+    d0[ok] = static_overlaps(A[ok], F[ok])
+    return d0
+
+
+def equilibrium_positions_of(radii, d0) -> np.ndarray:
+    """Bead centres (m, down from bead 0's centre; last axis) of beads of ``radii`` (m)
+    resting with static overlaps d0 ((..., n + 1))."""
+    n = len(radii)
+    x = np.zeros(np.shape(d0)[:-1] + (n,))
+    for k in range(1, n):
+        x[..., k] = x[..., k - 1] + radii[k - 1] + radii[k] - d0[..., k]
+    return x
 
 
 @dataclass(frozen=True)
@@ -124,54 +181,28 @@ class Chain:
         return self._cached("A", self._contact_constants)
 
     def _contact_constants(self) -> np.ndarray:
-        b = self.beads
-        A = np.full(self.n_beads + 1, np.nan)
-        if self.striker is not None:
-            A[0] = contact_constant(self.striker.material, math.inf, b[0].material, b[0].radius)
-        pairs = {}  # a chain repeats the same pair of beads many times
-        for k in range(1, self.n_beads):
-            up, down = b[k - 1], b[k]
-            key = (id(up.material), up.diameter, id(down.material), down.diameter)
-            if key not in pairs:
-                pairs[key] = contact_constant(up.material, up.radius, down.material, down.radius)
-            A[k] = pairs[key]
-        if self.wall is not None:
-            A[-1] = contact_constant(b[-1].material, b[-1].radius, self.wall.material, math.inf)
-        return A
+        return contact_constants_of(self)
 
     def static_forces(self) -> np.ndarray:
         """Static contact forces (N) of contacts 0..n_beads: weight above plus top force."""
         return self._cached("F0", self._static_forces)
 
     def _static_forces(self) -> np.ndarray:
-        F = np.zeros(self.n_beads + 1)
-        F[1:] = self.gravity * np.cumsum(self.masses) + self.initial_top_force
-        return F
+        return static_forces_of(self.masses, self.gravity, self.initial_top_force)
 
     def static_overlaps(self) -> np.ndarray:
         """Static overlaps (m), d0 = (F/A)^(2/3); 0 where a contact carries nothing."""
         return self._cached("d0", self._static_overlaps)
 
     def _static_overlaps(self) -> np.ndarray:
-        A = self.contact_constants()
-        F = self.static_forces()
-        d0 = np.zeros_like(F)
-        ok = np.isfinite(A) & (F > 0)
-        d0[ok] = static_overlaps(A[ok], F[ok])
-        return d0
+        return static_overlaps_of(self.contact_constants(), self.static_forces())
 
     def equilibrium_positions(self) -> np.ndarray:
         """Bead centres at equilibrium (m, down from bead 0's centre)."""
         return self._cached("x", self._equilibrium_positions)
 
     def _equilibrium_positions(self) -> np.ndarray:
-        r = [bead.radius for bead in self.beads]
-        d0 = self.static_overlaps().tolist()
-        x = [0.0] * self.n_beads
-        for k in range(1, self.n_beads):
-            x[k] = x[k - 1] + r[k - 1] + r[k] - d0[k]
-        x = np.array(x)
-        return x
+        return equilibrium_positions_of([bead.radius for bead in self.beads], self.static_overlaps())
 
     def wall_position(self) -> float:
         """The wall surface (m, down from bead 0's centre); nan without a wall."""

@@ -16,9 +16,10 @@ from rig.errors import RigError, invalid
 from rig.solver.kernels.ensemble import integrate_ensemble
 from rig.solver.methods import DEFAULT_METHOD
 from rig.solver.methods import method as get_method
+from rig.solver.problem import ProblemArrays
 from rig.solver.run import check_interval, time_grid
 from rig.solver.saveat import SaveAt
-from rig.solver.solution import KernelReport, SolverStats, Status
+from rig.solver.solution import KernelReport, SolverStats
 from rig.solver.stepsize import Stepping
 
 
@@ -50,42 +51,45 @@ class EnsembleSolution:
                            r.wall_impulse_Ns, accuracy, estimate, "study pilot" if estimate is not None else "none")
 
 
-def solve_ensemble(problems: list, t_end: float, *, save: SaveAt, dt: float | Stepping,
+def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping,
                    method: str = DEFAULT_METHOD, width: int | None = None) -> EnsembleSolution:
-    """Integrate every problem with the same stepping ``dt`` (a step in s, or a Stepping)
-    to ``t_end`` (s), recording what ``save`` names for each shot. ``width``: shots per
-    chunk (default: the batch shared out over numba's threads, 8 to 128: wider chunks
-    spread each row's loop overhead over more shots, and 128 shots of a 53-body chain
-    still fit the core's L2 cache)."""
-    if not problems:
-        raise invalid("problems", [], "at least one shot")
+    """Integrate every shot with the same stepping ``dt`` (a step in s, or a Stepping) to
+    ``t_end`` (s), recording what ``save`` names for each shot. ``problems``: a list of
+    ChainProblems of one layout, or their ProblemArrays. ``width``: shots per chunk
+    (default: the batch shared out over numba's threads, 8 to 128: wider chunks spread each
+    row's loop overhead over more shots, and 128 shots of a 53-body chain still fit the
+    core's L2 cache). A shot that blows up is reported so (its report's status), not raised."""
+    if not isinstance(problems, ProblemArrays):
+        if not problems:
+            raise invalid("problems", [], "at least one shot")
+        p0 = problems[0]
+        for p in problems:
+            if (p.n_bodies, p.wall_slot, p.offset) != (p0.n_bodies, p0.wall_slot, p0.offset):
+                raise RigError("an ensemble needs shots of one chain topology")
+        problems = ProblemArrays.of(problems)
+    p0 = problems.layout
+    if p0.sched_t.size or p0.chain.law.dissipative:
+        raise RigError("the batched kernel takes conservative chains with constant loads only")
     m = get_method(method)
-    p0 = problems[0]
-    for p in problems:
-        if (p.n_bodies, p.wall_slot, p.offset) != (p0.n_bodies, p0.wall_slot, p0.offset):
-            raise RigError("an ensemble needs shots of one chain topology")
-        if p.sched_t.size or p.chain.law.dissipative:
-            raise RigError("the batched kernel takes conservative chains with constant loads only")
     stepping = dt if isinstance(dt, Stepping) else Stepping(dt)
     if not (t_end > 0 and stepping.dt > 0):
         raise invalid("t_end/dt", (t_end, stepping.dt), "both > 0 s")
     ch_slot, ch_weight = save.channels(p0.offset)
     n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), save.sample_interval)
     sub = stepping.substeps(step, m.drifts)
-    n = len(problems)
+    n = problems.shots
     if width is None:
         import numba
 
         width = int(min(128, max(8, -(-n // numba.get_num_threads()))))
     n_chunks = -(-n // width)
-    padded = problems + [problems[-1]] * (n_chunks * width - n)  # the last chunk filled up
+    fill = np.concatenate((np.arange(n), np.full(n_chunks * width - n, n - 1)))  # the last chunk filled up
 
-    def blocks(values):  # -> (chunks, ..., width), each chunk C-contiguous
-        a = np.stack(values, axis=-1)
+    def stack(name):  # (shots, ...) -> (chunks, ..., width), each chunk C-contiguous
+        a = np.moveaxis(getattr(problems, name)[fill], 0, -1)
         return np.ascontiguousarray(np.moveaxis(a.reshape(a.shape[:-1] + (n_chunks, width)), -2, 0))
 
-    stack = lambda name: blocks([getattr(p, name) for p in padded])  # noqa: E731
-    out = np.zeros((n_chunks, width, len(save.names), n_out))
+    out = np.zeros((n_chunks, len(save.names), n_out, width))
     diag = np.zeros((n_chunks, 6, width))
     u, v = stack("u0"), stack("v0")
     t0 = time.perf_counter()
@@ -93,14 +97,12 @@ def solve_ensemble(problems: list, t_end: float, *, save: SaveAt, dt: float | St
                        stack("d0"), np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head, sub,
                        ch_slot, ch_weight, save.sample_interval, out,
                        check_interval(n_steps), stack("d_limit"), p0.wall_slot,
-                       blocks([p.energy_scale for p in padded]), blocks([p.momentum_scale for p in padded]),
-                       diag)
+                       stack("energy_scale"), stack("momentum_scale"), diag)
     wall = time.perf_counter() - t0
-    out = out.reshape(n_chunks * width, len(save.names), n_out)[:n]  # a view: (shots, channels, samples)
+    # (chunks, channels, samples, width) -> each channel (shots, samples), each shot's record contiguous
+    out = np.moveaxis(out, 3, 1).reshape(n_chunks * width, len(save.names), n_out)[:n]
     diag = np.moveaxis(diag, 0, -2).reshape(6, n_chunks * width)[:, :n]
     reports = tuple(KernelReport.of(diag[:, j]) for j in range(n))
-    bad = [j for j, r in enumerate(reports) if r.status is not Status.SUCCESS]
-    if bad:
-        raise RigError(f"shot(s) {bad[:10]}: {reports[bad[0]].status.message} (dt = {step:.4g} s)")
-    return EnsembleSolution({name: out[:, c] for c, name in enumerate(save.names)}, save.sample_interval,
+    return EnsembleSolution({name: np.ascontiguousarray(out[:, c]) for c, name in enumerate(save.names)},
+                            save.sample_interval,
                             step, n_steps, wall, m.name, reports)

@@ -1,5 +1,7 @@
 """ChainProblem: a Chain flattened into the arrays the kernels integrate (what is simulated;
-what is recorded is the SaveAt given to ``solve``)."""
+what is recorded is the SaveAt given to ``solve``). ``problem_arrays`` computes those
+arrays for many shots of one chain layout at once, shots first; a ChainProblem is its one
+row, so a shot of a study has the bits it has alone."""
 from __future__ import annotations
 
 import math
@@ -7,7 +9,90 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rig.model.chain import Chain, ForceSchedule
+from rig.model.chain import Chain, ForceSchedule, static_forces_of, static_overlaps_of
+
+PER_BODY = ("mass", "invm", "bias", "A", "d0", "f0", "damping", "d_limit", "u0", "v0")
+
+
+@dataclass(frozen=True, eq=False)
+class ProblemArrays:
+    """Many shots of one chain layout: the ChainProblem arrays with a leading shot axis
+    (``load`` (shots, bodies + 1), the others (shots, bodies)), energy_scale and
+    momentum_scale (shots,); ``layout``: a ChainProblem of the layout (its offset, wall
+    slot, law and schedule, which every shot shares)."""
+
+    layout: "ChainProblem"
+    mass: np.ndarray
+    invm: np.ndarray
+    bias: np.ndarray
+    load: np.ndarray
+    A: np.ndarray
+    d0: np.ndarray
+    f0: np.ndarray
+    damping: np.ndarray
+    d_limit: np.ndarray
+    u0: np.ndarray
+    v0: np.ndarray
+    energy_scale: np.ndarray
+    momentum_scale: np.ndarray
+
+    @property
+    def shots(self) -> int:
+        return self.mass.shape[0]
+
+    @classmethod
+    def of(cls, problems: list) -> "ProblemArrays":
+        """The problems' arrays stacked (one layout)."""
+        stack = {k: np.stack([getattr(p, k) for p in problems]) for k in PER_BODY + ("load",)}
+        return cls(problems[0], **stack, energy_scale=np.array([p.energy_scale for p in problems]),
+                   momentum_scale=np.array([p.momentum_scale for p in problems]))
+
+
+def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velocity=None) -> dict:
+    """The kernels' arrays of shots of ``chain``'s layout that differ in their bead masses
+    (kg, (shots, beads)), contact constants (N/m^1.5, (shots, contacts), nan where no
+    partner), initial top force (N, (shots,)), and striker mass (kg) and velocity (m/s)
+    ((shots,); None: the chain's): {name: array, shots first} (ChainProblem's fields)."""
+    masses, A_c = np.atleast_2d(masses), np.atleast_2d(A_c)
+    top = np.asarray(top_force, dtype=float).reshape(-1)
+    S, n = masses.shape
+    off = 1 if chain.striker is not None else 0
+    nb = off + n + (1 if chain.wall is not None else 0)
+    mass = np.zeros((S, nb))
+    mass[:, off:off + n] = masses
+    if off:
+        striker_mass = np.full(S, chain.striker.mass) if striker_mass is None else np.asarray(striker_mass, float)
+        velocity = np.full(S, chain.striker.velocity) if velocity is None else np.asarray(velocity, float)
+        mass[:, 0] = striker_mass
+    invm = np.divide(1.0, mass, out=np.zeros_like(mass), where=mass > 0)
+    bias = np.where(mass > 0, chain.gravity, 0.0)
+    bias[:, off] += top / mass[:, off]
+    load = np.zeros((S, nb + 1))
+    load[:, 1:] = np.cumsum(mass * bias, axis=1)
+
+    F_c = static_forces_of(masses, chain.gravity, top)
+    d_c = static_overlaps_of(A_c, F_c)
+    A, d0, f0 = np.zeros((S, nb)), np.zeros((S, nb)), np.zeros((S, nb))
+    d_limit = np.full((S, nb), math.inf)
+    radii = np.array([b.radius for b in chain.beads])
+    near = np.minimum(np.append(math.inf, radii), np.append(radii, math.inf))  # contact k: beads k-1, k
+    slot = np.arange(n + 1) + off
+    live = np.isfinite(chain.contact_constants()) & (slot > 0) & (slot < nb)
+    A[:, slot[live]], d0[:, slot[live]], f0[:, slot[live]] = A_c[:, live], d_c[:, live], F_c[:, live]
+    d_limit[:, slot[live]] = 0.5 * near[live]
+    if off:
+        d0[:, 1] = -chain.striker.gap
+    u0, v0 = np.zeros((S, nb)), np.zeros((S, nb))
+    if off:
+        v0[:, 0] = velocity
+        e_scale, p_scale = 0.5 * striker_mass * velocity**2, striker_mass * velocity
+    else:  # no impact: the static elastic energy and its momentum scale
+        e_scale = np.sum(0.4 * f0 * d0, axis=1)
+        e_scale = np.where(e_scale == 0.0, 1.0, e_scale)
+        p_scale = np.sqrt(2.0 * mass.sum(axis=1) * e_scale)
+    return dict(mass=mass, invm=invm, bias=bias, load=load, A=A, d0=d0, f0=f0,
+                damping=np.full((S, nb), chain.damping_time), d_limit=d_limit, u0=u0, v0=v0,
+                energy_scale=e_scale, momentum_scale=p_scale)
 
 
 @dataclass(frozen=True, eq=False)
@@ -44,55 +129,19 @@ class ChainProblem:
 
     @classmethod
     def from_chain(cls, chain: Chain) -> "ChainProblem":
+        a = problem_arrays(chain, chain.masses, chain.contact_constants(), chain.initial_top_force)
         off = 1 if chain.striker is not None else 0
-        n = chain.n_beads
-        nb = off + n + (1 if chain.wall is not None else 0)
-        mass = np.zeros(nb)
-        mass[off:off + n] = chain.masses
-        if off:
-            mass[0] = chain.striker.mass
-        invm = np.zeros(nb)
-        invm[mass > 0] = 1.0 / mass[mass > 0]
-        bias = np.where(mass > 0, chain.gravity, 0.0)
-        bias[off] += chain.initial_top_force / mass[off]
-        load = np.concatenate(([0.0], np.cumsum(mass * bias)))
-
-        A_c, F_c, d_c = chain.contact_constants(), chain.static_forces(), chain.static_overlaps()
-        A = np.zeros(nb)
-        d0 = np.zeros(nb)
-        f0 = np.zeros(nb)
-        d_limit = np.full(nb, math.inf)
-        radii = np.array([b.radius for b in chain.beads])
-        near = np.minimum(np.append(math.inf, radii), np.append(radii, math.inf))  # contact k: beads k-1, k
-        slot = np.arange(n + 1) + off
-        live = np.isfinite(A_c) & (slot > 0) & (slot < nb)
-        A[slot[live]], d0[slot[live]], f0[slot[live]] = A_c[live], d_c[live], F_c[live]
-        d_limit[slot[live]] = 0.5 * near[live]
-        if off:
-            d0[1] = -chain.striker.gap
-        damping = np.full(nb, chain.damping_time)
-
-        u0 = np.zeros(nb)
-        v0 = np.zeros(nb)
-        if off:
-            v0[0] = chain.striker.velocity
-
+        nb = a["mass"].shape[1]
         if isinstance(chain.top_force, ForceSchedule):
             sched_t = np.array(chain.top_force.times)
             sched_f = np.array(chain.top_force.forces) - chain.initial_top_force
         else:
             sched_t = np.zeros(0)
             sched_f = np.zeros(0)
-
-        if off:
-            e_scale = 0.5 * chain.striker.mass * chain.striker.velocity**2
-            p_scale = chain.striker.mass * chain.striker.velocity
-        else:  # no impact: the static elastic energy and its momentum scale
-            e_scale = float(np.sum(0.4 * f0 * d0)) or 1.0
-            p_scale = math.sqrt(2.0 * mass.sum() * e_scale)
-        return cls(chain, off, mass, invm, bias, load, A, d0, f0, damping, d_limit, u0, v0,
-                   off, sched_t, sched_f,
-                   nb - 1 if chain.wall is not None else 0, e_scale, p_scale)
+        return cls(chain, off, *(a[k][0] for k in ("mass", "invm", "bias", "load", "A", "d0", "f0", "damping",
+                                                    "d_limit", "u0", "v0")),
+                   off, sched_t, sched_f, nb - 1 if chain.wall is not None else 0,
+                   float(a["energy_scale"][0]), float(a["momentum_scale"][0]))
 
     @property
     def n_bodies(self) -> int:

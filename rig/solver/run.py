@@ -17,11 +17,12 @@ from rig.solver.solution import KernelReport, Solution, SolverStats, Status
 from rig.solver.stepsize import Stepping
 
 MAX_CHECKS = 50  # energy / momentum / blow-up checks per solve (each one O(N))
+CHECK_SPACING = 4  # steps at least between two checks: a check costs about half a step
 
 
 def check_interval(n_steps: int) -> int:
     """Steps between two checks of a solve of n_steps (the last step is always checked)."""
-    return max(1, n_steps // MAX_CHECKS)
+    return max(CHECK_SPACING, n_steps // MAX_CHECKS)
 
 
 def time_grid(t_end: float, dt: float, sample_interval: float) -> tuple:

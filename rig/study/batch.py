@@ -1,6 +1,9 @@
 """One batch of a Monte Carlo study: each shot's inputs (from its own SeedSequence child),
-its rig, one batched solve of all the shots, then per shot the instruments and the
-analysis of the leading pulse. ``refire`` runs one shot again alone, with the same numbers."""
+then one batched solve of all the shots at the study's step (its nominal pilot's), one
+batched acquisition and one batched analysis of the leading pulse, with no rig built per
+shot (rig/study/shots.py) where the study varies only what arrays carry; else each shot's
+rig, read and analysed as a lone shot is. ``refire`` runs one shot again alone, with the
+same numbers."""
 from __future__ import annotations
 
 import contextlib
@@ -9,6 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from instruments import batch as instrument_batch
 from instruments.pipeline import analyze_record
 from rig.errors import RigError
 from rig.experiment.measure import setup_for
@@ -20,6 +24,7 @@ from rig.solver.solution import Solution, Status
 from rig.solver.stepsize import stepping_at
 from rig.study.mc_spec import FAILURES, OUTPUTS, Study
 from rig.study.nominal import copied_table, nominal
+from rig.study.shots import array_keys, shots_of, wave_speeds, wiring_of
 from rig.study.sobol import sobol_matrix
 
 IMPOSSIBLE, UNSTABLE, NO_TRIGGER, SHORT_WINDOW, NON_FINITE = range(1, len(FAILURES))
@@ -105,35 +110,88 @@ def _batch(study: Study, b: int) -> BatchResult:
     design = sobol_matrix(study)[0] if study.sobol else None
     out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
     out["failure"][:] = 0
-    rigs, draws, seeds, xs = {}, {}, [], []
-    for j, i in enumerate(range(lo, hi)):
-        x, masses, seed = shot_inputs(study, i, base.values["chain"]["beads"], design)
-        seeds.append(seed)
-        xs.append([x[k] for k in study.keys])
-        try:
-            rigs[j], draws[j] = shot_rig(study, x, masses)
-        except ValueError:  # inputs no rig can have (a negative velocity): counted, not fatal
-            out["failure"][j] = IMPOSSIBLE
+    drawn = [shot_inputs(study, i, base.values["chain"]["beads"], design) for i in range(lo, hi)]
+    seeds = [seed for *_, seed in drawn]
+    xs = np.array([[x[k] for k in study.keys] for x, *_ in drawn], dtype=float).reshape(hi - lo, len(study.keys))
+    template = nom.template(study.window)
     traces = []
-    if rigs:
-        _fire_all(study, nom, rigs, draws, seeds, out, traces, lo)
-    return BatchResult(b, np.arange(lo, hi), np.array(xs, dtype=float).reshape(hi - lo, len(study.keys)),
-                       np.array(seeds, dtype=np.int64), out, tuple(traces))
+    if study.truth or study.traces or not array_keys(study.keys, template):
+        rigs, draws = {}, {}
+        for j, (x, masses, _) in enumerate(drawn):
+            try:
+                rigs[j], draws[j] = shot_rig(study, x, masses)
+            except ValueError:  # inputs no rig can have (a negative velocity): counted, not fatal
+                out["failure"][j] = IMPOSSIBLE
+        if rigs:
+            _fire_rigs(study, nom, rigs, draws, seeds, out, traces, lo)
+    else:
+        _fire_arrays(study, nom, template, drawn, out)
+    return BatchResult(b, np.arange(lo, hi), xs, np.array(seeds, dtype=np.int64), out, tuple(traces))
 
 
-def _fire_all(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dict, traces: list, lo: int):
-    """Solve the batch's possible rigs together, then read, analyse and judge each shot."""
+def _pilot(study: Study, nom, template: Rig):
+    """(the stepping every shot takes, the pilot's stats): the step is calibrated once, on
+    what every study measures (the gauges' averages, the wall), so that recording the
+    contacts too (--truth, --traces) changes no result."""
+    pilot = nom.pilot(study.window, template.save_at(contacts=False, averages=True), study.accuracy)
+    return stepping_at(pilot.problem, pilot.stats.dt_s), pilot.stats
+
+
+def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
+    """The batch with no rig built per shot (rig/study/shots.py): one batched solve, one
+    batched acquisition and one batched analysis of the leading pulse."""
+    shots = shots_of(template, [x for x, *_ in drawn], [m for _, m, _ in drawn])
+    out["failure"][~shots.possible] = IMPOSSIBLE
+    keep = np.flatnonzero(shots.possible)
+    if not keep.size:
+        return
+    sub = shots.take(keep)
+    dt, _ = _pilot(study, nom, template)
+    save = template.save_at(contacts=False, averages=True)
+    ens = solve_ensemble(sub.problems, template.solver.duration, save=save, dt=dt, method=template.solver.method)
+    wiring = wiring_of(template)
+    names = [f"gauge_{g.name}" for g in template.gauges] + (["wall"] if template.wall_sensor is not None else [])
+    forces = np.stack([ens.forces[n] for n in names], axis=1)
+    h = ens.sample_interval
+    speeds = wave_speeds(template, sub, forces, h)
+    records = instrument_batch.acquire(forces, h, wiring, [drawn[j][2] for j in keep], sub.fixed, speeds)
+    beta, F0 = nom.calibration
+    reports = instrument_batch.analysed(records, setup_for(template, beta, F0))
+    for e, j in enumerate(keep):
+        if ens.reports[e].status is not Status.SUCCESS:
+            out["failure"][j] = UNSTABLE
+            continue
+        if records.status[e] == instrument_batch.PAST_INPUT:  # the scope's record ends after the simulated window
+            out["failure"][j] = SHORT_WINDOW
+            continue
+        _outputs(out, j, reports[e], None, ens.reports[e].energy_error, ens.dt, records.status[e] == instrument_batch.OK)
+
+
+def _outputs(out: dict, j: int, m, t, energy_error: float, dt: float, triggered: bool):
+    """Shot j's outputs from its measured Report m (and truth Report t, or None), and its
+    failure, if any."""
+    for key, val in (("speed_m_per_s", m.speed_m_per_s), ("speed_xcorr_m_per_s", m.speed_xcorr_m_per_s),
+                     ("amplitude_N", m.amplitude_N), ("averaged_amplitude_N", m.averaged_amplitude_N),
+                     ("truth_speed_m_per_s", t and t.speed_m_per_s), ("truth_amplitude_N", t and t.amplitude_N),
+                     ("energy_error", energy_error), ("dt_s", dt)):
+        out[key][j] = np.nan if val is None else val
+    if not triggered:
+        out["failure"][j] = NO_TRIGGER
+    elif not (np.isfinite(out["speed_m_per_s"][j]) and np.isfinite(out["amplitude_N"][j])):
+        out["failure"][j] = NON_FINITE
+
+
+def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dict, traces: list, lo: int):
+    """The batch with a rig per shot (a key that changes the rig's parts, --truth,
+    --traces): one batched solve, then each shot read and analysed as a lone shot is."""
     base = nom.rig
     problems = [ChainProblem.from_chain(r.chain) for r in rigs.values()]
     t_end = nom.window(study.window).duration
-    first = next(iter(rigs.values()))
-    save = study_save(study, first)
-    # the step is calibrated on what every study measures (the gauges' averages, the wall),
-    # so that recording the contacts too (--truth, --traces) changes no result
-    pilot = nom.pilot(study.window, first.save_at(contacts=False, averages=True), study.accuracy).stats
-    dt = stepping_at(problems[0], pilot.dt_s)
-    ens = solve_ensemble(problems, t_end, save=save, dt=dt, method=base.solver.method)
+    template = nom.template(study.window)
+    dt, pilot = _pilot(study, nom, template)
+    ens = solve_ensemble(problems, t_end, save=study_save(study, template), dt=dt, method=base.solver.method)
     beta, F0 = nom.calibration
+    setup = setup_for(template, beta, F0)
     for e, ((j, rig), p) in enumerate(zip(rigs.items(), problems)):
         if ens.reports[e].status is not Status.SUCCESS:
             out["failure"][j] = UNSTABLE
@@ -152,17 +210,9 @@ def _fire_all(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dict
             entry = shot_entry(shot)
             traces.append(replace(entry, truth_key=None, facts=replace(entry.facts, study_shot=lo + j,
                                                                        study=study.digest())))
-        m = analyze_record(shot.scope, setup_for(rig, beta, F0), train=False)  # leading pulse only
-        t = rig.truth_analysis() if study.truth else None
-        for key, val in (("speed_m_per_s", m.speed_m_per_s), ("speed_xcorr_m_per_s", m.speed_xcorr_m_per_s),
-                         ("amplitude_N", m.amplitude_N), ("averaged_amplitude_N", m.averaged_amplitude_N),
-                         ("truth_speed_m_per_s", t and t.speed_m_per_s), ("truth_amplitude_N", t and t.amplitude_N),
-                         ("energy_error", stats.energy_error), ("dt_s", ens.dt)):
-            out[key][j] = np.nan if val is None else val
-        if not shot.scope.triggered:
-            out["failure"][j] = NO_TRIGGER
-        elif not (np.isfinite(out["speed_m_per_s"][j]) and np.isfinite(out["amplitude_N"][j])):
-            out["failure"][j] = NON_FINITE
+        m = analyze_record(shot.scope, setup, train=False)  # leading pulse only
+        _outputs(out, j, m, rig.truth_analysis() if study.truth else None, stats.energy_error, ens.dt,
+                 shot.scope.triggered)
 
 
 def refire(study: Study, i: int) -> dict:

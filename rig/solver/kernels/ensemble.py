@@ -14,10 +14,9 @@ import numpy as np
 from numba import prange
 
 from instruments.jit import jit
-from rig.model.contact import HERTZ
 from rig.solver.kernels.forces import state_sums
 from rig.solver.kernels.multirate import head_flow
-from rig.solver.kernels.record import hermite_weights, probe_overlaps, recorded_force
+from rig.solver.kernels.record import hermite_weights, probe_overlaps
 
 
 @jit
@@ -56,7 +55,7 @@ def _kick_drift(u, v, invm, f, hb, ha, head):
 
 
 @jit
-def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_work):
+def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_work, h_busy):
     """_kick_drift (and the head's flow) then _forces in one pass over the rows: row i is
     kicked and drifted (reading f[i], f[i+1], not yet renewed), then contact i is renewed
     from rows i-1 and i (both moved). The same operations as the two passes, so the same
@@ -64,7 +63,7 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
     start = 0
     if head > 0:
         _head_kick(v, invm, f, hb, head)
-        head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub, h_work)
+        head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub, h_work, h_busy)
         start = head + 1
     for i in range(start, v.shape[0]):
         for s in range(u.shape[1]):
@@ -76,6 +75,26 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
 
 
 @jit
+def _record(out, j, w, col, ch_slot, ch_weight, A, d_old, r_old, d_new, r_new):
+    """out[c, j, s]: channel c's force (N) of every shot s at sample j, whose Hermite weights
+    are column col of w: record.recorded_force's operations, in its order, with the shots
+    innermost (the loop vectorises)."""
+    W = out.shape[2]
+    for c in range(ch_slot.shape[0]):
+        for s in range(W):
+            out[c, j, s] = 0.0
+        for k in range(ch_slot.shape[1]):
+            wk = ch_weight[c, k]
+            if wk != 0.0:
+                i = ch_slot[c, k]
+                w0, w1, w2, w3 = w[0, col], w[1, col], w[2, col], w[3, col]
+                for s in range(W):
+                    d = w0 * d_old[c, k, s] + w1 * r_old[c, k, s] + w2 * d_new[c, k, s] + w3 * r_new[c, k, s]
+                    d = d if d > 0.0 else 0.0
+                    out[c, j, s] += wk * (A[i, s] * d * math.sqrt(d))
+
+
+@jit
 def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, head, sub,
            ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
            e_ref, p_ref, diag, f, d_old, r_old, d_new, r_new):
@@ -83,7 +102,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
     W = u.shape[1]
     n_drift = a_coef.shape[0]
     n_ch = ch_slot.shape[0]
-    n_out = out.shape[2]
+    n_out = out.shape[1]
     for s in range(u.shape[1]):
         f[0, s] = 0.0
         f[nb, s] = -load[nb, s]
@@ -96,17 +115,14 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
     net = np.empty(W)
     j_wall = np.zeros(W)
     w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
-    h_work = np.empty((2, 3, head + 1))  # the head flow's saved states
+    h_work, h_busy = np.empty((2, 3, head + 1)), np.empty(W)  # the head flow's work arrays
     state_sums(u, v, mass, bias, A, d0, d_limit, e0, p0, worst)
     for s in range(u.shape[1]):
         net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
     probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, 0.0, head, -1, 0.0, d_old, r_old)
     if n_out > 0:
         hermite_weights(0.0, dt, w, 0)
-        for c in range(n_ch):
-            for s in range(u.shape[1]):
-                out[s, c, 0] = recorded_force(w, 0, 0.0, c, s, ch_slot, ch_weight, A, A, HERTZ,
-                                              d_old, r_old, d_old, r_old)
+        _record(out, 0, w, 0, ch_slot, ch_weight, A, d_old, r_old, d_old, r_old)
     j_out = 1
     pending = 0.0
     for n in range(n_steps):
@@ -119,7 +135,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
                 for s in range(u.shape[1]):
                     j_wall[s] += hb * f[wall_slot, s]
             h = a_coef[st] * dt
-            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_work)
+            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_work, h_busy)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1
@@ -135,11 +151,8 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
             j_end += 1
         for j in range(j_out, j_end):  # the weights are the same for every shot and channel
             hermite_weights((j * sample_dt - t) / dt, dt, w, j - j_out)
-        for s in range(u.shape[1]):  # each shot's samples are contiguous: write them in runs
-            for c in range(n_ch):
-                for j in range(j_out, j_end):
-                    out[s, c, j] = recorded_force(w, j - j_out, (j * sample_dt - t) / dt, c, s, ch_slot, ch_weight,
-                                                  A, A, HERTZ, d_old, r_old, d_new, r_new)
+        for j in range(j_out, j_end):
+            _record(out, j, w, j - j_out, ch_slot, ch_weight, A, d_old, r_old, d_new, r_new)
         j_out = j_end
         d_old[:, :, :] = d_new
         r_old[:, :, :] = r_new
@@ -163,7 +176,7 @@ def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, 
                        ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
                        e_ref, p_ref, diag):
     """Integrate every shot of the (chunks, bodies, width) arrays in place; out is
-    (chunks, width, channels, samples) so that each shot's record is contiguous; diag is
+    (chunks, channels, samples, width), the shots innermost; diag is
     (chunks, 6, width) as in the single-shot kernel."""
     n_chunks, nb, W = u.shape
     n_ch = ch_slot.shape[0]

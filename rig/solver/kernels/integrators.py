@@ -113,7 +113,7 @@ BLOCK = 2048  # bodies per block of a step's wavefront (their arrays stay in the
 
 @jit
 def _step(u, v, invm, f, A, d0, damping, law, load, a_coef, b_coef, dt, t, pending, head, sub,
-          sched_body, sched_t, sched_f, wall_slot, heads, h_work, impulses):
+          sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses):
     """One step of the composition (its closing kick owed), every body and stage.
 
     Stage s on body i needs slot i + 1 at stage s - 1 and leaves slot i at stage s, so
@@ -123,7 +123,7 @@ def _step(u, v, invm, f, A, d0, damping, law, load, a_coef, b_coef, dt, t, pendi
     Each body sees the same operations in the same order as in stage-by-stage sweeps.
     With a multirate head, bodies 0..head get the kick of slot head + 1 and the head's
     flow (multirate.head_flow) instead. ``heads``: the (bodies, 1) views the head flow
-    takes, h_work its saved states; impulses[0] += the wall's dynamic impulse, impulses[1] += the schedule's (N s).
+    takes, h_work and h_busy its work arrays; impulses[0] += the wall's dynamic impulse, impulses[1] += the schedule's (N s).
     """
     nb = u.shape[0]
     u2, v2, im2, f2, A2, d02, load2 = heads
@@ -143,7 +143,7 @@ def _step(u, v, invm, f, A, d0, damping, law, load, a_coef, b_coef, dt, t, pendi
                 impulses[1] += _external_kick(v, invm, hb, ts, sched_body, sched_t, sched_f)
                 if head > 0:
                     v[head] += hb * (0.0 - f[head + 1]) * invm[head]
-                    head_flow(u2, v2, im2, f2, A2, d02, load2, head, a_coef, b_coef, h, sub[s], h_work)
+                    head_flow(u2, v2, im2, f2, A2, d02, load2, head, a_coef, b_coef, h, sub[s], h_work, h_busy)
                     lo = head + 1
                 else:
                     v0 = v[0] + hb * (f[0] - f[1]) * invm[0]
@@ -183,7 +183,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
     # (bodies, 1) views for the multirate head (shared with the batched kernel)
     heads = (u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1)),
              A.reshape((nb, 1)), d0.reshape((nb, 1)), load.reshape((nb + 1, 1)))
-    h_work = np.empty((2, 3, head + 1))  # the head flow's saved states
+    h_work, h_busy = np.empty((2, 3, head + 1)), np.empty(1)  # the head flow's work arrays
     # sum of constant loads, less the part the wall's slot carries (j_wall is dynamic)
     wall_load = load[wall_slot] if wall_slot > 0 else 0.0
     net_const = load[nb] - wall_load
@@ -229,7 +229,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
             us_old = u[sched_body]
             fe_old = schedule_force(t, sched_t, sched_f)
         _step(u, v, invm, f, A, d0, damping, law, load, a_coef, b_coef, dt, t, pending, head, sub,
-              sched_body, sched_t, sched_f, wall_slot, heads, h_work, impulses)
+              sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1

@@ -44,22 +44,27 @@ def _open_acceleration(j, invm, load, head, s):
 
 
 @jit
-def _stays_open(u, v, invm, d0, load, head, a_coef, b_coef, h, s):
-    """True where every head contact of shot s is open and provably stays open through a
-    drift of h seconds (bound in the module doc)."""
+def _busy(u, v, invm, d0, load, head, a_coef, b_coef, h, busy):
+    """busy[s]: 1 where a head contact of shot s is closed or may close during a drift of h
+    seconds, 0 where all are open and provably stay open (bound in the module doc); no
+    branch on the shot, so the loop vectorises."""
     sum_a = 0.0
     for a in a_coef:
         sum_a += abs(a)
     sum_b = 0.0
     for b in b_coef:
         sum_b += abs(b)
+    reach = abs(h) * sum_a
+    spread = h * h * sum_a * sum_b
+    for s in range(u.shape[1]):
+        busy[s] = 0.0
     for i in range(1, head + 1):
-        gap = -(d0[i, s] + u[i - 1, s] - u[i, s])
-        rate = v[i, s] - v[i - 1, s]
-        curv = _open_acceleration(i, invm, load, head, s) - _open_acceleration(i - 1, invm, load, head, s)
-        if not gap - abs(rate) * abs(h) * sum_a - abs(curv) * h * h * sum_a * sum_b > 0.0:
-            return False
-    return True
+        for s in range(u.shape[1]):
+            gap = -(d0[i, s] + u[i - 1, s] - u[i, s])
+            rate = v[i, s] - v[i - 1, s]
+            curv = (_open_acceleration(i, invm, load, head, s)
+                    - _open_acceleration(i - 1, invm, load, head, s))
+            busy[s] = busy[s] if gap - abs(rate) * reach - abs(curv) * spread > 0.0 else 1.0
 
 
 @jit
@@ -143,19 +148,22 @@ def _resolved_substeps(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, n, s
 
 
 @jit
-def head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, h, n, work):
+def head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, h, n, work, busy):
     """Advance every shot's head by h seconds (u, v, f in place): n resolved substeps where
     a head contact is or may come closed; elsewhere the exact flow under the constant
-    loads, u += h v + h^2 a / 2, v += h a (the forces stay -load). work: (2, 3, head + 1)."""
+    loads, u += h v + h^2 a / 2, v += h a (the forces stay -load), branch-free over the
+    shots. work: (2, 3, head + 1) saved states; busy: (shots,) float64."""
+    _busy(u, v, invm, d0, load, head, a_coef, b_coef, h, busy)
     for s in range(u.shape[1]):
-        if n > 0 and not _stays_open(u, v, invm, d0, load, head, a_coef, b_coef, h, s):
+        if busy[s] != 0.0:
             _resolved_substeps(u, v, invm, f, A, d0, load, head, a_coef, b_coef, h / n, n, s, work)
-            continue
-        for i in range(head + 1):
+    for i in range(head + 1):
+        for s in range(u.shape[1]):
             below = f[i + 1, s] if i < head else 0.0
             acc = (f[i, s] - below) * invm[i, s]
-            u[i, s] += h * v[i, s] + 0.5 * h * h * acc
-            v[i, s] += h * acc
+            free = 1.0 - busy[s]
+            u[i, s] += free * (h * v[i, s] + 0.5 * h * h * acc)
+            v[i, s] += free * (h * acc)
 
 
 @jit

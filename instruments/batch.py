@@ -1,0 +1,175 @@
+"""The instruments and the leading-pulse analysis of many shots at once: what a study
+fires. One compiled loop runs every shot's gauges and scope (_kernels/acquisition.shots),
+another every shot's analysis (``analysed``): the very functions PiezoGauge.read,
+Oscilloscope.acquire and the pipeline run for one shot, so a shot of a batch has the bits
+it has alone. Each shot's random numbers come from its own generator, seeded by its seed,
+in the order a lone shot draws them (acquisition.shot_draws)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import prange
+
+from ._kernels import acquisition, pulses
+from .frontend import highpass_coefficients
+from .jit import jit
+from .oscilloscope import CODE_MAX, CODE_MIN, Oscilloscope
+from .pipeline import Setup, report_of
+from .records import ScopeRecord
+from .report import Report
+
+OK, NO_TRIGGER, PAST_INPUT = acquisition.OK, acquisition.NO_TRIGGER, acquisition.PAST_INPUT  # a record's status
+
+
+@dataclass(frozen=True)
+class Wiring:
+    """What the shots of a batch read: the gauges in the order a shot draws them (the bead
+    gauges by name, then the wall sensor), each (scope channel, settings, delayed: whether
+    a position error delays it), and the scope."""
+
+    gauges: tuple
+    scope: Oscilloscope
+
+    @property
+    def channels(self) -> list:
+        return list(self.scope.channels)
+
+    def wired(self) -> np.ndarray:
+        """For each displayed channel, the index of the gauge on it (-1: nothing)."""
+        at = {ch: k for k, (ch, _, _) in enumerate(self.gauges)}
+        return np.array([at.get(ch, -1) for ch in self.scope.channels], np.int64)
+
+
+@dataclass(frozen=True, eq=False)
+class Records:
+    """The scope records of a batch: codes (shots, channels, samples) int8, over-range
+    flags (shots, channels), status (OK, NO_TRIGGER, PAST_INPUT), times
+    (shots, 2: the trigger crossing and the first sample, s), the gauges' draws (shots,
+    gauges, 2: gain factor and position error m), and the input they read (n_in samples
+    every h s)."""
+
+    wiring: Wiring
+    codes: np.ndarray
+    over: np.ndarray
+    status: np.ndarray
+    times: np.ndarray
+    draws: np.ndarray
+    n_in: int
+    h: float
+
+    def record(self, s: int) -> ScopeRecord:
+        """Shot s's ScopeRecord, as Oscilloscope.acquire returns it (InstrumentError where
+        its record runs past the input)."""
+        return self.wiring.scope.record_of(int(self.status[s]), float(self.times[s, 0]), float(self.times[s, 1]),
+                                           self.codes[s], self.over[s], self.n_in, self.h)
+
+
+def draws(seeds, wiring: Wiring, n_in: int) -> tuple:
+    """Every shot's random numbers (acquisition.shot_draws), from np.random.default_rng(seed):
+    (draws (shots, gauges, 2), gauge noise (shots, gauges, n_in), phases (shots,), scope
+    noise (shots, channels, samples)); an array a shot does not draw into is left zero
+    (a noise-free gauge) or empty (a noise-free scope)."""
+    settings = [s for _, s, _ in wiring.gauges]
+    scope = wiring.scope
+    cal = np.array([s.calibration_error for s in settings], dtype=float)
+    mis = np.array([s.misalignment_sd for s in settings], dtype=float)
+    noisy = np.array([bool(s.noise) for s in settings])
+    S, G, C = len(seeds), len(settings), len(scope.channels)
+    L = int(scope.timebase.record_length) if scope.noise_floor else 0
+    out = np.empty((S, G, 2))
+    z_gauge = np.zeros((S, G, n_in))
+    phase = np.empty(S)
+    z_scope = np.empty((S, C, L))
+    for s, seed in enumerate(seeds):
+        phase[s] = acquisition.shot_draws(np.random.default_rng(int(seed)), cal, mis, noisy, out[s], z_gauge[s],
+                                          scope.timebase.sample_interval, bool(scope.noise_floor), z_scope[s])
+    return out, z_gauge, phase, z_scope
+
+
+def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarray | None = None,
+            wave_speed: np.ndarray | None = None) -> Records:
+    """Every shot's scope record. forces (shots, gauges, samples): what each gauge reads
+    (N, every h s; a bead gauge its plate's average, the wall sensor the wall's contact);
+    seeds: one per shot; fixed (shots, gauges, 2): gain factors and position errors that
+    replace the drawn ones (nan: keep the draw); wave_speed (shots,): the pulse's speed
+    (m/s) that turns a position error into a delay (nan: none)."""
+    S, G, n_in = forces.shape
+    drawn, z_gauge, phase, z_scope = draws(seeds, wiring, n_in)
+    if fixed is not None:
+        drawn = np.where(np.isnan(fixed), drawn, fixed)
+    settings = [s for _, s, _ in wiring.gauges]
+    sens = np.array([s.sensitivity for s in settings], dtype=float)
+    delayed = np.array([d for _, _, d in wiring.gauges])
+    speed = np.full(S, np.nan) if wave_speed is None else np.asarray(wave_speed, dtype=float)
+    shift = np.where(delayed & ~np.isnan(speed)[:, None], drawn[:, :, 1] / speed[:, None], 0.0)
+    scale = sens * drawn[:, :, 0]
+    gauge_filter = np.array([highpass_coefficients(h, s.tau) for s in settings])
+    noise_sd = np.array([s.noise for s in settings], dtype=float)
+    front = wiring.scope.front_panel(h)
+    L = int(wiring.scope.timebase.record_length)
+    C = len(wiring.channels)
+    codes = np.empty((S, C, L), np.int8)
+    over = np.empty((S, C), np.bool_)
+    status = np.empty(S, np.int64)
+    times = np.empty((S, 2))
+    acquisition.shots(np.ascontiguousarray(forces, dtype=float), float(h), shift, scale, gauge_filter, noise_sd,
+                      z_gauge, wiring.wired(), front.probe, front.ac, front.lowpass, front.source, front.level,
+                      front.rising, phase, front.n_pre, wiring.scope.timebase.sample_interval, front.offset,
+                      front.ymult, front.yoff, front.sd, z_scope, float(CODE_MIN), float(CODE_MAX), codes, over,
+                      status, times)
+    return Records(wiring, codes, over, status, times, drawn, n_in, float(h))
+
+
+@jit(parallel=True)
+def _analysed(codes, status, times, dx, n_pre, ymult, yoff, yzero, roles, tau, sens, rules, answer, sigma, finite):
+    for s in prange(codes.shape[0]):
+        answer[s, :] = math.nan
+        sigma[s, :] = math.nan
+        finite[s] = True
+        if status[s] != acquisition.OK:
+            continue
+        t = times[s, 1] + dx * np.arange(codes.shape[2])
+        f = np.empty((2, codes.shape[2]))
+        for r in range(2):
+            c = roles[r]
+            volts = yzero[c] + ymult[c] * (codes[s, c].astype(np.float64) - yoff[c])
+            f[r] = pulses.conditioned(volts, n_pre, dx, tau[r], sens[r])
+            sigma[s, r] = pulses.noise_level(f[r], n_pre, abs(ymult[c]) / sens[r])
+            finite[s] = finite[s] and np.all(np.isfinite(f[r]))
+        if finite[s]:
+            pulses.leading_pair(t, f[0], f[1], sigma[s, 0], sigma[s, 1], rules, answer[s])
+
+
+def analysed(records: Records, setup: Setup) -> list:
+    """Every shot's Report of its leading pulse (the pipeline's analyze_record(record,
+    setup, train=False)), the numbers from one compiled loop over the shots."""
+    scope = records.wiring.scope
+    front = scope.front_panel(records.h)
+    channels = records.wiring.channels
+    roles = np.array([channels.index(setup.upper.channel), channels.index(setup.lower.channel)], np.int64)
+    gauges = (setup.upper, setup.lower)
+    S = records.codes.shape[0]
+    answer = np.empty((S, pulses.ANSWER))
+    sigma = np.empty((S, 2))
+    finite = np.empty(S, np.bool_)
+    dx = scope.timebase.sample_interval
+    _analysed(records.codes, records.status, records.times, dx, front.n_pre, front.ymult, front.yoff, front.offset,
+              roles, np.array([g.tau_s or 0.0 for g in gauges]), np.array([g.sensitivity_V_per_N for g in gauges]),
+              setup.rules.as_tuple(), answer, sigma, finite)
+    L = records.codes.shape[2]
+    out = []
+    for s in range(S):
+        rep = Report(beta=setup.beta, static_force_N=setup.static_force_N)
+        if records.status[s] != acquisition.OK:
+            out.append(rep.refuse("the scope did not trigger" if records.status[s] == acquisition.NO_TRIGGER
+                                  else "the scope's record runs past the input"))
+        elif not finite[s]:
+            out.append(rep.refuse("samples that are not finite numbers"))
+        else:
+            t = records.times[s, 1] + dx * np.arange(L)
+            noise = {r: None if math.isnan(sigma[s, k]) else float(sigma[s, k])
+                     for k, r in enumerate(("upper", "lower"))}
+            out.append(report_of(answer[s], t, {}, setup, False, noise))
+    return out
