@@ -101,7 +101,6 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
     nb = u.shape[0]
     W = u.shape[1]
     n_drift = a_coef.shape[0]
-    n_ch = ch_slot.shape[0]
     n_out = out.shape[1]
     for s in range(u.shape[1]):
         f[0, s] = 0.0
