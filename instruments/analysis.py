@@ -42,6 +42,13 @@ def noise_level(y: np.ndarray, n_pre: int, step: float = 0.0) -> float | None:
     return None if math.isnan(sigma) else float(sigma)
 
 
+def first_peak_time(f: np.ndarray, h: float) -> float | None:
+    """Time (s) of the first local maximum of f - f[0] above half its peak (samples every h
+    s): where the pulse first crests; None where f never rises above f[0]."""
+    i = pulses.first_peak(np.ascontiguousarray(f, dtype=float))
+    return None if i < 0 else i * h
+
+
 def invert_rc(y: np.ndarray, h: float, tau: float) -> np.ndarray:
     """Undo a one-pole RC high-pass of time constant tau (s): x = y + (1/tau) int y dt."""
     return undo_highpass(np.ascontiguousarray(y, dtype=float), float(h), float(tau))

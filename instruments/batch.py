@@ -79,7 +79,7 @@ def draws(seeds, wiring: Wiring, n_in: int) -> tuple:
     S, G, C = len(seeds), len(settings), len(scope.channels)
     L = int(scope.timebase.record_length) if scope.noise_floor else 0
     out = np.empty((S, G, 2))
-    z_gauge = np.zeros((S, G, n_in))
+    z_gauge = np.empty((S, G, n_in)) if noisy.all() else np.zeros((S, G, n_in))
     phase = np.empty(S)
     z_scope = np.empty((S, C, L))
     for s, seed in enumerate(seeds):
@@ -122,24 +122,32 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
     return Records(wiring, codes, over, status, times, drawn, n_in, float(h))
 
 
+@jit
+def _analyse_shot(codes, time0, dx, n_pre, ymult, yoff, yzero, roles, tau, sens, rules, answer, sigma):
+    """One shot's leading_pair answer and its channels' noise; False where a sample is not
+    a finite number."""
+    t = time0 + dx * np.arange(codes.shape[1])
+    f = np.empty((2, codes.shape[1]))
+    for r in range(2):
+        c = roles[r]
+        volts = yzero[c] + ymult[c] * (codes[c].astype(np.float64) - yoff[c])
+        f[r] = pulses.conditioned(volts, n_pre, dx, tau[r], sens[r])
+        sigma[r] = pulses.noise_level(f[r], n_pre, abs(ymult[c]) / sens[r])
+        if not np.all(np.isfinite(f[r])):
+            return False
+    pulses.leading_pair(t, f[0], f[1], sigma[0], sigma[1], rules, answer)
+    return True
+
+
 @jit(parallel=True)
 def _analysed(codes, status, times, dx, n_pre, ymult, yoff, yzero, roles, tau, sens, rules, answer, sigma, finite):
     for s in prange(codes.shape[0]):
         answer[s, :] = math.nan
         sigma[s, :] = math.nan
         finite[s] = True
-        if status[s] != acquisition.OK:
-            continue
-        t = times[s, 1] + dx * np.arange(codes.shape[2])
-        f = np.empty((2, codes.shape[2]))
-        for r in range(2):
-            c = roles[r]
-            volts = yzero[c] + ymult[c] * (codes[s, c].astype(np.float64) - yoff[c])
-            f[r] = pulses.conditioned(volts, n_pre, dx, tau[r], sens[r])
-            sigma[s, r] = pulses.noise_level(f[r], n_pre, abs(ymult[c]) / sens[r])
-            finite[s] = finite[s] and np.all(np.isfinite(f[r]))
-        if finite[s]:
-            pulses.leading_pair(t, f[0], f[1], sigma[s, 0], sigma[s, 1], rules, answer[s])
+        if status[s] == acquisition.OK:
+            finite[s] = _analyse_shot(codes[s], times[s, 1], dx, n_pre, ymult, yoff, yzero, roles, tau, sens, rules,
+                                      answer[s], sigma[s])
 
 
 def analysed(records: Records, setup: Setup) -> list:

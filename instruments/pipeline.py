@@ -22,7 +22,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ._kernels import pulses
-from ._kernels.pulses import AMPLITUDE, BASE_WIDTH, FOUND, FWHM, LAG, PEAK, RISE, STATUS, TIME, index_of
+from ._kernels.pulses import AMPLITUDE, BASE_WIDTH, FOUND, FWHM, LAG, PEAK, RISE, ROLE, STATUS, TIME
 from .analysis import MIN_BASELINE, PeakRules, Pulse, find_pulses, leading, noise_level
 from .errors import InstrumentError, check
 from .plausibility import Limits, record_doubt, speed_doubt
@@ -143,17 +143,17 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
             problems.append(f"{ch[r]}: fewer than {MIN_BASELINE} samples before the trigger: the noise, and so "
                             f"whether a pulse stands above it, cannot be measured")
             continue
-        peak = float(answer[index_of(k, PEAK)])
+        peak = float(answer[1 + ROLE * k + PEAK])
         if sigma is not None:
             rep.noise[ch[r]], rep.snr[ch[r]] = sigma, (peak / sigma if sigma > 0 else math.inf)
-        if answer[index_of(k, FOUND)] != 1.0:
+        if answer[1 + ROLE * k + FOUND] != 1.0:
             if sigma is not None and peak < rules.snr * sigma:
                 problems.append(f"{ch[r]}: no pulse stands {rules.snr:g} times above the pre-trigger noise "
                                 f"({sigma:.3g}): its highest excursion is {rep.snr[ch[r]]:.3g} times the noise")
             else:
                 problems.append(f"{ch[r]}: no pulse passes the peak rules (height, prominence, width)")
             continue
-        lead[r] = Pulse(*(float(answer[index_of(k, x)]) for x in (TIME, AMPLITUDE, FWHM, BASE_WIDTH, RISE)))
+        lead[r] = Pulse(*(float(answer[1 + ROLE * k + x]) for x in (TIME, AMPLITUDE, FWHM, BASE_WIDTH, RISE)))
         if sigma is not None and sigma > 0:
             rep.snr[ch[r]] = lead[r].amplitude / sigma
     if problems:

@@ -12,21 +12,29 @@ from numba import prange
 from instruments.jit import jit
 
 from .filters import one_pole
-from .quantiser import quantise
-from .resample import at_positions
+from .quantiser import code
+from .resample import read_at
 
 OK, NO_TRIGGER, PAST_INPUT = 0, 1, 2  # how an acquisition ended
 
 
 @jit
 def gauge_signal(force, h, shift, scale, b0, b1, a1, noise_sd, z):
-    """Volts of a piezo gauge (frontend.rc_highpass, gauges.PiezoGauge): the force (N,
-    sampled every h s) delayed by ``shift`` s, times ``scale`` (V/N), through the one-pole
-    high-pass (b0, b1, a1), plus noise_sd x z (z: standard normal draws, or empty)."""
-    x = scale * at_positions(force, np.arange(force.shape[0]) - shift / h)
-    y = one_pole(x, b0, b1, a1, x[0], False)
-    if z.shape[0]:
-        y = y + noise_sd * z
+    """Volts of a piezo gauge (gauges.PiezoGauge), in one pass: the force (N, sampled every
+    h s) read ``shift`` s earlier (linear between samples), times ``scale`` (V/N), through
+    the one-pole high-pass (b0, b1, a1) from rest (filters.one_pole's operations), plus
+    noise_sd x z (z: standard normal draws, or empty)."""
+    n = force.shape[0]
+    y = np.empty(n)
+    lag = shift / h
+    level = scale * read_at(force, 0 - lag)
+    state = 0.0
+    noisy = z.shape[0] > 0
+    for k in range(n):
+        u = scale * read_at(force, k - lag) - level
+        yk = state + b0 * u
+        state = u * b1 - yk * a1
+        y[k] = yk + noise_sd * z[k] if noisy else yk
     return y
 
 
@@ -69,9 +77,15 @@ def scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult
     t = t_cross + x_zero + dt * np.arange(codes.shape[1])
     if t[-1] > (analog.shape[1] - 1) * h * (1 + 1e-12):
         return PAST_INPUT, t_cross, x_zero
-    for c in range(analog.shape[0]):
-        codes[c], over[c] = quantise(at_positions(analog[c], t / h), offset[c], ymult[c], yoff[c], sd[c], z[c],
-                                     lo, hi)
+    for c in range(analog.shape[0]):  # read between input samples, then the converter, in one pass
+        noisy = z.shape[1] > 0
+        clipped = False
+        for k in range(t.shape[0]):
+            q = code(read_at(analog[c], t[k] / h), offset[c], ymult[c], yoff[c], noisy,
+                     sd[c] * z[c, k] if noisy else 0.0)
+            clipped |= q > hi or q < lo
+            codes[c, k] = np.int8(min(max(q, lo), hi))
+        over[c] = clipped
     return OK, t_cross, x_zero
 
 

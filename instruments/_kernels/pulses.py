@@ -23,13 +23,31 @@ MAD_TO_SD = 1.4826  # the standard deviation of Gaussian noise over its median a
 OK, SAME_RECORD, NO_PULSE, SWAPPED = 0, 1, 2, 3
 STATUS, LAG = 0, 15
 PEAK, FOUND, TIME, AMPLITUDE, FWHM, BASE_WIDTH, RISE = range(7)
+ROLE = 7  # fields of each role; role r's field x is at 1 + ROLE r + x
 ANSWER = 16
 
 
 @jit
 def index_of(r, field):
     """Index in leading_pair's answer of ``field`` of role r (0: upper gauge, 1: lower)."""
-    return 1 + 7 * r + field
+    return 1 + ROLE * r + field
+
+
+@jit
+def first_peak(f):
+    """Index of the first local maximum of f - f[0] above half its peak (-1: f never rises
+    above f[0]): the sample where the climb from the first one above half stops."""
+    top = 0.0
+    for k in range(f.shape[0]):
+        top = max(top, f[k] - f[0])
+    if top <= 0.0:
+        return -1
+    i = 0
+    while not f[i] - f[0] > 0.5 * top:
+        i += 1
+    while i + 1 < f.shape[0] and not (f[i + 1] - f[0] < f[i] - f[0]):
+        i += 1
+    return i
 
 
 @jit
@@ -43,14 +61,50 @@ def baseline_mean(y, n_pre):
 
 
 @jit
+def _select(a, k):
+    """a[k] once a is partly sorted in place so that a[:k] <= a[k] <= a[k + 1:] (Hoare)."""
+    lo, hi = 0, a.shape[0] - 1
+    while lo < hi:
+        pivot = a[(lo + hi) // 2]
+        i, j = lo, hi
+        while i <= j:
+            while a[i] < pivot:
+                i += 1
+            while a[j] > pivot:
+                j -= 1
+            if i <= j:
+                a[i], a[j] = a[j], a[i]
+                i += 1
+                j -= 1
+        if k <= j:
+            hi = j
+        elif k >= i:
+            lo = i
+        else:
+            break
+    return a[k]
+
+
+@jit
+def median(x):
+    """The median of x (numpy's: the middle value, or the mean of the two middle ones)."""
+    a = x.copy()
+    k = a.shape[0] // 2
+    upper = _select(a, k)
+    if a.shape[0] % 2:
+        return upper
+    return (np.max(a[:k]) + upper) / 2.0
+
+
+@jit
 def noise_level(y, n_pre, step):
     """1.4826 x the median absolute deviation of the first n_pre samples of y, never below
     step / sqrt(12); nan with fewer than MIN_BASELINE samples (analysis.noise_level)."""
     if n_pre < MIN_BASELINE:
         return math.nan
     pre = y[:n_pre]
-    centre = np.median(pre)
-    mad = MAD_TO_SD * np.median(np.abs(pre - centre))
+    centre = median(pre)
+    mad = MAD_TO_SD * median(np.abs(pre - centre))
     return max(mad, abs(step) / math.sqrt(12.0))
 
 

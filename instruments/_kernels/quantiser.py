@@ -5,6 +5,15 @@ from instruments.jit import jit
 
 
 @jit
+def code(v, offset, ymult, yoff, noisy, noise):
+    """One sample's code before clipping: rint((v - offset) / ymult + yoff [+ noise])."""
+    c = (v - offset) / ymult + yoff
+    if noisy:
+        c = c + noise
+    return np.rint(c)
+
+
+@jit
 def quantise(v, offset, ymult, yoff, sd, noise, lo, hi):
     """Codes round((v - offset) / ymult + yoff [+ sd * noise]) clipped to [lo, hi] (int8),
     and whether any was clipped. ``noise``: standard normal draws, one per sample, or an
@@ -15,15 +24,7 @@ def quantise(v, offset, ymult, yoff, sd, noise, lo, hi):
     noisy = noise.shape[0] > 0
     clipped = False
     for k in range(n):
-        c = (v[k] - offset) / ymult + yoff
-        if noisy:
-            c = c + sd * noise[k]
-        c = np.rint(c)
-        if c > hi:
-            c = hi
-            clipped = True
-        elif c < lo:
-            c = lo
-            clipped = True
-        codes[k] = np.int8(c)
+        c = code(v[k], offset, ymult, yoff, noisy, sd * noise[k] if noisy else 0.0)
+        clipped |= c > hi or c < lo
+        codes[k] = np.int8(min(max(c, lo), hi))
     return codes, clipped

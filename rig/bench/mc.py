@@ -1,13 +1,19 @@
-"""Monte Carlo benchmark (``rig bench mc``): ptfe52_magnetic at the scene's default
-accuracy, in the study's leading-pulse window, batches of 128 shots.
+"""Monte Carlo benchmark (``rig bench mc [--baseline REV]``): ptfe52_magnetic at the scene's
+default accuracy, in the study's leading-pulse window, batches of 128 shots, no traces.
 
-- the batched solver alone, numba threads over chunks of shots (every core);
-- the full pipeline (solver, instruments, measured analysis; no traces) in one process;
+- the batched solver alone (the kernel's time, and with building the shots' arrays), numba
+  threads over chunks of shots (every core);
+- the full pipeline (solver, instruments, measured analysis) in one process (numba threads
+  over the shots);
 - the full pipeline as ``rig mc --workers N`` runs it, one worker process per core: the
   steady rate (shots finished after each worker's first batch, over the time since) and
   the rate of the whole run, worker start-up included.
 
-Medians of 3 (the study runs once: it is long enough to average over many batches)."""
+Each figure is the median of ``repeats`` in a round (the study runs once a round). With
+``--baseline REV`` every round runs the same measurement with revision REV in a
+subprocess right after this one (rig/bench/baseline.py); the table gives the medians over
+the rounds and the median of the per-round ratios.
+"""
 from __future__ import annotations
 
 import os
@@ -16,49 +22,65 @@ import tempfile
 import time
 
 from rig.solver.ensemble import solve_ensemble
-from rig.solver.problem import ChainProblem
-from rig.solver.stepsize import stepping_at
-from rig.study.batch import run_batch, shot_inputs, shot_rig, study_save
+from rig.study.batch import run_batch, shot_inputs
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
 from rig.study.mc_spec import Study
 from rig.study.nominal import nominal
+from rig.study.shots import shots_of
 from rig.study.store import Store
 
 VARY = ("striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)")
 BATCH = 128
+FIGURES = ("solver_kernel_shots_per_s", "solver_shots_per_s", "pipeline_shots_per_s",
+           "pipeline_workers_steady_shots_per_s", "pipeline_workers_total_shots_per_s")
+SNIPPET = """
+import json
+from rig.bench import mc
+print(json.dumps(mc.run(**({"rounds": 1} if "rounds" in mc.run.__code__.co_varnames else {}))))
+"""
 
 
 def _solver(study: Study, shots: int) -> dict:
-    rigs = [shot_rig(study, *shot_inputs(study, i, 52)[:2])[0] for i in range(shots)]
-    problems = [ChainProblem.from_chain(r.chain) for r in rigs]
-    save = study_save(study, rigs[0])
-    t_end = rigs[0].solver.duration
-    pilot = nominal(study.scene, ()).pilot(study.window, rigs[0].save_at(contacts=False, averages=True), study.accuracy)
-    dt = stepping_at(problems[0], pilot.stats.dt_s)
-    solve_ensemble(problems[:8], t_end, save=save, dt=dt)
+    nom = nominal(study.scene, ())
+    template = nom.template(study.window)
+    save = template.save_at(contacts=False, averages=True)
+    pilot = nom.pilot(study.window, save, study.accuracy)
+
+    def arrays(lo):
+        drawn = [shot_inputs(study, i, 52) for i in range(lo, lo + BATCH)]
+        return shots_of(template, [x for x, *_ in drawn], [m for _, m, _ in drawn]).problems
+
+    from rig.solver.stepsize import stepping_at
+
+    dt = stepping_at(pilot.problem, pilot.stats.dt_s)
+    t_end = template.solver.duration
+    solve_ensemble(arrays(0), t_end, save=save, dt=dt)
     kernel, total = [], []
     for _ in range(3):  # in batches, as a study runs them (the recorded forces take memory)
         t0 = time.perf_counter()
         k = 0.0
         for lo in range(0, shots, BATCH):
-            ens = solve_ensemble(problems[lo:lo + BATCH], t_end, save=save, dt=dt)
+            ens = solve_ensemble(arrays(lo), t_end, save=save, dt=dt)
             k += ens.wall_s
         total.append(time.perf_counter() - t0)
         kernel.append(k)
     return {"dt_s": ens.dt, "steps": ens.steps, "t_end_s": t_end, "head": dt.head, "substep_s": dt.inner_dt,
+            "error_estimate": pilot.stats.error_estimate,
             "solver_kernel_shots_per_s": shots / statistics.median(kernel),
             "solver_shots_per_s": shots / statistics.median(total)}
 
 
-def _one_process(study: Study) -> float:
+def _one_process(study: Study) -> dict:
     run_batch(study, 0)
-    full = []
+    wall, cpu = [], []
     for b in range(1, 4):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         run_batch(study, b)
-        full.append(time.perf_counter() - t0)
-    return BATCH / statistics.median(full)
+        wall.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
+    return {"pipeline_shots_per_s": BATCH / statistics.median(wall),
+            "pipeline_cpu_us_per_shot": statistics.median(cpu) / BATCH * 1e6}
 
 
 def _workers(study: Study, workers: int) -> dict:
@@ -76,28 +98,64 @@ def _workers(study: Study, workers: int) -> dict:
     return {"pipeline_workers_steady_shots_per_s": steady, "pipeline_workers_total_shots_per_s": study.shots / total}
 
 
-def run(shots: int = 512, study_shots: int = 8192) -> dict:
+def measure(shots: int = 512, study_shots: int = 8192) -> dict:
+    """One round of every figure of this revision."""
     import numba
 
     study = Study("ptfe52_magnetic", tuple(parse_vary(VARY)), shots, batch=BATCH)
     workers = os.cpu_count() or 1
     out = {"scene": "ptfe52_magnetic", "shots": shots, "threads": numba.get_num_threads(), "workers": workers,
-           "study_shots": study_shots, **_solver(study, shots),
-           "pipeline_shots_per_s": _one_process(study)}
+           "study_shots": study_shots, **_solver(study, shots), **_one_process(study)}
     out.update(_workers(Study("ptfe52_magnetic", tuple(parse_vary(VARY)), study_shots, seed=1, batch=BATCH),
                         workers))
     return out
 
 
+def run(rounds: int = 3, baseline: str | None = None) -> dict:
+    from rig.bench.baseline import ROOT, checkout
+    from rig.bench.baseline import measure as measure_in
+
+    runs = {"current": [], "baseline": []}
+    with (checkout(baseline) if baseline else _nothing()) as tree:
+        for _ in range(rounds):
+            runs["current"].append(measure() if tree is None else measure_in(ROOT, SNIPPET, timeout=1800))
+            if tree is not None:
+                runs["baseline"].append(measure_in(tree, SNIPPET, timeout=1800))
+    out = dict(runs["current"][0], rounds=rounds, baseline_rev=baseline)
+    for key in FIGURES:
+        out[key] = statistics.median(r[key] for r in runs["current"])
+    if runs["baseline"]:
+        out["baseline"] = {key: statistics.median(r[key] for r in runs["baseline"]) for key in FIGURES}
+        out["ratio"] = {key: statistics.median(c[key] / b[key] for c, b in zip(runs["current"], runs["baseline"]))
+                        for key in FIGURES}
+    return out
+
+
+class _nothing:
+    def __enter__(self):
+        return None
+
+    def __exit__(self, *exc):
+        return False
+
+
 def table(r: dict) -> str:
-    return "\n".join([
-        f"Monte Carlo, {r['scene']} at default accuracy (dt = {r['dt_s'] * 1e9:.0f} ns, {r['steps']} steps "
-        f"to {r['t_end_s'] * 1e3:.3g} ms, the study's leading-pulse window; multirate head of {r['head']} "
-        f"contact(s), substep {r['substep_s'] * 1e9:.0f} ns), batches of {BATCH}",
-        f"  batched solver, kernel only, {r['threads']} threads          {r['solver_kernel_shots_per_s']:8.0f} shots/s",
-        f"  batched solver, with set-up, {r['threads']} threads          {r['solver_shots_per_s']:8.0f} shots/s",
-        f"  full pipeline, one process                      {r['pipeline_shots_per_s']:8.0f} shots/s",
-        (f"  full pipeline, rig mc --workers {r['workers']}, steady        "
-         f"{r['pipeline_workers_steady_shots_per_s']:8.0f} shots/s"),
-        (f"  full pipeline, rig mc --workers {r['workers']}, {r['study_shots']} shots incl. start-up "
-         f"{r['pipeline_workers_total_shots_per_s']:6.0f} shots/s")])
+    labels = {"solver_kernel_shots_per_s": f"batched solver, kernel only, {r['threads']} threads",
+              "solver_shots_per_s": f"batched solver, with set-up, {r['threads']} threads",
+              "pipeline_shots_per_s": f"full pipeline, one process, {r['threads']} threads",
+              "pipeline_workers_steady_shots_per_s": f"full pipeline, rig mc --workers {r['workers']}, steady",
+              "pipeline_workers_total_shots_per_s": f"full pipeline, rig mc --workers {r['workers']}, "
+                                                    f"{r['study_shots']} shots with start-up"}
+    base = r.get("baseline")
+    head = f"  {'':56s} {'shots/s':>9s}" + (f" {'baseline ' + r['baseline_rev']:>18s} {'ratio':>7s}" if base else "")
+    lines = [f"Monte Carlo, {r['scene']} at default accuracy (dt = {r['dt_s'] * 1e9:.0f} ns from the study's pilot, "
+             f"estimate {r['error_estimate']:.2g}; {r['steps']} steps to {r['t_end_s'] * 1e3:.3g} ms, the "
+             f"leading-pulse window; head of {r['head']} contact(s), substep {r['substep_s'] * 1e9:.0f} ns), "
+             f"batches of {BATCH}, medians of {r['rounds']} round(s)", head]
+    for key in FIGURES:
+        line = f"  {labels[key]:56s} {r[key]:9.0f}"
+        if base:
+            line += f" {base[key]:18.0f} {r['ratio'][key]:7.2f}"
+        lines.append(line)
+    lines.append(f"  CPU per shot of the one-process pipeline: {r['pipeline_cpu_us_per_shot']:.0f} us (all threads)")
+    return "\n".join(lines)

@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from instruments.analysis import first_peak_time
+
 
 @dataclass(frozen=True, eq=False)
 class GaugeTruth:
@@ -63,13 +65,3 @@ def speed_between(x_top: float, f_top: np.ndarray, x_bottom: float, f_bottom: np
     if t_top is None or t_bottom is None or t_bottom <= t_top:
         return None
     return (x_bottom - x_top) / (t_bottom - t_top)
-
-
-def first_peak_time(f: np.ndarray, h: float) -> float | None:
-    """Time (s) of the first local maximum of the dynamic force above half its peak."""
-    dyn = f - f[0]
-    if dyn.max() <= 0:
-        return None
-    i = int(np.argmax(dyn > 0.5 * dyn.max()))
-    falls = np.flatnonzero(dyn[i + 1:] < dyn[i:-1])  # climb from i to the first sample that falls
-    return (i + int(falls[0]) if falls.size else dyn.size - 1) * h

@@ -111,9 +111,14 @@ class GaugeBead(Bead):
         if self.caps_mass is None:
             plain = self.mass if self.mass is not None else (
                 self.material.rho * math.pi * self.diameter**3 / 6.0)
-            object.__setattr__(self, "caps_mass", PTFE_GAUGE_CAPS_FRACTION * plain)
+            object.__setattr__(self, "caps_mass", self.caps_of(plain))
         self._positive("gauge_bead", "caps_mass")
         object.__setattr__(self, "mass", self.caps_mass + self.plate_mass)
+
+    @staticmethod
+    def caps_of(plain_mass):
+        """The caps' mass (kg) cut from a plain bead of ``plain_mass`` (kg; floats or arrays)."""
+        return PTFE_GAUGE_CAPS_FRACTION * plain_mass
 
     @classmethod
     def like(cls, bead: Bead, **kw) -> "GaugeBead":

@@ -25,17 +25,22 @@ from rig.solver.stepsize import Stepping
 
 @dataclass(frozen=True, eq=False)
 class EnsembleSolution:
-    """forces: {probe: (shots, samples) array (N), each shot's row contiguous}; reports:
-    what the kernel reported of each shot (energy and momentum errors, wall impulse,
-    status)."""
+    """records: (shots, probes, samples) (N), the probes in the SaveAt's order, each shot's
+    record contiguous; forces: {probe: (shots, samples)}, views of it; reports: what the
+    kernel reported of each shot (energy and momentum errors, wall impulse, status)."""
 
-    forces: dict
+    records: np.ndarray
     sample_interval: float
     dt: float
     steps: int
     wall_s: float
     method: str
     reports: tuple
+    names: tuple
+
+    @property
+    def forces(self) -> dict:
+        return {name: self.records[:, c] for c, name in enumerate(self.names)}
 
     @property
     def shots(self) -> int:
@@ -89,7 +94,7 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
         a = np.moveaxis(getattr(problems, name)[fill], 0, -1)
         return np.ascontiguousarray(np.moveaxis(a.reshape(a.shape[:-1] + (n_chunks, width)), -2, 0))
 
-    out = np.zeros((n_chunks, len(save.names), n_out, width))
+    out = np.empty((n_chunks, len(save.names), n_out, width))  # the kernel writes every sample
     diag = np.zeros((n_chunks, 6, width))
     u, v = stack("u0"), stack("v0")
     t0 = time.perf_counter()
@@ -99,10 +104,8 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
                        check_interval(n_steps), stack("d_limit"), p0.wall_slot,
                        stack("energy_scale"), stack("momentum_scale"), diag)
     wall = time.perf_counter() - t0
-    # (chunks, channels, samples, width) -> each channel (shots, samples), each shot's record contiguous
-    out = np.moveaxis(out, 3, 1).reshape(n_chunks * width, len(save.names), n_out)[:n]
+    # (chunks, channels, samples, width) -> (shots, channels, samples), each shot's record contiguous
+    out = np.ascontiguousarray(np.moveaxis(out, 3, 1).reshape(n_chunks * width, len(save.names), n_out)[:n])
     diag = np.moveaxis(diag, 0, -2).reshape(6, n_chunks * width)[:, :n]
     reports = tuple(KernelReport.of(diag[:, j]) for j in range(n))
-    return EnsembleSolution({name: np.ascontiguousarray(out[:, c]) for c, name in enumerate(save.names)},
-                            save.sample_interval,
-                            step, n_steps, wall, m.name, reports)
+    return EnsembleSolution(out, save.sample_interval, step, n_steps, wall, m.name, reports, save.names)

@@ -34,7 +34,8 @@ IMPOSSIBLE, UNSTABLE, NO_TRIGGER, SHORT_WINDOW, NON_FINITE = range(1, len(FAILUR
 class BatchResult:
     """What batch ``batch`` gives: the shots' indices, inputs (shots, K) in the study's key
     order, instrument seeds, outputs {name: (shots,)} (OUTPUTS; nan where nothing was
-    measured; "failure": the index of FAILURES, 0 for a shot that did not fail) and, for a study with traces, each shot's archive Entry."""
+    measured; "failure": the index of FAILURES, 0 for a shot that did not fail) and, for a
+    study with traces, each shot's archive Entry."""
 
     batch: int
     index: np.ndarray
@@ -150,8 +151,7 @@ def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
     save = template.save_at(contacts=False, averages=True)
     ens = solve_ensemble(sub.problems, template.solver.duration, save=save, dt=dt, method=template.solver.method)
     wiring = wiring_of(template)
-    names = [f"gauge_{g.name}" for g in template.gauges] + (["wall"] if template.wall_sensor is not None else [])
-    forces = np.stack([ens.forces[n] for n in names], axis=1)
+    forces = ens.records  # what each gauge reads, in the wiring's order: the bead gauges by name, the wall
     h = ens.sample_interval
     speeds = wave_speeds(template, sub, forces, h)
     records = instrument_batch.acquire(forces, h, wiring, [drawn[j][2] for j in keep], sub.fixed, speeds)
@@ -164,7 +164,8 @@ def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
         if records.status[e] == instrument_batch.PAST_INPUT:  # the scope's record ends after the simulated window
             out["failure"][j] = SHORT_WINDOW
             continue
-        _outputs(out, j, reports[e], None, ens.reports[e].energy_error, ens.dt, records.status[e] == instrument_batch.OK)
+        triggered = records.status[e] == instrument_batch.OK
+        _outputs(out, j, reports[e], None, ens.reports[e].energy_error, ens.dt, triggered)
 
 
 def _outputs(out: dict, j: int, m, t, energy_error: float, dt: float, triggered: bool):

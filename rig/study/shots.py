@@ -76,12 +76,10 @@ def shots_of(template: Rig, values: list, masses: list) -> Shots:
     bead_mass = np.tile(chain.masses, (S, 1))
     if any(m is not None for m in masses):
         plain = [j for j, b in enumerate(chain.beads) if b.kind != "magnetic"]
-        gauges = {g.bead for g in template.gauges}
-        for s, m in enumerate(masses):
-            bead_mass[s, plain] = m
-            for j in gauges:  # the gauge bead's caps keep a fraction of the plain bead's mass (GaugeBead)
-                g = chain.beads[j]
-                bead_mass[s, j] = GaugeBead.like(g.with_mass(float(m[plain.index(j)]))).mass
+        bead_mass[:, plain] = np.array(masses, dtype=float)
+        for g in template.gauges:  # a gauge bead: caps cut from its plain bead, and the plate (GaugeBead)
+            bead = chain.beads[g.bead]
+            bead_mass[:, g.bead] = GaugeBead.caps_of(bead_mass[:, g.bead]) + bead.plate_mass
     plain_material = next(b.material for b in chain.beads if b.kind != "magnetic")
     E, nu = col("chain.youngs_modulus", plain_material.E), col("chain.poisson_ratio", plain_material.nu)
     top = col("magnet.force", chain.initial_top_force)

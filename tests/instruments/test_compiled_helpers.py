@@ -144,3 +144,12 @@ def test_quantiser_is_the_numpy_expression(sd):
     assert clipped == bool(np.any(ref > 127) or np.any(ref < -128)) and clipped
     assert codes.dtype == np.int8 and np.array_equal(codes, np.clip(ref, -128, 127).astype(np.int8))
     assert not quantise(v * 0.1, 0.0, 0.01, 0.0, sd, noise, -128.0, 127.0)[1]
+
+
+@pytest.mark.parametrize("n", [1, 2, 7, 16, 1250, 1251])
+def test_median_is_numpys(n):
+    from instruments._kernels.pulses import median
+
+    rng = np.random.default_rng(n)
+    for x in (rng.standard_normal(n), rng.integers(0, 4, n).astype(float)):  # ties as on 8-bit records
+        assert median(x) == np.median(x)

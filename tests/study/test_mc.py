@@ -201,3 +201,34 @@ def test_a_study_records_the_gauge_averages_and_contacts_only_when_needed():
     for k in ("speed_m_per_s", "amplitude_N"):
         assert np.array_equal(plain[k], with_truth[k])
     assert np.all(np.isfinite(with_truth["truth_speed_m_per_s"]))
+
+
+def test_a_batch_shot_has_the_bits_of_the_shot_fired_alone():
+    # no rig is built per shot in a batch (arrays all the way); the same shot built as a rig,
+    # solved alone at the study's step, fired with its seed and draws and analysed as one
+    # record gives the very same numbers
+    from instruments.pipeline import analyze_record
+    from rig.experiment.measure import setup_for
+    from rig.solver.problem import ChainProblem
+    from rig.solver.solve import solve
+    from rig.solver.stepsize import stepping_at
+    from rig.study.batch import shot_inputs, shot_rig
+    from rig.study.nominal import nominal
+
+    study = _study(16)
+    outputs = run_batch(study, 0).outputs
+    nom = nominal(study.scene, ())
+    template = nom.template(study.window)
+    save = template.save_at(contacts=False, averages=True)
+    pilot = nom.pilot(study.window, save, study.accuracy)
+    beta, F0 = nom.calibration
+    for i in (0, 5, 11):
+        x, masses, seed = shot_inputs(study, i, 52)
+        rig, draws = shot_rig(study, x, masses)
+        p = ChainProblem.from_chain(rig.chain)
+        rig.use_solution(solve(p, template.solver.duration, save=save, dt=stepping_at(p, pilot.stats.dt_s),
+                               estimate=False))
+        shot = rig.fire(seed=seed, fixed=draws, truth=False)
+        m = analyze_record(shot.scope, setup_for(template, beta, F0), train=False)
+        for key in ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_amplitude_N"):
+            assert getattr(m, key) == outputs[key][i], (i, key)

@@ -123,7 +123,8 @@ def _step(u, v, invm, f, A, d0, damping, law, load, a_coef, b_coef, dt, t, pendi
     Each body sees the same operations in the same order as in stage-by-stage sweeps.
     With a multirate head, bodies 0..head get the kick of slot head + 1 and the head's
     flow (multirate.head_flow) instead. ``heads``: the (bodies, 1) views the head flow
-    takes, h_work and h_busy its work arrays; impulses[0] += the wall's dynamic impulse, impulses[1] += the schedule's (N s).
+    takes, h_work and h_busy its work arrays; impulses[0] += the wall's dynamic impulse,
+    impulses[1] += the schedule's (N s).
     """
     nb = u.shape[0]
     u2, v2, im2, f2, A2, d02, load2 = heads

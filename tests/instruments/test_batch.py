@@ -1,0 +1,79 @@
+"""The batched instruments and analysis give each shot the bits it gets alone: the same
+codes as PiezoGauge.read and Oscilloscope.acquire fed the same generator, the same Report
+as the pipeline's analyze_record."""
+import numpy as np
+import pytest
+
+from instruments import batch
+from instruments.analysis import PeakRules
+from instruments.gauges import GaugeDraw, GaugeSettings, PiezoGauge
+from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
+from instruments.pipeline import GaugeSetup, Setup, analyze_record
+
+H = 2e-7
+N = 3000
+
+
+def _pulse(t0, amp=5.0, width=40e-6):
+    t = np.arange(N) * H
+    return amp / np.cosh((t - t0) / width) ** 2
+
+
+def _wiring(noise=1e-3, noise_floor=2e-4):
+    gauges = ((ch, GaugeSettings(noise=noise), delayed)
+              for ch, delayed in (("CH2", True), ("CH1", True), ("CH3", False)))
+    channels = {c: ChannelSettings(volts_per_div=0.05, bandwidth=20e6) for c in ("CH1", "CH2", "CH3")}
+    scope = Oscilloscope(channels=channels,
+                         timebase=Timebase(2e-7, 2000), trigger=Trigger("CH1", 0.02, "rising", 0.3),
+                         noise_floor=noise_floor)
+    return batch.Wiring(tuple(gauges), scope)
+
+
+def _alone(forces, wiring, seed, fixed, speed):
+    """One shot the way Rig.fire reads it: each gauge's draw and read, then the scope."""
+    rng = np.random.default_rng(seed)
+    inputs = {}
+    for k, (ch, settings, delayed) in enumerate(wiring.gauges):
+        draw = GaugeDraw.draw(settings, rng)
+        gain = draw.gain if np.isnan(fixed[k, 0]) else fixed[k, 0]
+        mis = draw.misalignment if np.isnan(fixed[k, 1]) else fixed[k, 1]
+        inputs[ch] = PiezoGauge(settings).read(forces[k], H, GaugeDraw(gain, mis), rng, speed if delayed else None)
+    return wiring.scope.acquire(inputs, H, rng)
+
+
+@pytest.mark.parametrize("noise,noise_floor", [(1e-3, 2e-4), (0.0, 0.0)])
+def test_a_batch_of_shots_reads_as_its_shots_alone(noise, noise_floor):
+    wiring = _wiring(noise, noise_floor)
+    S = 6
+    forces = np.stack([np.stack([_pulse(2.0e-4 + 1e-6 * s), _pulse(1.8e-4 + 1e-6 * s), _pulse(4e-4, 9.0)])
+                       for s in range(S)])
+    seeds = [11 + 7 * s for s in range(S)]
+    fixed = np.full((S, 3, 2), np.nan)
+    fixed[1, 0, 0] = 1.07  # a study's own gain for one gauge of one shot
+    speeds = np.full(S, 230.0)
+    speeds[2] = np.nan  # no wave speed: no delay
+    records = batch.acquire(forces, H, wiring, seeds, fixed, speeds)
+    for s in range(S):
+        alone = _alone(forces[s], wiring, seeds[s], fixed[s], None if np.isnan(speeds[s]) else speeds[s])
+        together = records.record(s)
+        assert together.triggered and alone.triggered
+        assert together.trigger_time == alone.trigger_time
+        for ch, w in alone.waveforms.items():
+            assert np.array_equal(together.waveforms[ch].codes, w.codes), (s, ch)
+            assert together.waveforms[ch].preamble == w.preamble
+    setup = Setup(GaugeSetup("CH2", 0.0, 0.05, 1e-3), GaugeSetup("CH1", 0.0043, 0.05, 1e-3),
+                  GaugeSetup("CH3", 0.02, 0.05, 1e-3), 4.76e-3, 1.1, 2.4, PeakRules())
+    for s, rep in enumerate(batch.analysed(records, setup)):
+        ref = analyze_record(records.record(s), setup, train=False)
+        assert rep.as_dict() == ref.as_dict(), s
+
+
+def test_a_shot_that_does_not_trigger_or_outlasts_its_input_says_so():
+    wiring = _wiring()
+    forces = np.stack([np.stack([_pulse(2e-4, 1e-4), _pulse(1.8e-4, 1e-4), _pulse(4e-4)]),  # far below the level
+                       np.stack([_pulse(5.9e-4), _pulse(5.8e-4), _pulse(5.9e-4)])])  # triggers too late
+    records = batch.acquire(forces, H, wiring, [1, 2])
+    assert list(records.status) == [batch.NO_TRIGGER, batch.PAST_INPUT]
+    assert not records.record(0).triggered
+    setup = Setup(GaugeSetup("CH2"), GaugeSetup("CH1", 0.0043))
+    assert "did not trigger" in batch.analysed(records, setup)[0].reasons["speed_m_per_s"]
