@@ -54,6 +54,7 @@ PEERS = {"scipy-DOP853": (1e-6, 1e-8, 1e-10), "numba-DOP853": (1e-6, 1e-7, 1e-8,
 EQUAL_ERRORS = (1e-4, 1e-5, 1e-6)
 KERNEL_SIZES = ((1000, 4000, 5), (1_000_000, 300, 1))  # (beads, steps, repeats) of the kernel figure
 SCALING_SIZES = (1000, 10_000, 100_000, 1_000_000)
+SCALING_PROBE, SCALING_T = 50, 1e-3  # the pulse passes contact 50 in about 0.4 ms
 QUICK = dict(divisions={"srkn6b": (3, 6, 12), "verlet": (32, 128)}, settings=(1e-4,), peers={
     "scipy-DOP853": (1e-8,), "numba-DOP853": (1e-8, 1e-10), "LAMMPS": (20,)}, scenarios=("precompressed",))
 
@@ -231,11 +232,12 @@ class _no_tree:
 
 
 def scaling(progress=None) -> dict:
-    """CPU per simulated second from 1e3 to 1e6 beads (precompressed chain), at the step the
-    accuracy control picks for 1e3 beads at the default accuracy, and the exponent of N."""
+    """CPU per simulated second from 1e3 to 1e6 beads (precompressed chain, the force of
+    contact SCALING_PROBE, which the pulse passes within SCALING_T), at the step the accuracy
+    control picks for 1e3 beads at the default accuracy, and the exponent of N."""
     p0 = ChainProblem.from_chain(chain(2.38))
-    save0 = SaveAt({"c500": chain(2.38).contact_probe(PROBE)}, SAMPLE_INTERVAL)
-    t_end = 1e-3
+    save0 = SaveAt({"c": chain(2.38).contact_probe(SCALING_PROBE)}, SAMPLE_INTERVAL)
+    t_end = SCALING_T
     stepping = stepping_at(p0, solve(p0, t_end, save=save0).stats.dt_s)
     rows = []
     for n in SCALING_SIZES:
@@ -243,7 +245,7 @@ def scaling(progress=None) -> dict:
             progress(f"scaling: {n} beads")
         c = chain(2.38, n)
         p = ChainProblem.from_chain(c)
-        save = SaveAt({"c500": c.contact_probe(PROBE)}, SAMPLE_INTERVAL)
+        save = SaveAt({"c": c.contact_probe(SCALING_PROBE)}, SAMPLE_INTERVAL)
         steps = max(100, int(2e7 / n))
         span = steps * stepping.dt
         solve(p, 2 * stepping.dt, save=save, dt=stepping, estimate=False)
