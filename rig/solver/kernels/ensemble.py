@@ -77,21 +77,25 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
 @jit
 def _record(out, j, w, col, ch_slot, ch_weight, A, d_old, r_old, d_new, r_new):
     """out[c, j, s]: channel c's force (N) of every shot s at sample j, whose Hermite weights
-    are column col of w: record.recorded_force's operations, in its order, with the shots
-    innermost (the loop vectorises)."""
+    are column col of w: record.recorded_force's operations, in its order (0 + the first
+    term is that term: no force is -0), with the shots innermost (the loop vectorises)."""
     W = out.shape[2]
+    w0, w1, w2, w3 = w[0, col], w[1, col], w[2, col], w[3, col]
     for c in range(ch_slot.shape[0]):
-        for s in range(W):
-            out[c, j, s] = 0.0
+        first = True
         for k in range(ch_slot.shape[1]):
             wk = ch_weight[c, k]
             if wk != 0.0:
                 i = ch_slot[c, k]
-                w0, w1, w2, w3 = w[0, col], w[1, col], w[2, col], w[3, col]
                 for s in range(W):
                     d = w0 * d_old[c, k, s] + w1 * r_old[c, k, s] + w2 * d_new[c, k, s] + w3 * r_new[c, k, s]
                     d = d if d > 0.0 else 0.0
-                    out[c, j, s] += wk * (A[i, s] * d * math.sqrt(d))
+                    fk = wk * (A[i, s] * d * math.sqrt(d))
+                    out[c, j, s] = fk if first else out[c, j, s] + fk
+                first = False
+        if first:  # a channel of no contact records nothing
+            for s in range(W):
+                out[c, j, s] = 0.0
 
 
 @jit
