@@ -17,6 +17,7 @@ the rounds and the median of the per-round ratios.
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import statistics
 import tempfile
@@ -119,7 +120,7 @@ def run(rounds: int = 3, baseline: str | None = None) -> dict:
     from rig.bench.baseline import measure as measure_in
 
     runs = {"current": [], "baseline": []}
-    with (checkout(baseline) if baseline else _nothing()) as tree:
+    with checkout(baseline) if baseline else contextlib.nullcontext() as tree:
         for _ in range(rounds):
             runs["current"].append(measure() if tree is None else measure_in(ROOT, SNIPPET, timeout=1800))
             if tree is not None:
@@ -132,14 +133,6 @@ def run(rounds: int = 3, baseline: str | None = None) -> dict:
         out["ratio"] = {key: statistics.median(c[key] / b[key] for c, b in zip(runs["current"], runs["baseline"]))
                         for key in FIGURES}
     return out
-
-
-class _nothing:
-    def __enter__(self):
-        return None
-
-    def __exit__(self, *exc):
-        return False
 
 
 def table(r: dict) -> str:

@@ -21,6 +21,7 @@ accuracy``. CPU times are process times, medians of ``repeats`` runs.
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import platform
@@ -133,18 +134,14 @@ def _peers(name, p, save, t_end, ref, peers, progress) -> tuple:
 
     rows, notes = [], []
     tau = contact_time_scale(p, head_contacts(p) + 1)
-    for rtol in peers["scipy-DOP853"]:
-        if progress:
-            progress(f"{name}: scipy DOP853 rtol={rtol:g}")
-        run = scipy_dop853(p, save, t_end, rtol)
-        rows.append(_row(name, run.name, run.setting, run.cpu_s, relative_error({"c": run.force}, {"c": ref["c500"]}),
-                         run.rhs_evaluations, p.moving_bodies))
-    for rtol in peers["numba-DOP853"]:
-        if progress:
-            progress(f"{name}: numba DOP853 rtol={rtol:g}")
-        run = numba_dop853(p, save, t_end, rtol)
-        rows.append(_row(name, run.name, run.setting, run.cpu_s, relative_error({"c": run.force}, {"c": ref["c500"]}),
-                         run.rhs_evaluations, p.moving_bodies))
+    for peer, integrate in (("scipy-DOP853", scipy_dop853), ("numba-DOP853", numba_dop853)):
+        for rtol in peers[peer]:
+            if progress:
+                progress(f"{name}: {peer} rtol={rtol:g}")
+            run = integrate(p, save, t_end, rtol)
+            rows.append(_row(name, run.name, run.setting, run.cpu_s,
+                             relative_error({"c": run.force}, {"c": ref["c500"]}), run.rhs_evaluations,
+                             p.moving_bodies))
     if lammps.executable() is None:
         notes.append("LAMMPS not installed (apt-get install lammps): skipped")
     else:
@@ -201,7 +198,7 @@ def kernel_figures(repeats: int, rounds: int, baseline: str | None, progress=Non
     sizes = tuple((n, steps, min(r, repeats)) for n, steps, r in KERNEL_SIZES)
     snippet = f"SIZES = {sizes!r}\n" + KERNEL_SNIPPET
     runs = {"current": [], "baseline": []}
-    with (checkout(baseline) if baseline else _no_tree()) as tree:
+    with checkout(baseline) if baseline else contextlib.nullcontext() as tree:
         for k in range(rounds):
             if progress:
                 progress(f"kernel figure, round {k + 1} of {rounds}")
@@ -221,14 +218,6 @@ def kernel_figures(repeats: int, rounds: int, baseline: str | None, progress=Non
                      # every array (u, v, f read and written, invm, A, d0, load read: 80 B)
                      "memory_state_ns": 48.0 / gbs, "memory_all_ns": 80.0 / gbs}
     return out
-
-
-class _no_tree:
-    def __enter__(self):
-        return None
-
-    def __exit__(self, *exc):
-        return False
 
 
 def scaling(progress=None) -> dict:

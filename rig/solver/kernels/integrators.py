@@ -71,7 +71,7 @@ def _fused_run(u, v, invm, f, A, d0, damping, law, load, hb, ha, lo, hi):
     (tests/solver/test_vectorised.py guards this)."""
     one = np.uint64(1)
     u_prev = u[lo - 1]
-    if law == HERTZ:
+    if law == HERTZ:  # a loop per law: a branch on the law inside the loop would stop it vectorising
         for i in range(np.uint64(lo), np.uint64(hi)):
             vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
             v[i] = vi

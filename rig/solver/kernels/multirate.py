@@ -117,31 +117,36 @@ def _restore(u, v, f, head, s, saved):
 
 
 @jit
+def _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s, saved):
+    """A substep of k seconds (_substep); where a head contact changed state during it,
+    the state is put back as it was and (pending, True) is returned, else (the closing kick
+    owed, False)."""
+    _save(u, v, f, head, s, saved)
+    owed, changed = _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s)
+    if not changed:
+        return owed, False
+    _restore(u, v, f, head, s, saved)
+    return pending, True
+
+
+@jit
 def _resolved_substeps(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, n, s, work):
     """n substeps of k seconds on shot s's head, each substep across a change of contact
     state taken again as REFINE, and the piece across it as REFINE again; ends with the
     owed closing kick applied. work: (2, 3, head + 1) saved states."""
     pending = 0.0
     for _ in range(n):
-        _save(u, v, f, head, s, work[0])
-        start = pending
-        pending, changed = _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s)
+        pending, changed = _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s, work[0])
         if not changed:
             continue
-        _restore(u, v, f, head, s, work[0])
-        pending = start
-        k1 = k / REFINE
         for _ in range(REFINE):
-            _save(u, v, f, head, s, work[1])
-            start1 = pending
-            pending, changed = _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k1, pending, s)
+            pending, changed = _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k / REFINE, pending, s,
+                                        work[1])
             if not changed:
                 continue
-            _restore(u, v, f, head, s, work[1])
-            pending = start1
             for _ in range(REFINE):
-                pending, changed = _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k1 / REFINE,
-                                            pending, s)
+                pending, _ = _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k / REFINE / REFINE,
+                                      pending, s)
     for i in range(head + 1):
         below = f[i + 1, s] if i < head else 0.0
         v[i, s] += pending * (f[i, s] - below) * invm[i, s]
