@@ -28,7 +28,8 @@ def cases(names=None):
     """(name, problem, save, t_end) of every contract case: the benchmark problems (the
     probe at contact 500 on a 1 MS/s grid) and the published scenes (their gauges' contacts
     and the wall, on their own grid, for their whole duration)."""
-    from rig.bench.solver import PROBE, SAMPLE_INTERVAL, SCENARIOS
+    from rig.bench.kernel_cost import SAMPLE_INTERVAL
+    from rig.bench.solver import PROBE, SCENARIOS
     from rig.bench.solver import chain as bench_chain
     from rig.experiment.shot import Rig
 

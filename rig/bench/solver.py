@@ -21,28 +21,20 @@ accuracy``. CPU times are process times, medians of ``repeats`` runs.
 """
 from __future__ import annotations
 
-import contextlib
 import math
 import os
 import platform
-import statistics
-import time
-
-import numpy as np
 
 from rig.bench.accuracy import cases, reference
-from rig.bench.kernels.bounds import sqrt_ns, triad_bandwidth
+from rig.bench.kernel_cost import kernel_figures, median_cpu, scaling
 from rig.model.chain import Chain
 from rig.model.parts import Bead, Striker, Wall
-from rig.solver.problem import ChainProblem
-from rig.solver.saveat import SaveAt
 from rig.solver.solution import relative_error
 from rig.solver.solve import solve
 from rig.solver.stepsize import contact_time_scale, head_contacts, stepping_at
 
 N_BEADS = 1000
 PROBE = 500
-SAMPLE_INTERVAL = 1e-6  # s: the probe's output grid, the same for every solver (1 MS/s)
 STEEL = dict(material="steel316", diameter="4.76 mm", mass="0.4501 g")
 SCENARIOS = {  # name: (top force N, t_end s) -- t_end lets the pulse pass contact 500
     "sonic-vacuum": (0.0, 5.0e-3),
@@ -53,53 +45,14 @@ SETTINGS = (1e-3, 1e-4, 1e-5, 1e-6)
 PEERS = {"scipy-DOP853": (1e-6, 1e-8, 1e-10), "numba-DOP853": (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12),
          "LAMMPS": (20, 50, 100)}  # rtol, or tau / dt for LAMMPS
 EQUAL_ERRORS = (1e-4, 1e-5, 1e-6)
-KERNEL_SIZES = ((1000, 4000, 5), (1_000_000, 300, 1))  # (beads, steps, repeats) of the kernel figure
-SCALING_SIZES = (1000, 10_000, 100_000, 1_000_000)
-SCALING_PROBE, SCALING_T = 50, 1e-3  # the pulse passes contact 50 in about 0.4 ms
 QUICK = dict(divisions={"srkn6b": (3, 6, 12), "verlet": (32, 128)}, settings=(1e-4,), peers={
     "scipy-DOP853": (1e-8,), "numba-DOP853": (1e-8, 1e-10), "LAMMPS": (20,)}, scenarios=("precompressed",))
-
-# The kernel figure, as a program both this revision and a baseline run: public API only.
-KERNEL_SNIPPET = """
-import inspect, json, statistics, time
-from rig import Bead, Chain, ChainProblem, SaveAt, Striker, Wall, solve
-from rig.solver.stepsize import contact_time_scale
-quiet = {"estimate": False} if "estimate" in inspect.signature(solve).parameters else {}
-out = {}
-for n, steps, repeats in SIZES:
-    bead = Bead(material="steel316", diameter="4.76 mm", mass="0.4501 g")
-    c = Chain([bead] * n, striker=Striker("steel316", "0.4501 g", "0.44 m/s"), wall=Wall(), gravity=0,
-              top_force=2.38)
-    p = ChainProblem.from_chain(c)
-    save = SaveAt({"c": c.contact_probe(min(500, n // 2))}, sample_interval=1e-6)
-    dt = contact_time_scale(p) / 8
-    solve(p, 2 * dt, save=save, dt=dt, **quiet)
-    ns = []
-    for _ in range(repeats):
-        t0 = time.process_time()
-        s = solve(p, steps * dt, save=save, dt=dt, **quiet)
-        ns.append((time.process_time() - t0) / (s.stats.force_evaluations * (p.n_bodies - 1)) * 1e9)
-    out[str(n)] = statistics.median(ns)
-print(json.dumps(out))
-"""
-
 
 def chain(top_force: float, n: int = N_BEADS) -> Chain:
     striker = Striker("steel316", "0.4501 g", "0.44 m/s")
     if top_force:
         return Chain([Bead(**STEEL)] * n, striker=striker, wall=Wall(), gravity=0, top_force=top_force)
     return Chain([Bead(**STEEL)] * n, striker=striker, gravity=0)
-
-
-def _median_cpu(fn, repeats: int):
-    """(result of the first call, median CPU seconds over ``repeats`` calls)."""
-    times, first = [], None
-    for _ in range(repeats):
-        t0 = time.process_time()
-        out = fn()
-        times.append(time.process_time() - t0)
-        first = out if first is None else first
-    return first, statistics.median(times)
 
 
 def _row(scenario, method, setting, cpu, error, evaluations, bodies, **extra) -> dict:
@@ -114,14 +67,14 @@ def _ours(name, p, save, t_end, ref, divisions, settings, repeats, progress) -> 
         for r in rs:
             if progress:
                 progress(f"{name}: {method} dt = tau/{r}")
-            sol, cpu = _median_cpu(lambda: solve(p, t_end, save=save, method=method, dt=stepping_at(p, tau / r),
+            sol, cpu = median_cpu(lambda: solve(p, t_end, save=save, method=method, dt=stepping_at(p, tau / r),
                                                  estimate=False), repeats)
             rows.append(_row(name, method, f"dt=tau/{r}", cpu, relative_error(sol.forces, ref),
                              sol.stats.force_evaluations, p.moving_bodies, dt_s=sol.stats.dt_s))
     for acc in settings:
         if progress:
             progress(f"{name}: srkn6b accuracy={acc:g} (controlled, with its estimate)")
-        sol, cpu = _median_cpu(lambda: solve(p, t_end, save=save, accuracy=acc), repeats)
+        sol, cpu = median_cpu(lambda: solve(p, t_end, save=save, accuracy=acc), repeats)
         rows.append(_row(name, "srkn6b-controlled", f"accuracy={acc:g}", cpu, relative_error(sol.forces, ref), None,
                          p.moving_bodies, dt_s=sol.stats.dt_s, estimate=sol.stats.error_estimate,
                          attempts=sol.stats.attempts))
@@ -190,61 +143,6 @@ def _interpolate(points, e):
     return math.exp(math.log(c0) + w * (math.log(c1) - math.log(c0)))
 
 
-def kernel_figures(repeats: int, rounds: int, baseline: str | None, progress=None) -> dict:
-    """ns per bead per force evaluation of the whole srkn6b step (KERNEL_SNIPPET), this
-    revision and, with ``baseline``, that revision in turns; medians over the rounds."""
-    from rig.bench.baseline import ROOT, checkout, measure
-
-    sizes = tuple((n, steps, min(r, repeats)) for n, steps, r in KERNEL_SIZES)
-    snippet = f"SIZES = {sizes!r}\n" + KERNEL_SNIPPET
-    runs = {"current": [], "baseline": []}
-    with checkout(baseline) if baseline else contextlib.nullcontext() as tree:
-        for k in range(rounds):
-            if progress:
-                progress(f"kernel figure, round {k + 1} of {rounds}")
-            runs["current"].append(measure(ROOT, snippet))
-            if tree is not None:
-                runs["baseline"].append(measure(tree, snippet))
-    out = {"beads": [n for n, *_ in KERNEL_SIZES], "baseline_rev": baseline}
-    for who, rs in runs.items():
-        if rs:
-            out[who] = {str(n): statistics.median(r[str(n)] for r in rs) for n, *_ in KERNEL_SIZES}
-    if runs["baseline"]:
-        pairs = list(zip(runs["current"], runs["baseline"]))
-        out["ratio"] = {str(n): statistics.median(c[str(n)] / b[str(n)] for c, b in pairs) for n, *_ in KERNEL_SIZES}
-    gbs = triad_bandwidth()
-    out["bounds"] = {"sqrt_ns": sqrt_ns(), "bandwidth_GB_s": gbs,
-                     # one pass over the state per evaluation: u, v, f read and written (48 B);
-                     # every array (u, v, f read and written, invm, A, d0, load read: 80 B)
-                     "memory_state_ns": 48.0 / gbs, "memory_all_ns": 80.0 / gbs}
-    return out
-
-
-def scaling(progress=None) -> dict:
-    """CPU per simulated second from 1e3 to 1e6 beads (precompressed chain, the force of
-    contact SCALING_PROBE, which the pulse passes within SCALING_T), at the step the accuracy
-    control picks for 1e3 beads at the default accuracy, and the exponent of N."""
-    p0 = ChainProblem.from_chain(chain(2.38))
-    save0 = SaveAt({"c": chain(2.38).contact_probe(SCALING_PROBE)}, SAMPLE_INTERVAL)
-    t_end = SCALING_T
-    stepping = stepping_at(p0, solve(p0, t_end, save=save0).stats.dt_s)
-    rows = []
-    for n in SCALING_SIZES:
-        if progress:
-            progress(f"scaling: {n} beads")
-        c = chain(2.38, n)
-        p = ChainProblem.from_chain(c)
-        save = SaveAt({"c": c.contact_probe(SCALING_PROBE)}, SAMPLE_INTERVAL)
-        steps = max(100, int(2e7 / n))
-        span = steps * stepping.dt
-        solve(p, 2 * stepping.dt, save=save, dt=stepping, estimate=False)
-        _, cpu = _median_cpu(lambda: solve(p, span, save=save, dt=stepping, estimate=False), 3)
-        rows.append({"beads": n, "cpu_per_simulated_s": cpu / span, "steps": steps})
-    n = np.log([r["beads"] for r in rows])
-    c = np.log([r["cpu_per_simulated_s"] for r in rows])
-    return {"dt_s": stepping.dt, "rows": rows, "exponent": float(np.polyfit(n, c, 1)[0])}
-
-
 def run(quick: bool = False, peers: bool = False, baseline: str | None = None, progress=None) -> dict:
     divisions = QUICK["divisions"] if quick else DIVISIONS
     settings = QUICK["settings"] if quick else SETTINGS
@@ -264,7 +162,7 @@ def run(quick: bool = False, peers: bool = False, baseline: str | None = None, p
     return dict(rows=rows, at_equal_error=at_equal_error(rows), notes=notes, machine=_machine(),
                 beads=N_BEADS, probe_contact=PROBE,
                 kernel=kernel_figures(1 if quick else 5, 1 if quick else 3, baseline, progress),
-                scaling=None if quick else scaling(progress))
+                scaling=None if quick else scaling(chain, progress))
 
 
 def _machine() -> str:
