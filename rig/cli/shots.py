@@ -57,7 +57,8 @@ def shot_summary(rig, shot) -> dict:
     return {"scenario": shot.scene, "seed": shot.seed, "overrides": list(shot.overrides),
             "solver": {"method": st.method, "dt_s": st.dt_s, "steps": st.steps,
                        "wall_s": st.wall_s, "energy_error": st.energy_error,
-                       "momentum_error": st.momentum_error},
+                       "momentum_error": st.momentum_error, "accuracy": st.accuracy,
+                       "error_estimate": st.error_estimate},
             "triggered": shot.scope.triggered, "no_trigger_reason": shot.scope.reason,
             "trigger": {"source": tr.source, "level_V": tr.level, "slope": tr.slope,
                         "time_after_impact_s": shot.scope.trigger_time},
@@ -70,6 +71,9 @@ def print_shot(out: dict):
     print(f"  solver {s['method']}: dt = {s['dt_s'] * 1e9:.1f} ns, {s['steps']} steps, "
           f"{s['wall_s'] * 1e3:.1f} ms, energy error {s['energy_error']:.1e}, "
           f"momentum error {s['momentum_error']:.1e}")
+    if s["error_estimate"] is not None:
+        print(f"  force error (relative to each record's dynamic peak): estimated {s['error_estimate']:.1e}"
+              + (f", accuracy asked {s['accuracy']:.0e}" if s["accuracy"] is not None else ""))
     tr = out["trigger"]
     if not out["triggered"]:
         print(f"  scope: NO TRIGGER ({out['no_trigger_reason']})")

@@ -102,7 +102,9 @@ def test_shot_json_keys(capsys):
     assert main(["shot", "steel21_magnetic", "--seed", "2", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["scenario"] == "steel21_magnetic" and out["seed"] == 2
-    assert set(out["solver"]) == {"method", "dt_s", "steps", "wall_s", "energy_error", "momentum_error"}
+    assert set(out["solver"]) == {"method", "dt_s", "steps", "wall_s", "energy_error", "momentum_error",
+                                  "accuracy", "error_estimate"}
+    assert out["solver"]["error_estimate"] <= out["solver"]["accuracy"]  # the contract, as the shot reports it
     assert set(out["channels"]) == {"CH1", "CH2", "CH3"}
     assert out["channels"]["CH3"]["connected"] == "wall_sensor"
 
