@@ -19,8 +19,9 @@ __version__ = "0.1.0"
 
 _PUBLIC = {
     "rig.model.chain": ("Chain", "ForceSchedule", "Probe", "STANDARD_GRAVITY"),
-    "rig.model.contact": ("CONTACT_LAWS", "hertz_constant", "hertz_energy", "hertz_force",
+    "rig.model.contact": ("CONTACT_LAWS", "hertz_constant", "hertz_energy", "hertz_force", "power_law_constant",
                           "static_overlaps"),
+    "rig.model.apparatus": ("Holder",),
     "rig.model.materials": ("MATERIALS", "Material", "material"),
     "rig.model.parts": ("Bead", "GaugeBead", "MagneticBead", "Striker", "Wall"),
     "rig.errors": ("RigError",),

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rig.errors import RigError, invalid
+from rig.model.contact import HERTZ
 from rig.solver.problem import ChainProblem
 from rig.solver.run import time_grid
 from rig.solver.saveat import SaveAt
@@ -78,8 +79,9 @@ def absolute_tolerances(problem: ChainProblem, rtol: float) -> np.ndarray:
 
 def check_conservative(problem: ChainProblem) -> None:
     """The peers integrate the conservative Hertz chain under constant loads only."""
-    if problem.chain.law.dissipative:
-        raise invalid("chain.contact_law", problem.chain.law.name, "the peers integrate the Hertz law only")
+    if problem.law != HERTZ or problem.onsite:
+        raise invalid("chain.contact_law", problem.chain.law.name,
+                      "the peers integrate the conservative Hertz law only")
     if problem.sched_t.size:
         raise invalid("chain.top_force", "ForceSchedule", "the peers take a constant top force only")
 
@@ -169,7 +171,7 @@ def numba_dop853(problem: ChainProblem, save: SaveAt, t_end: float, rtol: float)
         y = np.concatenate((problem.u0, problem.v0))
         out = np.zeros(n_out)
         counts = np.zeros(5, np.int64)
-        dop853.integrate(y, t, rtol, atol, problem.A, problem.d0, problem.damping, problem.load,
+        dop853.integrate(y, t, rtol, atol, problem.A, problem.d0, problem.load,
                          problem.invm, slot, save.sample_interval, out,
                          np.zeros((dop853.N_STAGES_EXTENDED, 2 * nb)), np.zeros(2 * nb),
                          np.zeros((2, 2 * nb)), np.zeros(nb + 1), counts)

@@ -56,7 +56,7 @@ class Assembly:
             self.gauges = tuple(self._gauge(name, dict(g), first, len(beads))
                                 for name, g in sorted(v.get("gauges", {}).items()))
         for g in self.gauges:
-            beads[g.bead] = GaugeBead.like(beads[g.bead])
+            beads[g.bead] = GaugeBead.like(beads[g.bead], mass=g.mass)
         self.striker = like.striker if shared("striker") else Striker(**v["striker"])
         self.holder.check(beads, self.striker)
         if shared("magnet"):
@@ -66,10 +66,14 @@ class Assembly:
         if self.magnet is not None and not first:
             raise invalid("magnet", "set", "a ring magnet needs chain.magnetic_bead = true")
         wall = like.chain.wall if shared("wall") else Wall(**v["wall"])
-        self.chain = Chain(beads, striker=self.striker, wall=wall, gravity=self.holder.gravity,
+        c, h = v["chain"], self.holder
+        self.chain = Chain(beads, striker=self.striker, wall=wall, gravity=h.gravity,
                            top_force=self.magnet.top_force() if self.magnet else 0.0,
-                           contact_law=v["chain"].get("contact_law", "hertz"),
-                           damping_time=v["chain"].get("damping_time", 0.0))
+                           contact_law=c.get("contact_law", "hertz"), damping_time=c.get("damping_time", 0.0),
+                           contact_damping=c.get("contact_damping", 0.0),
+                           contact_exponent=c.get("contact_exponent", 1.5),
+                           reference_force=c.get("reference_force", 1.0),
+                           drag=h.drag, friction=h.friction, slip_speed=h.slip_speed)
         if shared("wall_sensor"):
             self.wall_sensor = like.wall_sensor
         elif "wall_sensor" in v:
@@ -94,13 +98,19 @@ class Assembly:
             mat = Material(mat.name, c.get("youngs_modulus", mat.E), c.get("poisson_ratio", mat.nu), mat.rho,
                            mat.source + "; elastic constants set by the scene")
         plain = Bead(mat, c.get("diameter"), c.get("mass"))
+        magnetic = MagneticBead()
+        if "magnetic_youngs_modulus" in c or "magnetic_poisson_ratio" in c:
+            m = magnetic.material
+            magnetic = MagneticBead(Material(m.name, c.get("magnetic_youngs_modulus", m.E),
+                                             c.get("magnetic_poisson_ratio", m.nu), m.rho,
+                                             m.source + "; elastic constants set by the scene"))
         if self.bead_masses is None:
             plain_beads = [plain] * n
         else:
             if len(self.bead_masses) != n:
                 raise invalid("bead_masses", len(self.bead_masses), f"one mass per plain bead ({n})")
             plain_beads = [plain.with_mass(m) for m in self.bead_masses]
-        return ([MagneticBead()] if first else []) + plain_beads, first
+        return ([magnetic] if first else []) + plain_beads, first
 
     @staticmethod
     def _gauge(name: str, g: dict, first: int, total: int) -> GaugeWiring:
@@ -114,7 +124,8 @@ class Assembly:
             key = "bead" if bead is not None else "from_wall"
             raise invalid(f"{field}.{key}", count, f"the chain has beads 1..{plain} (magnetic bead not counted)")
         index = first + bead - 1 if bead is not None else total - from_wall
-        return GaugeWiring(name, index, g.pop("channel", None), GaugeSettings(**g))
+        mass = g.pop("mass", None)
+        return GaugeWiring(name, index, g.pop("channel", None), GaugeSettings(**g), mass)
 
     @staticmethod
     def _scope(s: dict) -> Oscilloscope:

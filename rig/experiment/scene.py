@@ -23,18 +23,21 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 GAUGE_KEYS = {"bead": int, "from_wall": int, "channel": str, "sensitivity": "V/N",
-              "calibration_error": float, "tau": "s", "noise": "V", "misalignment_sd": "m"}
+              "calibration_error": float, "tau": "s", "noise": "V", "misalignment_sd": "m", "mass": "kg"}
 CHANNEL_KEYS = {"volts_per_div": "V", "position": float, "offset": "V", "coupling": str,
                 "bandwidth": "Hz", "probe": float}
 SCHEMA = {
     "scene": {"name": str, "description": str, "reference": str},
     "chain": {"material": str, "diameter": "m", "mass": "kg", "beads": int,
-              "magnetic_bead": bool, "contact_law": str, "damping_time": "s",
-              "youngs_modulus": "Pa", "poisson_ratio": float},
+              "magnetic_bead": bool, "contact_law": str, "damping_time": "s", "contact_damping": "kg/s",
+              "contact_exponent": float, "reference_force": "N",
+              "youngs_modulus": "Pa", "poisson_ratio": float,
+              "magnetic_youngs_modulus": "Pa", "magnetic_poisson_ratio": float},
     "striker": {"material": str, "mass": "kg", "velocity": "m/s", "diameter": "m", "gap": "m"},
     "magnet": {"force": "N", "position": "m", "peak_force": "N", "schedule": list},
-    "holder": {"bore": "m", "outer_diameter": "m", "length": "m", "vertical": bool},
-    "wall": {"material": str},
+    "holder": {"bore": "m", "outer_diameter": "m", "length": "m", "vertical": bool,
+               "drag": "kg/s", "friction": "N", "slip_speed": "m/s"},
+    "wall": {"material": str, "plate_mass": "kg", "rod_stiffness": "N/m"},
     "wall_sensor": {"channel": str, "sensitivity": "V/N", "calibration_error": float,
                     "tau": "s", "noise": "V"},
     "gauges": {"*": GAUGE_KEYS},

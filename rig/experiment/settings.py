@@ -12,12 +12,14 @@ from rig.errors import invalid
 @dataclass(frozen=True)
 class GaugeWiring:
     """A gauge bead: its name in the scene, its chain index (0 = top bead, the magnetic
-    bead included), the scope channel it is wired to and its signal chain's settings."""
+    bead included), the scope channel it is wired to, its signal chain's settings and its
+    mass (kg; None: caps cut from a plain bead plus the plate, rig.model.parts.GaugeBead)."""
 
     name: str
     bead: int
     channel: str
     settings: GaugeSettings
+    mass: float | None = None
 
 
 @dataclass(frozen=True)

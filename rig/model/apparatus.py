@@ -12,12 +12,22 @@ from rig.model.chain import STANDARD_GRAVITY, ForceSchedule
 
 @dataclass(frozen=True)
 class Holder:
-    """The PTFE tube: bore and outer diameter (m), length (m), vertical or horizontal."""
+    """The PTFE tube: bore and outer diameter (m), length (m), vertical or horizontal, and
+    what the tube's wall does to each bead sliding in it (every bead; not the striker):
+
+        F = -drag v - friction tanh(v / slip_speed)
+
+    a viscous drag (kg/s) and Coulomb friction (N) smoothed over slip_speed (m/s), so that
+    a bead at rest feels none and the static equilibrium is the frictionless one. Both 0
+    by default (no cost in the solver when off)."""
 
     bore: float = 5e-3
     outer_diameter: float = 10e-3
     length: float = 0.5
     vertical: bool = True
+    drag: float = 0.0
+    friction: float = 0.0
+    slip_speed: float = 1e-3
 
     def __post_init__(self):
         if not self.bore > 0:
@@ -26,6 +36,11 @@ class Holder:
             raise invalid("holder.outer_diameter", self.outer_diameter, f"must exceed the bore {self.bore} m")
         if not self.length > 0:
             raise invalid("holder.length", self.length, "must be > 0 m")
+        for name, unit in (("drag", "kg/s"), ("friction", "N")):
+            if not getattr(self, name) >= 0:
+                raise invalid(f"holder.{name}", getattr(self, name), f"must be >= 0 {unit}")
+        if not self.slip_speed > 0:
+            raise invalid("holder.slip_speed", self.slip_speed, "must be > 0 m/s")
 
     @property
     def gravity(self) -> float:

@@ -19,17 +19,35 @@ import numpy as np
 from rig.errors import invalid
 from rig.memo import computed_once
 from rig.model.contact import contact_law as lookup_law
-from rig.model.contact import hertz_constant, static_overlaps
+from rig.model.contact import hertz_constant, power_law_constant, static_overlaps
 from rig.model.parts import Bead, Striker, Wall
 from rig.units import quantity
 
 STANDARD_GRAVITY = 9.80665  # m/s^2
 
 
+def follows_law(chain: "Chain") -> np.ndarray:
+    """Which contacts (0..n_beads, and the rod of a compliant wall) follow the chain's
+    contact law (its exponent and dissipation): those that touch a bead of the chain's
+    material (not the magnetic bead). The others (a striker on the magnetic bead, the rod)
+    keep their own: Hertz, and linear for the rod."""
+    b = chain.beads
+    chain_bead = [x.kind != "magnetic" for x in b]
+    out = np.zeros(chain.n_contacts, dtype=bool)
+    for k in range(chain.n_beads + 1):
+        above = chain_bead[k - 1] if k > 0 else False
+        below = chain_bead[k] if k < chain.n_beads else False
+        out[k] = above or below
+    return out
+
+
 def contact_constants_of(chain: "Chain", E=None, nu=None) -> np.ndarray:
-    """Hertz constants (N/m^1.5) of contacts 0..n_beads of ``chain`` (last axis; nan where
-    there is no partner); E, nu (Pa, -; arrays of shots, or None): the elastic constants of
-    its beads' material (every bead but a magnetic one) in place of the material's own."""
+    """Contact constants of contacts 0..n_beads of ``chain`` (and the rod of a compliant
+    wall; last axis; nan where there is no partner): Hertz constants (N/m^1.5), the
+    power-law constant (N/m^n, power_law_constant) for the contacts that follow a law of
+    another exponent, the rod's stiffness (N/m). E, nu (Pa, -; arrays of shots, or None):
+    the elastic constants of its beads' material (every bead but a magnetic one) in place
+    of the material's own."""
     b = chain.beads
     plain = next((x.material for x in b if x.kind != "magnetic"), None)
 
@@ -39,7 +57,7 @@ def contact_constants_of(chain: "Chain", E=None, nu=None) -> np.ndarray:
         return m.E, m.nu
 
     shape = () if E is None else np.shape(E)
-    A = np.full(shape + (chain.n_beads + 1,), np.nan)
+    A = np.full(shape + (chain.n_contacts,), np.nan)
     if chain.striker is not None:
         A[..., 0] = hertz_constant(*elastic(chain.striker.material), math.inf, *elastic(b[0].material), b[0].radius)
     pairs = {}  # a chain repeats the same pair of beads many times
@@ -50,26 +68,35 @@ def contact_constants_of(chain: "Chain", E=None, nu=None) -> np.ndarray:
             pairs[key] = hertz_constant(*elastic(up.material), up.radius, *elastic(down.material), down.radius)
         A[..., k] = pairs[key]
     if chain.wall is not None:
-        A[..., -1] = hertz_constant(*elastic(b[-1].material), b[-1].radius, *elastic(chain.wall.material), math.inf)
+        k = chain.n_beads
+        A[..., k] = hertz_constant(*elastic(b[-1].material), b[-1].radius, *elastic(chain.wall.material), math.inf)
+        if chain.wall.compliant:
+            A[..., k + 1] = chain.wall.rod_stiffness
+    if chain.contact_exponent != 1.5:
+        law = follows_law(chain)
+        A[..., law] = power_law_constant(A[..., law], chain.contact_exponent, chain.reference_force)
     return A
 
 
 def static_forces_of(masses, gravity: float, top_force) -> np.ndarray:
-    """Static contact forces (N) of contacts 0..n (last axis) of chains of bead masses
-    ``masses`` (kg, (..., n)): F_k = gravity x the mass of beads 0..k-1 + the top force;
-    contact 0 (the striker's) carries nothing."""
+    """Static contact forces (N) of contacts 0..n (last axis) of chains of body masses
+    ``masses`` (kg, (..., n): the beads, and the plate of a compliant wall last): F_k =
+    gravity x the mass of bodies 0..k-1 + the top force; contact 0 (the striker's) carries
+    nothing."""
     masses = np.asarray(masses, dtype=float)
     F = np.zeros(masses.shape[:-1] + (masses.shape[-1] + 1,))
     F[..., 1:] = gravity * np.cumsum(masses, axis=-1) + np.asarray(top_force, dtype=float)[..., None]
     return F
 
 
-def static_overlaps_of(A, F) -> np.ndarray:
-    """Static overlaps (m) d0 = (F/A)^(2/3) of contacts of constants A carrying F (N);
-    0 where a contact carries nothing or has no partner (A nan)."""
+def static_overlaps_of(A, F, n=1.5) -> np.ndarray:
+    """Static overlaps (m) d0 = (F/A)^(1/n) of contacts of constants A carrying F (N), of
+    exponents n (3/2: Hertz; an array along the last axis); 0 where a contact carries
+    nothing or has no partner (A nan)."""
     d0 = np.zeros_like(F)
     ok = np.isfinite(A) & (F > 0)
-    d0[ok] = static_overlaps(A[ok], F[ok])
+    n = np.broadcast_to(np.asarray(n, dtype=float), np.shape(F))
+    d0[ok] = static_overlaps(A[ok], F[ok], n[ok])
     return d0
 
 
@@ -118,12 +145,19 @@ class Chain:
 
     gravity: acceleration along +x (m/s^2); 0 for a horizontal chain.
     top_force: constant force (N) or ForceSchedule pulling bead 0 down (the ring magnet).
-    contact_law: "hertz" (default, conservative) or "kuwabara-kono" with damping_time (s).
+    contact_law: "hertz" (default, conservative), "kuwabara-kono" with damping_time (s),
+    or "dashpot" with contact_damping (kg/s) (rig.model.contact.CONTACT_LAWS); the contacts
+    that touch a bead of the chain's material follow it (follows_law), with the elastic
+    exponent contact_exponent (3/2: Hertz) matched to Hertz at reference_force (N).
+    drag (kg/s), friction (N), slip_speed (m/s): what the holder's wall does to each bead
+    (rig.model.apparatus.Holder); 0: nothing.
     """
 
     def __init__(self, beads, *, striker: Striker | None = None, wall: Wall | None = None,
                  gravity: float = STANDARD_GRAVITY, top_force=0.0,
-                 contact_law: str = "hertz", damping_time=0.0):
+                 contact_law: str = "hertz", damping_time=0.0, contact_damping=0.0,
+                 contact_exponent: float = 1.5, reference_force=1.0,
+                 drag=0.0, friction=0.0, slip_speed=1e-3):
         beads = list(beads)
         if not beads:
             raise invalid("chain.beads", beads, "a chain needs at least one bead")
@@ -146,11 +180,30 @@ class Chain:
             self.top_force = quantity(top_force, "N", "chain.top_force", bare_ok=True)
         self.law = lookup_law(contact_law)
         self.damping_time = quantity(damping_time, "s", "chain.damping_time", bare_ok=True)
-        if self.damping_time < 0:
-            raise invalid("chain.damping_time", damping_time, "must be >= 0 s")
-        if self.law.dissipative and self.damping_time == 0:
-            raise invalid("chain.damping_time", damping_time,
-                          f"contact law {self.law.name!r} needs a damping time > 0 s")
+        self.contact_damping = quantity(contact_damping, "kg/s", "chain.contact_damping", bare_ok=True)
+        for name, unit in (("damping_time", "s"), ("contact_damping", "kg/s")):
+            if getattr(self, name) < 0:
+                raise invalid(f"chain.{name}", getattr(self, name), f"must be >= 0 {unit}")
+        if self.law.dissipative and getattr(self, self.law.parameter) == 0:
+            raise invalid(f"chain.{self.law.parameter}", getattr(self, self.law.parameter),
+                          f"contact law {self.law.name!r} needs it > 0")
+        for name in ("damping_time", "contact_damping"):
+            if name != self.law.parameter and getattr(self, name) != 0:
+                raise invalid(f"chain.{name}", getattr(self, name),
+                              f"belongs to another contact law than {self.law.name!r}; leave it 0")
+        if not (isinstance(contact_exponent, (int, float)) and 1.0 <= contact_exponent <= 3.0):
+            raise invalid("chain.contact_exponent", contact_exponent, "an exponent in [1, 3] (Hertz: 1.5)")
+        self.contact_exponent = float(contact_exponent)
+        self.reference_force = quantity(reference_force, "N", "chain.reference_force", bare_ok=True)
+        if not self.reference_force > 0:
+            raise invalid("chain.reference_force", reference_force, "must be > 0 N")
+        self.drag = quantity(drag, "kg/s", "holder.drag", bare_ok=True)
+        self.friction = quantity(friction, "N", "holder.friction", bare_ok=True)
+        self.slip_speed = quantity(slip_speed, "m/s", "holder.slip_speed", bare_ok=True)
+        for name, value, allowed in (("drag", self.drag, "must be >= 0 kg/s"), ("friction", self.friction,
+                                     "must be >= 0 N"), ("slip_speed", self.slip_speed, "must be > 0 m/s")):
+            if not (value > 0 or (value == 0 and name != "slip_speed")):
+                raise invalid(f"holder.{name}", value, allowed)
         self._check_equilibrium()
 
     # --- geometry and statics -------------------------------------------------------
@@ -159,8 +212,39 @@ class Chain:
         return len(self.beads)
 
     @property
+    def n_contacts(self) -> int:
+        """Contacts 0..n_beads, and the rod of a compliant wall after them."""
+        return self.n_beads + 1 + (1 if self.wall is not None and self.wall.compliant else 0)
+
+    @property
     def masses(self) -> np.ndarray:
         return np.array([b.mass for b in self.beads])
+
+    @property
+    def body_masses(self) -> np.ndarray:
+        """The beads' masses (kg), and a compliant wall's plate last."""
+        if self.wall is not None and self.wall.compliant:
+            return np.append(self.masses, self.wall.plate_mass)
+        return self.masses
+
+    @property
+    def conservative(self) -> bool:
+        """No dissipation anywhere: an elastic contact law and nothing from the holder."""
+        return not self.law.dissipative and self.drag == 0 and self.friction == 0
+
+    def contact_exponents(self) -> np.ndarray:
+        """Exponent n of each contact's elastic law A delta^n (follows_law: the chain's
+        contact_exponent; 3/2 for the others, 1 for a compliant wall's rod)."""
+        n = np.where(follows_law(self), self.contact_exponent, 1.5)
+        if self.wall is not None and self.wall.compliant:
+            n[-1] = 1.0
+        return n
+
+    def contact_dissipation(self) -> np.ndarray:
+        """(2, contacts): each contact's Kuwabara-Kono damping time (s) and dashpot (kg/s),
+        0 where it does not follow the chain's law."""
+        law = follows_law(self)
+        return np.array([np.where(law, self.damping_time, 0.0), np.where(law, self.contact_damping, 0.0)])
 
     @property
     def initial_top_force(self) -> float:
@@ -188,14 +272,15 @@ class Chain:
         return self._cached("F0", self._static_forces)
 
     def _static_forces(self) -> np.ndarray:
-        return static_forces_of(self.masses, self.gravity, self.initial_top_force)
+        return static_forces_of(self.body_masses, self.gravity, self.initial_top_force)
 
     def static_overlaps(self) -> np.ndarray:
-        """Static overlaps (m), d0 = (F/A)^(2/3); 0 where a contact carries nothing."""
+        """Static overlaps (m), d0 = (F/A)^(1/n) ((F/A)^(2/3): Hertz); 0 where a contact
+        carries nothing."""
         return self._cached("d0", self._static_overlaps)
 
     def _static_overlaps(self) -> np.ndarray:
-        return static_overlaps_of(self.contact_constants(), self.static_forces())
+        return static_overlaps_of(self.contact_constants(), self.static_forces(), self.contact_exponents())
 
     def equilibrium_positions(self) -> np.ndarray:
         """Bead centres at equilibrium (m, down from bead 0's centre)."""
@@ -205,10 +290,11 @@ class Chain:
         return equilibrium_positions_of([bead.radius for bead in self.beads], self.static_overlaps())
 
     def wall_position(self) -> float:
-        """The wall surface (m, down from bead 0's centre); nan without a wall."""
+        """The wall surface (m, down from bead 0's centre; a compliant wall's plate at
+        rest); nan without a wall."""
         if self.wall is None:
             return math.nan
-        return self.equilibrium_positions()[-1] + self.beads[-1].radius - self.static_overlaps()[-1]
+        return self.equilibrium_positions()[-1] + self.beads[-1].radius - self.static_overlaps()[self.n_beads]
 
     def _check_equilibrium(self):
         loaded = self.gravity > 0 or self.initial_top_force != 0.0
@@ -224,10 +310,10 @@ class Chain:
     # --- probes -------------------------------------------------------------------
     def _check_contact(self, k: int, what: str):
         A = self.contact_constants()
-        if not (0 <= k <= self.n_beads) or not np.isfinite(A[k]):
+        if not (0 <= k < self.n_contacts) or not np.isfinite(A[k]):
             raise invalid(what, k, f"no such contact in a chain of {self.n_beads} beads "
-                                   f"(contacts 0..{self.n_beads}; 0 needs a striker, "
-                                   f"{self.n_beads} a wall)")
+                                   f"(contacts 0..{self.n_contacts - 1}; 0 needs a striker, "
+                                   f"{self.n_beads} a wall, {self.n_beads + 1} a compliant wall's rod)")
 
     def contact_probe(self, k: int) -> Probe:
         """The force of contact k (the contact above bead k)."""
@@ -243,7 +329,7 @@ class Chain:
         return Probe(tuple(k for k, _ in pairs), tuple(w for _, w in pairs))
 
     def wall_probe(self) -> Probe:
-        """The wall contact force."""
+        """What the wall sensor reads: the wall contact's force, or a compliant wall's rod's."""
         if self.wall is None:
             raise invalid("probe.wall", None, "this chain has no wall")
-        return Probe((self.n_beads,), (1.0,))
+        return Probe((self.n_contacts - 1,), (1.0,))

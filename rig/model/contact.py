@@ -1,4 +1,4 @@
-"""Contact laws between neighbours: the Hertz law and an optional dissipative variant.
+"""Contact laws between neighbours: the Hertz law, a power law, and dissipative variants.
 
 Hertz (e.g. Johnson, *Contact Mechanics*, 1985)::
 
@@ -7,6 +7,12 @@ Hertz (e.g. Johnson, *Contact Mechanics*, 1985)::
     elastic energy  U = (2/5) A delta^(5/2)
 
 A flat face (striker, wall) has R = infinity, so R_eff is the sphere's radius.
+
+A power law F = A_n delta^n, U = A_n delta^(n+1) / (n+1), describes a contact that departs
+from Hertz's 3/2 (a polymer's modulus that depends on strain and strain rate, rough
+surfaces): A_n is set so that it carries a reference force at the same overlap as the
+Hertz contact of the same parts (``power_law_constant``), so that the exponent and the
+modulus stay two separate parameters.
 """
 from __future__ import annotations
 
@@ -34,56 +40,106 @@ def contact_constant(m1: Material, R1: float, m2: Material, R2: float = math.inf
     return hertz_constant(m1.E, m1.nu, R1, m2.E, m2.nu, R2)
 
 
-def hertz_force(A, delta):
-    """F = A delta^(3/2) for delta > 0, else 0 (N); works on floats and arrays."""
+def power_of(delta, n):
+    """delta^n for delta > 0, else 0; n may be an array. The Hertz exponent takes
+    delta sqrt(delta) and the linear one delta itself, the kernels' operations."""
     d = np.maximum(delta, 0.0)
-    return A * d * np.sqrt(d)
+    n = np.asarray(n, dtype=float)
+    return np.where(n == 1.5, d * np.sqrt(d), np.where(n == 1.0, d, d ** n))
 
 
-def hertz_energy(A, delta):
-    """U = (2/5) A delta^(5/2) for delta > 0, else 0 (J)."""
+def hertz_force(A, delta, n=1.5):
+    """F = A delta^n for delta > 0, else 0 (N): Hertz's law at n = 3/2 (A in N/m^n);
+    works on floats and arrays."""
+    if np.all(np.asarray(n) == 1.5):
+        d = np.maximum(delta, 0.0)
+        return A * d * np.sqrt(d)
+    return A * power_of(delta, n)
+
+
+def hertz_energy(A, delta, n=1.5):
+    """U = A delta^(n+1) / (n+1) for delta > 0, else 0 (J): (2/5) A delta^(5/2) for Hertz."""
+    if np.all(np.asarray(n) == 1.5):
+        d = np.maximum(delta, 0.0)
+        return 0.4 * A * d * d * np.sqrt(d)
     d = np.maximum(delta, 0.0)
-    return 0.4 * A * d * d * np.sqrt(d)
+    return A * d * power_of(d, n) / (np.asarray(n, dtype=float) + 1.0)
 
 
-def static_overlaps(A, force):
-    """Overlap (m) at which a Hertz contact carries ``force`` (N): delta = (F/A)^(2/3)."""
-    return np.cbrt((np.asarray(force, dtype=float) / A) ** 2)
+def static_overlaps(A, force, n=1.5):
+    """Overlap (m) at which a contact A delta^n carries ``force`` (N): delta = (F/A)^(1/n)
+    ((F/A)^(2/3) for Hertz)."""
+    ratio = np.asarray(force, dtype=float) / A
+    if np.all(np.asarray(n) == 1.5):
+        return np.cbrt(ratio**2)
+    n = np.asarray(n, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return np.where(n == 1.5, np.cbrt(ratio**2), ratio ** (1.0 / n))
 
 
-def contact_stiffness(A, force):
-    """Tangent stiffness dF/ddelta = (3/2) A^(2/3) F^(1/3) (N/m) at contact force F."""
-    return 1.5 * np.cbrt(A**2 * np.asarray(force, dtype=float))
+def contact_stiffness(A, force, n=1.5):
+    """Tangent stiffness dF/ddelta = n A^(1/n) F^((n-1)/n) (N/m) at contact force F:
+    (3/2) A^(2/3) F^(1/3) for Hertz."""
+    if np.all(np.asarray(n) == 1.5):
+        return 1.5 * np.cbrt(A**2 * np.asarray(force, dtype=float))
+    n = np.asarray(n, dtype=float)
+    A, force = np.asarray(A, dtype=float), np.asarray(force, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return np.where(n == 1.5, 1.5 * np.cbrt(A**2 * force), n * A ** (1.0 / n) * force ** ((n - 1.0) / n))
 
 
-HERTZ = 0          # the kernels' code of each law: the one source (rig/solver/kernels/forces.py)
+def power_law_constant(A_hertz, n, reference_force):
+    """The constant A_n (N/m^n) of a power law F = A_n delta^n that carries
+    ``reference_force`` (N) at the overlap where the Hertz contact of constant A_hertz
+    (N/m^1.5) does: delta_ref = (F_ref / A_hertz)^(2/3), A_n = F_ref / delta_ref^n. A_hertz
+    itself for n = 3/2."""
+    if n == 1.5:
+        return A_hertz
+    delta_ref = np.cbrt((reference_force / np.asarray(A_hertz, dtype=float)) ** 2)
+    return reference_force / delta_ref**n
+
+
+# The kernels' code of a chain's contact forces (rig/solver/kernels/forces.py), chosen from
+# its contacts (rig/solver/problem.py), not named by users: HERTZ, every contact elastic
+# Hertz; KUWABARA_KONO, every contact Hertz with viscous terms (Kuwabara-Kono's and/or a
+# dashpot), vectorised; POWER, any exponent per contact (scalar: a pow per contact).
+HERTZ = 0
 KUWABARA_KONO = 1
+POWER = 2
 
 
 @dataclass(frozen=True)
 class ContactLaw:
-    """A contact law the kernels know by ``code``; ``damping_time`` (s) only where used."""
+    """A contact law between neighbours: what ``chain.contact_law`` names. Each has the
+    elastic part A delta^n (n = chain.contact_exponent, 3/2 by default) and its own
+    dissipative term (none for "hertz")."""
 
     name: str
-    code: int
     description: str
     dissipative: bool
+    parameter: str | None  # the chain's parameter of the dissipative term
 
 
 CONTACT_LAWS: dict[str, ContactLaw] = {
     law.name: law
     for law in (
-        ContactLaw("hertz", HERTZ, "elastic Hertz law F = A delta^(3/2) (conservative)", False),
+        ContactLaw("hertz", "elastic F = A delta^n: Hertz's law at n = 3/2 (the default), a power law "
+                   "otherwise (conservative)", False, None),
         ContactLaw(
-            "kuwabara-kono", KUWABARA_KONO,
-            "viscoelastic Hertz law F = A delta^(1/2) (delta + tau_d d(delta)/dt), never "
-            "attractive (Kuwabara & Kono, Jpn. J. Appl. Phys. 26, 1230 (1987); Brilliantov "
-            "et al., Phys. Rev. E 53, 5382 (1996)); tau_d is the material's damping time",
-            True),
+            "kuwabara-kono",
+            "viscoelastic F = A delta^(n-1) (delta + tau_d d(delta)/dt), never attractive (Kuwabara & Kono, "
+            "Jpn. J. Appl. Phys. 26, 1230 (1987); Brilliantov et al., Phys. Rev. E 53, 5382 (1996)); tau_d is "
+            "the material's damping time (chain.damping_time)", True, "damping_time"),
+        ContactLaw(
+            "dashpot",
+            "elastic A delta^n plus a dashpot mu d(delta)/dt while in contact, never attractive: damping "
+            "proportional to the relative velocity of the two beads (Herbold & Nesterenko, Phys. Rev. E 75, "
+            "021304 (2007); Rosas, Romero, Nesterenko & Lindenberg, Phys. Rev. Lett. 98, 164301 (2007)); mu "
+            "(kg/s) is chain.contact_damping", True, "contact_damping"),
     )
 }
 
 
 def contact_law(name) -> ContactLaw:
-    """Look a contact law up by name."""
-    return lookup(CONTACT_LAWS, name, "contact_law", ContactLaw)
+    """Look a contact law up by name (the scene key chain.contact_law)."""
+    return lookup(CONTACT_LAWS, name, "chain.contact_law", ContactLaw)

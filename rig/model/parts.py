@@ -19,7 +19,7 @@ PTFE_GAUGE_CAPS_FRACTION = 0.093 / 0.1226
 PZT_PLATE_MASS = 0.023e-3  # kg, 0.5 mm x 3 mm x 3 mm lead zirconate titanate with electrodes
 
 _UNITS = {"diameter": "m", "mass": "kg", "caps_mass": "kg", "plate_mass": "kg",
-          "velocity": "m/s", "gap": "m"}
+          "velocity": "m/s", "gap": "m", "rod_stiffness": "N/m"}
 
 
 @functools.cache
@@ -121,9 +121,15 @@ class GaugeBead(Bead):
         return PTFE_GAUGE_CAPS_FRACTION * plain_mass
 
     @classmethod
-    def like(cls, bead: Bead, **kw) -> "GaugeBead":
-        """The gauge version of a plain bead (same material, diameter; mass from its mass)."""
-        return cls(bead.material, bead.diameter, mass=bead.mass, **kw)
+    def like(cls, bead: Bead, mass: float | None = None) -> "GaugeBead":
+        """The gauge version of a plain bead (same material, diameter): caps cut from its
+        mass and the plate, or the whole gauge bead's ``mass`` (kg) when given (the plate
+        keeps its mass, the caps take the rest)."""
+        if mass is None:
+            return cls(bead.material, bead.diameter, mass=bead.mass)
+        if not mass > PZT_PLATE_MASS:
+            raise invalid("gauges.mass", mass, f"a gauge bead weighs more than its plate ({PZT_PLATE_MASS} kg)")
+        return cls(bead.material, bead.diameter, caps_mass=mass - PZT_PLATE_MASS)
 
 
 @dataclass(frozen=True)
@@ -155,10 +161,28 @@ class Striker(_Part):
 
 @dataclass(frozen=True)
 class Wall(_Part):
-    """The flat bottom wall (the force sensor's top plate)."""
+    """The bottom wall: the force sensor's top plate.
+
+    Rigid by default. With ``plate_mass`` (kg) and ``rod_stiffness`` (N/m) both given it
+    is a plate of that mass resting on a rod of that axial stiffness (the sensor plate on
+    its steel rod): the plate moves, the last bead presses on it by the chain's contact
+    law and the rod carries it by a linear spring F = k delta, whose force is what the
+    wall sensor reads.
+    """
 
     material: Material | str = "brass"
+    plate_mass: float | None = None
+    rod_stiffness: float | None = None
     kind = "wall"
 
     def __post_init__(self):
         self._convert("wall")
+        if (self.plate_mass is None) != (self.rod_stiffness is None):
+            raise invalid("wall.plate_mass", self.plate_mass,
+                          "a compliant wall needs both plate_mass and rod_stiffness (or neither: rigid)")
+        if self.compliant:
+            self._positive("wall", "plate_mass", "rod_stiffness")
+
+    @property
+    def compliant(self) -> bool:
+        return self.plate_mass is not None

@@ -19,8 +19,8 @@ from rig.solver.methods import method as get_method
 from rig.solver.problem import ProblemArrays
 from rig.solver.run import check_interval, time_grid
 from rig.solver.saveat import SaveAt
-from rig.solver.solution import KernelReport, SolverStats
-from rig.solver.stepsize import Stepping
+from rig.solver.solution import DIAGNOSTICS, KernelReport, SolverStats
+from rig.solver.stepsize import Stepping, viscous_rate
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,7 +53,8 @@ class EnsembleSolution:
         m = get_method(self.method)
         return SolverStats(m.name, self.dt, self.steps, self.steps * m.force_evaluations,
                            self.wall_s / self.shots, r.energy_error, r.momentum_error,
-                           r.wall_impulse_Ns, accuracy, estimate, "study pilot" if estimate is not None else "none")
+                           r.wall_impulse_Ns, accuracy, estimate, "study pilot" if estimate is not None else "none",
+                           dissipated_energy_J=r.dissipated_energy_J)
 
 
 def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping,
@@ -71,10 +72,12 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
         for p in problems:
             if (p.n_bodies, p.wall_slot, p.offset) != (p0.n_bodies, p0.wall_slot, p0.offset):
                 raise RigError("an ensemble needs shots of one chain topology")
+            if p.slip_speed != p0.slip_speed:
+                raise RigError("an ensemble needs shots of one holder.slip_speed")
         problems = ProblemArrays.of(problems)
     p0 = problems.layout
-    if p0.sched_t.size or p0.chain.law.dissipative:
-        raise RigError("the batched kernel takes conservative chains with constant loads only")
+    if p0.sched_t.size:
+        raise RigError("the batched kernel takes constant loads only (no magnet schedule)")
     m = get_method(method)
     stepping = dt if isinstance(dt, Stepping) else Stepping(dt)
     if not (t_end > 0 and stepping.dt > 0):
@@ -95,17 +98,20 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
         return np.ascontiguousarray(np.moveaxis(a.reshape(a.shape[:-1] + (n_chunks, width)), -2, 0))
 
     out = np.empty((n_chunks, len(save.names), n_out, width))  # the kernel writes every sample
-    diag = np.zeros((n_chunks, 6, width))
+    diag = np.zeros((n_chunks, DIAGNOSTICS, width))
     u, v = stack("u0"), stack("v0")
+    con = np.ascontiguousarray(np.stack([stack(k) for k in ("expo", "damping", "dashpot")], axis=1))
+    onsite = np.ascontiguousarray(np.stack([stack(k) for k in ("drag", "friction")], axis=1))
     t0 = time.perf_counter()
     integrate_ensemble(u, v, stack("mass"), stack("invm"), stack("bias"), stack("load"), stack("A"),
-                       stack("d0"), np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head, sub,
+                       stack("d0"), problems.law, con, onsite, p0.slip_speed, viscous_rate(problems),
+                       np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head, sub,
                        ch_slot, ch_weight, save.sample_interval, out,
                        check_interval(n_steps), stack("d_limit"), p0.wall_slot,
                        stack("energy_scale"), stack("momentum_scale"), diag)
     wall = time.perf_counter() - t0
     # (chunks, channels, samples, width) -> (shots, channels, samples), each shot's record contiguous
     out = np.ascontiguousarray(np.moveaxis(out, 3, 1).reshape(n_chunks * width, len(save.names), n_out)[:n])
-    diag = np.moveaxis(diag, 0, -2).reshape(6, n_chunks * width)[:, :n]
+    diag = np.moveaxis(diag, 0, -2).reshape(DIAGNOSTICS, n_chunks * width)[:, :n]
     reports = tuple(KernelReport.of(diag[:, j]) for j in range(n))
     return EnsembleSolution(out, save.sample_interval, step, n_steps, wall, m.name, reports, save.names)

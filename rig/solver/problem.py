@@ -10,8 +10,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from rig.model.chain import Chain, ForceSchedule, static_forces_of, static_overlaps_of
+from rig.model.contact import HERTZ, KUWABARA_KONO, POWER
 
-PER_BODY = ("mass", "invm", "bias", "A", "d0", "f0", "damping", "d_limit", "u0", "v0")
+PER_BODY = ("mass", "invm", "bias", "A", "expo", "d0", "f0", "damping", "dashpot", "d_limit", "drag", "friction",
+            "u0", "v0")
+
+
+def kernel_law(expo, damping, dashpot) -> int:
+    """The kernels' code for contacts of exponents ``expo``, damping times and dashpots
+    (arrays of the live slots): HERTZ, KUWABARA_KONO (Hertz with viscous terms) or POWER."""
+    if np.all(expo == 1.5):
+        return HERTZ if not (np.any(damping) or np.any(dashpot)) else KUWABARA_KONO
+    return POWER
 
 
 @dataclass(frozen=True, eq=False)
@@ -27,18 +37,37 @@ class ProblemArrays:
     bias: np.ndarray
     load: np.ndarray
     A: np.ndarray
+    expo: np.ndarray
     d0: np.ndarray
     f0: np.ndarray
     damping: np.ndarray
+    dashpot: np.ndarray
     d_limit: np.ndarray
+    drag: np.ndarray
+    friction: np.ndarray
     u0: np.ndarray
     v0: np.ndarray
     energy_scale: np.ndarray
     momentum_scale: np.ndarray
 
     @property
+    def law(self) -> int:
+        """The kernels' contact code of every shot together (kernel_law)."""
+        live = self.A > 0
+        return kernel_law(self.expo[live], self.damping[live], self.dashpot[live])
+
+    @property
+    def onsite(self) -> bool:
+        """Whether any shot's holder drags or rubs its beads."""
+        return bool(np.any(self.drag) or np.any(self.friction))
+
+    @property
     def shots(self) -> int:
         return self.mass.shape[0]
+
+    @property
+    def offset(self) -> int:
+        return self.layout.offset
 
     @classmethod
     def of(cls, problems: list) -> "ProblemArrays":
@@ -50,16 +79,20 @@ class ProblemArrays:
 
 def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velocity=None) -> dict:
     """The kernels' arrays of shots of ``chain``'s layout that differ in their bead masses
-    (kg, (shots, beads)), contact constants (N/m^1.5, (shots, contacts), nan where no
+    (kg, (shots, beads)), contact constants (N/m^n, (shots, contacts), nan where no
     partner), initial top force (N, (shots,)), and striker mass (kg) and velocity (m/s)
-    ((shots,); None: the chain's): {name: array, shots first} (ChainProblem's fields)."""
+    ((shots,); None: the chain's): {name: array, shots first} (ChainProblem's fields).
+    The contacts' exponents and dissipation, the holder's drag and friction and a
+    compliant wall's plate are the chain's."""
     masses, A_c = np.atleast_2d(masses), np.atleast_2d(A_c)
     top = np.asarray(top_force, dtype=float).reshape(-1)
     S, n = masses.shape
     off = 1 if chain.striker is not None else 0
-    nb = off + n + (1 if chain.wall is not None else 0)
+    plate = chain.wall is not None and chain.wall.compliant
+    nb = off + n + (1 if chain.wall is not None else 0) + (1 if plate else 0)
+    bodies = np.concatenate((masses, np.full((S, 1), chain.wall.plate_mass)), axis=1) if plate else masses
     mass = np.zeros((S, nb))
-    mass[:, off:off + n] = masses
+    mass[:, off:off + bodies.shape[1]] = bodies
     if off:
         striker_mass = np.full(S, chain.striker.mass) if striker_mass is None else np.asarray(striker_mass, float)
         velocity = np.full(S, chain.striker.velocity) if velocity is None else np.asarray(velocity, float)
@@ -70,28 +103,38 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     load = np.zeros((S, nb + 1))
     load[:, 1:] = np.cumsum(mass * bias, axis=1)
 
-    F_c = static_forces_of(masses, chain.gravity, top)
-    d_c = static_overlaps_of(A_c, F_c)
+    expo_c = chain.contact_exponents()
+    F_c = static_forces_of(bodies, chain.gravity, top)
+    d_c = static_overlaps_of(A_c, F_c, expo_c)
     A, d0, f0 = np.zeros((S, nb)), np.zeros((S, nb)), np.zeros((S, nb))
+    expo, damping, dashpot = np.full((S, nb), 1.5), np.zeros((S, nb)), np.zeros((S, nb))
     d_limit = np.full((S, nb), math.inf)
     radii = np.array([b.radius for b in chain.beads])
     near = np.minimum(np.append(math.inf, radii), np.append(radii, math.inf))  # contact k: beads k-1, k
-    slot = np.arange(n + 1) + off
+    near = np.append(near, math.inf) if plate else near  # the rod: no overlap limit of its own
+    slot = np.arange(chain.n_contacts) + off
     live = np.isfinite(chain.contact_constants()) & (slot > 0) & (slot < nb)
     A[:, slot[live]], d0[:, slot[live]], f0[:, slot[live]] = A_c[:, live], d_c[:, live], F_c[:, live]
+    expo[:, slot[live]] = expo_c[live]
+    tau_c, mu_c = chain.contact_dissipation()
+    damping[:, slot[live]], dashpot[:, slot[live]] = tau_c[live], mu_c[live]
     d_limit[:, slot[live]] = 0.5 * near[live]
     if off:
         d0[:, 1] = -chain.striker.gap
+    beads = np.zeros((S, nb), dtype=bool)
+    beads[:, off:off + n] = True  # the holder drags and rubs the beads only
+    drag = np.where(beads, chain.drag * invm, 0.0)
+    friction = np.where(beads, chain.friction * invm, 0.0)
     u0, v0 = np.zeros((S, nb)), np.zeros((S, nb))
     if off:
         v0[:, 0] = velocity
         e_scale, p_scale = 0.5 * striker_mass * velocity**2, striker_mass * velocity
     else:  # no impact: the static elastic energy and its momentum scale
-        e_scale = np.sum(0.4 * f0 * d0, axis=1)
+        e_scale = np.sum(np.where(expo == 1.5, 0.4 * f0 * d0, f0 * d0 / (expo + 1.0)), axis=1)
         e_scale = np.where(e_scale == 0.0, 1.0, e_scale)
         p_scale = np.sqrt(2.0 * mass.sum(axis=1) * e_scale)
-    return dict(mass=mass, invm=invm, bias=bias, load=load, A=A, d0=d0, f0=f0,
-                damping=np.full((S, nb), chain.damping_time), d_limit=d_limit, u0=u0, v0=v0,
+    return dict(mass=mass, invm=invm, bias=bias, load=load, A=A, expo=expo, d0=d0, f0=f0, damping=damping,
+                dashpot=dashpot, d_limit=d_limit, drag=drag, friction=friction, u0=u0, v0=v0,
                 energy_scale=e_scale, momentum_scale=p_scale)
 
 
@@ -101,10 +144,12 @@ class ChainProblem:
 
     Arrays are per body (size nb) in SI: mass (kg; 0 for the wall), invm (1/kg), bias
     (constant acceleration, m/s^2: gravity, plus top force / m on bead 0), load (size nb+1:
-    the constant force carried from above through each slot, N), and per contact
-    slot (slot i joins bodies i-1 and i): A (N/m^1.5), d0 (m), f0 (N), damping (s), d_limit
-    (m, an overlap beyond which the integration is declared unstable). u0, v0 the initial
-    state (m, m/s).
+    the constant force carried from above through each slot, N), drag (1/s) and friction
+    (m/s^2): the holder's drag and Coulomb friction over the body's mass; and per contact
+    slot (slot i joins bodies i-1 and i): A (N/m^n), expo (n), d0 (m), f0 (N), damping (s,
+    Kuwabara-Kono), dashpot (kg/s), d_limit (m, an overlap beyond which the integration is
+    declared unstable). u0, v0 the initial state (m, m/s). With a compliant wall the plate
+    is a body and the rod the slot below it, to the wall's immovable body.
     """
 
     chain: Chain
@@ -114,10 +159,14 @@ class ChainProblem:
     bias: np.ndarray
     load: np.ndarray
     A: np.ndarray
+    expo: np.ndarray
     d0: np.ndarray
     f0: np.ndarray
     damping: np.ndarray
+    dashpot: np.ndarray
     d_limit: np.ndarray
+    drag: np.ndarray
+    friction: np.ndarray
     u0: np.ndarray
     v0: np.ndarray
     sched_body: int
@@ -138,14 +187,30 @@ class ChainProblem:
         else:
             sched_t = np.zeros(0)
             sched_f = np.zeros(0)
-        return cls(chain, off, *(a[k][0] for k in ("mass", "invm", "bias", "load", "A", "d0", "f0", "damping",
-                                                    "d_limit", "u0", "v0")),
+        return cls(chain, off, *(a[k][0] for k in ("mass", "invm", "bias", "load", "A", "expo", "d0", "f0",
+                                                    "damping", "dashpot", "d_limit", "drag", "friction",
+                                                    "u0", "v0")),
                    off, sched_t, sched_f, nb - 1 if chain.wall is not None else 0,
                    float(a["energy_scale"][0]), float(a["momentum_scale"][0]))
 
     @property
     def n_bodies(self) -> int:
         return self.mass.shape[0]
+
+    @property
+    def law(self) -> int:
+        """The kernels' contact code (kernel_law)."""
+        live = self.A > 0
+        return kernel_law(self.expo[live], self.damping[live], self.dashpot[live])
+
+    @property
+    def onsite(self) -> bool:
+        """Whether the holder drags or rubs the beads."""
+        return bool(np.any(self.drag) or np.any(self.friction))
+
+    @property
+    def slip_speed(self) -> float:
+        return self.chain.slip_speed
 
     @property
     def moving_bodies(self) -> int:

@@ -13,8 +13,8 @@ from rig.solver.kernels.integrators import integrate
 from rig.solver.methods import Method
 from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
-from rig.solver.solution import KernelReport, Solution, SolverStats, Status
-from rig.solver.stepsize import Stepping
+from rig.solver.solution import DIAGNOSTICS, KernelReport, Solution, SolverStats, Status
+from rig.solver.stepsize import Stepping, viscous_rate
 
 MAX_CHECKS = 50  # energy / momentum / blow-up checks per solve (each one O(N))
 CHECK_SPACING = 4  # steps at least between two checks: a check costs about half a step
@@ -67,11 +67,12 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     frames = np.zeros((n_frames, problem.n_bodies))
     u = problem.u0.copy()
     v = problem.v0.copy()
-    diag = np.zeros(6)
+    diag = np.zeros(DIAGNOSTICS)
     check_every = check_interval(n_steps)
 
-    args = (problem.mass, problem.invm, problem.bias, problem.load, problem.A, problem.d0,
-            problem.damping, problem.chain.law.code, np.array(m.drifts), np.array(m.kicks), step)
+    args = (problem.mass, problem.invm, problem.bias, problem.load, problem.A, problem.d0, problem.law,
+            np.stack((problem.expo, problem.damping, problem.dashpot)), np.stack((problem.drag, problem.friction)),
+            problem.slip_speed, viscous_rate(problem), np.array(m.drifts), np.array(m.kicks), step)
     mid = (stepping.head, sub)
     tail = (problem.sched_body, problem.sched_t, problem.sched_f,
             ch_slot, ch_weight, save.sample_interval, out, frame_dt, frames,
@@ -86,9 +87,11 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
         raise Unstable(f"{report.status.message} (near t = {report.end_time_s:.4g} s, "
                        f"dt = {step:.4g} s, method {m.name})", stepping)
     stats = SolverStats(m.name, step, n_steps, n_steps * m.force_evaluations, wall,
-                        report.energy_error, report.momentum_error, report.wall_impulse_Ns, accuracy)
+                        report.energy_error, report.momentum_error, report.wall_impulse_Ns, accuracy,
+                        dissipated_energy_J=report.dissipated_energy_J)
     moving = slice(0, problem.n_bodies - (1 if problem.wall_slot else 0))
-    frames_abs = frames[:, moving] + frame_origin(problem.chain) if n_frames else None
+    shown = slice(0, problem.offset + problem.chain.n_beads)  # the striker and the beads (not a wall's plate)
+    frames_abs = frames[:, shown] + frame_origin(problem.chain) if n_frames else None
     return Solution(dict(zip(save.names, out)), save.sample_interval, frames_abs,
                     save.frame_interval, u[moving].copy(), v[moving].copy(), stats, problem,
                     report.status)

@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rig.model.contact import hertz_energy
+
 
 class Status(enum.IntEnum):
     """How a solve ended, as the kernels report it (like scipy's OdeResult.status)."""
@@ -20,9 +22,13 @@ class Status(enum.IntEnum):
                                  "bead radius); use a smaller dt or a tighter accuracy"}[self]
 
 
+DIAGNOSTICS = 7  # the floats of a kernel's diagnostics array
+
+
 @dataclass(frozen=True)
 class KernelReport:
-    """What an integration kernel reports in its float64[6] diagnostics array, by name."""
+    """What an integration kernel reports in its float64[DIAGNOSTICS] diagnostics array,
+    by name."""
 
     energy_error: float
     momentum_error: float
@@ -30,21 +36,24 @@ class KernelReport:
     status: Status
     steps: int
     end_time_s: float
+    dissipated_energy_J: float
 
     @classmethod
     def of(cls, diag) -> "KernelReport":
         return cls(float(diag[0]), float(diag[1]), float(diag[2]), Status(int(diag[3])),
-                   int(diag[4]), float(diag[5]))
+                   int(diag[4]), float(diag[5]), float(diag[6]))
 
 
 @dataclass(frozen=True)
 class SolverStats:
     """Diagnostics of one solve.
 
-    energy_error: max |E(t) - E(0)| / E_ref over the checks (E_ref: the striker's kinetic
-    energy, or the static elastic energy without a striker). momentum_error: max
-    |P(t) - P(0) - external impulse| / P_ref (P_ref: the striker's momentum), external
-    impulse = constant loads x t + scheduled force impulse - wall impulse.
+    energy_error: max |E(t) + dissipated(t) - E(0)| / E_ref over the checks (E_ref: the
+    striker's kinetic energy, or the static elastic energy without a striker; dissipated:
+    what the contacts' viscous terms and the holder's drag and friction took). momentum_error:
+    max |P(t) - P(0) - external impulse| / P_ref (P_ref: the striker's momentum), external
+    impulse = constant loads x t + scheduled force impulse - wall impulse + the holder's.
+    dissipated_energy_J: the energy dissipation took over the whole solve (J).
     error_estimate: the a-posteriori estimate of the largest error of any recorded force,
     relative to its dynamic peak (``relative_error``), over the whole record; None where
     nothing was recorded. estimate_basis: how it was obtained ("companion at 2 dt": a
@@ -67,6 +76,7 @@ class SolverStats:
     estimate_basis: str = "none"
     attempts: int = 1
     cpu_s: float = 0.0
+    dissipated_energy_J: float = 0.0
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -127,7 +137,7 @@ class Solution:
         u = np.zeros(p.n_bodies)
         u[:n] = self.final_u
         d = np.maximum(p.d0[1:] + u[:-1] - u[1:], 0.0)
-        contact = np.concatenate(([0.0], 0.4 * p.A[1:] * d**2.5, [0.0]))
+        contact = np.concatenate(([0.0], hertz_energy(p.A[1:], d, p.expo[1:]), [0.0]))
         e = 0.5 * p.mass * np.pad(self.final_v, (0, p.n_bodies - n)) ** 2
         e += 0.5 * (contact[:-1] + contact[1:])
         return e[:n]

@@ -81,14 +81,21 @@ def contact_time_scales(p) -> np.ndarray:
 
 
 def _contact_time_scales(p) -> np.ndarray:
+    """For a power law A d^n the impact scale is (m / (A v^(n-1)))^(1/(n+1)), the same
+    dimensional argument as Hertz's."""
     m = _reduced_masses(p)
     live = p.A > 0
     tau = np.full(p.n_bodies, np.inf)
     v = float(p.v0.max(initial=0.0))
+    hertz = live & (p.expo == 1.5)
+    other = live & ~hertz
     if v > 0:
-        tau[live] = (m[live] / (p.A[live] * math.sqrt(v))) ** 0.4
+        tau[hertz] = (m[hertz] / (p.A[hertz] * math.sqrt(v))) ** 0.4
+        n = p.expo[other]
+        tau[other] = (m[other] / (p.A[other] * v ** (n - 1.0))) ** (1.0 / (n + 1.0))
     loaded = live & (p.f0 > 0)
-    tau[loaded] = np.minimum(tau[loaded], np.sqrt(m[loaded] / contact_stiffness(p.A[loaded], p.f0[loaded])))
+    k0 = contact_stiffness(p.A[loaded], p.f0[loaded], p.expo[loaded])
+    tau[loaded] = np.minimum(tau[loaded], np.sqrt(m[loaded] / k0))
     return tau
 
 
@@ -105,30 +112,36 @@ def head_contacts(p) -> int:
     contacts that close and open at speed, and the head flow resolves those instants."""
     tau = contact_time_scales(p)[1:]
     finite = tau[np.isfinite(tau)]
-    if p.chain.law.dissipative or not p.offset or finite.size < 2 * MAX_HEAD:
+    elastic = (p.expo == 1.5) & (p.damping == 0.0) & (p.dashpot == 0.0)  # the head flow's law: Hertz
+    if not p.offset or finite.size < 2 * MAX_HEAD or not elastic[1]:
         return 0
     slow = HEAD_RATIO * float(np.median(finite))
     k = 1
-    while k < MAX_HEAD and (tau[k] < slow or p.f0[k + 1] == 0.0):
+    while k < MAX_HEAD and elastic[k + 1] and (tau[k] < slow or p.f0[k + 1] == 0.0):
         k += 1
     return k
 
 
 def peak_force_estimate(p) -> np.ndarray:
     """Upper estimate of each contact's peak force (N): static force plus twice the peak of
-    the striker hitting an immovable sphere, F = A (5 m_s v^2 / (4 A))^(3/5)."""
-    F = p.f0.copy()
-    if p.offset and p.v0[0] > 0:
-        A0 = p.A[1]
-        hit = A0 * (5.0 * p.mass[0] * p.v0[0] ** 2 / (4.0 * A0)) ** 0.6
-        F = F + 2.0 * hit
-    return F
+    the striker hitting an immovable sphere, F = A (5 m_s v^2 / (4 A))^(3/5) (a power law
+    A d^n: A ((n + 1) m_s v^2 / (2 A))^(n/(n+1))). Arrays (bodies,), or (shots, bodies)
+    for a batch's ProblemArrays."""
+    F = np.array(p.f0, dtype=float)
+    if not p.offset:
+        return F
+    m, v, A0, n = p.mass[..., 0], p.v0[..., 0], p.A[..., 1], p.expo[..., 1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        hertz = A0 * (5.0 * m * v**2 / (4.0 * A0)) ** 0.6
+        other = A0 * ((n + 1.0) * m * v**2 / (2.0 * A0)) ** (n / (n + 1.0))
+    hit = np.where(v > 0, np.where(n == 1.5, hertz, other), 0.0)
+    return F + 2.0 * np.asarray(hit)[..., None]
 
 
 def max_frequency(p, first: int = 1) -> float:
     """Gershgorin bound (rad/s) on the highest linear frequency at the peak-force estimate,
     counting the contacts of slots ``first``.. only."""
-    k = np.where(p.A > 0, contact_stiffness(p.A, peak_force_estimate(p)), 0.0)
+    k = np.where(p.A > 0, contact_stiffness(p.A, peak_force_estimate(p), p.expo), 0.0)
     k[:first] = 0.0
     k_above = k
     k_below, im_above, im_below = np.zeros_like(k), np.zeros_like(k), np.zeros_like(k)
@@ -136,6 +149,24 @@ def max_frequency(p, first: int = 1) -> float:
     k_below[:-1], im_above[1:], im_below[:-1] = k[1:], im[:-1], im[1:]
     rows = im * (k_above + k_below) + k_above * np.sqrt(im * im_above) + k_below * np.sqrt(im * im_below)
     return float(math.sqrt(rows.max())) if rows.max() > 0 else 0.0
+
+
+def viscous_rate(p) -> float:
+    """A bound (1/s) on the decay rates of the contacts' viscous flow (the dissipation's
+    substeps, rig/solver/kernels/dissipation.py): Gershgorin's on M^-1 L, L the chain's
+    Laplacian weighted by each contact's viscous coefficient c = mu + A tau d^(n-1) at
+    the peak-force estimate; 0 without viscous terms. A ChainProblem, or a batch's
+    ProblemArrays (the largest over its shots)."""
+    if not (np.any(p.damping) or np.any(p.dashpot)):
+        return 0.0
+    live = p.A > 0
+    F = peak_force_estimate(p)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = np.where(live, (F / np.where(live, p.A, 1.0)) ** (1.0 / p.expo), 0.0)
+        c = np.where(live, p.dashpot + p.damping * p.A * d ** (p.expo - 1.0), 0.0)
+    c_below = np.zeros_like(c)
+    c_below[..., :-1] = c[..., 1:]
+    return float(np.max(2.0 * (c + c_below) * p.invm))
 
 
 def stability_limit(p, method: Method, head: int = 0) -> float:
@@ -160,6 +191,10 @@ def crossed_contacts(p, t_end: float) -> float:
         return 1.0
     A = float(np.median(p.A[live]))
     m = float(np.median(p.chain.masses))
+    if np.any(p.expo[live] != 1.5):  # another exponent: the linear sound speed at the peak force bounds it
+        n = float(np.median(p.expo[live]))
+        k = float(contact_stiffness(A, float(peak_force_estimate(p)[live].max()), n))
+        return max(1.0, a * math.sqrt(k / m) * t_end / a)
     modulus, rho = 3.0 * A / math.sqrt(a), 6.0 * m / (math.pi * a**3)
     speed = max(float(sound_speed(modulus, 0.0, rho, a, float(p.f0[live].max()))),
                 float(sonic_vacuum_speed(modulus, 0.0, rho, a, float(peak_force_estimate(p)[live].max()))))

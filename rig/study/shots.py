@@ -94,8 +94,10 @@ def shots_of(template: Rig, values: list, masses: list) -> Shots:
     A = contact_constants_of(chain, E, nu) if varied else np.tile(chain.contact_constants(), (S, 1))
     arrays = problem_arrays(chain, bead_mass, A, top, striker_mass if striker else None,
                             velocity if striker else None)
-    d0 = static_overlaps_of(A, static_forces_of(bead_mass, chain.gravity, top))
-    x = equilibrium_positions_of([b.radius for b in chain.beads], d0)
+    bodies = np.append(bead_mass, np.full((S, len(chain.body_masses) - bead_mass.shape[1]),
+                                          chain.body_masses[-1]), axis=1)  # a compliant wall's plate
+    d0 = static_overlaps_of(A, static_forces_of(bodies, chain.gravity, top), chain.contact_exponents())
+    x = equilibrium_positions_of([b.radius for b in chain.beads], d0[:, :chain.n_beads + 1])
     beads = [g.bead for g in template.gauges]
     fixed = np.full((S, len(wiring_of(template).gauges), 2), np.nan)
     for k, g in enumerate(template.gauges):

@@ -67,10 +67,12 @@ def chain_frames(rig, n_frames: int) -> Frames:
     pos = sol.frames[:n_frames]
     u = pos - frame_origin(rig.chain)  # displacements from the static equilibrium (m)
     off, beads = problem.offset, len(rig.chain.beads)
-    u_all = np.concatenate([u, np.zeros((u.shape[0], 1))], axis=1) if problem.wall_slot else u
-    # whole contact force of every slot (slot i: bodies i-1 and i; slot 0 and a missing wall: 0)
-    slots = np.zeros((u.shape[0], off + beads + 2))
-    slots[:, 1:u_all.shape[1]] = hertz_force(problem.A[None, 1:], problem.d0[None, 1:] + u_all[:, :-1] - u_all[:, 1:])
+    # a compliant wall's plate is not in the frames: drawn at rest (it colours the last bead only)
+    u_all = np.concatenate([u, np.zeros((u.shape[0], problem.n_bodies - u.shape[1]))], axis=1)
+    # elastic contact force of every slot (slot i: bodies i-1 and i; slot 0 and a missing wall: 0)
+    slots = np.zeros((u.shape[0], problem.n_bodies + 1))
+    slots[:, 1:problem.n_bodies] = hertz_force(problem.A[None, 1:], problem.d0[None, 1:] + u_all[:, :-1] - u_all[:, 1:],
+                                                 problem.expo[None, 1:])
     above, below = slots[:, off: off + beads], slots[:, off + 1: off + 1 + beads]
     return Frames(np.arange(pos.shape[0]) * rec.frame_interval, pos, 0.5 * (above + below), u)
 

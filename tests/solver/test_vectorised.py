@@ -31,8 +31,8 @@ def _chain(nb=64):
 
 @pytest.mark.parametrize("law", [HERTZ, KUWABARA_KONO])
 def test_the_fused_kick_drift_force_pass_is_vectorised(law):
-    u, v, invm, f, A, d0, damping = _chain()
-    ir = _llvm(integrators._fused_run, u, v, invm, f, A, d0, damping, law, np.zeros(65), 1e-9, 1e-9, 3, 64)
+    u, v, invm, f, A, d0, _ = _chain()
+    ir = _llvm(integrators._fused_run, u, v, invm, f, A, d0, np.zeros(65), 1e-9, 1e-9, 3, 64, law, np.full(64, 1.5))
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the square roots of the force pass are scalar"
     assert _vector_ops(ir), "no vector arithmetic in the fused pass"
 

@@ -7,5 +7,5 @@ state ``y = [u, v]`` (size 2 nb).
 """
 from instruments.jit import drop_stale_cache
 
-# the kernels inline contact_forces (rig.solver.kernels.forces) and read HERTZ (rig.model.contact)
+# the kernels inline hertz_forces (rig.solver.kernels.forces)
 drop_stale_cache(__name__, constants=("rig.model.contact", "rig.solver.kernels.forces"))

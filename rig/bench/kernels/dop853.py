@@ -12,7 +12,7 @@ The system y' = F(y), y = [u, v] (m, m/s, size 2 nb):
     du_i/dt = v_i,   dv_i/dt = (f[i] - f[i+1]) invm[i],
     f[i] = A[i] max(d0[i] + u[i-1] - u[i], 0)^(3/2) - load[i],  f[0] = 0,  f[nb] = -load[nb]
 
-(the dynamic Hertz forces of rig.solver.kernels.forces.contact_forces, N).
+(the dynamic Hertz forces of rig.solver.kernels.forces.hertz_forces, N).
 
 One step of size h from (t, y): stages k_1 = F(y) (the last stage of the step before),
 k_s = F(y + h sum_{j<s} a_sj k_j), s = 2..12; y_new = y + h sum_i b_i k_i (order 8).
@@ -42,8 +42,7 @@ import numpy as np
 
 from instruments.jit import jit
 from rig.bench.kernels.dop853_table import DENSE_STAGES, E3, E5, N_STAGES, N_STAGES_EXTENDED, A, B, C, D  # noqa: F401
-from rig.model.contact import HERTZ
-from rig.solver.kernels.forces import contact_forces
+from rig.solver.kernels.forces import hertz_forces
 
 SAFETY = 0.9            # Hairer's safe
 FAC1 = 0.333            # h_new / h >= FAC1
@@ -58,11 +57,11 @@ EVALUATIONS, ACCEPTED, REJECTED, DENSE_STEPS, STATUS = range(5)
 
 
 @jit
-def chain_rhs(y, A_hertz, d0, damping, load, invm, f, dy):
+def chain_rhs(y, A_hertz, d0, load, invm, f, dy):
     """dy = F(y) (m/s, m/s^2) for the chain's state y = [u, v] (module doc); f (size nb + 1)
     holds the dynamic forces (N), f[0] = 0 and f[nb] = -load[nb] set by the caller."""
     nb = invm.shape[0]
-    contact_forces(y[:nb], y[nb:], A_hertz, d0, damping, HERTZ, load, f)
+    hertz_forces(y[:nb], A_hertz, d0, load, f)
     for i in range(nb):
         dy[i] = y[nb + i]
         dy[nb + i] = (f[i] - f[i + 1]) * invm[i]
@@ -121,7 +120,7 @@ def rms(x, scale):
 
 
 @jit
-def starting_step(y, k, t_end, rtol, atol, A_hertz, d0, damping, load, invm, f, work, scale):
+def starting_step(y, k, t_end, rtol, atol, A_hertz, d0, load, invm, f, work, scale):
     """The first step (s) by Hairer's rule (Sec. II.4, 8th order, the norms as scipy's):
     h0 = 0.01 |y|/|F(y)| (1e-6 s for tiny norms), one Euler step of h0 to estimate the
     second derivative d2, then h = min(100 h0, (0.01 / max(|F(y)|, d2))^(1/8), t_end).
@@ -135,7 +134,7 @@ def starting_step(y, k, t_end, rtol, atol, A_hertz, d0, damping, load, invm, f, 
     h0 = min(h0, t_end)
     for i in range(n):
         work[i] = y[i] + h0 * k[0, i]
-    chain_rhs(work, A_hertz, d0, damping, load, invm, f, k[1])
+    chain_rhs(work, A_hertz, d0, load, invm, f, k[1])
     for i in range(n):
         work[i] = k[1, i] - k[0, i]
     n2 = rms(work, scale) / h0
@@ -176,7 +175,7 @@ def dense_value(y0, r, theta):
 
 
 @jit
-def integrate(y, t_end, rtol, atol, A_hertz, d0, damping, load, invm, slot, sample_interval,
+def integrate(y, t_end, rtol, atol, A_hertz, d0, load, invm, slot, sample_interval,
               out, k, y_new, work, f, counts):
     """DOP853 (module doc) from t = 0 to t_end (s), y = [u, v] advanced in place; records the
     contact force of ``slot`` (N, probe_force) at t_j = j sample_interval into out[j].
@@ -194,8 +193,8 @@ def integrate(y, t_end, rtol, atol, A_hertz, d0, damping, load, invm, slot, samp
     n_out = out.shape[0]
     f[0] = 0.0
     f[nb] = -load[nb]
-    chain_rhs(y, A_hertz, d0, damping, load, invm, f, k[0])
-    h = starting_step(y, k, t_end, rtol, atol, A_hertz, d0, damping, load, invm, f, work[0], work[1])
+    chain_rhs(y, A_hertz, d0, load, invm, f, k[0])
+    h = starting_step(y, k, t_end, rtol, atol, A_hertz, d0, load, invm, f, work[0], work[1])
     counts[EVALUATIONS] = 2
     counts[ACCEPTED] = 0
     counts[REJECTED] = 0
@@ -216,7 +215,7 @@ def integrate(y, t_end, rtol, atol, A_hertz, d0, damping, load, invm, slot, samp
             last = True
         for s in range(1, N_STAGES):
             stage_argument(y, k, s, h, work[0])
-            chain_rhs(work[0], A_hertz, d0, damping, load, invm, f, k[s])
+            chain_rhs(work[0], A_hertz, d0, load, invm, f, k[s])
         stage_argument(y, k, N_STAGES, h, y_new)
         counts[EVALUATIONS] += N_STAGES - 1
         err = error_norm(y, y_new, k, h, rtol, atol, work[0], work[1])
@@ -224,14 +223,14 @@ def integrate(y, t_end, rtol, atol, A_hertz, d0, damping, load, invm, slot, samp
         if err <= 1.0:
             fac = max(1.0 / FAC2, min(1.0 / FAC1, fac11 / SAFETY))
             h_new = h / fac
-            chain_rhs(y_new, A_hertz, d0, damping, load, invm, f, k[N_STAGES])
+            chain_rhs(y_new, A_hertz, d0, load, invm, f, k[N_STAGES])
             counts[EVALUATIONS] += 1
             counts[ACCEPTED] += 1
             t_new = t_end if last else t + h
             if j_out < n_out and (last or j_out * sample_interval <= t_new):
                 for s in range(N_STAGES + 1, N_STAGES_EXTENDED):
                     stage_argument(y, k, s, h, work[0])
-                    chain_rhs(work[0], A_hertz, d0, damping, load, invm, f, k[s])
+                    chain_rhs(work[0], A_hertz, d0, load, invm, f, k[s])
                 counts[EVALUATIONS] += N_STAGES_EXTENDED - N_STAGES - 1
                 counts[DENSE_STEPS] += 1
                 dense_coefficients(y, y_new, k, h, above, r_above)

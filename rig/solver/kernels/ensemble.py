@@ -5,8 +5,9 @@ runs over ``width`` shots from 0, so every loop over the shots of a chunk vector
 ``integrate_ensemble`` runs the chunks on numba's threads. Every shot
 performs exactly the operations of the single-shot kernel (integrators.integrate) in the
 same order with the same step, so the two agree to the last bit (the multirate head
-runs the same multirate.head_flow in both). Conservative Hertz contacts and constant
-loads only (no force schedule, no dissipation).
+runs the same multirate.head_flow in both; dissipative laws and the holder's drag and
+friction the same forces.contact_force and forces.onsite_step). Constant loads only (no
+force schedule).
 """
 import math
 
@@ -14,7 +15,9 @@ import numpy as np
 from numba import prange
 
 from instruments.jit import jit
-from rig.solver.kernels.forces import state_sums
+from rig.model.contact import HERTZ, POWER
+from rig.solver.kernels.dissipation import dissipate
+from rig.solver.kernels.forces import contact_force, power, state_sums
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
 
@@ -29,9 +32,25 @@ def _contact_row(u, A, d0, load, f, i):
 
 
 @jit
-def _forces(u, A, d0, load, f):
-    for i in range(1, u.shape[0]):
+def _power_row(u, A, d0, load, f, i, expo):
+    """Contact slot i of every shot by a power law A d^n (forces.elastic_forces)."""
+    for s in range(u.shape[1]):
+        d = d0[i, s] + u[i - 1, s] - u[i, s]
+        f[i, s] = A[i, s] * power(d if d > 0.0 else 0.0, expo[i, s]) - load[i, s]
+
+
+@jit
+def _row(u, A, d0, load, f, i, law, expo):
+    if law != POWER:
         _contact_row(u, A, d0, load, f, i)
+    else:
+        _power_row(u, A, d0, load, f, i, expo)
+
+
+@jit
+def _forces(u, A, d0, load, f, law, expo):
+    for i in range(1, u.shape[0]):
+        _row(u, A, d0, load, f, i, law, expo)
 
 
 @jit
@@ -55,7 +74,7 @@ def _kick_drift(u, v, invm, f, hb, ha, head):
 
 
 @jit
-def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_work, h_busy):
+def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_work, h_busy, law, expo):
     """_kick_drift (and the head's flow) then _forces in one pass over the rows: row i is
     kicked and drifted (reading f[i], f[i+1], not yet renewed), then contact i is renewed
     from rows i-1 and i (both moved). The same operations as the two passes, so the same
@@ -71,14 +90,15 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
             v[i, s] = vi
             u[i, s] += ha * vi
         if i >= 1:
-            _contact_row(u, A, d0, load, f, i)
+            _row(u, A, d0, load, f, i, law, expo)
 
 
 @jit
-def _record(out, j, w, col, ch_slot, ch_weight, A, d_old, r_old, d_new, r_new):
-    """out[c, j, s]: channel c's force (N) of every shot s at sample j, whose Hermite weights
-    are column col of w: record.recorded_force's operations, in its order (0 + the first
-    term is that term: no force is -0), with the shots innermost (the loop vectorises)."""
+def _record(out, j, w, col, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new):
+    """out[c, j, s]: channel c's force (N) of every shot s at sample j (fraction x of the
+    step), whose Hermite weights are column col of w: record.recorded_force's operations,
+    in its order (0 + the first term is that term: no force is -0), with the shots
+    innermost (the Hertz loop vectorises)."""
     W = out.shape[2]
     w0, w1, w2, w3 = w[0, col], w[1, col], w[2, col], w[3, col]
     for c in range(ch_slot.shape[0]):
@@ -89,8 +109,13 @@ def _record(out, j, w, col, ch_slot, ch_weight, A, d_old, r_old, d_new, r_new):
                 i = ch_slot[c, k]
                 for s in range(W):
                     d = w0 * d_old[c, k, s] + w1 * r_old[c, k, s] + w2 * d_new[c, k, s] + w3 * r_new[c, k, s]
-                    d = d if d > 0.0 else 0.0
-                    fk = wk * (A[i, s] * d * math.sqrt(d))
+                    if law == HERTZ:
+                        d = d if d > 0.0 else 0.0
+                        fk = wk * (A[i, s] * d * math.sqrt(d))
+                    else:
+                        rate = (1.0 - x) * r_old[c, k, s] + x * r_new[c, k, s]
+                        fc, _ = contact_force(d, rate, A[i, s], con[0, i, s], con[1, i, s], con[2, i, s], law)
+                        fk = wk * fc
                     out[c, j, s] = fk if first else out[c, j, s] + fk
                 first = False
         if first:  # a channel of no contact records nothing
@@ -99,17 +124,27 @@ def _record(out, j, w, col, ch_slot, ch_weight, A, d_old, r_old, d_new, r_new):
 
 
 @jit
-def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, head, sub,
-           ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
+def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_rate, a_coef, b_coef, dt, n_steps,
+           head, sub, ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
            e_ref, p_ref, diag, f, d_old, r_old, d_new, r_new):
     nb = u.shape[0]
     W = u.shape[1]
     n_drift = a_coef.shape[0]
     n_out = out.shape[1]
+    viscous = False
+    dissipative = False
+    for i in range(nb):
+        for s in range(W):
+            viscous = viscous or con[1, i, s] != 0.0 or con[2, i, s] != 0.0
+            dissipative = dissipative or viscous or onsite[0, i, s] != 0.0 or onsite[1, i, s] != 0.0
+    work = np.zeros((4, nb + 1, W))  # the dissipation's work arrays
+    lost = np.zeros(W)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
+    j_visc = np.zeros(W)
+    j_holder = np.zeros(W)
     for s in range(u.shape[1]):
         f[0, s] = 0.0
         f[nb, s] = -load[nb, s]
-    _forces(u, A, d0, load, f)
+    _forces(u, A, d0, load, f, law, con[0])
     e0 = np.empty(W)
     p0 = np.empty(W)
     e = np.empty(W)
@@ -118,18 +153,22 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
     net = np.empty(W)
     j_wall = np.zeros(W)
     w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
+    x = np.empty(w.shape[1])  # their fractions of the step
     h_work, h_busy = np.empty((2, 3, head + 1)), np.empty(W)  # the head flow's work arrays
-    state_sums(u, v, mass, bias, A, d0, d_limit, e0, p0, worst)
+    state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, e0, p0, worst)
     for s in range(u.shape[1]):
         net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
     probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, 0.0, head, -1, 0.0, d_old, r_old)
     if n_out > 0:
         hermite_weights(0.0, dt, w, 0)
-        _record(out, 0, w, 0, ch_slot, ch_weight, A, d_old, r_old, d_old, r_old)
+        _record(out, 0, w, 0, 0.0, ch_slot, ch_weight, A, law, con, d_old, r_old, d_old, r_old)
     j_out = 1
     pending = 0.0
     for n in range(n_steps):
         t = n * dt
+        if dissipative:  # E(dt/2) S(dt) E(dt/2) (integrators.integrate)
+            dissipate(u, v, mass, invm, A, d0, con, onsite, slip, viscous, viscous_rate, 0.5 * dt, wall_slot, work,
+                      lost, j_visc, j_holder)
         for st in range(n_drift):
             hb = b_coef[st] * dt
             if st == 0:
@@ -138,49 +177,56 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, hea
                 for s in range(u.shape[1]):
                     j_wall[s] += hb * f[wall_slot, s]
             h = a_coef[st] * dt
-            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_work, h_busy)
+            _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_work, h_busy,
+                               law, con[0])
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1
-        if check:
+        if check or dissipative:
             if wall_slot > 0:
                 for s in range(u.shape[1]):
                     j_wall[s] += pending * f[wall_slot, s]
             _kick_drift(u, v, invm, f, pending, 0.0, head)
             pending = 0.0
+        if dissipative:
+            dissipate(u, v, mass, invm, A, d0, con, onsite, slip, viscous, viscous_rate, 0.5 * dt, wall_slot, work,
+                      lost, j_visc, j_holder)
         probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, pending, head, -1, 0.0, d_new, r_new)
         j_end = j_out
         while j_end < n_out and j_end * sample_dt <= t_new * (1.0 + 1e-12):
             j_end += 1
         for j in range(j_out, j_end):  # the weights are the same for every shot and channel
-            hermite_weights((j * sample_dt - t) / dt, dt, w, j - j_out)
+            x[j - j_out] = (j * sample_dt - t) / dt
+            hermite_weights(x[j - j_out], dt, w, j - j_out)
         for j in range(j_out, j_end):
-            _record(out, j, w, j - j_out, ch_slot, ch_weight, A, d_old, r_old, d_new, r_new)
+            _record(out, j, w, j - j_out, x[j - j_out], ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new)
         j_out = j_end
         d_old[:, :, :] = d_new
         r_old[:, :, :] = r_new
         if check:
-            state_sums(u, v, mass, bias, A, d0, d_limit, e, pn, worst)
+            state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, e, pn, worst)
             for s in range(u.shape[1]):
-                err = abs(e[s] - e0[s]) / e_ref[s]
-                pe = abs(pn[s] - p0[s] - (t_new * net[s] - j_wall[s])) / p_ref[s]
+                err = abs(e[s] + lost[s] - e0[s]) / e_ref[s]
+                pe = abs(pn[s] - p0[s] - (t_new * net[s] - (j_wall[s] + j_visc[s]) + j_holder[s])) / p_ref[s]
                 if not (err < 1e300) or not (worst[s] <= 1.0):
                     diag[3, s] = 1.0
                 diag[0, s] = max(diag[0, s], err)
                 diag[1, s] = max(diag[1, s], pe)
     for s in range(u.shape[1]):
-        diag[2, s] = j_wall[s] + (load[wall_slot, s] if wall_slot > 0 else 0.0) * n_steps * dt
+        diag[2, s] = j_wall[s] + j_visc[s] + (load[wall_slot, s] if wall_slot > 0 else 0.0) * n_steps * dt
         diag[4, s] = n_steps
         diag[5, s] = n_steps * dt
+        diag[6, s] = lost[s]
 
 
 @jit(parallel=True)
-def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, n_steps, head, sub,
-                       ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
+def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_rate, a_coef, b_coef,
+                       dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
                        e_ref, p_ref, diag):
-    """Integrate every shot of the (chunks, bodies, width) arrays in place; out is
-    (chunks, channels, samples, width), the shots innermost; diag is
-    (chunks, 6, width) as in the single-shot kernel."""
+    """Integrate every shot of the (chunks, bodies, width) arrays in place; con
+    (chunks, 3, bodies, width) and onsite (chunks, 2, bodies, width) as in the single-shot
+    kernel; out is (chunks, channels, samples, width), the shots innermost; diag is
+    (chunks, DIAGNOSTICS, width) as in the single-shot kernel."""
     n_chunks, nb, W = u.shape
     n_ch = ch_slot.shape[0]
     for k in prange(n_chunks):
@@ -189,6 +235,6 @@ def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, a_coef, b_coef, dt, 
         r_old = np.zeros((n_ch, ch_slot.shape[1], W))
         d_new = np.zeros((n_ch, ch_slot.shape[1], W))
         r_new = np.zeros((n_ch, ch_slot.shape[1], W))
-        _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], a_coef, b_coef, dt, n_steps, head, sub,
-               ch_slot, ch_weight, sample_dt, out[k], check_every, d_limit[k], wall_slot,
-               e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)
+        _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], law, con[k], onsite[k], slip,
+               viscous_rate, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out[k],
+               check_every, d_limit[k], wall_slot, e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)

@@ -1,41 +1,106 @@
-"""Contact forces and the chain's energy, momentum and largest overlap (numba)."""
+"""Contact forces, the holder's on-site forces and the chain's energy, momentum and largest
+overlap (numba).
+
+A contact at overlap d (m) closing at rate r = d' (m/s) pushes its two bodies apart with
+
+    HERTZ          F = A d^(3/2)
+    KUWABARA_KONO  F = max(A d^(1/2) (d + tau r) + mu r, 0)      (Hertz with viscous terms)
+    POWER          F = max(A d^(n-1) (d + tau r) + mu r, 0)      (any exponent n per contact)
+
+for d > 0, and 0 otherwise (rig.model.contact: tau the Kuwabara-Kono damping time, mu a
+dashpot). Its elastic part is A d^n, its energy A d^(n+1) / (n+1); the rest, c r with
+c = mu + A tau d^(n-1), is viscous (dissipation.py integrates it). The law code is the
+problem's (rig.solver.problem.kernel_law): the kernels' force passes carry the elastic
+part, by the Hertz loops wherever every exponent is 3/2.
+"""
 import math
 
 from instruments.jit import jit
-from rig.model.contact import HERTZ
+from rig.model.contact import HERTZ, KUWABARA_KONO, POWER
 
 
 @jit
-def contact_forces(u, v, A, d0, damping, law, load, f):
-    """Fill f[1:nb] with the dynamic contact forces (N): contact force minus ``load``.
+def power(d, n):
+    """d^n for d >= 0: d sqrt(d) for Hertz's 3/2 and d for a linear spring, exactly."""
+    if n == 1.5:
+        return d * math.sqrt(d)
+    if n == 1.0:
+        return d
+    return d**n
+
+
+@jit
+def contact_force(d, rate, A, n, tau, mu, law):
+    """(F, its elastic part) (N) of one contact at overlap d (m), closing at rate (m/s),
+    by the law of code ``law`` (module doc)."""
+    d = d if d > 0.0 else 0.0
+    if law == HERTZ:
+        el = A * d * math.sqrt(d)
+        return el, el
+    if law == KUWABARA_KONO:
+        s = math.sqrt(d)
+        fi = A * s * (d + tau * rate) + (mu * rate if d > 0.0 else 0.0)
+        return (fi if fi > 0.0 else 0.0), A * s * d
+    p = power(d, n)
+    el = A * p
+    fi = A * (p + tau * rate * (p / d if d > 0.0 else 0.0)) + (mu * rate if d > 0.0 else 0.0)
+    return (fi if fi > 0.0 else 0.0), el
+
+
+@jit
+def elastic_energy(d, A, n):
+    """A d^(n+1) / (n+1) (J) for d > 0, else 0: (2/5) A d^(5/2) for Hertz."""
+    if not d > 0.0:
+        return 0.0
+    if n == 1.5:
+        return 0.4 * A * d * d * math.sqrt(d)
+    return A * d * power(d, n) / (n + 1.0)
+
+
+@jit
+def hertz_forces(u, A, d0, load, f):
+    """f[1:nb] = A d^(3/2) - load: contact_forces' Hertz loop."""
+    for i in range(1, u.shape[0]):
+        d = d0[i] + u[i - 1] - u[i]
+        d = d if d > 0.0 else 0.0
+        f[i] = A[i] * d * math.sqrt(d) - load[i]
+
+
+@jit
+def viscous_coefficient(d, A, n, tau, mu):
+    """c = mu + A tau d^(n-1) (kg/s) of a contact at overlap d > 0 (its viscous force is
+    c d'); 0 for d <= 0."""
+    if not d > 0.0:
+        return 0.0
+    if tau == 0.0:
+        return mu
+    return mu + A * tau * (math.sqrt(d) if n == 1.5 else d ** (n - 1.0))
+
+
+@jit
+def elastic_forces(u, A, d0, load, f, law, expo):
+    """Fill f[1:nb] with the dynamic elastic contact forces (N): A d^n minus ``load``.
 
     load[i] is the constant external force carried from above through slot i (the weight
     and magnet force of bodies 0..i-1), so that body i is pushed by f[i] - f[i+1] alone
     (its own constant load is load[i+1] - load[i]) and a chain at rest has f = 0.
     Hertz: A d^(3/2), d = max(d0[i] + u[i-1] - u[i], 0), branch-free so that LLVM
-    vectorises the square roots. Kuwabara-Kono adds A d^(1/2) tau_d d(d)/dt and clips the
-    contact force at zero (no attraction).
+    vectorises the square roots.
     """
-    nb = u.shape[0]
-    if law == HERTZ:
-        for i in range(1, nb):
-            d = d0[i] + u[i - 1] - u[i]
-            d = d if d > 0.0 else 0.0
-            f[i] = A[i] * d * math.sqrt(d) - load[i]
+    if law != POWER:
+        hertz_forces(u, A, d0, load, f)
     else:
-        for i in range(1, nb):
+        for i in range(1, u.shape[0]):
             d = d0[i] + u[i - 1] - u[i]
-            d = d if d > 0.0 else 0.0
-            fi = A[i] * math.sqrt(d) * (d + damping[i] * (v[i - 1] - v[i]))
-            f[i] = (fi if fi > 0.0 else 0.0) - load[i]
+            f[i] = A[i] * power(d if d > 0.0 else 0.0, expo[i]) - load[i]
 
 
 @jit
-def state_sums(u, v, mass, bias, A, d0, d_limit, e, p, w):
+def state_sums(u, v, mass, bias, A, expo, d0, d_limit, law, e, p, w):
     """Each shot's energy e (J), momentum p (kg m/s) and largest d / d_limit w (> 1: an
     overlap no real contact reaches; inf for nan), arrays (bodies, shots), in two passes:
 
-        E = sum m v^2 / 2 + sum (2/5) A d^(5/2) - sum m b u,   P = sum m v,
+        E = sum m v^2 / 2 + sum A d^(n+1) / (n+1) - sum m b u,   P = sum m v,
 
     m b each body's constant external force (gravity, the magnet's force at t = 0); the
     wall (mass 0 here) counts for neither."""
@@ -51,6 +116,9 @@ def state_sums(u, v, mass, bias, A, d0, d_limit, e, p, w):
         for s in range(u.shape[1]):
             d = d0[i, s] + u[i - 1, s] - u[i, s]
             if d > 0.0:
-                e[s] += 0.4 * A[i, s] * d * d * math.sqrt(d)
+                if law == HERTZ or law == KUWABARA_KONO:
+                    e[s] += 0.4 * A[i, s] * d * d * math.sqrt(d)
+                else:
+                    e[s] += elastic_energy(d, A[i, s], expo[i, s])
             q = d / d_limit[i, s]
             w[s] = max(w[s], q) if q == q else math.inf

@@ -17,14 +17,21 @@ dF/dt = (3/2) A d^(1/2) d(d)/dt), so the output grid may be finer than the step.
 With a multirate head (head > 0, see rig/stepsize.py) the kicks carry every contact but
 the first ``head`` ones, and each drift moves bodies 0..head by multirate.head_flow
 (``sub[s]`` substeps of the same method in drift s) instead of a plain drift.
+
+Dissipation. The force passes carry the contacts' elastic part only; the contacts'
+viscous terms and the holder's drag and friction are a flow of the velocities, taken
+apart in a Strang splitting E(dt/2) S(dt) E(dt/2) (dissipation.py): second order where
+they act, each step then ending synchronised. E counts the energy it takes, so the
+balance E(t) + dissipated = E(0) closes to the method's own error.
 """
 import math
 
 import numpy as np
 
 from instruments.jit import jit
-from rig.model.contact import HERTZ
-from rig.solver.kernels.forces import contact_forces, state_sums
+from rig.model.contact import POWER
+from rig.solver.kernels.dissipation import dissipate
+from rig.solver.kernels.forces import elastic_forces, power, state_sums
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite, hermite_weights, probe_overlaps, recorded_force
 
@@ -60,18 +67,19 @@ def _external_kick(v, invm, h, t, sched_body, sched_t, sched_f):
 
 
 @jit
-def _fused_run(u, v, invm, f, A, d0, damping, law, load, hb, ha, lo, hi):
+def _fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, expo):
     """Bodies lo..hi-1 (lo >= 1), in order: kick v += hb (f_above - f_below)/m, drift
-    u += ha v, then renew contact slot i from bodies i-1 and i (both moved; the law of
-    forces.contact_forces, the same operations). Slot i + 1 is still the old force when
-    body i is kicked, so one pass does what a kick-drift pass and a force pass do.
+    u += ha v, then renew contact slot i's elastic force from bodies i-1 and i (both moved;
+    forces.elastic_forces' operations). Slot i + 1 is still the old force when body i is
+    kicked, so one pass does what a kick-drift pass and a force pass do. ``law``: POWER
+    takes each slot's exponent ``expo``, any other code Hertz's.
 
     The index is unsigned: with a signed start known only at run time numba keeps its
     negative-index wraparound in the loop and LLVM no longer vectorises it
     (tests/solver/test_vectorised.py guards this)."""
     one = np.uint64(1)
     u_prev = u[lo - 1]
-    if law == HERTZ:  # a loop per law: a branch on the law inside the loop would stop it vectorising
+    if law != POWER:  # a loop per law: a branch on the law inside the loop would stop it vectorising
         for i in range(np.uint64(lo), np.uint64(hi)):
             vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
             v[i] = vi
@@ -82,18 +90,14 @@ def _fused_run(u, v, invm, f, A, d0, damping, law, load, hb, ha, lo, hi):
             f[i] = A[i] * d * math.sqrt(d) - load[i]
             u_prev = ui
     else:
-        v_prev = v[lo - 1]
         for i in range(np.uint64(lo), np.uint64(hi)):
             vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
             v[i] = vi
             ui = u[i] + ha * vi
             u[i] = ui
             d = d0[i] + u_prev - ui
-            d = d if d > 0.0 else 0.0
-            fi = A[i] * math.sqrt(d) * (d + damping[i] * (v_prev - vi))
-            f[i] = (fi if fi > 0.0 else 0.0) - load[i]
+            f[i] = A[i] * power(d if d > 0.0 else 0.0, expo[i]) - load[i]
             u_prev = ui
-            v_prev = vi
 
 
 @jit
@@ -112,7 +116,7 @@ BLOCK = 2048  # bodies per block of a step's wavefront (their arrays stay in the
 
 
 @jit
-def _step(u, v, invm, f, A, d0, damping, law, load, a_coef, b_coef, dt, t, pending, head, sub,
+def _step(u, v, invm, f, A, d0, load, law, expo, a_coef, b_coef, dt, t, pending, head, sub,
           sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses):
     """One step of the composition (its closing kick owed), every body and stage.
 
@@ -121,10 +125,10 @@ def _step(u, v, invm, f, A, d0, damping, law, load, a_coef, b_coef, dt, t, pendi
     bodies, each block taken through every stage (stage s on bodies kB - s .. (k+1)B - s)
     while it is in cache, instead of every stage streaming the whole chain from memory.
     Each body sees the same operations in the same order as in stage-by-stage sweeps.
-    With a multirate head, bodies 0..head get the kick of slot head + 1 and the head's
-    flow (multirate.head_flow) instead. ``heads``: the (bodies, 1) views the head flow
-    takes, h_work and h_busy its work arrays; impulses[0] += the wall's dynamic impulse,
-    impulses[1] += the schedule's (N s).
+    With a multirate head, bodies 0..head get the kick of slot
+    head + 1 and the head's flow (multirate.head_flow) instead. ``heads``: the
+    (bodies, 1) views the head flow takes, h_work and h_busy its work arrays;
+    impulses[0] += the wall's dynamic impulse, impulses[1] += the schedule's (N s).
     """
     nb = u.shape[0]
     u2, v2, im2, f2, A2, d02, load2 = heads
@@ -152,12 +156,12 @@ def _step(u, v, invm, f, A, d0, damping, law, load, a_coef, b_coef, dt, t, pendi
                     u[0] += h * v0
                     lo = 1
             if hi > lo:
-                _fused_run(u, v, invm, f, A, d0, damping, law, load, hb, h, lo, hi)
+                _fused_run(u, v, invm, f, A, d0, load, hb, h, lo, hi, law, expo)
             ts += h
 
 
 @jit
-def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
+def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_rate,
               a_coef, b_coef, dt, n_steps, head, sub,
               sched_body, sched_t, sched_f,
               ch_slot, ch_weight, sample_dt, out,
@@ -165,10 +169,16 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
               check_every, d_limit, wall_slot, e_ref, p_ref, diag):
     """Integrate n_steps of size dt in place; fill out (n_ch, n_out) and frames (n_fr, nb).
 
-    diag (float64[6]) receives: max relative energy error, max relative momentum balance
-    error, total wall impulse (N s), status (0 ok, 1 unstable), steps done, final time.
-    Energy: E = kinetic + elastic - work of constant loads - work of the scheduled force.
-    Momentum balance: P(t) - P(0) - [t * sum(constant loads) + J_schedule - J_wall].
+    law: the contact code (forces.py) with con (3, nb): each slot's exponent, damping
+    time (s) and dashpot (kg/s); onsite (2, nb): each body's drag rate (1/s) and friction
+    deceleration (m/s^2), smoothed over slip (m/s); viscous_rate (1/s): a bound on the
+    contacts' viscous decay rates (dissipation.substeps).
+    diag (float64[7]) receives: max relative energy error, max relative momentum balance
+    error, total wall impulse (N s), status (0 ok, 1 unstable), steps done, final time,
+    dissipated energy (J).
+    Energy: E = kinetic + elastic - work of constant loads - work of the scheduled force,
+    and E + dissipated stays E(0).
+    Momentum balance: P(t) - P(0) - [t * sum(constant loads) + J_schedule - J_wall + J_holder].
     load[i] (size nb + 1): constant force carried from above through slot i (N).
     """
     nb = u.shape[0]
@@ -179,24 +189,34 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
     n_out = out.shape[1]
     n_frames = frames.shape[0]
     has_sched = sched_t.shape[0] > 0
+    viscous = False
+    dissipative = False
+    for i in range(nb):
+        viscous = viscous or con[1, i] != 0.0 or con[2, i] != 0.0
+        dissipative = dissipative or viscous or onsite[0, i] != 0.0 or onsite[1, i] != 0.0
 
-    contact_forces(u, v, A, d0, damping, law, load, f)
-    # (bodies, 1) views for the multirate head (shared with the batched kernel)
+    elastic_forces(u, A, d0, load, f, law, con[0])
+    # (bodies, 1) views for the multirate head, the records and the dissipation (shared with the batched kernel)
     heads = (u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1)),
              A.reshape((nb, 1)), d0.reshape((nb, 1)), load.reshape((nb + 1, 1)))
+    con3 = con.reshape((3, nb, 1))
+    onsite3 = onsite.reshape((2, nb, 1))
+    work = np.zeros((4, nb + 1, 1))  # the dissipation's work arrays
+    lost = np.zeros(1)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
+    j_visc = np.zeros(1)
+    j_holder = np.zeros(1)
     h_work, h_busy = np.empty((2, 3, head + 1)), np.empty(1)  # the head flow's work arrays
     # sum of constant loads, less the part the wall's slot carries (j_wall is dynamic)
     wall_load = load[wall_slot] if wall_slot > 0 else 0.0
     net_const = load[nb] - wall_load
     sums = np.empty(3)  # energy (J), momentum (kg m/s), largest d / d_limit of one state
     m2, b2, dl2 = mass.reshape((nb, 1)), bias.reshape((nb, 1)), d_limit.reshape((nb, 1))
-    state_sums(heads[0], heads[1], m2, b2, heads[4], heads[5], dl2, sums[0:1], sums[1:2], sums[2:3])
+    state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, law, sums[0:1], sums[1:2], sums[2:3])
     e0, p0 = sums[0], sums[1]
     impulses = np.zeros(2)  # the wall's dynamic impulse, the schedule's (N s)
     w_sched = 0.0
 
     u2, v2, im2, f2, A2, d02, load2 = heads
-    dm2 = damping.reshape((nb, 1))
     d_old = np.zeros((n_ch, ch_slot.shape[1], 1))  # overlaps (m) and rates (m/s) the channels read
     r_old = np.zeros_like(d_old)
     d_new = np.zeros_like(d_old)
@@ -206,7 +226,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
     if n_out > 0:
         hermite_weights(0.0, dt, w, 0)
         for c in range(n_ch):
-            out[c, 0] = recorded_force(w, 0, 0.0, c, 0, ch_slot, ch_weight, A2, dm2, law, d_old, r_old, d_old, r_old)
+            out[c, 0] = recorded_force(w, 0, 0.0, c, 0, ch_slot, ch_weight, A2, con3, law, d_old, r_old, d_old, r_old)
     j_out = 1
     u_old = np.empty(nb if n_frames > 0 else 0)
     v_old = np.empty(nb if n_frames > 0 else 0)
@@ -229,17 +249,23 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
         if has_sched:
             us_old = u[sched_body]
             fe_old = schedule_force(t, sched_t, sched_f)
-        _step(u, v, invm, f, A, d0, damping, law, load, a_coef, b_coef, dt, t, pending, head, sub,
+        if dissipative:  # E(dt/2) S(dt) E(dt/2): each step ends synchronised
+            dissipate(u2, v2, m2, im2, A2, d02, con3, onsite3, slip, viscous, viscous_rate, 0.5 * dt, wall_slot, work,
+                      lost, j_visc, j_holder)
+        _step(u, v, invm, f, A, d0, load, law, con[0], a_coef, b_coef, dt, t, pending, head, sub,
               sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1
-        if check or n_frames > 0:  # synchronise every velocity
+        if check or n_frames > 0 or dissipative:  # synchronise every velocity
             if wall_slot > 0:
                 impulses[0] += pending * f[wall_slot]
             impulses[1] += _external_kick(v, invm, pending, t_new, sched_body, sched_t, sched_f)
             _kick(v, invm, f, pending, head)
             pending = 0.0
+        if dissipative:
+            dissipate(u2, v2, m2, im2, A2, d02, con3, onsite3, slip, viscous, viscous_rate, 0.5 * dt, wall_slot, work,
+                      lost, j_visc, j_holder)
         if has_sched:
             fe_new = schedule_force(t_new, sched_t, sched_f)
             w_sched += 0.5 * (fe_old + fe_new) * (u[sched_body] - us_old)
@@ -252,7 +278,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
             x = (j_out * sample_dt - t) / dt
             hermite_weights(x, dt, w, 0)
             for c in range(n_ch):
-                out[c, j_out] = recorded_force(w, 0, x, c, 0, ch_slot, ch_weight, A2, dm2, law,
+                out[c, j_out] = recorded_force(w, 0, x, c, 0, ch_slot, ch_weight, A2, con3, law,
                                                d_old, r_old, d_new, r_new)
             j_out += 1
         d_old[:, :, :] = d_new
@@ -264,10 +290,12 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
             j_frame += 1
 
         if check:
-            state_sums(heads[0], heads[1], m2, b2, heads[4], heads[5], dl2, sums[0:1], sums[1:2], sums[2:3])
-            e = sums[0] - w_sched
+            state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, law, sums[0:1], sums[1:2],
+                       sums[2:3])
+            e = sums[0] - w_sched + lost[0]
             err = abs(e - e0) / e_ref
-            pe = abs(sums[1] - p0 - (t_new * net_const + impulses[1] - impulses[0])) / p_ref
+            j_wall = impulses[0] + j_visc[0]
+            pe = abs(sums[1] - p0 - (t_new * net_const + impulses[1] - j_wall + j_holder[0])) / p_ref
             if not (err < 1e300) or not (sums[2] <= 1.0):
                 status = 1
                 break
@@ -276,7 +304,8 @@ def integrate(u, v, mass, invm, bias, load, A, d0, damping, law,
 
     diag[0] = e_err
     diag[1] = p_err
-    diag[2] = impulses[0] + wall_load * steps_done * dt
+    diag[2] = impulses[0] + j_visc[0] + wall_load * steps_done * dt
     diag[3] = status
     diag[4] = steps_done
     diag[5] = steps_done * dt
+    diag[6] = lost[0]

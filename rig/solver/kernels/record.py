@@ -14,6 +14,7 @@ import math
 
 from instruments.jit import jit
 from rig.model.contact import HERTZ
+from rig.solver.kernels.forces import contact_force
 from rig.solver.kernels.multirate import slow_net
 
 
@@ -61,22 +62,22 @@ def hermite(w, k, y0, r0, y1, r1):
 
 
 @jit
-def recorded_force(w, col, x, c, s, ch_slot, ch_weight, A, damping, law, d_old, r_old, d_new, r_new):
+def recorded_force(w, col, x, c, s, ch_slot, ch_weight, A, con, law, d_old, r_old, d_new, r_new):
     """Channel c's force (N) in shot s at fraction x of a step, whose Hermite weights are
-    column col of w: sum over its contacts of weight x A max(d, 0)^(3/2), d the interpolated
-    overlap. Kuwabara-Kono adds A d^(1/2) tau_d d' (d' linear in the step) and clips each
-    contact's force at zero."""
+    column col of w: sum over its contacts of weight x the contact law (forces.contact_force;
+    con: (3, bodies, shots) exponents, damping times, dashpots) at the interpolated overlap
+    d and, for a law with viscous terms, the rate d' linear in the step."""
     y = 0.0
     for k in range(ch_slot.shape[1]):
         wk = ch_weight[c, k]
         if wk != 0.0:
             i = ch_slot[c, k]
             d = hermite(w, col, d_old[c, k, s], r_old[c, k, s], d_new[c, k, s], r_new[c, k, s])
-            d = d if d > 0.0 else 0.0
             if law == HERTZ:
+                d = d if d > 0.0 else 0.0
                 y += wk * (A[i, s] * d * math.sqrt(d))
             else:
                 rate = (1.0 - x) * r_old[c, k, s] + x * r_new[c, k, s]
-                fk = A[i, s] * math.sqrt(d) * (d + damping[i, s] * rate)
-                y += wk * (fk if fk > 0.0 else 0.0)
+                fk, _ = contact_force(d, rate, A[i, s], con[0, i, s], con[1, i, s], con[2, i, s], law)
+                y += wk * fk
     return y
