@@ -1,7 +1,8 @@
-"""The exact travelling solitary wave of the discrete Hertz chain.
+"""The exact travelling solitary wave of the discrete Hertz (or power-law) chain.
 
-Contact overlaps r_n of a uniform chain (bead mass m, Hertz constant A) obey
-m r_n'' = A (G(r_{n+1}) - 2 G(r_n) + G(r_{n-1})), G(r) = max(r, 0)^(3/2). A wave
+Contact overlaps r_n of a uniform chain (bead mass m, contact constant A) obey
+m r_n'' = A (G(r_{n+1}) - 2 G(r_n) + G(r_{n-1})), G(r) = max(r, 0)^p, where p = 3/2 for
+Hertz and any 1 < p <= 3 for a power-law contact F = A delta^p (keyword ``n``). A wave
 r_n(t) = r0 + w(n - c t) travelling at c contacts per second satisfies, in Fourier space
 (xi in bead numbers, wavenumber k),
 
@@ -83,9 +84,12 @@ class SolitaryWave:
 
 
 def solitary_wave(mass: float, A: float, diameter: float, Fm: float, F0: float = 0.0,
-                  tol: float = 1e-13) -> SolitaryWave:
+                  tol: float = 1e-13, n: float = 1.5) -> SolitaryWave:
     """The exact discrete solitary wave of amplitude Fm (N) on a uniform chain of beads of
-    mass (kg), Hertz constant A (N/m^1.5) and diameter (m), precompressed by F0 (N)."""
+    mass (kg), contact law F = A delta^n (A in N/m^n; Hertz: n = 3/2) and diameter (m),
+    precompressed by F0 (N). A linear contact (n = 1) has no solitary wave: 1 < n <= 3."""
+    if not 1.0 < n <= 3.0:
+        raise invalid("n", n, "the contact exponent must be in (1, 3]")
     for name, val in (("mass", mass), ("A", A), ("diameter", diameter)):
         if not val > 0:
             raise invalid(name, val, "must be > 0")
@@ -94,16 +98,16 @@ def solitary_wave(mass: float, A: float, diameter: float, Fm: float, F0: float =
     if not Fm >= F0 * MIN_FORCE_RATIO:
         raise invalid("Fm", Fm, f"the discrete solitary wave is computed for Fm >= "
                                 f"{MIN_FORCE_RATIO} F0 = {MIN_FORCE_RATIO * F0:.4g} N (closer to F0 it "
-                                f"is a wide, weakly nonlinear wave: use Eq (1))")
-    r0 = (F0 / A) ** (2.0 / 3.0)
-    w_max = (Fm / A) ** (2.0 / 3.0) - r0
+                                f"is a wide, weakly nonlinear wave: use Eq (1) or power_law_wave_speed)")
+    r0 = (F0 / A) ** (1.0 / n)  # 1.0 / 1.5 is the same double as 2.0 / 3.0
+    w_max = (Fm / A) ** (1.0 / n) - r0
     fr = Fm / F0 if F0 > 0 else math.inf
     # the wave widens like 1/sqrt(f_r - 1) towards the sound speed: size the domain for it
     xi, sinc2 = _grid(48 if fr > 2 else 64 / math.sqrt(fr - 1))
-    g0 = r0**1.5
+    g0 = r0**n
     w = w_max * np.exp(-(xi / 2.0) ** 2)
     for _ in range(20000):
-        P = np.fft.irfft(sinc2 * np.fft.rfft(np.maximum(r0 + w, 0.0) ** 1.5 - g0), len(w))
+        P = np.fft.irfft(sinc2 * np.fft.rfft(np.maximum(r0 + w, 0.0) ** n - g0), len(w))
         mu = _peak(xi, P) / w_max
         w_new = P / mu
         done = np.max(np.abs(w_new - w)) < tol * w_max
@@ -113,19 +117,20 @@ def solitary_wave(mass: float, A: float, diameter: float, Fm: float, F0: float =
     else:
         raise RigError(f"the discrete solitary wave (Fm = {Fm:.4g} N, F0 = {F0:.4g} N) did not converge")
     c = math.sqrt(mu * A / mass)
-    return SolitaryWave(c * (diameter - r0), c, xi, A * np.maximum(r0 + w, 0.0) ** 1.5, F0, Fm,
+    return SolitaryWave(c * (diameter - r0), c, xi, A * np.maximum(r0 + w, 0.0) ** n, F0, Fm,
                         diameter - r0)
 
 
-def beta(force_ratio: float) -> float:
+def beta(force_ratio: float, n: float = 1.5) -> float:
     """beta(F_m/F_0) = F_d / F_m,e of a uniform chain from its exact solitary wave.
 
     The ratio of the maximum dynamic contact force to the maximum dynamic mean of two
     neighbouring contacts (what a rigid gauge bead reads) depends on F_m/F_0 alone, not on
     the material (Daraio et al. 2006); ``force_ratio = inf`` gives the sonic-vacuum value.
+    ``n`` is the contact exponent of F = A delta^n (Hertz: 3/2).
     """
     if not force_ratio >= MIN_FORCE_RATIO:
         raise invalid("force_ratio", force_ratio, f"F_m/F_0 must be >= {MIN_FORCE_RATIO}")
     if math.isinf(force_ratio):
-        return solitary_wave(1.0, 1.0, 1.0, 1.0).beta
-    return solitary_wave(1.0, 1.0, 1.0, force_ratio, 1.0).beta
+        return solitary_wave(1.0, 1.0, 1.0, 1.0, n=n).beta
+    return solitary_wave(1.0, 1.0, 1.0, force_ratio, 1.0, n=n).beta
