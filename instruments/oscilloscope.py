@@ -124,12 +124,8 @@ class Oscilloscope:
         read noise. Returns a ScopeRecord; a record that does not trigger says so. Draws
         from rng the clock's phase, then each displayed channel's noise (shot_draws' order).
         """
-        n_in = max((len(v) for v in inputs.values()), default=0)
         front = self.front_panel(h)
-        analog = np.empty((len(self.channels), n_in))
-        for c, ch in enumerate(self.channels):
-            v = np.ascontiguousarray(inputs[ch], dtype=float) if ch in inputs else np.zeros(n_in)
-            analog[c] = condition(v, front.probe[c], front.ac[c], front.lowpass[c])
+        analog = self.analog(inputs, h)
         tb = self.timebase
         phase = rng.uniform(0.0, tb.sample_interval)
         shape = (len(self.channels), int(tb.record_length) if self.noise_floor else 0)
@@ -139,7 +135,19 @@ class Oscilloscope:
         status, t_cross, x_zero = scope_shot(analog, float(h), front.source, front.level, front.rising, phase,
                                              front.n_pre, tb.sample_interval, front.offset, front.ymult, front.yoff,
                                              front.sd, noise, float(CODE_MIN), float(CODE_MAX), codes, over)
-        return self.record_of(status, t_cross, x_zero, codes, over, n_in, h)
+        return self.record_of(status, t_cross, x_zero, codes, over, analog.shape[1], h)
+
+    def analog(self, inputs: dict, h: float) -> np.ndarray:
+        """(channels, samples): each displayed channel's input (volts at the probe tip, every
+        h s) after the front end (probe factor, AC coupling, bandwidth limit), before the
+        noise and the 8-bit conversion; a channel without input reads 0."""
+        n_in = max((len(v) for v in inputs.values()), default=0)
+        front = self.front_panel(h)
+        analog = np.empty((len(self.channels), n_in))
+        for c, ch in enumerate(self.channels):
+            v = np.ascontiguousarray(inputs[ch], dtype=float) if ch in inputs else np.zeros(n_in)
+            analog[c] = condition(v, front.probe[c], front.ac[c], front.lowpass[c])
+        return analog
 
     def record_of(self, status: int, t_cross: float, x_zero: float, codes, over, n_in: int, h: float) -> ScopeRecord:
         """The ScopeRecord of one acquisition (acquisition.scope_shot's status and times,

@@ -10,7 +10,7 @@ import sys
 
 from instruments.errors import InstrumentError
 from rig import __version__
-from rig.cli import data, shots, study, sweeps, tools
+from rig.cli import data, fitting, shots, study, sweeps, tools
 from rig.cli.common import (
     OneLineParser,
     allow_large,
@@ -88,7 +88,26 @@ def build_parser() -> argparse.ArgumentParser:
     rp = _command(sub, "reproduce", "re-run a published study (daraio2006)", sweeps.cmd_reproduce)
     rp.add_argument("study", choices=["daraio2006"], help="the published study to re-run")
     rp.add_argument("--out", required=True, metavar="DIR", help="folder for tables and figures")
+    rp.add_argument("--fitted", action="store_true",
+                    help="also fit the PTFE model to the published experiment (Table 1) and compare its shots")
     rp.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    fi = _command(sub, "fit", "fit scene keys to measured points or scope records", fitting.cmd_fit)
+    fi.add_argument("scene", help="the model: a scene file, or a published scene's name")
+    fi.add_argument("--param", action="append", metavar="KEY=LO:HI",
+                    help="a scene key to fit with its bounds in units, e.g. 'chain.youngs_modulus=0.4 GPa:2 GPa' "
+                         "(a dimensionless key: plain numbers, e.g. chain.contact_exponent=1.2:2.4)")
+    fi.add_argument("--records", nargs="+", metavar="FILE", help="one shot's scope files (ISF, CSV, WFM)")
+    fi.add_argument("--archive", metavar="A.h5", help="an archive: every shot (or --shot N)")
+    fi.add_argument("--shot", type=int, help="with --archive: one shot")
+    fi.add_argument("--points", metavar="TABLE.csv",
+                    help="measured points: columns 'F_d [N]', 'F_d_sd [N]', 'V_s [m/s]', 'V_s_sd [m/s]' "
+                         "and scene keys per row, e.g. 'magnet.force [N]'")
+    fi.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides of the scene")
+    fi.add_argument("--out", required=True, metavar="DIR",
+                    help="folder for fit.json, residuals.csv, fit.png, fitted.toml; its evaluations/ resume a fit")
+    fi.add_argument("--max-evaluations", type=count_arg, default=400, help="the fit's budget (default 400)")
+    fi.add_argument("--quiet", action="store_true", help="no progress lines")
 
     mc = _command(sub, "mc", "Monte Carlo study over many virtual shots", study.cmd_mc)
     mc.add_argument("scene")

@@ -59,7 +59,21 @@ def cmd_reproduce(args) -> dict:
 
         with writing_to(args.out):
             results = reproduce(args.study, args.out, progress)
+    block = {"out": args.out, "table1": results["table1"], "summary": results["summary"]}
+    if args.fitted:
+        from rig.study.reproduce_fitted import reproduce_fitted
+
+        with progress_bar(args.quiet, total=14, desc="fitted model", unit="step") as bar:
+            def progress(what):
+                bar.set_postfix_str(what[:40])
+                bar.update()
+
+            with writing_to(args.out):
+                block["fitted"] = reproduce_fitted(args.out, progress)
     if not args.json:
         print((Path(args.out) / "table1.md").read_text())
-        print(f"wrote {args.out}/: table1.md, table1.csv, summary.md, results.json and the figures")
-    return {"out": args.out, "table1": results["table1"], "summary": results["summary"]}
+        if args.fitted:
+            print((Path(args.out) / "fitted.md").read_text())
+        print(f"wrote {args.out}/: table1.md, table1.csv, summary.md, results.json and the figures"
+              + (", fitted.md, fitted.json" if args.fitted else ""))
+    return block

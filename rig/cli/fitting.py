@@ -1,0 +1,63 @@
+"""`rig fit`: fit a scene's keys to measured points or to scope records."""
+from __future__ import annotations
+
+import sys
+
+
+def _records(args) -> list:
+    """The scope records to fit: one shot's files (--records), or an archive's shots."""
+    from instruments.formats import read_record
+
+    if args.records:
+        return [read_record(args.records)]
+    from instruments.archive import Archive
+
+    arch = Archive(args.archive, mode="r")
+    ids = arch.ids() if args.shot is None else [args.shot]
+    return [arch.read(i, with_truth=False).record for i in ids]
+
+
+def cmd_fit(args) -> dict:
+    from rig.cli.common import writing_to
+    from rig.errors import RigError
+    from rig.experiment import scene as scene_io
+    from rig.fit.fitting import stderr_progress
+    from rig.fit.parameters import parse_parameters
+    from rig.fit.run import run_fit
+
+    sources = [s for s in ("records", "archive", "points") if getattr(args, s)]
+    if len(sources) != 1:
+        raise RigError("no data to fit: give one of --records FILES, --archive A.h5 or --points TABLE.csv"
+                       if not sources else f"give one kind of data, not {' and '.join('--' + s for s in sources)}")
+    params = parse_parameters(args.param)
+    overrides = list(args.set or [])
+    scene_io.load(args.scene, overrides)  # the scene and its overrides, checked before any work
+    if args.points:
+        from rig.fit.data import read_points
+        from rig.fit.points import PointObjective
+
+        objective = PointObjective(args.scene, params, read_points(args.points), overrides)
+    else:
+        from rig.fit.traces import TraceObjective
+
+        objective = TraceObjective(args.scene, params, _records(args), overrides)
+    progress = None if args.quiet else stderr_progress
+    with writing_to(args.out):
+        block = run_fit(args.scene, objective, args.out, progress, args.max_evaluations)
+    if not args.json:
+        for k, p in block["parameters"].items():
+            unit = "" if p["unit"] == "1" else f" {p['unit']}"
+            print(f"{k:28s} {p['estimate']:.6g} +- {p['std']:.2g}{unit}   95%: [{p['ci95'][0]:.6g}, "
+                  f"{p['ci95'][1]:.6g}]{'  AT BOUND' if k in block['at_bound'] else ''}")
+        print(f"chi2/dof {block['chi2_reduced']:.3f} (p = {block['p_value']:.3g}), BIC {block['bic']:.2f}, "
+              f"residual rms {block['residual_rms_relative']:.2%}")
+        for pair in block["highly_correlated"]:
+            print(f"warning: {pair['keys'][0]} and {pair['keys'][1]} cannot be told apart "
+                  f"(correlation {pair['correlation']:+.3f}); their intervals are wide for that reason")
+        print(f"wrote {args.out}/: fit.json, residuals.csv, fit.png"
+              + (f", fitted.toml (rig shot {block['fitted_scene']})" if block["fitted_scene"] else ""))
+    if not block["converged"]:
+        print(f"rig fit: error: the fit did not converge ({block['message']}); no fitted scene written",
+              file=sys.stderr)
+        args.exit_code = 1
+    return block

@@ -1,0 +1,174 @@
+"""The fit itself: bounded weighted least squares (scipy.optimize.least_squares, trust
+region reflective) of an objective's residuals r(theta, eta), theta the scene parameters
+(each candidate a virtual shot or curve, expensive) and eta the objective's nuisance
+parameters (cheap: no solve).
+
+The Jacobian's theta columns are forward differences whose candidates are solved together
+in one batched call (rig.fit.evaluate); every evaluation is kept on disk in the fit's
+folder, so a fit that is stopped and started again replays what it had done without
+solving it again (resume). Uncertainties: the covariance (J^T J)^-1 of the normalised
+residuals at the solution, scaled by chi^2/dof when that exceeds 1 (the misfit is then
+larger than the stated uncertainties explain); 95% intervals estimate +- 1.96 sd, cut at
+the bounds. Goodness: chi^2, dof, its p-value, BIC = chi^2 + k ln n.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy import optimize, stats
+
+from rig.errors import RigError
+
+FD_STEP = 0.01
+"""Forward-difference step, as a fraction of each parameter's bound interval: large enough
+that the change of the model stands far above the solver's error (accuracy 1e-4)."""
+HIGH_CORRELATION = 0.95
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """A finished fit: estimates, standard deviations and 95% intervals (SI units, in the
+    order of ``keys``), correlation matrix, residuals, goodness and convergence."""
+
+    keys: tuple
+    units: tuple
+    estimate: np.ndarray
+    std: np.ndarray
+    ci95: np.ndarray
+    correlation: np.ndarray
+    residuals: np.ndarray
+    chi2: float
+    dof: int
+    converged: bool
+    message: str
+    evaluations: int
+    at_bound: tuple
+    nuisance: dict = field(default_factory=dict)
+    eta: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def chi2_reduced(self) -> float:
+        return self.chi2 / self.dof if self.dof > 0 else math.nan
+
+    @property
+    def p_value(self) -> float:
+        return float(stats.chi2.sf(self.chi2, self.dof)) if self.dof > 0 else math.nan
+
+    @property
+    def bic(self) -> float:
+        return self.chi2 + len(self.keys) * math.log(max(self.residuals.size, 1))
+
+    def correlated_pairs(self) -> list:
+        """[(key, key, rho)] of parameters whose |correlation| exceeds HIGH_CORRELATION."""
+        k = len(self.keys)
+        return [(self.keys[i], self.keys[j], float(self.correlation[i, j]))
+                for i in range(k) for j in range(i + 1, k) if abs(self.correlation[i, j]) > HIGH_CORRELATION]
+
+
+class EvaluationCache:
+    """Every model evaluation of a fit, in memory and (with a folder) on disk: one .npz
+    per candidate, named by the digest of the fit's specification and the candidate."""
+
+    def __init__(self, objective, folder: Path | None):
+        self.objective = objective
+        self.memory = {}
+        self.folder = None if folder is None else Path(folder)
+        self.spec = hashlib.sha256(json.dumps(objective.spec(), sort_keys=True).encode()).hexdigest()[:16]
+        self.solved = 0  # candidates solved in this run (not replayed from disk)
+        if self.folder is not None:
+            try:
+                self.folder.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise RigError(f"fit cache {self.folder}: cannot create ({exc.strerror})") from None
+
+    def _path(self, key: tuple) -> Path:
+        digest = hashlib.sha256((self.spec + repr(key)).encode()).hexdigest()[:20]
+        return self.folder / f"{digest}.npz"
+
+    def get(self, thetas: list) -> list:
+        keys = [tuple(float(x) for x in t) for t in thetas]
+        todo = []
+        for k in dict.fromkeys(keys):
+            if k in self.memory:
+                continue
+            if self.folder is not None and self._path(k).is_file():
+                with np.load(self._path(k)) as z:
+                    self.memory[k] = self.objective.unpack({n: z[n] for n in z.files})
+                continue
+            todo.append(k)
+        if todo:
+            for k, model in zip(todo, self.objective.evaluate([np.array(k) for k in todo])):
+                self.memory[k] = model
+                self.solved += 1
+                if self.folder is not None:
+                    try:
+                        np.savez(self._path(k), **self.objective.pack(model))
+                    except OSError as exc:
+                        raise RigError(f"fit cache {self.folder}: cannot write ({exc.strerror})") from None
+        return [self.memory[k] for k in keys]
+
+
+def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None) -> FitResult:
+    """Fit ``objective`` (rig.fit.points.PointObjective or rig.fit.traces.TraceObjective)."""
+    params = objective.params
+    P = len(params)
+    lo = np.array([p.lo for p in params])
+    span = np.array([p.hi - p.lo for p in params])
+    eta0, eta_lo, eta_hi = objective.nuisance_start()
+    x0 = np.concatenate((np.clip((objective.start() - lo) / span, 0.0, 1.0), eta0))
+    bounds = (np.concatenate((np.zeros(P), eta_lo)), np.concatenate((np.ones(P), eta_hi)))
+    cache = EvaluationCache(objective, cache_folder)
+    tell = progress or (lambda text: None)
+    count = {"batches": 0}
+
+    def theta(x):
+        return lo + span * x[:P]
+
+    def fun(x):
+        (model,) = cache.get([theta(x)])
+        return objective.residuals(model, x[P:])
+
+    def jac(x):
+        h = np.where(x[:P] + FD_STEP <= 1.0, FD_STEP, -FD_STEP)
+        cands = [theta(x)] + [theta(x + h[k] * np.eye(x.size)[k]) for k in range(P)]
+        models = cache.get(cands)
+        count["batches"] += 1
+        r0 = objective.residuals(models[0], x[P:])
+        J = np.empty((r0.size, x.size))
+        for k in range(P):
+            J[:, k] = (objective.residuals(models[k + 1], x[P:]) - r0) / h[k]
+        J[:, P:] = objective.nuisance_jacobian(models[0], x[P:])
+        tell(f"fit: Jacobian {count['batches']}: chi2 {float(r0 @ r0):.6g}, "
+             + ", ".join(p.key + " " + p.shown(v) for p, v in zip(params, theta(x)))
+             + f" ({cache.solved} candidates solved)")
+        return J
+
+    res = optimize.least_squares(fun, x0, jac=jac, bounds=bounds, method="trf", x_scale="jac",
+                                 max_nfev=max_evaluations, xtol=1e-6, ftol=1e-8, gtol=1e-8)
+    r = fun(res.x)
+    J = jac(res.x)
+    chi2 = float(r @ r)
+    dof = int(r.size - x0.size)
+    cov_n = np.linalg.pinv(J.T @ J)
+    cov_n = cov_n * max(1.0, chi2 / dof if dof > 0 else 1.0)
+    sd_n = np.sqrt(np.clip(np.diag(cov_n)[:P], 0.0, None))
+    est = theta(res.x)
+    std = sd_n * span
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov_n[:P, :P] / np.outer(sd_n, sd_n)
+    ci = np.column_stack((np.maximum(est - 1.96 * std, lo), np.minimum(est + 1.96 * std, lo + span)))
+    at_bound = tuple(p.key for p, x in zip(params, res.x[:P]) if x <= 1e-6 or x >= 1 - 1e-6)
+    converged = bool(res.success and res.status > 0 and np.all(np.isfinite(std)))
+    return FitResult(tuple(p.key for p in params), tuple(p.unit for p in params), est, std, ci, corr, r, chi2, dof,
+                     converged, str(res.message), cache.solved, at_bound, objective.nuisance_report(res.x[P:]),
+                     res.x[P:].copy())
+
+
+def stderr_progress(text: str):
+    print(text, file=sys.stderr, flush=True)

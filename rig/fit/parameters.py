@@ -1,0 +1,89 @@
+"""What a fit may vary: numeric scene keys with bounds in units (``KEY=LO:HI``)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from rig.errors import RigError, invalid
+from rig.experiment.scene import schema_node
+from rig.units import quantity
+
+POSITIVE_LAW_KEYS = {"chain.damping_time": "kuwabara-kono", "chain.contact_damping": "dashpot"}
+"""Keys that switch their contact law on (the law needs them > 0)."""
+
+
+@dataclass(frozen=True)
+class FitParameter:
+    """A scene key varied between lo and hi (in its SI unit ``unit``; "1": a pure number)."""
+
+    key: str
+    lo: float
+    hi: float
+    unit: str
+
+    def override(self, value: float) -> str:
+        """The --set text of this key at ``value`` (SI)."""
+        return f"{self.key}={float(value)!r}"
+
+    def shown(self, value: float) -> str:
+        return f"{value:.6g}" if self.unit == "1" else f"{value:.6g} {self.unit}"
+
+
+def parse_parameter(text: str) -> FitParameter:
+    """``KEY=LO:HI``: a numeric scene key, each bound with the key's unit (a pure number for a
+    dimensionless key), LO < HI. Raises RigError naming what is wrong."""
+    if "=" not in text:
+        raise invalid("--param", text, "needs bounds: KEY=LO:HI, e.g. chain.youngs_modulus=0.4 GPa:2 GPa")
+    key, bounds = (s.strip() for s in text.split("=", 1))
+    try:
+        spec = schema_node(key)
+    except KeyError:
+        raise invalid("--param", key, "not a scene key (see `rig scene --keys`)") from None
+    if spec is float:
+        unit = "1"
+    elif isinstance(spec, str):
+        unit = spec
+    else:
+        raise invalid("--param", key, "not a numeric scene key (a quantity or a number)")
+    if bounds.count(":") != 1:
+        raise invalid(f"--param {key}", bounds, "bounds LO:HI, e.g. 0.4 GPa:2 GPa")
+    lo_text, hi_text = (s.strip() for s in bounds.split(":"))
+    values = []
+    for name, t in (("LO", lo_text), ("HI", hi_text)):
+        if unit == "1":
+            try:
+                values.append(float(t))
+            except ValueError:
+                raise invalid(f"--param {key} {name}", t, "a number (this key has no unit)") from None
+        else:
+            try:
+                float(t)
+            except ValueError:
+                values.append(quantity(t, unit, f"--param {key} {name}"))
+            else:
+                raise invalid(f"--param {key} {name}", t, f"bounds need units, e.g. '{t} {unit}'")
+    lo, hi = values
+    if not lo < hi:
+        raise invalid(f"--param {key}", bounds, "LO < HI")
+    if key in POSITIVE_LAW_KEYS and lo <= 0:
+        raise invalid(f"--param {key} LO", lo_text, f"> 0 (the {POSITIVE_LAW_KEYS[key]} law needs it; "
+                                                   "leave the key out to fit without it)")
+    return FitParameter(key, lo, hi, unit)
+
+
+def parse_parameters(texts) -> tuple:
+    params = tuple(parse_parameter(t) for t in texts or ())
+    if not params:
+        raise RigError("--param: no parameter to fit; give at least one KEY=LO:HI")
+    keys = [p.key for p in params]
+    for k in keys:
+        if keys.count(k) > 1:
+            raise invalid("--param", k, "each key once")
+    return params
+
+
+def law_overrides(params) -> list:
+    """The contact-law switch a fitted key needs (chain.contact_law=...)."""
+    laws = {POSITIVE_LAW_KEYS[p.key] for p in params if p.key in POSITIVE_LAW_KEYS}
+    if len(laws) > 1:
+        raise invalid("--param", sorted(laws), "one contact law at a time (damping_time or contact_damping)")
+    return [f"chain.contact_law={laws.pop()}"] if laws else []

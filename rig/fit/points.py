@@ -1,0 +1,120 @@
+"""Fitting a scene to measured (F_d, V_s) points, with uncertainties on both coordinates.
+
+For each configuration of the points (e.g. with and without the magnet) and each candidate
+parameter set, the model is the curve V_s(F_d) of the leading pulse that virtual shots give
+over a fixed set of striker velocities (rig.fit.evaluate.curves: the truth analysis, as the
+published numerics were analysed). A point's residual is its speed's distance to the curve
+at its force, in units of the effective standard deviation (errors in variables, the
+effective-variance method: Orear, Am. J. Phys. 50, 912 (1982)):
+
+    r_i = (V(F_i) - V_i) / sqrt(sd_V,i^2 + (dV/dF)^2 sd_F,i^2)
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from rig.errors import RigError
+from rig.experiment import scene as scene_io
+from rig.fit.data import Points
+from rig.fit.evaluate import Curve, curves
+from rig.fit.parameters import law_overrides
+
+VELOCITY_FACTORS = (0.35, 0.5, 0.7, 1.0, 1.4, 2.0, 2.8)
+"""The striker velocities of a curve, times the scene's own."""
+NO_CURVE = 1e3
+"""The residual (in standard deviations) of a point whose configuration gave no curve."""
+
+
+def scene_value(values: dict, key: str):
+    node = values
+    for p in key.split("."):
+        if not isinstance(node, dict) or p not in node:
+            return None
+        node = node[p]
+    return node if isinstance(node, (int, float)) and not isinstance(node, bool) else None
+
+
+def start_values(scene: str, overrides, params) -> np.ndarray:
+    """Each parameter's scene value where the scene sets it inside the bounds, else the
+    middle of its bounds."""
+    values = scene_io.load(scene, overrides).values
+    out = []
+    for p in params:
+        v = scene_value(values, p.key)
+        out.append(v if v is not None and p.lo <= v <= p.hi else 0.5 * (p.lo + p.hi))
+    return np.array(out, dtype=float)
+
+
+class PointObjective:
+    """Residuals of Points against the model's curves (module doc)."""
+
+    def __init__(self, scene: str, params: tuple, points: Points, overrides=()):
+        self.scene, self.params, self.points = scene, tuple(params), points
+        self.overrides = list(overrides) + law_overrides(params)
+        self.configs = points.configurations()
+        self.config_of = np.array([self.configs.index(c) for c in points.configs])
+        v0 = scene_io.load(scene, self.overrides).values["striker"]["velocity"]
+        self.velocities = v0 * np.array(VELOCITY_FACTORS)
+        self._start = start_values(scene, self.overrides, params)
+
+    def spec(self) -> dict:
+        p = self.points
+        return {"kind": "points", "scene": self.scene, "overrides": self.overrides,
+                "params": [(q.key, q.lo, q.hi) for q in self.params], "configs": self.configs,
+                "velocities": self.velocities.tolist(), "data": [p.force.tolist(), p.force_sd.tolist(),
+                                                                  p.speed.tolist(), p.speed_sd.tolist()]}
+
+    def start(self) -> np.ndarray:
+        return self._start
+
+    def candidate_overrides(self, theta, config) -> list:
+        return self.overrides + [q.override(x) for q, x in zip(self.params, theta)] + list(config)
+
+    def evaluate(self, thetas: list) -> list:
+        cands = [self.candidate_overrides(t, c) for t in thetas for c in self.configs]
+        flat = curves(self.scene, cands, self.velocities, len(cands))
+        C = len(self.configs)
+        return [tuple(flat[i * C:(i + 1) * C]) for i in range(len(thetas))]
+
+    @staticmethod
+    def pack(model) -> dict:
+        return {"velocity": model[0].velocity, "force": np.array([c.force for c in model]),
+                "speed": np.array([c.speed for c in model])}
+
+    @staticmethod
+    def unpack(z: dict):
+        return tuple(Curve(z["velocity"], f, v) for f, v in zip(z["force"], z["speed"]))
+
+    def model_speeds(self, model) -> tuple:
+        """(V_s at each point's F_d, dlnV/dlnF there); nan where its curve is missing."""
+        p = self.points
+        V, s = np.full(p.n, np.nan), np.full(p.n, np.nan)
+        for c, curve in enumerate(model):
+            rows = self.config_of == c
+            try:
+                V[rows], s[rows] = curve.speed_at(p.force[rows])
+            except RigError:  # fewer than two pulses on this curve: its points get NO_CURVE
+                continue
+        return V, s
+
+    def residuals(self, model, eta) -> np.ndarray:
+        p = self.points
+        V, s = self.model_speeds(model)
+        sd = np.sqrt(p.speed_sd ** 2 + (s * V / p.force * p.force_sd) ** 2)
+        r = (V - p.speed) / sd
+        return np.where(np.isfinite(r), r, NO_CURVE)
+
+    def relative_residuals(self, model) -> np.ndarray:
+        """V_model(F_i) / V_i - 1 at each point."""
+        return self.model_speeds(model)[0] / self.points.speed - 1.0
+
+    @staticmethod
+    def nuisance_start():
+        return np.zeros(0), np.zeros(0), np.zeros(0)
+
+    def nuisance_jacobian(self, model, eta):
+        return np.zeros((self.points.n, 0))
+
+    @staticmethod
+    def nuisance_report(eta) -> dict:
+        return {}

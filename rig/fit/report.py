@@ -1,0 +1,133 @@
+"""What a fit leaves in its folder: fit.json (the --json block and more), residuals.csv,
+fit.png (the data against the fitted model) and, only for a fit that converged,
+fitted.toml: the scene with the fitted values, which `rig shot` fires."""
+from __future__ import annotations
+
+import csv
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from rig.experiment import scene as scene_io
+from rig.fit.fitting import FitResult
+
+
+def summary(result: FitResult, objective, model, fitted_scene) -> dict:
+    """The --json block: {"parameters": {KEY: {"estimate", "std", "ci95", "unit"}}, "correlation",
+    "residual_rms_relative", "converged", "fitted_scene", ...}."""
+    rel = (objective.relative_residuals(model) if hasattr(objective, "relative_residuals")
+           else None)
+    rms = (float(np.sqrt(np.nanmean(rel ** 2))) if rel is not None
+           else objective.relative_rms(model, result.eta))
+    return {
+        "parameters": {k: {"estimate": float(e), "std": float(s), "ci95": [float(lo), float(hi)], "unit": u}
+                       for k, u, e, s, (lo, hi) in zip(result.keys, result.units, result.estimate, result.std,
+                                                        result.ci95)},
+        "correlation": np.round(result.correlation, 6).tolist(),
+        "highly_correlated": [{"keys": [a, b], "correlation": rho} for a, b, rho in result.correlated_pairs()],
+        "residual_rms_relative": rms,
+        "converged": result.converged,
+        "message": result.message,
+        "at_bound": list(result.at_bound),
+        "chi2": result.chi2, "dof": result.dof, "chi2_reduced": result.chi2_reduced,
+        "p_value": result.p_value, "bic": result.bic,
+        "evaluations": result.evaluations,
+        "nuisance": result.nuisance,
+        "fitted_scene": None if fitted_scene is None else str(fitted_scene),
+    }
+
+
+def fitted_scene_text(scene: str, overrides: list, result: FitResult) -> str:
+    """The scene's TOML with the overrides and the fitted values set (each with its unit)."""
+    import tomli_w
+
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover
+        import tomli as tomllib
+    path = scene_io.find_scene(scene)
+    raw = tomllib.loads(path.read_text())
+    text_overrides = list(overrides) + [f"{k}={float(v)!r}" for k, v in zip(result.keys, result.estimate)]
+    for item in text_overrides:
+        key, value = (s.strip() for s in item.split("=", 1))
+        spec = scene_io.schema_node(key)
+        node = raw
+        parts = key.split(".")
+        for p in parts[:-1]:
+            node = node.setdefault(p, {})
+        if isinstance(spec, str):
+            node[parts[-1]] = f"{float(value):.8g} {spec}"
+        elif spec is float:
+            node[parts[-1]] = float(value)
+        else:
+            node[parts[-1]] = value
+    raw.setdefault("scene", {})["name"] = f"{raw.get('scene', {}).get('name', path.stem)}_fitted"
+    head = (f"# {path.stem} fitted by `rig fit`: "
+            + ", ".join(f"{k} = {e:.6g} +- {s:.2g}" for k, e, s in zip(result.keys, result.estimate, result.std))
+            + "\n")
+    return head + tomli_w.dumps(raw)
+
+
+def write_residuals(path: Path, objective, result: FitResult, model):
+    with open(path, "w", newline="") as fh:
+        wr = csv.writer(fh)
+        if hasattr(objective, "points"):
+            p = objective.points
+            V, _ = objective.model_speeds(model)
+            wr.writerow(["F_d [N]", "V_s [m/s]", "V_s model [m/s]", "relative", "normalised", "configuration"])
+            for i in range(p.n):
+                wr.writerow([p.force[i], p.speed[i], V[i], V[i] / p.speed[i] - 1, result.residuals[i],
+                             " ".join(p.configs[i])])
+        else:
+            wr.writerow(["record", "channel", "samples", "rms residual [V]", "noise sd [V]", "chi2 per sample"])
+            k = 0
+            for c in objective.channels:
+                r = result.residuals[k:k + c.t.size]
+                k += c.t.size
+                wr.writerow([c.record, c.name, c.t.size, float(np.sqrt(np.mean(r ** 2))) * c.sd, c.sd,
+                             float(np.mean(r ** 2))])
+
+
+def draw(path: Path, objective, result: FitResult, model, eta):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    if hasattr(objective, "points"):
+        p = objective.points
+        fig, ax = plt.subplots(figsize=(6.4, 4.6))
+        for c, (config, curve) in enumerate(zip(objective.configs, model)):
+            rows = objective.config_of == c
+            label = " ".join(config) or "data"
+            ax.errorbar(p.force[rows], p.speed[rows], xerr=p.force_sd[rows], yerr=p.speed_sd[rows], fmt="o",
+                        ms=5, capsize=2, label=f"measured {label}", color=f"C{c}")
+            ok = np.isfinite(curve.force) & np.isfinite(curve.speed)
+            ax.plot(curve.force[ok], curve.speed[ok], "-", color=f"C{c}", label=f"fitted model {label}")
+        ax.set_xscale("log")
+        ax.set_xlabel("dynamic contact force F_d (N)")
+        ax.set_ylabel("leading pulse speed V_s (m/s)")
+    else:
+        traces = objective.traces(model, eta)
+        fig, axes = plt.subplots(len(objective.channels), 1, figsize=(7.0, 2.2 * len(objective.channels)),
+                                 sharex=True, squeeze=False)
+        for ax, c, m in zip(axes[:, 0], objective.channels, traces):
+            ax.plot(c.t * 1e3, c.y, ".", ms=1.5, color="0.5", label=f"record {c.record} {c.name}")
+            if m is not None:
+                ax.plot(c.t * 1e3, m, "-", lw=1.0, color="C3", label="fitted model")
+            ax.set_ylabel("V")
+            ax.legend(fontsize=7, loc="upper right")
+        ax = axes[-1, 0]
+        ax.set_xlabel("time from the trigger (ms)")
+    title = ", ".join(f"{k.split('.')[-1]} = {e:.4g} ± {s:.2g}" for k, e, s in zip(result.keys, result.estimate,
+                                                                                     result.std))
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def finite_or_none(x):
+    return None if x is None or (isinstance(x, float) and not math.isfinite(x)) else x

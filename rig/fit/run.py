@@ -1,0 +1,45 @@
+"""`rig fit`: a scene's keys fitted to measured points or scope records (rig.fit)."""
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+from rig.errors import RigError
+from rig.experiment import scene as scene_io
+from rig.fit import report
+from rig.fit.fitting import fit
+
+
+def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 400) -> dict:
+    """Fit ``objective`` and write the folder ``out`` (rig.fit.report); returns the JSON
+    block. Evaluations are cached in out/evaluations/: the same command run again after an
+    interruption replays them instead of solving them again. A fit that did not converge
+    writes everything but the fitted scene."""
+    out = Path(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise RigError(f"--out {out}: cannot create ({exc.strerror})") from None
+    result = fit(objective, out / "evaluations", max_evaluations=max_evaluations, progress=progress)
+    (model,) = objective.evaluate([result.estimate])
+    fitted = None
+    stale = out / "fitted.toml"
+    if stale.exists():
+        stale.unlink()  # a fitted scene from an earlier fit must not outlive a failed one
+    if result.converged:
+        text = report.fitted_scene_text(scene, objective.overrides, result)
+        tmp = out / "fitted.part.toml"
+        tmp.write_text(text)
+        try:
+            scene_io.load(tmp)  # the written scene must load as it is
+        except RigError:
+            tmp.unlink()
+            raise
+        os.replace(tmp, stale)
+        fitted = stale
+    block = report.summary(result, objective, model, fitted)
+    report.write_residuals(out / "residuals.csv", objective, result, model)
+    report.draw(out / "fit.png", objective, result, model, result.eta)
+    (out / "fit.json").write_text(json.dumps(block, indent=1, default=float))
+    return block

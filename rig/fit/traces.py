@@ -1,0 +1,223 @@
+"""Fitting a scene to scope records, sample by sample, through the instrument model.
+
+The model of a channel is what the scene's instruments make of a candidate's noise-free
+solution: the gauge (sensitivity, RC high-pass) and the scope's front end (probe, coupling,
+bandwidth), before noise and the 8-bit conversion (instruments.oscilloscope.analog). A
+record's channel is compared with it after its pre-trigger baseline is removed:
+
+    r_c(t_k) = (g_c m_c(t_k + t_0 + d_c) - y_c(t_k)) / sd_c
+
+with nuisance parameters per record, like the ones the instruments drew: the trigger's time
+on the model's clock t_0 (free), each channel's gain g_c (prior 1 +- the scene's
+calibration_error) and each gauge's delay d_c (prior 0 +- misalignment_sd / the pulse speed),
+the priors entering as residuals (g_c - 1)/sd_g and d_c/sd_d. sd_c: the spread of the
+record's pre-trigger samples (at least an 8-bit step / sqrt(12)).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from instruments.gauges import GaugeDraw, PiezoGauge
+from rig.errors import RigError
+from rig.experiment.shot import Rig
+from rig.fit.evaluate import solve_rigs
+from rig.fit.parameters import law_overrides
+from rig.fit.points import start_values
+
+MAX_SAMPLES = 2500  # per channel: longer records are decimated (every k-th sample)
+TRIGGER_SLACK = 50e-6  # s: how far a record's trigger may sit from the model's own crossing
+US = 1e-6  # nuisance times are carried in microseconds
+
+
+@dataclass(frozen=True)
+class Channel:
+    """One record's channel as fitted: times from the trigger (s), volts less the baseline,
+    the noise sd (V), and the gain's and delay's prior sds (delay_sd 0: no delay)."""
+
+    record: int
+    name: str
+    t: np.ndarray
+    y: np.ndarray
+    sd: float
+    gain_sd: float
+    delay_sd: float
+
+
+def noise_sd(t: np.ndarray, v: np.ndarray) -> float:
+    """A record's noise (V): the spread of its quiet pre-trigger samples (the first three
+    quarters before the trigger: the trigger channel's pulse rises in the last), else
+    1.4826 MAD of its first differences / sqrt(2), which a smooth pulse barely moves."""
+    pre = v[t < 0]
+    quiet = pre[: 3 * pre.size // 4]
+    if quiet.size >= 50:
+        return float(np.std(quiet))
+    d = np.diff(v)
+    return float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0))
+
+
+def channels_of(rig: Rig, records: list) -> list:
+    """The records' channels that the scene's instruments read (RigError when none is)."""
+    settings = {g.channel: (g.settings, True) for g in rig.gauges}
+    if rig.wall_sensor is not None:
+        settings[rig.wall_sensor.channel] = (rig.wall_sensor.settings, False)
+    truth = rig.truth()
+    speed = truth.wave_speed_m_per_s or math.nan
+    out = []
+    for i, rec in enumerate(records):
+        for name, w in rec.waveforms.items():
+            if name not in settings:
+                continue
+            s, gauge = settings[name]
+            t, v = w.time(), w.volts().astype(float)
+            step = max(1, -(-t.size // MAX_SAMPLES))
+            pre = v[t < 0]
+            base = float(np.median(pre)) if pre.size >= 10 else 0.0
+            lsb = abs(w.preamble.y_multiplier) if w.codes is not None else 0.0
+            sd = max(math.hypot(noise_sd(t, v), lsb / math.sqrt(12)), 1e-9)  # 8-bit rounding beside the noise
+            delay_sd = s.misalignment_sd / speed if gauge and math.isfinite(speed) else 0.0
+            out.append(Channel(i, name, t[::step], v[::step] - base, sd, s.calibration_error, delay_sd))
+    if not out:
+        raise RigError(f"the records have none of the scene's channels ({', '.join(settings)})")
+    return out
+
+
+def model_traces(rig: Rig) -> dict:
+    """{channel: volts} of the rig's installed solution through its noise-free instruments,
+    every solution sample interval from the impact."""
+    truth = rig.truth()
+    h = truth.sample_interval
+    inputs = {}
+    for g in rig.gauges:
+        gauge = PiezoGauge(replace(g.settings, noise=0.0))
+        inputs[g.channel] = gauge.read(truth.gauges[g.name].average_force, h, GaugeDraw(1.0, 0.0), None)
+    if rig.wall_sensor is not None:
+        gauge = PiezoGauge(replace(rig.wall_sensor.settings, noise=0.0))
+        inputs[rig.wall_sensor.channel] = gauge.read(truth.wall_force, h, GaugeDraw(1.0, 0.0), None)
+    analog = rig.scope.analog(inputs, h)
+    return {"h": np.array([h]), **{ch: analog[c] for c, ch in enumerate(rig.scope.channels) if ch in inputs}}
+
+
+class TraceObjective:
+    """Residuals of scope records against the model's records (module doc)."""
+
+    def __init__(self, scene: str, params: tuple, records: list, overrides=()):
+        self.scene, self.params = scene, tuple(params)
+        self.overrides = list(overrides) + law_overrides(params)
+        self._start = start_values(scene, self.overrides, params)
+        rig = self.rig_of(self._start)
+        if not solve_rigs([rig])[0]:
+            raise RigError("the scene's own shot blew up; check the scene before fitting it")
+        self.channels = channels_of(rig, records)
+        self.records = sorted({c.record for c in self.channels})
+        self.gauges = [k for k, c in enumerate(self.channels) if c.delay_sd > 0]
+        self.trigger = rig.scope.trigger
+
+    def rig_of(self, theta) -> Rig:
+        return Rig.from_scene(self.scene, self.overrides + [q.override(x) for q, x in zip(self.params, theta)])
+
+    def trigger_time(self, model) -> float:
+        """Where the model's trigger channel first crosses the scene's trigger level (s from
+        the impact, interpolated between samples; 0 if it never does): a record's time 0."""
+        v = model.get(self.trigger.source)
+        h = float(model["h"][0])
+        if v is None or not math.isfinite(h):
+            return 0.0
+        sign = 1.0 if self.trigger.slope == "rising" else -1.0
+        x = sign * (v - self.trigger.level)
+        hit = np.flatnonzero((x[1:] >= 0) & (x[:-1] < 0))
+        if not hit.size:
+            return 0.0
+        k = hit[0]
+        return float((k + x[k] / (x[k] - x[k + 1])) * h)
+
+    def spec(self) -> dict:
+        return {"kind": "traces", "scene": self.scene, "overrides": self.overrides,
+                "params": [(q.key, q.lo, q.hi) for q in self.params],
+                "data": [[c.name, c.sd, float(np.sum(c.y)), c.t.size] for c in self.channels]}
+
+    def start(self) -> np.ndarray:
+        return self._start
+
+    def evaluate(self, thetas: list) -> list:
+        rigs = [self.rig_of(t) for t in thetas]
+        ok = solve_rigs(rigs)
+        return [model_traces(r) if good else {"h": np.array([math.nan])} for r, good in zip(rigs, ok)]
+
+    @staticmethod
+    def pack(model) -> dict:
+        return model
+
+    @staticmethod
+    def unpack(z: dict):
+        return z
+
+    # nuisance: per record the trigger's offset from the model's own crossing (us), a gain
+    # per channel, a delay per gauge channel (us)
+    def nuisance_start(self):
+        R, C = len(self.records), len(self.channels)
+        d = np.array([5 * self.channels[k].delay_sd / US for k in self.gauges])
+        x0 = np.concatenate((np.zeros(R), np.ones(C), np.zeros(d.size)))
+        lo = np.concatenate((np.full(R, -TRIGGER_SLACK / US), np.full(C, 0.3), -d))
+        hi = np.concatenate((np.full(R, TRIGGER_SLACK / US), np.full(C, 3.0), d))
+        return x0, lo, hi
+
+    def _split(self, eta):
+        R, C = len(self.records), len(self.channels)
+        delays = np.zeros(C)
+        delays[self.gauges] = eta[R + C:]
+        return eta[:R], eta[R:R + C], delays
+
+    def traces(self, model, eta) -> list:
+        """The model's value at each channel's samples (V), or None where it has none."""
+        t0, gains, delays = self._split(eta)
+        h = float(model["h"][0])
+        t0 = t0 + self.trigger_time(model) / US
+        out = []
+        for k, c in enumerate(self.channels):
+            m = model.get(c.name)
+            if m is None or not math.isfinite(h):
+                out.append(None)
+                continue
+            tm = c.t + (t0[self.records.index(c.record)] + delays[k]) * US
+            out.append(gains[k] * np.interp(tm, np.arange(m.size) * h, m, left=0.0, right=np.nan))
+        return out
+
+    def residuals(self, model, eta) -> np.ndarray:
+        _, gains, delays = self._split(eta)
+        parts = []
+        for k, (c, m) in enumerate(zip(self.channels, self.traces(model, eta))):
+            r = np.full(c.t.size, 1e3) if m is None else (m - c.y) / c.sd
+            parts.append(np.where(np.isfinite(r), r, 0.0))  # past the model's end: not compared
+        priors = [(gains[k] - 1.0) / c.gain_sd for k, c in enumerate(self.channels) if c.gain_sd > 0]
+        priors += [delays[k] * US / self.channels[k].delay_sd for k in self.gauges]
+        return np.concatenate(parts + [np.array(priors)])
+
+    def nuisance_jacobian(self, model, eta):
+        r0 = self.residuals(model, eta)
+        J = np.empty((r0.size, eta.size))
+        for j in range(eta.size):
+            d = 1e-3 if j < len(self.records) or j >= len(self.records) + len(self.channels) else 1e-5
+            e = eta.copy()
+            e[j] += d
+            J[:, j] = (self.residuals(model, e) - r0) / d
+        return J
+
+    def nuisance_report(self, eta) -> dict:
+        t0, gains, delays = self._split(eta)
+        return {"trigger_offset_s": (t0 * US).tolist(),
+                "gains": {c.name if len(self.records) == 1 else f"{c.name}@{c.record}": float(g)
+                          for c, g in zip(self.channels, gains)},
+                "delays_s": {self.channels[k].name: float(delays[k] * US) for k in self.gauges}}
+
+    def relative_rms(self, model, eta) -> float:
+        """rms(model - data) / the largest |data| over the channels."""
+        diffs, peak = [], 0.0
+        for c, m in zip(self.channels, self.traces(model, eta)):
+            if m is not None:
+                ok = np.isfinite(m)
+                diffs.append(m[ok] - c.y[ok])
+                peak = max(peak, float(np.max(np.abs(c.y))))
+        return float(np.sqrt(np.mean(np.concatenate(diffs) ** 2)) / peak) if diffs and peak > 0 else math.nan

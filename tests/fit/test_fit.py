@@ -1,0 +1,133 @@
+"""rig fit: parameters with units, data tables, fits that recover known values (points and
+scope records), resume from the evaluation cache, and clear lines for bad input."""
+import json
+
+import numpy as np
+import pytest
+
+from rig.cli import main
+from rig.errors import RigError
+from rig.experiment.shot import Rig
+from rig.fit.data import read_points
+from rig.fit.evaluate import curves
+from rig.fit.fitting import fit
+from rig.fit.parameters import parse_parameter, parse_parameters
+from rig.fit.points import PointObjective
+from rig.fit.traces import TraceObjective
+
+SCENE = "ptfe20_gravity"
+
+
+def test_parameters_carry_units():
+    p = parse_parameter("chain.youngs_modulus=0.4 GPa:2 GPa")
+    assert (p.lo, p.hi, p.unit) == (0.4e9, 2e9, "Pa")
+    assert parse_parameter("chain.contact_exponent=1.2:2").unit == "1"
+
+
+@pytest.mark.parametrize("text,match", [
+    ("chain.youngs_modulus", "needs bounds"),
+    ("chain.youngs_modulus=0.4:2", "bounds need units"),
+    ("chain.youngs_modulus=2 GPa:0.4 GPa", "LO < HI"),
+    ("chain.youngs_modulus=0.4 m:2 m", "youngs_modulus"),
+    ("chain.colour=1:2", "not a scene key"),
+    ("chain.material=1:2", "not a numeric scene key"),
+    ("chain.contact_damping=0 kg/s:1 kg/s", "> 0"),
+])
+def test_bad_parameters_get_one_line(text, match):
+    with pytest.raises(RigError, match=match):
+        parse_parameter(text)
+
+
+def test_no_parameter_is_refused():
+    with pytest.raises(RigError, match="no parameter"):
+        parse_parameters([])
+
+
+def _write(tmp_path, text):
+    p = tmp_path / "points.csv"
+    p.write_text(text)
+    return p
+
+
+@pytest.mark.parametrize("text,match", [
+    ("F_d [N],V_s [m/s]\n1,2\n", "columns missing"),
+    ("F_d,F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n1,1,1,1\n", "needs its unit"),
+    ("F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n", "no data"),
+    ("F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n1,x,1,1\n", "line 2 F_d_sd"),
+    ("F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n1,0,1,1\n", "> 0"),
+])
+def test_bad_point_tables_name_the_problem(tmp_path, text, match):
+    with pytest.raises(RigError, match=match):
+        read_points(_write(tmp_path, text))
+
+
+def test_point_fit_recovers_the_modulus_of_virtual_points(tmp_path):
+    """Points on the model's own curve at E = 1.1 GPa, with 3% / 10% uncertainties: the fit
+    finds E within its interval, and the interval is as wide as the uncertainties allow."""
+    c = curves(SCENE, [["chain.youngs_modulus=1.1e9"]], [0.5, 0.9, 1.6], 1)[0]
+    rows = "\n".join(f"{F},{0.1 * F},{V},{0.03 * V}" for F, V in zip(c.force, c.speed))
+    pts = read_points(_write(tmp_path, "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n" + rows + "\n"))
+    r = fit(PointObjective(SCENE, parse_parameters(["chain.youngs_modulus=0.5 GPa:3 GPa"]), pts))
+    assert r.converged
+    assert r.ci95[0, 0] <= 1.1e9 <= r.ci95[0, 1]
+    assert abs(r.estimate[0] / 1.1e9 - 1) < 0.01  # exact data: only the curve's interpolation
+    assert 0.01 < r.std[0] / 1.1e9 < 0.2
+
+
+def test_trace_fit_recovers_modulus_and_damping_from_one_shot(tmp_path):
+    """A virtual shot with the scene's instrument errors, fitted back from its scope record:
+    the true values lie in the 95% intervals, the gains the shot drew are recovered."""
+    true = ["chain.youngs_modulus=1.2e9", "chain.contact_law=dashpot", "chain.contact_damping=0.4",
+            "solver.accuracy=1e-6"]
+    shot = Rig.from_scene(SCENE, true).fire(seed=3)
+    params = parse_parameters(["chain.youngs_modulus=0.5 GPa:3 GPa", "chain.contact_damping=0.05 kg/s:2 kg/s"])
+    obj = TraceObjective(SCENE, params, [shot.scope], ["solver.accuracy=1e-5"])
+    r = fit(obj, tmp_path / "cache")
+    assert r.converged
+    for k, v in zip(r.keys, (1.2e9, 0.4)):
+        lo, hi = r.ci95[r.keys.index(k)]
+        assert lo <= v <= hi, (k, lo, v, hi)
+    upper = next(g for g in Rig.from_scene(SCENE).gauges if g.name == "upper")
+    assert r.nuisance["gains"][upper.channel] == pytest.approx(shot.draws["upper"]["gain"], abs=0.02)
+    again = fit(TraceObjective(SCENE, params, [shot.scope], ["solver.accuracy=1e-5"]), tmp_path / "cache")
+    assert again.evaluations == 0  # resumed: every candidate read back from the cache
+    assert np.array_equal(again.estimate, r.estimate)
+
+
+def test_cli_fit_writes_a_scene_that_fires(tmp_path, capsys):
+    c = curves(SCENE, [["chain.youngs_modulus=1.1e9"]], [0.5, 0.9, 1.6], 1)[0]
+    rows = "\n".join(f"{F},{0.1 * F},{V},{0.03 * V}" for F, V in zip(c.force, c.speed))
+    pts = _write(tmp_path, "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n" + rows + "\n")
+    out = tmp_path / "fit"
+    assert main(["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+                 "--out", str(out), "--json", "--quiet"]) == 0
+    block = json.loads(capsys.readouterr().out)
+    assert set(block) >= {"parameters", "correlation", "residual_rms_relative", "converged", "fitted_scene"}
+    assert set(block["parameters"]["chain.youngs_modulus"]) >= {"estimate", "std", "ci95"}
+    fitted = Rig.from_scene(block["fitted_scene"])
+    assert fitted.chain.beads[-1].material.E == pytest.approx(block["parameters"]["chain.youngs_modulus"]["estimate"],
+                                                              rel=1e-7)
+    assert (out / "fit.png").stat().st_size > 0 and (out / "residuals.csv").is_file()
+
+
+def test_cli_fit_that_does_not_converge_writes_no_scene(tmp_path, capsys):
+    c = curves(SCENE, [["chain.youngs_modulus=1.1e9"]], [0.5, 0.9, 1.6], 1)[0]
+    rows = "\n".join(f"{F},{0.1 * F},{V},{0.03 * V}" for F, V in zip(c.force, c.speed))
+    pts = _write(tmp_path, "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n" + rows + "\n")
+    out = tmp_path / "fit"
+    assert main(["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+                 "--param", "chain.contact_exponent=1.2:2.2", "--out", str(out), "--max-evaluations", "1",
+                 "--quiet"]) == 1
+    assert "did not converge" in capsys.readouterr().err
+    assert not (out / "fitted.toml").exists()
+
+
+@pytest.mark.parametrize("argv,match", [
+    (["--param", "chain.youngs_modulus=0.5 GPa:3 GPa"], "no data to fit"),
+    (["--points", "missing.csv", "--param", "chain.youngs_modulus=0.5:3"], "bounds need units"),
+    (["--points", "missing.csv", "--param", "chain.youngs_modulus=0.5 GPa:3 GPa"], "cannot read"),
+])
+def test_cli_bad_input_is_one_line(tmp_path, capsys, argv, match):
+    assert main(["fit", SCENE, "--out", str(tmp_path / "o")] + argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert match in err and len(err.splitlines()) == 1
