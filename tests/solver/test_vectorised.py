@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rig.model.contact import HERTZ, KUWABARA_KONO
-from rig.solver.kernels import ensemble, integrators
+from rig.solver.kernels import ensemble, step
 
 
 def _llvm(kernel, *args) -> str:
@@ -32,14 +32,14 @@ def _chain(nb=64):
 @pytest.mark.parametrize("law", [HERTZ, KUWABARA_KONO])
 def test_the_fused_kick_drift_force_pass_is_vectorised(law):
     u, v, invm, f, A, d0, _ = _chain()
-    ir = _llvm(integrators._fused_run, u, v, invm, f, A, d0, np.zeros(65), 1e-9, 1e-9, 3, 64, law, np.full(64, 1.5))
+    ir = _llvm(step.fused_run, u, v, invm, f, A, d0, np.zeros(65), 1e-9, 1e-9, 3, 64, law, np.full(64, 1.5))
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the square roots of the force pass are scalar"
     assert _vector_ops(ir), "no vector arithmetic in the fused pass"
 
 
 def test_the_closing_kick_is_vectorised():
     u, v, invm, f, *_ = _chain()
-    assert _vector_ops(_llvm(integrators._kick, v, invm, f, 1e-9, 1)), "the closing kick is scalar"
+    assert _vector_ops(_llvm(step.closing_kick, v, invm, f, 1e-9, 1)), "the closing kick is scalar"
 
 
 def test_the_batched_kernel_vectorises_over_shots():

@@ -60,11 +60,11 @@ def _holder(v, onsite, slip, t):
 
 
 @jit
-def _viscous(u, v, A, d0, con, c, el, g):
+def _viscous(v, c, el, g):
     """g[i, s]: each slot's viscous force (N) at velocities v, c d' clipped at -el (the
     coefficients c and elastic forces el of the fixed positions)."""
-    for i in range(1, u.shape[0]):
-        for s in range(u.shape[1]):
+    for i in range(1, v.shape[0]):
+        for s in range(v.shape[1]):
             gi = c[i, s] * (v[i - 1, s] - v[i, s])
             g[i, s] = gi if gi > -el[i, s] else -el[i, s]
 
@@ -85,11 +85,11 @@ def _contacts(u, v, invm, A, d0, con, t, n, wall_slot, work, j_wall):
             el[i, s] = A[i, s] * power(d, con[0, i, s]) if d > 0.0 else 0.0
     h = t / n
     for _ in range(n):
-        _viscous(u, v, A, d0, con, c, el, g)
+        _viscous(v, c, el, g)
         for i in range(nb):
             for s in range(u.shape[1]):
                 v_half[i, s] = v[i, s] + 0.5 * h * (g[i, s] - g[i + 1, s]) * invm[i, s]
-        _viscous(u, v_half, A, d0, con, c, el, g)
+        _viscous(v_half, c, el, g)
         for i in range(nb):
             for s in range(u.shape[1]):
                 v[i, s] += h * (g[i, s] - g[i + 1, s]) * invm[i, s]
@@ -107,19 +107,26 @@ def substeps(t, rate):
 
 
 @jit
-def dissipate(u, v, mass, invm, A, d0, con, onsite, slip, viscous, rate, t, wall_slot, work, lost, j_wall,
-              j_holder):
-    """E(t) (module doc) on every shot: lost[s] += the kinetic energy it takes (J),
-    j_wall[s] += its impulse on the wall, j_holder[s] += the holder's impulse (N s).
-    viscous: whether any contact has viscous terms; rate: the bound of ``substeps``."""
+def _book(v, mass, sign, lost, j_holder):
+    """lost[s] += sign x each shot's kinetic energy (J), j_holder[s] -= sign x its momentum
+    (N s): taken before the flow (sign 1) and after it (sign -1), what the flow removed."""
     for s in range(v.shape[1]):
         ke = 0.0
         p = 0.0
         for i in range(v.shape[0]):
             ke += 0.5 * mass[i, s] * v[i, s] * v[i, s]
             p += mass[i, s] * v[i, s]
-        lost[s] += ke
-        j_holder[s] -= p
+        lost[s] += sign * ke
+        j_holder[s] -= sign * p
+
+
+@jit
+def dissipate(u, v, mass, invm, A, d0, con, onsite, slip, viscous, rate, t, wall_slot, work, lost, j_wall,
+              j_holder):
+    """E(t) (module doc) on every shot: lost[s] += the kinetic energy it takes (J),
+    j_wall[s] += its impulse on the wall, j_holder[s] += the holder's impulse (N s).
+    viscous: whether any contact has viscous terms; rate: the bound of ``substeps``."""
+    _book(v, mass, 1.0, lost, j_holder)
     _holder(v, onsite, slip, 0.5 * t)
     if viscous:
         for s in range(v.shape[1]):  # the contacts' flow conserves momentum but for the wall's share
@@ -128,11 +135,4 @@ def dissipate(u, v, mass, invm, A, d0, con, onsite, slip, viscous, rate, t, wall
         for s in range(v.shape[1]):
             j_holder[s] += j_wall[s]
     _holder(v, onsite, slip, 0.5 * t)
-    for s in range(v.shape[1]):
-        ke = 0.0
-        p = 0.0
-        for i in range(v.shape[0]):
-            ke += 0.5 * mass[i, s] * v[i, s] * v[i, s]
-            p += mass[i, s] * v[i, s]
-        lost[s] -= ke
-        j_holder[s] += p
+    _book(v, mass, -1.0, lost, j_holder)

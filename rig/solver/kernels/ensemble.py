@@ -5,9 +5,8 @@ runs over ``width`` shots from 0, so every loop over the shots of a chunk vector
 ``integrate_ensemble`` runs the chunks on numba's threads. Every shot
 performs exactly the operations of the single-shot kernel (integrators.integrate) in the
 same order with the same step, so the two agree to the last bit (the multirate head
-runs the same multirate.head_flow in both; dissipative laws and the holder's drag and
-friction the same forces.contact_force and forces.onsite_step). Constant loads only (no
-force schedule).
+runs the same multirate.head_flow in both; the viscous contacts and the holder's drag and
+friction the same dissipation.dissipate). Constant loads only (no force schedule).
 """
 import math
 
@@ -24,7 +23,8 @@ from rig.solver.kernels.record import hermite_weights, probe_overlaps
 
 @jit
 def _contact_row(u, A, d0, load, f, i):
-    """Dynamic force of contact slot i for every shot: A d^(3/2) - load (integrators.py)."""
+    """Dynamic Hertz force of contact slot i for every shot: A d^(3/2) - load
+    (forces.hertz_forces)."""
     for s in range(u.shape[1]):
         d = d0[i, s] + u[i - 1, s] - u[i, s]
         d = d if d > 0.0 else 0.0
@@ -155,7 +155,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
     w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
     x = np.empty(w.shape[1])  # their fractions of the step
     h_work, h_busy = np.empty((2, 3, head + 1)), np.empty(W)  # the head flow's work arrays
-    state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, e0, p0, worst)
+    state_sums(u, v, mass, bias, A, con[0], d0, d_limit, e0, p0, worst)
     for s in range(u.shape[1]):
         net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
     probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, 0.0, head, -1, 0.0, d_old, r_old)
@@ -204,7 +204,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
         d_old[:, :, :] = d_new
         r_old[:, :, :] = r_new
         if check:
-            state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, e, pn, worst)
+            state_sums(u, v, mass, bias, A, con[0], d0, d_limit, e, pn, worst)
             for s in range(u.shape[1]):
                 err = abs(e[s] + lost[s] - e0[s]) / e_ref[s]
                 pe = abs(pn[s] - p0[s] - (t_new * net[s] - (j_wall[s] + j_visc[s]) + j_holder[s])) / p_ref[s]

@@ -59,7 +59,7 @@ def elastic_energy(d, A, n):
 
 @jit
 def hertz_forces(u, A, d0, load, f):
-    """f[1:nb] = A d^(3/2) - load: contact_forces' Hertz loop."""
+    """f[1:nb] = A d^(3/2) - load: elastic_forces' Hertz loop."""
     for i in range(1, u.shape[0]):
         d = d0[i] + u[i - 1] - u[i]
         d = d if d > 0.0 else 0.0
@@ -96,7 +96,7 @@ def elastic_forces(u, A, d0, load, f, law, expo):
 
 
 @jit
-def state_sums(u, v, mass, bias, A, expo, d0, d_limit, law, e, p, w):
+def state_sums(u, v, mass, bias, A, expo, d0, d_limit, e, p, w):
     """Each shot's energy e (J), momentum p (kg m/s) and largest d / d_limit w (> 1: an
     overlap no real contact reaches; inf for nan), arrays (bodies, shots), in two passes:
 
@@ -116,9 +116,6 @@ def state_sums(u, v, mass, bias, A, expo, d0, d_limit, law, e, p, w):
         for s in range(u.shape[1]):
             d = d0[i, s] + u[i - 1, s] - u[i, s]
             if d > 0.0:
-                if law == HERTZ or law == KUWABARA_KONO:
-                    e[s] += 0.4 * A[i, s] * d * d * math.sqrt(d)
-                else:
-                    e[s] += elastic_energy(d, A[i, s], expo[i, s])
+                e[s] += elastic_energy(d, A[i, s], expo[i, s])
             q = d / d_limit[i, s]
             w[s] = max(w[s], q) if q == q else math.inf

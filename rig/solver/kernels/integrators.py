@@ -14,9 +14,9 @@ Recorded channels are linear combinations of contact forces, interpolated onto a
 output grid by cubic Hermite interpolation between step ends (force and its rate
 dF/dt = (3/2) A d^(1/2) d(d)/dt), so the output grid may be finer than the step.
 
-With a multirate head (head > 0, see rig/stepsize.py) the kicks carry every contact but
-the first ``head`` ones, and each drift moves bodies 0..head by multirate.head_flow
-(``sub[s]`` substeps of the same method in drift s) instead of a plain drift.
+One step of the composition is step.py's (its fused kick-drift-force passes, the blocks
+of its wavefront, the multirate head); this module drives the steps: the records, the
+checks, the frames and the dissipation.
 
 Dissipation. The force passes carry the contacts' elastic part only; the contacts'
 viscous terms and the holder's drag and friction are a flow of the velocities, taken
@@ -24,140 +24,14 @@ apart in a Strang splitting E(dt/2) S(dt) E(dt/2) (dissipation.py): second order
 they act, each step then ending synchronised. E counts the energy it takes, so the
 balance E(t) + dissipated = E(0) closes to the method's own error.
 """
-import math
 
 import numpy as np
 
 from instruments.jit import jit
-from rig.model.contact import POWER
 from rig.solver.kernels.dissipation import dissipate
-from rig.solver.kernels.forces import elastic_forces, power, state_sums
-from rig.solver.kernels.multirate import head_flow
+from rig.solver.kernels.forces import elastic_forces, state_sums
 from rig.solver.kernels.record import hermite, hermite_weights, probe_overlaps, recorded_force
-
-
-@jit
-def schedule_force(t, times, forces):
-    """Piecewise-linear force (N) at time t from a table; held constant outside it."""
-    n = times.shape[0]
-    if t <= times[0]:
-        return forces[0]
-    if t >= times[n - 1]:
-        return forces[n - 1]
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if times[mid] <= t:
-            lo = mid
-        else:
-            hi = mid
-    w = (t - times[lo]) / (times[hi] - times[lo])
-    return forces[lo] + w * (forces[hi] - forces[lo])
-
-
-@jit
-def _external_kick(v, invm, h, t, sched_body, sched_t, sched_f):
-    """Kick by the scheduled force at time t; returns its impulse (N s)."""
-    if sched_t.shape[0] == 0:
-        return 0.0
-    fe = schedule_force(t, sched_t, sched_f)
-    v[sched_body] += h * fe * invm[sched_body]
-    return h * fe
-
-
-@jit
-def _fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, expo):
-    """Bodies lo..hi-1 (lo >= 1), in order: kick v += hb (f_above - f_below)/m, drift
-    u += ha v, then renew contact slot i's elastic force from bodies i-1 and i (both moved;
-    forces.elastic_forces' operations). Slot i + 1 is still the old force when body i is
-    kicked, so one pass does what a kick-drift pass and a force pass do. ``law``: POWER
-    takes each slot's exponent ``expo``, any other code Hertz's.
-
-    The index is unsigned: with a signed start known only at run time numba keeps its
-    negative-index wraparound in the loop and LLVM no longer vectorises it
-    (tests/solver/test_vectorised.py guards this)."""
-    one = np.uint64(1)
-    u_prev = u[lo - 1]
-    if law != POWER:  # a loop per law: a branch on the law inside the loop would stop it vectorising
-        for i in range(np.uint64(lo), np.uint64(hi)):
-            vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
-            v[i] = vi
-            ui = u[i] + ha * vi
-            u[i] = ui
-            d = d0[i] + u_prev - ui
-            d = d if d > 0.0 else 0.0
-            f[i] = A[i] * d * math.sqrt(d) - load[i]
-            u_prev = ui
-    else:
-        for i in range(np.uint64(lo), np.uint64(hi)):
-            vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
-            v[i] = vi
-            ui = u[i] + ha * vi
-            u[i] = ui
-            d = d0[i] + u_prev - ui
-            f[i] = A[i] * power(d if d > 0.0 else 0.0, expo[i]) - load[i]
-            u_prev = ui
-
-
-@jit
-def _kick(v, invm, f, hb, head):
-    """Kick only (the owed closing kick), every body; the head's bodies get only the force
-    of slot head + 1 (their own contacts are the head flow's)."""
-    start = 0
-    if head > 0:
-        v[head] += hb * (0.0 - f[head + 1]) * invm[head]
-        start = head + 1
-    for i in range(np.uint64(start), np.uint64(v.shape[0])):
-        v[i] = v[i] + hb * (f[i] - f[i + np.uint64(1)]) * invm[i]
-
-
-BLOCK = 2048  # bodies per block of a step's wavefront (their arrays stay in the core's L2 cache)
-
-
-@jit
-def _step(u, v, invm, f, A, d0, load, law, expo, a_coef, b_coef, dt, t, pending, head, sub,
-          sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses):
-    """One step of the composition (its closing kick owed), every body and stage.
-
-    Stage s on body i needs slot i + 1 at stage s - 1 and leaves slot i at stage s, so
-    stage s may run one body behind stage s - 1: the chain is swept in blocks of BLOCK
-    bodies, each block taken through every stage (stage s on bodies kB - s .. (k+1)B - s)
-    while it is in cache, instead of every stage streaming the whole chain from memory.
-    Each body sees the same operations in the same order as in stage-by-stage sweeps.
-    With a multirate head, bodies 0..head get the kick of slot
-    head + 1 and the head's flow (multirate.head_flow) instead. ``heads``: the
-    (bodies, 1) views the head flow takes, h_work and h_busy its work arrays;
-    impulses[0] += the wall's dynamic impulse, impulses[1] += the schedule's (N s).
-    """
-    nb = u.shape[0]
-    u2, v2, im2, f2, A2, d02, load2 = heads
-    n_blocks = max(1, (nb + BLOCK - 1) // BLOCK)
-    for k in range(n_blocks):
-        ts = t
-        for s in range(a_coef.shape[0]):
-            hb = b_coef[s] * dt
-            if s == 0:
-                hb += pending
-            h = a_coef[s] * dt
-            lo = max(k * BLOCK - s, 0)
-            hi = nb if k == n_blocks - 1 else (k + 1) * BLOCK - s
-            if k == n_blocks - 1 and wall_slot > 0:
-                impulses[0] += hb * f[wall_slot]
-            if k == 0:
-                impulses[1] += _external_kick(v, invm, hb, ts, sched_body, sched_t, sched_f)
-                if head > 0:
-                    v[head] += hb * (0.0 - f[head + 1]) * invm[head]
-                    head_flow(u2, v2, im2, f2, A2, d02, load2, head, a_coef, b_coef, h, sub[s], h_work, h_busy)
-                    lo = head + 1
-                else:
-                    v0 = v[0] + hb * (f[0] - f[1]) * invm[0]
-                    v[0] = v0
-                    u[0] += h * v0
-                    lo = 1
-            if hi > lo:
-                _fused_run(u, v, invm, f, A, d0, load, hb, h, lo, hi, law, expo)
-            ts += h
+from rig.solver.kernels.step import closing_kick, external_kick, schedule_force, step
 
 
 @jit
@@ -211,7 +85,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
     net_const = load[nb] - wall_load
     sums = np.empty(3)  # energy (J), momentum (kg m/s), largest d / d_limit of one state
     m2, b2, dl2 = mass.reshape((nb, 1)), bias.reshape((nb, 1)), d_limit.reshape((nb, 1))
-    state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, law, sums[0:1], sums[1:2], sums[2:3])
+    state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, sums[0:1], sums[1:2], sums[2:3])
     e0, p0 = sums[0], sums[1]
     impulses = np.zeros(2)  # the wall's dynamic impulse, the schedule's (N s)
     w_sched = 0.0
@@ -252,7 +126,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
         if dissipative:  # E(dt/2) S(dt) E(dt/2): each step ends synchronised
             dissipate(u2, v2, m2, im2, A2, d02, con3, onsite3, slip, viscous, viscous_rate, 0.5 * dt, wall_slot, work,
                       lost, j_visc, j_holder)
-        _step(u, v, invm, f, A, d0, load, law, con[0], a_coef, b_coef, dt, t, pending, head, sub,
+        step(u, v, invm, f, A, d0, load, law, con[0], a_coef, b_coef, dt, t, pending, head, sub,
               sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
@@ -260,8 +134,8 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
         if check or n_frames > 0 or dissipative:  # synchronise every velocity
             if wall_slot > 0:
                 impulses[0] += pending * f[wall_slot]
-            impulses[1] += _external_kick(v, invm, pending, t_new, sched_body, sched_t, sched_f)
-            _kick(v, invm, f, pending, head)
+            impulses[1] += external_kick(v, invm, pending, t_new, sched_body, sched_t, sched_f)
+            closing_kick(v, invm, f, pending, head)
             pending = 0.0
         if dissipative:
             dissipate(u2, v2, m2, im2, A2, d02, con3, onsite3, slip, viscous, viscous_rate, 0.5 * dt, wall_slot, work,
@@ -290,7 +164,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
             j_frame += 1
 
         if check:
-            state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, law, sums[0:1], sums[1:2],
+            state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, sums[0:1], sums[1:2],
                        sums[2:3])
             e = sums[0] - w_sched + lost[0]
             err = abs(e - e0) / e_ref

@@ -10,10 +10,8 @@ contact closes or opens, so the recorded force keeps the integrator's accuracy t
 interpolating the force itself would be accurate only to O(h^1.5) in such a step (the
 force grows as (t - t0)^(3/2) from the instant t0 the contact closes).
 """
-import math
 
 from instruments.jit import jit
-from rig.model.contact import HERTZ
 from rig.solver.kernels.forces import contact_force
 from rig.solver.kernels.multirate import slow_net
 
@@ -66,18 +64,14 @@ def recorded_force(w, col, x, c, s, ch_slot, ch_weight, A, con, law, d_old, r_ol
     """Channel c's force (N) in shot s at fraction x of a step, whose Hermite weights are
     column col of w: sum over its contacts of weight x the contact law (forces.contact_force;
     con: (3, bodies, shots) exponents, damping times, dashpots) at the interpolated overlap
-    d and, for a law with viscous terms, the rate d' linear in the step."""
+    d and the rate d' linear in the step (which only a law with viscous terms reads)."""
     y = 0.0
     for k in range(ch_slot.shape[1]):
         wk = ch_weight[c, k]
         if wk != 0.0:
             i = ch_slot[c, k]
             d = hermite(w, col, d_old[c, k, s], r_old[c, k, s], d_new[c, k, s], r_new[c, k, s])
-            if law == HERTZ:
-                d = d if d > 0.0 else 0.0
-                y += wk * (A[i, s] * d * math.sqrt(d))
-            else:
-                rate = (1.0 - x) * r_old[c, k, s] + x * r_new[c, k, s]
-                fk, _ = contact_force(d, rate, A[i, s], con[0, i, s], con[1, i, s], con[2, i, s], law)
-                y += wk * fk
+            rate = (1.0 - x) * r_old[c, k, s] + x * r_new[c, k, s]
+            fk, _ = contact_force(d, rate, A[i, s], con[0, i, s], con[1, i, s], con[2, i, s], law)
+            y += wk * fk
     return y
