@@ -9,8 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rig.model.chain import Chain, ForceSchedule, static_forces_of, static_overlaps_of
+from rig.model.chain import Chain, ForceSchedule
 from rig.model.contact import HERTZ, KUWABARA_KONO, POWER
+from rig.model.statics import static_forces_of, static_overlaps_of
 
 PER_BODY = ("mass", "invm", "bias", "A", "expo", "d0", "f0", "damping", "dashpot", "d_limit", "drag", "friction",
             "u0", "v0")

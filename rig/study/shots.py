@@ -15,8 +15,8 @@ import numpy as np
 from instruments.batch import Wiring
 from rig.experiment.shot import Rig
 from rig.experiment.truth import speed_between
-from rig.model.chain import contact_constants_of, equilibrium_positions_of, static_forces_of, static_overlaps_of
 from rig.model.parts import GaugeBead
+from rig.model.statics import contact_constants_of, equilibrium_positions_of, static_forces_of, static_overlaps_of
 from rig.solver.problem import PER_BODY, ChainProblem, ProblemArrays, problem_arrays
 
 ARRAY_KEYS = ("striker.velocity", "striker.mass", "chain.bead_mass", "chain.youngs_modulus", "chain.poisson_ratio",
