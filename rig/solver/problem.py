@@ -25,8 +25,23 @@ def kernel_law(expo, damping, dashpot) -> int:
     return POWER
 
 
+class _ContactCodes:
+    """What the kernels read off the arrays of a ChainProblem or of ProblemArrays alike."""
+
+    @property
+    def law(self) -> int:
+        """The kernels' contact code of the live slots (of every shot together; kernel_law)."""
+        live = self.A > 0
+        return kernel_law(self.expo[live], self.damping[live], self.dashpot[live])
+
+    @property
+    def onsite(self) -> bool:
+        """Whether the holder drags or rubs any bead."""
+        return bool(np.any(self.drag) or np.any(self.friction))
+
+
 @dataclass(frozen=True, eq=False)
-class ProblemArrays:
+class ProblemArrays(_ContactCodes):
     """Many shots of one chain layout: the ChainProblem arrays with a leading shot axis
     (``load`` (shots, bodies + 1), the others (shots, bodies)), energy_scale and
     momentum_scale (shots,); ``layout``: a ChainProblem of the layout (its offset, wall
@@ -50,17 +65,6 @@ class ProblemArrays:
     v0: np.ndarray
     energy_scale: np.ndarray
     momentum_scale: np.ndarray
-
-    @property
-    def law(self) -> int:
-        """The kernels' contact code of every shot together (kernel_law)."""
-        live = self.A > 0
-        return kernel_law(self.expo[live], self.damping[live], self.dashpot[live])
-
-    @property
-    def onsite(self) -> bool:
-        """Whether any shot's holder drags or rubs its beads."""
-        return bool(np.any(self.drag) or np.any(self.friction))
 
     @property
     def shots(self) -> int:
@@ -140,7 +144,7 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
 
 
 @dataclass(frozen=True, eq=False)
-class ChainProblem:
+class ChainProblem(_ContactCodes):
     """Bodies from the top: [striker] + beads + [wall as a body of zero inverse mass].
 
     Arrays are per body (size nb) in SI: mass (kg; 0 for the wall), invm (1/kg), bias
@@ -188,26 +192,13 @@ class ChainProblem:
         else:
             sched_t = np.zeros(0)
             sched_f = np.zeros(0)
-        return cls(chain, off, *(a[k][0] for k in ("mass", "invm", "bias", "load", "A", "expo", "d0", "f0",
-                                                    "damping", "dashpot", "d_limit", "drag", "friction",
-                                                    "u0", "v0")),
-                   off, sched_t, sched_f, nb - 1 if chain.wall is not None else 0,
-                   float(a["energy_scale"][0]), float(a["momentum_scale"][0]))
+        return cls(chain, off, **{k: a[k][0] for k in PER_BODY + ("load",)}, sched_body=off, sched_t=sched_t,
+                   sched_f=sched_f, wall_slot=nb - 1 if chain.wall is not None else 0,
+                   energy_scale=float(a["energy_scale"][0]), momentum_scale=float(a["momentum_scale"][0]))
 
     @property
     def n_bodies(self) -> int:
         return self.mass.shape[0]
-
-    @property
-    def law(self) -> int:
-        """The kernels' contact code (kernel_law)."""
-        live = self.A > 0
-        return kernel_law(self.expo[live], self.damping[live], self.dashpot[live])
-
-    @property
-    def onsite(self) -> bool:
-        """Whether the holder drags or rubs the beads."""
-        return bool(np.any(self.drag) or np.any(self.friction))
 
     @property
     def slip_speed(self) -> float:
