@@ -79,8 +79,9 @@ class Scene:
         return Scene(self.name, self.text, self.overrides, values)
 
 
-def load(name_or_path, overrides=()) -> Scene:
-    """Parse, override and validate a scene file (a path, or a published scene's name)."""
+def read_raw(name_or_path) -> tuple:
+    """(text, raw TOML table) of a scene file, its scene.name defaulting to the file's stem;
+    nothing checked against SCHEMA yet."""
     path = find_scene(name_or_path)
     try:
         text = path.read_text()
@@ -91,14 +92,22 @@ def load(name_or_path, overrides=()) -> Scene:
     except tomllib.TOMLDecodeError as exc:
         raise RigError(f"scene {path}: not valid TOML ({exc})") from None
     raw.setdefault("scene", {}).setdefault("name", path.stem)
+    return text, raw
+
+
+def load(name_or_path, overrides=()) -> Scene:
+    """Parse, override and validate a scene file (a path, or a published scene's name)."""
+    text, raw = read_raw(name_or_path)
     overrides = tuple(overrides)
     for item in overrides:
-        _override(raw, item)
+        apply_override(raw, item)
     values = convert(raw)
     return Scene(values["scene"]["name"], text, overrides, values)
 
 
-def _override(raw: dict, item: str):
+def apply_override(raw: dict, item: str):
+    """Set ``key=value`` in a scene's raw TOML table (the value a quantity of the key's SI
+    unit when it is a plain number), checked against SCHEMA."""
     if "=" not in item:
         raise invalid("--set", item, "expected key=value, e.g. striker.velocity=1.2")
     key, value = (s.strip() for s in item.split("=", 1))

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from rig.errors import RigError
-from rig.experiment.measure import truth_report
 from rig.experiment.shot import Rig
 from rig.solver.ensemble import solve_ensemble
 from rig.solver.methods import method as get_method
@@ -84,33 +83,26 @@ class Curve:
         return np.exp(y[k] + slopes[k] * (lx - x[k])), slopes[k]
 
 
-def curves(scene: str, overrides: list, velocities, n_candidates: int) -> list:
-    """Curves of ``n_candidates`` candidates (overrides[c]: the candidate's scene overrides)
-    at the striker ``velocities`` (m/s): one batched solve of all of them."""
-    rigs, index, refused = [], [], []
-    for c in range(n_candidates):
-        for v in velocities:
+def curves(scene: str, overrides: list, velocities) -> list:
+    """The Curve of each candidate (overrides[c]: its scene overrides) at the striker
+    ``velocities`` (m/s): one batched solve of all of them. A candidate the scene refuses
+    (a value out of a part's range) has no points; RigError if the scene refuses them all."""
+    v = np.asarray(velocities, dtype=float)
+    F = np.full((len(overrides), v.size), math.nan)
+    V = np.full((len(overrides), v.size), math.nan)
+    rigs, where, refused = [], [], []
+    for c, extra in enumerate(overrides):
+        for k, vel in enumerate(v):
             try:
-                rigs.append(Rig.from_scene(scene, list(overrides[c]) + [f"striker.velocity={float(v)!r}"]))
-                index.append(c)
-            except RigError as exc:  # a candidate the scene refuses (out of a part's range): no curve
-                index.append(-1 - c)
+                rigs.append(Rig.from_scene(scene, list(extra) + [f"striker.velocity={float(vel)!r}"]))
+                where.append((c, k))
+            except RigError as exc:
                 refused.append(str(exc))
     if not rigs:
         raise RigError(f"every candidate refused by the scene: {refused[0]}")
-    ok = solve_rigs(rigs)
-    F = np.full((n_candidates, len(velocities)), math.nan)
-    V = np.full((n_candidates, len(velocities)), math.nan)
-    r = iter(zip(rigs, ok))
-    for j, c in enumerate(index):
-        if c < 0:
-            continue
-        rig, good = next(r)
-        if not good:
-            continue
-        rep = truth_report(rig, rig.truth())
-        k = j % len(velocities)
-        if rep.speed_m_per_s is not None and rep.amplitude_N is not None:
-            F[c, k], V[c, k] = rep.amplitude_N, rep.speed_m_per_s
-    v = np.asarray(velocities, dtype=float)
-    return [Curve(v, F[c], V[c]) for c in range(n_candidates)]
+    for (c, k), rig, good in zip(where, rigs, solve_rigs(rigs)):
+        if good:
+            rep = rig.truth_analysis()
+            if rep.speed_m_per_s is not None and rep.amplitude_N is not None:
+                F[c, k], V[c, k] = rep.amplitude_N, rep.speed_m_per_s
+    return [Curve(v, F[c], V[c]) for c in range(len(overrides))]

@@ -34,7 +34,8 @@ HIGH_CORRELATION = 0.95
 @dataclass(frozen=True)
 class FitResult:
     """A finished fit: estimates, standard deviations and 95% intervals (SI units, in the
-    order of ``keys``), correlation matrix, residuals, goodness and convergence."""
+    order of ``keys``), correlation matrix, residuals, goodness and convergence; ``model``:
+    the objective's evaluation at the estimate, ``eta`` its nuisance parameters."""
 
     keys: tuple
     units: tuple
@@ -51,6 +52,7 @@ class FitResult:
     at_bound: tuple
     nuisance: dict = field(default_factory=dict)
     eta: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    model: object = None
 
     @property
     def chi2_reduced(self) -> float:
@@ -136,7 +138,9 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
 
     def jac(x):
         h = np.where(x[:P] + FD_STEP <= 1.0, FD_STEP, -FD_STEP)
-        cands = [theta(x)] + [theta(x + h[k] * np.eye(x.size)[k]) for k in range(P)]
+        steps = np.zeros((P, x.size))
+        steps[np.arange(P), np.arange(P)] = h
+        cands = [theta(x)] + [theta(x + e) for e in steps]
         models = cache.get(cands)
         count["batches"] += 1
         r0 = objective.residuals(models[0], x[P:])
@@ -151,7 +155,8 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
 
     res = optimize.least_squares(fun, x0, jac=jac, bounds=bounds, method="trf", x_scale="jac",
                                  max_nfev=max_evaluations, xtol=1e-6, ftol=1e-8, gtol=1e-8)
-    r = fun(res.x)
+    (model,) = cache.get([theta(res.x)])
+    r = objective.residuals(model, res.x[P:])
     J = jac(res.x)
     chi2 = float(r @ r)
     dof = int(r.size - x0.size)
@@ -167,7 +172,7 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
     converged = bool(res.success and res.status > 0 and np.all(np.isfinite(std)))
     return FitResult(tuple(p.key for p in params), tuple(p.unit for p in params), est, std, ci, corr, r, chi2, dof,
                      converged, str(res.message), cache.solved, at_bound, objective.nuisance_report(res.x[P:]),
-                     res.x[P:].copy())
+                     res.x[P:].copy(), model)
 
 
 def stderr_progress(text: str):

@@ -72,7 +72,7 @@ class PointObjective:
 
     def evaluate(self, thetas: list) -> list:
         cands = [self.candidate_overrides(t, c) for t in thetas for c in self.configs]
-        flat = curves(self.scene, cands, self.velocities, len(cands))
+        flat = curves(self.scene, cands, self.velocities)
         C = len(self.configs)
         return [tuple(flat[i * C:(i + 1) * C]) for i in range(len(thetas))]
 
@@ -107,6 +107,10 @@ class PointObjective:
     def relative_residuals(self, model) -> np.ndarray:
         """V_model(F_i) / V_i - 1 at each point."""
         return self.model_speeds(model)[0] / self.points.speed - 1.0
+
+    def relative_rms(self, model, eta) -> float:
+        """RMS of the relative speed residuals (points without a model curve left out)."""
+        return float(np.sqrt(np.nanmean(self.relative_residuals(model) ** 2)))
 
     @staticmethod
     def nuisance_start():

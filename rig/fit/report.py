@@ -4,30 +4,25 @@ fitted.toml: the scene with the fitted values, which `rig shot` fires."""
 from __future__ import annotations
 
 import csv
-import math
-import sys
 from pathlib import Path
 
 import numpy as np
 
 from rig.experiment import scene as scene_io
 from rig.fit.fitting import FitResult
+from rig.fit.points import PointObjective
 
 
-def summary(result: FitResult, objective, model, fitted_scene) -> dict:
+def summary(result: FitResult, objective, fitted_scene) -> dict:
     """The --json block: {"parameters": {KEY: {"estimate", "std", "ci95", "unit"}}, "correlation",
     "residual_rms_relative", "converged", "fitted_scene", ...}."""
-    rel = (objective.relative_residuals(model) if hasattr(objective, "relative_residuals")
-           else None)
-    rms = (float(np.sqrt(np.nanmean(rel ** 2))) if rel is not None
-           else objective.relative_rms(model, result.eta))
     return {
         "parameters": {k: {"estimate": float(e), "std": float(s), "ci95": [float(lo), float(hi)], "unit": u}
                        for k, u, e, s, (lo, hi) in zip(result.keys, result.units, result.estimate, result.std,
                                                         result.ci95)},
         "correlation": np.round(result.correlation, 6).tolist(),
         "highly_correlated": [{"keys": [a, b], "correlation": rho} for a, b, rho in result.correlated_pairs()],
-        "residual_rms_relative": rms,
+        "residual_rms_relative": objective.relative_rms(result.model, result.eta),
         "converged": result.converged,
         "message": result.message,
         "at_bound": list(result.at_bound),
@@ -43,37 +38,22 @@ def fitted_scene_text(scene: str, overrides: list, result: FitResult) -> str:
     """The scene's TOML with the overrides and the fitted values set (each with its unit)."""
     import tomli_w
 
-    if sys.version_info >= (3, 11):
-        import tomllib
-    else:  # pragma: no cover
-        import tomli as tomllib
-    path = scene_io.find_scene(scene)
-    raw = tomllib.loads(path.read_text())
-    text_overrides = list(overrides) + [f"{k}={float(v)!r}" for k, v in zip(result.keys, result.estimate)]
-    for item in text_overrides:
-        key, value = (s.strip() for s in item.split("=", 1))
-        spec = scene_io.schema_node(key)
-        node = raw
-        parts = key.split(".")
-        for p in parts[:-1]:
-            node = node.setdefault(p, {})
-        if isinstance(spec, str):
-            node[parts[-1]] = f"{float(value):.8g} {spec}"
-        elif spec is float:
-            node[parts[-1]] = float(value)
-        else:
-            node[parts[-1]] = value
-    raw.setdefault("scene", {})["name"] = f"{raw.get('scene', {}).get('name', path.stem)}_fitted"
-    head = (f"# {path.stem} fitted by `rig fit`: "
+    _, raw = scene_io.read_raw(scene)
+    name = raw["scene"]["name"]
+    for item in list(overrides) + [f"{k}={float(v)!r}" for k, v in zip(result.keys, result.estimate)]:
+        scene_io.apply_override(raw, item)
+    raw["scene"]["name"] = f"{name}_fitted"
+    head = (f"# {name} fitted by `rig fit`: "
             + ", ".join(f"{k} = {e:.6g} +- {s:.2g}" for k, e, s in zip(result.keys, result.estimate, result.std))
             + "\n")
     return head + tomli_w.dumps(raw)
 
 
-def write_residuals(path: Path, objective, result: FitResult, model):
+def write_residuals(path: Path, objective, result: FitResult):
+    model = result.model
     with open(path, "w", newline="") as fh:
         wr = csv.writer(fh)
-        if hasattr(objective, "points"):
+        if isinstance(objective, PointObjective):
             p = objective.points
             V, _ = objective.model_speeds(model)
             wr.writerow(["F_d [N]", "V_s [m/s]", "V_s model [m/s]", "relative", "normalised", "configuration"])
@@ -90,13 +70,14 @@ def write_residuals(path: Path, objective, result: FitResult, model):
                              float(np.mean(r ** 2))])
 
 
-def draw(path: Path, objective, result: FitResult, model, eta):
+def draw(path: Path, objective, result: FitResult):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    if hasattr(objective, "points"):
+    model = result.model
+    if isinstance(objective, PointObjective):
         p = objective.points
         fig, ax = plt.subplots(figsize=(6.4, 4.6))
         for c, (config, curve) in enumerate(zip(objective.configs, model)):
@@ -110,7 +91,7 @@ def draw(path: Path, objective, result: FitResult, model, eta):
         ax.set_xlabel("dynamic contact force F_d (N)")
         ax.set_ylabel("leading pulse speed V_s (m/s)")
     else:
-        traces = objective.traces(model, eta)
+        traces = objective.traces(model, result.eta)
         fig, axes = plt.subplots(len(objective.channels), 1, figsize=(7.0, 2.2 * len(objective.channels)),
                                  sharex=True, squeeze=False)
         for ax, c, m in zip(axes[:, 0], objective.channels, traces):
@@ -127,7 +108,3 @@ def draw(path: Path, objective, result: FitResult, model, eta):
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
-
-
-def finite_or_none(x):
-    return None if x is None or (isinstance(x, float) and not math.isfinite(x)) else x

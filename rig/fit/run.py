@@ -22,7 +22,6 @@ def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 40
     except OSError as exc:
         raise RigError(f"--out {out}: cannot create ({exc.strerror})") from None
     result = fit(objective, out / "evaluations", max_evaluations=max_evaluations, progress=progress)
-    (model,) = objective.evaluate([result.estimate])
     fitted = None
     stale = out / "fitted.toml"
     if stale.exists():
@@ -38,8 +37,8 @@ def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 40
             raise
         os.replace(tmp, stale)
         fitted = stale
-    block = report.summary(result, objective, model, fitted)
-    report.write_residuals(out / "residuals.csv", objective, result, model)
-    report.draw(out / "fit.png", objective, result, model, result.eta)
+    block = report.summary(result, objective, fitted)
+    report.write_residuals(out / "residuals.csv", objective, result)
+    report.draw(out / "fit.png", objective, result)
     (out / "fit.json").write_text(json.dumps(block, indent=1, default=float))
     return block

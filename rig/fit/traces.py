@@ -15,6 +15,7 @@ record's pre-trigger samples (at least an 8-bit step / sqrt(12)).
 """
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass, replace
 
@@ -136,7 +137,8 @@ class TraceObjective:
     def spec(self) -> dict:
         return {"kind": "traces", "scene": self.scene, "overrides": self.overrides,
                 "params": [(q.key, q.lo, q.hi) for q in self.params],
-                "data": [[c.name, c.sd, float(np.sum(c.y)), c.t.size] for c in self.channels]}
+                "data": [[c.record, c.name, c.sd, hashlib.sha256(c.t.tobytes() + c.y.tobytes()).hexdigest()]
+                         for c in self.channels]}
 
     def start(self) -> np.ndarray:
         return self._start

@@ -46,10 +46,8 @@ def table1_points():
 def _fit(points, bounds, tell):
     obj = PointObjective("ptfe52_gravity", parse_parameters(bounds), points)
     r = fit(obj)
-    (model,) = obj.evaluate([r.estimate])
-    rel = obj.relative_residuals(model)
     tell(f"fitted {', '.join(b.split('=')[0] for b in bounds)}")
-    return obj, r, model, rel
+    return obj, r, r.model, obj.relative_residuals(r.model)
 
 
 def _block(r, rel) -> dict:
@@ -145,13 +143,13 @@ def _steel(tell) -> dict:
     grid = np.linspace(120e9, 260e9, 15)
     scenes = ("steel21_gravity", "steel21_magnetic")
     target = np.array([PUBLISHED["steel_gravity_speed"], PUBLISHED["steel_magnetic_speed"]])
-    speeds = np.array([[c.speed[0] for c in curves(s, [[f"chain.youngs_modulus={float(E)!r}"] for E in grid], [0.44],
-                                                   grid.size)] for s in scenes]).T
+    moduli = [[f"chain.youngs_modulus={float(E)!r}"] for E in grid]
+    speeds = np.array([[c.speed[0] for c in curves(s, moduli, [0.44])] for s in scenes]).T
     chi2 = np.sum(((speeds - target) / (0.1 * target)) ** 2, axis=1)
     k = int(np.clip(np.nanargmin(chi2), 1, grid.size - 2))
     a, b, c = np.polyfit(grid[k - 1:k + 2], chi2[k - 1:k + 2], 2)
     E = float(-b / (2 * a)) if a > 0 else float(grid[k])
-    fitted = [c.speed[0] for s in scenes for c in curves(s, [[f"chain.youngs_modulus={E!r}"]], [0.44], 1)]
+    fitted = [c.speed[0] for s in scenes for c in curves(s, [[f"chain.youngs_modulus={E!r}"]], [0.44])]
     tell("steel")
     return {"youngs_modulus_Pa": E, "youngs_modulus_std_Pa": float(math.sqrt(2 / a)) if a > 0 else math.nan,
             "gravity_speed_m_per_s": fitted[0], "magnetic_speed_m_per_s": fitted[1],

@@ -49,6 +49,13 @@ def _write(tmp_path, text):
     return p
 
 
+def _virtual_points(tmp_path):
+    """A points table on the model's own curve at E = 1.1 GPa (10% / 3% uncertainties)."""
+    (c,) = curves(SCENE, [["chain.youngs_modulus=1.1e9"]], [0.5, 0.9, 1.6])
+    rows = "\n".join(f"{F},{0.1 * F},{V},{0.03 * V}" for F, V in zip(c.force, c.speed))
+    return _write(tmp_path, "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n" + rows + "\n")
+
+
 @pytest.mark.parametrize("text,match", [
     ("F_d [N],V_s [m/s]\n1,2\n", "columns missing"),
     ("F_d,F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n1,1,1,1\n", "needs its unit"),
@@ -64,9 +71,7 @@ def test_bad_point_tables_name_the_problem(tmp_path, text, match):
 def test_point_fit_recovers_the_modulus_of_virtual_points(tmp_path):
     """Points on the model's own curve at E = 1.1 GPa, with 3% / 10% uncertainties: the fit
     finds E within its interval, and the interval is as wide as the uncertainties allow."""
-    c = curves(SCENE, [["chain.youngs_modulus=1.1e9"]], [0.5, 0.9, 1.6], 1)[0]
-    rows = "\n".join(f"{F},{0.1 * F},{V},{0.03 * V}" for F, V in zip(c.force, c.speed))
-    pts = read_points(_write(tmp_path, "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n" + rows + "\n"))
+    pts = read_points(_virtual_points(tmp_path))
     r = fit(PointObjective(SCENE, parse_parameters(["chain.youngs_modulus=0.5 GPa:3 GPa"]), pts))
     assert r.converged
     assert r.ci95[0, 0] <= 1.1e9 <= r.ci95[0, 1]
@@ -95,9 +100,7 @@ def test_trace_fit_recovers_modulus_and_damping_from_one_shot(tmp_path):
 
 
 def test_cli_fit_writes_a_scene_that_fires(tmp_path, capsys):
-    c = curves(SCENE, [["chain.youngs_modulus=1.1e9"]], [0.5, 0.9, 1.6], 1)[0]
-    rows = "\n".join(f"{F},{0.1 * F},{V},{0.03 * V}" for F, V in zip(c.force, c.speed))
-    pts = _write(tmp_path, "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n" + rows + "\n")
+    pts = _virtual_points(tmp_path)
     out = tmp_path / "fit"
     assert main(["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
                  "--out", str(out), "--json", "--quiet"]) == 0
@@ -111,9 +114,7 @@ def test_cli_fit_writes_a_scene_that_fires(tmp_path, capsys):
 
 
 def test_cli_fit_that_does_not_converge_writes_no_scene(tmp_path, capsys):
-    c = curves(SCENE, [["chain.youngs_modulus=1.1e9"]], [0.5, 0.9, 1.6], 1)[0]
-    rows = "\n".join(f"{F},{0.1 * F},{V},{0.03 * V}" for F, V in zip(c.force, c.speed))
-    pts = _write(tmp_path, "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n" + rows + "\n")
+    pts = _virtual_points(tmp_path)
     out = tmp_path / "fit"
     assert main(["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
                  "--param", "chain.contact_exponent=1.2:2.2", "--out", str(out), "--max-evaluations", "1",
