@@ -17,7 +17,9 @@ accuracy``. CPU times are process times, medians of ``repeats`` runs.
   N = 1e6, beside the machine's bounds (vectorised square roots; memory bandwidth) and,
   with ``--baseline REV``, the same figure of that revision measured in turns with it;
 - the cost per simulated second from 1e3 to 1e6 beads at the step the accuracy control
-  picks for 1e3, and its exponent.
+  picks for 1e3, and its exponent;
+- the optional chain models (rig/bench/models.py): each one's cost per step and at the
+  accuracy contract beside plain Hertz, and its cost when off (none: the same bits).
 """
 from __future__ import annotations
 
@@ -25,6 +27,7 @@ import math
 import os
 import platform
 
+from rig.bench import models
 from rig.bench.accuracy import cases, reference
 from rig.bench.kernel_cost import kernel_figures, median_cpu, scaling
 from rig.model.chain import Chain
@@ -162,7 +165,7 @@ def run(quick: bool = False, peers: bool = False, baseline: str | None = None, p
     return dict(rows=rows, at_equal_error=at_equal_error(rows), notes=notes, machine=_machine(),
                 beads=N_BEADS, probe_contact=PROBE,
                 kernel=kernel_figures(1 if quick else 5, 1 if quick else 3, baseline, progress),
-                scaling=None if quick else scaling(chain, progress))
+                scaling=None if quick else scaling(chain, progress), models=models.run(quick, progress))
 
 
 def _machine() -> str:
@@ -204,5 +207,6 @@ def table(result: dict) -> str:
         for r in s["rows"]:
             lines.append(f"  {r['beads']:>9,d} beads: {r['cpu_per_simulated_s']:10.2f} s/s")
         lines.append(f"  exponent of N: {s['exponent']:.3f}")
+    lines += ["", models.table(result["models"])]
     lines += [f"note: {n}" for n in result["notes"]]
     return "\n".join(lines)

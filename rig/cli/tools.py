@@ -57,7 +57,7 @@ def cmd_bench(args) -> dict:
     if args.baseline and args.what not in ("solver", "mc"):
         raise RigError(f"--baseline {args.baseline}: only rig bench solver and rig bench mc measure a baseline")
     kw = {}
-    if args.what in ("solver", "accuracy"):
+    if args.what in ("solver", "accuracy", "models", "fit"):
         kw = {"quick": args.quick,
               "progress": None if args.json else (lambda msg: print(f"  running {msg}", file=sys.stderr, flush=True))}
     if args.what == "solver":
