@@ -180,10 +180,11 @@ def test_stiff_rod_tends_to_the_rigid_wall():
 def test_holder_flow_exact_limits():
     """Drag alone: v e^(-gamma t). Friction at |v| >> slip: |v| falls by a t (sliding);
     near rest, it decays and never changes sign."""
-    assert holder_flow(0.3, 200.0, 0.0, 1e-3, 1e-3) == pytest.approx(0.3 * math.exp(-0.2), rel=1e-14)
-    assert holder_flow(0.3, 0.0, 50.0, 1e-4, 1e-3) == pytest.approx(0.25, rel=1e-12)
-    assert holder_flow(-0.3, 0.0, 50.0, 1e-4, 1e-3) == pytest.approx(-0.25, rel=1e-12)
-    v = holder_flow(1e-5, 0.0, 50.0, 1e-4, 1e-3)
+    half_decay = math.exp(-0.5 * 200.0 * 1e-3)  # gamma = 200 /s over t = 1 ms
+    assert holder_flow(0.3, half_decay, 0.0, 1e-3, 1e-3) == pytest.approx(0.3 * math.exp(-0.2), rel=1e-14)
+    assert holder_flow(0.3, 1.0, 50.0, 1e-4, 1e-3) == pytest.approx(0.25, rel=1e-12)
+    assert holder_flow(-0.3, 1.0, 50.0, 1e-4, 1e-3) == pytest.approx(-0.25, rel=1e-12)
+    v = holder_flow(1e-5, 1.0, 50.0, 1e-4, 1e-3)
     assert 0 < v < 1e-5
 
 

@@ -9,8 +9,8 @@ import numba
 import numpy as np
 import pytest
 
-from rig.model.contact import HERTZ, KUWABARA_KONO
-from rig.solver.kernels import ensemble, step
+from rig.model.contact import HERTZ, KUWABARA_KONO, POWER
+from rig.solver.kernels import dissipation, ensemble, step
 
 
 def _llvm(kernel, *args) -> str:
@@ -29,8 +29,9 @@ def _chain(nb=64):
     return u, np.zeros(nb), np.ones(nb), np.zeros(nb + 1), np.full(nb, 1e9), np.full(nb, 1e-7), np.zeros(nb)
 
 
-@pytest.mark.parametrize("law", [HERTZ, KUWABARA_KONO])
+@pytest.mark.parametrize("law", [HERTZ, KUWABARA_KONO, POWER])
 def test_the_fused_kick_drift_force_pass_is_vectorised(law):
+    """POWER too: its pass is Hertz's, the slots of another exponent renewed after it."""
     u, v, invm, f, A, d0, _ = _chain()
     ir = _llvm(step.fused_run, u, v, invm, f, A, d0, np.zeros(65), 1e-9, 1e-9, 3, 64, law, np.full(64, 1.5))
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the square roots of the force pass are scalar"
@@ -48,3 +49,20 @@ def test_the_batched_kernel_vectorises_over_shots():
     ir = _llvm(ensemble._contact_row, u, np.ones((nb, W)), np.full((nb, W), 1e-7), np.zeros((nb + 1, W)),
                np.zeros((nb + 1, W)), 3)
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the batched force row is scalar"
+
+
+def test_the_viscous_contacts_flow_is_vectorised():
+    """Dissipation's contacts (Kuwabara-Kono, dashpot): the coefficients' square roots and
+    the midpoint substeps over the flat (bodies x shots) arrays."""
+    nb = 64
+    u, v = np.zeros((nb, 1)), np.zeros((nb, 1))
+    ones = np.ones((nb, 1))
+    con = np.zeros((3, nb, 1))
+    con[0], con[1] = 1.5, 1e-6
+    ir = _llvm(dissipation._contacts, u, v, ones, 1e9 * ones, 1e-7 * ones, con, 1e-9, 1, nb - 1,
+               np.zeros((4, nb + 1, 1)), np.zeros(1))
+    assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the viscous coefficients' square roots are scalar"
+    assert _vector_ops(ir), "no vector arithmetic in the viscous substeps"
+    flat = np.zeros(nb + 1)
+    assert _vector_ops(_llvm(dissipation._viscous, flat, flat, flat, flat, np.uint64(1), nb)), \
+        "the viscous forces are scalar"

@@ -15,7 +15,8 @@ end) and E the flow of dv/dt = what dissipates, at fixed positions:
 - each bead's drag and Coulomb friction (rig.model.apparatus.Holder), by their exact flows
   (``holder_flow``);
 
-E(t) = H(t/2) V(t) H(t/2), H the holder's flow and V the contacts'. E moves no body, so
+E(t) = H(t/2) V(t) H(t/2), H the holder's flow and V the contacts' (without viscous
+contacts E(t) = H(t), one pass over the bodies). E moves no body, so
 the energy it takes is the kinetic energy it removes, counted exactly; its impulse on the
 wall (a contact's viscous force on an immovable body) joins the wall's.
 
@@ -24,18 +25,20 @@ Arrays are (bodies, shots), as in the batched kernel; the single-shot kernel pas
 """
 import math
 
+import numpy as np
+
 from instruments.jit import jit
 from rig.solver.kernels.forces import power, viscous_coefficient
 
 
 @jit
-def holder_flow(v, gamma, a, slip, t):
+def holder_flow(v, half_decay, a, slip, t):
     """Velocity (m/s) after t seconds of dv/dt = -gamma v - a tanh(v / slip) (the holder's
-    drag rate gamma (1/s) and friction deceleration a (m/s^2)): the exact flows of the two
-    terms composed symmetrically, drag t/2, friction t, drag t/2. Friction's exact flow:
-    sinh(v/slip) decays as exp(-a t / slip); at |v| >> slip, |v| falls by a t."""
-    if gamma > 0.0:
-        v = v * math.exp(-0.5 * gamma * t)
+    drag rate gamma (1/s), given as half_decay = e^(-gamma t / 2), and friction deceleration
+    a (m/s^2)): the exact flows of the two terms composed symmetrically, drag t/2, friction
+    t, drag t/2. Friction's exact flow: sinh(v/slip) decays as exp(-a t / slip); at
+    |v| >> slip, |v| falls by a t."""
+    v = v * half_decay
     if a > 0.0:
         x = abs(v) / slip
         k = a * t / slip
@@ -44,58 +47,83 @@ def holder_flow(v, gamma, a, slip, t):
         else:
             y = math.asinh(0.5 * math.exp(x - k) - 0.5 * math.exp(-x - k))
         v = math.copysign(y * slip, v)
-    if gamma > 0.0:
-        v = v * math.exp(-0.5 * gamma * t)
-    return v
+    return v * half_decay
 
 
 @jit
-def _holder(v, onsite, slip, t):
-    """Every body's velocity after t seconds of the holder's flow (onsite: (2, bodies,
-    shots) drag rates and friction decelerations)."""
+def holder_factors(onsite, t):
+    """(2, bodies, shots): each body's half_decay e^(-gamma t / 2) for a holder flow of t
+    seconds (holder_flow), and its friction deceleration (m/s^2), from onsite (2, bodies,
+    shots): drag rates gamma (1/s) and friction decelerations. The exponentials once per
+    solve instead of twice per body per flow."""
+    out = np.empty_like(onsite)
+    for i in range(onsite.shape[1]):
+        for s in range(onsite.shape[2]):
+            out[0, i, s] = math.exp(-0.5 * onsite[0, i, s] * t)
+            out[1, i, s] = onsite[1, i, s]
+    return out
+
+
+@jit
+def _holder(v, mass, hold, slip, t, lost, j_holder):
+    """Every body's velocity after t seconds of the holder's flow (hold: holder_factors of
+    t); lost[s] += the kinetic energy it took (J), j_holder[s] += the momentum it gave (N s)."""
     for i in range(v.shape[0]):
         for s in range(v.shape[1]):
-            if onsite[0, i, s] > 0.0 or onsite[1, i, s] > 0.0:
-                v[i, s] = holder_flow(v[i, s], onsite[0, i, s], onsite[1, i, s], slip, t)
+            if hold[0, i, s] != 1.0 or hold[1, i, s] > 0.0:
+                v0 = v[i, s]
+                v1 = holder_flow(v0, hold[0, i, s], hold[1, i, s], slip, t)
+                v[i, s] = v1
+                lost[s] += 0.5 * mass[i, s] * (v0 - v1) * (v0 + v1)
+                j_holder[s] += mass[i, s] * (v1 - v0)
 
 
 @jit
-def _viscous(v, c, el, g):
-    """g[i, s]: each slot's viscous force (N) at velocities v, c d' clipped at -el (the
-    coefficients c and elastic forces el of the fixed positions)."""
-    for i in range(1, v.shape[0]):
-        for s in range(v.shape[1]):
-            gi = c[i, s] * (v[i - 1, s] - v[i, s])
-            g[i, s] = gi if gi > -el[i, s] else -el[i, s]
+def _viscous(v, c, el, g, w, m):
+    """g[k]: each slot's viscous force (N) at velocities v, c d' clipped at -el (the
+    coefficients c and elastic forces el of the fixed positions). Flat (bodies x shots)
+    arrays: slot k joins bodies k - w and k (w shots per row); k from w to m."""
+    for k in range(np.uint64(w), np.uint64(m)):
+        gi = c[k] * (v[k - w] - v[k])
+        g[k] = gi if gi > -el[k] else -el[k]
 
 
 @jit
 def _contacts(u, v, invm, A, d0, con, t, n, wall_slot, work, j_wall):
     """V(t): n explicit midpoint substeps of the contacts' viscous flow; j_wall[s] += the
-    viscous impulse on the wall (N s). work: (4, bodies + 1, shots)."""
-    c, el, g, v_half = work[0], work[1], work[2], work[3]
-    nb = u.shape[0]
-    for s in range(u.shape[1]):
-        g[0, s] = 0.0
-        g[nb, s] = 0.0
-    for i in range(1, nb):
-        for s in range(u.shape[1]):
-            d = d0[i, s] + u[i - 1, s] - u[i, s]
-            c[i, s] = viscous_coefficient(d, A[i, s], con[0, i, s], con[1, i, s], con[2, i, s])
-            el[i, s] = A[i, s] * power(d, con[0, i, s]) if d > 0.0 else 0.0
+    viscous impulse on the wall (N s). work: (4, bodies + 1, shots). The (bodies, shots)
+    arrays are C-contiguous and taken flat, row after row, so that the loops vectorise."""
+    nb, W = u.shape
+    w = np.uint64(W)
+    m = nb * W
+    uf, vf, im, Af, d0f = u.reshape(m), v.reshape(m), invm.reshape(m), A.reshape(m), d0.reshape(m)
+    ex, tau, mu = con[0].reshape(m), con[1].reshape(m), con[2].reshape(m)
+    size = (nb + 1) * W
+    c, el, g, v_half = work[0].reshape(size), work[1].reshape(size), work[2].reshape(size), work[3].reshape(size)
+    g[:W] = 0.0
+    g[m:] = 0.0
+    for k in range(w, np.uint64(m)):  # every slot as Hertz's (vectorised square roots), then the others
+        d = d0f[k] + uf[k - w] - uf[k]
+        dp = d if d > 0.0 else 0.0
+        r = math.sqrt(dp)
+        c[k] = mu[k] + Af[k] * tau[k] * r if d > 0.0 else 0.0
+        el[k] = Af[k] * dp * r
+    for k in range(w, np.uint64(m)):
+        if ex[k] != 1.5:
+            d = d0f[k] + uf[k - w] - uf[k]
+            c[k] = viscous_coefficient(d, Af[k], ex[k], tau[k], mu[k])
+            el[k] = Af[k] * power(d, ex[k]) if d > 0.0 else 0.0
     h = t / n
     for _ in range(n):
-        _viscous(v, c, el, g)
-        for i in range(nb):
-            for s in range(u.shape[1]):
-                v_half[i, s] = v[i, s] + 0.5 * h * (g[i, s] - g[i + 1, s]) * invm[i, s]
-        _viscous(v_half, c, el, g)
-        for i in range(nb):
-            for s in range(u.shape[1]):
-                v[i, s] += h * (g[i, s] - g[i + 1, s]) * invm[i, s]
+        _viscous(vf, c, el, g, w, m)
+        for k in range(np.uint64(m)):
+            v_half[k] = vf[k] + 0.5 * h * (g[k] - g[k + w]) * im[k]
+        _viscous(v_half, c, el, g, w, m)
+        for k in range(np.uint64(m)):
+            vf[k] += h * (g[k] - g[k + w]) * im[k]
         if wall_slot > 0:
-            for s in range(u.shape[1]):
-                j_wall[s] += h * g[wall_slot, s]
+            for s in range(W):
+                j_wall[s] += h * g[wall_slot * W + s]
 
 
 @jit
@@ -121,18 +149,24 @@ def _book(v, mass, sign, lost, j_holder):
 
 
 @jit
-def dissipate(u, v, mass, invm, A, d0, con, onsite, slip, viscous, rate, t, wall_slot, work, lost, j_wall,
+def dissipate(u, v, mass, invm, A, d0, con, hold, slip, viscous, holder, rate, t, wall_slot, work, lost, j_wall,
               j_holder):
     """E(t) (module doc) on every shot: lost[s] += the kinetic energy it takes (J),
     j_wall[s] += its impulse on the wall, j_holder[s] += the holder's impulse (N s).
-    viscous: whether any contact has viscous terms; rate: the bound of ``substeps``."""
+    viscous: whether any contact has viscous terms; holder: whether any body has drag or
+    friction; rate: the bound of ``substeps``; hold: holder_factors of t / 2 with viscous
+    contacts (H(t/2) V(t) H(t/2)), else of t (E(t) = H(t), one pass)."""
+    if not viscous:
+        _holder(v, mass, hold, slip, t, lost, j_holder)
+        return
+    if holder:
+        _holder(v, mass, hold, slip, 0.5 * t, lost, j_holder)
     _book(v, mass, 1.0, lost, j_holder)
-    _holder(v, onsite, slip, 0.5 * t)
-    if viscous:
-        for s in range(v.shape[1]):  # the contacts' flow conserves momentum but for the wall's share
-            j_holder[s] -= j_wall[s]
-        _contacts(u, v, invm, A, d0, con, t, substeps(t, rate), wall_slot, work, j_wall)
-        for s in range(v.shape[1]):
-            j_holder[s] += j_wall[s]
-    _holder(v, onsite, slip, 0.5 * t)
+    for s in range(v.shape[1]):  # the contacts' flow conserves momentum but for the wall's share
+        j_holder[s] -= j_wall[s]
+    _contacts(u, v, invm, A, d0, con, t, substeps(t, rate), wall_slot, work, j_wall)
+    for s in range(v.shape[1]):
+        j_holder[s] += j_wall[s]
     _book(v, mass, -1.0, lost, j_holder)
+    if holder:
+        _holder(v, mass, hold, slip, 0.5 * t, lost, j_holder)

@@ -15,7 +15,7 @@ from numba import prange
 
 from instruments.jit import jit
 from rig.model.contact import HERTZ, POWER
-from rig.solver.kernels.dissipation import dissipate
+from rig.solver.kernels.dissipation import dissipate, holder_factors
 from rig.solver.kernels.forces import contact_force, power, state_sums
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
@@ -33,17 +33,19 @@ def _contact_row(u, A, d0, load, f, i):
 
 @jit
 def _power_row(u, A, d0, load, f, i, expo):
-    """Contact slot i of every shot by a power law A d^n (forces.elastic_forces)."""
+    """Contact slot i of every shot whose exponent is not 3/2 by its own law, A d^n - load,
+    after _contact_row (forces.other_law's operations)."""
     for s in range(u.shape[1]):
-        d = d0[i, s] + u[i - 1, s] - u[i, s]
-        f[i, s] = A[i, s] * power(d if d > 0.0 else 0.0, expo[i, s]) - load[i, s]
+        n = expo[i, s]
+        if n != 1.5:
+            d = d0[i, s] + u[i - 1, s] - u[i, s]
+            f[i, s] = A[i, s] * power(d if d > 0.0 else 0.0, n) - load[i, s]
 
 
 @jit
 def _row(u, A, d0, load, f, i, law, expo):
-    if law != POWER:
-        _contact_row(u, A, d0, load, f, i)
-    else:
+    _contact_row(u, A, d0, load, f, i)
+    if law == POWER:
         _power_row(u, A, d0, load, f, i, expo)
 
 
@@ -132,12 +134,14 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
     n_drift = a_coef.shape[0]
     n_out = out.shape[1]
     viscous = False
-    dissipative = False
+    holder = False
     for i in range(nb):
         for s in range(W):
             viscous = viscous or con[1, i, s] != 0.0 or con[2, i, s] != 0.0
-            dissipative = dissipative or viscous or onsite[0, i, s] != 0.0 or onsite[1, i, s] != 0.0
+            holder = holder or onsite[0, i, s] != 0.0 or onsite[1, i, s] != 0.0
+    dissipative = viscous or holder
     work = np.zeros((4, nb + 1, W))  # the dissipation's work arrays
+    hold = holder_factors(onsite, (0.25 if viscous else 0.5) * dt)  # E(dt/2)'s holder flows
     lost = np.zeros(W)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
     j_visc = np.zeros(W)
     j_holder = np.zeros(W)
@@ -167,8 +171,8 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
     for n in range(n_steps):
         t = n * dt
         if dissipative:  # E(dt/2) S(dt) E(dt/2) (integrators.integrate)
-            dissipate(u, v, mass, invm, A, d0, con, onsite, slip, viscous, viscous_rate, 0.5 * dt, wall_slot, work,
-                      lost, j_visc, j_holder)
+            dissipate(u, v, mass, invm, A, d0, con, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
+                      work, lost, j_visc, j_holder)
         for st in range(n_drift):
             hb = b_coef[st] * dt
             if st == 0:
@@ -189,8 +193,8 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
             _kick_drift(u, v, invm, f, pending, 0.0, head)
             pending = 0.0
         if dissipative:
-            dissipate(u, v, mass, invm, A, d0, con, onsite, slip, viscous, viscous_rate, 0.5 * dt, wall_slot, work,
-                      lost, j_visc, j_holder)
+            dissipate(u, v, mass, invm, A, d0, con, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
+                      work, lost, j_visc, j_holder)
         probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, pending, head, -1, 0.0, d_new, r_new)
         j_end = j_out
         while j_end < n_out and j_end * sample_dt <= t_new * (1.0 + 1e-12):

@@ -30,6 +30,20 @@ def power(d, n):
 
 
 @jit
+def other_law(u, A, d0, load, f, expo, lo, hi):
+    """Renew slots lo..hi-1 whose exponent is not 3/2 by their own law, A d^n - load,
+    after a Hertz pass renewed every slot from the same positions (a scalar pass: a pow per
+    such slot; an exponent-3/2 slot keeps the Hertz pass's bits). Keeping the pow out of the
+    Hertz loop keeps that loop vectorised: a chain with a few other slots (a compliant
+    wall's linear rod) costs a Hertz pass and a scan."""
+    for i in range(lo, hi):
+        n = expo[i]
+        if n != 1.5:
+            d = d0[i] + u[i - 1] - u[i]
+            f[i] = A[i] * power(d if d > 0.0 else 0.0, n) - load[i]
+
+
+@jit
 def contact_force(d, rate, A, n, tau, mu, law):
     """(F, its elastic part) (N) of one contact at overlap d (m), closing at rate (m/s),
     by the law of code ``law`` (module doc)."""
@@ -85,14 +99,11 @@ def elastic_forces(u, A, d0, load, f, law, expo):
     and magnet force of bodies 0..i-1), so that body i is pushed by f[i] - f[i+1] alone
     (its own constant load is load[i+1] - load[i]) and a chain at rest has f = 0.
     Hertz: A d^(3/2), d = max(d0[i] + u[i-1] - u[i], 0), branch-free so that LLVM
-    vectorises the square roots.
+    vectorises the square roots; POWER: that pass, then other_law's.
     """
-    if law != POWER:
-        hertz_forces(u, A, d0, load, f)
-    else:
-        for i in range(1, u.shape[0]):
-            d = d0[i] + u[i - 1] - u[i]
-            f[i] = A[i] * power(d if d > 0.0 else 0.0, expo[i]) - load[i]
+    hertz_forces(u, A, d0, load, f)
+    if law == POWER:
+        other_law(u, A, d0, load, f, expo, 1, u.shape[0])
 
 
 @jit

@@ -28,7 +28,7 @@ balance E(t) + dissipated = E(0) closes to the method's own error.
 import numpy as np
 
 from instruments.jit import jit
-from rig.solver.kernels.dissipation import dissipate
+from rig.solver.kernels.dissipation import dissipate, holder_factors
 from rig.solver.kernels.forces import elastic_forces, state_sums
 from rig.solver.kernels.record import hermite, hermite_weights, probe_overlaps, recorded_force
 from rig.solver.kernels.step import closing_kick, external_kick, schedule_force, step
@@ -64,17 +64,18 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
     n_frames = frames.shape[0]
     has_sched = sched_t.shape[0] > 0
     viscous = False
-    dissipative = False
+    holder = False
     for i in range(nb):
         viscous = viscous or con[1, i] != 0.0 or con[2, i] != 0.0
-        dissipative = dissipative or viscous or onsite[0, i] != 0.0 or onsite[1, i] != 0.0
+        holder = holder or onsite[0, i] != 0.0 or onsite[1, i] != 0.0
+    dissipative = viscous or holder
 
     elastic_forces(u, A, d0, load, f, law, con[0])
     # (bodies, 1) views for the multirate head, the records and the dissipation (shared with the batched kernel)
     heads = (u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1)),
              A.reshape((nb, 1)), d0.reshape((nb, 1)), load.reshape((nb + 1, 1)))
     con3 = con.reshape((3, nb, 1))
-    onsite3 = onsite.reshape((2, nb, 1))
+    hold = holder_factors(onsite.reshape((2, nb, 1)), (0.25 if viscous else 0.5) * dt)  # E(dt/2)'s holder flows
     work = np.zeros((4, nb + 1, 1))  # the dissipation's work arrays
     lost = np.zeros(1)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
     j_visc = np.zeros(1)
@@ -124,8 +125,8 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
             us_old = u[sched_body]
             fe_old = schedule_force(t, sched_t, sched_f)
         if dissipative:  # E(dt/2) S(dt) E(dt/2): each step ends synchronised
-            dissipate(u2, v2, m2, im2, A2, d02, con3, onsite3, slip, viscous, viscous_rate, 0.5 * dt, wall_slot, work,
-                      lost, j_visc, j_holder)
+            dissipate(u2, v2, m2, im2, A2, d02, con3, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
+                      work, lost, j_visc, j_holder)
         step(u, v, invm, f, A, d0, load, law, con[0], a_coef, b_coef, dt, t, pending, head, sub,
               sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses)
         t_new = (n + 1) * dt
@@ -138,8 +139,8 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
             closing_kick(v, invm, f, pending, head)
             pending = 0.0
         if dissipative:
-            dissipate(u2, v2, m2, im2, A2, d02, con3, onsite3, slip, viscous, viscous_rate, 0.5 * dt, wall_slot, work,
-                      lost, j_visc, j_holder)
+            dissipate(u2, v2, m2, im2, A2, d02, con3, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
+                      work, lost, j_visc, j_holder)
         if has_sched:
             fe_new = schedule_force(t_new, sched_t, sched_f)
             w_sched += 0.5 * (fe_old + fe_new) * (u[sched_body] - us_old)

@@ -14,7 +14,7 @@ import numpy as np
 
 from instruments.jit import jit
 from rig.model.contact import POWER
-from rig.solver.kernels.forces import power
+from rig.solver.kernels.forces import other_law
 from rig.solver.kernels.multirate import head_flow
 
 
@@ -54,32 +54,26 @@ def fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, expo):
     u += ha v, then renew contact slot i's elastic force from bodies i-1 and i (both moved;
     forces.elastic_forces' operations). Slot i + 1 is still the old force when body i is
     kicked, so one pass does what a kick-drift pass and a force pass do. ``law``: POWER
-    takes each slot's exponent ``expo``, any other code Hertz's.
+    renews the slots whose exponent ``expo`` is not 3/2 again by their own law
+    (forces.other_law; no slot's force is read in the pass that renews it, so this is the
+    same as renewing them in the pass), any other code is Hertz's.
 
     The index is unsigned: with a signed start known only at run time numba keeps its
     negative-index wraparound in the loop and LLVM no longer vectorises it
     (tests/solver/test_vectorised.py guards this)."""
     one = np.uint64(1)
     u_prev = u[lo - 1]
-    if law != POWER:  # a loop per law: a branch on the law inside the loop would stop it vectorising
-        for i in range(np.uint64(lo), np.uint64(hi)):
-            vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
-            v[i] = vi
-            ui = u[i] + ha * vi
-            u[i] = ui
-            d = d0[i] + u_prev - ui
-            d = d if d > 0.0 else 0.0
-            f[i] = A[i] * d * math.sqrt(d) - load[i]
-            u_prev = ui
-    else:
-        for i in range(np.uint64(lo), np.uint64(hi)):
-            vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
-            v[i] = vi
-            ui = u[i] + ha * vi
-            u[i] = ui
-            d = d0[i] + u_prev - ui
-            f[i] = A[i] * power(d if d > 0.0 else 0.0, expo[i]) - load[i]
-            u_prev = ui
+    for i in range(np.uint64(lo), np.uint64(hi)):
+        vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
+        v[i] = vi
+        ui = u[i] + ha * vi
+        u[i] = ui
+        d = d0[i] + u_prev - ui
+        d = d if d > 0.0 else 0.0
+        f[i] = A[i] * d * math.sqrt(d) - load[i]
+        u_prev = ui
+    if law == POWER:  # not in the loop: a pow there (even behind a branch) stops it vectorising
+        other_law(u, A, d0, load, f, expo, lo, hi)
 
 
 @jit
