@@ -12,20 +12,17 @@ evaluations a fit costs. "solved": candidates the fit solved.
 from __future__ import annotations
 
 import json
-import resource
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from importlib import resources
 from pathlib import Path
 
+from rig.bench.startup import RIG, timed_child
 from rig.study.reproduce_fitted import MODELS
 
 ROUNDS = 3
 LIMIT_S = 60.0
-RIG = "import sys; from rig.cli import main; sys.exit(main(sys.argv[1:]))"
 
 
 def _command(bounds: list, points: Path, out: Path, max_evaluations: int | None = None) -> list:
@@ -40,17 +37,11 @@ def _command(bounds: list, points: Path, out: Path, max_evaluations: int | None 
 
 def _timed(cmd: list) -> tuple:
     """(wall s, CPU s of the child, its JSON block or None)."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    done = subprocess.run(cmd, capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    wall, cpu, out = timed_child(cmd, check=False)  # a fit that does not converge exits 1: still timed
     try:
-        block = json.loads(done.stdout)
+        return wall, cpu, json.loads(out)
     except json.JSONDecodeError:
-        block = None
-    return wall, cpu, block
+        return wall, cpu, None
 
 
 def run(quick: bool = False, progress=None) -> dict:

@@ -123,7 +123,6 @@ def run(quick: bool = False, progress=None) -> dict:
             same = all(np.array_equal(forces[k], hertz[k]) for k in hertz)
         rows.append(dict(model=name, off=name in OFF, overrides=cases[name], ns_per_bead_eval=per_step[name]["ns"],
                          ns_ratio_to_hertz=per_step[name]["ratio"], same_bits_as_hertz=same, **c))
-    controlled["hertz"].pop("forces", None)
     return dict(scene=SCENE, beads_per_step_figure=LONG_BEADS, fixed_dt_s=dt, accuracy=ACCURACY,
                 duration_s=DURATION, rows=rows)
 

@@ -46,13 +46,14 @@ def _commands(folder: Path) -> dict:
             "rig shot ptfe52_magnetic --seed 1": [sys.executable, "-c", RIG, "shot", "ptfe52_magnetic", "--seed", "1"]}
 
 
-def _timed(cmd: list, cwd: str) -> tuple:
+def timed_child(cmd: list, cwd: str | None = None, check: bool = True) -> tuple:
+    """(wall s, CPU s (the child's user + system), its stdout) of one run of ``cmd``."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    subprocess.run(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True)
+    done = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, check=check)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), done.stdout
 
 
 def _top_imports(cmd: list, cwd: str, n: int = 10) -> list:
@@ -72,12 +73,12 @@ def run(rounds: int = ROUNDS) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         cmds = _commands(Path(tmp))
         for cmd in cmds.values():  # warm the caches (numba, the file system)
-            _timed(cmd, tmp)
+            timed_child(cmd, tmp)
         wall = {name: [] for name in cmds}
         cpu = {name: [] for name in cmds}
         for _ in range(rounds):
             for name, cmd in cmds.items():
-                w, c = _timed(cmd, tmp)
+                w, c, _ = timed_child(cmd, tmp)
                 wall[name].append(w)
                 cpu[name].append(c)
         imports = {name: _top_imports(cmds[name], tmp) for name in TARGETS}

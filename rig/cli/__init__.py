@@ -159,7 +159,8 @@ def build_parser() -> argparse.ArgumentParser:
     ls.add_argument("archive")
 
     be = _command(sub, "bench", "benchmarks", tools.cmd_bench)
-    be.add_argument("what", choices=["solver", "accuracy", "models", "fit", "shot", "archive", "pipeline", "mc", "animate", "startup"],
+    be.add_argument("what", choices=["solver", "accuracy", "models", "fit", "shot", "archive", "pipeline", "mc",
+                                     "animate", "startup"],
                     help="what to benchmark")
     be.add_argument("--quick", action="store_true", help="fewer settings, one repeat")
     be.add_argument("--peers", action="store_true",

@@ -51,11 +51,13 @@ def holder_flow(v, half_decay, a, slip, t):
 
 
 @jit
-def holder_factors(onsite, t):
-    """(2, bodies, shots): each body's half_decay e^(-gamma t / 2) for a holder flow of t
-    seconds (holder_flow), and its friction deceleration (m/s^2), from onsite (2, bodies,
-    shots): drag rates gamma (1/s) and friction decelerations. The exponentials once per
-    solve instead of twice per body per flow."""
+def holder_factors(onsite, t_flow, viscous):
+    """(2, bodies, shots): each body's half_decay e^(-gamma t / 2) (holder_flow) for the
+    holder flows of ``dissipate(..., t_flow, ...)`` (t = t_flow / 2 with viscous contacts,
+    else t_flow), and its friction deceleration (m/s^2), from onsite (2, bodies, shots):
+    drag rates gamma (1/s) and friction decelerations. The exponentials once per solve
+    instead of twice per body per flow."""
+    t = 0.5 * t_flow if viscous else t_flow
     out = np.empty_like(onsite)
     for i in range(onsite.shape[1]):
         for s in range(onsite.shape[2]):
@@ -154,8 +156,8 @@ def dissipate(u, v, mass, invm, A, d0, con, hold, slip, viscous, holder, rate, t
     """E(t) (module doc) on every shot: lost[s] += the kinetic energy it takes (J),
     j_wall[s] += its impulse on the wall, j_holder[s] += the holder's impulse (N s).
     viscous: whether any contact has viscous terms; holder: whether any body has drag or
-    friction; rate: the bound of ``substeps``; hold: holder_factors of t / 2 with viscous
-    contacts (H(t/2) V(t) H(t/2)), else of t (E(t) = H(t), one pass)."""
+    friction; rate: the bound of ``substeps``; hold: holder_factors(onsite, t, viscous)
+    (H(t/2) V(t) H(t/2) with viscous contacts, else E(t) = H(t), one pass)."""
     if not viscous:
         _holder(v, mass, hold, slip, t, lost, j_holder)
         return

@@ -141,7 +141,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
             holder = holder or onsite[0, i, s] != 0.0 or onsite[1, i, s] != 0.0
     dissipative = viscous or holder
     work = np.zeros((4, nb + 1, W))  # the dissipation's work arrays
-    hold = holder_factors(onsite, (0.25 if viscous else 0.5) * dt)  # E(dt/2)'s holder flows
+    hold = holder_factors(onsite, 0.5 * dt, viscous)  # E(dt/2)'s holder flows
     lost = np.zeros(W)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
     j_visc = np.zeros(W)
     j_holder = np.zeros(W)

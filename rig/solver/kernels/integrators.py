@@ -75,7 +75,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
     heads = (u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1)),
              A.reshape((nb, 1)), d0.reshape((nb, 1)), load.reshape((nb + 1, 1)))
     con3 = con.reshape((3, nb, 1))
-    hold = holder_factors(onsite.reshape((2, nb, 1)), (0.25 if viscous else 0.5) * dt)  # E(dt/2)'s holder flows
+    hold = holder_factors(onsite.reshape((2, nb, 1)), 0.5 * dt, viscous)  # E(dt/2)'s holder flows
     work = np.zeros((4, nb + 1, 1))  # the dissipation's work arrays
     lost = np.zeros(1)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
     j_visc = np.zeros(1)
