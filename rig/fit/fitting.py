@@ -3,8 +3,9 @@ region reflective) of an objective's residuals r(theta, eta), theta the scene pa
 (each candidate a virtual shot or curve, expensive) and eta the objective's nuisance
 parameters (cheap: no solve).
 
-The Jacobian's theta columns are forward differences whose candidates are solved together
-in one batched call (rig.fit.evaluate); every evaluation is kept on disk in the fit's
+The Jacobian's theta columns are finite differences, forward or central as the objective
+declares (``central_differences``), whose candidates are solved together in one batched
+call (rig.fit.evaluate); every evaluation is kept on disk in the fit's
 folder, so a fit that is stopped and started again replays what it had done without
 solving it again (resume). Uncertainties: the covariance (J^T J)^-1 of the normalised
 residuals at the solution, scaled by chi^2/dof when that exceeds 1 (the misfit is then
@@ -26,8 +27,11 @@ from scipy import optimize, stats
 from rig.errors import RigError
 
 FD_STEP = 0.01
-"""Forward-difference step, as a fraction of each parameter's bound interval: large enough
-that the change of the model stands far above the solver's error (accuracy 1e-4)."""
+"""Finite-difference step, as a fraction of each parameter's bound interval: large enough
+that the change of the model stands far above the solver's error (accuracy 1e-4). Where the
+model is far from linear over the step (a scope trace, whose pulses move with the
+parameters), a forward difference is a secant and not the derivative: the objective then
+asks for central differences, whose error falls as the step squared."""
 HIGH_CORRELATION = 0.95
 
 
@@ -116,6 +120,15 @@ class EvaluationCache:
         return [self.memory[k] for k in keys]
 
 
+def difference_steps(x: np.ndarray, central: bool) -> tuple:
+    """The steps (up, down) of each normalised parameter x (in [0, 1]) for its Jacobian
+    column (r(x + up) - r(x + down)) / (up - down): central (+-FD_STEP) where asked and both
+    fit within the bounds, else forward (down 0), backward at the upper bound."""
+    up = np.where(x + FD_STEP <= 1.0, FD_STEP, -FD_STEP)
+    down = np.where(central & (x - FD_STEP >= 0.0) & (up > 0), -FD_STEP, 0.0)
+    return up, down
+
+
 def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None) -> FitResult:
     """Fit ``objective`` (rig.fit.points.PointObjective or rig.fit.traces.TraceObjective)."""
     params = objective.params
@@ -137,16 +150,16 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
         return objective.residuals(model, x[P:])
 
     def jac(x):
-        h = np.where(x[:P] + FD_STEP <= 1.0, FD_STEP, -FD_STEP)
-        steps = np.zeros((P, x.size))
-        steps[np.arange(P), np.arange(P)] = h
-        cands = [theta(x)] + [theta(x + e) for e in steps]
+        up, down = difference_steps(x[:P], objective.central_differences)
+        eye = np.eye(x.size)[:P]
+        cands = [theta(x)] + [theta(x + h * e) for h, e in zip(up, eye)] + [theta(x + h * e) for h, e in zip(down, eye)]
         models = cache.get(cands)
         count["batches"] += 1
         r0 = objective.residuals(models[0], x[P:])
         J = np.empty((r0.size, x.size))
         for k in range(P):
-            J[:, k] = (objective.residuals(models[k + 1], x[P:]) - r0) / h[k]
+            below = objective.residuals(models[1 + P + k], x[P:]) if down[k] else r0
+            J[:, k] = (objective.residuals(models[1 + k], x[P:]) - below) / (up[k] - down[k])
         J[:, P:] = objective.nuisance_jacobian(models[0], x[P:])
         tell(f"fit: Jacobian {count['batches']}: chi2 {float(r0 @ r0):.6g}, "
              + ", ".join(p.key + " " + p.shown(v) for p, v in zip(params, theta(x)))

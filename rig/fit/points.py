@@ -48,6 +48,8 @@ def start_values(scene: str, overrides, params) -> np.ndarray:
 class PointObjective:
     """Residuals of Points against the model's curves (module doc)."""
 
+    central_differences = False  # speed curves change slowly with the parameters: half the solves
+
     def __init__(self, scene: str, params: tuple, points: Points, overrides=()):
         self.scene, self.params, self.points = scene, tuple(params), points
         self.overrides = list(overrides) + law_overrides(params)
