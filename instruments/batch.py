@@ -66,11 +66,12 @@ class Records:
                                            self.codes[s], self.over[s], self.n_in, self.h)
 
 
-def draws(seeds, wiring: Wiring, n_in: int) -> tuple:
-    """Every shot's random numbers (acquisition.shot_draws), from np.random.default_rng(seed):
-    (draws (shots, gauges, 2), gauge noise (shots, gauges, n_in), phases (shots,), scope
-    noise (shots, channels, samples)); an array a shot does not draw into is left zero
-    (a noise-free gauge) or empty (a noise-free scope)."""
+def draws(seeds, wiring: Wiring, n_in: int, rng: np.random.Generator | None = None) -> tuple:
+    """Every shot's random numbers (acquisition.shot_draws), from np.random.default_rng(seed)
+    (or, for one shot, from ``rng``, left where the shot's draws end): (draws (shots,
+    gauges, 2), gauge noise (shots, gauges, n_in), phases (shots,), scope noise (shots,
+    channels, samples)); an array a shot does not draw into is left zero (a noise-free
+    gauge) or empty (a noise-free scope)."""
     settings = [s for _, s, _ in wiring.gauges]
     scope = wiring.scope
     cal = np.array([s.calibration_error for s in settings], dtype=float)
@@ -83,7 +84,8 @@ def draws(seeds, wiring: Wiring, n_in: int) -> tuple:
     phase = np.empty(S)
     z_scope = np.empty((S, C, L))
     for s, seed in enumerate(seeds):
-        phase[s] = acquisition.shot_draws(np.random.default_rng(int(seed)), cal, mis, noisy, out[s], z_gauge[s],
+        gen = rng if rng is not None else np.random.default_rng(int(seed))
+        phase[s] = acquisition.shot_draws(gen, cal, mis, noisy, out[s], z_gauge[s],
                                           scope.timebase.sample_interval, bool(scope.noise_floor), z_scope[s])
     return out, z_gauge, phase, z_scope
 
@@ -114,12 +116,35 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
     over = np.empty((S, C), np.bool_)
     status = np.empty(S, np.int64)
     times = np.empty((S, 2))
-    acquisition.shots(np.ascontiguousarray(forces, dtype=float), float(h), shift, scale, gauge_filter, noise_sd,
-                      z_gauge, wiring.wired(), front.probe, front.ac, front.lowpass, front.source, front.level,
-                      front.rising, phase, front.n_pre, wiring.scope.timebase.sample_interval, front.offset,
-                      front.ymult, front.yoff, front.sd, z_scope, float(CODE_MIN), float(CODE_MAX), codes, over,
-                      status, times)
+    forces = np.ascontiguousarray(forces, dtype=float)
+    wired = wiring.wired()
+
+    def run(sl, z_rest):
+        acquisition.shots(forces[sl], float(h), shift[sl], scale[sl], gauge_filter, noise_sd, z_gauge[sl], z_rest,
+                          wired, front.probe, front.ac, front.lowpass, front.source, front.level, front.rising,
+                          phase[sl], front.n_pre, wiring.scope.timebase.sample_interval, front.offset, front.ymult,
+                          front.yoff, front.sd, z_scope[sl], float(CODE_MIN), float(CODE_MAX), codes[sl], over[sl],
+                          status[sl], times[sl])
+
+    run(slice(None), np.empty((S, G, 0)))
+    for s in range(S):  # records that start before the impact, again with the inputs at rest before it
+        n_pad = acquisition.samples_before_input(status[s], times[s, 0], times[s, 1], h)
+        if n_pad:
+            run(slice(s, s + 1), rest_draws(seeds[s], wiring, n_in, n_pad)[None])
     return Records(wiring, codes, over, status, times, drawn, n_in, float(h))
+
+
+def rest_draws(seed, wiring: Wiring, n_in: int, n_pad: int) -> np.ndarray:
+    """(gauges, n_pad): the rest noise of a shot whose record starts n_pad input samples
+    before the impact, drawn after the shot's other draws, in the order of the displayed
+    channels (Oscilloscope.acquire's order); zero for a noise-free gauge."""
+    rng = np.random.default_rng(int(seed))
+    draws([seed], wiring, n_in, rng)
+    z = np.zeros((len(wiring.gauges), n_pad))
+    for g in wiring.wired():
+        if g >= 0 and wiring.gauges[g][1].noise:
+            z[g] = rng.standard_normal(n_pad)
+    return z
 
 
 @jit

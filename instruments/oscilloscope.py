@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._kernels.acquisition import NO_TRIGGER, PAST_INPUT, condition, scope_shot
+from ._kernels.acquisition import NO_TRIGGER, PAST_INPUT, at_rest_before, condition, samples_before_input, scope_shot
 from .errors import InstrumentError, check
 from .frontend import highpass_coefficients, lowpass_coefficients
 from .records import Preamble, ScopeRecord, Waveform
@@ -116,26 +116,50 @@ class Oscilloscope:
         check("scope.noise_floor", self.noise_floor, lo=0, lo_closed=True, unit="V")
 
     # --- acquisition ----------------------------------------------------------------
-    def acquire(self, inputs: dict, h: float, rng: np.random.Generator) -> ScopeRecord:
+    def acquire(self, inputs: dict, h: float, rng: np.random.Generator, rest: dict | None = None) -> ScopeRecord:
         """Acquire one record.
 
-        inputs: {channel: volts at the probe tip}, sampled every h seconds from t = 0; before
-        t = 0 each input is held at its first value. Displayed channels without an input
-        read noise. Returns a ScopeRecord; a record that does not trigger says so. Draws
-        from rng the clock's phase, then each displayed channel's noise (shot_draws' order).
+        inputs: {channel: volts at the probe tip}, sampled every h seconds from t = 0 (the
+        impact). Before t = 0 each input is at rest: its noise ``rest[channel]`` (V rms; a
+        gauge's noise) about its rest level, or, without noise, its first value held. Displayed
+        channels without an input read noise. Returns a ScopeRecord; a record that does not
+        trigger says so. Draws from rng the clock's phase, then each displayed channel's noise
+        (shot_draws' order), then, only for a record that starts before t = 0, the rest noise
+        of each input over the samples before it, in the order of the displayed channels.
         """
-        front = self.front_panel(h)
-        analog = self.analog(inputs, h)
         tb = self.timebase
         phase = rng.uniform(0.0, tb.sample_interval)
         shape = (len(self.channels), int(tb.record_length) if self.noise_floor else 0)
         noise = rng.standard_normal(shape) if self.noise_floor else np.empty(shape)
+        n_in = max((len(v) for v in inputs.values()), default=0)
+        status, t_cross, x_zero, codes, over = self._convert(inputs, h, phase, noise)
+        n_pad = samples_before_input(status, t_cross, x_zero, h)
+        if n_pad:
+            rest = rest or {}
+            padded = {}
+            for ch in self.channels:
+                if ch in inputs:
+                    sd = float(rest.get(ch, 0.0))
+                    z = rng.standard_normal(n_pad) if sd > 0 else np.zeros(n_pad)
+                    padded[ch] = at_rest_before(np.ascontiguousarray(inputs[ch], dtype=float), sd, z)
+            status, t_cross, x_zero, codes, over = self._convert(padded, h, phase, noise)
+            t_cross -= n_pad * h
+        return self.record_of(status, t_cross, x_zero, codes, over, n_in, h)
+
+    def _convert(self, inputs: dict, h: float, phase: float, noise: np.ndarray) -> tuple:
+        """The trigger and the 8-bit conversion of inputs (every h s from their first sample)
+        with the clock's phase and the scope's noise draws: (status, time of the trigger
+        crossing from the first input sample s, time of the first sample after it s, codes,
+        over-range flags)."""
+        front = self.front_panel(h)
+        tb = self.timebase
         codes = np.empty((len(self.channels), int(tb.record_length)), np.int8)
         over = np.empty(len(self.channels), np.bool_)
-        status, t_cross, x_zero = scope_shot(analog, float(h), front.source, front.level, front.rising, phase,
-                                             front.n_pre, tb.sample_interval, front.offset, front.ymult, front.yoff,
-                                             front.sd, noise, float(CODE_MIN), float(CODE_MAX), codes, over)
-        return self.record_of(status, t_cross, x_zero, codes, over, analog.shape[1], h)
+        status, t_cross, x_zero = scope_shot(self.analog(inputs, h), float(h), front.source, front.level,
+                                             front.rising, phase, front.n_pre, tb.sample_interval, front.offset,
+                                             front.ymult, front.yoff, front.sd, noise, float(CODE_MIN),
+                                             float(CODE_MAX), codes, over)
+        return status, t_cross, x_zero, codes, over
 
     def analog(self, inputs: dict, h: float) -> np.ndarray:
         """(channels, samples): each displayed channel's input (volts at the probe tip, every

@@ -89,38 +89,66 @@ def scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult
     return OK, t_cross, x_zero
 
 
+def samples_before_input(status, t_cross, x_zero, h) -> int:
+    """How many input samples (every h s) to put before the input's start so that a record
+    whose first sample lies before it (t_cross + x_zero < 0 s: a pre-trigger longer than
+    the time from the impact to the trigger) reads the input at rest there, with a margin
+    of two; 0 where the record starts within the input or did not trigger."""
+    first = t_cross + x_zero
+    if status != OK or not first < 0.0:
+        return 0
+    return int(math.ceil(-first / h)) + 2
+
+
 @jit
-def _one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, wired, probe, ac, lowpass, source, level,
-              rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over):
-    n = force.shape[1]
+def at_rest_before(v, rest_sd, z_rest):
+    """v (an input, every h s) with z_rest.shape[0] samples before it of the input at rest:
+    its noise rest_sd x z_rest (V), or, noise-free, its first value held."""
+    n_pad = z_rest.shape[0]
+    out = np.empty(n_pad + v.shape[0])
+    for k in range(n_pad):
+        out[k] = rest_sd * z_rest[k] if rest_sd > 0.0 else v[0]
+    out[n_pad:] = v
+    return out
+
+
+@jit
+def _one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired, probe, ac, lowpass, source,
+              level, rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over):
+    n_pad = z_rest.shape[1]
+    n = force.shape[1] + n_pad
     analog = np.empty((wired.shape[0], n))
     for c in range(wired.shape[0]):
         g = wired[c]
         if g >= 0:
             v = gauge_signal(force[g], h, shift[g], scale[g], gauge_filter[g, 0], gauge_filter[g, 1],
                              gauge_filter[g, 2], noise_sd[g], z_gauge[g])
+            if n_pad:
+                v = at_rest_before(v, noise_sd[g], z_rest[g])
         else:
             v = np.zeros(n)
         analog[c] = condition(v, probe[c], ac[c], lowpass[c])
-    return scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi,
-                      codes, over)
+    st, t_cross, x_zero = scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult, yoff, sd,
+                                     z_scope, lo, hi, codes, over)
+    return st, t_cross - n_pad * h, x_zero
 
 
 @jit(parallel=True)
-def shots(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, wired, probe, ac, lowpass, source, level,
+def shots(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired, probe, ac, lowpass, source, level,
           rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over, status, times):
     """Every shot s of a batch: gauge g reads force[s, g] (N, every h s) delayed by
     shift[s, g] s with gain scale[s, g] V/N, its high-pass gauge_filter[g] and noise
-    noise_sd[g] z_gauge[s, g]; scope channel c displays gauge wired[c] (-1: nothing), with
-    probe[c], ac[c] and lowpass[c] (condition), offset, ymult, yoff (the converter) and
-    noise sd[c] z_scope[s, c]; the trigger on channel ``source`` at ``level`` V, the clock's
-    phase[s] s, n_pre pre-trigger samples every dt s. Fills codes (shots, channels,
-    samples), over (shots, channels), status (shots) and times (shots, 2: the trigger
-    crossing and the first sample after it, s)."""
+    noise_sd[g] z_gauge[s, g], and before the impact, for z_rest.shape[2] samples, its rest:
+    noise_sd[g] z_rest[s, g] (at_rest_before); scope channel c displays gauge wired[c] (-1:
+    nothing), with probe[c], ac[c] and lowpass[c] (condition), offset, ymult, yoff (the
+    converter) and noise sd[c] z_scope[s, c]; the trigger on channel ``source`` at ``level``
+    V, the clock's phase[s] s, n_pre pre-trigger samples every dt s. Fills codes (shots,
+    channels, samples), over (shots, channels), status (shots) and times (shots, 2: the
+    trigger crossing from the impact and the first sample after it, s)."""
     for s in prange(force.shape[0]):
-        st, t_cross, x_zero = _one_shot(force[s], h, shift[s], scale[s], gauge_filter, noise_sd, z_gauge[s], wired,
-                                        probe, ac, lowpass, source, level, rising, phase[s], n_pre, dt, offset,
-                                        ymult, yoff, sd, z_scope[s], lo, hi, codes[s], over[s])
+        st, t_cross, x_zero = _one_shot(force[s], h, shift[s], scale[s], gauge_filter, noise_sd, z_gauge[s],
+                                        z_rest[s], wired, probe, ac, lowpass, source, level, rising, phase[s], n_pre,
+                                        dt, offset, ymult, yoff, sd, z_scope[s], lo, hi, codes[s], over[s])
         status[s] = st
         times[s, 0] = t_cross
         times[s, 1] = x_zero

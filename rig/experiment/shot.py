@@ -115,7 +115,7 @@ class Rig(Assembly):
         rng = np.random.default_rng(int(seed))
         forces = self.truth()
         h = forces.sample_interval
-        inputs, draws = {}, {}
+        inputs, draws, rest = {}, {}, {}
         for g in self.gauges:
             draw = GaugeDraw.draw(g.settings, rng)
             if fixed and g.name in fixed:
@@ -124,13 +124,15 @@ class Rig(Assembly):
             draws[g.name] = {"gain": draw.gain, "misalignment_m": draw.misalignment}
             inputs[g.channel] = PiezoGauge(g.settings).read(forces.gauges[g.name].average_force, h, draw, rng,
                                                             forces.wave_speed_m_per_s)
+            rest[g.channel] = g.settings.noise
         if self.wall_sensor is not None:
             draw = GaugeDraw.draw(self.wall_sensor.settings, rng)
             draws["wall_sensor"] = {"gain": draw.gain}
             inputs[self.wall_sensor.channel] = PiezoGauge(self.wall_sensor.settings).read(forces.wall_force, h,
                                                                                           draw, rng)
+            rest[self.wall_sensor.channel] = self.wall_sensor.settings.noise
         try:
-            record = self.scope.acquire(inputs, h, rng)
+            record = self.scope.acquire(inputs, h, rng, rest)
         except ValueError as exc:
             raise RigError(f"{exc} (solver.duration = {self.solver.duration:g} s)") from None
         truth_analysis = self.truth_analysis().as_dict() if truth and len(self.gauges) >= 2 else None

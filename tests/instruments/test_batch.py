@@ -38,15 +38,18 @@ def _alone(forces, wiring, seed, fixed, speed):
         gain = draw.gain if np.isnan(fixed[k, 0]) else fixed[k, 0]
         mis = draw.misalignment if np.isnan(fixed[k, 1]) else fixed[k, 1]
         inputs[ch] = PiezoGauge(settings).read(forces[k], H, GaugeDraw(gain, mis), rng, speed if delayed else None)
-    return wiring.scope.acquire(inputs, H, rng)
+    return wiring.scope.acquire(inputs, H, rng, {ch: settings.noise for ch, settings, _ in wiring.gauges})
 
 
 @pytest.mark.parametrize("noise,noise_floor", [(1e-3, 2e-4), (0.0, 0.0)])
 def test_a_batch_of_shots_reads_as_its_shots_alone(noise, noise_floor):
     wiring = _wiring(noise, noise_floor)
     S = 6
-    forces = np.stack([np.stack([_pulse(2.0e-4 + 1e-6 * s), _pulse(1.8e-4 + 1e-6 * s), _pulse(4e-4, 9.0)])
-                       for s in range(S)])
+    # shots 3 and 4 trigger 60 us after the impact, within the 120 us pre-trigger: their
+    # records start before the input, where the gauges are at rest
+    early = np.array([0, 0, 0, 1, 1, 0]) * 1.4e-4
+    forces = np.stack([np.stack([_pulse(2.0e-4 + 1e-6 * s - early[s]), _pulse(1.8e-4 + 1e-6 * s - early[s]),
+                                 _pulse(4e-4, 9.0)]) for s in range(S)])
     seeds = [11 + 7 * s for s in range(S)]
     fixed = np.full((S, 3, 2), np.nan)
     fixed[1, 0, 0] = 1.07  # a study's own gain for one gauge of one shot
@@ -66,6 +69,28 @@ def test_a_batch_of_shots_reads_as_its_shots_alone(noise, noise_floor):
     for s, rep in enumerate(batch.analysed(records, setup)):
         ref = analyze_record(records.record(s), setup, train=False)
         assert rep.as_dict() == ref.as_dict(), s
+
+
+def test_before_the_impact_a_record_reads_the_gauges_at_rest():
+    """A pre-trigger longer than the time from the impact to the trigger: the record's
+    samples before the impact carry the gauges' noise about their rest level (0 V), not a
+    held first sample; the trigger's time is counted from the impact."""
+    wiring = _wiring(noise=4e-3, noise_floor=0.0)  # 2 codes rms: the spread is read off the codes
+    forces = np.stack([_pulse(9e-5, width=20e-6), _pulse(8e-5, width=20e-6), _pulse(4e-4, 9.0)])[None]  # CH2, CH1
+    records = batch.acquire(forces, H, wiring, [5])
+    rec = records.record(0)
+    t_first = rec.trigger_time + rec.waveforms["CH1"].preamble.x_zero
+    assert 0 < rec.trigger_time < 70e-6  # the trigger on CH1's rise, the pre-trigger 120 us
+    assert t_first == pytest.approx(rec.trigger_time - 120e-6, abs=2e-7)
+    w = rec.waveforms["CH3"]  # the wall sensor: quiet for 150 us after the impact too
+    t = w.time() + rec.trigger_time  # from the impact
+    before, after = w.volts()[t < 0], w.volts()[(t > 0) & (t < 100e-6)]
+    assert before.size > 300 and after.size > 300
+    # the same noise before the impact as after it: sds agree within 15% (an sd of ~400
+    # samples is good to 1/sqrt(2 x 400) = 3.5%), the mean is 0 V within 4 standard errors
+    assert before.std() == pytest.approx(after.std(), rel=0.15)
+    assert after.std() > 1e-3  # the gauge's 4 mV through the bandwidth limit, rounded to 2 mV codes
+    assert abs(before.mean()) < 4 * before.std() / np.sqrt(before.size)
 
 
 def test_a_shot_that_does_not_trigger_or_outlasts_its_input_says_so():
