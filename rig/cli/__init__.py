@@ -107,6 +107,11 @@ def build_parser() -> argparse.ArgumentParser:
     fi.add_argument("--out", required=True, metavar="DIR",
                     help="folder for fit.json, residuals.csv, fit.png, fitted.toml; its evaluations/ resume a fit")
     fi.add_argument("--max-evaluations", type=count_arg, default=400, help="the fit's budget (default 400)")
+    fi.add_argument("--posterior", type=count_arg, default=0, metavar="STEPS",
+                    help="then sample the posterior by MCMC for STEPS steps (needs the extra: "
+                         "pip install 'sonic-rig[posterior]'); resumes in DIR/posterior.h5")
+    fi.add_argument("--walkers", type=count_arg, help="with --posterior: walkers (default 4 per parameter, at least 8)")
+    fi.add_argument("--seed", type=seed_arg, default=0, help="with --posterior: the walkers' seed (default 0)")
     fi.add_argument("--quiet", action="store_true", help="no progress lines")
 
     mc = _command(sub, "mc", "Monte Carlo study over many virtual shots", study.cmd_mc)

@@ -30,6 +30,10 @@ def cmd_fit(args) -> dict:
         raise RigError("no data to fit: give one of --records FILES, --archive A.h5 or --points TABLE.csv"
                        if not sources else f"give one kind of data, not {' and '.join('--' + s for s in sources)}")
     params = parse_parameters(args.param)
+    if args.posterior:
+        from rig.fit.posterior import check
+
+        check(args.walkers, len(params))
     overrides = list(args.set or [])
     scene_io.load(args.scene, overrides)  # the scene and its overrides, checked before any work
     if args.points:
@@ -43,7 +47,8 @@ def cmd_fit(args) -> dict:
         objective = TraceObjective(args.scene, params, _records(args), overrides)
     progress = None if args.quiet else stderr_progress
     with writing_to(args.out):
-        block = run_fit(args.scene, objective, args.out, progress, args.max_evaluations)
+        block = run_fit(args.scene, objective, args.out, progress, args.max_evaluations, args.posterior,
+                        args.walkers, args.seed)
     if not args.json:
         for k, p in block["parameters"].items():
             unit = "" if p["unit"] == "1" else f" {p['unit']}"
@@ -54,7 +59,15 @@ def cmd_fit(args) -> dict:
         for pair in block["highly_correlated"]:
             print(f"warning: {pair['keys'][0]} and {pair['keys'][1]} cannot be told apart "
                   f"(correlation {pair['correlation']:+.3f}); their intervals are wide for that reason")
-        print(f"wrote {args.out}/: fit.json, residuals.csv, fit.png"
+        post = block.get("posterior")
+        if post:
+            print(f"posterior ({post['walkers']} walkers x {post['steps']} steps, acceptance "
+                  f"{post['acceptance_fraction']:.2f}, seed {post['seed']}):")
+            for k, p in post["parameters"].items():
+                unit = "" if p["unit"] == "1" else f" {p['unit']}"
+                print(f"  {k:26s} median {p['median']:.6g}{unit}   68%: [{p['ci68'][0]:.6g}, {p['ci68'][1]:.6g}]"
+                      f"   95%: [{p['ci95'][0]:.6g}, {p['ci95'][1]:.6g}]")
+        print(f"wrote {args.out}/: fit.json, residuals.csv, fit.png" + (", posterior.png" if post else "")
               + (f", fitted.toml (rig shot {block['fitted_scene']})" if block["fitted_scene"] else ""))
     if not block["converged"]:
         print(f"rig fit: error: the fit did not converge ({block['message']}); no fitted scene written",

@@ -11,11 +11,14 @@ from rig.fit import report
 from rig.fit.fitting import fit
 
 
-def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 400) -> dict:
+def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 400, posterior_steps: int = 0,
+            walkers: int | None = None, seed: int = 0) -> dict:
     """Fit ``objective`` and write the folder ``out`` (rig.fit.report); returns the JSON
     block. Evaluations are cached in out/evaluations/: the same command run again after an
     interruption replays them instead of solving them again. A fit that did not converge
-    writes everything but the fitted scene."""
+    writes everything but the fitted scene. posterior_steps > 0: a converged fit's posterior
+    is then sampled (rig.fit.posterior: ``walkers``, default 4 per parameter and at least
+    8, drawn from ``seed``) into the block's "posterior" and out/posterior.png."""
     out = Path(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -38,6 +41,13 @@ def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 40
         os.replace(tmp, stale)
         fitted = stale
     block = report.summary(result, objective, fitted)
+    if posterior_steps and result.converged:
+        from rig.fit import posterior
+
+        post = posterior.sample(objective, result, out, walkers or max(8, 4 * len(result.keys)), posterior_steps,
+                                seed, progress)
+        block["posterior"] = post.as_dict()
+        posterior.draw(out / "posterior.png", post)
     report.write_residuals(out / "residuals.csv", objective, result)
     report.draw(out / "fit.png", objective, result)
     (out / "fit.json").write_text(json.dumps(block, indent=1, default=float))

@@ -113,6 +113,20 @@ def test_cli_fit_writes_a_scene_that_fires(tmp_path, capsys):
     assert (out / "fit.png").stat().st_size > 0 and (out / "residuals.csv").is_file()
 
 
+def test_cli_fit_samples_the_posterior_and_resumes_it(tmp_path, capsys):
+    pts = _virtual_points(tmp_path)
+    argv = ["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+            "--out", str(tmp_path / "fit"), "--json", "--quiet", "--posterior", "4", "--walkers", "4", "--seed", "3"]
+    assert main(argv) == 0
+    post = json.loads(capsys.readouterr().out)["posterior"]
+    assert post["steps"] == 4 and post["walkers"] == 4 and post["seed"] == 3
+    lo, hi = post["parameters"]["chain.youngs_modulus"]["ci95"]
+    assert 0.5e9 <= lo <= post["parameters"]["chain.youngs_modulus"]["median"] <= hi <= 3e9
+    assert (tmp_path / "fit" / "posterior.png").stat().st_size > 0
+    assert main(argv) == 0  # the same command again: the chain read back from posterior.h5
+    assert json.loads(capsys.readouterr().out)["posterior"] == post
+
+
 def test_cli_fit_that_does_not_converge_writes_no_scene(tmp_path, capsys):
     pts = _virtual_points(tmp_path)
     out = tmp_path / "fit"
@@ -127,6 +141,8 @@ def test_cli_fit_that_does_not_converge_writes_no_scene(tmp_path, capsys):
     (["--param", "chain.youngs_modulus=0.5 GPa:3 GPa"], "no data to fit"),
     (["--points", "missing.csv", "--param", "chain.youngs_modulus=0.5:3"], "bounds need units"),
     (["--points", "missing.csv", "--param", "chain.youngs_modulus=0.5 GPa:3 GPa"], "cannot read"),
+    (["--points", "missing.csv", "--param", "chain.youngs_modulus=0.5 GPa:3 GPa", "--posterior", "10",
+      "--walkers", "1"], "--walkers 1: needs at least 2 per parameter"),
 ])
 def test_cli_bad_input_is_one_line(tmp_path, capsys, argv, match):
     assert main(["fit", SCENE, "--out", str(tmp_path / "o")] + argv) == 2
