@@ -20,6 +20,7 @@ from __future__ import annotations
 import hashlib
 import importlib.util
 import json
+import logging
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,7 +39,8 @@ class Posterior:
     """Posterior medians and central 68% / 95% intervals (SI units, in the order of
     ``keys``) from walkers x (steps - burn) samples; the mean acceptance fraction; each
     parameter's integrated autocorrelation time in steps (nan where the chain is too short
-    to estimate it: fewer than 50 of them); the seed of the walkers' start and moves."""
+    to estimate it: fewer than 50 of them) and whether the kept chain is 50 of them long,
+    emcee's rule for a trustworthy estimate; the seed of the walkers' start and moves."""
 
     keys: tuple
     units: tuple
@@ -50,6 +52,7 @@ class Posterior:
     burn: int
     acceptance: float
     autocorr_steps: np.ndarray
+    long_enough: bool
     seed: int
     samples: np.ndarray
 
@@ -61,7 +64,7 @@ class Posterior:
                 "walkers": self.walkers, "steps": self.steps, "burn": self.burn,
                 "acceptance_fraction": self.acceptance,
                 "autocorr_steps": [None if math.isnan(t) else float(t) for t in self.autocorr_steps],
-                "seed": self.seed}
+                "long_enough": self.long_enough, "seed": self.seed}
 
 
 def check(walkers: int | None, n_params: int):
@@ -126,10 +129,17 @@ def sample(objective, result: FitResult, folder, walkers: int, steps: int, seed:
     theta = lo + span * chain
     tau = np.full(P, np.nan)
     if total - burn >= 50:
-        tau = backend.get_autocorr_time(discard=burn, quiet=True)
+        quiet = logging.getLogger("emcee").level
+        logging.getLogger("emcee").setLevel(logging.ERROR)  # its "chain too short" is said by long_enough
+        try:
+            tau = backend.get_autocorr_time(discard=burn, quiet=True)
+        finally:
+            logging.getLogger("emcee").setLevel(quiet)
+    long_enough = bool(np.all(np.isfinite(tau)) and total - burn >= 50 * np.max(tau))
     q = np.percentile(theta, [2.5, 16, 50, 84, 97.5], axis=0)
     return Posterior(tuple(p.key for p in params), tuple(p.unit for p in params), q[2], q[[1, 3]].T, q[[0, 4]].T,
-                     walkers, total, burn, float(np.mean(backend.accepted / max(total, 1))), tau, seed, theta)
+                     walkers, total, burn, float(np.mean(backend.accepted / max(total, 1))), tau, long_enough,
+                     seed, theta)
 
 
 def _run_chain(objective, x_hat, sd, folder, walkers, steps, seed, log_prob, tell):
