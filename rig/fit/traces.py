@@ -11,7 +11,8 @@ with nuisance parameters per record, like the ones the instruments drew: the tri
 on the model's clock t_0 (free), each channel's gain g_c (prior 1 +- the scene's
 calibration_error) and each gauge's delay d_c (prior 0 +- misalignment_sd / the pulse speed),
 the priors entering as residuals (g_c - 1)/sd_g and d_c/sd_d. sd_c: the spread of the
-record's pre-trigger samples (at least an 8-bit step / sqrt(12)).
+record's pre-trigger samples and the ADC's rounding (its step / sqrt(12); from a file of
+volts, the step of the grid the values lie on), in quadrature.
 """
 from __future__ import annotations
 
@@ -59,6 +60,16 @@ def noise_sd(t: np.ndarray, v: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0))
 
 
+def volts_step(v: np.ndarray) -> float:
+    """The step (V) of the grid a record's volts lie on, for a file that gives volts and not
+    the scope's codes (a CSV export): the smallest gap between the distinct values, which
+    is the ADC's step for an 8-bit record and negligible for finer data."""
+    u = np.unique(v[np.isfinite(v)])
+    gaps = np.diff(u)
+    gaps = gaps[gaps > 1e-9 * max(float(np.max(np.abs(u))), 1e-300)] if u.size > 1 else gaps
+    return float(gaps.min()) if gaps.size else 0.0
+
+
 def channels_of(rig: Rig, records: list) -> list:
     """The records' channels that the scene's instruments read (RigError when none is)."""
     settings = {g.channel: (g.settings, True) for g in rig.gauges}
@@ -76,7 +87,7 @@ def channels_of(rig: Rig, records: list) -> list:
             step = max(1, -(-t.size // MAX_SAMPLES))
             pre = v[t < 0]
             base = float(np.median(pre)) if pre.size >= 10 else 0.0
-            lsb = abs(w.preamble.y_multiplier) if w.codes is not None else 0.0
+            lsb = abs(w.preamble.y_multiplier) if w.codes is not None else volts_step(v)
             sd = max(math.hypot(noise_sd(t, v), lsb / math.sqrt(12)), 1e-9)  # 8-bit rounding beside the noise
             delay_sd = s.misalignment_sd / speed if gauge and math.isfinite(speed) else 0.0
             out.append(Channel(i, name, t[::step], v[::step] - base, sd, s.calibration_error, delay_sd))

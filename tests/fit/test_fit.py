@@ -99,6 +99,22 @@ def test_trace_fit_recovers_modulus_and_damping_from_one_shot(tmp_path):
     assert np.array_equal(again.estimate, r.estimate)
 
 
+def test_trace_fit_of_a_csv_export_is_the_fit_of_its_record(tmp_path):
+    """A CSV export gives volts, not the scope's codes: the fit finds the ADC's rounding from
+    the grid the volts lie on (2 mV here; without it the wall channel's 0.5 mV noise alone
+    made chi2/dof 2.3), so the export fits as its record does, to the CSV's printed digits."""
+    from instruments.formats import read_record
+    from instruments.formats.tek_csv import write_csv
+
+    shot = Rig.from_scene(SCENE).fire(seed=3)
+    (path,) = write_csv(shot.scope.waveforms, tmp_path, "shot")
+    params = parse_parameters(["chain.youngs_modulus=0.5 GPa:3 GPa"])
+    direct, exported = (fit(TraceObjective(SCENE, params, [rec])) for rec in (shot.scope, read_record([path])))
+    assert exported.chi2_reduced == pytest.approx(direct.chi2_reduced, rel=1e-3)
+    assert abs(exported.estimate[0] - direct.estimate[0]) < 0.01 * direct.std[0]
+    assert exported.std[0] == pytest.approx(direct.std[0], rel=1e-3)
+
+
 def test_cli_fit_writes_a_scene_that_fires(tmp_path, capsys):
     pts = _virtual_points(tmp_path)
     out = tmp_path / "fit"
