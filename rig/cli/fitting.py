@@ -68,9 +68,13 @@ def cmd_fit(args) -> dict:
                 print(f"  {k:26s} median {p['median']:.6g}{unit}   68%: [{p['ci68'][0]:.6g}, {p['ci68'][1]:.6g}]"
                       f"   95%: [{p['ci95'][0]:.6g}, {p['ci95'][1]:.6g}]")
             if not post["long_enough"]:
-                taus = ", ".join("?" if t is None else f"{t:.1f}" for t in post["autocorr_steps"])
-                print(f"  {post['steps'] - post['burn']} steps kept, fewer than 50 autocorrelation times ({taus} "
-                      "steps): the same command with more steps goes on with this chain")
+                kept = post["steps"] - post["burn"]
+                if None in post["autocorr_steps"]:
+                    why = "too few to estimate the autocorrelation times (50 at least)"
+                else:
+                    taus = ", ".join(f"{t:.1f}" for t in post["autocorr_steps"])
+                    why = f"fewer than 50 autocorrelation times ({taus} steps)"
+                print(f"  {kept} steps kept, {why}: the same command with more steps goes on with this chain")
         print(f"wrote {args.out}/: fit.json, residuals.csv, fit.png" + (", posterior.png" if post else "")
               + (f", fitted.toml (rig shot {block['fitted_scene']})" if block["fitted_scene"] else ""))
     if not block["converged"]:
