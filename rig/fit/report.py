@@ -102,8 +102,8 @@ def draw(path: Path, objective, result: FitResult):
             ax.legend(fontsize=7, loc="upper right")
         ax = axes[-1, 0]
         ax.set_xlabel("time from the trigger (ms)")
-    title = ", ".join(f"{k.split('.')[-1]} = {e:.4g} ± {s:.2g}" for k, e, s in zip(result.keys, result.estimate,
-                                                                                     result.std))
+    title = ", ".join(f"{k.split('.')[-1]} = {e:.6g} ± {s:.2g}" + ("" if u == "1" else f" {u}")
+                      for k, u, e, s in zip(result.keys, result.units, result.estimate, result.std))
     fig.suptitle(title, fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
