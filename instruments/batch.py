@@ -7,8 +7,10 @@ in the order a lone shot draws them (acquisition.shot_draws)."""
 from __future__ import annotations
 
 import math
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from numba import prange
 
@@ -71,7 +73,8 @@ def draws(seeds, wiring: Wiring, n_in: int, rng: np.random.Generator | None = No
     (or, for one shot, from ``rng``, left where the shot's draws end): (draws (shots,
     gauges, 2), gauge noise (shots, gauges, n_in), phases (shots,), scope noise (shots,
     channels, samples)); an array a shot does not draw into is left zero (a noise-free
-    gauge) or empty (a noise-free scope)."""
+    gauge) or empty (a noise-free scope). The shots draw on numba's number of threads
+    (shot_draws runs without Python's lock)."""
     settings = [s for _, s, _ in wiring.gauges]
     scope = wiring.scope
     cal = np.array([s.calibration_error for s in settings], dtype=float)
@@ -83,10 +86,20 @@ def draws(seeds, wiring: Wiring, n_in: int, rng: np.random.Generator | None = No
     z_gauge = np.empty((S, G, n_in)) if noisy.all() else np.zeros((S, G, n_in))
     phase = np.empty(S)
     z_scope = np.empty((S, C, L))
-    for s, seed in enumerate(seeds):
-        gen = rng if rng is not None else np.random.default_rng(int(seed))
-        phase[s] = acquisition.shot_draws(gen, cal, mis, noisy, out[s], z_gauge[s],
-                                          scope.timebase.sample_interval, bool(scope.noise_floor), z_scope[s])
+
+    def shots_from(lo: int, hi: int) -> None:
+        for s in range(lo, hi):
+            gen = rng if rng is not None else np.random.default_rng(int(seeds[s]))
+            phase[s] = acquisition.shot_draws(gen, cal, mis, noisy, out[s], z_gauge[s],
+                                              scope.timebase.sample_interval, bool(scope.noise_floor), z_scope[s])
+
+    threads = 1 if rng is not None else min(numba.get_num_threads(), S)
+    if threads > 1:  # each shot has its own generator: the shots split over threads draw the same numbers
+        cuts = np.linspace(0, S, threads + 1).astype(int)
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(shots_from, cuts[:-1], cuts[1:]))
+    else:
+        shots_from(0, S)
     return out, z_gauge, phase, z_scope
 
 

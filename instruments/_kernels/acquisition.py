@@ -154,14 +154,15 @@ def shots(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired
         times[s, 1] = x_zero
 
 
-@jit
+@jit(nogil=True)
 def shot_draws(g, calibration_error, misalignment_sd, noisy, draws, z_gauge, phase_span, scope_noisy, z_scope):
     """One shot's random draws from its generator g, in the order a shot takes them: for
     each gauge (the bead gauges by name, then the wall sensor) its gain factor
     1 + calibration_error z and position error misalignment_sd z (draws[:, 0], draws[:, 1]),
     then its noise (z_gauge[k], where noisy[k]); then the scope's clock phase
     uniform(0, phase_span) (returned) and each displayed channel's noise (z_scope, where
-    scope_noisy). numba's Generator gives numpy's numbers, draw for draw."""
+    scope_noisy). numba's Generator gives numpy's numbers, draw for draw. It runs without
+    Python's lock, so the shots of a batch draw on several threads at once."""
     for k in range(draws.shape[0]):
         draws[k, 0] = 1.0 + calibration_error[k] * g.standard_normal()
         draws[k, 1] = misalignment_sd[k] * g.standard_normal()
