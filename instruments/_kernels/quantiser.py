@@ -4,7 +4,7 @@ import numpy as np
 from instruments.jit import jit
 
 
-@jit
+@jit(inline="always")
 def code(v, offset, ymult, yoff, noisy, noise):
     """One sample's code before clipping: rint((v - offset) / ymult + yoff [+ noise])."""
     c = (v - offset) / ymult + yoff

@@ -6,7 +6,7 @@ import numpy as np
 from instruments.jit import jit
 
 
-@jit
+@jit(inline="always")
 def read_at(f, p):
     """f (samples 0..n-1) at the fractional position p >= 0 or not (not nan), linearly
     interpolated, the ends held: np.interp's operations."""

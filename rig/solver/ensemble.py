@@ -97,7 +97,7 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
         a = np.moveaxis(getattr(problems, name)[fill], 0, -1)
         return np.ascontiguousarray(np.moveaxis(a.reshape(a.shape[:-1] + (n_chunks, width)), -2, 0))
 
-    out = np.empty((n_chunks, len(save.names), n_out, width))  # the kernel writes every sample
+    out = np.empty((n, len(save.names), n_out))  # the kernel writes every sample of every shot
     diag = np.zeros((n_chunks, DIAGNOSTICS, width))
     u, v = stack("u0"), stack("v0")
     con = np.ascontiguousarray(np.stack([stack(k) for k in ("expo", "damping", "dashpot")], axis=1))
@@ -110,8 +110,6 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
                        check_interval(n_steps), stack("d_limit"), p0.wall_slot,
                        stack("energy_scale"), stack("momentum_scale"), diag)
     wall = time.perf_counter() - t0
-    # (chunks, channels, samples, width) -> (shots, channels, samples), each shot's record contiguous
-    out = np.ascontiguousarray(np.moveaxis(out, 3, 1).reshape(n_chunks * width, len(save.names), n_out)[:n])
     diag = np.moveaxis(diag, 0, -2).reshape(DIAGNOSTICS, n_chunks * width)[:, :n]
     reports = tuple(KernelReport.of(diag[:, j]) for j in range(n))
     return EnsembleSolution(out, save.sample_interval, step, n_steps, wall, m.name, reports, save.names)

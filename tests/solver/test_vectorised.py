@@ -51,6 +51,22 @@ def test_the_batched_kernel_vectorises_over_shots():
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the batched force row is scalar"
 
 
+def test_the_batched_pass_runs_its_rows_inline():
+    """The batched kick-drift-force pass calls a row helper per body: called (not inlined),
+    each call costs about as much as a row of 64 shots (the pass ran 2.1x slower so)."""
+    from rig.solver.methods import method
+
+    nb, W = 16, 32
+    m = method("srkn6b")
+    z = np.zeros((nb, W))
+    ir = _llvm(ensemble._kick_drift_forces, z, z.copy(), np.ones((nb, W)), np.zeros((nb + 1, W)), np.ones((nb, W)),
+               np.full((nb, W), 1e-7), np.zeros((nb + 1, W)), 1e-9, 1e-9, 0, np.array(m.drifts), np.array(m.kicks),
+               1, np.zeros((2, 3, 1)), np.zeros(W), HERTZ, np.full((nb, W), 1.5))
+    called = set(re.findall(r"call [^@]*@\"?([\w.$]+)", ir))
+    assert not [name for name in called if "_row" in name], f"row helpers called, not inlined: {called}"
+    assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the batched force rows are scalar"
+
+
 def test_the_viscous_contacts_flow_is_vectorised():
     """Dissipation's contacts (Kuwabara-Kono, dashpot): the coefficients' square roots and
     the midpoint substeps over the flat (bodies x shots) arrays."""

@@ -7,6 +7,10 @@ performs exactly the operations of the single-shot kernel (integrators.integrate
 same order with the same step, so the two agree to the last bit (the multirate head
 runs the same multirate.head_flow in both; the viscous contacts and the holder's drag and
 friction the same dissipation.dissipate). Constant loads only (no force schedule).
+
+The per-row helpers of the passes are inlined (numba's inline="always"): LLVM does not
+inline numba's calls, and a call per row cost as much as the row of 64 shots itself
+(tests/solver/test_vectorised.py guards this).
 """
 import math
 
@@ -21,7 +25,7 @@ from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
 
 
-@jit
+@jit(inline="always")
 def _contact_row(u, A, d0, load, f, i):
     """Dynamic Hertz force of contact slot i for every shot: A d^(3/2) - load
     (forces.hertz_forces)."""
@@ -31,7 +35,7 @@ def _contact_row(u, A, d0, load, f, i):
         f[i, s] = A[i, s] * d * math.sqrt(d) - load[i, s]
 
 
-@jit
+@jit(inline="always")
 def _power_row(u, A, d0, load, f, i, expo):
     """Contact slot i of every shot whose exponent is not 3/2 by its own law, A d^n - load,
     after _contact_row (forces.other_law's operations)."""
@@ -42,7 +46,7 @@ def _power_row(u, A, d0, load, f, i, expo):
             f[i, s] = A[i, s] * power(d if d > 0.0 else 0.0, n) - load[i, s]
 
 
-@jit
+@jit(inline="always")
 def _row(u, A, d0, load, f, i, law, expo):
     _contact_row(u, A, d0, load, f, i)
     if law == POWER:
@@ -62,6 +66,15 @@ def _head_kick(v, invm, f, hb, head):
         v[head, s] += hb * (0.0 - f[head + 1, s]) * invm[head, s]
 
 
+@jit(inline="always")
+def _kick_drift_row(u, v, invm, f, hb, ha, i):
+    """Kick then drift body i of every shot."""
+    for s in range(u.shape[1]):
+        vi = v[i, s] + hb * (f[i, s] - f[i + 1, s]) * invm[i, s]
+        v[i, s] = vi
+        u[i, s] += ha * vi
+
+
 @jit
 def _kick_drift(u, v, invm, f, hb, ha, head):
     start = 0
@@ -69,10 +82,7 @@ def _kick_drift(u, v, invm, f, hb, ha, head):
         _head_kick(v, invm, f, hb, head)
         start = head + 1
     for i in range(start, v.shape[0]):
-        for s in range(u.shape[1]):
-            vi = v[i, s] + hb * (f[i, s] - f[i + 1, s]) * invm[i, s]
-            v[i, s] = vi
-            u[i, s] += ha * vi
+        _kick_drift_row(u, v, invm, f, hb, ha, i)
 
 
 @jit
@@ -87,21 +97,18 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
         head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub, h_work, h_busy)
         start = head + 1
     for i in range(start, v.shape[0]):
-        for s in range(u.shape[1]):
-            vi = v[i, s] + hb * (f[i, s] - f[i + 1, s]) * invm[i, s]
-            v[i, s] = vi
-            u[i, s] += ha * vi
+        _kick_drift_row(u, v, invm, f, hb, ha, i)
         if i >= 1:
             _row(u, A, d0, load, f, i, law, expo)
 
 
 @jit
-def _record(out, j, w, col, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new):
-    """out[c, j, s]: channel c's force (N) of every shot s at sample j (fraction x of the
+def _record(row, w, col, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new):
+    """row[c, s]: channel c's force (N) of every shot s at one sample (fraction x of the
     step), whose Hermite weights are column col of w: record.recorded_force's operations,
     in its order (0 + the first term is that term: no force is -0), with the shots
     innermost (the Hertz loop vectorises)."""
-    W = out.shape[2]
+    W = row.shape[1]
     w0, w1, w2, w3 = w[0, col], w[1, col], w[2, col], w[3, col]
     for c in range(ch_slot.shape[0]):
         first = True
@@ -118,21 +125,31 @@ def _record(out, j, w, col, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_
                         rate = (1.0 - x) * r_old[c, k, s] + x * r_new[c, k, s]
                         fc, _ = contact_force(d, rate, A[i, s], con[0, i, s], con[1, i, s], con[2, i, s], law)
                         fk = wk * fc
-                    out[c, j, s] = fk if first else out[c, j, s] + fk
+                    row[c, s] = fk if first else row[c, s] + fk
                 first = False
         if first:  # a channel of no contact records nothing
             for s in range(W):
-                out[c, j, s] = 0.0
+                row[c, s] = 0.0
+
+
+@jit(inline="always")
+def _deliver(row, out, j, lo):
+    """out[lo + s, c, j] = row[c, s] for the shots of the chunk that out holds (the chunk's
+    last ones may be fill)."""
+    for s in range(min(row.shape[1], out.shape[0] - lo)):
+        for c in range(row.shape[0]):
+            out[lo + s, c, j] = row[c, s]
 
 
 @jit
 def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_rate, a_coef, b_coef, dt, n_steps,
-           head, sub, ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
+           head, sub, ch_slot, ch_weight, sample_dt, out, lo, check_every, d_limit, wall_slot,
            e_ref, p_ref, diag, f, d_old, r_old, d_new, r_new):
     nb = u.shape[0]
     W = u.shape[1]
     n_drift = a_coef.shape[0]
-    n_out = out.shape[1]
+    n_out = out.shape[2]
+    row = np.empty((ch_slot.shape[0], W))  # one sample of every channel and shot
     viscous = False
     holder = False
     for i in range(nb):
@@ -165,7 +182,8 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
     probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, 0.0, head, -1, 0.0, d_old, r_old)
     if n_out > 0:
         hermite_weights(0.0, dt, w, 0)
-        _record(out, 0, w, 0, 0.0, ch_slot, ch_weight, A, law, con, d_old, r_old, d_old, r_old)
+        _record(row, w, 0, 0.0, ch_slot, ch_weight, A, law, con, d_old, r_old, d_old, r_old)
+        _deliver(row, out, 0, lo)
     j_out = 1
     pending = 0.0
     for n in range(n_steps):
@@ -203,7 +221,8 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
             x[j - j_out] = (j * sample_dt - t) / dt
             hermite_weights(x[j - j_out], dt, w, j - j_out)
         for j in range(j_out, j_end):
-            _record(out, j, w, j - j_out, x[j - j_out], ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new)
+            _record(row, w, j - j_out, x[j - j_out], ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new)
+            _deliver(row, out, j, lo)
         j_out = j_end
         d_old[:, :, :] = d_new
         r_old[:, :, :] = r_new
@@ -229,7 +248,8 @@ def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, law, con, onsite, sl
                        e_ref, p_ref, diag):
     """Integrate every shot of the (chunks, bodies, width) arrays in place; con
     (chunks, 3, bodies, width) and onsite (chunks, 2, bodies, width) as in the single-shot
-    kernel; out is (chunks, channels, samples, width), the shots innermost; diag is
+    kernel; out is (shots, channels, samples), each shot's record contiguous, chunk k
+    holding shots k width .. (k + 1) width - 1 (fill past the last shot); diag is
     (chunks, DIAGNOSTICS, width) as in the single-shot kernel."""
     n_chunks, nb, W = u.shape
     n_ch = ch_slot.shape[0]
@@ -240,5 +260,6 @@ def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, law, con, onsite, sl
         d_new = np.zeros((n_ch, ch_slot.shape[1], W))
         r_new = np.zeros((n_ch, ch_slot.shape[1], W))
         _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], law, con[k], onsite[k], slip,
-               viscous_rate, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out[k],
+               viscous_rate, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, k * W,
                check_every, d_limit[k], wall_slot, e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)
+

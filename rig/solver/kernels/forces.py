@@ -19,7 +19,7 @@ from instruments.jit import jit
 from rig.model.contact import HERTZ, KUWABARA_KONO, POWER
 
 
-@jit
+@jit(inline="always")
 def power(d, n):
     """d^n for d >= 0: d sqrt(d) for Hertz's 3/2 and d for a linear spring, exactly."""
     if n == 1.5:
@@ -61,7 +61,7 @@ def contact_force(d, rate, A, n, tau, mu, law):
     return (fi if fi > 0.0 else 0.0), el
 
 
-@jit
+@jit(inline="always")
 def elastic_energy(d, A, n):
     """A d^(n+1) / (n+1) (J) for d > 0, else 0: (2/5) A d^(5/2) for Hertz."""
     if not d > 0.0:
@@ -80,7 +80,7 @@ def hertz_forces(u, A, d0, load, f):
         f[i] = A[i] * d * math.sqrt(d) - load[i]
 
 
-@jit
+@jit(inline="always")
 def viscous_coefficient(d, A, n, tau, mu):
     """c = mu + A tau d^(n-1) (kg/s) of a contact at overlap d > 0 (its viscous force is
     c d'); 0 for d <= 0."""

@@ -35,7 +35,7 @@ from instruments.jit import jit
 REFINE = 16  # pieces of a substep across which a head contact opens or closes (two levels)
 
 
-@jit
+@jit(inline="always")
 def _open_acceleration(j, invm, load, head, s):
     """Acceleration of head body j (m/s^2) while every head contact is open: the loads only."""
     above = -load[j, s] if j > 0 else 0.0
@@ -67,12 +67,12 @@ def _busy(u, v, invm, d0, load, head, a_coef, b_coef, h, busy):
             busy[s] = busy[s] if gap - abs(rate) * reach - abs(curv) * spread > 0.0 else 1.0
 
 
-@jit
+@jit(inline="always")
 def _closed(d0, u, i, s):
     return d0[i, s] + u[i - 1, s] - u[i, s] > 0.0
 
 
-@jit
+@jit(inline="always")
 def _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s):
     """One step of k seconds of the composition on the head of shot s, its first kick
     merged with the owed ``pending`` seconds; returns (the closing kick it owes (s),
@@ -100,7 +100,7 @@ def _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s):
     return b_coef[a_coef.shape[0]] * k, changed
 
 
-@jit
+@jit(inline="always")
 def _save(u, v, f, head, s, saved):
     for i in range(head + 1):
         saved[0, i] = u[i, s]
@@ -108,7 +108,7 @@ def _save(u, v, f, head, s, saved):
         saved[2, i] = f[i, s]
 
 
-@jit
+@jit(inline="always")
 def _restore(u, v, f, head, s, saved):
     for i in range(head + 1):
         u[i, s] = saved[0, i]
@@ -116,7 +116,7 @@ def _restore(u, v, f, head, s, saved):
         f[i, s] = saved[2, i]
 
 
-@jit
+@jit(inline="always")
 def _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s, saved):
     """A substep of k seconds (_substep); where a head contact changed state during it,
     the state is put back as it was and (pending, True) is returned, else (the closing kick
@@ -171,7 +171,7 @@ def head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, h, n, work, busy
             v[i, s] += free * (h * acc)
 
 
-@jit
+@jit(inline="always")
 def slow_net(f, j, head, s):
     """Net force on body j from the slots the method's kicks carry (all but the head's)."""
     if head == 0:
