@@ -72,7 +72,7 @@ def _closed(d0, u, i, s):
     return d0[i, s] + u[i - 1, s] - u[i, s] > 0.0
 
 
-@jit(inline="always")
+@jit
 def _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s):
     """One step of k seconds of the composition on the head of shot s, its first kick
     merged with the owed ``pending`` seconds; returns (the closing kick it owes (s),
@@ -100,7 +100,7 @@ def _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s):
     return b_coef[a_coef.shape[0]] * k, changed
 
 
-@jit(inline="always")
+@jit
 def _save(u, v, f, head, s, saved):
     for i in range(head + 1):
         saved[0, i] = u[i, s]
@@ -108,7 +108,7 @@ def _save(u, v, f, head, s, saved):
         saved[2, i] = f[i, s]
 
 
-@jit(inline="always")
+@jit
 def _restore(u, v, f, head, s, saved):
     for i in range(head + 1):
         u[i, s] = saved[0, i]
@@ -116,7 +116,7 @@ def _restore(u, v, f, head, s, saved):
         f[i, s] = saved[2, i]
 
 
-@jit(inline="always")
+@jit
 def _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s, saved):
     """A substep of k seconds (_substep); where a head contact changed state during it,
     the state is put back as it was and (pending, True) is returned, else (the closing kick

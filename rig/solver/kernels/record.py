@@ -40,7 +40,7 @@ def probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, pending, head, sched_b
                                   - synced_velocity(i, s, v, invm, f, pending, head, sched_body, f_sched))
 
 
-@jit(inline="always")
+@jit
 def hermite_weights(x, h, w, k):
     """Column k of w (4, n) gets the weights of the cubic Hermite interpolant at fraction x
     of a step of h seconds: y(x) = w0 y0 + w1 r0 + w2 y1 + w3 r1 (values y, rates r at the
@@ -53,7 +53,7 @@ def hermite_weights(x, h, w, k):
     w[3, k] = (x3 - x2) * h
 
 
-@jit(inline="always")
+@jit
 def hermite(w, k, y0, r0, y1, r1):
     """The interpolant with the weights of column k (hermite_weights)."""
     return w[0, k] * y0 + w[1, k] * r0 + w[2, k] * y1 + w[3, k] * r1
