@@ -8,7 +8,9 @@ default accuracy, in the study's leading-pulse window, batches of 128 shots, no 
   over the shots);
 - the full pipeline as ``rig mc --workers N`` runs it, one worker process per core: the
   steady rate (shots finished after each worker's first batch, over the time since) and
-  the rate of the whole run, worker start-up included.
+  the rate of the whole run, worker start-up included;
+- where a shot's wall time goes in one process: each stage of a batch (rig/study/batch.py)
+  timed apart, the instruments' random draws apart from the rest of the acquisition.
 
 Each figure is the median of ``repeats`` in a round (the study runs once a round). With
 ``--baseline REV`` every round runs the same measurement with revision REV in a
@@ -23,13 +25,16 @@ import statistics
 import tempfile
 import time
 
+from instruments import batch as instrument_batch
+from rig.experiment.measure import setup_for
 from rig.solver.ensemble import solve_ensemble
+from rig.solver.stepsize import stepping_at
 from rig.study.batch import run_batch, shot_inputs
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
 from rig.study.mc_spec import Study
 from rig.study.nominal import nominal
-from rig.study.shots import shots_of
+from rig.study.shots import shots_of, wave_speeds, wiring_of
 from rig.study.store import Store
 
 VARY = ("striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)")
@@ -48,8 +53,6 @@ def _solver(study: Study, shots: int) -> dict:
     template = nom.template(study.window)
     save = template.save_at(contacts=False, averages=True)
     pilot = nom.pilot(study.window, save, study.accuracy)
-    from rig.solver.stepsize import stepping_at
-
     dt = stepping_at(pilot.problem, pilot.stats.dt_s)
     t_end = template.solver.duration
     t0 = time.perf_counter()
@@ -87,6 +90,47 @@ def _one_process(study: Study) -> dict:
             "pipeline_cpu_us_per_shot": statistics.median(cpu) / BATCH * 1e6}
 
 
+STAGES = {"inputs": "each shot's inputs drawn, the shots' arrays built",
+          "solver": "batched solver (the whole call) and the pulse speeds",
+          "draws": "the instruments' random draws (gauge and scope noise)",
+          "acquisition": "gauges, front ends, trigger, 8-bit codes (draws apart)",
+          "analysis": "leading pulses, delays, each shot's Report"}
+
+
+def _stages(study: Study, batches: int = 4) -> dict:
+    """Wall time per shot (us) of each stage of a batch, run in turn as run_batch runs them
+    (numba's threads; the first batch warms up and is not counted)."""
+    nom = nominal(study.scene, ())
+    template = nom.template(study.window)
+    save = template.save_at(contacts=False, averages=True)
+    pilot = nom.pilot(study.window, save, study.accuracy)
+    dt = stepping_at(pilot.problem, pilot.stats.dt_s)
+    wiring = wiring_of(template)
+    setup = setup_for(template, *nom.calibration)
+    spent = dict.fromkeys(STAGES, 0.0)
+    for b in range(batches + 1):
+        t = [time.perf_counter()]
+        drawn = [shot_inputs(study, i, 52) for i in range(b * BATCH, (b + 1) * BATCH)]
+        shots = shots_of(template, [x for x, *_ in drawn], [m for _, m, _ in drawn])
+        t.append(time.perf_counter())
+        ens = solve_ensemble(shots.problems, template.solver.duration, save=save, dt=dt)
+        speeds = wave_speeds(template, shots, ens.records, ens.sample_interval)
+        t.append(time.perf_counter())
+        seeds = [seed for *_, seed in drawn]
+        instrument_batch.draws(seeds, wiring, ens.records.shape[2])
+        t.append(time.perf_counter())
+        records = instrument_batch.acquire(ens.records, ens.sample_interval, wiring, seeds, shots.fixed, speeds)
+        t.append(time.perf_counter())
+        instrument_batch.analysed(records, setup)
+        t.append(time.perf_counter())
+        if b:
+            laps = [t1 - t0 for t0, t1 in zip(t, t[1:])]
+            laps[3] -= laps[2]  # acquire draws again: its own time less the draws
+            for key, lap in zip(STAGES, laps):
+                spent[key] += lap
+    return {f"stage_{key}_us_per_shot": v / (batches * BATCH) * 1e6 for key, v in spent.items()}
+
+
 def _workers(study: Study, workers: int) -> dict:
     ticks = []
     with tempfile.TemporaryDirectory() as folder:
@@ -109,7 +153,7 @@ def measure(shots: int = 512, study_shots: int = 8192) -> dict:
     study = Study("ptfe52_magnetic", tuple(parse_vary(VARY)), shots, batch=BATCH)
     workers = os.cpu_count() or 1
     out = {"scene": "ptfe52_magnetic", "shots": shots, "threads": numba.get_num_threads(), "workers": workers,
-           "study_shots": study_shots, **_solver(study, shots), **_one_process(study)}
+           "study_shots": study_shots, **_solver(study, shots), **_one_process(study), **_stages(study)}
     out.update(_workers(Study("ptfe52_magnetic", tuple(parse_vary(VARY)), study_shots, seed=1, batch=BATCH),
                         workers))
     return out
@@ -126,7 +170,7 @@ def run(rounds: int = 3, baseline: str | None = None) -> dict:
             if tree is not None:
                 runs["baseline"].append(measure_in(tree, SNIPPET, timeout=1800))
     out = dict(runs["current"][0], rounds=rounds, baseline_rev=baseline)
-    for key in FIGURES:
+    for key in FIGURES + tuple(f"stage_{k}_us_per_shot" for k in STAGES):
         out[key] = statistics.median(r[key] for r in runs["current"])
     if runs["baseline"]:
         out["baseline"] = {key: statistics.median(r[key] for r in runs["baseline"]) for key in FIGURES}
@@ -155,4 +199,10 @@ def table(r: dict) -> str:
         lines.append(line)
     lines.append(f"  CPU per shot of the one-process pipeline: {r['pipeline_cpu_us_per_shot']:.0f} us (all threads); "
                  f"building a shot's arrays (inputs drawn, problem arrays): {r['arrays_us_per_shot']:.0f} us")
+    if "stage_inputs_us_per_shot" in r:
+        total = sum(r[f"stage_{k}_us_per_shot"] for k in STAGES)
+        lines.append(f"  where a shot's wall time goes in one process ({r['threads']} threads), us per shot:")
+        for key, what in STAGES.items():
+            us = r[f"stage_{key}_us_per_shot"]
+            lines.append(f"    {key:12s} {us:7.1f}  {100 * us / total:4.0f}%  {what}")
     return "\n".join(lines)
