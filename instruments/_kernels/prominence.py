@@ -13,10 +13,6 @@ Only the bases of samples at or above ``floor`` are wanted (find_peaks' height r
 a sample below the floor never stops a scan from such a sample, so each run of them enters
 the stack as its lowest sample alone (the last of equal lows, the one closest to what
 follows), which keeps the noisy baseline of a record out of the stack.
-
-A record with a few candidate peaks (a clean pulse train) is cheaper scanned peak by
-peak, as scipy does: ``bases_of`` takes the scans up to SCAN_PEAKS candidates and the
-stack above that; both give scipy's bases.
 """
 import numpy as np
 
@@ -70,37 +66,3 @@ def prominence_bases(x, floor=-np.inf):
         m = mirrored[n - 1 - i]
         right[i] = n - 1 - m if m >= 0 else -1
     return left, right
-
-
-SCAN_PEAKS = 8  # up to this many peaks, one outward scan each costs less than the two stack passes
-
-
-@jit
-def _scan(x, p, step):
-    """scipy's base of peak p on one side (step -1: left, +1: right): the lowest sample
-    (the first met on ties) before the first one higher than x[p]."""
-    base = p
-    i = p
-    while 0 <= i < x.shape[0] and x[i] <= x[p]:
-        if x[i] < x[base]:
-            base = i
-        i += step
-    return base
-
-
-@jit
-def bases_of(x, peaks, floor=-np.inf):
-    """(left bases, right bases) of ``peaks`` (indices of samples at or above ``floor``),
-    as scipy.signal.peak_prominences finds them: a scan from each peak when there are at
-    most SCAN_PEAKS of them, else prominence_bases' stack."""
-    n = peaks.shape[0]
-    if n > SCAN_PEAKS:
-        left, right = prominence_bases(x, floor)
-        return left[peaks], right[peaks]
-    left = np.empty(n, np.int64)
-    right = np.empty(n, np.int64)
-    for k in range(n):
-        left[k] = _scan(x, peaks[k], -1)
-        right[k] = _scan(x, peaks[k], 1)
-    return left, right
-

@@ -14,7 +14,7 @@ from .crossings import level_bracket
 from .filters import undo_highpass
 from .parabola import parabola
 from .peaks import local_maxima, thin_by_distance, widths_at
-from .prominence import bases_of
+from .prominence import prominence_bases
 
 MIN_BASELINE = 16  # pre-trigger samples needed to measure the noise (the MAD to about 1/3)
 MAD_TO_SD = 1.4826  # the standard deviation of Gaussian noise over its median absolute deviation
@@ -130,7 +130,8 @@ def candidates(f, height, min_prominence, spacing, min_width):
     idx = idx[f[idx] >= height]
     if spacing > 1 and idx.shape[0]:
         idx = idx[thin_by_distance(idx, np.argsort(f[idx], kind="mergesort"), float(spacing))]
-    left, right = bases_of(f, idx, height)
+    left, right = prominence_bases(f, height)
+    left, right = left[idx], right[idx]
     prominence = f[idx] - np.maximum(f[left], f[right])
     keep = prominence >= min_prominence
     idx, prominence, left, right = idx[keep], prominence[keep], left[keep], right[keep]

@@ -10,7 +10,7 @@ from scipy.signal import find_peaks, lfilter, peak_prominences, peak_widths
 from instruments._kernels.filters import one_pole, undo_highpass
 from instruments._kernels.parabola import parabola
 from instruments._kernels.peaks import local_maxima, thin_by_distance, widths_at
-from instruments._kernels.prominence import SCAN_PEAKS, bases_of, prominence_bases
+from instruments._kernels.prominence import prominence_bases
 from instruments._kernels.quantiser import quantise
 from instruments._kernels.resample import at_positions
 
@@ -48,25 +48,6 @@ def test_prominence_bases_are_scipys_bit_for_bit(with_floor):
         assert np.all(lb[x < floor] == -1) and np.all(rb[x < floor] == -1)
         checked += peaks.size
     assert checked > 2000
-
-
-def test_bases_of_a_few_peaks_or_many_are_scipys():
-    # up to SCAN_PEAKS peaks each is scanned, above that the stack serves: both give scipy's bases
-    rng = np.random.default_rng(13)
-    scanned = stacked = 0
-    for x in _signals():
-        floor = float(np.quantile(x, rng.uniform(0, 0.5)))
-        peaks = find_peaks(x, height=floor)[0]
-        if not peaks.size:
-            continue
-        few = np.sort(rng.choice(peaks, min(peaks.size, int(rng.integers(1, SCAN_PEAKS + 1))), replace=False))
-        for chosen in (few, peaks):
-            _, left, right = peak_prominences(x, chosen)
-            lb, rb = bases_of(x, chosen, floor)
-            assert np.array_equal(lb, left) and np.array_equal(rb, right)
-        scanned += few.size
-        stacked += peaks.size if peaks.size > SCAN_PEAKS else 0
-    assert scanned > 500 and stacked > 2000
 
 
 @pytest.mark.parametrize("distance", [None, 2, 5, 17.5])
