@@ -1,6 +1,7 @@
 """The instruments and the leading-pulse analysis of many shots at once: what a study
-fires. One compiled loop runs every shot's gauges and scope (_kernels/acquisition.shots),
-another every shot's analysis (``analysed``): the very functions PiezoGauge.read,
+fires. Every shot's draws, gauges and scope run on a few threads (``acquire``: compiled
+per-shot functions, acquisition.shot_draws and acquisition.one_shot), every shot's analysis
+in one compiled loop (``analysed``): the very functions PiezoGauge.read,
 Oscilloscope.acquire and the pipeline run for one shot, so a shot of a batch has the bits
 it has alone. Each shot's random numbers come from its own generator, seeded by its seed,
 in the order a lone shot draws them (acquisition.shot_draws)."""
@@ -68,96 +69,74 @@ class Records:
                                            self.codes[s], self.over[s], self.n_in, self.h)
 
 
-def draws(seeds, wiring: Wiring, n_in: int, rng: np.random.Generator | None = None) -> tuple:
-    """Every shot's random numbers (acquisition.shot_draws), from np.random.default_rng(seed)
-    (or, for one shot, from ``rng``, left where the shot's draws end): (draws (shots,
-    gauges, 2), gauge noise (shots, gauges, n_in), phases (shots,), scope noise (shots,
-    channels, samples)); an array a shot does not draw into is left zero (a noise-free
-    gauge) or empty (a noise-free scope). The shots draw on numba's number of threads
-    (shot_draws runs without Python's lock)."""
-    settings = [s for _, s, _ in wiring.gauges]
-    scope = wiring.scope
-    cal = np.array([s.calibration_error for s in settings], dtype=float)
-    mis = np.array([s.misalignment_sd for s in settings], dtype=float)
-    noisy = np.array([bool(s.noise) for s in settings])
-    S, G, C = len(seeds), len(settings), len(scope.channels)
-    L = int(scope.timebase.record_length) if scope.noise_floor else 0
-    out = np.empty((S, G, 2))
-    z_gauge = np.empty((S, G, n_in)) if noisy.all() else np.zeros((S, G, n_in))
-    phase = np.empty(S)
-    z_scope = np.empty((S, C, L))
-
-    def shots_from(lo: int, hi: int) -> None:
-        for s in range(lo, hi):
-            gen = rng if rng is not None else np.random.default_rng(int(seeds[s]))
-            phase[s] = acquisition.shot_draws(gen, cal, mis, noisy, out[s], z_gauge[s],
-                                              scope.timebase.sample_interval, bool(scope.noise_floor), z_scope[s])
-
-    threads = 1 if rng is not None else min(numba.get_num_threads(), S)
-    if threads > 1:  # each shot has its own generator: the shots split over threads draw the same numbers
-        cuts = np.linspace(0, S, threads + 1).astype(int)
-        with ThreadPoolExecutor(threads) as pool:
-            list(pool.map(shots_from, cuts[:-1], cuts[1:]))
-    else:
-        shots_from(0, S)
-    return out, z_gauge, phase, z_scope
-
-
 def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarray | None = None,
             wave_speed: np.ndarray | None = None) -> Records:
     """Every shot's scope record. forces (shots, gauges, samples): what each gauge reads
     (N, every h s; a bead gauge its plate's average, the wall sensor the wall's contact);
     seeds: one per shot; fixed (shots, gauges, 2): gain factors and position errors that
     replace the drawn ones (nan: keep the draw); wave_speed (shots,): the pulse's speed
-    (m/s) that turns a position error into a delay (nan: none)."""
+    (m/s) that turns a position error into a delay (nan: none).
+
+    The shots are shared out over numba's number of threads; each thread takes its shots
+    one by one: the shot's draws into the thread's own noise buffers (they stay in cache),
+    then its gauges and scope (acquisition.one_shot), both compiled without Python's lock."""
     S, G, n_in = forces.shape
-    drawn, z_gauge, phase, z_scope = draws(seeds, wiring, n_in)
-    if fixed is not None:
-        drawn = np.where(np.isnan(fixed), drawn, fixed)
     settings = [s for _, s, _ in wiring.gauges]
+    scope = wiring.scope
+    cal = np.array([s.calibration_error for s in settings], dtype=float)
+    mis = np.array([s.misalignment_sd for s in settings], dtype=float)
+    noisy = np.array([bool(s.noise) for s in settings])
     sens = np.array([s.sensitivity for s in settings], dtype=float)
     delayed = np.array([d for _, _, d in wiring.gauges])
     speed = np.full(S, np.nan) if wave_speed is None else np.asarray(wave_speed, dtype=float)
-    shift = np.where(delayed & ~np.isnan(speed)[:, None], drawn[:, :, 1] / speed[:, None], 0.0)
-    scale = sens * drawn[:, :, 0]
+    replace = np.full((S, G, 2), np.nan) if fixed is None else np.asarray(fixed, dtype=float)
     gauge_filter = np.array([highpass_coefficients(h, s.tau) for s in settings])
     noise_sd = np.array([s.noise for s in settings], dtype=float)
-    front = wiring.scope.front_panel(h)
-    L = int(wiring.scope.timebase.record_length)
+    front = scope.front_panel(h)
+    dx = scope.timebase.sample_interval
+    L = int(scope.timebase.record_length)
     C = len(wiring.channels)
     codes = np.empty((S, C, L), np.int8)
     over = np.empty((S, C), np.bool_)
     status = np.empty(S, np.int64)
     times = np.empty((S, 2))
+    drawn = np.empty((S, G, 2))
     forces = np.ascontiguousarray(forces, dtype=float)
     wired = wiring.wired()
+    rested = [g for g in wired if g >= 0 and settings[g].noise]  # the inputs with noise before the impact
 
-    def run(sl, z_rest):
-        acquisition.shots(forces[sl], float(h), shift[sl], scale[sl], gauge_filter, noise_sd, z_gauge[sl], z_rest,
-                          wired, front.probe, front.ac, front.lowpass, front.source, front.level, front.rising,
-                          phase[sl], front.n_pre, wiring.scope.timebase.sample_interval, front.offset, front.ymult,
-                          front.yoff, front.sd, z_scope[sl], float(CODE_MIN), float(CODE_MAX), codes[sl], over[sl],
-                          status[sl], times[sl])
+    def record(s, z_gauge, z_rest, phase, z_scope, shift, scale):
+        return acquisition.one_shot(forces[s], float(h), shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired,
+                                    front.probe, front.ac, front.lowpass, front.source, front.level, front.rising,
+                                    phase, front.n_pre, dx, front.offset, front.ymult, front.yoff, front.sd, z_scope,
+                                    float(CODE_MIN), float(CODE_MAX), codes[s], over[s])
 
-    run(slice(None), np.empty((S, G, 0)))
-    for s in range(S):  # records that start before the impact, again with the inputs at rest before it
-        n_pad = acquisition.samples_before_input(status[s], times[s, 0], times[s, 1], h)
-        if n_pad:
-            run(slice(s, s + 1), rest_draws(seeds[s], wiring, n_in, n_pad)[None])
+    def shots_from(lo: int, hi: int) -> None:
+        z_gauge = np.empty((G, n_in)) if noisy.all() else np.zeros((G, n_in))  # a noise-free gauge's row stays 0
+        z_scope = np.empty((C, L if scope.noise_floor else 0))
+        shift, scale = np.empty(G), np.empty(G)
+        for s in range(lo, hi):
+            gen = np.random.default_rng(int(seeds[s]))
+            phase = acquisition.shot_draws(gen, cal, mis, noisy, drawn[s], z_gauge, dx, bool(scope.noise_floor),
+                                           z_scope)
+            acquisition.shot_settings(drawn[s], replace[s], sens, delayed, speed[s], shift, scale)
+            st, t_cross, x_zero = record(s, z_gauge, np.empty((G, 0)), phase, z_scope, shift, scale)
+            n_pad = acquisition.samples_before_input(st, t_cross, x_zero, h)
+            if n_pad:  # a record that starts before the impact, again with the inputs at rest before it
+                z_rest = np.zeros((G, n_pad))
+                for g in rested:  # drawn after the shot's other draws, in the displayed channels' order
+                    z_rest[g] = gen.standard_normal(n_pad)
+                st, t_cross, x_zero = record(s, z_gauge, z_rest, phase, z_scope, shift, scale)
+            status[s], times[s, 0], times[s, 1] = st, t_cross, x_zero
+
+    threads = min(numba.get_num_threads(), S)
+    if threads > 1:
+        cuts = np.linspace(0, S, threads + 1).astype(int)
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(shots_from, cuts[:-1], cuts[1:]))
+    else:
+        shots_from(0, S)
     return Records(wiring, codes, over, status, times, drawn, n_in, float(h))
-
-
-def rest_draws(seed, wiring: Wiring, n_in: int, n_pad: int) -> np.ndarray:
-    """(gauges, n_pad): the rest noise of a shot whose record starts n_pad input samples
-    before the impact, drawn after the shot's other draws, in the order of the displayed
-    channels (Oscilloscope.acquire's order); zero for a noise-free gauge."""
-    rng = np.random.default_rng(int(seed))
-    draws([seed], wiring, n_in, rng)
-    z = np.zeros((len(wiring.gauges), n_pad))
-    for g in wiring.wired():
-        if g >= 0 and wiring.gauges[g][1].noise:
-            z[g] = rng.standard_normal(n_pad)
-    return z
 
 
 @jit

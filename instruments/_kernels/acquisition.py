@@ -1,13 +1,12 @@
 """The instruments of one shot, compiled (numba): a gauge's signal chain and the
 oscilloscope's acquisition. PiezoGauge.read and Oscilloscope.acquire run them for one shot;
-the batched instruments (instruments/batch.py) run them for every shot of a study in one
-compiled loop: the same code, so the same bits. Random draws come in as arrays, drawn
+the batched instruments (instruments/batch.py) run them (``one_shot``) for every shot of a
+study, on a few threads: the same code, so the same bits. Random draws come in as arrays, drawn
 beforehand from each shot's generator in a fixed order (``shot_draws``).
 """
 import math
 
 import numpy as np
-from numba import prange
 
 from instruments.jit import jit
 
@@ -112,9 +111,18 @@ def at_rest_before(v, rest_sd, z_rest):
     return out
 
 
-@jit
-def _one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired, probe, ac, lowpass, source,
-              level, rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over):
+@jit(nogil=True)
+def one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired, probe, ac, lowpass, source,
+             level, rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over):
+    """One shot: gauge g reads force[g] (N, every h s) delayed by shift[g] s with gain
+    scale[g] V/N, its high-pass gauge_filter[g] and noise noise_sd[g] z_gauge[g], and before
+    the impact, for z_rest.shape[1] samples, its rest: noise_sd[g] z_rest[g]
+    (at_rest_before); scope channel c displays gauge wired[c] (-1: nothing), with probe[c],
+    ac[c] and lowpass[c] (condition), offset, ymult, yoff (the converter) and noise sd[c]
+    z_scope[c]; the trigger on channel ``source`` at ``level`` V, the clock's phase s,
+    n_pre pre-trigger samples every dt s. Fills codes (channels, samples) and over
+    (channels); returns (status, the trigger crossing from the impact s, the first sample
+    after it s)."""
     n_pad = z_rest.shape[1]
     n = force.shape[1] + n_pad
     analog = np.empty((wired.shape[0], n))
@@ -133,25 +141,18 @@ def _one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, w
     return st, t_cross - n_pad * h, x_zero
 
 
-@jit(parallel=True)
-def shots(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired, probe, ac, lowpass, source, level,
-          rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over, status, times):
-    """Every shot s of a batch: gauge g reads force[s, g] (N, every h s) delayed by
-    shift[s, g] s with gain scale[s, g] V/N, its high-pass gauge_filter[g] and noise
-    noise_sd[g] z_gauge[s, g], and before the impact, for z_rest.shape[2] samples, its rest:
-    noise_sd[g] z_rest[s, g] (at_rest_before); scope channel c displays gauge wired[c] (-1:
-    nothing), with probe[c], ac[c] and lowpass[c] (condition), offset, ymult, yoff (the
-    converter) and noise sd[c] z_scope[s, c]; the trigger on channel ``source`` at ``level``
-    V, the clock's phase[s] s, n_pre pre-trigger samples every dt s. Fills codes (shots,
-    channels, samples), over (shots, channels), status (shots) and times (shots, 2: the
-    trigger crossing from the impact and the first sample after it, s)."""
-    for s in prange(force.shape[0]):
-        st, t_cross, x_zero = _one_shot(force[s], h, shift[s], scale[s], gauge_filter, noise_sd, z_gauge[s],
-                                        z_rest[s], wired, probe, ac, lowpass, source, level, rising, phase[s], n_pre,
-                                        dt, offset, ymult, yoff, sd, z_scope[s], lo, hi, codes[s], over[s])
-        status[s] = st
-        times[s, 0] = t_cross
-        times[s, 1] = x_zero
+@jit(nogil=True)
+def shot_settings(draws, fixed, sensitivity, delayed, speed, shift, scale):
+    """A shot's gauges from their draws (gauges, 2: gain factor, position error m): each
+    draw replaced by ``fixed`` where that is not nan (draws updated in place); shift[g] the
+    delay (s) of a position error at the pulse's ``speed`` (m/s) where gauge g is
+    ``delayed`` and the speed is known, else 0; scale[g] = sensitivity (V/N) x gain."""
+    for g in range(draws.shape[0]):
+        for k in range(2):
+            if not math.isnan(fixed[g, k]):
+                draws[g, k] = fixed[g, k]
+        shift[g] = draws[g, 1] / speed if delayed[g] and not math.isnan(speed) else 0.0
+        scale[g] = sensitivity[g] * draws[g, 0]
 
 
 @jit(nogil=True)

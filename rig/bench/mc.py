@@ -10,7 +10,7 @@ default accuracy, in the study's leading-pulse window, batches of 128 shots, no 
   steady rate (shots finished after each worker's first batch, over the time since) and
   the rate of the whole run, worker start-up included;
 - where a shot's wall time goes in one process: each stage of a batch (rig/study/batch.py)
-  timed apart, the instruments' random draws apart from the rest of the acquisition.
+  timed apart.
 
 Each figure is the median of ``repeats`` in a round (the study runs once a round). With
 ``--baseline REV`` every round runs the same measurement with revision REV in a
@@ -78,10 +78,15 @@ def _solver(study: Study, shots: int) -> dict:
             "arrays_us_per_shot": arrays / shots * 1e6}
 
 
+WARM_UP = 3  # batches before the timed ones: numba's threads started, and the batches' large arrays
+# (tens of MB) reused by the allocator instead of fresh pages faulted in (about a third of a batch's time)
+
+
 def _one_process(study: Study) -> dict:
-    run_batch(study, 0)
+    for b in range(WARM_UP):
+        run_batch(study, b)
     wall, cpu = [], []
-    for b in range(1, 4):
+    for b in range(WARM_UP, WARM_UP + 6):
         t0, c0 = time.perf_counter(), time.process_time()
         run_batch(study, b)
         wall.append(time.perf_counter() - t0)
@@ -92,14 +97,13 @@ def _one_process(study: Study) -> dict:
 
 STAGES = {"inputs": "each shot's inputs drawn, the shots' arrays built",
           "solver": "batched solver (the whole call) and the pulse speeds",
-          "draws": "the instruments' random draws (gauge and scope noise)",
-          "acquisition": "gauges, front ends, trigger, 8-bit codes (draws apart)",
+          "acquisition": "the instruments' random draws (22,000 normals), gauges, front ends, trigger, 8-bit codes",
           "analysis": "leading pulses, delays, each shot's Report"}
 
 
 def _stages(study: Study, batches: int = 4) -> dict:
     """Wall time per shot (us) of each stage of a batch, run in turn as run_batch runs them
-    (numba's threads; the first batch warms up and is not counted)."""
+    (numba's threads; after WARM_UP batches)."""
     nom = nominal(study.scene, ())
     template = nom.template(study.window)
     save = template.save_at(contacts=False, averages=True)
@@ -108,7 +112,7 @@ def _stages(study: Study, batches: int = 4) -> dict:
     wiring = wiring_of(template)
     setup = setup_for(template, *nom.calibration)
     spent = dict.fromkeys(STAGES, 0.0)
-    for b in range(batches + 1):
+    for b in range(WARM_UP + batches):
         t = [time.perf_counter()]
         drawn = [shot_inputs(study, i, 52) for i in range(b * BATCH, (b + 1) * BATCH)]
         shots = shots_of(template, [x for x, *_ in drawn], [m for _, m, _ in drawn])
@@ -117,17 +121,13 @@ def _stages(study: Study, batches: int = 4) -> dict:
         speeds = wave_speeds(template, shots, ens.records, ens.sample_interval)
         t.append(time.perf_counter())
         seeds = [seed for *_, seed in drawn]
-        instrument_batch.draws(seeds, wiring, ens.records.shape[2])
-        t.append(time.perf_counter())
         records = instrument_batch.acquire(ens.records, ens.sample_interval, wiring, seeds, shots.fixed, speeds)
         t.append(time.perf_counter())
         instrument_batch.analysed(records, setup)
         t.append(time.perf_counter())
-        if b:
-            laps = [t1 - t0 for t0, t1 in zip(t, t[1:])]
-            laps[3] -= laps[2]  # acquire draws again: its own time less the draws
-            for key, lap in zip(STAGES, laps):
-                spent[key] += lap
+        if b >= WARM_UP:
+            for key, t0, t1 in zip(STAGES, t, t[1:]):
+                spent[key] += t1 - t0
     return {f"stage_{key}_us_per_shot": v / (batches * BATCH) * 1e6 for key, v in spent.items()}
 
 
@@ -153,7 +153,8 @@ def measure(shots: int = 512, study_shots: int = 8192) -> dict:
     study = Study("ptfe52_magnetic", tuple(parse_vary(VARY)), shots, batch=BATCH)
     workers = os.cpu_count() or 1
     out = {"scene": "ptfe52_magnetic", "shots": shots, "threads": numba.get_num_threads(), "workers": workers,
-           "study_shots": study_shots, **_solver(study, shots), **_one_process(study), **_stages(study)}
+           "study_shots": study_shots, **_solver(study, shots), **_stages(study)}
+    out.update(_one_process(Study("ptfe52_magnetic", tuple(parse_vary(VARY)), study_shots, batch=BATCH)))
     out.update(_workers(Study("ptfe52_magnetic", tuple(parse_vary(VARY)), study_shots, seed=1, batch=BATCH),
                         workers))
     return out
