@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 
+from rig.bench.baseline import machine
 from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import relative_error
@@ -69,7 +70,7 @@ def run(quick: bool = False, progress=None) -> dict:
                          "dt_s": sol.stats.dt_s, "attempts": sol.stats.attempts,
                          "single_solve_cpu_s": _single_cpu(p, t_end, save, sol.stats.dt_s),
                          "estimate_from_2dt": _coarse_estimate(p, t_end, save, sol)})
-    return {"rows": rows, "reference_check": checks}
+    return {"rows": rows, "reference_check": checks, "machine": machine()}
 
 
 def _single_cpu(p, t_end, save, dt) -> float:
@@ -117,4 +118,5 @@ def table(r: dict) -> str:
                  f"{min(cost):.1f} to {max(cost):.1f}) times one solve at its final step")
     lines.append("reference check (reference against one at twice its step): " + ", ".join(
         f"{k} {v:.1e}" for k, v in r["reference_check"].items()))
+    lines.append(f"machine: {r['machine']} (the CPU column is this machine's)")
     return "\n".join(lines)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import platform
 import subprocess
 import sys
 import tempfile
@@ -21,6 +22,26 @@ from pathlib import Path
 from rig.errors import RigError
 
 ROOT = Path(__file__).resolve().parents[2]
+
+
+def machine(cpuinfo: str = "/proc/cpuinfo") -> str:
+    """The CPU a benchmark's figures come from: its model, its widest vector extension
+    (AVX-512, AVX2 or neither, from the flags in ``cpuinfo``: the kernels' floor, the square
+    roots' throughput, depends on it) and the cores Python sees."""
+    model, flags = "", set()
+    try:
+        with open(cpuinfo) as fh:
+            for line in fh:
+                key, _, value = line.partition(":")
+                if key.strip() == "model name" and not model:
+                    model = value.strip()
+                elif key.strip() == "flags" and not flags:
+                    flags = set(value.split())
+    except OSError:
+        pass
+    model = model or platform.processor() or "unknown CPU"
+    vector = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "no AVX2"
+    return f"{model}, {vector} ({os.cpu_count()} cores), {platform.system()} {platform.machine()}"
 
 
 @contextlib.contextmanager

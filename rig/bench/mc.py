@@ -161,7 +161,7 @@ def measure(shots: int = 512, study_shots: int = 8192) -> dict:
 
 
 def run(rounds: int = 3, baseline: str | None = None) -> dict:
-    from rig.bench.baseline import ROOT, checkout
+    from rig.bench.baseline import ROOT, checkout, machine
     from rig.bench.baseline import measure as measure_in
 
     runs = {"current": [], "baseline": []}
@@ -170,7 +170,7 @@ def run(rounds: int = 3, baseline: str | None = None) -> dict:
             runs["current"].append(measure() if tree is None else measure_in(ROOT, SNIPPET, timeout=1800))
             if tree is not None:
                 runs["baseline"].append(measure_in(tree, SNIPPET, timeout=1800))
-    out = dict(runs["current"][0], rounds=rounds, baseline_rev=baseline)
+    out = dict(runs["current"][0], rounds=rounds, baseline_rev=baseline, machine=machine())
     for key in FIGURES + tuple(f"stage_{k}_us_per_shot" for k in STAGES):
         out[key] = statistics.median(r[key] for r in runs["current"])
     if runs["baseline"]:
@@ -192,7 +192,7 @@ def table(r: dict) -> str:
     lines = [f"Monte Carlo, {r['scene']} at default accuracy (dt = {r['dt_s'] * 1e9:.0f} ns from the study's pilot, "
              f"estimate {r['error_estimate']:.2g}; {r['steps']} steps to {r['t_end_s'] * 1e3:.3g} ms, the "
              f"leading-pulse window; head of {r['head']} contact(s), substep {r['substep_s'] * 1e9:.0f} ns), "
-             f"batches of {BATCH}, medians of {r['rounds']} round(s)", head]
+             f"batches of {BATCH}, medians of {r['rounds']} round(s); machine: {r['machine']}", head]
     for key in FIGURES:
         line = f"  {labels[key]:56s} {r[key]:9.0f}"
         if base:

@@ -4,7 +4,9 @@ Two 1000-bead steel chains struck by one bead mass at 0.44 m/s: sonic vacuum (no
 no precompression) and precompressed (2.38 N from the top, wall at the bottom). Every
 solver records the same probe, the force of contact 500, on the same 1 MS/s grid. Error:
 max |F - F_ref| / max |F_ref - F_ref(0)| against the converged reference of ``rig bench
-accuracy``. CPU times are process times, medians of ``repeats`` runs.
+accuracy``. CPU times are process times, medians of ROUNDS rounds in which every run of a
+scenario takes its turn (the machine's drift over minutes falls on every method alike);
+ratios at equal error are the medians of the per-round ratios.
 
 - srkn6b and verlet at fixed outer steps tau / r (the head resolved), no estimate: the
   integrators' work-precision curves; srkn6b at the accuracy settings, the controlled
@@ -24,12 +26,13 @@ accuracy``. CPU times are process times, medians of ``repeats`` runs.
 from __future__ import annotations
 
 import math
-import os
-import platform
+import statistics
+import time
 
 from rig.bench import models
 from rig.bench.accuracy import cases, reference
-from rig.bench.kernel_cost import kernel_figures, median_cpu, scaling
+from rig.bench.baseline import machine
+from rig.bench.kernel_cost import kernel_figures, scaling
 from rig.model.chain import Chain
 from rig.model.parts import Bead, Striker, Wall
 from rig.solver.solution import relative_error
@@ -48,6 +51,7 @@ SETTINGS = (1e-3, 1e-4, 1e-5, 1e-6)
 PEERS = {"scipy-DOP853": (1e-6, 1e-8, 1e-10), "numba-DOP853": (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12),
          "LAMMPS": (20, 50, 100)}  # rtol, or tau / dt for LAMMPS
 EQUAL_ERRORS = (1e-4, 1e-5, 1e-6)
+ROUNDS = 5  # every run of the work-precision curves, in turns with the others (interleaved)
 QUICK = dict(divisions={"srkn6b": (3, 6, 12), "verlet": (32, 128)}, settings=(1e-4,), peers={
     "scipy-DOP853": (1e-8,), "numba-DOP853": (1e-8, 1e-10), "LAMMPS": (20,)}, scenarios=("precompressed",))
 
@@ -63,53 +67,102 @@ def _row(scenario, method, setting, cpu, error, evaluations, bodies, **extra) ->
                 ns_per_bead_eval=cpu / (evaluations * bodies) * 1e9 if evaluations else None, **extra)
 
 
-def _ours(name, p, save, t_end, ref, divisions, settings, repeats, progress) -> list:
-    rows = []
+def _timed(fn) -> tuple:
+    """(fn(), CPU seconds it took)."""
+    t0 = time.process_time()
+    out = fn()
+    return out, time.process_time() - t0
+
+
+def _ours(name, p, save, t_end, ref, divisions, settings) -> list:
+    """The runs of srkn6b and verlet on one scenario, each a function giving its row: fixed
+    outer steps tau / r without estimate, and the controlled solve at each accuracy setting."""
     tau = contact_time_scale(p, head_contacts(p) + 1)
-    for method, rs in divisions.items():
-        for r in rs:
-            if progress:
-                progress(f"{name}: {method} dt = tau/{r}")
-            sol, cpu = median_cpu(lambda: solve(p, t_end, save=save, method=method, dt=stepping_at(p, tau / r),
-                                                 estimate=False), repeats)
-            rows.append(_row(name, method, f"dt=tau/{r}", cpu, relative_error(sol.forces, ref),
-                             sol.stats.force_evaluations, p.moving_bodies, dt_s=sol.stats.dt_s))
-    for acc in settings:
-        if progress:
-            progress(f"{name}: srkn6b accuracy={acc:g} (controlled, with its estimate)")
-        sol, cpu = median_cpu(lambda: solve(p, t_end, save=save, accuracy=acc), repeats)
-        rows.append(_row(name, "srkn6b-controlled", f"accuracy={acc:g}", cpu, relative_error(sol.forces, ref), None,
-                         p.moving_bodies, dt_s=sol.stats.dt_s, estimate=sol.stats.error_estimate,
-                         attempts=sol.stats.attempts))
-    return rows
+
+    def fixed(method, r):
+        def go():
+            sol, cpu = _timed(lambda: solve(p, t_end, save=save, method=method, dt=stepping_at(p, tau / r),
+                                            estimate=False))
+            return _row(name, method, f"dt=tau/{r}", cpu, relative_error(sol.forces, ref),
+                        sol.stats.force_evaluations, p.moving_bodies, dt_s=sol.stats.dt_s)
+        return f"{name}: {method} dt = tau/{r}", go
+
+    def controlled(acc):
+        def go():
+            sol, cpu = _timed(lambda: solve(p, t_end, save=save, accuracy=acc))
+            return _row(name, "srkn6b-controlled", f"accuracy={acc:g}", cpu, relative_error(sol.forces, ref), None,
+                        p.moving_bodies, dt_s=sol.stats.dt_s, estimate=sol.stats.error_estimate,
+                        attempts=sol.stats.attempts)
+        return f"{name}: srkn6b accuracy={acc:g} (controlled, with its estimate)", go
+
+    return ([fixed(method, r) for method, rs in divisions.items() for r in rs]
+            + [controlled(acc) for acc in settings])
 
 
-def _peers(name, p, save, t_end, ref, peers, progress) -> tuple:
+def _peers(name, p, save, t_end, ref, peers) -> tuple:
+    """(the runs of the peers on one scenario, each a function giving its row; notes)."""
     from rig.bench import lammps
     from rig.bench.peers import numba_dop853, scipy_dop853
 
-    rows, notes = [], []
-    tau = contact_time_scale(p, head_contacts(p) + 1)
-    for peer, integrate in (("scipy-DOP853", scipy_dop853), ("numba-DOP853", numba_dop853)):
-        for rtol in peers[peer]:
-            if progress:
-                progress(f"{name}: {peer} rtol={rtol:g}")
-            run = integrate(p, save, t_end, rtol)
-            rows.append(_row(name, run.name, run.setting, run.cpu_s,
-                             relative_error({"c": run.force}, {"c": ref["c500"]}), run.rhs_evaluations,
-                             p.moving_bodies))
+    def peer(label, integrate, setting):
+        def go():
+            run = integrate(p, save, t_end, setting)
+            return _row(name, run.name, run.setting, run.cpu_s, relative_error({"c": run.force}, {"c": ref["c500"]}),
+                        run.rhs_evaluations, p.moving_bodies, **({"note": run.note} if label == "LAMMPS" else {}))
+        return f"{name}: {label} {'dt = tau/' if label == 'LAMMPS' else 'rtol='}{setting:g}", go
+
+    runs = [peer(label, integrate, rtol) for label, integrate in (("scipy-DOP853", scipy_dop853),
+                                                                 ("numba-DOP853", numba_dop853))
+            for rtol in peers[label]]
     if lammps.executable() is None:
-        notes.append("LAMMPS not installed (apt-get install lammps): skipped")
-    else:
-        for r in peers["LAMMPS"]:
+        return runs, ["LAMMPS not installed (apt-get install lammps): skipped"]
+    tau = contact_time_scale(p, head_contacts(p) + 1)
+    return runs + [peer("LAMMPS", lambda p_, s_, t_, r: lammps.lammps_hertz(p_, s_, t_, tau / r), r)
+                   for r in peers["LAMMPS"]], []
+
+
+def interleaved(runs: list, rounds: int, progress=None) -> list:
+    """Rows of every run, ``rounds`` times, each round running them all in turn, every other
+    round in reverse order (so that the machine's drift over minutes, even within a round,
+    falls on every method alike): a list per round, in the order of ``runs``."""
+    out = []
+    for k in range(rounds):
+        order = range(len(runs)) if k % 2 == 0 else range(len(runs) - 1, -1, -1)
+        rows = [None] * len(runs)
+        for i in order:
+            label, go = runs[i]
             if progress:
-                progress(f"{name}: LAMMPS dt = tau/{r}")
-            run = lammps.lammps_hertz(p, save, t_end, tau / r)
-            rows.append(_row(name, run.name, run.setting, run.cpu_s,
-                             relative_error({"c": run.force}, {"c": ref["c500"]}), run.rhs_evaluations,
-                             p.moving_bodies))
-            notes.append(f"LAMMPS: {run.note}")
-    return rows, notes
+                progress(f"{label} (round {k + 1} of {rounds})")
+            rows[i] = go()
+        out.append(rows)
+    return out
+
+
+def median_rows(per_round: list) -> list:
+    """One row per run: the first round's (errors are the same every round) with the median
+    CPU time over the rounds (and ns per bead per evaluation from it)."""
+    out = []
+    for rows in zip(*per_round):
+        row = dict(rows[0])
+        cpu = statistics.median(r["cpu_s"] for r in rows)
+        if row["ns_per_bead_eval"]:
+            row["ns_per_bead_eval"] *= cpu / row["cpu_s"]
+        row.update(cpu_s=cpu, cpu_rounds_s=[r["cpu_s"] for r in rows])
+        out.append(row)
+    return out
+
+
+def equal_error_rounds(per_round: list) -> list:
+    """at_equal_error within each round, then, per scenario, method and error, the median
+    CPU and the median of the per-round ratios to srkn6b."""
+    tables = [at_equal_error(rows) for rows in per_round]
+    out = []
+    for entries in zip(*tables):
+        cpus = [e["cpu_s"] for e in entries if e["cpu_s"] is not None]
+        ratios = [e["ratio_to_srkn6b"] for e in entries if e["ratio_to_srkn6b"] is not None]
+        out.append(dict(entries[0], cpu_s=statistics.median(cpus) if cpus else None,
+                        ratio_to_srkn6b=statistics.median(ratios) if ratios else None, rounds=len(ratios)))
+    return out
 
 
 def at_equal_error(rows: list, errors=EQUAL_ERRORS) -> list:
@@ -151,31 +204,24 @@ def run(quick: bool = False, peers: bool = False, baseline: str | None = None, p
     settings = QUICK["settings"] if quick else SETTINGS
     names = QUICK["scenarios"] if quick else tuple(SCENARIOS)
     peer_settings = QUICK["peers"] if quick else PEERS
-    repeats = 1 if quick else 3
-    rows, notes = [], []
+    rounds = 1 if quick else ROUNDS
+    per_round, notes = [[] for _ in range(rounds)], []
     for name, p, save, t_end in cases(names):
         if progress:
             progress(f"{name}: reference")
         ref = reference(p, t_end, save)
-        rows += _ours(name, p, save, t_end, ref, divisions, settings, repeats, progress)
+        runs = _ours(name, p, save, t_end, ref, divisions, settings)
         if peers:
-            more, said = _peers(name, p, save, t_end, ref, peer_settings, progress)
-            rows += more
+            more, said = _peers(name, p, save, t_end, ref, peer_settings)
+            runs += more
             notes += [n for n in said if n not in notes]
-    return dict(rows=rows, at_equal_error=at_equal_error(rows), notes=notes, machine=_machine(),
-                beads=N_BEADS, probe_contact=PROBE,
+        for k, rows in enumerate(interleaved(runs, rounds, progress)):
+            per_round[k] += rows
+    notes += list(dict.fromkeys(f"LAMMPS: {r['note']}" for r in per_round[0] if r.get("note")))
+    return dict(rows=median_rows(per_round), at_equal_error=equal_error_rounds(per_round), rounds=rounds,
+                notes=notes, machine=machine(), beads=N_BEADS, probe_contact=PROBE,
                 kernel=kernel_figures(1 if quick else 5, 1 if quick else 3, baseline, progress),
                 scaling=None if quick else scaling(chain, progress), models=models.run(quick, progress))
-
-
-def _machine() -> str:
-    model = platform.processor() or ""
-    try:
-        with open("/proc/cpuinfo") as fh:
-            model = next((line.split(":", 1)[1].strip() for line in fh if line.startswith("model name")), model)
-    except OSError:
-        pass
-    return f"{model} ({os.cpu_count()} cores), {platform.system()} {platform.machine()}"
 
 
 def table(result: dict) -> str:
@@ -186,7 +232,8 @@ def table(result: dict) -> str:
         extra = f"  estimate {r['estimate']:.2e}, {r['attempts']} solves" if r.get("estimate") else ""
         lines.append(f"{r['scenario']:14s} {r['method']:18s} {r['setting']:17s} {r['cpu_s']:8.4f} "
                      f"{r['error']:9.2e} {ns}{extra}")
-    lines += ["", "At equal error: CPU seconds, interpolated log-log, and as a multiple of srkn6b's (fixed steps)"]
+    lines += ["", f"At equal error: CPU seconds, interpolated log-log, and as a multiple of srkn6b's (fixed steps); "
+                  f"medians over {result['rounds']} interleaved round(s)"]
     for r in result["at_equal_error"]:
         if r["cpu_s"] is not None:
             ratio = f"{r['ratio_to_srkn6b']:7.1f} x" if r["ratio_to_srkn6b"] else "      -"

@@ -3,7 +3,7 @@ import json
 
 import pytest
 
-from rig.bench.solver import at_equal_error
+from rig.bench.solver import at_equal_error, equal_error_rounds, interleaved, median_rows
 from rig.cli import main
 
 
@@ -138,3 +138,29 @@ def test_sensitivity_with_its_unit_equals_the_plain_number(capsys, realdata):
     with_unit, plain = runs
     assert with_unit == plain
     assert with_unit[0] == 1  # its second record is an envelope: refused, with the reason, exit 1
+
+
+def test_work_precision_ratios_are_medians_of_interleaved_rounds():
+    # round 2 ran on a machine twice as slow for every method: the ratios do not see it; a
+    # method timed alone in a slow minute (round 3, DOP853 only) moves one ratio of three
+    def rows(ours, theirs):
+        return [dict(scenario="s", method="srkn6b", setting="a", cpu_s=ours, error=1e-3, ns_per_bead_eval=1.0),
+                dict(scenario="s", method="srkn6b", setting="b", cpu_s=2 * ours, error=1e-5, ns_per_bead_eval=1.0),
+                dict(scenario="s", method="numba-DOP853", setting="c", cpu_s=theirs, error=1e-3, ns_per_bead_eval=None),
+                dict(scenario="s", method="numba-DOP853", setting="d", cpu_s=2 * theirs, error=1e-5,
+                     ns_per_bead_eval=None)]
+    per_round = [rows(0.1, 0.5), rows(0.2, 1.0), rows(0.1, 1.5)]
+    at = {(r["method"], r["error"]): r for r in equal_error_rounds(per_round)}
+    assert at["numba-DOP853", 1e-4]["ratio_to_srkn6b"] == pytest.approx(5.0)
+    assert at["numba-DOP853", 1e-4]["rounds"] == 3
+    med = median_rows(per_round)
+    assert [r["cpu_s"] for r in med] == pytest.approx([0.1, 0.2, 1.0, 2.0])
+    assert med[0]["cpu_rounds_s"] == pytest.approx([0.1, 0.2, 0.1]) and med[0]["ns_per_bead_eval"] == 1.0
+
+
+def test_interleaved_rounds_alternate_their_order():
+    done = []
+    runs = [(name, lambda name=name: done.append(name) or {"name": name}) for name in "abc"]
+    per_round = interleaved(runs, 3)
+    assert done == list("abccbaabc")  # a drift within a round falls on the first and the last alike
+    assert all([r["name"] for r in rows] == list("abc") for rows in per_round)
