@@ -24,16 +24,20 @@ import os
 import statistics
 import tempfile
 import time
+from dataclasses import dataclass
 
 from instruments import batch as instrument_batch
 from rig.experiment.measure import setup_for
+from rig.experiment.shot import Rig
 from rig.solver.ensemble import solve_ensemble
-from rig.solver.stepsize import stepping_at
+from rig.solver.saveat import SaveAt
+from rig.solver.solution import Solution
+from rig.solver.stepsize import Stepping, stepping_at
 from rig.study.batch import run_batch, shot_inputs
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
 from rig.study.mc_spec import Study
-from rig.study.nominal import nominal
+from rig.study.nominal import Nominal, nominal
 from rig.study.shots import shots_of, wave_speeds, wiring_of
 from rig.study.store import Store
 
@@ -48,18 +52,39 @@ print(json.dumps(mc.run(**({"rounds": 1} if "rounds" in mc.run.__code__.co_varna
 """
 
 
+@dataclass(frozen=True)
+class Setting:
+    """What every shot of the benchmark's study starts from, as run_batch takes it: the
+    nominal rig's template in the study's window, the channels a study records, its pilot
+    (the step's calibration) and the stepping the shots take."""
+
+    nominal: Nominal
+    template: Rig
+    save: SaveAt
+    pilot: Solution
+    stepping: Stepping
+
+    @classmethod
+    def of(cls, study: Study) -> "Setting":
+        nom = nominal(study.scene, ())
+        template = nom.template(study.window)
+        save = template.save_at(contacts=False, averages=True)
+        pilot = nom.pilot(study.window, save, study.accuracy)
+        return cls(nom, template, save, pilot, stepping_at(pilot.problem, pilot.stats.dt_s))
+
+    def shots(self, study: Study, lo: int, hi: int) -> tuple:
+        """(shots lo..hi-1 as the solver's arrays (rig/study/shots.py), their instruments' seeds)."""
+        beads = self.nominal.rig.values["chain"]["beads"]
+        drawn = [shot_inputs(study, i, beads) for i in range(lo, hi)]
+        return shots_of(self.template, [x for x, *_ in drawn], [m for _, m, _ in drawn]), [s for *_, s in drawn]
+
+
 def _solver(study: Study, shots: int) -> dict:
-    nom = nominal(study.scene, ())
-    template = nom.template(study.window)
-    save = template.save_at(contacts=False, averages=True)
-    pilot = nom.pilot(study.window, save, study.accuracy)
-    dt = stepping_at(pilot.problem, pilot.stats.dt_s)
+    setting = Setting.of(study)
+    template, save, pilot, dt = setting.template, setting.save, setting.pilot, setting.stepping
     t_end = template.solver.duration
     t0 = time.perf_counter()
-    batches = []
-    for lo in range(0, shots, BATCH):  # each batch's shots as the solver's arrays (rig/study/shots.py)
-        drawn = [shot_inputs(study, i, 52) for i in range(lo, lo + BATCH)]
-        batches.append(shots_of(template, [x for x, *_ in drawn], [m for _, m, _ in drawn]).problems)
+    batches = [setting.shots(study, lo, lo + BATCH)[0].problems for lo in range(0, shots, BATCH)]
     arrays = time.perf_counter() - t0
     solve_ensemble(batches[0], t_end, save=save, dt=dt)
     kernel, total = [], []
@@ -104,23 +129,18 @@ STAGES = {"inputs": "each shot's inputs drawn, the shots' arrays built",
 def _stages(study: Study, batches: int = 4) -> dict:
     """Wall time per shot (us) of each stage of a batch, run in turn as run_batch runs them
     (numba's threads; after WARM_UP batches)."""
-    nom = nominal(study.scene, ())
-    template = nom.template(study.window)
-    save = template.save_at(contacts=False, averages=True)
-    pilot = nom.pilot(study.window, save, study.accuracy)
-    dt = stepping_at(pilot.problem, pilot.stats.dt_s)
+    setting = Setting.of(study)
+    template = setting.template
     wiring = wiring_of(template)
-    setup = setup_for(template, *nom.calibration)
+    setup = setup_for(template, *setting.nominal.calibration)
     spent = dict.fromkeys(STAGES, 0.0)
     for b in range(WARM_UP + batches):
         t = [time.perf_counter()]
-        drawn = [shot_inputs(study, i, 52) for i in range(b * BATCH, (b + 1) * BATCH)]
-        shots = shots_of(template, [x for x, *_ in drawn], [m for _, m, _ in drawn])
+        shots, seeds = setting.shots(study, b * BATCH, (b + 1) * BATCH)
         t.append(time.perf_counter())
-        ens = solve_ensemble(shots.problems, template.solver.duration, save=save, dt=dt)
+        ens = solve_ensemble(shots.problems, template.solver.duration, save=setting.save, dt=setting.stepping)
         speeds = wave_speeds(template, shots, ens.records, ens.sample_interval)
         t.append(time.perf_counter())
-        seeds = [seed for *_, seed in drawn]
         records = instrument_batch.acquire(ens.records, ens.sample_interval, wiring, seeds, shots.fixed, speeds)
         t.append(time.perf_counter())
         instrument_batch.analysed(records, setup)

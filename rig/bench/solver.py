@@ -27,12 +27,11 @@ from __future__ import annotations
 
 import math
 import statistics
-import time
 
 from rig.bench import models
 from rig.bench.accuracy import cases, reference
 from rig.bench.baseline import machine
-from rig.bench.kernel_cost import kernel_figures, scaling
+from rig.bench.kernel_cost import kernel_figures, median_cpu, scaling
 from rig.model.chain import Chain
 from rig.model.parts import Bead, Striker, Wall
 from rig.solver.solution import relative_error
@@ -67,13 +66,6 @@ def _row(scenario, method, setting, cpu, error, evaluations, bodies, **extra) ->
                 ns_per_bead_eval=cpu / (evaluations * bodies) * 1e9 if evaluations else None, **extra)
 
 
-def _timed(fn) -> tuple:
-    """(fn(), CPU seconds it took)."""
-    t0 = time.process_time()
-    out = fn()
-    return out, time.process_time() - t0
-
-
 def _ours(name, p, save, t_end, ref, divisions, settings) -> list:
     """The runs of srkn6b and verlet on one scenario, each a function giving its row: fixed
     outer steps tau / r without estimate, and the controlled solve at each accuracy setting."""
@@ -81,15 +73,15 @@ def _ours(name, p, save, t_end, ref, divisions, settings) -> list:
 
     def fixed(method, r):
         def go():
-            sol, cpu = _timed(lambda: solve(p, t_end, save=save, method=method, dt=stepping_at(p, tau / r),
-                                            estimate=False))
+            sol, cpu = median_cpu(lambda: solve(p, t_end, save=save, method=method, dt=stepping_at(p, tau / r),
+                                                estimate=False), 1)
             return _row(name, method, f"dt=tau/{r}", cpu, relative_error(sol.forces, ref),
                         sol.stats.force_evaluations, p.moving_bodies, dt_s=sol.stats.dt_s)
         return f"{name}: {method} dt = tau/{r}", go
 
     def controlled(acc):
         def go():
-            sol, cpu = _timed(lambda: solve(p, t_end, save=save, accuracy=acc))
+            sol, cpu = median_cpu(lambda: solve(p, t_end, save=save, accuracy=acc), 1)
             return _row(name, "srkn6b-controlled", f"accuracy={acc:g}", cpu, relative_error(sol.forces, ref), None,
                         p.moving_bodies, dt_s=sol.stats.dt_s, estimate=sol.stats.error_estimate,
                         attempts=sol.stats.attempts)

@@ -262,4 +262,3 @@ def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, law, con, onsite, sl
         _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], law, con[k], onsite[k], slip,
                viscous_rate, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, k * W,
                check_every, d_limit[k], wall_slot, e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)
-
