@@ -103,42 +103,38 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
 
 
 @jit
-def _record(row, w, col, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new):
-    """row[c, s]: channel c's force (N) of every shot s at one sample (fraction x of the
-    step), whose Hermite weights are column col of w: record.recorded_force's operations,
-    in its order (0 + the first term is that term: no force is -0), with the shots
-    innermost (the Hertz loop vectorises)."""
-    W = row.shape[1]
-    w0, w1, w2, w3 = w[0, col], w[1, col], w[2, col], w[3, col]
-    for c in range(ch_slot.shape[0]):
-        first = True
-        for k in range(ch_slot.shape[1]):
-            wk = ch_weight[c, k]
-            if wk != 0.0:
-                i = ch_slot[c, k]
-                for s in range(W):
-                    d = w0 * d_old[c, k, s] + w1 * r_old[c, k, s] + w2 * d_new[c, k, s] + w3 * r_new[c, k, s]
-                    if law == HERTZ:
-                        d = d if d > 0.0 else 0.0
-                        fk = wk * (A[i, s] * d * math.sqrt(d))
-                    else:
-                        rate = (1.0 - x) * r_old[c, k, s] + x * r_new[c, k, s]
-                        fc, _ = contact_force(d, rate, A[i, s], con[0, i, s], con[1, i, s], con[2, i, s], law)
-                        fk = wk * fc
-                    row[c, s] = fk if first else row[c, s] + fk
-                first = False
-        if first:  # a channel of no contact records nothing
-            for s in range(W):
-                row[c, s] = 0.0
-
-
-@jit(inline="always")
-def _deliver(row, out, j, lo):
-    """out[lo + s, c, j] = row[c, s] for the shots of the chunk that out holds (the chunk's
-    last ones may be fill)."""
-    for s in range(min(row.shape[1], out.shape[0] - lo)):
-        for c in range(row.shape[0]):
-            out[lo + s, c, j] = row[c, s]
+def _record(out, lo, j0, nj, w, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new):
+    """out[lo + s, c, j0 + m] for m < nj: channel c's force (N) of every shot s of the chunk
+    (its last ones may be fill, not in out) at the step's m-th sample, at fraction x[m] of
+    the step, whose Hermite weights are column m of w: record.recorded_force's operations,
+    in its order (0 + the first term is that term: no force is -0). The samples of a step
+    are innermost: the Hertz loop vectorises over them, and each shot's channel is written
+    as one contiguous run of its record."""
+    n_ch = ch_slot.shape[0]
+    for s in range(min(d_old.shape[2], out.shape[0] - lo)):
+        for c in range(n_ch):
+            o = out[lo + s, c, j0:j0 + nj]
+            first = True
+            for k in range(ch_slot.shape[1]):
+                wk = ch_weight[c, k]
+                if wk != 0.0:
+                    i = ch_slot[c, k]
+                    a = A[i, s]
+                    y0, r0, y1, r1 = d_old[c, k, s], r_old[c, k, s], d_new[c, k, s], r_new[c, k, s]
+                    for m in range(nj):
+                        d = w[0, m] * y0 + w[1, m] * r0 + w[2, m] * y1 + w[3, m] * r1
+                        if law == HERTZ:
+                            d = d if d > 0.0 else 0.0
+                            fk = wk * (a * d * math.sqrt(d))
+                        else:
+                            rate = (1.0 - x[m]) * r0 + x[m] * r1
+                            fc, _ = contact_force(d, rate, a, con[0, i, s], con[1, i, s], con[2, i, s], law)
+                            fk = wk * fc
+                        o[m] = fk if first else o[m] + fk
+                    first = False
+            if first:  # a channel of no contact records nothing
+                for m in range(nj):
+                    o[m] = 0.0
 
 
 @jit
@@ -149,7 +145,6 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
     W = u.shape[1]
     n_drift = a_coef.shape[0]
     n_out = out.shape[2]
-    row = np.empty((ch_slot.shape[0], W))  # one sample of every channel and shot
     viscous = False
     holder = False
     for i in range(nb):
@@ -175,15 +170,15 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
     j_wall = np.zeros(W)
     w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
     x = np.empty(w.shape[1])  # their fractions of the step
-    h_work, h_busy = np.empty((2, 3, head + 1)), np.empty(W)  # the head flow's work arrays
+    h_work, h_busy = np.empty((2, 3, head + 1, W)), np.empty((5 + head, W))  # the head flow's work arrays
     state_sums(u, v, mass, bias, A, con[0], d0, d_limit, e0, p0, worst)
     for s in range(u.shape[1]):
         net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
     probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, 0.0, head, -1, 0.0, d_old, r_old)
     if n_out > 0:
         hermite_weights(0.0, dt, w, 0)
-        _record(row, w, 0, 0.0, ch_slot, ch_weight, A, law, con, d_old, r_old, d_old, r_old)
-        _deliver(row, out, 0, lo)
+        x[0] = 0.0
+        _record(out, lo, 0, 1, w, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_old, r_old)
     j_out = 1
     pending = 0.0
     for n in range(n_steps):
@@ -220,9 +215,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
         for j in range(j_out, j_end):  # the weights are the same for every shot and channel
             x[j - j_out] = (j * sample_dt - t) / dt
             hermite_weights(x[j - j_out], dt, w, j - j_out)
-        for j in range(j_out, j_end):
-            _record(row, w, j - j_out, x[j - j_out], ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new)
-            _deliver(row, out, j, lo)
+        _record(out, lo, j_out, j_end - j_out, w, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new)
         j_out = j_end
         d_old[:, :, :] = d_new
         r_old[:, :, :] = r_new

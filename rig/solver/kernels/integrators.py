@@ -80,7 +80,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
     lost = np.zeros(1)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
     j_visc = np.zeros(1)
     j_holder = np.zeros(1)
-    h_work, h_busy = np.empty((2, 3, head + 1)), np.empty(1)  # the head flow's work arrays
+    h_work, h_busy = np.empty((2, 3, head + 1, 1)), np.empty((5 + head, 1))  # the head flow's work arrays
     # sum of constant loads, less the part the wall's slot carries (j_wall is dynamic)
     wall_load = load[wall_slot] if wall_slot > 0 else 0.0
     net_const = load[nb] - wall_load

@@ -67,101 +67,125 @@ def _busy(u, v, invm, d0, load, head, a_coef, b_coef, h, busy):
             busy[s] = busy[s] if gap - abs(rate) * reach - abs(curv) * spread > 0.0 else 1.0
 
 
-@jit(inline="always")
-def _closed(d0, u, i, s):
-    return d0[i, s] + u[i - 1, s] - u[i, s] > 0.0
-
-
 @jit
-def _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s):
-    """One step of k seconds of the composition on the head of shot s, its first kick
-    merged with the owed ``pending`` seconds; returns (the closing kick it owes (s),
-    whether a head contact opened or closed during it)."""
-    changed = False
-    state = 0  # bit i: slot i + 1 closed at the start
+def _lane_substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, active, changed, closed):
+    """One step of k seconds of the composition on the head of every shot s with
+    active[s] != 0 (the others' rows are left as they were), its first kick merged with
+    the owed pending[s] seconds; changed[s] = 1 where a head contact opened or closed during
+    it. closed: (head, shots) work array. The shots are innermost and every store is a
+    select, so the loops vectorise; each shot gets the operations of a scalar substep."""
+    W = u.shape[1]
     for i in range(1, head + 1):
-        if _closed(d0, u, i, s):
-            state |= 1 << (i - 1)
+        for s in range(W):
+            closed[i - 1, s] = 1.0 if d0[i, s] + u[i - 1, s] - u[i, s] > 0.0 else 0.0
+    for s in range(W):
+        changed[s] = 0.0
     for st in range(a_coef.shape[0]):
-        hb = b_coef[st] * k
-        if st == 0:
-            hb += pending
+        hk = b_coef[st] * k
+        ha = a_coef[st] * k
         for i in range(head + 1):
-            below = f[i + 1, s] if i < head else 0.0
-            v[i, s] += hb * (f[i, s] - below) * invm[i, s]
+            if i < head:
+                for s in range(W):
+                    hb = hk + pending[s] if st == 0 else hk
+                    vn = v[i, s] + hb * (f[i, s] - f[i + 1, s]) * invm[i, s]
+                    v[i, s] = vn if active[s] != 0.0 else v[i, s]
+            else:  # the head's last body: the slot below it is the method's kicks' (slow_net)
+                for s in range(W):
+                    hb = hk + pending[s] if st == 0 else hk
+                    vn = v[i, s] + hb * (f[i, s] - 0.0) * invm[i, s]
+                    v[i, s] = vn if active[s] != 0.0 else v[i, s]
         for i in range(head + 1):
-            u[i, s] += a_coef[st] * k * v[i, s]
+            for s in range(W):
+                un = u[i, s] + ha * v[i, s]
+                u[i, s] = un if active[s] != 0.0 else u[i, s]
         for i in range(1, head + 1):
-            d = d0[i, s] + u[i - 1, s] - u[i, s]
-            if (d > 0.0) != ((state >> (i - 1)) & 1 == 1):
-                changed = True
-            d = d if d > 0.0 else 0.0
-            f[i, s] = A[i, s] * d * math.sqrt(d) - load[i, s]
-    return b_coef[a_coef.shape[0]] * k, changed
+            for s in range(W):
+                d = d0[i, s] + u[i - 1, s] - u[i, s]
+                flip = (d > 0.0) != (closed[i - 1, s] != 0.0)
+                changed[s] = 1.0 if flip and active[s] != 0.0 else changed[s]
+                d = d if d > 0.0 else 0.0
+                fn = A[i, s] * d * math.sqrt(d) - load[i, s]
+                f[i, s] = fn if active[s] != 0.0 else f[i, s]
 
 
 @jit
-def _save(u, v, f, head, s, saved):
+def _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, active, changed, closed, saved):
+    """A substep of k seconds on the active shots (_lane_substep). A shot in which a head
+    contact changed state is put back as it was before it (its pending kick kept) and keeps
+    changed[s] = 1; every other active shot owes the substep's closing kick (pending[s]).
+    Returns whether any shot changed. saved: (3, head + 1, shots)."""
+    W = u.shape[1]
     for i in range(head + 1):
-        saved[0, i] = u[i, s]
-        saved[1, i] = v[i, s]
-        saved[2, i] = f[i, s]
-
-
-@jit
-def _restore(u, v, f, head, s, saved):
+        for s in range(W):
+            saved[0, i, s] = u[i, s]
+            saved[1, i, s] = v[i, s]
+            saved[2, i, s] = f[i, s]
+    _lane_substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, active, changed, closed)
+    owed = b_coef[a_coef.shape[0]] * k
+    hits = 0.0
+    for s in range(W):
+        hit = active[s] != 0.0 and changed[s] != 0.0
+        changed[s] = 1.0 if hit else 0.0
+        pending[s] = pending[s] if hit or active[s] == 0.0 else owed
+        hits += changed[s]
+    if hits == 0.0:
+        return False
     for i in range(head + 1):
-        u[i, s] = saved[0, i]
-        v[i, s] = saved[1, i]
-        f[i, s] = saved[2, i]
+        for s in range(W):
+            back = changed[s] != 0.0
+            u[i, s] = saved[0, i, s] if back else u[i, s]
+            v[i, s] = saved[1, i, s] if back else v[i, s]
+            f[i, s] = saved[2, i, s] if back else f[i, s]
+    return True
 
 
 @jit
-def _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s, saved):
-    """A substep of k seconds (_substep); where a head contact changed state during it,
-    the state is put back as it was and (pending, True) is returned, else (the closing kick
-    owed, False)."""
-    _save(u, v, f, head, s, saved)
-    owed, changed = _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s)
-    if not changed:
-        return owed, False
-    _restore(u, v, f, head, s, saved)
-    return pending, True
-
-
-@jit
-def _resolved_substeps(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, n, s, work):
-    """n substeps of k seconds on shot s's head, each substep across a change of contact
-    state taken again as REFINE, and the piece across it as REFINE again; ends with the
-    owed closing kick applied. work: (2, 3, head + 1) saved states."""
-    pending = 0.0
+def _resolved_substeps(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, n, saved, lanes):
+    """n substeps of k seconds on the head of every busy shot (lanes[0] != 0), each substep
+    across a change of contact state taken again as REFINE, and the piece across it as
+    REFINE again; ends with the owed closing kick applied. All shots of a level run at
+    once, masked (the shots of a batch strike at about the same substeps); each shot gets
+    the operations of its own sequence of substeps. saved: (2, 3, head + 1, shots);
+    lanes: (5 + head, shots) work array (busy, pending, changed, the shots refined at
+    each level, the head contacts' states)."""
+    busy, pending, changed, fine, finest, closed = lanes[0], lanes[1], lanes[2], lanes[3], lanes[4], lanes[5:]
+    last = b_coef[a_coef.shape[0]]
+    W = u.shape[1]
+    for s in range(W):
+        pending[s] = 0.0
     for _ in range(n):
-        pending, changed = _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, s, work[0])
-        if not changed:
+        if not _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, busy, changed, closed,
+                        saved[0]):
             continue
+        fine[:] = changed
         for _ in range(REFINE):
-            pending, changed = _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k / REFINE, pending, s,
-                                        work[1])
-            if not changed:
+            if not _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k / REFINE, pending, fine, changed,
+                            closed, saved[1]):
                 continue
+            finest[:] = changed
+            kk = k / REFINE / REFINE
             for _ in range(REFINE):
-                pending, _ = _substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k / REFINE / REFINE,
-                                      pending, s)
+                _lane_substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, kk, pending, finest, changed, closed)
+                for s in range(W):
+                    pending[s] = last * kk if finest[s] != 0.0 else pending[s]
     for i in range(head + 1):
-        below = f[i + 1, s] if i < head else 0.0
-        v[i, s] += pending * (f[i, s] - below) * invm[i, s]
+        for s in range(W):
+            below = f[i + 1, s] if i < head else 0.0
+            vn = v[i, s] + pending[s] * (f[i, s] - below) * invm[i, s]
+            v[i, s] = vn if busy[s] != 0.0 else v[i, s]
 
 
 @jit
-def head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, h, n, work, busy):
+def head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, h, n, work, lanes):
     """Advance every shot's head by h seconds (u, v, f in place): n resolved substeps where
     a head contact is or may come closed; elsewhere the exact flow under the constant
     loads, u += h v + h^2 a / 2, v += h a (the forces stay -load), branch-free over the
-    shots. work: (2, 3, head + 1) saved states; busy: (shots,) float64."""
+    shots. work: (2, 3, head + 1, shots) saved states; lanes: (5 + head, shots) float64
+    (_resolved_substeps)."""
+    busy = lanes[0]
     _busy(u, v, invm, d0, load, head, a_coef, b_coef, h, busy)
-    for s in range(u.shape[1]):
-        if busy[s] != 0.0:
-            _resolved_substeps(u, v, invm, f, A, d0, load, head, a_coef, b_coef, h / n, n, s, work)
+    if busy.sum() > 0.0:
+        _resolved_substeps(u, v, invm, f, A, d0, load, head, a_coef, b_coef, h / n, n, work, lanes)
     for i in range(head + 1):
         for s in range(u.shape[1]):
             below = f[i + 1, s] if i < head else 0.0
