@@ -171,7 +171,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
     w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
     x = np.empty(w.shape[1])  # their fractions of the step
     h_work, h_busy = np.empty((2, 3, head + 1, W)), np.empty((5 + head, W))  # the head flow's work arrays
-    state_sums(u, v, mass, bias, A, con[0], d0, d_limit, e0, p0, worst)
+    state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, e0, p0, worst)
     for s in range(u.shape[1]):
         net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
     probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, 0.0, head, -1, 0.0, d_old, r_old)
@@ -220,7 +220,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
         d_old[:, :, :] = d_new
         r_old[:, :, :] = r_new
         if check:
-            state_sums(u, v, mass, bias, A, con[0], d0, d_limit, e, pn, worst)
+            state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, e, pn, worst)
             for s in range(u.shape[1]):
                 err = abs(e[s] + lost[s] - e0[s]) / e_ref[s]
                 pe = abs(pn[s] - p0[s] - (t_new * net[s] - (j_wall[s] + j_visc[s]) + j_holder[s])) / p_ref[s]

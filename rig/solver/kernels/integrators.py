@@ -86,7 +86,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
     net_const = load[nb] - wall_load
     sums = np.empty(3)  # energy (J), momentum (kg m/s), largest d / d_limit of one state
     m2, b2, dl2 = mass.reshape((nb, 1)), bias.reshape((nb, 1)), d_limit.reshape((nb, 1))
-    state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, sums[0:1], sums[1:2], sums[2:3])
+    state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, law, sums[0:1], sums[1:2], sums[2:3])
     e0, p0 = sums[0], sums[1]
     impulses = np.zeros(2)  # the wall's dynamic impulse, the schedule's (N s)
     w_sched = 0.0
@@ -165,7 +165,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
             j_frame += 1
 
         if check:
-            state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, sums[0:1], sums[1:2],
+            state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, law, sums[0:1], sums[1:2],
                        sums[2:3])
             e = sums[0] - w_sched + lost[0]
             err = abs(e - e0) / e_ref
