@@ -27,6 +27,13 @@ the drift: with gap g, its rate g' and its constant second derivative g'',
 
 keeps it open over the drift, with room to spare (sum|a_s| >= 1). The choice is made per
 shot from its own state, the same in both kernels.
+
+The substeps of the shots that need them run together, the shots innermost: every store
+a select on the shot's mask (busy, refined at the first level, at the second), so the
+loops vectorise, and each shot still gets the operations of its own sequence of
+substeps. The shots of a batch strike at about the same instant, so the masks are mostly
+full; taken one shot at a time through scalar calls, the head cost a batched shot of
+ptfe52_magnetic about as much as its force passes.
 """
 import math
 
