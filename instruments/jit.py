@@ -5,6 +5,8 @@ Every compiled kernel (the chain integrators in rig/solver/kernels/, the instrum
 and the analysis' loops in instruments/_kernels/) is declared with ``@jit`` (or
 ``@jit(parallel=True)``): numba's ``njit`` with ``cache=True`` (compiled once per machine,
 kept on disk) and ``fastmath=False`` (IEEE arithmetic: results bit-identical to numpy's).
+A loop that divides and must vectorise takes ``error_model="numpy"`` (a division by zero
+gives inf, as in numpy; numba's default checks every divisor, a branch per element).
 A kernel package calls ``drop_stale_cache(__name__)`` in its ``__init__``.
 
 OpenMP's threads sleep when a parallel loop ends (OMP_WAIT_POLICY=PASSIVE, unless the

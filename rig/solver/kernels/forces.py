@@ -106,7 +106,7 @@ def elastic_forces(u, A, d0, load, f, law, expo):
         other_law(u, A, d0, load, f, expo, 1, u.shape[0])
 
 
-@jit
+@jit(error_model="numpy")  # a division by zero gives inf (no check per element, which stops vectorising)
 def state_sums(u, v, mass, bias, A, expo, d0, d_limit, law, e, p, w):
     """Each shot's energy e (J), momentum p (kg m/s) and largest d / d_limit w (> 1: an
     overlap no real contact reaches; inf for nan), arrays (bodies, shots), in two passes:
