@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rig.model.contact import HERTZ, KUWABARA_KONO, POWER
-from rig.solver.kernels import dissipation, ensemble, forces, record, step
+from rig.solver.kernels import dissipation, ensemble, forces, multirate, record, step
 
 
 def _llvm(kernel, *args) -> str:
@@ -72,7 +72,6 @@ def test_the_head_substeps_run_over_the_shots_at_once():
     """The multirate head's substeps (a struck chain's costliest part when each shot took
     them alone: about a quarter of a batched shot) run over every shot of a chunk, masked,
     and vectorise."""
-    from rig.solver.kernels import multirate
     from rig.solver.methods import method
 
     W, head = 32, 1

@@ -114,10 +114,10 @@ def state_sums(u, v, mass, bias, A, expo, d0, d_limit, law, e, p, w):
         E = sum m v^2 / 2 + sum A d^(n+1) / (n+1) - sum m b u,   P = sum m v,
 
     m b each body's constant external force (gravity, the magnet's force at t = 0); the
-    wall (mass 0 here) counts for neither. Where every exponent is 3/2 (law not POWER) the
-    energies are taken branch-free, so that the loop over the shots vectorises (an open
-    contact adds +0, which leaves a sum unchanged), and the overlaps' ratios in a pass of
-    their own (fused with the energies, neither loop vectorised)."""
+    wall (mass 0 here) counts for neither. An open contact adds +0, which leaves a sum
+    unchanged. Where every exponent is 3/2 (law not POWER) the loop over the shots
+    vectorises; the overlaps' ratios take a pass of their own (fused with the energies,
+    neither loop vectorised)."""
     nb = u.shape[0]
     e[:] = 0.0
     p[:] = 0.0
@@ -127,18 +127,12 @@ def state_sums(u, v, mass, bias, A, expo, d0, d_limit, law, e, p, w):
             e[s] += 0.5 * mass[i, s] * v[i, s] * v[i, s] - mass[i, s] * bias[i, s] * u[i, s]
             p[s] += mass[i, s] * v[i, s]
     for i in range(1, nb):
-        if law != POWER:
+        if law != POWER:  # the exponent a literal: no branch on the data, the loop vectorises
             for s in range(u.shape[1]):
-                d = d0[i, s] + u[i - 1, s] - u[i, s]
-                a = A[i, s]
-                dp = d if d > 0.0 else 0.0
-                el = 0.4 * a * dp * dp * math.sqrt(dp)
-                e[s] += el if d > 0.0 else 0.0
+                e[s] += elastic_energy(d0[i, s] + u[i - 1, s] - u[i, s], A[i, s], 1.5)
         else:
             for s in range(u.shape[1]):
-                d = d0[i, s] + u[i - 1, s] - u[i, s]
-                if d > 0.0:
-                    e[s] += elastic_energy(d, A[i, s], expo[i, s])
+                e[s] += elastic_energy(d0[i, s] + u[i - 1, s] - u[i, s], A[i, s], expo[i, s])
         for s in range(u.shape[1]):
             q = (d0[i, s] + u[i - 1, s] - u[i, s]) / d_limit[i, s]
             w[s] = max(w[s], q) if q == q else math.inf

@@ -91,16 +91,11 @@ def _lane_substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, 
         hk = b_coef[st] * k
         ha = a_coef[st] * k
         for i in range(head + 1):
-            if i < head:
-                for s in range(W):
-                    hb = hk + pending[s] if st == 0 else hk
-                    vn = v[i, s] + hb * (f[i, s] - f[i + 1, s]) * invm[i, s]
-                    v[i, s] = vn if active[s] != 0.0 else v[i, s]
-            else:  # the head's last body: the slot below it is the method's kicks' (slow_net)
-                for s in range(W):
-                    hb = hk + pending[s] if st == 0 else hk
-                    vn = v[i, s] + hb * (f[i, s] - 0.0) * invm[i, s]
-                    v[i, s] = vn if active[s] != 0.0 else v[i, s]
+            for s in range(W):
+                hb = hk + pending[s] if st == 0 else hk
+                below = f[i + 1, s] if i < head else 0.0  # the head's last body: slot head + 1 is the kicks'
+                vn = v[i, s] + hb * (f[i, s] - below) * invm[i, s]
+                v[i, s] = vn if active[s] != 0.0 else v[i, s]
         for i in range(head + 1):
             for s in range(W):
                 un = u[i, s] + ha * v[i, s]
