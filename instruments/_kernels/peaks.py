@@ -9,16 +9,19 @@ from instruments.jit import jit
 
 
 @jit
-def local_maxima(x):
-    """Indices of the local maxima of x: samples higher than their left neighbour and
-    than the first different sample on their right; a flat top counts once, at its middle
-    ((first + last) // 2), as scipy.signal's _local_maxima_1d."""
+def local_maxima(x, floor=-np.inf):
+    """Indices of the local maxima of x at or above ``floor``: samples higher than their
+    left neighbour and than the first different sample on their right; a flat top counts
+    once, at its middle ((first + last) // 2), as scipy.signal's _local_maxima_1d. The
+    floor (find_peaks' height rule) gives the maxima that filtering all of them by it
+    gives, and a sample below it costs one comparison (a noisy baseline's signs are a
+    coin toss for the branch predictor)."""
     out = np.empty(x.shape[0] // 2 + 1, np.int64)
     m = 0
     i = 1
     last = x.shape[0] - 1
     while i < last:
-        if x[i - 1] < x[i]:
+        if x[i] >= floor and x[i - 1] < x[i]:
             ahead = i + 1
             while ahead < last and x[ahead] == x[i]:
                 ahead += 1

@@ -126,8 +126,7 @@ def candidates(f, height, min_prominence, spacing, min_width):
     samples of width at half prominence. Nothing if f never rises above 0."""
     if f.shape[0] == 0 or np.max(f) <= 0.0:
         return np.empty(0, np.int64)
-    idx = local_maxima(f)
-    idx = idx[f[idx] >= height]
+    idx = local_maxima(f, height)
     if spacing > 1 and idx.shape[0]:
         idx = idx[thin_by_distance(idx, np.argsort(f[idx], kind="mergesort"), float(spacing))]
     left, right = prominence_bases(f, height)
