@@ -59,6 +59,13 @@ def cmd_fit(args) -> dict:
         for pair in block["highly_correlated"]:
             print(f"warning: {pair['keys'][0]} and {pair['keys'][1]} cannot be told apart "
                   f"(correlation {pair['correlation']:+.3f}); their intervals are wide for that reason")
+        num = block["numerics"]
+        est = ", ".join("none" if e is None else f"{e:.2g}" for e in (num["estimate_at_start"], num["estimate_at_fit"]))
+        print(f"numerics: the model's error estimate {est} (start, result) against the accuracy "
+              f"{num['accuracy']:.2g} (relative force error)")
+        if not num["within_accuracy"]:
+            print("warning: the model's error estimate exceeds the scenes' accuracy setting; "
+                  "set a smaller solver.accuracy (--set) and fit again")
         post = block.get("posterior")
         if post:
             print(f"posterior ({post['walkers']} walkers x {post['steps']} steps, acceptance "

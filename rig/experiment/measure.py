@@ -44,6 +44,20 @@ def midway_static_force(rig) -> float:
     return float(rig.chain.static_forces()[(j1 + 1 + j2) // 2])
 
 
+TAIL_FWHM = 3.0
+"""The leading pulse has passed a gauge this many full widths after it peaks there."""
+
+
+def leading_end(report: Report) -> float | None:
+    """When the leading pulse of ``report`` has passed its last gauge (s from the impact):
+    its peak time there + TAIL_FWHM full widths. None where the report has no leading
+    pulse or its width is unknown (a pulse cut off by the record's end)."""
+    last = (report.leading or {}).get("lower") or (report.leading or {}).get("upper")
+    if not last or not math.isfinite(last.get("fwhm", math.nan)) or not last["fwhm"] > 0:
+        return None
+    return last["time"] + TAIL_FWHM * last["fwhm"]
+
+
 def truth_report(rig, truth) -> Report:
     """The pipeline on the noise-free truth, with F_d from the contact forces."""
     F0 = midway_static_force(rig)

@@ -11,12 +11,14 @@ effective-variance method: Orear, Am. J. Phys. 50, 912 (1982)):
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from rig.errors import RigError
 from rig.experiment import scene as scene_io
 from rig.fit.data import Points
-from rig.fit.evaluate import Curve, curves
+from rig.fit.evaluate import Curve, Pilot, calibrate, curves, leading_window, numerics, shot_rigs
 from rig.fit.parameters import law_overrides
 
 VELOCITY_FACTORS = (0.35, 0.5, 0.7, 1.0, 1.4, 2.0, 2.8)
@@ -59,12 +61,35 @@ class PointObjective:
         self.velocities = v0 * np.array(VELOCITY_FACTORS)
         self._start = start_values(scene, self.overrides, params)
 
+    def shots(self, theta, duration: float = float("inf")) -> list:
+        """The rigs of candidate ``theta``'s shots, each configuration at each velocity,
+        simulated for ``duration`` (s; inf: the scene's own)."""
+        overrides = [self.candidate_overrides(theta, c) for c in self.configs]
+        return shot_rigs(self.scene, overrides, self.velocities, duration)[0]
+
+    @functools.cached_property
+    def pilot(self) -> Pilot:
+        """The fit's numerics, calibrated once on the start values' shots over their
+        leading window (rig.fit.evaluate)."""
+        rigs = self.shots(self._start)
+        if not rigs:
+            raise RigError("the scene refuses the fit's start values")
+        window = leading_window(rigs)
+        return calibrate(self.shots(self._start, window), window)
+
     def spec(self) -> dict:
+        """What the fit's evaluations depend on (the key of its cache), the pilot's numerics
+        included."""
         p = self.points
         return {"kind": "points", "scene": self.scene, "overrides": self.overrides,
                 "params": [(q.key, q.lo, q.hi) for q in self.params], "configs": self.configs,
                 "velocities": self.velocities.tolist(), "data": [p.force.tolist(), p.force_sd.tolist(),
-                                                                  p.speed.tolist(), p.speed_sd.tolist()]}
+                                                                  p.speed.tolist(), p.speed_sd.tolist()],
+                "pilot": self.pilot.spec()}
+
+    def numerics(self, theta) -> dict:
+        """The fit's numerics at ``theta`` (its result), rig.fit.evaluate.numerics."""
+        return numerics(self.pilot, self.shots(theta, self.pilot.window_s))
 
     def start(self) -> np.ndarray:
         return self._start
@@ -74,7 +99,7 @@ class PointObjective:
 
     def evaluate(self, thetas: list) -> list:
         cands = [self.candidate_overrides(t, c) for t in thetas for c in self.configs]
-        flat = curves(self.scene, cands, self.velocities)
+        flat = curves(self.scene, cands, self.velocities, self.pilot)
         C = len(self.configs)
         return [tuple(flat[i * C:(i + 1) * C]) for i in range(len(thetas))]
 

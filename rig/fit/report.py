@@ -15,7 +15,7 @@ from rig.fit.points import PointObjective
 
 def summary(result: FitResult, objective, fitted_scene) -> dict:
     """The --json block: {"parameters": {KEY: {"estimate", "std", "ci95", "unit"}}, "correlation",
-    "residual_rms_relative", "converged", "fitted_scene", ...}."""
+    "residual_rms_relative", "converged", "fitted_scene", "numerics", ...}."""
     return {
         "parameters": {k: {"estimate": float(e), "std": float(s), "ci95": [float(lo), float(hi)], "unit": u}
                        for k, u, e, s, (lo, hi) in zip(result.keys, result.units, result.estimate, result.std,
@@ -31,6 +31,7 @@ def summary(result: FitResult, objective, fitted_scene) -> dict:
         "evaluations": result.evaluations,
         "nuisance": result.nuisance,
         "fitted_scene": None if fitted_scene is None else str(fitted_scene),
+        "numerics": objective.numerics(result.estimate),
     }
 
 

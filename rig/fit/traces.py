@@ -25,7 +25,7 @@ import numpy as np
 from instruments.gauges import GaugeDraw, PiezoGauge
 from rig.errors import RigError
 from rig.experiment.shot import Rig
-from rig.fit.evaluate import solve_rigs
+from rig.fit.evaluate import Pilot, calibrate, numerics, solve_rigs
 from rig.fit.parameters import law_overrides
 from rig.fit.points import start_values
 
@@ -125,7 +125,8 @@ class TraceObjective:
         self.overrides = list(overrides) + law_overrides(params)
         self._start = start_values(scene, self.overrides, params)
         rig = self.rig_of(self._start)
-        if not solve_rigs([rig])[0]:
+        self.pilot: Pilot = calibrate([rig])  # the fit's numerics, calibrated on its start (rig.fit.evaluate)
+        if not solve_rigs([rig], self.pilot)[0]:
             raise RigError("the scene's own shot blew up; check the scene before fitting it")
         self.channels = channels_of(rig, records)
         self.records = sorted({c.record for c in self.channels})
@@ -154,14 +155,18 @@ class TraceObjective:
         return {"kind": "traces", "scene": self.scene, "overrides": self.overrides,
                 "params": [(q.key, q.lo, q.hi) for q in self.params],
                 "data": [[c.record, c.name, c.sd, hashlib.sha256(c.t.tobytes() + c.y.tobytes()).hexdigest()]
-                         for c in self.channels]}
+                         for c in self.channels], "pilot": self.pilot.spec()}
+
+    def numerics(self, theta) -> dict:
+        """The fit's numerics at ``theta`` (its result), rig.fit.evaluate.numerics."""
+        return numerics(self.pilot, [self.rig_of(theta)])
 
     def start(self) -> np.ndarray:
         return self._start
 
     def evaluate(self, thetas: list) -> list:
         rigs = [self.rig_of(t) for t in thetas]
-        ok = solve_rigs(rigs)
+        ok = solve_rigs(rigs, self.pilot)
         return [model_traces(r) if good else {"h": np.array([math.nan])} for r, good in zip(rigs, ok)]
 
     @staticmethod

@@ -75,12 +75,15 @@ def estimated_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method
     return with_estimate(sol, est, basis, 1, time.process_time() - t0)
 
 
-def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, accuracy: float) -> Solution:
-    """The solve meeting ``accuracy`` (module doc): tries at most MAX_ATTEMPTS steps."""
+def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, accuracy: float,
+                     shortest: float = 0.0) -> Solution:
+    """The solve meeting ``accuracy`` (module doc): tries at most MAX_ATTEMPTS steps, none
+    shorter than ``shortest`` (s; a caller's bound on the cost: the solve at that step is
+    then returned with its estimate, above the accuracy)."""
     t0 = time.process_time()
     first = default_step(problem, m, accuracy, t_end)
     longest = largest_step(problem, m, t_end)
-    dt = min(first.dt, longest)
+    dt = max(min(first.dt, longest), shortest)
     tried = []  # (solution, estimate, basis)
     for _ in range(MAX_ATTEMPTS):
         stepping = Stepping(dt, first.head, first.inner_dt * dt / first.dt)
@@ -95,7 +98,9 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
             break
         if est < ACCEPT_LOW * accuracy and dt >= longest:
             break  # as coarse as the chain allows
-        dt = min(_next_step(tried, TARGET * accuracy), longest)
+        if est > ACCEPT_HIGH * accuracy and dt <= shortest:
+            break  # as fine as the caller allows
+        dt = max(min(_next_step(tried, TARGET * accuracy), longest), shortest)
     if not tried:
         raise Unstable(f"unstable at every step tried down to dt = {2 * dt:.4g} s", stepping)
     sol, est, basis = _choice(tried, accuracy)

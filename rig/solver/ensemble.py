@@ -46,14 +46,15 @@ class EnsembleSolution:
     def shots(self) -> int:
         return len(self.reports)
 
-    def stats(self, j: int, accuracy: float | None = None, estimate: float | None = None) -> SolverStats:
+    def stats(self, j: int, accuracy: float | None = None, estimate: float | None = None,
+              basis: str = "study pilot") -> SolverStats:
         """Shot j's SolverStats (the batch's wall time shared out evenly); ``estimate``: the
-        error estimate of the study's pilot, which set the step."""
+        error estimate of the pilot that set the step, ``basis`` which pilot that was."""
         r = self.reports[j]
         m = get_method(self.method)
         return SolverStats(m.name, self.dt, self.steps, self.steps * m.force_evaluations,
                            self.wall_s / self.shots, r.energy_error, r.momentum_error,
-                           r.wall_impulse_Ns, accuracy, estimate, "study pilot" if estimate is not None else "none",
+                           r.wall_impulse_Ns, accuracy, estimate, basis if estimate is not None else "none",
                            dissipated_energy_J=r.dissipated_energy_J)
 
 

@@ -56,8 +56,9 @@ class SolverStats:
     dissipated_energy_J: the energy dissipation took over the whole solve (J).
     error_estimate: the a-posteriori estimate of the largest error of any recorded force,
     relative to its dynamic peak (``relative_error``), over the whole record; None where
-    nothing was recorded. estimate_basis: how it was obtained ("companion at 2 dt": a
-    second solve at twice the step, Richardson; "study pilot": the nominal shot of a study).
+    nothing was recorded. estimate_basis: how it was obtained ("companion at dt/2": a
+    second solve at half the step, Richardson; "study pilot": the nominal shot of a study;
+    "fit pilot": a fit's start values, rig.fit.evaluate).
     attempts: solves the accuracy control ran (rig/solver/control.py). wall_s: the kernel's
     wall time of the solve returned; cpu_s: the process CPU time of everything solve did,
     its attempts and companions included.

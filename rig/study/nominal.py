@@ -13,10 +13,9 @@ import functools
 from dataclasses import dataclass
 
 from rig.experiment import scene as scene_io
-from rig.experiment.measure import midway_static_force
+from rig.experiment.measure import TAIL_FWHM, midway_static_force
 from rig.experiment.shot import Rig
 
-TAIL_FWHM = 3.0  # the leading window ends this many widths after the last gauge's leading peak
 NOMINAL_SEED = 0
 """The seed of the nominal shot's instrument draws (gains, misalignments, noise, the scope's
 noise floor): the shot that times the scope's trigger for the leading window. Every study's
