@@ -63,3 +63,15 @@ def test_reproduce_writes_everything_and_repeats_exactly(tmp_path, capsys):
     assert 4.0 < s["ptfe52_gravity_leading_width_1pct_diameters"] < 6.0  # about five diameters
     mass = json.loads((a / "results.json").read_text())["mass_ratio"]
     assert [m["pulses_lower_gauge"] for m in mass][:3] == [1, 2, 3]  # about the mass ratio
+
+
+def test_the_fitted_models_shots_keep_their_whole_records_to_the_accuracy():
+    """`rig reproduce daraio2006 --fitted` reads whole records (the wall's peak, the pulses
+    at the lower gauge): its two shots are solved at a pilot's calibrated step and carry
+    its estimate, within the scenes' accuracy."""
+    from rig.study.reproduce_fitted import fitted_shots
+
+    shots = fitted_shots(["chain.youngs_modulus=1.05e9", "chain.contact_exponent=1.74"])
+    for name, s in shots.items():
+        assert 0 < s["error_estimate"] <= 1e-4, name
+        assert s["speed_m_per_s"] > 0 and s["wall_peak_N"] > 0
