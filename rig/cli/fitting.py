@@ -12,7 +12,7 @@ def _records(args) -> list:
         return [read_record(args.records)]
     from instruments.archive import Archive
 
-    arch = Archive(args.archive, mode="r")
+    arch = Archive(args.archive)
     ids = arch.ids() if args.shot is None else [args.shot]
     return [arch.read(i, with_truth=False).record for i in ids]
 
@@ -63,9 +63,17 @@ def cmd_fit(args) -> dict:
         est = ", ".join("none" if e is None else f"{e:.2g}" for e in (num["estimate_at_start"], num["estimate_at_fit"]))
         print(f"numerics: the model's error estimate {est} (start, result) against the accuracy "
               f"{num['accuracy']:.2g} (relative force error)")
-        if not num["within_accuracy"]:
-            print("warning: the model's error estimate exceeds the scenes' accuracy setting; "
+        if not num["within_accuracy"] and num["step_at_floor"]:
+            print("warning: the model's error estimate exceeds the scene's accuracy setting even at the "
+                  "finest step a fit takes (1/16 of the a-priori rule's): the record's error does not fall "
+                  "with the step (a contact that closes or not by a hair); the intervals do not include it")
+        elif not num["within_accuracy"]:
+            print("warning: the model's error estimate exceeds the scene's accuracy setting; "
                   "set a smaller solver.accuracy (--set) and fit again")
+        if block["p_value"] is not None and block["p_value"] < 1e-3:
+            print(f"warning: the model does not describe the data (chi2/dof {block['chi2_reduced']:.3g}, "
+                  f"p = {block['p_value']:.2g}): the misfit is systematic, and the intervals, widened by "
+                  f"sqrt(chi2/dof), treat it as noise")
         post = block.get("posterior")
         if post:
             print(f"posterior ({post['walkers']} walkers x {post['steps']} steps, acceptance "

@@ -132,6 +132,12 @@ def schema_node(key: str):
     return node
 
 
+def key_spec(key: str):
+    """The SCHEMA entry (a type or a unit string) of a dotted scene key; RigError naming
+    the keys known where it goes wrong, or that it is a table."""
+    return _spec_for(key.split("."))
+
+
 def _spec_for(parts):
     key = ".".join(parts)
     try:

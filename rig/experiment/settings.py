@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 from instruments.gauges import GaugeSettings
 from rig.errors import invalid
+from rig.solver.stepsize import checked_accuracy
 
 
 @dataclass(frozen=True)
@@ -44,6 +45,8 @@ class SolverSettings:
         d = self.duration
         if d is None or not (isinstance(d, (int, float)) and math.isfinite(d) and d > 0):
             raise invalid("solver.duration", d, "simulated time > 0 s, e.g. '4 ms'")
+        if self.accuracy is not None:
+            checked_accuracy(self.accuracy, "solver.accuracy")
 
     @classmethod
     def from_table(cls, table: dict) -> "SolverSettings":

@@ -63,7 +63,9 @@ def read_points(path) -> Points:
         text = path.read_text()
     except (OSError, UnicodeDecodeError) as exc:
         raise RigError(f"--points {path}: cannot read ({exc})") from None
-    rows = [r for r in csv.reader(text.splitlines()) if r and not r[0].lstrip().startswith("#")]
+    numbered = [(n, r) for n, r in enumerate(csv.reader(text.splitlines()), start=1)
+                if r and not r[0].lstrip().startswith("#")]
+    lines, rows = [n for n, _ in numbered], [r for _, r in numbered]  # the file's line of each row
     if len(rows) < 2:
         raise RigError(f"--points {path}: no data (a header and at least one row are needed)")
     columns = []
@@ -91,7 +93,7 @@ def read_points(path) -> Points:
     if missing:
         raise invalid(f"--points {path}", ", ".join(names), f"columns missing: {', '.join(missing)}")
     data = {n: [] for n in names}
-    for i, row in enumerate(rows[1:], start=2):
+    for i, row in zip(lines[1:], rows[1:]):
         if len(row) != len(columns):
             raise invalid(f"--points {path} line {i}", ",".join(row), f"{len(columns)} values")
         for (name, unit, si), cell in zip(columns, row):
@@ -105,8 +107,9 @@ def read_points(path) -> Points:
     arr = {n: np.array(v) for n, v in data.items()}
     for name in POINT_COLUMNS:
         if np.any(arr[name] <= 0):
-            bad = arr[name][arr[name] <= 0][0]
-            raise invalid(f"--points {path} {name}", bad, "> 0 (forces, speeds and uncertainties)")
+            j = int(np.flatnonzero(arr[name] <= 0)[0])
+            raise invalid(f"--points {path} line {lines[j + 1]} {name}", float(arr[name][j]),
+                          "> 0 (forces, speeds and uncertainties)")
     keys = [n for n in names if n not in POINT_COLUMNS]
     configs = tuple(tuple(f"{k}={float(arr[k][j])!r}" for k in keys) for j in range(len(rows) - 1))
     return Points(arr["F_d"], arr["F_d_sd"], arr["V_s"], arr["V_s_sd"], configs, str(path))

@@ -191,14 +191,15 @@ class Curve:
 
 
 def numerics(pilot: Pilot, rigs: list) -> dict:
-    """What a fit reports of its numerics: the pilot's step factor and estimate (at the
-    start values), and the largest companion estimate of ``rigs`` (the shots of its result)
-    solved as the fit solved them (None where one blew up); within_accuracy: both within
-    the scenes' accuracy setting."""
+    """What a fit reports of its numerics: the pilot's step factor (step_at_floor: the
+    pilot stopped at MIN_STEP_FACTOR) and estimate (at the start values), and the largest
+    companion estimate of ``rigs`` (the shots of its result) solved as the fit solved them
+    (None where one blew up); within_accuracy: both within the scene's accuracy setting."""
     at_fit = estimates(rigs, pilot)
     worst = max(at_fit) if at_fit and all(math.isfinite(e) for e in at_fit) else None
     start = pilot.estimate if math.isfinite(pilot.estimate) else None
     return {"basis": PILOT_BASIS, "accuracy": pilot.accuracy, "step_factor": pilot.step_factor,
+            "step_at_floor": pilot.step_factor <= MIN_STEP_FACTOR * 1.01,
             "pilot_shots": pilot.shots, "window_s": pilot.window_s if math.isfinite(pilot.window_s) else None,
             "estimate_at_start": start, "estimate_at_fit": worst,
             "within_accuracy": start is not None and worst is not None and max(start, worst) <= pilot.accuracy}

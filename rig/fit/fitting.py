@@ -57,6 +57,7 @@ class FitResult:
     nuisance: dict = field(default_factory=dict)
     eta: np.ndarray = field(default_factory=lambda: np.zeros(0))
     model: object = None
+    replayed: int = 0  # candidates read back from the cache of an earlier run (evaluations: solved in this one)
 
     @property
     def chi2_reduced(self) -> float:
@@ -87,6 +88,7 @@ class EvaluationCache:
         self.folder = None if folder is None else Path(folder)
         self.spec = hashlib.sha256(json.dumps(objective.spec(), sort_keys=True).encode()).hexdigest()[:16]
         self.solved = 0  # candidates solved in this run (not replayed from disk)
+        self.replayed = 0  # candidates read back from disk
         if self.folder is not None:
             try:
                 self.folder.mkdir(parents=True, exist_ok=True)
@@ -106,6 +108,7 @@ class EvaluationCache:
             if self.folder is not None and self._path(k).is_file():
                 with np.load(self._path(k)) as z:
                     self.memory[k] = self.objective.unpack({n: z[n] for n in z.files})
+                self.replayed += 1
                 continue
             todo.append(k)
         if todo:
@@ -185,7 +188,7 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
     converged = bool(res.success and res.status > 0 and np.all(np.isfinite(std)))
     return FitResult(tuple(p.key for p in params), tuple(p.unit for p in params), est, std, ci, corr, r, chi2, dof,
                      converged, str(res.message), cache.solved, at_bound, objective.nuisance_report(res.x[P:]),
-                     res.x[P:].copy(), model)
+                     res.x[P:].copy(), model, cache.replayed)
 
 
 def stderr_progress(text: str):

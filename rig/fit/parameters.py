@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from rig.errors import RigError, invalid
-from rig.experiment.scene import schema_node
+from rig.experiment.scene import key_spec
 from rig.units import quantity
 
 POSITIVE_LAW_KEYS = {"chain.damping_time": "kuwabara-kono", "chain.contact_damping": "dashpot"}
@@ -34,10 +34,7 @@ def parse_parameter(text: str) -> FitParameter:
     if "=" not in text:
         raise invalid("--param", text, "needs bounds: KEY=LO:HI, e.g. chain.youngs_modulus=0.4 GPa:2 GPa")
     key, bounds = (s.strip() for s in text.split("=", 1))
-    try:
-        spec = schema_node(key)
-    except KeyError:
-        raise invalid("--param", key, "not a scene key (see `rig scene --keys`)") from None
+    spec = key_spec(key)
     if spec is float:
         unit = "1"
     elif isinstance(spec, str):
@@ -63,7 +60,7 @@ def parse_parameter(text: str) -> FitParameter:
                 raise invalid(f"--param {key} {name}", t, f"bounds need units, e.g. '{t} {unit}'")
     lo, hi = values
     if not lo < hi:
-        raise invalid(f"--param {key}", bounds, "LO < HI")
+        raise invalid(f"--param {key}", bounds, "needs LO < HI, the lower bound first")
     if key in POSITIVE_LAW_KEYS and lo <= 0:
         raise invalid(f"--param {key} LO", lo_text, f"> 0 (the {POSITIVE_LAW_KEYS[key]} law needs it; "
                                                    "leave the key out to fit without it)")

@@ -28,7 +28,7 @@ def summary(result: FitResult, objective, fitted_scene) -> dict:
         "at_bound": list(result.at_bound),
         "chi2": result.chi2, "dof": result.dof, "chi2_reduced": result.chi2_reduced,
         "p_value": result.p_value, "bic": result.bic,
-        "evaluations": result.evaluations,
+        "evaluations": result.evaluations, "evaluations_replayed": result.replayed,
         "nuisance": result.nuisance,
         "fitted_scene": None if fitted_scene is None else str(fitted_scene),
         "numerics": objective.numerics(result.estimate),

@@ -220,12 +220,12 @@ def stepping_at(p, dt: float, head: int | None = None) -> Stepping:
     return Stepping(dt, head, HEAD_SUBSTEP * dt * min(ratio, 1.0))
 
 
-def checked_accuracy(accuracy: float | None) -> float:
+def checked_accuracy(accuracy: float | None, field: str = "accuracy") -> float:
     """The accuracy target of a solve: DEFAULT_ACCURACY when None; refused outside
-    [1e-14, 0.1] (relative force error)."""
+    [1e-14, 0.1] (relative force error), the message naming ``field``."""
     accuracy = DEFAULT_ACCURACY if accuracy is None else accuracy
     if not (isinstance(accuracy, (int, float)) and 1e-14 <= accuracy <= 0.1):
-        raise invalid("accuracy", accuracy, "relative accuracy target in [1e-14, 0.1]")
+        raise invalid(field, accuracy, "relative accuracy target in [1e-14, 0.1]")
     return accuracy
 
 

@@ -31,7 +31,7 @@ def test_parameters_carry_units():
     ("chain.youngs_modulus=0.4:2", "bounds need units"),
     ("chain.youngs_modulus=2 GPa:0.4 GPa", "LO < HI"),
     ("chain.youngs_modulus=0.4 m:2 m", "youngs_modulus"),
-    ("chain.colour=1:2", "not a scene key"),
+    ("chain.colour=1:2", "unknown key; known in chain: .*youngs_modulus"),
     ("chain.material=1:2", "not a numeric scene key"),
     ("chain.contact_damping=0 kg/s:1 kg/s", "> 0"),
 ])
@@ -63,7 +63,7 @@ def _virtual_points(tmp_path):
     ("F_d,F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n1,1,1,1\n", "needs its unit"),
     ("F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n", "no data"),
     ("F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n1,x,1,1\n", "line 2 F_d_sd"),
-    ("F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n1,0,1,1\n", "> 0"),
+    ("F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n1,1,1,1\n# a comment\n\n1,0,1,1\n", "line 5 F_d_sd = 0.0: > 0"),
 ])
 def test_bad_point_tables_name_the_problem(tmp_path, text, match):
     with pytest.raises(RigError, match=match):
@@ -143,6 +143,7 @@ def test_trace_fit_recovers_modulus_and_damping_from_one_shot(tmp_path):
     assert r.nuisance["gains"][upper.channel] == pytest.approx(shot.draws["upper"]["gain"], abs=0.02)
     again = fit(TraceObjective(SCENE, params, [shot.scope], ["solver.accuracy=1e-5"]), tmp_path / "cache")
     assert again.evaluations == 0  # resumed: every candidate read back from the cache
+    assert again.replayed == r.evaluations  # the same candidates, in the same order
     assert np.array_equal(again.estimate, r.estimate)
 
 
@@ -197,6 +198,39 @@ def test_cli_fit_writes_a_scene_that_fires(tmp_path, capsys):
     assert fitted.chain.beads[-1].material.E == pytest.approx(block["parameters"]["chain.youngs_modulus"]["estimate"],
                                                               rel=1e-7)
     assert (out / "fit.png").stat().st_size > 0 and (out / "residuals.csv").is_file()
+
+
+def test_cli_fit_warns_when_the_model_does_not_describe_the_data(tmp_path, capsys):
+    """Points whose speeds grow 4x slower with the force than any modulus lets the model's:
+    the fit converges but says that its chi2 rules the model out; its numerics line shows
+    the error estimates against the accuracy."""
+    (c,) = curves(SCENE, [["chain.youngs_modulus=1.1e9"]], [0.5, 0.9, 1.6])
+    speeds = c.speed[0] * (c.force / c.force[0]) ** (0.25 * np.log(c.speed[-1] / c.speed[0])
+                                                    / np.log(c.force[-1] / c.force[0]))
+    rows = "\n".join(f"{F},{0.01 * F},{V},{0.002 * V}" for F, V in zip(c.force, speeds))
+    pts = _write(tmp_path, "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n" + rows + "\n")
+    main(["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+          "--out", str(tmp_path / "fit"), "--quiet"])
+    out = capsys.readouterr().out
+    assert "warning: the model does not describe the data (chi2/dof" in out
+    assert "numerics: the model's error estimate" in out and "against the accuracy 0.0001" in out
+
+
+def test_cli_fit_reads_the_shots_of_an_archive(tmp_path, capsys):
+    """--archive: the shot that `rig shot --out` archived is fitted from its stored record;
+    a missing archive is one line, exit 2."""
+    archive = tmp_path / "A.h5"
+    assert main(["shot", SCENE, "--seed", "3", "--out", str(archive), "--json"]) == 0
+    capsys.readouterr()
+    argv = ["fit", SCENE, "--param", "chain.youngs_modulus=0.5 GPa:3 GPa", "--json", "--quiet"]
+    assert main(argv + ["--archive", str(archive), "--shot", "1", "--out", str(tmp_path / "fit")]) == 0
+    block = json.loads(capsys.readouterr().out)
+    E = Rig.from_scene(SCENE).chain.beads[-1].material.E
+    lo, hi = block["parameters"]["chain.youngs_modulus"]["ci95"]
+    assert lo <= E <= hi and block["chi2_reduced"] < 2
+    assert main(argv + ["--archive", str(tmp_path / "none.h5"), "--out", str(tmp_path / "f2")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "no such archive" in err and len(err.splitlines()) == 1
 
 
 def test_cli_fit_samples_the_posterior_and_resumes_it(tmp_path, capsys):
