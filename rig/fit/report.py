@@ -45,7 +45,8 @@ def fitted_scene_text(scene: str, overrides: list, result: FitResult) -> str:
         scene_io.apply_override(raw, item)
     raw["scene"]["name"] = f"{name}_fitted"
     head = (f"# {name} fitted by `rig fit`: "
-            + ", ".join(f"{k} = {e:.6g} +- {s:.2g}" for k, e, s in zip(result.keys, result.estimate, result.std))
+            + ", ".join(f"{k} = {e:.6g} +- {s:.2g}" + ("" if u == "1" else f" {u}")
+                        for k, u, e, s in zip(result.keys, result.units, result.estimate, result.std))
             + "\n")
     return head + tomli_w.dumps(raw)
 
@@ -57,7 +58,8 @@ def write_residuals(path: Path, objective, result: FitResult):
         if isinstance(objective, PointObjective):
             p = objective.points
             V, _ = objective.model_speeds(model)
-            wr.writerow(["F_d [N]", "V_s [m/s]", "V_s model [m/s]", "relative", "normalised", "configuration"])
+            wr.writerow(["F_d [N]", "V_s [m/s]", "V_s model [m/s]", "relative (model / measured - 1)",
+                         "normalised (model - measured) / effective sd", "configuration"])
             for i in range(p.n):
                 wr.writerow([p.force[i], p.speed[i], V[i], V[i] / p.speed[i] - 1, result.residuals[i],
                              " ".join(p.configs[i])])
@@ -89,6 +91,7 @@ def draw(path: Path, objective, result: FitResult):
             ok = np.isfinite(curve.force) & np.isfinite(curve.speed)
             ax.plot(curve.force[ok], curve.speed[ok], "-", color=f"C{c}", label=f"fitted model {label}")
         ax.set_xscale("log")
+        ax.legend(fontsize=7)
         ax.set_xlabel("dynamic contact force F_d (N)")
         ax.set_ylabel("leading pulse speed V_s (m/s)")
     else:
