@@ -108,8 +108,12 @@ class Archive:
 
     @contextlib.contextmanager
     def _lock(self):
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        with open(self.path.with_name(self.path.name + ".lock"), "a") as fh:
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            fh = open(self.path.with_name(self.path.name + ".lock"), "a")  # noqa: SIM115 - closed below
+        except OSError as exc:
+            raise InstrumentError(f"{self.path}: cannot write an archive there ({exc.strerror})") from None
+        with fh:
             fcntl.flock(fh, fcntl.LOCK_EX)
             try:
                 yield

@@ -5,6 +5,10 @@ class RigError(ValueError):
     """Bad input: the message names the field, the value and what is allowed."""
 
 
+class Interrupted(RigError):
+    """A run stopped by the user (Ctrl-C): the message says what it kept."""
+
+
 def invalid(field: str, value, allowed: str) -> RigError:
     """Build the standard message: ``field = value: allowed``."""
     return RigError(f"{field} = {value!r}: {allowed}")

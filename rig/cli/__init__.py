@@ -21,7 +21,7 @@ from rig.cli.common import (
     quantity_type,
     seed_arg,
 )
-from rig.errors import RigError
+from rig.errors import Interrupted, RigError
 
 
 def _command(sub, name: str, help_text: str, func):
@@ -145,7 +145,8 @@ def build_parser() -> argparse.ArgumentParser:
                                   "and why any figure is missing (exit 1 when no source gives a speed)",
                   data.cmd_analyze)
     an.add_argument("files", nargs="+", metavar="FILE", help=".isf, .csv, .wfm (Tektronix) or .h5 (an archive)")
-    an.add_argument("--shot", type=int, help="one shot of an archive, a whole number >= 0 (default: every shot)")
+    an.add_argument("--shot", type=int,
+                    help="one shot of an archive, by its number (shots are numbered from 1; default: every shot)")
     an.add_argument("--gauge-distance", type=quantity_type("m", "--gauge-distance"),
                     help="distance between the two gauges (plain number: m), for real files")
     an.add_argument("--channels", help="UPPER,LOWER[,WALL] channel names (default: file order)")
@@ -181,12 +182,18 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
         out = args.func(args)
+    except Interrupted as exc:  # Ctrl-C, with what the run kept
+        _fail(args.command, str(exc))
+        return 130
     except (RigError, InstrumentError) as exc:
         return _fail(args.command, str(exc))
     except OSError as exc:
         return _fail(args.command, os_error_line(exc))
     except MemoryError:
         return _fail(args.command, "out of memory: choose a shorter duration, fewer beads or fewer points")
+    except KeyboardInterrupt:
+        _fail(args.command, "interrupted")
+        return 130
     if args.json:
         print(json.dumps(out, indent=2))
     return getattr(args, "exit_code", 0)

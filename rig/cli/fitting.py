@@ -56,6 +56,11 @@ def cmd_fit(args) -> dict:
                   f"{p['ci95'][1]:.6g}]{'  AT BOUND' if k in block['at_bound'] else ''}")
         print(f"chi2/dof {block['chi2_reduced']:.3f} (p = {block['p_value']:.3g}), BIC {block['bic']:.2f}, "
               f"residual rms {block['residual_rms_relative']:.2%}")
+        for q in params:
+            sd = block["parameters"][q.key]["std"]
+            if not sd <= q.hi - q.lo:
+                print(f"warning: the data do not determine {q.key}: its sd {sd:.2g} is wider than its bounds "
+                      f"({q.hi - q.lo:.2g} apart)")
         for pair in block["highly_correlated"]:
             print(f"warning: {pair['keys'][0]} and {pair['keys'][1]} cannot be told apart "
                   f"(correlation {pair['correlation']:+.3f}); their intervals are wide for that reason")

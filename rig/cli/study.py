@@ -27,8 +27,8 @@ def cmd_mc(args) -> dict:
                   args.sobol, args.truth, args.window, args.traces)
     from rig.study.nominal import nominal
 
-    per_batch = nominal(study.scene, study.overrides).rig.estimate(controlled=False).times(study.batch, study.batch)
-    check_size(per_batch, args, f"each batch of {study.batch} shots")
+    whole = nominal(study.scene, study.overrides).rig.estimate(controlled=False).times(study.shots, study.batch)
+    check_size(whole, args, f"the study's {study.shots} shots (batches of {study.batch} held at once)")
     with progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot") as bar:
         def started(done):
             bar.update(done)

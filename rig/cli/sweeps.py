@@ -5,6 +5,7 @@ from pathlib import Path
 
 from rig.cli.common import check_size, progress_bar, writing_to
 from rig.cli.shots import shot_summary
+from rig.errors import Interrupted
 
 MAX_SWEEP_POINTS = 10_000  # more needs --allow-large (each point's shot is kept to the end)
 
@@ -21,7 +22,17 @@ def cmd_sweep(args) -> dict:
     check_size(Rig(scene).estimate().times(n, n), args, f"this sweep of {n} points")  # every point is kept
     with progress_bar(args.quiet, total=len(vary.values), desc=f"sweep {vary.key}", unit="shot") as bar:
         with writing_to(args.out or "the sweep"):
-            points = run_sweep(args.scene, vary, args.set or (), args.seed, bar.update, args.out)
+            fired = []
+
+            def tick():
+                fired.append(1)
+                bar.update()
+
+            try:
+                points = run_sweep(args.scene, vary, args.set or (), args.seed, tick, args.out)
+            except KeyboardInterrupt:
+                kept = f"those points' shots are in {args.out}" if args.out else "nothing is kept (no --out)"
+                raise Interrupted(f"interrupted after {len(fired)} of {n} points: {kept}") from None
     out = {"points": []}
     for p in points:
         one = shot_summary(p.rig, p.shot)

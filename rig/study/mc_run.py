@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rig.errors import RigError
+from rig.errors import Interrupted, RigError
 from rig.experiment.measure import midway_static_force
 from rig.study.executors import DEFAULT_WORKER_TIMEOUT, run_study
 from rig.study.mc_spec import Study
@@ -59,7 +59,7 @@ def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None,
         run_study(study, store, workers, scheduler, progress, worker_timeout)
     except KeyboardInterrupt:
         kept = sum(len(study.shots_of(b)) for b in store.done())
-        raise RigError(f"interrupted: {kept} of {study.shots} shots are kept in {folder}; "
+        raise Interrupted(f"interrupted: {kept} of {study.shots} shots are kept in {folder}; "
                        f"run the same command again to resume") from None
     ran = study.shots - done
     elapsed = time.perf_counter() - t0

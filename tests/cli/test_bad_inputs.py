@@ -102,6 +102,7 @@ CASES = [
     (["mc", S, "--shots", "0", "--vary", VEL, "--out", "{d}/mc"], "--shots"),
     (["mc", S, "--shots", "-5", "--vary", VEL, "--out", "{d}/mc"], "--shots"),
     (["mc", S, "--shots", "8", "--batch", "0", "--vary", VEL, "--out", "{d}/mc"], "--batch"),
+    (["mc", S, "--shots", "100000000", "--vary", VEL, "--out", "{d}/mc"], "add --allow-large to run it anyway"),
     (["mc", S, "--shots", "8", "--workers", "0", "--vary", VEL, "--out", "{d}/mc"], "--workers"),
     (["mc", S, "--shots", "8", "--accuracy", "0", "--vary", VEL, "--out", "{d}/mc"], "accuracy"),
     (["mc", S, "--shots", "8", "--out", "{d}/mc"], "--vary"),

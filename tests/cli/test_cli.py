@@ -164,3 +164,32 @@ def test_interleaved_rounds_alternate_their_order():
     per_round = interleaved(runs, 3)
     assert done == list("abccbaabc")  # a drift within a round falls on the first and the last alike
     assert all([r["name"] for r in rows] == list("abc") for rows in per_round)
+
+
+def test_an_interrupted_sweep_says_what_it_kept(tmp_path, monkeypatch, capsys):
+    """Ctrl-C during a sweep: one line saying how many points were fired and where their
+    shots are, not a traceback."""
+    import rig.study.sweep as sweep
+
+    def interrupted(scene, vary, overrides, seed, progress, archive):
+        progress()
+        progress()
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sweep, "run_sweep", interrupted)
+    out = tmp_path / "s.h5"
+    argv = ["sweep", "ptfe20_gravity", "--vary", "striker.velocity=0.3:1.5:5", "--out", str(out), "--quiet"]
+    assert main(argv) == 130
+    err = capsys.readouterr().err.strip()
+    assert err == f"rig sweep: error: interrupted after 2 of 5 points: those points' shots are in {out}"
+
+
+def test_any_interrupted_command_is_one_line_and_exit_130(monkeypatch, capsys):
+    import rig.cli.tools as tools
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(tools, "cmd_theory", interrupted)
+    assert main(["theory", "--f0", "1"]) == 130
+    assert capsys.readouterr().err.strip() == "rig theory: error: interrupted"

@@ -213,7 +213,18 @@ def test_cli_fit_warns_when_the_model_does_not_describe_the_data(tmp_path, capsy
           "--out", str(tmp_path / "fit"), "--quiet"])
     out = capsys.readouterr().out
     assert "warning: the model does not describe the data (chi2/dof" in out
+    assert "do not determine" not in out  # E is determined, if by a bad model
     assert "numerics: the model's error estimate" in out and "against the accuracy 0.0001" in out
+
+
+def test_cli_fit_warns_of_parameters_the_data_do_not_determine(tmp_path, capsys):
+    """E and Poisson's ratio enter the Hertz contact only as E / (1 - nu^2): their sds pass
+    their bounds' spans, and the fit says so for each."""
+    main(["fit", SCENE, "--points", str(_virtual_points(tmp_path)), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+          "--param", "chain.poisson_ratio=0.1:0.45", "--out", str(tmp_path / "fit"), "--quiet"])
+    out = capsys.readouterr().out
+    for key in ("chain.youngs_modulus", "chain.poisson_ratio"):
+        assert f"warning: the data do not determine {key}: its sd" in out
 
 
 def test_cli_fit_reads_the_shots_of_an_archive(tmp_path, capsys):
