@@ -215,15 +215,16 @@ class Archive:
 
     def summary(self) -> list:
         """One row per shot: id, title, start time (and what it is), simulated, scene, seed,
-        channels, triggered, source files, the striker's settings."""
+        channels, triggered, source files, the striker's settings; a shot that cannot be
+        read: its id and "damaged" (why), the other shots' rows still given."""
         rows = []
         with self._open() as f:
             for name in shot_names(f):
                 try:
                     e = read_entry(f[name], self.path, with_truth=False)
-                except Exception as exc:  # noqa: BLE001 - a damaged file, one line
-                    raise InstrumentError(f"{self.path}: {name}: unreadable ({_cause(exc)}); "
-                                          f"run `rig verify {self.path}`") from None
+                except Exception as exc:  # noqa: BLE001 - a damaged shot, one row
+                    rows.append({"shot": int(name.split("_", 1)[1]), "damaged": f"unreadable ({_cause(exc)})"})
+                    continue
                 rows.append({"shot": e.shot_id, "title": e.title, "start_time": e.start_time,
                              "start_time_source": e.start_time_source, "simulated": e.simulated,
                              "scene": e.scene, "seed": e.seed, "triggered": e.record.triggered,

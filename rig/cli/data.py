@@ -119,6 +119,9 @@ def cmd_ls(args) -> list:
     if not args.json:
         print(f"{'shot':>5s}  {'start (UTC)':20s}  {'kind':7s}  {'scene':22s}  {'seed':>20s}  channels")
         for r in rows:
+            if "damaged" in r:
+                print(f"{r['shot']:5d}  DAMAGED: {r['damaged']}; run `rig verify {args.archive}`")
+                continue
             mark = "~" if r["start_time_source"].startswith("file modification") else " "
             s = r["settings"]
             extra = f"  v={s['velocity']:g} m/s" if "velocity" in s else ""
@@ -126,8 +129,9 @@ def cmd_ls(args) -> list:
             print(f"{r['shot']:5d}  {r['start_time'][:19]:19s}{mark}  {'virtual' if r['simulated'] else 'real':7s}  "
                   f"{what:22s}  {'' if r['seed'] is None else r['seed']:>20}  "
                   f"{','.join(r['channels'])}{'' if r['triggered'] else '  NO TRIGGER'}{extra}")
-        if any(r["start_time_source"].startswith("file modification") for r in rows):
+        if any(r.get("start_time_source", "").startswith("file modification") for r in rows):
             print("~ the file's modification time (the file holds no acquisition time)")
+    args.exit_code = 1 if any("damaged" in r for r in rows) else 0  # a finding, as rig verify's
     return rows
 
 

@@ -211,3 +211,22 @@ def test_import_refuses_a_foreign_or_old_archive_and_upgrade_converts(tmp_path, 
     assert main(["ls", str(old), "--json"]) == 0
     row = json.loads(capsys.readouterr().out)[3]
     assert row["title"] == "tek_16bit_dpo.isf" and row["start_time_source"].startswith("file modification time")
+
+
+def test_ls_lists_the_good_shots_beside_a_damaged_one(tmp_path, capsys):
+    """A shot that cannot be read is a row saying so (exit 1, as verify's findings); the
+    other shots are still listed."""
+    import h5py
+
+    path = tmp_path / "a.h5"
+    rig = Rig.from_scene("steel21_gravity")
+    Archive(path).append([shot_entry(rig.fire(seed=s)) for s in (1, 2, 3)])
+    with h5py.File(path, "a") as f:
+        f["shot_000002/instrument/oscilloscope/CH1"].attrs["preamble"] = "{damaged"
+    assert main(["ls", str(path)]) == 1
+    out = capsys.readouterr().out
+    assert "    2  DAMAGED: unreadable (" in out and f"run `rig verify {path}`" in out
+    assert main(["ls", str(path), "--json"]) == 1
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["shot"] for r in rows] == [1, 2, 3] and "damaged" in rows[1]
+    assert rows[0]["seed"] == 1 and rows[2]["seed"] == 3
