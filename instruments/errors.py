@@ -19,8 +19,8 @@ def check(field: str, value, *, lo=None, hi=None, lo_closed=False, hi_closed=Tru
     too_low = lo is not None and (x < lo if lo_closed else x <= lo)
     too_high = hi is not None and (x > hi if hi_closed else x >= hi)
     if too_low or too_high or x != x:
-        lo_s = "" if lo is None else f"{lo} {'<=' if lo_closed else '<'} "
-        hi_s = "" if hi is None else f" {'<=' if hi_closed else '<'} {hi}"
+        lo_s = "" if lo is None else f"{lo:.6g} {'<=' if lo_closed else '<'} "
+        hi_s = "" if hi is None else f" {'<=' if hi_closed else '<'} {hi:.6g}"
         raise InstrumentError(f"{field} = {value!r}: allowed {lo_s}{field.split('.')[-1]}{hi_s}"
                               f"{' (' + unit + ')' if unit else ''}")
     return x

@@ -39,14 +39,14 @@ class ChannelSettings:
     probe: float = 1.0
 
     def __post_init__(self):
-        check("scope.channel.volts_per_div", self.volts_per_div, lo=1e-3 * 0.999, hi=10.0 * 1.001,
+        check("scope.channels.CHn.volts_per_div", self.volts_per_div, lo=1e-3 * 0.999, hi=10.0 * 1.001,
               lo_closed=True, unit="V/div")
-        check("scope.channel.position", self.position, lo=-5, hi=5, lo_closed=True, unit="div")
-        check("scope.channel.offset", self.offset, lo=-100, hi=100, lo_closed=True, unit="V")
-        check("scope.channel.coupling", self.coupling, choices=("DC", "AC"))
+        check("scope.channels.CHn.position", self.position, lo=-5, hi=5, lo_closed=True, unit="div")
+        check("scope.channels.CHn.offset", self.offset, lo=-100, hi=100, lo_closed=True, unit="V")
+        check("scope.channels.CHn.coupling", self.coupling, choices=("DC", "AC"))
         if self.bandwidth is not None:
-            check("scope.channel.bandwidth", self.bandwidth, lo=0, unit="Hz")
-        check("scope.channel.probe", self.probe, lo=1, hi=1000, lo_closed=True)
+            check("scope.channels.CHn.bandwidth", self.bandwidth, lo=0, unit="Hz")
+        check("scope.channels.CHn.probe", self.probe, lo=1, hi=1000, lo_closed=True)
 
     @property
     def y_multiplier(self) -> float:

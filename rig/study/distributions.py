@@ -106,9 +106,12 @@ class Distribution:
         if k == "lognormal" and lo >= 0:
             below = False
         if below or above:
-            raise invalid(field, self.text(), f"can draw values outside the allowed range "
-                                              f"({'(' if lo_open else '['}{lo:g}, {hi:g}); truncate it "
-                                              f"(truncnormal) or use a lognormal")
+            unit = key_unit(self.key)
+            allowed = (f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if math.isinf(hi) else ']'}"
+                       + ("" if unit is float else f" {unit}"))
+            raise invalid(field, self.text(), f"can draw values outside the allowed range {allowed} "
+                                              f"(the values in SI units); truncate it (truncnormal) "
+                                              f"or use a lognormal")
 
     def text(self) -> str:
         return f"{self.kind}({', '.join(f'{x:g}' for x in self.params)})"

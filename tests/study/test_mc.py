@@ -31,6 +31,7 @@ def _outputs(folder):
     ("magnet.force=uniform(3 N, 2 N)", "LO < HI"),
     ("striker.colour=normal(1, 2)", "unknown key"),
     ("striker.mass=normal(0.47 g, 0.3 g)", "outside the allowed range"),
+    ("chain.bead_mass=normal(0.1226 g, 0.1 g)", "outside the allowed range (0, inf) kg (the values in SI units)"),
     ("gauges.middle.gain=normal(1, 0.05)", "no gauge 'middle'"),
     ("striker.velocity=normal(0.89, 0.01)", "unit is required"),
 ])
