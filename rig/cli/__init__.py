@@ -151,7 +151,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="distance between the two gauges (plain number: m), for real files")
     an.add_argument("--channels", help="UPPER,LOWER[,WALL] channel names (default: file order)")
     an.add_argument("--wall", action="store_true", help="the third channel is the wall sensor")
-    an.add_argument("--sensitivity", type=quantity_type("V/N", "--sensitivity"), default=1.0,
+    an.add_argument("--sensitivity", type=quantity_type("V/N", "--sensitivity"),
                     help="gauge sensitivity, e.g. '0.05 V/N' (plain number: V/N; default 1: volts)")
     an.add_argument("--tau", type=quantity_type("s", "--tau"), help="gauge RC time constant to invert (s)")
     an.add_argument("--beta", type=float, default=1.0, help="beta = F_d / F_m,e, dimensionless, > 0 (default 1)")

@@ -87,17 +87,22 @@ def cmd_analyze(args) -> list:
     from rig.experiment.analyze import AnalyzeOptions, analyze_paths
 
     options = AnalyzeOptions(files=tuple(args.files), shot=args.shot, gauge_distance=args.gauge_distance,
-                             channels=args.channels, wall=args.wall, sensitivity=args.sensitivity, tau=args.tau,
+                             channels=args.channels, wall=args.wall,
+                             sensitivity=1.0 if args.sensitivity is None else args.sensitivity, tau=args.tau,
                              beta=args.beta, f0=args.f0, diameter=args.diameter, material=args.material)
     results = analyze_paths(options)
     args.exit_code = 0 if any(r["speed_m_per_s"] is not None for r in results) else 1
     if not args.json:
         fmt = lambda v, spec=".2f": "-" if v is None else format(v, spec)  # noqa: E731
+        if args.sensitivity is None:
+            print("note: without --sensitivity a real scope file's forces are its gauges' volts (1 V/N); "
+                  "give e.g. --sensitivity '0.05 V/N' for newtons (a virtual shot's archive has its own)")
         print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d N':>8s} {'F_m,e N':>8s} "
               f"{'pulses':>6s} {'FWHM us':>8s} {'Eq1 m/s':>8s}")
         for r in results:
             fwhm = None if r["duration_s"] is None else r["duration_s"] * 1e6
-            print(f"{r['source'][-40:]:40s} {fmt(r['speed_m_per_s'], '.1f'):>8s} "
+            src = r["source"] if len(r["source"]) <= 40 else "..." + r["source"][-37:]
+            print(f"{src:40s} {fmt(r['speed_m_per_s'], '.1f'):>8s} "
                   f"{fmt(r['speed_xcorr_m_per_s'], '.1f'):>8s} {fmt(r['amplitude_N'], '.3f'):>8s} "
                   f"{fmt(r['averaged_amplitude_N'], '.3f'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
                   f"{fmt(fwhm, '.1f'):>8s} {fmt(r['theory_speed_m_per_s'], '.1f'):>8s}")

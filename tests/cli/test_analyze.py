@@ -60,6 +60,17 @@ def test_text_output_states_snr_and_reasons(gauge_files, capsys):
                for line in out), out
 
 
+def test_text_output_says_when_its_forces_are_volts(gauge_files, capsys):
+    """Without --sensitivity the force columns hold the gauges' volts (1 V/N): the table
+    says so above its header, and not when the sensitivity is given."""
+    volts = ["--gauge-distance", "40 mm", "--tau", "1 ms"]
+    assert main(["analyze", *gauge_files, *volts]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("note: without --sensitivity a real scope file's forces are its gauges' volts")
+    assert main(["analyze", *gauge_files, *GAUGE]) == 0
+    assert not capsys.readouterr().out.startswith("note:")
+
+
 def test_19_km_between_the_gauges_is_refused(gauge_files, capsys):
     code, (r,), _ = run(capsys, "analyze", *gauge_files, *GAUGE, "--gauge-distance", "19 km")
     assert code == 1
