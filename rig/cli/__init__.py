@@ -179,7 +179,9 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     """Run one command. A user mistake or an I/O failure (a missing file, a folder, no
     permission, a full disk, ...) is one line on stderr and exit 2; never a traceback."""
-    args = build_parser().parse_args(argv)
+    args, extra = build_parser().parse_known_args(argv)
+    if extra:  # named by the command's parser, not the top one's ("rig: error:")
+        return _fail(args.command, f"unrecognized arguments: {' '.join(extra)} (see rig {args.command} --help)")
     try:
         out = args.func(args)
     except Interrupted as exc:  # Ctrl-C, with what the run kept

@@ -148,6 +148,7 @@ CASES = [
     # analyze, import, verify, ls (the archive and the analysis)
     (["analyze", "{d}/missing.isf", "--gauge-distance", "43 mm"], "missing.isf"),
     (["analyze", "{d}/empty.isf", "--gauge-distance", "43 mm"], "empty.isf"),
+    (["analyze", "{d}/empty.isf", "--archive", "a.h5"], "rig analyze: error: unrecognized arguments: --archive a.h5"),
     (["analyze", "{d}/junk.isf", "--gauge-distance", "43 mm"], "junk.isf"),
     (["analyze", "{d}/folder", "--gauge-distance", "43 mm"], "folder"),
     (["analyze", "{d}/text.h5"], "text.h5"),
