@@ -13,7 +13,7 @@ import functools
 from dataclasses import dataclass
 
 from rig.experiment import scene as scene_io
-from rig.experiment.measure import TAIL_FWHM, midway_static_force
+from rig.experiment.measure import leading_end, midway_static_force
 from rig.experiment.shot import Rig
 
 NOMINAL_SEED = 0
@@ -54,20 +54,20 @@ class Nominal:
 
     @functools.cached_property
     def leading_window(self) -> Window:
-        """Simulated until TAIL_FWHM full widths after the nominal leading pulse peaks at the
-        last gauge (the cross-correlation searches 2 widths around it; the third covers the
-        shot-to-shot spread of its arrival); the scope keeps the scene's pre-trigger samples
-        (the baseline comes from them) and records after the trigger only as long as the
-        simulation lasts, the trigger taken at the nominal shot's time + 5% (spread). The
-        scene's own window where the nominal shot shows no leading pulse or no trigger."""
+        """Simulated until the nominal leading pulse has passed the last gauge (leading_end:
+        TAIL_FWHM full widths after it peaks there; the cross-correlation searches 2 widths
+        around it, the third covers the shot-to-shot spread of its arrival); the scope keeps
+        the scene's pre-trigger samples (the baseline comes from them) and records after the
+        trigger only as long as the simulation lasts, the trigger taken at the nominal shot's time + 5% (spread). The
+        scene's own window where the nominal shot shows no leading pulse (or one cut off by
+        the record's end) or no trigger."""
         rig = self.rig
         tb, pre = rig.scope.timebase, rig.scope.trigger.pre_trigger
-        lead = rig.truth_analysis().leading
-        last = lead.get("lower") or lead.get("upper")
+        end = leading_end(rig.truth_analysis())
         trigger = nominal_trigger_time(rig)
-        if not last or not last.get("fwhm") or trigger is None:
+        if end is None or trigger is None:
             return self.record_window
-        duration = min(rig.solver.duration, last["time"] + TAIL_FWHM * last["fwhm"])
+        duration = min(rig.solver.duration, end)
         n_pre = int(round(pre * tb.record_length))
         n_post = int((duration - 1.05 * trigger) / tb.sample_interval)
         if n_post <= 0 or n_pre + n_post >= tb.record_length:
