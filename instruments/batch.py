@@ -13,11 +13,9 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-from numba import prange
 
-from ._kernels import acquisition, pulses
+from ._kernels import acquisition, batch_analysis, pulses
 from .frontend import highpass_coefficients
-from .jit import jit
 from .oscilloscope import CODE_MAX, CODE_MIN, Oscilloscope
 from .pipeline import Setup, report_of
 from .records import ScopeRecord
@@ -139,34 +137,6 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
     return Records(wiring, codes, over, status, times, drawn, n_in, float(h))
 
 
-@jit
-def _analyse_shot(codes, time0, dx, n_pre, ymult, yoff, yzero, roles, tau, sens, rules, answer, sigma):
-    """One shot's leading_pair answer and its channels' noise; False where a sample is not
-    a finite number."""
-    t = time0 + dx * np.arange(codes.shape[1])
-    f = np.empty((2, codes.shape[1]))
-    for r in range(2):
-        c = roles[r]
-        volts = yzero[c] + ymult[c] * (codes[c].astype(np.float64) - yoff[c])
-        f[r] = pulses.conditioned(volts, n_pre, dx, tau[r], sens[r])
-        sigma[r] = pulses.noise_level(f[r], n_pre, abs(ymult[c]) / sens[r])
-        if not np.all(np.isfinite(f[r])):
-            return False
-    pulses.leading_pair(t, f[0], f[1], sigma[0], sigma[1], rules, answer)
-    return True
-
-
-@jit(parallel=True)
-def _analysed(codes, status, times, dx, n_pre, ymult, yoff, yzero, roles, tau, sens, rules, answer, sigma, finite):
-    for s in prange(codes.shape[0]):
-        answer[s, :] = math.nan
-        sigma[s, :] = math.nan
-        finite[s] = True
-        if status[s] == acquisition.OK:
-            finite[s] = _analyse_shot(codes[s], times[s, 1], dx, n_pre, ymult, yoff, yzero, roles, tau, sens, rules,
-                                      answer[s], sigma[s])
-
-
 def analysed(records: Records, setup: Setup) -> list:
     """Every shot's Report of its leading pulse (the pipeline's analyze_record(record,
     setup, train=False)), the numbers from one compiled loop over the shots."""
@@ -180,7 +150,7 @@ def analysed(records: Records, setup: Setup) -> list:
     sigma = np.empty((S, 2))
     finite = np.empty(S, np.bool_)
     dx = scope.timebase.sample_interval
-    _analysed(records.codes, records.status, records.times, dx, front.n_pre, front.ymult, front.yoff, front.offset,
+    batch_analysis.analyse_shots(records.codes, records.status, records.times, dx, front.n_pre, front.ymult, front.yoff, front.offset,
               roles, np.array([g.tau_s or 0.0 for g in gauges]), np.array([g.sensitivity_V_per_N for g in gauges]),
               setup.rules.as_tuple(), answer, sigma, finite)
     L = records.codes.shape[2]

@@ -154,3 +154,37 @@ def test_median_is_numpys(n):
     rng = np.random.default_rng(n)
     for x in (rng.standard_normal(n), rng.integers(0, 4, n).astype(float)):  # ties as on 8-bit records
         assert median(x) == np.median(x)
+
+
+def test_correlation_adds_each_lag_in_order():
+    # the cross-correlation's sums, four terms at a time, are the plain sums over j in
+    # order (numpy adds a[j] b[j:j + K] to c one j after another), bit for bit, for
+    # windows that are and are not multiples of four
+    from instruments._kernels.pulses import correlate
+
+    rng = np.random.default_rng(13)
+    for m in (1, 3, 4, 5, 8, 611, 614):
+        for K in (1, 2, 9, 615):
+            a, b = rng.standard_normal(m), rng.standard_normal(m + K - 1) * 1e3
+            ref = np.zeros(K)
+            for j in range(m):
+                ref += b[j:j + K] * a[j]
+            c = np.zeros(K)
+            correlate(a, b, c)
+            assert _same_bits(c, ref)
+
+
+def test_median_of_many_records_is_numpys():
+    # sorted, tied and noisy inputs of every length parity: the selection's pivots and
+    # buffers give numpy's value exactly; a nan gives nan, as np.median does
+    from instruments._kernels.pulses import median
+
+    rng = np.random.default_rng(21)
+    for t in range(600):
+        n = int(rng.integers(1, 1500))
+        x = rng.standard_normal(n) if t % 3 else rng.integers(0, 5, n).astype(float)
+        if t % 5 == 0:
+            x = np.sort(x)[::-1 if t % 2 else 1].copy()
+        assert median(x) == np.median(x)
+    x[len(x) // 2] = np.nan
+    assert math.isnan(median(x))

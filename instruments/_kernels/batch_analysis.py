@@ -1,0 +1,46 @@
+"""The leading-pulse analysis of a batch of scope records, compiled (numba): each shot's
+channels from their 8-bit codes to forces, their noise and leading_pair's answer, over
+the shots on numba's threads. instruments/batch.analysed turns the numbers into Reports.
+The same functions as a lone record's analysis (pulses.py), so the same bits.
+"""
+import math
+
+import numpy as np
+from numba import prange
+
+from instruments.jit import jit
+
+from .acquisition import OK
+from .pulses import conditioned, leading_pair, noise_level
+
+
+@jit
+def analyse_shot(codes, time0, dx, n_pre, ymult, yoff, yzero, roles, tau, sens, rules, answer, sigma):
+    """One shot's leading_pair answer and its channels' noise (roles: the upper and lower
+    gauges' channels; tau s, sens V/N: their gauges'); False where a sample is not a
+    finite number."""
+    t = time0 + dx * np.arange(codes.shape[1])
+    f = np.empty((2, codes.shape[1]))
+    for r in range(2):
+        c = roles[r]
+        volts = yzero[c] + ymult[c] * (codes[c].astype(np.float64) - yoff[c])
+        f[r] = conditioned(volts, n_pre, dx, tau[r], sens[r])
+        sigma[r] = noise_level(f[r], n_pre, abs(ymult[c]) / sens[r])
+        if not np.all(np.isfinite(f[r])):
+            return False
+    leading_pair(t, f[0], f[1], sigma[0], sigma[1], rules, answer)
+    return True
+
+
+@jit(parallel=True)
+def analyse_shots(codes, status, times, dx, n_pre, ymult, yoff, yzero, roles, tau, sens, rules, answer, sigma,
+                  finite):
+    """analyse_shot for every shot whose record status is OK (codes (shots, channels,
+    samples), times[:, 1]: each record's first sample s); answer and sigma nan elsewhere."""
+    for s in prange(codes.shape[0]):
+        answer[s, :] = math.nan
+        sigma[s, :] = math.nan
+        finite[s] = True
+        if status[s] == OK:
+            finite[s] = analyse_shot(codes[s], times[s, 1], dx, n_pre, ymult, yoff, yzero, roles, tau, sens, rules,
+                                     answer[s], sigma[s])
