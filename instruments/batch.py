@@ -150,9 +150,10 @@ def analysed(records: Records, setup: Setup) -> list:
     sigma = np.empty((S, 2))
     finite = np.empty(S, np.bool_)
     dx = scope.timebase.sample_interval
-    batch_analysis.analyse_shots(records.codes, records.status, records.times, dx, front.n_pre, front.ymult, front.yoff, front.offset,
-              roles, np.array([g.tau_s or 0.0 for g in gauges]), np.array([g.sensitivity_V_per_N for g in gauges]),
-              setup.rules.as_tuple(), answer, sigma, finite)
+    batch_analysis.analyse_shots(records.codes, records.status, records.times, dx, front.n_pre, front.ymult,
+                                 front.yoff, front.offset, roles, np.array([g.tau_s or 0.0 for g in gauges]),
+                                 np.array([g.sensitivity_V_per_N for g in gauges]), setup.rules.as_tuple(), answer,
+                                 sigma, finite)
     L = records.codes.shape[2]
     out = []
     for s in range(S):
