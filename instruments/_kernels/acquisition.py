@@ -10,9 +10,9 @@ import numpy as np
 
 from instruments.jit import jit
 
-from .filters import one_pole
-from .quantiser import code
-from .resample import read_at
+from .filters import pole_step
+from .quantiser import quantise
+from .resample import at_positions, read_at
 
 OK, NO_TRIGGER, PAST_INPUT = 0, 1, 2  # how an acquisition ended
 
@@ -30,9 +30,7 @@ def gauge_signal(force, h, shift, scale, b0, b1, a1, noise_sd, z):
     state = 0.0
     noisy = z.shape[0] > 0
     for k in range(n):
-        u = scale * read_at(force, k - lag) - level
-        yk = state + b0 * u
-        state = u * b1 - yk * a1
+        yk, state = pole_step(state, scale * read_at(force, k - lag) - level, b0, b1, a1)
         y[k] = yk + noise_sd * z[k] if noisy else yk
     return y
 
@@ -40,14 +38,29 @@ def gauge_signal(force, h, shift, scale, b0, b1, a1, noise_sd, z):
 @jit
 def condition(v, probe, ac, lowpass):
     """A scope channel's analog front end on the volts at the probe tip: the input divided
-    by the probe, AC coupling and the bandwidth limit (each a one-pole (b0, b1, a1); a1 nan:
-    off), expressed back at the probe tip."""
-    x = v / probe
-    if not math.isnan(ac[2]):
-        x = one_pole(x, ac[0], ac[1], ac[2], x[0], False)
-    if not math.isnan(lowpass[2]):
-        x = one_pole(x, lowpass[0], lowpass[1], lowpass[2], x[0], True)
-    return x * probe
+    by the probe, AC coupling and the bandwidth limit (each a one-pole (b0, b1, a1) from
+    rest about its input's first value, filters.one_pole; a1 nan: off; the bandwidth limit
+    adds that value back), expressed back at the probe tip. One pass: the two filters'
+    recursions overlap; a 1x probe divides and multiplies by 1, which changes no bit, so it
+    is skipped."""
+    n = v.shape[0]
+    out = np.empty(n)
+    unit = probe == 1.0
+    coupled, limited = not math.isnan(ac[2]), not math.isnan(lowpass[2])
+    z_ac = z_lp = level_ac = level_lp = 0.0
+    for k in range(n):
+        x = v[k] if unit else v[k] / probe
+        if coupled:
+            if k == 0:
+                level_ac = x
+            x, z_ac = pole_step(z_ac, x - level_ac, ac[0], ac[1], ac[2])
+        if limited:
+            if k == 0:
+                level_lp = x
+            y, z_lp = pole_step(z_lp, x - level_lp, lowpass[0], lowpass[1], lowpass[2])
+            x = y + level_lp
+        out[k] = x if unit else x * probe
+    return out
 
 
 @jit
@@ -76,15 +89,9 @@ def scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult
     t = t_cross + x_zero + dt * np.arange(codes.shape[1])
     if t[-1] > (analog.shape[1] - 1) * h * (1 + 1e-12):
         return PAST_INPUT, t_cross, x_zero
-    for c in range(analog.shape[0]):  # read between input samples, then the converter, in one pass
-        noisy = z.shape[1] > 0
-        clipped = False
-        for k in range(t.shape[0]):
-            q = code(read_at(analog[c], t[k] / h), offset[c], ymult[c], yoff[c], noisy,
-                     sd[c] * z[c, k] if noisy else 0.0)
-            clipped |= q > hi or q < lo
-            codes[c, k] = np.int8(min(max(q, lo), hi))
-        over[c] = clipped
+    pos = t / h
+    for c in range(analog.shape[0]):  # read between input samples, then the converter (a pass that vectorises)
+        over[c] = quantise(at_positions(analog[c], pos), offset[c], ymult[c], yoff[c], sd[c], z[c], lo, hi, codes[c])
     return OK, t_cross, x_zero
 
 

@@ -4,6 +4,14 @@ import numpy as np
 from instruments.jit import jit
 
 
+@jit(inline="always")
+def pole_step(z, u, b0, b1, a1):
+    """One sample of a one-pole filter in direct form II transposed (scipy.signal.lfilter's
+    operations): input u, state z -> (output y = z + b0 u, next state u b1 - y a1)."""
+    y = z + b0 * u
+    return y, u * b1 - y * a1
+
+
 @jit
 def one_pole(x, b0, b1, a1, level, restore):
     """y[n] = b0 u[n] + b1 u[n-1] - a1 y[n-1], u = x - level, from rest; plus level again
@@ -13,9 +21,7 @@ def one_pole(x, b0, b1, a1, level, restore):
     y = np.empty(n)
     z = 0.0
     for k in range(n):
-        u = x[k] - level
-        yk = z + b0 * u
-        z = u * b1 - yk * a1
+        yk, z = pole_step(z, x[k] - level, b0, b1, a1)
         y[k] = yk + level if restore else yk
     return y
 

@@ -14,17 +14,22 @@ def code(v, offset, ymult, yoff, noisy, noise):
 
 
 @jit
-def quantise(v, offset, ymult, yoff, sd, noise, lo, hi):
-    """Codes round((v - offset) / ymult + yoff [+ sd * noise]) clipped to [lo, hi] (int8),
-    and whether any was clipped. ``noise``: standard normal draws, one per sample, or an
-    empty array for none. The same operations, in the same order, as numpy's
-    clip(rint((v - offset) / ymult + yoff + sd * noise), lo, hi).astype(int8), in one pass."""
-    n = v.shape[0]
-    codes = np.empty(n, np.int8)
-    noisy = noise.shape[0] > 0
+def quantise(v, offset, ymult, yoff, sd, noise, lo, hi, codes):
+    """Codes round((v - offset) / ymult + yoff [+ sd * noise]) clipped to [lo, hi] into
+    ``codes`` (int8, v's length); returns whether any was clipped. ``noise``: standard
+    normal draws, one per sample, or an empty array for none. The same operations, in the
+    same order, as numpy's clip(rint((v - offset) / ymult + yoff + sd * noise), lo,
+    hi).astype(int8), in one pass that vectorises (a loop for each case, the settings held
+    in locals)."""
     clipped = False
-    for k in range(n):
-        c = code(v[k], offset, ymult, yoff, noisy, sd * noise[k] if noisy else 0.0)
-        clipped |= c > hi or c < lo
-        codes[k] = np.int8(min(max(c, lo), hi))
-    return codes, clipped
+    if noise.shape[0] > 0:
+        for k in range(v.shape[0]):
+            c = code(v[k], offset, ymult, yoff, True, sd * noise[k])
+            clipped |= c > hi or c < lo
+            codes[k] = np.int8(min(max(c, lo), hi))
+    else:
+        for k in range(v.shape[0]):
+            c = code(v[k], offset, ymult, yoff, False, 0.0)
+            clipped |= c > hi or c < lo
+            codes[k] = np.int8(min(max(c, lo), hi))
+    return clipped

@@ -137,14 +137,15 @@ def test_quantiser_is_the_numpy_expression(sd):
     rng = np.random.default_rng(9)
     v = rng.uniform(-1.5, 1.5, 20000)
     noise = rng.standard_normal(v.size) if sd else np.empty(0)
-    codes, clipped = quantise(v, 0.1, 0.01, -25.0, sd, noise, -128.0, 127.0)
+    codes = np.empty(v.size, np.int8)
+    clipped = quantise(v, 0.1, 0.01, -25.0, sd, noise, -128.0, 127.0, codes)
     ref = (v - 0.1) / 0.01 + -25.0
     if sd:
         ref = ref + sd * noise
     ref = np.rint(ref)
     assert clipped == bool(np.any(ref > 127) or np.any(ref < -128)) and clipped
     assert codes.dtype == np.int8 and np.array_equal(codes, np.clip(ref, -128, 127).astype(np.int8))
-    assert not quantise(v * 0.1, 0.0, 0.01, 0.0, sd, noise, -128.0, 127.0)[1]
+    assert not quantise(v * 0.1, 0.0, 0.01, 0.0, sd, noise, -128.0, 127.0, codes)
 
 
 @pytest.mark.parametrize("n", [1, 2, 7, 16, 1250, 1251])
@@ -188,3 +189,24 @@ def test_median_of_many_records_is_numpys():
         assert median(x) == np.median(x)
     x[len(x) // 2] = np.nan
     assert math.isnan(median(x))
+
+
+@pytest.mark.parametrize("probe", [1.0, 10.0])
+def test_front_end_is_its_filters_one_after_another(probe):
+    # the scope channel's front end in one pass (both filters' recursions together, a 1x
+    # probe skipped) is the input over the probe, lfilter's AC coupling, lfilter's bandwidth
+    # limit about its first value, times the probe, bit for bit, each filter on or off
+    from instruments._kernels.acquisition import condition
+
+    rng = np.random.default_rng(17)
+    v = np.cumsum(rng.standard_normal(3000)) * 1e-3 + 0.2
+    ac = np.array([0.99, -0.99, -0.98])
+    lowpass = np.array([0.96, 0.04, -1.2e-3])
+    off = np.full(3, np.nan)
+    for a, lp in ((ac, lowpass), (ac, off), (off, lowpass), (off, off)):
+        x = v / probe
+        if not math.isnan(a[2]):
+            x = lfilter(a[:2], [1.0, a[2]], x - x[0])
+        if not math.isnan(lp[2]):
+            x = lfilter(lp[:2], [1.0, lp[2]], x - x[0]) + x[0]
+        assert _same_bits(condition(v, probe, a, lp), x * probe)
