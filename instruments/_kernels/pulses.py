@@ -14,7 +14,7 @@ from .crossings import level_bracket
 from .filters import undo_highpass
 from .parabola import parabola
 from .peaks import local_maxima, thin_by_distance, widths_at
-from .prominence import prominence_bases
+from .prominence import prominent
 
 MIN_BASELINE = 16  # pre-trigger samples needed to measure the noise (the MAD to about 1/3)
 MAD_TO_SD = 1.4826  # the standard deviation of Gaussian noise over its median absolute deviation
@@ -144,11 +144,7 @@ def candidates(f, height, min_prominence, spacing, min_width):
     idx = local_maxima(f, height)
     if spacing > 1 and idx.shape[0]:
         idx = idx[thin_by_distance(idx, np.argsort(f[idx], kind="mergesort"), float(spacing))]
-    left, right = prominence_bases(f, height)
-    left, right = left[idx], right[idx]
-    prominence = f[idx] - np.maximum(f[left], f[right])
-    keep = prominence >= min_prominence
-    idx, prominence, left, right = idx[keep], prominence[keep], left[keep], right[keep]
+    idx, prominence, left, right = prominent(f, idx, min_prominence, height)
     if min_width > 0.0 and idx.shape[0]:
         idx = idx[widths_at(f, idx, 0.5, prominence, left, right) >= min_width]
     return idx

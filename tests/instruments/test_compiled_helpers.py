@@ -10,7 +10,7 @@ from scipy.signal import find_peaks, lfilter, peak_prominences, peak_widths
 from instruments._kernels.filters import one_pole, undo_highpass
 from instruments._kernels.parabola import parabola
 from instruments._kernels.peaks import local_maxima, thin_by_distance, widths_at
-from instruments._kernels.prominence import prominence_bases
+from instruments._kernels.prominence import prominence_bases, prominent
 from instruments._kernels.quantiser import quantise
 from instruments._kernels.resample import at_positions
 
@@ -48,6 +48,40 @@ def test_prominence_bases_are_scipys_bit_for_bit(with_floor):
         assert np.all(lb[x < floor] == -1) and np.all(rb[x < floor] == -1)
         checked += peaks.size
     assert checked > 2000
+
+
+def _scipy_prominent(x, peaks, pmin):
+    prom, left, right = peak_prominences(x, peaks)
+    keep = prom >= pmin
+    return peaks[keep], prom[keep], left[keep], right[keep]
+
+
+def test_prominent_peaks_are_find_peaks_bit_for_bit():
+    # the early-dropping scans keep the peaks find_peaks' prominence rule keeps, with
+    # scipy's prominences and bases; thresholds from none to more than any peak has
+    rng = np.random.default_rng(19)
+    checked = 0
+    for x in _signals():
+        floor = float(np.quantile(x, rng.uniform(0, 1)))
+        peaks = find_peaks(x, height=floor)[0]
+        spread = float(np.ptp(x)) or 1.0
+        for pmin in (0.0, rng.uniform(0, 0.3) * spread, rng.uniform(0.3, 1.2) * spread):
+            got, ref = prominent(x, peaks, pmin, floor), _scipy_prominent(x, peaks, pmin)
+            assert np.array_equal(got[0], ref[0]) and _same_bits(got[1], ref[1])
+            assert np.array_equal(got[2], ref[2]) and np.array_equal(got[3], ref[3])
+            checked += ref[0].size
+    assert checked > 1000
+
+
+def test_prominent_peaks_of_equal_pulses_end_to_end():
+    # 600 equal pulses: every scan runs over the others (<= the peak), the scans' budget
+    # runs out and the one-pass bases answer, still scipy's
+    x = np.tile(np.array([0.0, 0.5, 1.0, 0.5, 0.0, 0.2]), 600)
+    x[::97] -= 0.05  # uneven dips
+    peaks = find_peaks(x)[0]
+    for pmin in (0.0, 0.6, 0.99):
+        got, ref = prominent(x, peaks, pmin), _scipy_prominent(x, peaks, pmin)
+        assert got[0].size == ref[0].size and all(np.array_equal(a, b) for a, b in zip(got, ref))
 
 
 @pytest.mark.parametrize("distance", [None, 2, 5, 17.5])
