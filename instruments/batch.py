@@ -48,8 +48,9 @@ class Records:
     """The scope records of a batch: codes (shots, channels, samples) int8, over-range
     flags (shots, channels), status (OK, NO_TRIGGER, PAST_INPUT), times
     (shots, 2: the trigger crossing and the first sample, s), the gauges' draws (shots,
-    gauges, 2: gain factor and position error m), and the input they read (n_in samples
-    every h s)."""
+    gauges, 2: gain factor and position error m), the input they read (n_in samples
+    every h s) and which channels were converted (read (channels,): the others hold code
+    0)."""
 
     wiring: Wiring
     codes: np.ndarray
@@ -59,21 +60,29 @@ class Records:
     draws: np.ndarray
     n_in: int
     h: float
+    read: np.ndarray
 
     def record(self, s: int) -> ScopeRecord:
-        """Shot s's ScopeRecord, as Oscilloscope.acquire returns it (InstrumentError where
-        its record runs past the input)."""
+        """Shot s's ScopeRecord of the channels read, as Oscilloscope.acquire returns it
+        (InstrumentError where its record runs past the input)."""
         return self.wiring.scope.record_of(int(self.status[s]), float(self.times[s, 0]), float(self.times[s, 1]),
-                                           self.codes[s], self.over[s], self.n_in, self.h)
+                                           self.codes[s], self.over[s], self.n_in, self.h, self.read)
 
 
 def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarray | None = None,
-            wave_speed: np.ndarray | None = None) -> Records:
+            wave_speed: np.ndarray | None = None, read=None) -> Records:
     """Every shot's scope record. forces (shots, gauges, samples): what each gauge reads
     (N, every h s; a bead gauge its plate's average, the wall sensor the wall's contact);
     seeds: one per shot; fixed (shots, gauges, 2): gain factors and position errors that
     replace the drawn ones (nan: keep the draw); wave_speed (shots,): the pulse's speed
-    (m/s) that turns a position error into a delay (nan: none).
+    (m/s) that turns a position error into a delay (nan: none); read: the channels anyone
+    will look at (None: all), the trigger's source always among them.
+
+    A channel nobody reads is neither filtered nor converted, and its scope noise is not
+    drawn where no draw of the shot comes after it; every shot still draws every other
+    number in a lone shot's order (a record that starts before the impact draws the
+    skipped noise before its inputs' rest noise), so the channels read have the bits they
+    have in a whole record.
 
     The shots are shared out over numba's number of threads; each thread takes its shots
     one by one: the shot's draws into the thread's own noise buffers (they stay in cache),
@@ -101,13 +110,16 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
     drawn = np.empty((S, G, 2))
     forces = np.ascontiguousarray(forces, dtype=float)
     wired = wiring.wired()
+    names = wiring.channels
+    reads = np.array([read is None or ch in read or c == front.source for c, ch in enumerate(names)], np.bool_)
+    drawn_rows = int(np.flatnonzero(reads)[-1]) + 1 if scope.noise_floor else 0  # scope noise drawn with the shot
     rested = [g for g in wired if g >= 0 and settings[g].noise]  # the inputs with noise before the impact
 
     def record(s, z_gauge, z_rest, phase, z_scope, shift, scale):
         return acquisition.one_shot(forces[s], float(h), shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired,
                                     front.probe, front.ac, front.lowpass, front.source, front.level, front.rising,
                                     phase, front.n_pre, dx, front.offset, front.ymult, front.yoff, front.sd, z_scope,
-                                    float(CODE_MIN), float(CODE_MAX), codes[s], over[s])
+                                    float(CODE_MIN), float(CODE_MAX), codes[s], over[s], reads)
 
     def shots_from(lo: int, hi: int) -> None:
         z_gauge = np.empty((G, n_in)) if noisy.all() else np.zeros((G, n_in))  # a noise-free gauge's row stays 0
@@ -116,11 +128,13 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
         for s in range(lo, hi):
             gen = np.random.default_rng(int(seeds[s]))
             phase = acquisition.shot_draws(gen, cal, mis, noisy, drawn[s], z_gauge, dx, bool(scope.noise_floor),
-                                           z_scope)
+                                           z_scope[:drawn_rows])
             acquisition.shot_settings(drawn[s], replace[s], sens, delayed, speed[s], shift, scale)
             st, t_cross, x_zero = record(s, z_gauge, np.empty((G, 0)), phase, z_scope, shift, scale)
             n_pad = acquisition.samples_before_input(st, t_cross, x_zero, h)
             if n_pad:  # a record that starts before the impact, again with the inputs at rest before it
+                if scope.noise_floor:
+                    gen.standard_normal((C - drawn_rows) * L)  # the noise of the channels not read, in its turn
                 z_rest = np.zeros((G, n_pad))
                 for g in rested:  # drawn after the shot's other draws, in the displayed channels' order
                     z_rest[g] = gen.standard_normal(n_pad)
@@ -134,7 +148,7 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
             list(pool.map(shots_from, cuts[:-1], cuts[1:]))
     else:
         shots_from(0, S)
-    return Records(wiring, codes, over, status, times, drawn, n_in, float(h))
+    return Records(wiring, codes, over, status, times, drawn, n_in, float(h), reads)
 
 
 def analysed(records: Records, setup: Setup) -> list:

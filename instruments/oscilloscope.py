@@ -158,7 +158,7 @@ class Oscilloscope:
         status, t_cross, x_zero = scope_shot(self.analog(inputs, h), float(h), front.source, front.level,
                                              front.rising, phase, front.n_pre, tb.sample_interval, front.offset,
                                              front.ymult, front.yoff, front.sd, noise, float(CODE_MIN),
-                                             float(CODE_MAX), codes, over)
+                                             float(CODE_MAX), codes, over, np.ones(len(self.channels), np.bool_))
         return status, t_cross, x_zero, codes, over
 
     def analog(self, inputs: dict, h: float) -> np.ndarray:
@@ -173,10 +173,12 @@ class Oscilloscope:
             analog[c] = condition(v, front.probe[c], front.ac[c], front.lowpass[c])
         return analog
 
-    def record_of(self, status: int, t_cross: float, x_zero: float, codes, over, n_in: int, h: float) -> ScopeRecord:
+    def record_of(self, status: int, t_cross: float, x_zero: float, codes, over, n_in: int, h: float,
+                  read=None) -> ScopeRecord:
         """The ScopeRecord of one acquisition (acquisition.scope_shot's status and times,
-        codes (channels, samples), over-range flags), or InstrumentError where the record
-        would run past the input of n_in samples every h s."""
+        codes (channels, samples), over-range flags; read (channels,): the channels
+        converted, None: all), or InstrumentError where the record would run past the input
+        of n_in samples every h s."""
         tb, tr = self.timebase, self.trigger
         if status == NO_TRIGGER:
             return ScopeRecord({}, False,
@@ -188,7 +190,7 @@ class Oscilloscope:
                 f"record a longer input or shorten the record")
         n_pre = int(round(tr.pre_trigger * tb.record_length))
         waves = {ch: self._waveform(ch, s, codes[c], bool(over[c]), float(x_zero), n_pre)
-                 for c, (ch, s) in enumerate(self.channels.items())}
+                 for c, (ch, s) in enumerate(self.channels.items()) if read is None or read[c]}
         return ScopeRecord(waves, True, None, float(t_cross))
 
     def front_panel(self, h: float) -> "FrontPanel":

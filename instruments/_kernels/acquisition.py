@@ -75,13 +75,14 @@ def first_crossing(x, h, level, rising):
 
 @jit
 def scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult, yoff, sd, z, lo, hi,
-               codes, over):
+               codes, over, read):
     """One acquisition of conditioned channels ``analog`` (channels, samples every h s):
     the edge trigger on channel ``source``, the record of codes.shape[1] samples every dt s
     from n_pre samples before it (plus the clock's phase), read linearly between input
     samples, through the 8-bit converter (quantise) with the scope's noise sd x z[c]
-    (z[c] empty: none). Fills codes (channels, samples) and over; returns (status, time of
-    the trigger crossing s, time of the first sample after the trigger s)."""
+    (z[c] empty: none). Fills codes (channels, samples) and over of the channels ``read``
+    (the others: codes 0, not over); returns (status, time of the trigger crossing s, time
+    of the first sample after the trigger s)."""
     t_cross = first_crossing(analog[source], h, level, rising)
     if math.isnan(t_cross):
         return NO_TRIGGER, t_cross, math.nan
@@ -91,7 +92,12 @@ def scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult
         return PAST_INPUT, t_cross, x_zero
     pos = t / h
     for c in range(analog.shape[0]):  # read between input samples, then the converter (a pass that vectorises)
-        over[c] = quantise(at_positions(analog[c], pos), offset[c], ymult[c], yoff[c], sd[c], z[c], lo, hi, codes[c])
+        if read[c]:
+            over[c] = quantise(at_positions(analog[c], pos), offset[c], ymult[c], yoff[c], sd[c], z[c], lo, hi,
+                               codes[c])
+        else:
+            codes[c] = 0
+            over[c] = False
     return OK, t_cross, x_zero
 
 
@@ -120,7 +126,7 @@ def at_rest_before(v, rest_sd, z_rest):
 
 @jit(nogil=True)
 def one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired, probe, ac, lowpass, source,
-             level, rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over):
+             level, rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over, read):
     """One shot: gauge g reads force[g] (N, every h s) delayed by shift[g] s with gain
     scale[g] V/N, its high-pass gauge_filter[g] and noise noise_sd[g] z_gauge[g], and before
     the impact, for z_rest.shape[1] samples, its rest: noise_sd[g] z_rest[g]
@@ -128,12 +134,14 @@ def one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wi
     ac[c] and lowpass[c] (condition), offset, ymult, yoff (the converter) and noise sd[c]
     z_scope[c]; the trigger on channel ``source`` at ``level`` V, the clock's phase s,
     n_pre pre-trigger samples every dt s. Fills codes (channels, samples) and over
-    (channels); returns (status, the trigger crossing from the impact s, the first sample
-    after it s)."""
+    (channels) of the channels ``read`` (the source among them; scope_shot); returns
+    (status, the trigger crossing from the impact s, the first sample after it s)."""
     n_pad = z_rest.shape[1]
     n = force.shape[1] + n_pad
     analog = np.empty((wired.shape[0], n))
     for c in range(wired.shape[0]):
+        if not read[c]:
+            continue
         g = wired[c]
         if g >= 0:
             v = gauge_signal(force[g], h, shift[g], scale[g], gauge_filter[g, 0], gauge_filter[g, 1],
@@ -144,7 +152,7 @@ def one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wi
             v = np.zeros(n)
         analog[c] = condition(v, probe[c], ac[c], lowpass[c])
     st, t_cross, x_zero = scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult, yoff, sd,
-                                     z_scope, lo, hi, codes, over)
+                                     z_scope, lo, hi, codes, over, read)
     return st, t_cross - n_pad * h, x_zero
 
 

@@ -122,7 +122,8 @@ def _one_process(study: Study) -> dict:
 
 STAGES = {"inputs": "each shot's inputs drawn, the shots' arrays built",
           "solver": "batched solver (the whole call) and the pulse speeds",
-          "acquisition": "the instruments' random draws (22,000 normals), gauges, front ends, trigger, 8-bit codes",
+          "acquisition": "the instruments' random draws (19,000 normals), the read channels' gauges, front ends, "
+                         "trigger and 8-bit codes",
           "analysis": "leading pulses, delays, each shot's Report"}
 
 
@@ -141,7 +142,8 @@ def _stages(study: Study, batches: int = 4) -> dict:
         ens = solve_ensemble(shots.problems, template.solver.duration, save=setting.save, dt=setting.stepping)
         speeds = wave_speeds(template, shots, ens.records, ens.sample_interval)
         t.append(time.perf_counter())
-        records = instrument_batch.acquire(ens.records, ens.sample_interval, wiring, seeds, shots.fixed, speeds)
+        records = instrument_batch.acquire(ens.records, ens.sample_interval, wiring, seeds, shots.fixed, speeds,
+                                           read=(setup.upper.channel, setup.lower.channel))
         t.append(time.perf_counter())
         instrument_batch.analysed(records, setup)
         t.append(time.perf_counter())

@@ -154,9 +154,10 @@ def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
     forces = ens.records  # what each gauge reads, in the wiring's order: the bead gauges by name, the wall
     h = ens.sample_interval
     speeds = wave_speeds(template, sub, forces, h)
-    records = instrument_batch.acquire(forces, h, wiring, [drawn[j][2] for j in keep], sub.fixed, speeds)
-    beta, F0 = nom.calibration
-    reports = instrument_batch.analysed(records, setup_for(template, beta, F0))
+    setup = setup_for(template, *nom.calibration)
+    records = instrument_batch.acquire(forces, h, wiring, [drawn[j][2] for j in keep], sub.fixed, speeds,
+                                       read=(setup.upper.channel, setup.lower.channel))  # what the analysis reads
+    reports = instrument_batch.analysed(records, setup)
     for e, j in enumerate(keep):
         if ens.reports[e].status is not Status.SUCCESS:
             out["failure"][j] = UNSTABLE

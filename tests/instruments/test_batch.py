@@ -71,6 +71,32 @@ def test_a_batch_of_shots_reads_as_its_shots_alone(noise, noise_floor):
         assert rep.as_dict() == ref.as_dict(), s
 
 
+@pytest.mark.parametrize("read", [("CH1", "CH2"), ("CH2",), ("CH2", "CH3"), ("CH1", "CH3")])
+def test_channels_nobody_reads_are_skipped_without_changing_the_others(read):
+    # a study reads two channels: the others are neither filtered nor converted and the
+    # last one's scope noise is not drawn, yet the channels read keep their bits, records
+    # that start before the impact (shots 1 and 2) included; the trigger's source (CH1)
+    # is always read
+    wiring = _wiring()
+    early = np.array([0, 1, 1, 0]) * 1.4e-4
+    forces = np.stack([np.stack([_pulse(2.0e-4 - early[s]), _pulse(1.8e-4 + 1e-6 * s - early[s]),
+                                 _pulse(4e-4, 9.0)]) for s in range(4)])
+    seeds, speeds = [3, 5, 8, 13], np.full(4, 230.0)
+    whole = batch.acquire(forces, H, wiring, seeds, None, speeds)
+    part = batch.acquire(forces, H, wiring, seeds, None, speeds, read=read)
+    kept = sorted(set(read) | {"CH1"})
+    assert [ch for ch, r in zip(wiring.channels, part.read) if r] == kept
+    assert np.array_equal(part.times, whole.times) and np.array_equal(part.status, whole.status)
+    for s in range(4):
+        rec, ref = part.record(s), whole.record(s)
+        assert sorted(rec.waveforms) == kept
+        for ch in kept:
+            assert np.array_equal(rec.waveforms[ch].codes, ref.waveforms[ch].codes), (s, ch)
+    setup = Setup(GaugeSetup("CH2", 0.0, 0.05, 1e-3), GaugeSetup("CH1", 0.0043, 0.05, 1e-3))
+    if {"CH1", "CH2"} <= set(kept):
+        assert [r.as_dict() for r in batch.analysed(part, setup)] == [r.as_dict() for r in batch.analysed(whole, setup)]
+
+
 def test_before_the_impact_a_record_reads_the_gauges_at_rest():
     """A pre-trigger longer than the time from the impact to the trigger: the record's
     samples before the impact carry the gauges' noise about their rest level (0 V), not a
