@@ -33,7 +33,7 @@ from rig.solver.ensemble import solve_ensemble
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution
 from rig.solver.stepsize import Stepping, stepping_at
-from rig.study.batch import run_batch, shot_inputs
+from rig.study.batch import collector_paused, run_batch, shot_inputs
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
 from rig.study.mc_spec import Study
@@ -129,28 +129,35 @@ STAGES = {"inputs": "each shot's inputs drawn, the shots' arrays built",
 
 def _stages(study: Study, batches: int = 4) -> dict:
     """Wall time per shot (us) of each stage of a batch, run in turn as run_batch runs them
-    (numba's threads; after WARM_UP batches)."""
+    (numba's threads, Python's cycle collector paused; after WARM_UP batches)."""
     setting = Setting.of(study)
     template = setting.template
     wiring = wiring_of(template)
     setup = setup_for(template, *setting.nominal.calibration)
     spent = dict.fromkeys(STAGES, 0.0)
     for b in range(WARM_UP + batches):
-        t = [time.perf_counter()]
-        shots, seeds = setting.shots(study, b * BATCH, (b + 1) * BATCH)
-        t.append(time.perf_counter())
-        ens = solve_ensemble(shots.problems, template.solver.duration, save=setting.save, dt=setting.stepping)
-        speeds = wave_speeds(template, shots, ens.records, ens.sample_interval)
-        t.append(time.perf_counter())
-        records = instrument_batch.acquire(ens.records, ens.sample_interval, wiring, seeds, shots.fixed, speeds,
-                                           read=(setup.upper.channel, setup.lower.channel))
-        t.append(time.perf_counter())
-        instrument_batch.analysed(records, setup)
-        t.append(time.perf_counter())
+        with collector_paused():  # as run_batch runs a batch
+            t = _stage_times(study, setting, template, wiring, setup, b)
         if b >= WARM_UP:
             for key, t0, t1 in zip(STAGES, t, t[1:]):
                 spent[key] += t1 - t0
     return {f"stage_{key}_us_per_shot": v / (batches * BATCH) * 1e6 for key, v in spent.items()}
+
+
+def _stage_times(study: Study, setting: Setting, template: Rig, wiring, setup, b: int) -> list:
+    """The clock (s) before batch b and after each of its stages."""
+    t = [time.perf_counter()]
+    shots, seeds = setting.shots(study, b * BATCH, (b + 1) * BATCH)
+    t.append(time.perf_counter())
+    ens = solve_ensemble(shots.problems, template.solver.duration, save=setting.save, dt=setting.stepping)
+    speeds = wave_speeds(template, shots, ens.records, ens.sample_interval)
+    t.append(time.perf_counter())
+    records = instrument_batch.acquire(ens.records, ens.sample_interval, wiring, seeds, shots.fixed, speeds,
+                                       read=(setup.upper.channel, setup.lower.channel))
+    t.append(time.perf_counter())
+    instrument_batch.analysed(records, setup)
+    t.append(time.perf_counter())
+    return t
 
 
 def _workers(study: Study, workers: int) -> dict:
