@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 
 from instruments.errors import InstrumentError
@@ -176,14 +177,32 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+SIGPIPE_EXIT = 141  # 128 + SIGPIPE: what a shell reports for a command whose reader went away
+
+
 def main(argv=None) -> int:
     """Run one command. A user mistake or an I/O failure (a missing file, a folder, no
-    permission, a full disk, ...) is one line on stderr and exit 2; never a traceback."""
+    permission, a full disk, ...) is one line on stderr and exit 2; never a traceback. A
+    reader that closes the output early (``rig analyze ... --json | head``) ends the command
+    quietly, as it ends cat or grep (exit 141)."""
+    try:
+        try:
+            return _run(argv)
+        finally:  # here, not at the interpreter's exit, where a closed pipe prints a warning (--help too)
+            sys.stdout.flush()
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # Python's last flush goes nowhere
+        return SIGPIPE_EXIT
+
+
+def _run(argv) -> int:
     args, extra = build_parser().parse_known_args(argv)
     if extra:  # named by the command's parser, not the top one's ("rig: error:")
         return _fail(args.command, f"unrecognized arguments: {' '.join(extra)} (see rig {args.command} --help)")
     try:
         out = args.func(args)
+    except BrokenPipeError:
+        raise
     except Interrupted as exc:  # Ctrl-C, with what the run kept
         _fail(args.command, str(exc))
         return 130

@@ -84,19 +84,23 @@ def cmd_analyze(args) -> list:
     missing. Exit 0 when at least one source gave a speed, 1 when none did (as `rig verify`
     with bad shots); a mistake in the flags or files is exit 2 (main)."""
     from instruments.report import FIGURES
-    from rig.experiment.analyze import AnalyzeOptions, analyze_paths
+    from rig.experiment.analyze import AnalyzeOptions, analyze_paths, real_file_flags
 
     options = AnalyzeOptions(files=tuple(args.files), shot=args.shot, gauge_distance=args.gauge_distance,
                              channels=args.channels, wall=args.wall,
-                             sensitivity=1.0 if args.sensitivity is None else args.sensitivity, tau=args.tau,
+                             sensitivity=args.sensitivity, tau=args.tau,
                              beta=args.beta, f0=args.f0, diameter=args.diameter, material=args.material)
     results = analyze_paths(options)
     args.exit_code = 0 if any(r["speed_m_per_s"] is not None for r in results) else 1
     if not args.json:
         fmt = lambda v, spec=".2f": "-" if v is None else format(v, spec)  # noqa: E731
-        if args.sensitivity is None:
-            print("note: without --sensitivity a real scope file's forces are its gauges' volts (1 V/N); "
-                  "give e.g. --sensitivity '0.05 V/N' for newtons (a virtual shot's archive has its own)")
+        if any(r["force_unit"] == "V" for r in results):
+            print("note: without --sensitivity a real scope file's forces are its gauges' volts (1 V/N): its "
+                  "F_d and F_m,e columns and noise are in V; give e.g. --sensitivity '0.05 V/N' for newtons")
+        flags = real_file_flags(options)
+        if flags and any(r["simulated"] for r in results):
+            print(f"note: {', '.join(flags)} {'describe' if len(flags) > 1 else 'describes'} the real records; "
+                  f"the virtual shots use their own set-up")
         print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d N':>8s} {'F_m,e N':>8s} "
               f"{'pulses':>6s} {'FWHM us':>8s} {'Eq1 m/s':>8s}")
         for r in results:
@@ -107,8 +111,10 @@ def cmd_analyze(args) -> list:
                   f"{fmt(r['averaged_amplitude_N'], '.3f'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
                   f"{fmt(fwhm, '.1f'):>8s} {fmt(r['theory_speed_m_per_s'], '.1f'):>8s}")
             if r["snr"]:
-                print("  SNR (leading pulse / pre-trigger noise): "
-                      + ", ".join(f"{ch} {fmt(v, '.3g')}" for ch, v in r["snr"].items()))
+                noise = r["noise"]
+                print("  SNR (leading pulse / pre-trigger noise): " + ", ".join(
+                    f"{ch} {fmt(v, '.3g')}" + (f" (noise {noise[ch]:.3g} {r['force_unit']})" if ch in noise else "")
+                    for ch, v in r["snr"].items()))
             why = {}
             for figure, reason in r["reasons"].items():
                 why.setdefault(reason, []).append(figure)

@@ -34,15 +34,18 @@ class AnalyzeOptions:
     """What `rig analyze` is told. files: scope files and/or archives (.h5); shot: one shot
     of an archive (None: all). For real files: gauge_distance (m) between the two gauges,
     channels "UPPER,LOWER[,WALL]" (None: file order), wall (the third channel is the wall
-    sensor), sensitivity (V/N), tau (s, the gauge RC to invert; None: none), beta
-    (F_d / F_m,e), f0 (N, precompression), diameter (m), material (adds the Eq (1) speed)."""
+    sensor), sensitivity (V/N; None: 1 V/N, the forces are the gauges' volts), tau (s, the
+    gauge RC to invert; None: none), beta (F_d / F_m,e), f0 (N, precompression), diameter
+    (m), material (adds the Eq (1) speed). A virtual shot carries its own set-up: these
+    flags are refused where only virtual shots are analysed, and apply to the real ones
+    where both are."""
 
     files: tuple
     shot: int | None = None
     gauge_distance: float | None = None
     channels: str | None = None
     wall: bool = False
-    sensitivity: float = 1.0
+    sensitivity: float | None = None
     tau: float | None = None
     beta: float = 1.0
     f0: float = 0.0
@@ -72,14 +75,16 @@ def analyze_paths(options: AnalyzeOptions) -> list:
     paths = [Path(p) for p in options.files]
     archives = [p for p in paths if p.suffix.lower() in (".h5", ".hdf5", ".nxs")]
     files = [p for p in paths if p not in archives]
-    results = []
+    shots = []
     for a in archives:
         archive = Archive(a)
         ids = [options.shot] if options.shot is not None else archive.ids()
-        for i in ids:
-            entry = archive.read(i, with_truth=False)
-            setup = _setup_from_entry(entry, options) if entry.simulated else _setup_from_flags(options, entry.record)
-            results.append(_result(f"{a}#{i}", entry.record, setup, options, entry))
+        shots += [(f"{a}#{i}", archive.read(i, with_truth=False)) for i in ids]
+    real = bool(files) or not all(entry.simulated for _, entry in shots)
+    results = []
+    for source, entry in shots:
+        setup = _setup_from_entry(entry, options, real) if entry.simulated else _setup_from_flags(options, entry.record)
+        results.append(_result(source, entry.record, setup, options, entry))
     if files:
         record = read_record(files)
         results.append(_result(", ".join(map(str, files)), record, _setup_from_flags(options, record), options))
@@ -89,16 +94,18 @@ def analyze_paths(options: AnalyzeOptions) -> list:
 REAL_FILE_FLAGS = ("gauge_distance", "channels", "wall", "sensitivity", "tau", "beta", "f0", "diameter")
 
 
-def _real_file_flags(options: AnalyzeOptions) -> list:
+def real_file_flags(options: AnalyzeOptions) -> list:
     """The flags given (other than their defaults) that describe a real set-up: a virtual
     shot carries its own."""
     defaults = {f.name: f.default for f in fields(AnalyzeOptions)}
     return [f"--{name.replace('_', '-')}" for name in REAL_FILE_FLAGS if getattr(options, name) != defaults[name]]
 
 
-def _setup_from_entry(entry, options: AnalyzeOptions) -> Setup:
-    flags = _real_file_flags(options)
-    if flags:
+def _setup_from_entry(entry, options: AnalyzeOptions, real: bool) -> Setup:
+    """A virtual shot's own set-up; ``real``: real records are analysed beside it, for which
+    the real-file flags are given."""
+    flags = real_file_flags(options)
+    if flags and not real:
         raise RigError(f"{', '.join(flags)}: for real scope files only; shot {entry.shot_id} is a virtual shot "
                        f"and carries its own gauge positions, sensitivities and beta")
     facts, settings = entry.facts, entry.settings
@@ -133,7 +140,8 @@ def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
             raise invalid("--channels", options.channels, f"{n!r} is not in the files (channels: {held})")
     if len(set(names)) < len(names):
         raise invalid("--channels", options.channels, "a channel named twice (each gauge has its own channel)")
-    g = lambda ch, x: GaugeSetup(ch, x, options.sensitivity, options.tau)  # noqa: E731
+    volts_per_newton = 1.0 if options.sensitivity is None else options.sensitivity
+    g = lambda ch, x: GaugeSetup(ch, x, volts_per_newton, options.tau)  # noqa: E731
     wall = g(names[2], math.inf) if len(names) > 2 else None
     return Setup(g(names[0], 0.0), g(names[1], options.gauge_distance), wall, options.diameter,
                  options.beta, options.f0, PeakRules())
@@ -152,6 +160,9 @@ def _result(source, record, setup: Setup, options: AnalyzeOptions, entry=None) -
     rep = analyze_record(record, setup)
     out = {"source": source, "channels": [setup.upper.channel, setup.lower.channel], **rep.as_dict()}
     out.pop("leading", None)
+    virtual = entry is not None and entry.simulated
+    out["simulated"] = virtual
+    out["force_unit"] = "N" if virtual or options.sensitivity is not None else "V"  # of the forces and the noise
     out["theory_speed_m_per_s"] = None
     if not mat:
         out["reasons"]["theory_speed_m_per_s"] = "no bead material given (--material)"

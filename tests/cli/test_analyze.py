@@ -67,8 +67,15 @@ def test_text_output_says_when_its_forces_are_volts(gauge_files, capsys):
     assert main(["analyze", *gauge_files, *volts]) == 0
     out = capsys.readouterr().out.splitlines()
     assert out[0].startswith("note: without --sensitivity a real scope file's forces are its gauges' volts")
+    assert out[3].startswith("  SNR (leading pulse / pre-trigger noise): CH1 ") and out[3].count(" V)") == 2
     assert main(["analyze", *gauge_files, *GAUGE]) == 0
-    assert not capsys.readouterr().out.startswith("note:")
+    out = capsys.readouterr().out
+    assert not out.startswith("note:") and out.splitlines()[2].count(" N)") == 2
+    # the JSON says the unit of the forces and the noise; the noise scales with the sensitivity
+    (_, (v,), _), (_, (n,), _) = run(capsys, "analyze", *gauge_files, *volts), run(capsys, "analyze", *gauge_files,
+                                                                                    *GAUGE)
+    assert (v["force_unit"], n["force_unit"], v["simulated"]) == ("V", "N", False)
+    assert v["noise"]["CH1"] == pytest.approx(0.05 * n["noise"]["CH1"], rel=1e-12)
 
 
 def test_19_km_between_the_gauges_is_refused(gauge_files, capsys):
@@ -174,3 +181,53 @@ def test_a_virtual_archive_analyses_as_the_shot_measured_it(tmp_path, capsys):
     assert r["pulses"] == measured["pulses"]
     assert 0.8 < r["speed_m_per_s"] / r["theory_speed_m_per_s"] < 1.25
     assert min(r["snr"].values()) > 100
+
+
+def test_real_records_and_virtual_shots_in_one_call(gauge_files, tmp_path, capsys):
+    """The real-file flags describe the real records: refused where only virtual shots are
+    analysed, applied to the real ones beside a virtual shot, which keeps its own set-up
+    (the same figures as alone), in one archive or as files beside it."""
+    path = str(tmp_path / "mixed.h5")
+    assert main(["shot", "ptfe52_magnetic", "--seed", "3", "--out", path]) == 0
+    capsys.readouterr()
+    _, (alone,), _ = run(capsys, "analyze", path)
+    assert (alone["simulated"], alone["force_unit"]) == (True, "N")
+    code, out, err = run(capsys, "analyze", path, *GAUGE)
+    assert code == 2 and out is None
+    assert "--gauge-distance, --sensitivity, --tau: for real scope files only; shot 1 is a virtual shot" in err
+    code, (virtual, real), _ = run(capsys, "analyze", path, *gauge_files, *GAUGE)
+    assert code == 0 and virtual == alone and real["speed_m_per_s"] == pytest.approx(200.0, rel=5e-3)
+    assert main(["import", *gauge_files, "--together", "--into", path]) == 0
+    capsys.readouterr()
+    assert main(["analyze", path, *GAUGE]) == 0
+    text = capsys.readouterr().out.splitlines()
+    assert text[0] == ("note: --gauge-distance, --sensitivity, --tau describe the real records; "
+                       "the virtual shots use their own set-up")
+    code, (virtual, real), _ = run(capsys, "analyze", path, *GAUGE)
+    assert virtual == alone and real["source"].endswith("#2") and real["speed_m_per_s"] == pytest.approx(200, rel=5e-3)
+
+
+def test_a_reader_that_closes_the_output_early_ends_the_command_quietly(tmp_path):
+    # `rig ... | head`: the output's reader is gone before the command writes; exit 141
+    # (as cat's), no traceback and no 'Exception ignored' warning
+    import os
+    import subprocess
+    import sys
+
+    for argv in (["theory", "--f0", "1 N", "--fm", "5 N"], ["theory", "--f0", "1 N", "--json"]):
+        r, w = os.pipe()
+        os.close(r)
+        try:
+            done = subprocess.run([sys.executable, "-m", "rig.cli", *argv], stdout=w, stderr=subprocess.PIPE,
+                                  text=True, timeout=120)
+        finally:
+            os.close(w)
+        assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr, done.stderr
+        assert done.returncode == 141 and not done.stderr, (argv, done.returncode, done.stderr)
+    # --help: argparse drops its own failed write; nothing to say either
+    r, w = os.pipe()
+    os.close(r)
+    done = subprocess.run([sys.executable, "-m", "rig.cli", "--help"], stdout=w, stderr=subprocess.PIPE, text=True,
+                          timeout=120)
+    os.close(w)
+    assert not done.stderr
