@@ -200,7 +200,7 @@ class Archive:
             f = self._open()
         except InstrumentError as exc:
             return {"shots": 0, "ok": 0, "bad": [{"shot": None, "shots": [], "where": str(self.path),
-                                                  "reason": str(exc)}]}
+                                                  "reason": str(exc).removeprefix(f"{self.path}: ")}]}
         with f:
             try:
                 return check(f)

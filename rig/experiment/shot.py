@@ -7,6 +7,7 @@ instrument and the oscilloscope, and returns a ShotRecord. Same seed, same bits.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,6 +20,7 @@ from rig.experiment.assembly import Assembly
 from rig.experiment.truth import Truth, truth_of
 from rig.solver.estimate import RunEstimate, estimate_solve
 from rig.solver.problem import ChainProblem
+from rig.solver.run import Unstable
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution, SolverStats
 from rig.solver.solve import solve
@@ -38,6 +40,23 @@ class ShotRecord:
     solver: SolverStats
     draws: dict
     analysis_truth: dict | None = None  # the truth block of rig/experiment/measure.py, when computed
+
+
+def impact_doubt(chain) -> str:
+    """Why a chain's solve may blow up at any step, or "": a striker whose energy could
+    press it more than a tenth of the top bead's radius into it (Chain.impact_overlap), far
+    outside the contact law's range (the solver stops as unstable at half the radius), and
+    the speed that keeps it within a tenth."""
+    if chain.striker is None:
+        return ""
+    overlap, radius = chain.impact_overlap(), chain.beads[0].radius
+    if not overlap > radius / 10:
+        return ""
+    st, A, n = chain.striker, float(chain.contact_constants()[0]), float(chain.contact_exponents()[0])
+    v_tenth = math.sqrt(2 * A * (radius / 10) ** (n + 1) / ((n + 1) * st.mass))
+    return (f": striker.velocity = {st.velocity:g} m/s with striker.mass = {st.mass:g} kg could press the striker "
+            f"{overlap:.3g} m into the top bead, {overlap / radius:.3g} times its {radius * 1e3:.3g} mm radius; the "
+            f"contact law holds for overlaps far below the radius (a tenth of it up to {v_tenth:.3g} m/s here)")
 
 
 def fresh_seed() -> int:
@@ -84,8 +103,11 @@ class Rig(Assembly):
     def solution(self) -> Solution:
         if self._solution is None:
             s = self.solver
-            self._solution = solve(self.chain, s.duration, save=self.save_at(), method=s.method,
-                                   accuracy=s.accuracy)
+            try:
+                self._solution = solve(self.chain, s.duration, save=self.save_at(), method=s.method,
+                                       accuracy=s.accuracy)
+            except Unstable as exc:
+                raise Unstable(f"{exc}{impact_doubt(self.chain)}", exc.stepping) from None
         return self._solution
 
     def truth(self) -> Truth:

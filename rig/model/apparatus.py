@@ -56,7 +56,12 @@ class Holder:
         if striker is not None and striker.diameter > self.bore:
             raise invalid("striker.diameter", striker.diameter,
                           f"wider than holder.bore = {self.bore * 1e3:g} mm")
-        stack = sum(b.diameter for b in beads) + (striker.length if striker else 0.0)
+        chain = sum(b.diameter for b in beads)
+        if striker is not None and striker.length > self.length:  # the striker alone: its mass is the mistake
+            raise invalid("striker.mass", striker.mass,
+                          f"a {striker.diameter * 1e3:g} mm {striker.material.name} cylinder of {striker.mass:g} kg "
+                          f"is {striker.length:.4g} m long, more than holder.length = {self.length:g} m")
+        stack = chain + (striker.length if striker else 0.0)
         if stack > self.length:
             raise invalid("holder.length", self.length,
                           f"the chain and striker need {stack:.4g} m of tube")

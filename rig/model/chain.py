@@ -199,6 +199,15 @@ class Chain:
         return self._cached("x", lambda: equilibrium_positions_of([b.radius for b in self.beads],
                                                                   self.static_overlaps()))
 
+    def impact_overlap(self) -> float:
+        """The striker's overlap with the top bead (m) if all its kinetic energy went into
+        their contact: (1/2) m v^2 = A delta^(n+1) / (n+1), delta = ((n+1) m v^2 / (2A))^(1/(n+1));
+        an upper bound of the first contact's largest overlap (0 without a striker)."""
+        if self.striker is None:
+            return 0.0
+        A, n = float(self.contact_constants()[0]), float(self.contact_exponents()[0])
+        return ((n + 1) * self.striker.mass * self.striker.velocity ** 2 / (2 * A)) ** (1 / (n + 1))
+
     def wall_position(self) -> float:
         """The wall surface (m, down from bead 0's centre; a compliant wall's plate at
         rest); nan without a wall."""

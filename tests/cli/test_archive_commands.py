@@ -68,8 +68,13 @@ def test_bad_archives_are_one_line_errors(tmp_path, capsys, make):
     assert main(["ls", str(path)]) == 2
     err = capsys.readouterr().err
     assert str(path) in err and "Traceback" not in err
-    # a damaged file is a finding of verify (exit 1); a path with no file is a mistake (exit 2)
+    # a damaged file is a finding of verify (exit 1), naming the file once; a path with no
+    # file is a mistake (exit 2)
     assert main(["verify", str(path)]) == (2 if make == "missing" else 1)
+    out = capsys.readouterr().out
+    why = "cannot be opened as HDF5" if make == "truncated" else "not an HDF5 file"
+    assert make == "missing" or out.splitlines()[1].startswith(f"  archive: {path}: {why}")
+    assert out.count(str(path)) == (0 if make == "missing" else 2)  # the summary line and the bad row
 
 
 def test_every_readable_real_csv_imports_and_reads_back_exactly(tmp_path, capsys, realdata):

@@ -53,6 +53,12 @@ CASES = [
     (["shot", S, *_set("striker.velocity=nan")], "striker.velocity"),
     (["shot", S, *_set("striker.velocity=inf")], "striker.velocity"),
     (["shot", S, *_set("striker.velocity=1 kg")], "striker.velocity"),
+    # far outside the contact law: the solver's refusal names the key, the overlap and a safe speed
+    (["shot", S, *_set("striker.velocity=1e9")], "striker.velocity = 1e+09 m/s with striker.mass = 0.00047 kg "
+                                                  "could press the striker 81.6 m into the top bead"),
+    # a striker longer than the tube: its mass is the mistake, not the tube's length
+    (["shot", S, *_set("striker.mass=1e6")], "striker.mass = 1000000.0: a 4.76 mm alumina cylinder of 1e+06 kg "
+                                              "is 1.441e+07 m long, more than holder.length = 0.4 m"),
     (["shot", S, *_set("chain.colour=red")], "chain.colour"),
     (["shot", S, *_set("chain.beads=0")], "chain.beads"),
     (["shot", S, *_set("chain.beads=-5")], "chain.beads"),
