@@ -138,3 +138,33 @@ def test_random_byte_flips_are_found_and_named_and_never_crash(pristine, tmp_pat
     print(f"{FLIPS} flips: {seen} changed what a reader sees, {appended} appended after, {refused} refused")
     assert unnamed == []
     assert seen >= FLIPS // 4 and appended + refused == FLIPS  # most flips change what readers see
+
+
+@pytest.mark.parametrize("item", ["forces/wall_force", "settings"])
+def test_a_shot_read_without_its_truth_ignores_only_damaged_truth(tmp_path, item):
+    # the analysis reads a shot's scope records, facts and settings, not its truth's
+    # forces: damaged shared forces do not stop it (a read with the truth still refuses);
+    # damaged shared settings do
+    import h5py
+
+    path = tmp_path / "a.h5"
+    Archive(path).append([tiny_entry(1)])
+    with h5py.File(path, "r+") as f:
+        (key,) = list(f["shared"])
+        d = f[f"shared/{key}/{item}"]
+        if d.dtype.kind == "f":
+            d[5] = d[5] + 1.0
+        else:
+            d[()] = '{"probe": "tinY"}'
+    with pytest.raises(InstrumentError, match=f"shot 1: shared/{key}/{item}: damaged"):
+        Archive(path).read(1)
+    if item == "settings":
+        with pytest.raises(InstrumentError, match=f"shared/{key}/settings: damaged"):
+            Archive(path).read(1, with_truth=False)
+    else:
+        archive = Archive(path)
+        e = archive.read(1, with_truth=False)
+        assert e.truth is None
+        assert np.array_equal(e.record.waveforms["CH1"].codes, tiny_entry(1).record.waveforms["CH1"].codes)
+        with pytest.raises(InstrumentError, match="forces/wall_force: damaged"):
+            archive.read(1)  # the same Archive: the shared group was not remembered as sound
