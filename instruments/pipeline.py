@@ -197,10 +197,20 @@ def solitary_train(t, f, lead, cut: float, rules: PeakRules = PeakRules(), refin
                    noise: float | None = None) -> list:
     """The solitary waves of a train at one gauge: pulses above 5% of the leading one (and
     ``rules.snr`` times the noise, where known), from the leading one until ``cut`` (s; when
-    the wall's reflection arrives)."""
+    the wall's reflection arrives). Maxima closer than the leading pulse's FWHM are one
+    pulse, the highest (the first of equals): the flat top of a quantised pulse, whose
+    flickers between two codes each reach the top code, is not a train of its own."""
     floor = 0.05 * lead.amplitude if noise is None else max(0.05 * lead.amplitude, rules.snr * noise)
-    train = find_pulses(t, f, rules, floor=floor, refine=refine)
-    return [p for p in train if lead.time - 0.5 * lead.fwhm <= p.time < cut]
+    train = []
+    for p in find_pulses(t, f, rules, floor=floor, refine=refine):
+        if not lead.time - 0.5 * lead.fwhm <= p.time < cut:
+            continue
+        if train and p.time - train[-1].time < lead.fwhm:
+            if p.amplitude > train[-1].amplitude:
+                train[-1] = p
+            continue
+        train.append(p)
+    return train
 
 
 def reflection_time(t, forces, setup: Setup, low, speed, noise: dict | None = None) -> float:

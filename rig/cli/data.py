@@ -115,6 +115,9 @@ def cmd_analyze(args) -> list:
                 print("  SNR (leading pulse / pre-trigger noise): " + ", ".join(
                     f"{ch} {fmt(v, '.3g')}" + (f" (noise {noise[ch]:.3g} {r['force_unit']})" if ch in noise else "")
                     for ch, v in r["snr"].items()))
+            if r["pulses"] is not None and not r["simulated"] and not args.wall:
+                print("  pulses: counted to the record's end; without --wall (the wall sensor's channel) the wall's "
+                      "reflection may be among them")
             why = {}
             for figure, reason in r["reasons"].items():
                 why.setdefault(reason, []).append(figure)

@@ -231,3 +231,10 @@ def test_a_reader_that_closes_the_output_early_ends_the_command_quietly(tmp_path
                           timeout=120)
     os.close(w)
     assert not done.stderr
+
+
+def test_a_train_counted_without_the_wall_channel_says_so(gauge_files, capsys):
+    assert main(["analyze", *gauge_files, *GAUGE]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert "  pulses: counted to the record's end; without --wall (the wall sensor's channel) the wall's " \
+           "reflection may be among them" in out

@@ -61,6 +61,21 @@ def test_time_of_flight_two_ways_and_train_count():
     assert rep.pulses == 3  # the 2% one is below 5% of the leading pulse
 
 
+def test_a_quantised_train_counts_each_flat_top_once():
+    # 8-bit-like codes with a flicker of one code: each flat top holds several local maxima
+    # at the top code, each with the whole pulse as its prominence (scipy's ties); they are
+    # one pulse, not a train of their own
+    rng = np.random.default_rng(4)
+    a = sech2(0.5e-3, 2e-5)
+    train = sech2(0.7e-3, 2e-5) + sech2(0.85e-3, 2e-5, 0.5) + sech2(1.0e-3, 2e-5, 0.2)
+    flicker = lambda f: np.round(f * 40 + rng.uniform(-0.3, 0.3, f.size)) / 40  # noqa: E731
+    quantised = flicker(train)
+    assert len(find_pulses(T, quantised, floor=0.05)) > 3  # what the maxima alone say
+    setup = Setup(GaugeSetup("A", 0.0), GaugeSetup("B", 0.05))
+    rep = analyze_forces(T, {"upper": flicker(a), "lower": quantised}, setup)
+    assert rep.pulses == 3
+
+
 def test_leading_pulse_is_the_first_large_one_even_when_a_reflection_is_larger():
     f = sech2(1e-3, 2e-5, 1.0) + sech2(2e-3, 2e-5, 1.8) + sech2(0.5e-3, 2e-5, 0.05)
     assert leading(find_pulses(T, f), PeakRules()).time == pytest.approx(1e-3, abs=1e-9)
