@@ -26,7 +26,9 @@ class GaugeFact:
 @dataclass(frozen=True)
 class ShotFacts:
     """sample_interval_s: the truth's grid (s); gauges: {name: GaugeFact}; analysis: the
-    pipeline on the noise-free truth (its JSON block) or None; wave_speed_m_per_s; draws:
+    pipeline on the noise-free truth (its JSON block), or for a Monte Carlo study's traces
+    the calibration its analysis applied ({"beta", "static_force_N", "basis"}), or None;
+    wave_speed_m_per_s; draws:
     {part: {draw: value}} of the instruments; trigger_time_after_impact_s; solver: the
     solver's statistics; overrides: the scene overrides; study_shot, study: the shot's
     index and the study's digest when a Monte Carlo study archived it."""

@@ -91,7 +91,7 @@ def analyze_paths(options: AnalyzeOptions) -> list:
     return results
 
 
-REAL_FILE_FLAGS = ("gauge_distance", "channels", "wall", "sensitivity", "tau", "beta", "f0", "diameter")
+REAL_FILE_FLAGS = ("gauge_distance", "channels", "wall", "sensitivity", "tau", "beta", "f0", "diameter", "material")
 
 
 def real_file_flags(options: AnalyzeOptions) -> list:
@@ -107,7 +107,7 @@ def _setup_from_entry(entry, options: AnalyzeOptions, real: bool) -> Setup:
     flags = real_file_flags(options)
     if flags and not real:
         raise RigError(f"{', '.join(flags)}: for real scope files only; shot {entry.shot_id} is a virtual shot "
-                       f"and carries its own gauge positions, sensitivities and beta")
+                       f"and carries its own gauge positions, sensitivities, beta and bead material")
     facts, settings = entry.facts, entry.settings
     if facts is None:
         raise RigError(f"shot {entry.shot_id}: a virtual shot without its facts (gauge positions) cannot be analysed")
@@ -120,9 +120,9 @@ def _setup_from_entry(entry, options: AnalyzeOptions, real: bool) -> Setup:
     if "wall_sensor" in settings:
         ws = settings["wall_sensor"]
         wall = GaugeSetup(ws["channel"], math.inf, ws.get("sensitivity", 0.05), ws.get("tau", 1e-3))
-    truth = facts.analysis or {}
-    return Setup(roles[0], roles[1], wall, settings["chain"]["diameter"], truth.get("beta") or 1.0,
-                 truth.get("static_force_N") or 0.0, PeakRules())
+    calibration = facts.analysis or {}  # the truth's analysis, or a study's calibration (ShotFacts)
+    return Setup(roles[0], roles[1], wall, settings["chain"]["diameter"], calibration.get("beta") or 1.0,
+                 calibration.get("static_force_N") or 0.0, PeakRules())
 
 
 def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
@@ -155,12 +155,15 @@ def _limits(name: str | None) -> Limits:
 
 
 def _result(source, record, setup: Setup, options: AnalyzeOptions, entry=None) -> dict:
-    mat = options.material or (entry.settings["chain"]["material"] if entry is not None and entry.simulated else None)
+    virtual = entry is not None and entry.simulated
+    mat = entry.settings["chain"]["material"] if virtual else options.material
     setup = replace(setup, limits=_limits(mat))
     rep = analyze_record(record, setup)
+    if virtual and not (entry.facts.analysis or {}).get("beta"):
+        rep.refuse("this virtual shot was stored without its calibration (beta, F_0): only F_m,e is measured",
+                   ("amplitude_N", "total_force_N"))
     out = {"source": source, "channels": [setup.upper.channel, setup.lower.channel], **rep.as_dict()}
     out.pop("leading", None)
-    virtual = entry is not None and entry.simulated
     out["simulated"] = virtual
     out["force_unit"] = "N" if virtual or options.sensitivity is not None else "V"  # of the forces and the noise
     out["theory_speed_m_per_s"] = None
@@ -177,8 +180,9 @@ def _result(source, record, setup: Setup, options: AnalyzeOptions, entry=None) -
     out["theory_speed_m_per_s"] = theory
     v = out["speed_m_per_s"]
     if v is not None and not 1 / THEORY_FACTOR <= v / theory <= THEORY_FACTOR:
+        check = "is the leading pulse the one found?" if virtual else "are --material, --sensitivity, --f0 right?"
         why = (f"implausible speed: {v:.4g} m/s is off Eq (1)'s {theory:.4g} m/s for {m.name} at the measured "
-               f"amplitude by more than a factor {THEORY_FACTOR:g} (are --material, --sensitivity, --f0 right?)")
+               f"amplitude by more than a factor {THEORY_FACTOR:g} ({check})")
         for k in SPEED_FIGURES:
             out[k] = None
             out["reasons"].setdefault(k, why)

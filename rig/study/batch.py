@@ -210,8 +210,9 @@ def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dic
             from rig.experiment.entry import shot_entry  # the archive's Entry (h5py): only with traces
 
             entry = shot_entry(shot)
+            calibration = {"beta": beta, "static_force_N": F0, "basis": "the study's nominal shot"}  # what it applied
             traces.append(replace(entry, truth_key=None, facts=replace(entry.facts, study_shot=lo + j,
-                                                                       study=study.digest())))
+                                                                       study=study.digest(), analysis=calibration)))
         m = analyze_record(shot.scope, setup, train=False)  # leading pulse only
         _outputs(out, j, m, rig.truth_analysis() if study.truth else None, stats.energy_error, ens.dt,
                  shot.scope.triggered)

@@ -238,3 +238,18 @@ def test_a_train_counted_without_the_wall_channel_says_so(gauge_files, capsys):
     out = capsys.readouterr().out.splitlines()
     assert "  pulses: counted to the record's end; without --wall (the wall sensor's channel) the wall's " \
            "reflection may be among them" in out
+
+
+def test_the_bead_material_of_a_virtual_shot_is_its_own(gauge_files, tmp_path, capsys):
+    # --material describes the real records, as the other real-file flags: refused where
+    # only virtual shots are analysed, and beside real records the virtual shot keeps its
+    # scene's PTFE (the same Eq (1) speed as alone) while the real pair is judged as steel
+    path = str(tmp_path / "v.h5")
+    assert main(["shot", "ptfe52_magnetic", "--seed", "3", "--out", path]) == 0
+    capsys.readouterr()
+    _, (alone,), _ = run(capsys, "analyze", path)
+    code, out, err = run(capsys, "analyze", path, "--material", "steel316")
+    assert code == 2 and "--material: for real scope files only; shot 1 is a virtual shot" in err
+    code, (virtual, real), _ = run(capsys, "analyze", path, *gauge_files, *GAUGE, "--material", "steel316")
+    assert virtual == alone and virtual["speed_m_per_s"] is not None
+    assert "for steel316" in real["reasons"]["speed_m_per_s"]  # 200 m/s is far below steel's Eq (1)

@@ -184,6 +184,14 @@ def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(t
     # the traces do not change the results
     for k, v in plain.collect().outputs.items():
         assert np.array_equal(store.collect().outputs[k], v, equal_nan=True)
+    # each archived shot carries the calibration the study applied: rig analyze gives the
+    # amplitude the study stored (beta and F_0 of the nominal shot, not 1 and 0)
+    assert e.facts.analysis == {"beta": beta, "static_force_N": F0, "basis": "the study's nominal shot"}
+    from rig.experiment.analyze import AnalyzeOptions, analyze_paths
+
+    (r,) = analyze_paths(AnalyzeOptions(files=(str(archives[1]),), shot=4))
+    assert (r["beta"], r["static_force_N"]) == (beta, F0)
+    assert r["amplitude_N"] == pytest.approx(store.collect().outputs["amplitude_N"][19], rel=1e-12)
 
 
 def test_a_study_records_the_gauge_averages_and_contacts_only_when_needed():
