@@ -181,5 +181,6 @@ def analysed(records: Records, setup: Setup) -> list:
             t = records.times[s, 1] + dx * np.arange(L)
             noise = {r: None if math.isnan(sigma[s, k]) else float(sigma[s, k])
                      for k, r in enumerate(("upper", "lower"))}
-            out.append(report_of(answer[s], t, {}, setup, False, noise))
+            clipped = tuple(channels[c] for c in roles if records.over[s, c])
+            out.append(report_of(answer[s], t, {}, setup, False, noise, clipped))
     return out

@@ -112,28 +112,34 @@ def _code_step(w) -> float:
     return float(steps.min()) if steps.size else 0.0
 
 
-def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True, noise: dict | None = None) -> Report:
+def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True, noise: dict | None = None,
+                   clipped: tuple = ()) -> Report:
     """Speed, amplitudes, pulse count and widths from dynamic forces (baseline 0).
     train=False leaves the solitary train uncounted (pulses None): studies that need only
     the leading pulse skip the wall channel and two peak searches. noise: role -> noise (N;
     None: unmeasurable, and no pulse is accepted) for the SNR rule; None: noise-free
-    signals (the truth), no SNR rule. The leading pulses and their delay come from the
-    compiled _kernels/pulses.leading_pair, as in a study's batched analysis."""
+    signals (the truth), no SNR rule; clipped: the gauge channels that ran off the scope's
+    range (report_of). The leading pulses and their delay come from the compiled
+    _kernels/pulses.leading_pair, as in a study's batched analysis."""
     sigma = {r: math.nan if noise is None or noise.get(r) is None else float(noise[r]) for r in ("upper", "lower")}
     answer = np.empty(pulses.ANSWER)
     c = np.ascontiguousarray
     pulses.leading_pair(c(t, dtype=float), c(forces["upper"], dtype=float), c(forces["lower"], dtype=float),
                         sigma["upper"], sigma["lower"], setup.rules.as_tuple(), answer)
-    return report_of(answer, t, forces, setup, train, noise)
+    return report_of(answer, t, forces, setup, train, noise, clipped)
 
 
 def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, train: bool,
-              noise: dict | None) -> Report:
+              noise: dict | None, clipped: tuple = ()) -> Report:
     """The Report of leading_pair's answer (its layout in _kernels/pulses.py): every figure
     it allows, a reason for each it does not, the plausibility rules, and with ``train``
-    the solitary train counted on ``forces``."""
+    the solitary train counted on ``forces``. ``clipped``: the gauge channels whose record
+    ran off the scope's range (their pulses' tops are cut: no figure is given)."""
     rules, rep = setup.rules, Report(beta=setup.beta, static_force_N=setup.static_force_N)
     ch = {r: getattr(setup, r).channel for r in ("upper", "lower")}
+    if clipped:
+        return rep.refuse(f"{', '.join(clipped)}: clipped: the signal ran off the scope's range, which cuts the "
+                          f"pulses' tops (a larger volts_per_div keeps them on screen)")
     if answer[STATUS] == pulses.SAME_RECORD:
         return rep.refuse(f"{ch['upper']} and {ch['lower']} hold the same record (the same file twice?)")
     problems, lead = [], {}
@@ -249,4 +255,6 @@ def analyze_record(record: ScopeRecord, setup: Setup, train: bool = True) -> Rep
     if bad:
         return rep.refuse(f"{', '.join(bad)}: samples that are not finite numbers (a non-finite scale factor "
                           f"or sample in the file?)")
-    return analyze_forces(t, forces, setup, train, record_noise(record, setup, forces))
+    clipped = tuple(getattr(setup, r).channel for r in ("upper", "lower")
+                    if record.waveforms[getattr(setup, r).channel].overrange)
+    return analyze_forces(t, forces, setup, train, record_noise(record, setup, forces), clipped)

@@ -107,6 +107,13 @@ def print_blocks(t, m, th):
     print(f"  theory     c0 = {fmt(th['sound_speed_m_per_s'])} m/s (Eq 2), "
           f"Eq (1) at the truth amplitude: {fmt(th['speed_m_per_s'])} m/s; "
           f"cross-correlation speed {fmt(m['speed_xcorr_m_per_s'])} m/s")
+    from instruments.report import FIGURES
+
+    why = {}
+    for figure, reason in m.get("reasons", {}).items():
+        why.setdefault(reason, []).append(figure)
+    for reason, figures in why.items():
+        print(f"  measured: no {'result' if set(FIGURES) <= set(figures) else ', '.join(figures)}: {reason}")
 
 
 def cmd_animate(args) -> dict:

@@ -115,6 +115,7 @@ def shot_blocks(rig, shot) -> dict:
     pick = lambda r: {k: _clean(getattr(r, k)) for k in keys}  # noqa: E731
     m = pick(measured)
     m["speed_xcorr_m_per_s"] = _clean(measured.speed_xcorr_m_per_s)
+    m["reasons"] = dict(measured.reasons)  # why each missing figure is missing
     return {"truth": pick(truth), "measured": m, "theory": theory_block(rig, truth)}
 
 

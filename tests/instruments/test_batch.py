@@ -128,3 +128,20 @@ def test_a_shot_that_does_not_trigger_or_outlasts_its_input_says_so():
     assert not records.record(0).triggered
     setup = Setup(GaugeSetup("CH2"), GaugeSetup("CH1", 0.0043))
     assert "did not trigger" in batch.analysed(records, setup)[0].reasons["speed_m_per_s"]
+
+
+def test_a_clipped_gauge_channel_gives_no_figure_alone_or_in_a_batch():
+    # 9 N at 0.05 V/N is 0.45 V, off a 50 mV/div screen: the pulse's top is cut, so its
+    # amplitude, width and time are not measured; the batch and the lone record agree
+    wiring = _wiring()
+    forces = np.stack([np.stack([_pulse(1.8e-4, 9.0), _pulse(2.0e-4, 3.0), _pulse(4e-4, 3.0)]),
+                       np.stack([_pulse(1.8e-4, 3.0), _pulse(2.0e-4, 3.0), _pulse(4e-4, 3.0)])])
+    records = batch.acquire(forces, H, wiring, [1, 2])
+    assert records.over[0].tolist() == [False, True, False] and not records.over[1].any()
+    setup = Setup(GaugeSetup("CH2", 0.0, 0.05, 1e-3), GaugeSetup("CH1", 0.0043, 0.05, 1e-3))
+    reports = batch.analysed(records, setup)
+    alone = analyze_record(records.record(0), setup, train=False)
+    assert reports[0].as_dict() == alone.as_dict()
+    assert alone.speed_m_per_s is None and alone.amplitude_N is None
+    assert alone.reasons["amplitude_N"].startswith("CH2: clipped: the signal ran off the scope's range")
+    assert reports[1].speed_m_per_s is not None and set(reports[1].reasons) == {"pulses"}  # leading pulse only
