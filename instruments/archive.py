@@ -142,7 +142,11 @@ class Archive:
         except Exception as exc:  # noqa: BLE001 - any failure of a damaged file
             raise InstrumentError(f"{path}: cannot be opened as HDF5 (truncated or damaged?): {_cause(exc)}") from None
         if creator != "sonic-rig":
+            study = "study" in f.attrs and "outputs" in f  # a Monte Carlo study's results (rig mc)
             f.close()
+            if study:
+                raise InstrumentError(f"{path}: a Monte Carlo study's results (rig mc), not a shot archive: its "
+                                      f"shots' scope records are archived under traces/ when it runs with --traces")
             raise InstrumentError(f"{path}: not a rig archive (an HDF5 file that this project did not write)")
         if current and version != LAYOUT_VERSION:
             f.close()

@@ -18,11 +18,18 @@ def cmd_verify(args) -> dict:
         raise RigError(f"{path}: a folder, not an archive file")
     report = Archive(path).verify()
     if not args.json:
-        print(f"{args.archive}: {report['shots']} shots, {report['ok']} ok, {len(report['bad'])} bad")
+        n = len(report["bad"])
+        print(f"{args.archive}: {report['shots']} shots, {report['ok']} ok, {report['shots'] - report['ok']} bad "
+              f"({n} problem{'' if n == 1 else 's'})")
         for b in report["bad"]:
             who = f"shot {b['shot']}" if b["shot"] is not None else \
                 f"shots {', '.join(map(str, b['shots']))}" if b["shots"] else "archive"
-            print(f"  {who}: {b['where']}: {b['reason']}")
+            parts = 3 if b["where"].startswith("/shared/") else 2 if b["where"].startswith("/shot_") else 1
+            item = b["where"].split("/", parts)[-1]  # the dataset or attribute within its group
+            what = b["reason"]
+            for head in (f"{item}: ", f"attribute {item}: "):
+                what = what.removeprefix(head)  # the path names it already
+            print(f"  {who}: {b['where']}: {what}")
     args.exit_code = 1 if report["bad"] else 0
     return report
 

@@ -19,11 +19,12 @@ from pathlib import Path
 
 from instruments.analysis import PeakRules
 from instruments.archive import Archive
+from instruments.errors import InstrumentError
 from instruments.formats import read_record
 from instruments.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.plausibility import Limits
 from instruments.records import ScopeRecord
-from instruments.report import SPEED_FIGURES
+from instruments.report import SPEED_FIGURES, Report
 from rig.errors import RigError, invalid
 from rig.model.materials import MATERIALS, material
 from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed
@@ -75,16 +76,32 @@ def analyze_paths(options: AnalyzeOptions) -> list:
     paths = [Path(p) for p in options.files]
     archives = [p for p in paths if p.suffix.lower() in (".h5", ".hdf5", ".nxs")]
     files = [p for p in paths if p not in archives]
-    shots = []
+    shots, unread = [], {}
     for a in archives:
         archive = Archive(a)
         ids = [options.shot] if options.shot is not None else archive.ids()
-        shots += [(f"{a}#{i}", archive.read(i, with_truth=False)) for i in ids]
-    real = bool(files) or not all(entry.simulated for _, entry in shots)
+        for i in ids:
+            try:
+                shots.append((f"{a}#{i}", archive.read(i, with_truth=False)))
+            except InstrumentError as exc:  # a damaged shot of several: a row with its reason, the others go on
+                if options.shot is not None:
+                    raise
+                shots.append((f"{a}#{i}", None))
+                unread[f"{a}#{i}"] = str(exc).removeprefix(f"{a}: ")
+    real = bool(files) or not all(entry.simulated for _, entry in shots if entry is not None)
     results = []
     for source, entry in shots:
-        setup = _setup_from_entry(entry, options, real) if entry.simulated else _setup_from_flags(options, entry.record)
-        results.append(_result(source, entry.record, setup, options, entry))
+        if entry is None:
+            results.append(_refused(source, unread[source]))
+            continue
+        try:
+            setup = (_setup_from_entry(entry, options, real) if entry.simulated
+                     else _setup_from_flags(options, entry.record))
+            results.append(_result(source, entry.record, setup, options, entry))
+        except (RigError, InstrumentError) as exc:
+            if len(shots) + bool(files) == 1 or (entry.simulated and not real):
+                raise
+            results.append(_refused(source, f"shot {entry.shot_id}: {exc}", entry.simulated))
     if files:
         record = read_record(files)
         results.append(_result(", ".join(map(str, files)), record, _setup_from_flags(options, record), options))
@@ -134,7 +151,7 @@ def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
     if options.channels and not 2 <= len(names) <= 3:
         raise invalid("--channels", options.channels, f"UPPER,LOWER[,WALL]: two or three of {held}")
     if len(names) < 2:
-        raise RigError(f"two gauge channels are needed; the files hold {held}")
+        raise RigError(f"two gauge channels are needed; the record holds {held}")
     for n in names:
         if n not in record.waveforms:
             raise invalid("--channels", options.channels, f"{n!r} is not in the files (channels: {held})")
@@ -145,6 +162,16 @@ def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
     wall = g(names[2], math.inf) if len(names) > 2 else None
     return Setup(g(names[0], 0.0), g(names[1], options.gauge_distance), wall, options.diameter,
                  options.beta, options.f0, PeakRules())
+
+
+def _refused(source: str, why: str, simulated: bool | None = None) -> dict:
+    """The result row of an archive shot that cannot be analysed (damaged, or a set-up that
+    does not fit its record), beside the shots that can: every figure None, with ``why``."""
+    out = {"source": source, "channels": [], **Report().refuse(why).as_dict()}
+    out.pop("leading", None)
+    out.update(simulated=simulated, force_unit=None, theory_speed_m_per_s=None)
+    out["reasons"]["theory_speed_m_per_s"] = why
+    return out
 
 
 def _limits(name: str | None) -> Limits:

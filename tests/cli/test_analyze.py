@@ -253,3 +253,26 @@ def test_the_bead_material_of_a_virtual_shot_is_its_own(gauge_files, tmp_path, c
     code, (virtual, real), _ = run(capsys, "analyze", path, *gauge_files, *GAUGE, "--material", "steel316")
     assert virtual == alone and virtual["speed_m_per_s"] is not None
     assert "for steel316" in real["reasons"]["speed_m_per_s"]  # 200 m/s is far below steel's Eq (1)
+
+
+def test_a_bad_shot_of_an_archive_is_a_row_with_its_reason(gauge_files, tmp_path, capsys, realdata):
+    # one damaged shot and one real record that holds a single channel do not stop the
+    # other shots: each is a row whose every figure is missing for its reason (exit 0: a
+    # speed was measured); alone, the same shot is a one-line refusal (exit 2)
+    import h5py
+
+    path = str(tmp_path / "three.h5")
+    for seed in ("3", "4"):
+        assert main(["shot", "ptfe52_magnetic", "--seed", seed, "--out", path]) == 0
+    assert main(["import", str(realdata / "tek_16bit_dpo.isf"), "--into", path]) == 0
+    capsys.readouterr()
+    with h5py.File(path, "r+") as f:
+        f["shot_000002/instrument/oscilloscope/CH1"][100] += 3
+    code, rows, _ = run(capsys, "analyze", path, "--gauge-distance", "43 mm")
+    assert code == 0 and [r["source"] for r in rows] == [f"{path}#{i}" for i in (1, 2, 3)]
+    assert rows[0]["speed_m_per_s"] is not None and set(rows[1]) == set(rows[0])
+    assert rows[1]["reasons"]["speed_m_per_s"] == "shot 2: instrument/oscilloscope/CH1: damaged (SHA-256 differs)"
+    assert rows[2]["reasons"]["amplitude_N"].startswith("shot 3: two gauge channels are needed; the record holds")
+    assert all(rows[k][f] is None for k in (1, 2) for f in FIGURES)
+    code, _, err = run(capsys, "analyze", path, "--shot", "2")
+    assert code == 2 and "shot 2: instrument/oscilloscope/CH1: damaged" in err

@@ -166,6 +166,13 @@ def test_verify_names_the_shot_and_the_dataset_of_a_flip(tmp_path, capsys):
     assert report["ok"] == 0 and len(report["bad"]) == 1, report
     assert report["bad"][0]["where"] == f"/shared/{key}/forces/upper_average_force"
     assert report["bad"][0]["shots"] == [1, 2] and forces_name.endswith("upper_average_force")
+    # the text counts the shots the problem touches (2 bad, 1 problem) and names the
+    # dataset once per row
+    assert main(["verify", str(path)]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == f"{path}: 2 shots, 0 ok, 2 bad (1 problem)"
+    assert out[1].startswith(f"  shots 1, 2: /shared/{key}/forces/upper_average_force: damaged (")
+    assert out[1].endswith("(shared by shots 1, 2)") and out[1].count("upper_average_force") == 1
 
 
 def test_a_full_disk_is_one_line_and_loses_nothing(tmp_path, capsys, monkeypatch):
