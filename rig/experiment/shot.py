@@ -42,21 +42,31 @@ class ShotRecord:
     analysis_truth: dict | None = None  # the truth block of rig/experiment/measure.py, when computed
 
 
-def impact_doubt(chain) -> str:
-    """Why a chain's solve may blow up at any step, or "": a striker whose energy could
-    press it more than a tenth of the top bead's radius into it (Chain.impact_overlap), far
-    outside the contact law's range (the solver stops as unstable at half the radius), and
-    the speed that keeps it within a tenth."""
+FAR = 20  # an overlap of more than radius / FAR is far outside the contact law's range
+
+
+def overlap_doubt(chain) -> str:
+    """Why a chain's solve may blow up at every step, or "": a static load that presses a
+    contact more than 1/FAR of its bead's radius together (Chain.static_overlaps), or a
+    striker whose energy could press it that far into the top bead (Chain.impact_overlap);
+    the solver stops as unstable at half a radius."""
+    radii = np.array([b.radius for b in chain.beads])
+    static = chain.static_overlaps()[:radii.size] / radii  # contact k: above bead k
+    k = int(np.argmax(static))
+    if static[k] > 1 / FAR:
+        return (f": the static load, {chain.static_forces()[k]:.4g} N at contact {k} (magnet.force and the chain's "
+                f"weight), presses it {static[k]:.3g} times a bead's {radii[k] * 1e3:.3g} mm radius together; the "
+                f"contact law holds for overlaps far below the radius")
     if chain.striker is None:
         return ""
-    overlap, radius = chain.impact_overlap(), chain.beads[0].radius
-    if not overlap > radius / 10:
+    overlap, radius = chain.impact_overlap(), radii[0]
+    if not overlap > radius / FAR:
         return ""
     st, A, n = chain.striker, float(chain.contact_constants()[0]), float(chain.contact_exponents()[0])
-    v_tenth = math.sqrt(2 * A * (radius / 10) ** (n + 1) / ((n + 1) * st.mass))
+    v_far = math.sqrt(2 * A * (radius / FAR) ** (n + 1) / ((n + 1) * st.mass))
     return (f": striker.velocity = {st.velocity:g} m/s with striker.mass = {st.mass:g} kg could press the striker "
             f"{overlap:.3g} m into the top bead, {overlap / radius:.3g} times its {radius * 1e3:.3g} mm radius; the "
-            f"contact law holds for overlaps far below the radius (a tenth of it up to {v_tenth:.3g} m/s here)")
+            f"contact law holds for overlaps far below the radius (1/{FAR} of it up to {v_far:.3g} m/s here)")
 
 
 def fresh_seed() -> int:
@@ -107,7 +117,7 @@ class Rig(Assembly):
                 self._solution = solve(self.chain, s.duration, save=self.save_at(), method=s.method,
                                        accuracy=s.accuracy)
             except Unstable as exc:
-                raise Unstable(f"{exc}{impact_doubt(self.chain)}", exc.stepping) from None
+                raise Unstable(f"{exc}{overlap_doubt(self.chain)}", exc.stepping) from None
         return self._solution
 
     def truth(self) -> Truth:

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rig.errors import invalid
+from rig.errors import RigError, invalid
 from rig.model.chain import STANDARD_GRAVITY, ForceSchedule
 
 
@@ -57,10 +57,10 @@ class Holder:
             raise invalid("striker.diameter", striker.diameter,
                           f"wider than holder.bore = {self.bore * 1e3:g} mm")
         chain = sum(b.diameter for b in beads)
-        if striker is not None and striker.length > self.length:  # the striker alone: its mass is the mistake
-            raise invalid("striker.mass", striker.mass,
-                          f"a {striker.diameter * 1e3:g} mm {striker.material.name} cylinder of {striker.mass:g} kg "
-                          f"is {striker.length:.4g} m long, more than holder.length = {self.length:g} m")
+        if striker is not None and striker.length > self.length:  # the striker alone: its mass or the tube
+            raise RigError(f"striker.mass = {striker.mass:g} kg and holder.length = {self.length:g} m: a "
+                           f"{striker.diameter * 1e3:g} mm {striker.material.name} striker of that mass is "
+                           f"{striker.length:.4g} m long, longer than the tube")
         stack = chain + (striker.length if striker else 0.0)
         if stack > self.length:
             raise invalid("holder.length", self.length,

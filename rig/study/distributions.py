@@ -42,9 +42,12 @@ def key_unit(key: str):
         node = schema_node(key)
     except KeyError:
         raise invalid("--vary", key, "unknown key") from None
-    if node not in (float, int) and not isinstance(node, str):
+    if node is int:
+        raise invalid("--vary", key, "a whole-number key (a count or an index) cannot take a continuous "
+                                     "distribution; run one study per value, or rig sweep")
+    if node is not float and not isinstance(node, str):
         raise invalid("--vary", key, "only numeric keys can be uncertain")
-    return float if node in (float, int) else node
+    return float if node is float else node
 
 
 def key_range(key: str):

@@ -56,9 +56,13 @@ CASES = [
     # far outside the contact law: the solver's refusal names the key, the overlap and a safe speed
     (["shot", S, *_set("striker.velocity=1e9")], "striker.velocity = 1e+09 m/s with striker.mass = 0.00047 kg "
                                                   "could press the striker 81.6 m into the top bead"),
-    # a striker longer than the tube: its mass is the mistake, not the tube's length
-    (["shot", S, *_set("striker.mass=1e6")], "striker.mass = 1000000.0: a 4.76 mm alumina cylinder of 1e+06 kg "
-                                              "is 1.441e+07 m long, more than holder.length = 0.4 m"),
+    (["shot", S, *_set("striker.velocity=120")], "striker.velocity = 120 m/s"),
+    (["shot", S, *_set("magnet.force=1e4")], "the static load, 1e+04 N at contact 52 (magnet.force and the chain's "
+                                              "weight), presses it 1.6 times a bead's 2.38 mm radius together"),
+    # a striker longer than the tube: its mass and the tube's length are both named
+    (["shot", S, *_set("striker.mass=1e6")], "striker.mass = 1e+06 kg and holder.length = 0.4 m: a 4.76 mm "
+                                              "alumina striker of that mass is 1.441e+07 m long, longer than the tube"),
+    (["shot", S, *_set("holder.length=1 mm")], "striker.mass = 0.00047 kg and holder.length = 0.001 m"),
     (["shot", S, *_set("chain.colour=red")], "chain.colour"),
     (["shot", S, *_set("chain.beads=0")], "chain.beads"),
     (["shot", S, *_set("chain.beads=-5")], "chain.beads"),
@@ -108,6 +112,8 @@ CASES = [
     (["sweep", S, "--vary", "striker.velocity=0.3:1.5:3", *_set("chain.beads=1.5")], "chain.beads"),
     # mc
     (["mc", S, "--shots", "0", "--vary", VEL, "--out", "{d}/mc"], "--shots"),
+    (["mc", S, "--shots", "8", "--vary", "chain.beads=uniform(10, 60)", "--out", "{d}/mc"],
+     "--vary = 'chain.beads': a whole-number key (a count or an index) cannot take a continuous distribution"),
     (["mc", S, "--shots", "-5", "--vary", VEL, "--out", "{d}/mc"], "--shots"),
     (["mc", S, "--shots", "8", "--batch", "0", "--vary", VEL, "--out", "{d}/mc"], "--batch"),
     (["mc", S, "--shots", "100000000", "--vary", VEL, "--out", "{d}/mc"], "add --allow-large to run it anyway"),

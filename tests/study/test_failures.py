@@ -49,6 +49,21 @@ def test_a_wide_study_counts_its_failed_shots_and_fails_past_the_threshold(tmp_p
     assert "failed: " in capsys.readouterr().out
 
 
+def test_a_study_whose_every_shot_fails_says_so_in_one_line(tmp_path, capsys):
+    # 100 to 300 m/s is far outside the contact law: every shot is unstable; the report
+    # and its figures are still written, and stderr holds the one line (no numpy warning)
+    import warnings
+
+    argv = ["mc", "ptfe52_magnetic", "--shots", "16", "--vary", "striker.velocity=uniform(100 m/s, 300 m/s)",
+            "--out", str(tmp_path / "bad"), "--quiet"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # numpy's all-nan slice warning reached the terminal
+        assert main(argv) == 1
+    err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert err == ["rig mc: error: 16 of 16 shots failed (100.0%, more than --max-failed 5.0%): 16 solver unstable"]
+    assert (tmp_path / "bad" / "speed_vs_amplitude.png").is_file()
+
+
 def test_worker_watch_stops_after_the_timeout_without_workers():
     now = [0.0]
     watch = WorkerWatch(10.0, clock=lambda: now[0])
