@@ -54,7 +54,7 @@ def cmd_import(args) -> dict:
     from pathlib import Path
 
     from instruments.archive import Archive, Entry, raw_digest
-    from instruments.formats import read_record
+    from instruments.formats import read_record, read_waveforms
 
     groups = [args.files] if args.together else [[f] for f in args.files]
     entries = []
@@ -62,7 +62,17 @@ def cmd_import(args) -> dict:
         # scope files hold no acquisition time: the start time is the oldest file's
         # modification time, stored as what it is
         mtime = datetime.fromtimestamp(min(Path(f).stat().st_mtime for f in files), timezone.utc).isoformat()
-        entries.append(Entry(read_record(files), False, scene="",
+        record = read_record(files)
+        if any("@" in ch for ch in record.waveforms):  # a channel name met in two files: name them
+            seen = {}
+            for f in files:
+                for w in read_waveforms(f):
+                    if w.channel in seen:
+                        raise RigError(f"--together: {seen[w.channel]} and {f} both hold {w.channel}: the channels "
+                                       f"of one shot have different names; import these files as separate shots "
+                                       f"(without --together)")
+                    seen[w.channel] = f
+        entries.append(Entry(record, False, scene="",
                              settings={"source_files": [str(Path(f).resolve().name) for f in files]},
                              start_time=mtime, file_modification_time=mtime,
                              start_time_source="file modification time (the file holds no acquisition time)"))

@@ -76,6 +76,8 @@ def analyze_paths(options: AnalyzeOptions) -> list:
     paths = [Path(p) for p in options.files]
     archives = [p for p in paths if p.suffix.lower() in (".h5", ".hdf5", ".nxs")]
     files = [p for p in paths if p not in archives]
+    if options.shot is not None and not archives:
+        raise invalid("--shot", options.shot, "picks a shot of an archive (.h5); scope files are one shot together")
     shots, unread = [], {}
     for a in archives:
         archive = Archive(a)
@@ -152,6 +154,8 @@ def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
         raise invalid("--channels", options.channels, f"UPPER,LOWER[,WALL]: two or three of {held}")
     if len(names) < 2:
         raise RigError(f"two gauge channels are needed; the record holds {held}")
+    if options.wall and not options.channels and len(names) < 3:
+        raise RigError(f"--wall reads the third channel as the wall sensor; the record holds {held}")
     for n in names:
         if n not in record.waveforms:
             raise invalid("--channels", options.channels, f"{n!r} is not in the files (channels: {held})")

@@ -123,10 +123,12 @@ def test_the_speed_is_checked_against_eq1_for_the_material(gauge_files, capsys):
     ("--channels", "CH1,CH1", "--channels = 'CH1,CH1': a channel named twice"),
     ("--channels", "CH1", "--channels = 'CH1': UPPER,LOWER[,WALL]: two or three of CH1, CH2"),
     ("--material", "unobtainium", "material = 'unobtainium': known materials:"),
+    ("--shot", "1", "--shot = 1: picks a shot of an archive (.h5); scope files are one shot together"),
+    ("--wall", None, "--wall reads the third channel as the wall sensor; the record holds CH1, CH2"),
 ])
 def test_bad_flags_are_one_line_and_exit_2(gauge_files, capsys, flag, value, message):
     try:
-        code = main(["analyze", *gauge_files, *GAUGE, flag, value])
+        code = main(["analyze", *gauge_files, *GAUGE, flag, *([] if value is None else [value])])
     except SystemExit as exc:  # argparse's own checks
         code = exc.code
     err = capsys.readouterr().err.strip().splitlines()

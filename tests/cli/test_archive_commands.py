@@ -242,3 +242,14 @@ def test_ls_lists_the_good_shots_beside_a_damaged_one(tmp_path, capsys):
     rows = json.loads(capsys.readouterr().out)
     assert [r["shot"] for r in rows] == [1, 2, 3] and "damaged" in rows[1]
     assert rows[0]["seed"] == 1 and rows[2]["seed"] == 3
+
+
+def test_one_shot_of_files_that_hold_the_same_channel_is_refused(tmp_path, capsys, realdata):
+    # --together makes the files the channels of one shot: two files that both hold the
+    # same channel are named, and nothing is written
+    f = str(realdata / "tek_16bit_dpo.isf")
+    into = tmp_path / "a.h5"
+    assert main(["import", f, f, "--together", "--into", str(into)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"rig import: error: --together: {f} and {f} both hold ") and err.count("\n") == 0
+    assert "import these files as separate shots (without --together)" in err and not into.exists()
