@@ -51,7 +51,8 @@ class Setup:
     """What the analysis is told: the two gauges (upper first), the wall sensor if any, the
     bead diameter (m), beta = F_d / F_m,e and F_0 (N) from the scene's numerics, the peak
     rules, the distance from the lower gauge to the wall (m) where no wall sensor says
-    when the reflection arrives, and the limits of a plausible speed."""
+    when the reflection arrives, the limits of a plausible speed, and the unit of the
+    forces ("N", or "V" where no sensitivity converts the gauges' volts)."""
 
     upper: GaugeSetup
     lower: GaugeSetup
@@ -62,9 +63,14 @@ class Setup:
     rules: PeakRules = field(default_factory=PeakRules)
     wall_distance_m: float | None = None
     limits: Limits = field(default_factory=Limits)
+    force_unit: str = "N"
 
     def __post_init__(self):
-        check("gauge_distance", self.lower.position_m - self.upper.position_m, lo=0, unit="m")
+        distance = self.lower.position_m - self.upper.position_m
+        if not distance > 0:
+            raise InstrumentError(f"the lower gauge ({self.lower.channel}, {self.lower.position_m:.6g} m) is not "
+                                  f"below the upper one ({self.upper.channel}, {self.upper.position_m:.6g} m): "
+                                  f"their distance is {distance:.6g} m; allowed > 0 m")
         check("beta", self.beta, lo=0, hi=10)
 
 
@@ -155,7 +161,8 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
         if answer[1 + ROLE * k + FOUND] != 1.0:
             if sigma is not None and peak < rules.snr * sigma:
                 problems.append(f"{ch[r]}: no pulse stands {rules.snr:g} times above the pre-trigger noise "
-                                f"({sigma:.3g}): its highest excursion is {rep.snr[ch[r]]:.3g} times the noise")
+                                f"({sigma:.3g} {setup.force_unit}): its highest excursion is "
+                                f"{rep.snr[ch[r]]:.3g} times the noise")
             else:
                 problems.append(f"{ch[r]}: no pulse passes the peak rules (height, prominence, width)")
             continue

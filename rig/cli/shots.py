@@ -36,7 +36,7 @@ def cmd_shot(args) -> dict:
         with writing_to(args.out):
             out["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot_entry(shot)])[0]}
     if not args.json:
-        print_shot(out)
+        print_shot(out, "the striker's kinetic energy" if rig.chain.striker is not None else "the static energy")
     return out
 
 
@@ -65,11 +65,12 @@ def shot_summary(rig, shot) -> dict:
             "channels": channels}
 
 
-def print_shot(out: dict):
+def print_shot(out: dict, energy: str):
+    """The summary of `rig shot`; ``energy``: what the energy error is relative to."""
     s = out["solver"]
     print(f"{out['scenario']} (seed {out['seed']})")
-    print(f"  solver {s['method']}: dt = {s['dt_s'] * 1e9:.1f} ns, {s['steps']} steps, "
-          f"{s['wall_s'] * 1e3:.1f} ms, energy error {s['energy_error']:.1e}, "
+    print(f"  solver {s['method']}: dt = {s['dt_s'] * 1e9:.1f} ns, {s['steps']} steps in "
+          f"{s['wall_s'] * 1e3:.1f} ms, energy error {s['energy_error']:.1e} of {energy}, "
           f"momentum error {s['momentum_error']:.1e}")
     if s["error_estimate"] is not None:
         print(f"  force error (relative to each record's dynamic peak): estimated {s['error_estimate']:.1e}"

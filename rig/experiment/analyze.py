@@ -165,7 +165,7 @@ def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
     g = lambda ch, x: GaugeSetup(ch, x, volts_per_newton, options.tau)  # noqa: E731
     wall = g(names[2], math.inf) if len(names) > 2 else None
     return Setup(g(names[0], 0.0), g(names[1], options.gauge_distance), wall, options.diameter,
-                 options.beta, options.f0, PeakRules())
+                 options.beta, options.f0, PeakRules(), force_unit="V" if options.sensitivity is None else "N")
 
 
 def _refused(source: str, why: str, simulated: bool | None = None) -> dict:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from instruments.gauges import GaugeSettings
 from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
-from rig.errors import invalid
+from rig.errors import RigError, invalid
 from rig.experiment.scene import Scene
 from rig.experiment.settings import GaugeWiring, SolverSettings, WallWiring
 from rig.model.apparatus import Holder, RingMagnet
@@ -55,6 +55,12 @@ class Assembly:
         else:
             self.gauges = tuple(self._gauge(name, dict(g), first, len(beads))
                                 for name, g in sorted(v.get("gauges", {}).items()))
+            on = {}
+            for g in self.gauges:  # one gauge per bead: a bead holds one piezo plate
+                if g.bead in on:
+                    raise RigError(f"gauges.{on[g.bead]} and gauges.{g.name} are both on bead {g.bead - first + 1} "
+                                   f"(from the top): each gauge needs a bead of its own")
+                on[g.bead] = g.name
         for g in self.gauges:
             beads[g.bead] = GaugeBead.like(beads[g.bead], mass=g.mass)
         self.striker = like.striker if shared("striker") else Striker(**v["striker"])

@@ -278,3 +278,14 @@ def test_a_bad_shot_of_an_archive_is_a_row_with_its_reason(gauge_files, tmp_path
     assert all(rows[k][f] is None for k in (1, 2) for f in FIGURES)
     code, _, err = run(capsys, "analyze", path, "--shot", "2")
     assert code == 2 and "shot 2: instrument/oscilloscope/CH1: damaged" in err
+
+
+def test_a_noise_refusal_states_the_noise_in_the_forces_unit(realdata, capsys):
+    # a sine record (no pulse): the SNR refusal gives its noise in V without --sensitivity,
+    # in N with it (the noise in N is the volts over the sensitivity)
+    f = str(realdata / "bee331_MSO3012_tek0000.csv")
+    _, (v,), _ = run(capsys, "analyze", f, "--gauge-distance", "43 mm")
+    _, (n,), _ = run(capsys, "analyze", f, "--gauge-distance", "43 mm", "--sensitivity", "0.5 V/N")
+    why_v, why_n = v["reasons"]["speed_m_per_s"], n["reasons"]["speed_m_per_s"]
+    sigma = v["noise"]["CH1"]
+    assert f"pre-trigger noise ({sigma:.3g} V)" in why_v and f"pre-trigger noise ({sigma / 0.5:.3g} N)" in why_n

@@ -57,6 +57,7 @@ CASES = [
     (["shot", S, *_set("striker.velocity=1e9")], "striker.velocity = 1e+09 m/s with striker.mass = 0.00047 kg "
                                                   "could press the striker 81.6 m into the top bead"),
     (["shot", S, *_set("striker.velocity=120")], "striker.velocity = 120 m/s"),
+    (["shot", S, *_set("gauges.lower.bead=20")], "gauges.lower and gauges.upper are both on bead 20 (from the top)"),
     (["shot", S, *_set("magnet.force=1e4")], "the static load, 1e+04 N at contact 52 (magnet.force and the chain's "
                                               "weight), presses it 1.6 times a bead's 2.38 mm radius together"),
     # a striker longer than the tube: its mass and the tube's length are both named
