@@ -113,12 +113,14 @@ def cmd_analyze(args) -> list:
         fmt = lambda v, spec=".2f": "-" if v is None else format(v, spec)  # noqa: E731
         if any(r["force_unit"] == "V" for r in results):
             print("note: without --sensitivity a real scope file's forces are its gauges' volts (1 V/N): its "
-                  "F_d and F_m,e columns and noise are in V; give e.g. --sensitivity '0.05 V/N' for newtons")
+                  "F_d and F_m,e and noise are in V; give e.g. --sensitivity '0.05 V/N' for newtons")
         flags = real_file_flags(options)
         if flags and any(r["simulated"] for r in results):
             print(f"note: {', '.join(flags)} {'describe' if len(flags) > 1 else 'describes'} the real records; "
                   f"the virtual shots use their own set-up")
-        print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d N':>8s} {'F_m,e N':>8s} "
+        units = {r["force_unit"] for r in results} - {None}
+        unit = units.pop() if len(units) == 1 else "N|V"  # mixed: each row's unit as the note says
+        print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d ' + unit:>8s} {'F_m,e ' + unit:>8s} "
               f"{'pulses':>6s} {'FWHM us':>8s} {'Eq1 m/s':>8s}")
         for r in results:
             fwhm = None if r["duration_s"] is None else r["duration_s"] * 1e6
