@@ -289,3 +289,10 @@ def test_a_noise_refusal_states_the_noise_in_the_forces_unit(realdata, capsys):
     why_v, why_n = v["reasons"]["speed_m_per_s"], n["reasons"]["speed_m_per_s"]
     sigma = v["noise"]["CH1"]
     assert f"pre-trigger noise ({sigma:.3g} V)" in why_v and f"pre-trigger noise ({sigma / 0.5:.3g} N)" in why_n
+
+
+def test_the_force_columns_are_headed_with_their_unit(gauge_files, capsys):
+    for flags, unit in ((["--gauge-distance", "40 mm", "--tau", "1 ms"], "V"), (GAUGE, "N")):
+        assert main(["analyze", *gauge_files, *flags]) == 0
+        header = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("source"))
+        assert f"F_d {unit}" in header and f"F_m,e {unit}" in header
