@@ -5,7 +5,7 @@ from pathlib import Path
 
 from rig.cli.common import check_size, progress_bar, writing_to
 from rig.cli.shots import shot_summary
-from rig.errors import Interrupted
+from rig.errors import Interrupted, RigError
 
 MAX_SWEEP_POINTS = 10_000  # more needs --allow-large (each point's shot is kept to the end)
 
@@ -33,6 +33,11 @@ def cmd_sweep(args) -> dict:
             except KeyboardInterrupt:
                 kept = f"those points' shots are in {args.out}" if args.out else "nothing is kept (no --out)"
                 raise Interrupted(f"interrupted after {len(fired)} of {n} points: {kept}") from None
+            except RigError as exc:  # a point that cannot be fired, after others were
+                if not fired:
+                    raise
+                kept = f"the shots of the {len(fired)} before it are in {args.out}" if args.out else "nothing is kept"
+                raise RigError(f"point {len(fired) + 1} of {n}: {exc} ({kept})") from None
     out = {"points": []}
     for p in points:
         one = shot_summary(p.rig, p.shot)
@@ -52,8 +57,8 @@ def cmd_sweep(args) -> dict:
                   f"{'  CLIPPED: ' + ','.join(c) if (c := [k for k, v in p['channels'].items() if v['clipped']]) else ''}")
             clipped += [p["value"]] if any(v["clipped"] for v in p["channels"].values()) else []
         if clipped:
-            print(f"clipped scope channels at {vary.key} = {', '.join(f'{v:g}' for v in clipped)}: "
-                  f"those measurements read low; raise scope.channels.CHn.volts_per_div")
+            print(f"clipped scope channels at {vary.key} = {', '.join(f'{v:g}' for v in clipped)}: a clipped "
+                  f"gauge channel gives no measured figure; raise scope.channels.CHn.volts_per_div")
         if args.out:
             print(f"appended {len(points)} shots to {args.out}")
     return out

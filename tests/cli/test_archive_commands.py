@@ -253,3 +253,15 @@ def test_one_shot_of_files_that_hold_the_same_channel_is_refused(tmp_path, capsy
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"rig import: error: --together: {f} and {f} both hold ") and err.count("\n") == 0
     assert "import these files as separate shots (without --together)" in err and not into.exists()
+
+
+def test_a_sweep_point_that_cannot_be_fired_says_what_was_kept(tmp_path, capsys):
+    # the second point is far outside the contact law: the refusal names the point and
+    # says that the first point's shot is already in the archive
+    out = tmp_path / "sw.h5"
+    assert main(["sweep", "ptfe52_magnetic", "--vary", "striker.velocity=50:300:3", "--out", str(out),
+                 "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("rig sweep: error: point 2 of 3: unstable at every step") and "\n" not in err
+    assert err.endswith(f"(the shots of the 1 before it are in {out})")
+    assert Archive(out).ids() == [1]
