@@ -134,6 +134,8 @@ def cmd_analyze(args) -> list:
                 print("  SNR (leading pulse / pre-trigger noise): " + ", ".join(
                     f"{ch} {fmt(v, '.3g')}" + (f" (noise {noise[ch]:.3g} {r['force_unit']})" if ch in noise else "")
                     for ch, v in r["snr"].items()))
+            if r["theory_speed_m_per_s"] is not None and not r["simulated"] and not args.f0:
+                print("  Eq1: with F_0 = 0 (no --f0): the speed of a chain without precompression")
             if r["pulses"] is not None and not r["simulated"] and not args.wall:
                 print("  pulses: counted to the record's end; without --wall (the wall sensor's channel) the wall's "
                       "reflection may be among them")

@@ -45,7 +45,7 @@ def cmd_sweep(args) -> dict:
         one["value"] = p.value
         out["points"].append(one)
     if not args.json:
-        fmt = lambda v, spec: "-" if v is None else format(v, spec)  # noqa: E731
+        fmt = lambda v, spec: "-".rjust(int(spec.split(".")[0])) if v is None else format(v, spec)  # noqa: E731
         print(f"{vary.key:>18s} | {'truth F_d N':>11s} {'V_s m/s':>8s} | {'measured F_d N':>14s} "
               f"{'V_s m/s':>8s} | {'Eq (1) m/s':>10s}")
         clipped = []

@@ -296,3 +296,10 @@ def test_the_force_columns_are_headed_with_their_unit(gauge_files, capsys):
         assert main(["analyze", *gauge_files, *flags]) == 0
         header = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("source"))
         assert f"F_d {unit}" in header and f"F_m,e {unit}" in header
+
+
+def test_eq1_without_f0_says_it_assumes_no_precompression(gauge_files, capsys):
+    assert main(["analyze", *gauge_files, *GAUGE, "--material", "ptfe"]) in (0, 1)
+    assert "  Eq1: with F_0 = 0 (no --f0): the speed of a chain without precompression" in capsys.readouterr().out
+    assert main(["analyze", *gauge_files, *GAUGE, "--material", "ptfe", "--f0", "2.4 N"]) in (0, 1)
+    assert "Eq1: with F_0 = 0" not in capsys.readouterr().out
