@@ -137,3 +137,15 @@ def writing_to(path):
         if exc.filename is None:
             raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
         raise
+
+
+def missing_lines(reasons: dict) -> list:
+    """One line per reason of a Report's missing figures ({figure: reason}): "no F1, F2:
+    reason", or "no result: reason" where every figure is missing for it."""
+    from instruments.report import FIGURES
+
+    why = {}
+    for figure, reason in reasons.items():
+        why.setdefault(reason, []).append(figure)
+    return [f"no {'result' if set(FIGURES) <= set(figures) else ', '.join(figures)}: {reason}"
+            for reason, figures in why.items()]

@@ -1,6 +1,7 @@
 """`rig verify`, `rig upgrade`, `rig import`, `rig analyze` and `rig ls`."""
 from __future__ import annotations
 
+from rig.cli.common import missing_lines
 from rig.errors import RigError
 
 
@@ -100,12 +101,10 @@ def cmd_analyze(args) -> list:
     """The analysis table, each channel's SNR and, under each source, why any figure is
     missing. Exit 0 when at least one source gave a speed, 1 when none did (as `rig verify`
     with bad shots); a mistake in the flags or files is exit 2 (main)."""
-    from instruments.report import FIGURES
     from rig.experiment.analyze import AnalyzeOptions, analyze_paths, real_file_flags
 
     options = AnalyzeOptions(files=tuple(args.files), shot=args.shot, gauge_distance=args.gauge_distance,
-                             channels=args.channels, wall=args.wall,
-                             sensitivity=args.sensitivity, tau=args.tau,
+                             channels=args.channels, wall=args.wall, sensitivity=args.sensitivity, tau=args.tau,
                              beta=args.beta, f0=args.f0, diameter=args.diameter, material=args.material)
     results = analyze_paths(options)
     args.exit_code = 0 if any(r["speed_m_per_s"] is not None for r in results) else 1
@@ -139,11 +138,8 @@ def cmd_analyze(args) -> list:
             if r["pulses"] is not None and not r["simulated"] and not args.wall:
                 print("  pulses: counted to the record's end; without --wall (the wall sensor's channel) the wall's "
                       "reflection may be among them")
-            why = {}
-            for figure, reason in r["reasons"].items():
-                why.setdefault(reason, []).append(figure)
-            for reason, figures in why.items():
-                print(f"  no {'result' if set(FIGURES) <= set(figures) else ', '.join(figures)}: {reason}")
+            for line in missing_lines(r["reasons"]):
+                print(f"  {line}")
     return results
 
 

@@ -1,7 +1,7 @@
 """`rig shot` and `rig animate`: one virtual shot, summarised, exported or rendered."""
 from __future__ import annotations
 
-from rig.cli.common import check_size, progress_bar, writing_to
+from rig.cli.common import check_size, missing_lines, progress_bar, writing_to
 from rig.errors import RigError
 
 
@@ -108,13 +108,8 @@ def print_blocks(t, m, th):
     print(f"  theory     c0 = {fmt(th['sound_speed_m_per_s'])} m/s (Eq 2), "
           f"Eq (1) at the truth amplitude: {fmt(th['speed_m_per_s'])} m/s; "
           f"cross-correlation speed {fmt(m['speed_xcorr_m_per_s'])} m/s")
-    from instruments.report import FIGURES
-
-    why = {}
-    for figure, reason in m.get("reasons", {}).items():
-        why.setdefault(reason, []).append(figure)
-    for reason, figures in why.items():
-        print(f"  measured: no {'result' if set(FIGURES) <= set(figures) else ', '.join(figures)}: {reason}")
+    for line in missing_lines(m.get("reasons", {})):
+        print(f"  measured: {line}")
 
 
 def cmd_animate(args) -> dict:

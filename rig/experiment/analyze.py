@@ -196,7 +196,7 @@ def _result(source, record, setup: Setup, options: AnalyzeOptions, entry=None) -
     out = {"source": source, "channels": [setup.upper.channel, setup.lower.channel], **rep.as_dict()}
     out.pop("leading", None)
     out["simulated"] = virtual
-    out["force_unit"] = "N" if virtual or options.sensitivity is not None else "V"  # of the forces and the noise
+    out["force_unit"] = setup.force_unit  # of the forces and the noise
     out["theory_speed_m_per_s"] = None
     if not mat:
         out["reasons"]["theory_speed_m_per_s"] = "no bead material given (--material)"

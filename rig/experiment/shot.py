@@ -7,7 +7,6 @@ instrument and the oscilloscope, and returns a ShotRecord. Same seed, same bits.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,8 +61,8 @@ def overlap_doubt(chain) -> str:
     overlap, radius = chain.impact_overlap(), radii[0]
     if not overlap > radius / FAR:
         return ""
-    st, A, n = chain.striker, float(chain.contact_constants()[0]), float(chain.contact_exponents()[0])
-    v_far = math.sqrt(2 * A * (radius / FAR) ** (n + 1) / ((n + 1) * st.mass))
+    st, n = chain.striker, float(chain.contact_exponents()[0])
+    v_far = st.velocity * (radius / FAR / overlap) ** ((n + 1) / 2)  # the overlap grows as v^(2 / (n + 1))
     return (f": striker.velocity = {st.velocity:g} m/s with striker.mass = {st.mass:g} kg could press the striker "
             f"{overlap:.3g} m into the top bead, {overlap / radius:.3g} times its {radius * 1e3:.3g} mm radius; the "
             f"contact law holds for overlaps far below the radius (1/{FAR} of it up to {v_far:.3g} m/s here)")

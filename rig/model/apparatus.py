@@ -56,12 +56,11 @@ class Holder:
         if striker is not None and striker.diameter > self.bore:
             raise invalid("striker.diameter", striker.diameter,
                           f"wider than holder.bore = {self.bore * 1e3:g} mm")
-        chain = sum(b.diameter for b in beads)
         if striker is not None and striker.length > self.length:  # the striker alone: its mass or the tube
             raise RigError(f"striker.mass = {striker.mass:g} kg and holder.length = {self.length:g} m: a "
                            f"{striker.diameter * 1e3:g} mm {striker.material.name} striker of that mass is "
                            f"{striker.length:.4g} m long, longer than the tube")
-        stack = chain + (striker.length if striker else 0.0)
+        stack = sum(b.diameter for b in beads) + (striker.length if striker else 0.0)
         if stack > self.length:
             raise invalid("holder.length", self.length,
                           f"the chain and striker need {stack:.4g} m of tube")
