@@ -9,14 +9,16 @@ scenario takes its turn (the machine's drift over minutes falls on every method 
 ratios at equal error are the medians of the per-round ratios.
 
 - srkn6b and verlet at fixed outer steps tau / r (the head resolved), no estimate: the
-  integrators' work-precision curves; srkn6b at the accuracy settings, the controlled
+  integrators' work-precision curves (ns/bead/eval per body a step integrated: the beads
+  the pulse has not reached are left at rest, rig/solver/kernels/integrators.py; the peers
+  integrate every body); srkn6b at the accuracy settings, the controlled
   solve with its estimate: what the contract costs;
 - with ``--peers`` (rig/bench/peers.py): scipy's DOP853 and a numba-compiled DOP853 at
   several rtol, and LAMMPS at fixed steps when it is installed;
 - at equal error: each method's CPU time interpolated (log-log) at 1e-4, 1e-5 and 1e-6,
   as a multiple of srkn6b's;
 - the kernel: the whole srkn6b step in ns per bead per force evaluation at N = 1000 and
-  N = 1e6, beside the machine's bounds (vectorised square roots; memory bandwidth) and,
+  N = 1e6, every bead moving, beside the machine's bounds (vectorised square roots; memory bandwidth) and,
   with ``--baseline REV``, the same figure of that revision measured in turns with it;
 - the cost per simulated second from 1e3 to 1e6 beads at the step the accuracy control
   picks for 1e3, and its exponent;
@@ -76,7 +78,8 @@ def _ours(name, p, save, t_end, ref, divisions, settings) -> list:
             sol, cpu = median_cpu(lambda: solve(p, t_end, save=save, method=method, dt=stepping_at(p, tau / r),
                                                 estimate=False), 1)
             return _row(name, method, f"dt=tau/{r}", cpu, relative_error(sol.forces, ref),
-                        sol.stats.force_evaluations, p.moving_bodies, dt_s=sol.stats.dt_s)
+                        sol.stats.force_evaluations, sol.stats.bodies_stepped, dt_s=sol.stats.dt_s,
+                        bodies_stepped=sol.stats.bodies_stepped)
         return f"{name}: {method} dt = tau/{r}", go
 
     def controlled(acc):

@@ -126,6 +126,7 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     d_limit[:, slot[live]] = 0.5 * near[live]
     if off:
         d0[:, 1] = -chain.striker.gap
+    balance_at_rest(load, A, d0, expo, invm)  # before d_limit, f0, e_scale read d0
     beads = np.zeros((S, nb), dtype=bool)
     beads[:, off:off + n] = True  # the holder drags and rubs the beads only
     drag = np.where(beads, chain.drag * invm, 0.0)
@@ -141,6 +142,30 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     return dict(mass=mass, invm=invm, bias=bias, load=load, A=A, expo=expo, d0=d0, f0=f0, damping=damping,
                 dashpot=dashpot, d_limit=d_limit, drag=drag, friction=friction, u0=u0, v0=v0,
                 energy_scale=e_scale, momentum_scale=p_scale)
+
+
+REST_TOLERANCE = 1e-12  # a body's net force at rest below this x its loads is rounding, not physics
+NUDGES = 6  # ulps either side tried by balance_at_rest, of a slot's static overlap and of its load
+
+
+def balance_at_rest(load, A, d0, expo, invm):
+    """Round the slot loads (N, (shots, bodies + 1)) and static overlaps (m, (shots,
+    bodies)) so that every body meant to rest is at rest bit for bit: its two slots' forces
+    at rest, elastic(d0) - load, computed as the kernels compute them, are the same number,
+    and its kick is exactly 0.
+
+    A body is meant to rest where those two forces differ by rounding only (by less than
+    REST_TOLERANCE x its loads); the lower slot's d0 and load then move by at most NUDGES
+    ulps each, to the nearest pair for which the kernels' subtraction gives the upper
+    slot's force exactly (left as they were where none does). Beads below a striker in
+    flight rest too: every slot's load carries its weight, which the slot of its gap
+    carries rounded to a multiple of the ulp of the largest load (a part in 1e13 at most
+    for chains under 1e4 beads), so that the slots below can carry it exactly. The change
+    is otherwise a few parts in 1e16; the kernels integrate the bodies ahead of a pulse
+    only where they are at rest bit for bit (rig/solver/kernels/integrators.py)."""
+    from rig.solver.kernels.forces import balance_at_rest as balance  # numba: loaded when a problem is built
+
+    balance(load, A, d0, expo, invm, REST_TOLERANCE, NUDGES)
 
 
 @dataclass(frozen=True, eq=False)

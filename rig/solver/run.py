@@ -52,9 +52,11 @@ class Unstable(RigError):
 
 
 def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, stepping: Stepping,
-                 accuracy: float | None = None) -> Solution:
+                 accuracy: float | None = None, front: bool = True) -> Solution:
     """Integrate ``problem`` from the impact to t_end (s) with ``stepping`` (whole steps
-    ending at t_end), recording what ``save`` names. Raises Unstable if it blows up."""
+    ending at t_end), recording what ``save`` names. Raises Unstable if it blows up.
+    ``front``: integrate only the bodies the pulse has reached, those still at rest bit for
+    bit being left as they are (False: every body every step; the same bits, for tests)."""
     ch_slot, ch_weight = save.channels(problem.offset)
     n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), save.sample_interval)
     sub = stepping.substeps(step, m.drifts)
@@ -77,7 +79,7 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     tail = (problem.sched_body, problem.sched_t, problem.sched_f,
             ch_slot, ch_weight, save.sample_interval, out, frame_dt, frames,
             check_every, problem.d_limit, problem.wall_slot,
-            problem.energy_scale, problem.momentum_scale, diag)
+            problem.energy_scale, problem.momentum_scale, diag, front)
     integrate(u.copy(), v.copy(), *args, 0, *mid, *tail)  # load the compiled kernel before timing
     t0 = time.perf_counter()
     integrate(u, v, *args, n_steps, *mid, *tail)
@@ -88,7 +90,7 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
                        f"dt = {step:.4g} s, method {m.name})", stepping)
     stats = SolverStats(m.name, step, n_steps, n_steps * m.force_evaluations, wall,
                         report.energy_error, report.momentum_error, report.wall_impulse_Ns, accuracy,
-                        dissipated_energy_J=report.dissipated_energy_J)
+                        dissipated_energy_J=report.dissipated_energy_J, bodies_stepped=report.bodies_stepped)
     moving = slice(0, problem.n_bodies - (1 if problem.wall_slot else 0))
     shown = slice(0, problem.offset + problem.chain.n_beads)  # the striker and the beads (not a wall's plate)
     frames_abs = frames[:, shown] + frame_origin(problem.chain) if n_frames else None

@@ -22,7 +22,7 @@ class Status(enum.IntEnum):
                                  "bead radius); use a smaller dt or a tighter accuracy"}[self]
 
 
-DIAGNOSTICS = 7  # the floats of a kernel's diagnostics array
+DIAGNOSTICS = 8  # the floats of a kernel's diagnostics array
 
 
 @dataclass(frozen=True)
@@ -37,11 +37,12 @@ class KernelReport:
     steps: int
     end_time_s: float
     dissipated_energy_J: float
+    bodies_stepped: float  # the bodies a step integrated, on average (the front; all of them at most)
 
     @classmethod
     def of(cls, diag) -> "KernelReport":
         return cls(float(diag[0]), float(diag[1]), float(diag[2]), Status(int(diag[3])),
-                   int(diag[4]), float(diag[5]), float(diag[6]))
+                   int(diag[4]), float(diag[5]), float(diag[6]), float(diag[7]) / max(int(diag[4]), 1))
 
 
 @dataclass(frozen=True)
@@ -54,6 +55,10 @@ class SolverStats:
     max |P(t) - P(0) - external impulse| / P_ref (P_ref: the striker's momentum), external
     impulse = constant loads x t + scheduled force impulse - wall impulse + the holder's.
     dissipated_energy_J: the energy dissipation took over the whole solve (J).
+    bodies_stepped: the bodies a step integrated, on average: the beads the pulse has not
+    reached are at rest and left as they are (rig/solver/kernels/integrators.py), so this is
+    less than the chain's bodies where the record ends before the pulse fills the chain
+    (0 for a batch's shots, whose chunks of shots share one front).
     error_estimate: the a-posteriori estimate of the largest error of any recorded force,
     relative to its dynamic peak (``relative_error``), over the whole record; None where
     nothing was recorded. estimate_basis: how it was obtained ("companion at dt/2": a
@@ -78,6 +83,7 @@ class SolverStats:
     attempts: int = 1
     cpu_s: float = 0.0
     dissipated_energy_J: float = 0.0
+    bodies_stepped: float = 0.0
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)

@@ -41,7 +41,7 @@ def test_the_fused_kick_drift_force_pass_is_vectorised(law):
 
 def test_the_closing_kick_is_vectorised():
     u, v, invm, f, *_ = _chain()
-    assert _vector_ops(_llvm(step.closing_kick, v, invm, f, 1e-9, 1)), "the closing kick is scalar"
+    assert _vector_ops(_llvm(step.closing_kick, v, invm, f, 1e-9, 1, v.shape[0])), "the closing kick is scalar"
 
 
 def test_the_batched_kernel_vectorises_over_shots():
@@ -62,7 +62,7 @@ def test_the_batched_pass_runs_its_rows_inline():
     z = np.zeros((nb, W))
     ir = _llvm(ensemble._kick_drift_forces, z, z.copy(), np.ones((nb, W)), np.zeros((nb + 1, W)), np.ones((nb, W)),
                np.full((nb, W), 1e-7), np.zeros((nb + 1, W)), 1e-9, 1e-9, 0, np.array(m.drifts), np.array(m.kicks),
-               1, np.zeros((2, 3, 1, W)), np.zeros((5, W)), HERTZ, np.full((nb, W), 1.5))
+               1, np.zeros((2, 3, 1, W)), np.zeros((5, W)), HERTZ, np.full((nb, W), 1.5), nb)
     called = set(re.findall(r"call [^@]*@\"?([\w.$]+)", ir))
     assert not [name for name in called if "_row" in name], f"row helpers called, not inlined: {called}"
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the batched force rows are scalar"

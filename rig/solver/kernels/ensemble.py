@@ -21,6 +21,7 @@ from instruments.jit import jit
 from rig.model.contact import HERTZ, POWER
 from rig.solver.kernels.dissipation import dissipate, holder_factors
 from rig.solver.kernels.forces import contact_force, power, state_sums
+from rig.solver.kernels.integrators import rest_from
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
 
@@ -47,14 +48,14 @@ def _power_row(u, A, d0, load, f, i, expo):
 
 
 @jit
-def _other_laws(u, A, d0, load, f, expo, law, lo):
+def _other_laws(u, A, d0, load, f, expo, law, lo, hi):
     """POWER: slots lo.. whose exponent is not 3/2 renewed by their own law, after a pass
     renewed every slot as Hertz's from the same positions (no pass reads a slot's force
     after renewing it, so this is the same as renewing them in the pass). Apart from the
     pass: inlined in its loop, this branch kept numba's atomic reference counts there (6%
     of the pass)."""
     if law == POWER:
-        for i in range(max(lo, 1), u.shape[0]):
+        for i in range(max(lo, 1), hi):
             _power_row(u, A, d0, load, f, i, expo)
 
 
@@ -62,7 +63,7 @@ def _other_laws(u, A, d0, load, f, expo, law, lo):
 def _forces(u, A, d0, load, f, law, expo):
     for i in range(1, u.shape[0]):
         _contact_row(u, A, d0, load, f, i)
-    _other_laws(u, A, d0, load, f, expo, law, 1)
+    _other_laws(u, A, d0, load, f, expo, law, 1, u.shape[0])
 
 
 @jit
@@ -82,31 +83,45 @@ def _kick_drift_row(u, v, invm, f, hb, ha, i):
 
 
 @jit
-def _kick_drift(u, v, invm, f, hb, ha, head):
+def _kick_drift(u, v, invm, f, hb, ha, head, reach):
     start = 0
     if head > 0:
         _head_kick(v, invm, f, hb, head)
         start = head + 1
-    for i in range(start, v.shape[0]):
+    for i in range(start, reach):
         _kick_drift_row(u, v, invm, f, hb, ha, i)
 
 
 @jit
-def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_work, h_busy, law, expo):
-    """_kick_drift (and the head's flow) then _forces in one pass over the rows: row i is
-    kicked and drifted (reading f[i], f[i+1], not yet renewed), then contact i is renewed
-    from rows i-1 and i (both moved). The same operations as the two passes, so the same
-    bits."""
+def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_work, h_busy, law, expo,
+                       reach):
+    """_kick_drift (and the head's flow) then _forces in one pass over rows 0..reach-1 (the
+    others at rest bit for bit, integrators.integrate's front): row i is kicked and drifted
+    (reading f[i], f[i+1], not yet renewed), then contact i is renewed from rows i-1 and i
+    (both moved). The same operations as the two passes, so the same bits."""
     start = 0
     if head > 0:
         _head_kick(v, invm, f, hb, head)
         head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub, h_work, h_busy)
         start = head + 1
-    for i in range(start, v.shape[0]):
+    for i in range(start, reach):
         _kick_drift_row(u, v, invm, f, hb, ha, i)
         if i >= 1:
             _contact_row(u, A, d0, load, f, i)
-    _other_laws(u, A, d0, load, f, expo, law, start)
+    _other_laws(u, A, d0, load, f, expo, law, start, reach)
+
+
+@jit
+def _still_rows(u, v, u_rest, lo, hi):
+    """integrators.still_from over every shot: the first row r in [lo, hi] from which rows
+    r..hi-1 of every shot are where they rest with v = 0."""
+    r = hi
+    while r > lo:
+        for s in range(u.shape[1]):
+            if v[r - 1, s] != 0.0 or u[r - 1, s] != u_rest[r - 1, s]:
+                return r
+        r -= 1
+    return r
 
 
 @jit
@@ -182,14 +197,23 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
     for s in range(u.shape[1]):
         net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
     probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, 0.0, head, -1, 0.0, d_old, r_old)
+    u_rest = u.copy()
+    still = nb
+    if not dissipative:
+        still = 1
+        for s in range(W):
+            still = max(still, rest_from(v[:, s], invm[:, s], f[:, s], head + 1))
     if n_out > 0:
         hermite_weights(0.0, dt, w, 0)
         x[0] = 0.0
         _record(out, lo, 0, 1, w, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_old, r_old)
     j_out = 1
     pending = 0.0
+    stepped = 0
     for n in range(n_steps):
         t = n * dt
+        reach = min(nb, still + n_drift + 2)
+        stepped += reach
         if dissipative:  # E(dt/2) S(dt) E(dt/2) (integrators.integrate)
             dissipate(u, v, mass, invm, A, d0, con, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
                       work, lost, j_visc, j_holder)
@@ -202,7 +226,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
                     j_wall[s] += hb * f[wall_slot, s]
             h = a_coef[st] * dt
             _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_work, h_busy,
-                               law, con[0])
+                               law, con[0], reach)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1
@@ -210,8 +234,10 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
             if wall_slot > 0:
                 for s in range(u.shape[1]):
                     j_wall[s] += pending * f[wall_slot, s]
-            _kick_drift(u, v, invm, f, pending, 0.0, head)
+            _kick_drift(u, v, invm, f, pending, 0.0, head, reach)
             pending = 0.0
+        if still < nb:
+            still = _still_rows(u, v, u_rest, still, reach)
         if dissipative:
             dissipate(u, v, mass, invm, A, d0, con, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
                       work, lost, j_visc, j_holder)
@@ -240,6 +266,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
         diag[4, s] = n_steps
         diag[5, s] = n_steps * dt
         diag[6, s] = lost[s]
+        diag[7, s] = stepped
 
 
 @jit(parallel=True)

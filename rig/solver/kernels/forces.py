@@ -15,6 +15,8 @@ part, by the Hertz loops wherever every exponent is 3/2.
 """
 import math
 
+import numpy as np
+
 from instruments.jit import jit
 from rig.model.contact import HERTZ, KUWABARA_KONO, POWER
 
@@ -136,3 +138,60 @@ def state_sums(u, v, mass, bias, A, expo, d0, d_limit, law, e, p, w):
         for s in range(u.shape[1]):
             q = (d0[i, s] + u[i - 1, s] - u[i, s]) / d_limit[i, s]
             w[s] = max(w[s], q) if q == q else math.inf
+
+
+@jit(inline="always")
+def rest_elastic(A, d0, n):
+    """The elastic force (N) of a slot at rest (u = 0) by the force passes' own operations:
+    (A d) sqrt(d) for Hertz, A d^n for other exponents, d = max(d0 + 0 - 0, 0)."""
+    d = d0 + 0.0 - 0.0
+    d = d if d > 0.0 else 0.0
+    return A * d * math.sqrt(d) if n == 1.5 else A * power(d, n)
+
+
+@jit(inline="always")
+def _ulps(x, k):
+    """x moved by k ulps (k > 0 up, < 0 down)."""
+    for _ in range(abs(k)):
+        x = np.nextafter(x, math.inf if k > 0 else -math.inf)
+    return x
+
+
+@jit
+def balance_at_rest(load, A, d0, expo, invm, tolerance, nudges):
+    """rig.solver.problem.balance_at_rest's rounding, shot by shot (arrays (shots, ...)):
+    the open slots' loads rounded to multiples of the ulp of the shot's largest load, then,
+    down the chain, each body meant to rest given a lower slot whose force at rest is its
+    upper slot's bit for bit, d0 and load moved by at most ``nudges`` ulps each."""
+    nb = A.shape[1]
+    for s in range(A.shape[0]):
+        top = 0.0
+        for i in range(nb + 1):
+            top = max(top, abs(load[s, i]))
+        q = np.spacing(top)
+        for i in range(nb):
+            if d0[s, i] <= 0.0 and load[s, i] != 0.0:
+                load[s, i] = np.round(load[s, i] / q) * q
+        target = rest_elastic(A[s, 0], d0[s, 0], expo[s, 0]) - load[s, 0]
+        for i in range(nb - 1):
+            el = rest_elastic(A[s, i + 1], d0[s, i + 1], expo[s, i + 1])
+            f = el - load[s, i + 1]
+            scale = max(abs(load[s, i]), abs(load[s, i + 1]))
+            if invm[s, i] > 0.0 and f != target and abs(f - target) <= tolerance * scale:
+                done = False
+                for jj in range(2 * nudges + 1):
+                    j = (jj + 1) // 2 * (1 if jj % 2 else -1)  # 0, 1, -1, 2, -2, ...
+                    d = _ulps(d0[s, i + 1], j)
+                    el = rest_elastic(A[s, i + 1], d, expo[s, i + 1])
+                    base = el - target
+                    for kk in range(2 * nudges + 1):
+                        cand = _ulps(base, (kk + 1) // 2 * (1 if kk % 2 else -1))
+                        if el - cand == target:
+                            d0[s, i + 1] = d
+                            load[s, i + 1] = cand
+                            f = target
+                            done = True
+                            break
+                    if done:
+                        break
+            target = f

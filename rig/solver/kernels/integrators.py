@@ -18,6 +18,15 @@ One step of the composition is step.py's (its fused kick-drift-force passes, the
 of its wavefront, the multirate head); this module drives the steps: the records, the
 checks, the frames and the dissipation.
 
+The front. Beads that the pulse has not reached are at rest, their contact forces equal
+and constant: a step leaves them bit for bit as they are. A stage moves at most one more
+body than the last (body i is pushed by slots i and i + 1, slot i + 1 renewed from bodies
+i and i + 1), so with bodies ``still`` onwards untouched before a step, the step and its
+closing kick change none beyond still + S (S stages). Each step integrates bodies
+0..still + S + 1 only and finds ``still`` again among the bodies it took: the same bits as
+integrating every body, at the cost of the part of the chain in motion. (Not with
+dissipation, whose flows take every body.)
+
 Dissipation. The force passes carry the contacts' elastic part only; the contacts'
 viscous terms and the holder's drag and friction are a flow of the velocities, taken
 apart in a Strang splitting E(dt/2) S(dt) E(dt/2) (dissipation.py): second order where
@@ -35,25 +44,48 @@ from rig.solver.kernels.step import closing_kick, external_kick, schedule_force,
 
 
 @jit
+def rest_from(v, invm, f, first):
+    """The first body r >= ``first`` from which every body is at rest (v = 0) with forces
+    that cancel bit for bit (f[i] = f[i + 1], or immovable): a kick leaves such a body as it
+    is, and a drift too. nb where the last body moves or is pushed."""
+    r = v.shape[0]
+    while r > first and v[r - 1] == 0.0 and (f[r - 1] == f[r] or invm[r - 1] == 0.0):
+        r -= 1
+    return r
+
+
+@jit
+def still_from(u, v, u_rest, lo, hi):
+    """The first body r in [lo, hi] from which bodies r..hi-1 are where they rest (u =
+    u_rest) with v = 0."""
+    r = hi
+    while r > lo and v[r - 1] == 0.0 and u[r - 1] == u_rest[r - 1]:
+        r -= 1
+    return r
+
+
+@jit
 def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_rate,
               a_coef, b_coef, dt, n_steps, head, sub,
               sched_body, sched_t, sched_f,
               ch_slot, ch_weight, sample_dt, out,
               frame_dt, frames,
-              check_every, d_limit, wall_slot, e_ref, p_ref, diag):
+              check_every, d_limit, wall_slot, e_ref, p_ref, diag, front):
     """Integrate n_steps of size dt in place; fill out (n_ch, n_out) and frames (n_fr, nb).
 
     law: the contact code (forces.py) with con (3, nb): each slot's exponent, damping
     time (s) and dashpot (kg/s); onsite (2, nb): each body's drag rate (1/s) and friction
     deceleration (m/s^2), smoothed over slip (m/s); viscous_rate (1/s): a bound on the
     contacts' viscous decay rates (dissipation.substeps).
-    diag (float64[7]) receives: max relative energy error, max relative momentum balance
+    diag (float64[8]) receives: max relative energy error, max relative momentum balance
     error, total wall impulse (N s), status (0 ok, 1 unstable), steps done, final time,
-    dissipated energy (J).
+    dissipated energy (J), bodies integrated summed over the steps.
     Energy: E = kinetic + elastic - work of constant loads - work of the scheduled force,
     and E + dissipated stays E(0).
     Momentum balance: P(t) - P(0) - [t * sum(constant loads) + J_schedule - J_wall + J_holder].
     load[i] (size nb + 1): constant force carried from above through slot i (N).
+    front: integrate only the bodies the pulse has reached (module doc); False: every body
+    every step (the same bits).
     """
     nb = u.shape[0]
     f = np.zeros(nb + 1)
@@ -92,6 +124,9 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
     w_sched = 0.0
 
     u2, v2, im2, f2, A2, d02, load2 = heads
+    u_rest = u.copy()
+    first = max(head + 1, sched_body + 1 if has_sched else 1)
+    still = rest_from(v, invm, f, first) if front and not dissipative else nb
     d_old = np.zeros((n_ch, ch_slot.shape[1], 1))  # overlaps (m) and rates (m/s) the channels read
     r_old = np.zeros_like(d_old)
     d_new = np.zeros_like(d_old)
@@ -114,6 +149,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
     status = 0
     steps_done = 0
     pending = 0.0  # closing kick owed by the last step, merged into the next first kick
+    stepped = 0
     for n in range(n_steps):
         t = n * dt
         if n_frames > 0:
@@ -127,8 +163,10 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
         if dissipative:  # E(dt/2) S(dt) E(dt/2): each step ends synchronised
             dissipate(u2, v2, m2, im2, A2, d02, con3, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
                       work, lost, j_visc, j_holder)
+        reach = min(nb, still + n_drift + 2)
+        stepped += reach
         step(u, v, invm, f, A, d0, load, law, con[0], a_coef, b_coef, dt, t, pending, head, sub,
-              sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses)
+              sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1
@@ -136,8 +174,10 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
             if wall_slot > 0:
                 impulses[0] += pending * f[wall_slot]
             impulses[1] += external_kick(v, invm, pending, t_new, sched_body, sched_t, sched_f)
-            closing_kick(v, invm, f, pending, head)
+            closing_kick(v, invm, f, pending, head, reach)
             pending = 0.0
+        if still < nb:
+            still = still_from(u, v, u_rest, still, reach)
         if dissipative:
             dissipate(u2, v2, m2, im2, A2, d02, con3, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
                       work, lost, j_visc, j_holder)
@@ -184,3 +224,4 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
     diag[4] = steps_done
     diag[5] = steps_done * dt
     diag[6] = lost[0]
+    diag[7] = stepped

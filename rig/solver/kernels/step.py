@@ -77,14 +77,15 @@ def fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, expo):
 
 
 @jit
-def closing_kick(v, invm, f, hb, head):
-    """Kick only (the owed closing kick), every body; the head's bodies get only the force
-    of slot head + 1 (their own contacts are the head flow's)."""
+def closing_kick(v, invm, f, hb, head, reach):
+    """Kick only (the owed closing kick), bodies 0..reach-1 (the others are at rest and
+    unforced, see ``step``); the head's bodies get only the force of slot head + 1 (their
+    own contacts are the head flow's)."""
     start = 0
     if head > 0:
         v[head] += hb * (0.0 - f[head + 1]) * invm[head]
         start = head + 1
-    for i in range(np.uint64(start), np.uint64(v.shape[0])):
+    for i in range(np.uint64(start), np.uint64(reach)):
         v[i] = v[i] + hb * (f[i] - f[i + np.uint64(1)]) * invm[i]
 
 
@@ -93,8 +94,10 @@ BLOCK = 2048  # bodies per block of a step's wavefront (their arrays stay in the
 
 @jit
 def step(u, v, invm, f, A, d0, load, law, expo, a_coef, b_coef, dt, t, pending, head, sub,
-          sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses):
-    """One step of the composition (its closing kick owed), every body and stage.
+          sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach):
+    """One step of the composition (its closing kick owed), bodies 0..reach-1, every stage.
+    ``reach``: the bodies beyond it are still at rest and unforced (integrators.quiet_from):
+    the step would leave them bit for bit as they are.
 
     Stage s on body i needs slot i + 1 at stage s - 1 and leaves slot i at stage s, so
     stage s may run one body behind stage s - 1: the chain is swept in blocks of BLOCK
@@ -106,7 +109,7 @@ def step(u, v, invm, f, A, d0, load, law, expo, a_coef, b_coef, dt, t, pending, 
     (bodies, 1) views the head flow takes, h_work and h_busy its work arrays;
     impulses[0] += the wall's dynamic impulse, impulses[1] += the schedule's (N s).
     """
-    nb = u.shape[0]
+    nb = reach
     u2, v2, im2, f2, A2, d02, load2 = heads
     n_blocks = max(1, (nb + BLOCK - 1) // BLOCK)
     for k in range(n_blocks):
