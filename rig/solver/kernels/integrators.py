@@ -196,8 +196,8 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
                 out[c, j_out] = recorded_force(w, 0, x, c, 0, ch_slot, ch_weight, A2, con3, law,
                                                d_old, r_old, d_new, r_new)
             j_out += 1
-        d_old[:, :, :] = d_new
-        r_old[:, :, :] = r_new
+        d_old, d_new = d_new, d_old  # this step's end is the next one's start
+        r_old, r_new = r_new, r_old
         while j_frame < n_frames and j_frame * frame_dt <= t_new * (1.0 + 1e-12):
             hermite_weights((j_frame * frame_dt - t) / dt, dt, w, 0)
             for i in range(nb):

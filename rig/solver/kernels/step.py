@@ -38,7 +38,7 @@ def schedule_force(t, times, forces):
     return forces[lo] + w * (forces[hi] - forces[lo])
 
 
-@jit
+@jit(inline="always")
 def external_kick(v, invm, h, t, sched_body, sched_t, sched_f):
     """Kick by the scheduled force at time t; returns its impulse (N s)."""
     if sched_t.shape[0] == 0:
@@ -48,7 +48,7 @@ def external_kick(v, invm, h, t, sched_body, sched_t, sched_f):
     return h * fe
 
 
-@jit
+@jit(inline="always")
 def fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, expo):
     """Bodies lo..hi-1 (lo >= 1), in order: kick v += hb (f_above - f_below)/m, drift
     u += ha v, then renew contact slot i's elastic force from bodies i-1 and i (both moved;
@@ -92,7 +92,7 @@ def closing_kick(v, invm, f, hb, head, reach):
 BLOCK = 2048  # bodies per block of a step's wavefront (their arrays stay in the core's L2 cache)
 
 
-@jit
+@jit(inline="always")
 def step(u, v, invm, f, A, d0, load, law, expo, a_coef, b_coef, dt, t, pending, head, sub,
           sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach):
     """One step of the composition (its closing kick owed), bodies 0..reach-1, every stage.
