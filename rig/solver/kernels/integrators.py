@@ -47,14 +47,18 @@ from rig.solver.kernels.step import closing_kick, external_kick, schedule_force,
 def rest_from(v, invm, f, first):
     """The first body r >= ``first`` from which every body is at rest (v = 0) with forces
     that cancel bit for bit (f[i] = f[i + 1], or immovable): a kick leaves such a body as it
-    is, and a drift too. nb where the last body moves or is pushed."""
-    r = v.shape[0]
+    is, and a drift too. nb where no movable body is so (the wall's body alone is no front)."""
+    nb = v.shape[0]
+    r = nb
     while r > first and v[r - 1] == 0.0 and (f[r - 1] == f[r] or invm[r - 1] == 0.0):
         r -= 1
-    return r
+    for i in range(r, nb):
+        if invm[i] != 0.0:
+            return r
+    return nb
 
 
-@jit
+@jit(inline="always")
 def still_from(u, v, u_rest, lo, hi):
     """The first body r in [lo, hi] from which bodies r..hi-1 are where they rest (u =
     u_rest) with v = 0."""
