@@ -135,6 +135,9 @@ def cmd_analyze(args) -> list:
                     for ch, v in r["snr"].items()))
             if r["theory_speed_m_per_s"] is not None and not r["simulated"] and not args.f0:
                 print("  Eq1: with F_0 = 0 (no --f0): the speed of a chain without precompression")
+            if r.get("unread_channels"):
+                print(f"  not read: {', '.join(r['unread_channels'])} (the gauges are {', '.join(r['channels'])}; "
+                      f"--channels UPPER,LOWER[,WALL] names them, --wall reads a third channel as the wall sensor)")
             if r["pulses"] is not None and not r["simulated"] and not args.wall:
                 print("  pulses: counted to the record's end; without --wall (the wall sensor's channel) the wall's "
                       "reflection may be among them")

@@ -173,7 +173,7 @@ def _refused(source: str, why: str, simulated: bool | None = None) -> dict:
     does not fit its record), beside the shots that can: every figure None, with ``why``."""
     out = {"source": source, "channels": [], **Report().refuse(why).as_dict()}
     out.pop("leading", None)
-    out.update(simulated=simulated, force_unit=None, theory_speed_m_per_s=None)
+    out.update(simulated=simulated, force_unit=None, theory_speed_m_per_s=None, unread_channels=[])
     out["reasons"]["theory_speed_m_per_s"] = why
     return out
 
@@ -197,6 +197,8 @@ def _result(source, record, setup: Setup, options: AnalyzeOptions, entry=None) -
     out.pop("leading", None)
     out["simulated"] = virtual
     out["force_unit"] = setup.force_unit  # of the forces and the noise
+    read = {setup.upper.channel, setup.lower.channel} | ({setup.wall.channel} if setup.wall else set())
+    out["unread_channels"] = [] if virtual else [ch for ch in record.waveforms if ch not in read]
     out["theory_speed_m_per_s"] = None
     if not mat:
         out["reasons"]["theory_speed_m_per_s"] = "no bead material given (--material)"

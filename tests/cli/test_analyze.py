@@ -303,3 +303,22 @@ def test_eq1_without_f0_says_it_assumes_no_precompression(gauge_files, capsys):
     assert "  Eq1: with F_0 = 0 (no --f0): the speed of a chain without precompression" in capsys.readouterr().out
     assert main(["analyze", *gauge_files, *GAUGE, "--material", "ptfe", "--f0", "2.4 N"]) in (0, 1)
     assert "Eq1: with F_0 = 0" not in capsys.readouterr().out
+
+
+def test_a_channel_the_analysis_does_not_read_is_named(tmp_path, capsys):
+    """Three channels without --wall or --channels: the first two are the gauges, and the
+    third is named as not read (it had been dropped without a word)."""
+    t = np.arange(30000) * H
+    pulse = lambda t0: 4.0 / np.cosh((t - t0) / 3e-5) ** 2  # noqa: E731
+    chans = {ch: ChannelSettings(0.05, -1.0) for ch in ("CH1", "CH2", "CH3")}
+    scope = Oscilloscope(channels=chans, timebase=Timebase(2e-7, 10000), trigger=Trigger("CH1", 0.03, "rising", 0.1))
+    volts = {ch: rc_highpass(0.05 * pulse(t0), H, 1e-3) for ch, t0 in (("CH1", 1e-3), ("CH2", 1.2e-3),
+                                                                        ("CH3", 1.6e-3))}
+    files = [str(p) for p in write_isf(scope.acquire(volts, H, np.random.default_rng(0)).waveforms, tmp_path, "s")]
+    code, rows, _ = run(capsys, "analyze", *files, *GAUGE)
+    assert code == 0 and rows[0]["unread_channels"] == ["CH3"] and rows[0]["channels"] == ["CH1", "CH2"]
+    assert main(["analyze", *files, *GAUGE]) == 0
+    assert ("  not read: CH3 (the gauges are CH1, CH2; --channels UPPER,LOWER[,WALL] names them, --wall reads a "
+            "third channel as the wall sensor)") in capsys.readouterr().out.splitlines()
+    code, rows, _ = run(capsys, "analyze", *files, *GAUGE, "--wall")
+    assert code == 0 and rows[0]["unread_channels"] == []
