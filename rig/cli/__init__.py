@@ -123,7 +123,8 @@ def build_parser() -> argparse.ArgumentParser:
                          'gauges.NAME.gain, gauges.NAME.misalignment')
     mc.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides")
     mc.add_argument("--seed", type=seed_arg, default=0, help="the study's seed (default 0)")
-    mc.add_argument("--batch", type=count_arg, default=128, help="shots per batch (default 128)")
+    mc.add_argument("--batch", type=count_arg, help="shots per batch (default 256; resuming a study in --out: "
+                                                    "its own)")
     mc.add_argument("--accuracy", type=float, help="solver accuracy (default: the scene's)")
     mc.add_argument("--workers", type=count_arg, default=1, help="local worker processes (default 1)")
     mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")

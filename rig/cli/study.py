@@ -13,7 +13,8 @@ def cmd_mc(args) -> dict:
     load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
     from rig.study.distributions import parse_vary
     from rig.study.mc_run import run_to
-    from rig.study.mc_spec import Study
+    from rig.study.mc_spec import DEFAULT_BATCH, Study
+    from rig.study.store import Store
     from rig.study.sobol import sobol_shots
 
     dists = tuple(parse_vary(args.vary or []))
@@ -23,7 +24,8 @@ def cmd_mc(args) -> dict:
         if shots != args.shots and not args.json:
             print(f"Sobol design over {len(dists)} inputs: {shots} shots "
                   f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
-    study = Study(args.scene, dists, shots, args.seed, tuple(args.set or ()), args.batch, args.accuracy,
+    batch = args.batch or Store.stored_batch(args.out) or DEFAULT_BATCH  # a study resumed keeps its batches
+    study = Study(args.scene, dists, shots, args.seed, tuple(args.set or ()), batch, args.accuracy,
                   args.sobol, args.truth, args.window, args.traces)
     from rig.study.nominal import nominal
 

@@ -20,6 +20,9 @@ FAILURES = ("none", "impossible inputs (the rig refuses them)", "solver unstable
             "non-finite measured speed or amplitude")
 
 
+DEFAULT_BATCH = 256  # shots per batch: a batch's fixed costs (threads, arrays) spread over more shots
+
+
 @dataclass(frozen=True)
 class Study:
     scene: str
@@ -27,7 +30,7 @@ class Study:
     shots: int
     seed: int = 0
     overrides: tuple = ()
-    batch: int = 128
+    batch: int = DEFAULT_BATCH
     accuracy: float | None = None
     sobol: bool = False
     truth: bool = False  # also analyse each shot's noise-free truth (slower)

@@ -56,6 +56,16 @@ class Store:
         self.batches = self.folder / "batches"
         self.traces = self.folder / "traces"
 
+    @staticmethod
+    def stored_batch(folder) -> int | None:
+        """The batch size of the study in ``folder`` (DIR/study.json), or None where there is
+        none (or it cannot be read: Store.open then says why)."""
+        try:
+            batch = json.loads((Path(folder) / "study.json").read_text()).get("batch")
+        except (OSError, ValueError, AttributeError):
+            return None
+        return batch if isinstance(batch, int) and not isinstance(batch, bool) and batch >= 1 else None
+
     def open(self) -> "Store":
         """Create the folder, or check that it holds this very study (to resume it)."""
         self.batches.mkdir(parents=True, exist_ok=True)

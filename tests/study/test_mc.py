@@ -1,4 +1,5 @@
 """Monte Carlo studies: inputs, seeds, executors, resume, report, Sobol."""
+import dataclasses
 import json
 
 import h5py
@@ -55,6 +56,30 @@ def test_identical_results_with_one_two_workers_and_dask(tmp_path):
         assert np.array_equal(runs[name].seeds, runs["one"].seeds)
         for k, v in runs["one"].outputs.items():
             assert np.array_equal(runs[name].outputs[k], v, equal_nan=True), k
+
+
+def test_the_batch_size_changes_no_result():
+    """Shot i's inputs, seed and outputs are its own, whatever batch it runs in."""
+    a = run_batch(_study(shots=12), 0)  # shots 0..11 in one batch of 16
+    b = [run_batch(dataclasses.replace(_study(shots=12), batch=5), k) for k in range(3)]
+    assert np.array_equal(np.concatenate([r.index for r in b]), a.index)
+    assert np.array_equal(np.concatenate([r.seeds for r in b]), a.seeds)
+    assert np.array_equal(np.concatenate([r.inputs for r in b]), a.inputs)
+    for k, v in a.outputs.items():
+        assert np.array_equal(np.concatenate([r.outputs[k] for r in b]), v, equal_nan=True), k
+
+
+def test_a_resumed_study_keeps_its_batch_size(tmp_path, capsys):
+    """`rig mc` without --batch resumes a study in --out with the batch size it was started
+    with (the default changed from 128 to 256: an older study must still resume)."""
+    out = tmp_path / "s"
+    args = ["mc", "ptfe52_magnetic", "--shots", "6", "--vary", VARY[0], "--out", str(out), "--quiet", "--json"]
+    assert main([*args, "--batch", "3"]) == 0
+    capsys.readouterr()
+    assert main(args) == 0
+    assert json.loads((out / "study.json").read_text())["batch"] == 3
+    assert main([*args, "--batch", "4"]) == 2  # another batch size is another study
+    assert "holds another study" in capsys.readouterr().err
 
 
 def test_interrupted_study_keeps_finished_shots_and_resumes(tmp_path):
