@@ -45,12 +45,12 @@ VARY = ("striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0
 BATCH = DEFAULT_BATCH  # rig mc's
 FIGURES = ("solver_kernel_shots_per_s", "solver_shots_per_s", "pipeline_shots_per_s",
            "pipeline_workers_steady_shots_per_s", "pipeline_workers_total_shots_per_s")
-SNIPPET = f"""
+SNIPPET = """
 import json
 from rig.bench import mc
-mc.BATCH = {BATCH}  # a baseline whose default batch differs runs this one's
+mc.BATCH = %d  # a baseline whose default batch differs runs this one's
 print(json.dumps(mc.run(**({"rounds": 1} if "rounds" in mc.run.__code__.co_varnames else {}))))
-"""
+""" % BATCH
 
 
 @dataclass(frozen=True)
