@@ -117,6 +117,7 @@ def cmd_analyze(args) -> list:
         if flags and any(r["simulated"] for r in results):
             print(f"note: {', '.join(flags)} {'describe' if len(flags) > 1 else 'describes'} the real records; "
                   f"the virtual shots use their own set-up")
+        wall_read = args.wall or (args.channels is not None and len(args.channels.split(",")) == 3)
         units = {r["force_unit"] for r in results} - {None}
         unit = units.pop() if len(units) == 1 else "N|V"  # mixed: each row's unit as the note says
         print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d ' + unit:>8s} {'F_m,e ' + unit:>8s} "
@@ -136,9 +137,11 @@ def cmd_analyze(args) -> list:
             if r["theory_speed_m_per_s"] is not None and not r["simulated"] and not args.f0:
                 print("  Eq1: with F_0 = 0 (no --f0): the speed of a chain without precompression")
             if r.get("unread_channels"):
-                print(f"  not read: {', '.join(r['unread_channels'])} (the gauges are {', '.join(r['channels'])}; "
-                      f"--channels UPPER,LOWER[,WALL] names them, --wall reads a third channel as the wall sensor)")
-            if r["pulses"] is not None and not r["simulated"] and not args.wall:
+                hint = "" if args.channels else (f" (the gauges are {', '.join(r['channels'])}; --channels "
+                                                 f"UPPER,LOWER[,WALL] names them, --wall reads a third channel as "
+                                                 f"the wall sensor)")
+                print(f"  not read: {', '.join(r['unread_channels'])}{hint}")
+            if r["pulses"] is not None and not r["simulated"] and not wall_read:
                 print("  pulses: counted to the record's end; without --wall (the wall sensor's channel) the wall's "
                       "reflection may be among them")
             for line in missing_lines(r["reasons"]):

@@ -58,7 +58,7 @@ def shot_summary(rig, shot) -> dict:
             "solver": {"method": st.method, "dt_s": st.dt_s, "steps": st.steps,
                        "wall_s": st.wall_s, "energy_error": st.energy_error,
                        "momentum_error": st.momentum_error, "accuracy": st.accuracy,
-                       "error_estimate": st.error_estimate},
+                       "error_estimate": st.error_estimate, "bodies_stepped": st.bodies_stepped},
             "triggered": shot.scope.triggered, "no_trigger_reason": shot.scope.reason,
             "trigger": {"source": tr.source, "level_V": tr.level, "slope": tr.slope,
                         "time_after_impact_s": shot.scope.trigger_time},

@@ -14,8 +14,8 @@ def cmd_mc(args) -> dict:
     from rig.study.distributions import parse_vary
     from rig.study.mc_run import run_to
     from rig.study.mc_spec import DEFAULT_BATCH, Study
-    from rig.study.store import Store
     from rig.study.sobol import sobol_shots
+    from rig.study.store import Store
 
     dists = tuple(parse_vary(args.vary or []))
     shots = args.shots
@@ -29,8 +29,9 @@ def cmd_mc(args) -> dict:
                   args.sobol, args.truth, args.window, args.traces)
     from rig.study.nominal import nominal
 
-    whole = nominal(study.scene, study.overrides).rig.estimate(controlled=False).times(study.shots, study.batch)
-    check_size(whole, args, f"the study's {study.shots} shots (batches of {study.batch} held at once)")
+    held = min(study.batch, study.shots)  # the shots a batch holds at once
+    whole = nominal(study.scene, study.overrides).rig.estimate(controlled=False).times(study.shots, held)
+    check_size(whole, args, f"the study's {study.shots} shots (batches of {held} held at once)")
     with progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot") as bar:
         def started(done):
             bar.update(done)

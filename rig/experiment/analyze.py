@@ -156,6 +156,9 @@ def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
         raise RigError(f"two gauge channels are needed; the record holds {held}")
     if options.wall and not options.channels and len(names) < 3:
         raise RigError(f"--wall reads the third channel as the wall sensor; the record holds {held}")
+    if options.wall and options.channels and len(names) < 3:
+        raise invalid("--channels", options.channels, "with --wall, name the wall sensor's channel third: "
+                                                      "UPPER,LOWER,WALL")
     for n in names:
         if n not in record.waveforms:
             raise invalid("--channels", options.channels, f"{n!r} is not in the files (channels: {held})")

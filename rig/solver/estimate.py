@@ -46,8 +46,11 @@ class RunEstimate:
     def refuse_unless(self, allowed: bool, what: str):
         """RigError naming the estimate and the confirming flag, if large and not allowed."""
         if self.large and not allowed:
-            raise RigError(f"{what} needs {self.describe()}, beyond the limits of {LIMIT_BYTES / 1e9:g} GB and "
-                           f"{LIMIT_SECONDS:g} s; add --allow-large to run it anyway")
+            beyond = [f"{LIMIT_BYTES / 1e9:g} GB" if self.bytes > LIMIT_BYTES else "",
+                      f"{LIMIT_SECONDS:g} s" if self.seconds > LIMIT_SECONDS else ""]
+            limits = " and ".join(b for b in beyond if b)
+            raise RigError(f"{what} needs {self.describe()}, beyond the limit{'s' if all(beyond) else ''} of "
+                           f"{limits}; add --allow-large to run it anyway")
 
 
 def estimate_solve(problem: ChainProblem, t_end: float, channels: int, sample_interval: float,

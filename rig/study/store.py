@@ -68,20 +68,39 @@ class Store:
 
     def open(self) -> "Store":
         """Create the folder, or check that it holds this very study (to resume it)."""
-        self.batches.mkdir(parents=True, exist_ok=True)
         meta = self.folder / "study.json"
         spec = {"digest": self.study.digest(), **self.study.spec()}
         if meta.exists():
             try:
                 old = json.loads(meta.read_text())
             except (ValueError, OSError) as exc:
-                raise RigError(f"{meta}: not a study file ({exc}); give another --out or remove it") from None
+                raise RigError(f"{meta}: not a study file ({exc}); give another --out or remove "
+                               f"{self.folder}") from None
+            if not isinstance(old, dict):
+                raise RigError(f"{meta}: not a study file (a JSON {type(old).__name__}, not an object); give "
+                               f"another --out or remove {self.folder}")
             if old.get("digest") != spec["digest"]:
-                raise RigError(f"{self.folder} holds another study (scene {old.get('scene')}, "
-                               f"{old.get('shots')} shots); give another --out or remove it")
-        else:
+                raise RigError(self._other_study(old, spec))
+        elif self.batches.exists() and any(self.batches.glob("batch_*.h5")):
+            # finished batches without the study they belong to: their shots' sizes and inputs are unknown
+            raise RigError(f"{self.folder} holds finished batches but no study.json: they belong to a study that "
+                           f"cannot be checked; give another --out or remove {self.folder}")
+        self.batches.mkdir(parents=True, exist_ok=True)
+        if not meta.exists():
             atomic_write(meta, lambda tmp: Path(tmp).write_text(json.dumps(spec, indent=1)))
         return self
+
+    def _other_study(self, old: dict, spec: dict) -> str:
+        """Why ``self.folder``'s study (``old``, from its study.json) is not this one: the
+        fields that differ, and what to do."""
+        spec = json.loads(json.dumps(spec))  # tuples as JSON has them
+        differ = [k for k in spec if k != "digest" and old.get(k) != spec[k]]
+        if differ == ["batch"]:
+            return (f"{self.folder} holds this study begun with --batch {old.get('batch')!r}; run it with that "
+                    f"batch size (or without --batch) to resume it, or give another --out")
+        shown = ", ".join(f"{k} {old.get(k)!r} (now {spec[k]!r})" for k in differ[:3]) or "its digest"
+        return (f"{self.folder} holds another study ({shown}{', ...' if len(differ) > 3 else ''}); give "
+                f"another --out or remove {self.folder}")
 
     def done(self) -> set:
         return {int(p.stem.split("_")[1]) for p in self.batches.glob("batch_*.h5")}

@@ -322,3 +322,20 @@ def test_a_channel_the_analysis_does_not_read_is_named(tmp_path, capsys):
             "third channel as the wall sensor)") in capsys.readouterr().out.splitlines()
     code, rows, _ = run(capsys, "analyze", *files, *GAUGE, "--wall")
     assert code == 0 and rows[0]["unread_channels"] == []
+
+
+def test_wall_flags_that_disagree_are_refused_and_a_named_wall_needs_no_note(tmp_path, capsys):
+    t = np.arange(30000) * H
+    pulse = lambda t0: 4.0 / np.cosh((t - t0) / 3e-5) ** 2  # noqa: E731
+    chans = {ch: ChannelSettings(0.05, -1.0) for ch in ("CH1", "CH2", "CH3")}
+    scope = Oscilloscope(channels=chans, timebase=Timebase(2e-7, 10000), trigger=Trigger("CH1", 0.03, "rising", 0.1))
+    volts = {ch: rc_highpass(0.05 * pulse(t0), H, 1e-3) for ch, t0 in (("CH1", 1e-3), ("CH2", 1.2e-3),
+                                                                        ("CH3", 1.6e-3))}
+    files = [str(p) for p in write_isf(scope.acquire(volts, H, np.random.default_rng(0)).waveforms, tmp_path, "s")]
+    assert main(["analyze", *files, *GAUGE, "--wall", "--channels", "CH1,CH2"]) == 2
+    assert "with --wall, name the wall sensor's channel third" in capsys.readouterr().err
+    assert main(["analyze", *files, *GAUGE, "--channels", "CH1,CH2,CH3"]) == 0
+    out = capsys.readouterr().out
+    assert "without --wall" not in out and "not read" not in out
+    assert main(["analyze", *files, *GAUGE, "--channels", "CH1,CH2"]) == 0
+    assert "  not read: CH3" in capsys.readouterr().out.splitlines()  # named, without a hint to pass --channels

@@ -79,7 +79,8 @@ def test_a_resumed_study_keeps_its_batch_size(tmp_path, capsys):
     assert main(args) == 0
     assert json.loads((out / "study.json").read_text())["batch"] == 3
     assert main([*args, "--batch", "4"]) == 2  # another batch size is another study
-    assert "holds another study" in capsys.readouterr().err
+    assert "holds this study begun with --batch 3; run it with that batch size (or without --batch)" in \
+        capsys.readouterr().err
 
 
 def test_interrupted_study_keeps_finished_shots_and_resumes(tmp_path):
@@ -266,3 +267,25 @@ def test_a_batch_shot_has_the_bits_of_the_shot_fired_alone():
         m = analyze_record(shot.scope, setup_for(template, beta, F0), train=False)
         for key in ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_amplitude_N"):
             assert getattr(m, key) == outputs[key][i], (i, key)
+
+
+def test_a_study_folder_that_cannot_be_checked_is_refused(tmp_path, capsys):
+    """Batches without their study.json (whose batch size and inputs are unknown) are not
+    taken as finished shots; a study.json that is not an object is one line, exit 2."""
+    out = tmp_path / "s"
+    args = ["mc", "ptfe52_magnetic", "--shots", "6", "--vary", VARY[0], "--out", str(out), "--quiet", "--json"]
+    assert main([*args, "--batch", "3"]) == 0
+    (out / "study.json").unlink()
+    capsys.readouterr()
+    assert main(args) == 2
+    assert "holds finished batches but no study.json" in capsys.readouterr().err
+    (out / "study.json").write_text("[1, 2]")
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "not a study file (a JSON list, not an object)" in err and "Traceback" not in err
+
+
+def test_a_small_study_is_sized_by_its_shots_not_its_batch(tmp_path, capsys):
+    out = tmp_path / "s"
+    assert main(["mc", "ptfe52_magnetic", "--shots", "4", "--vary", VARY[0], "--out", str(out), "--quiet",
+                 "--json", "--batch", "99999"]) == 0
