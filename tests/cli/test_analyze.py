@@ -305,16 +305,23 @@ def test_eq1_without_f0_says_it_assumes_no_precompression(gauge_files, capsys):
     assert "Eq1: with F_0 = 0" not in capsys.readouterr().out
 
 
-def test_a_channel_the_analysis_does_not_read_is_named(tmp_path, capsys):
-    """Three channels without --wall or --channels: the first two are the gauges, and the
-    third is named as not read (it had been dropped without a word)."""
+@pytest.fixture(scope="module")
+def three_channels(tmp_path_factory):
+    """gauge_files' record with a third channel, CH3, a later pulse (the wall sensor's place)."""
     t = np.arange(30000) * H
     pulse = lambda t0: 4.0 / np.cosh((t - t0) / 3e-5) ** 2  # noqa: E731
     chans = {ch: ChannelSettings(0.05, -1.0) for ch in ("CH1", "CH2", "CH3")}
     scope = Oscilloscope(channels=chans, timebase=Timebase(2e-7, 10000), trigger=Trigger("CH1", 0.03, "rising", 0.1))
     volts = {ch: rc_highpass(0.05 * pulse(t0), H, 1e-3) for ch, t0 in (("CH1", 1e-3), ("CH2", 1.2e-3),
                                                                         ("CH3", 1.6e-3))}
-    files = [str(p) for p in write_isf(scope.acquire(volts, H, np.random.default_rng(0)).waveforms, tmp_path, "s")]
+    rec = scope.acquire(volts, H, np.random.default_rng(0))
+    return [str(p) for p in write_isf(rec.waveforms, tmp_path_factory.mktemp("three"), "s")]
+
+
+def test_a_channel_the_analysis_does_not_read_is_named(three_channels, capsys):
+    """Three channels without --wall or --channels: the first two are the gauges, and the
+    third is named as not read (it had been dropped without a word)."""
+    files = three_channels
     code, rows, _ = run(capsys, "analyze", *files, *GAUGE)
     assert code == 0 and rows[0]["unread_channels"] == ["CH3"] and rows[0]["channels"] == ["CH1", "CH2"]
     assert main(["analyze", *files, *GAUGE]) == 0
@@ -324,14 +331,8 @@ def test_a_channel_the_analysis_does_not_read_is_named(tmp_path, capsys):
     assert code == 0 and rows[0]["unread_channels"] == []
 
 
-def test_wall_flags_that_disagree_are_refused_and_a_named_wall_needs_no_note(tmp_path, capsys):
-    t = np.arange(30000) * H
-    pulse = lambda t0: 4.0 / np.cosh((t - t0) / 3e-5) ** 2  # noqa: E731
-    chans = {ch: ChannelSettings(0.05, -1.0) for ch in ("CH1", "CH2", "CH3")}
-    scope = Oscilloscope(channels=chans, timebase=Timebase(2e-7, 10000), trigger=Trigger("CH1", 0.03, "rising", 0.1))
-    volts = {ch: rc_highpass(0.05 * pulse(t0), H, 1e-3) for ch, t0 in (("CH1", 1e-3), ("CH2", 1.2e-3),
-                                                                        ("CH3", 1.6e-3))}
-    files = [str(p) for p in write_isf(scope.acquire(volts, H, np.random.default_rng(0)).waveforms, tmp_path, "s")]
+def test_wall_flags_that_disagree_are_refused_and_a_named_wall_needs_no_note(three_channels, capsys):
+    files = three_channels
     assert main(["analyze", *files, *GAUGE, "--wall", "--channels", "CH1,CH2"]) == 2
     assert "with --wall, name the wall sensor's channel third" in capsys.readouterr().err
     assert main(["analyze", *files, *GAUGE, "--channels", "CH1,CH2,CH3"]) == 0
