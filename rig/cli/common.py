@@ -13,6 +13,9 @@ class OneLineParser(argparse.ArgumentParser):
     """argparse with the project's error policy: a mistake is one line, exit 2."""
 
     def error(self, message):
+        if message.endswith("expected one argument"):  # argparse reads a value starting with '-' as a flag
+            flag = message.split()[1].rstrip(":")
+            message += f" (a value that starts with '-' is written {flag}=VALUE)"
         print(f"{self.prog}: error: {message}", file=sys.stderr)
         sys.exit(2)
 

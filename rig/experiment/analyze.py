@@ -62,8 +62,8 @@ class AnalyzeOptions:
                                            ("--f0", self.f0, True, "N"), ("--diameter", self.diameter, False, "m")):
             if value is not None and not (math.isfinite(value) and (value >= 0 if zero_ok else value > 0)):
                 raise invalid(flag, value, f"a finite number {'>= 0' if zero_ok else '> 0'}{' ' + unit if unit else ''}")
-        if self.material is not None:
-            material(self.material)  # an unknown name is a user mistake: one line naming the known ones
+        if self.material is not None and str(self.material).strip().lower() not in MATERIALS:
+            raise invalid("--material", self.material, f"known materials: {', '.join(sorted(MATERIALS))}")
 
 
 THEORY_FACTOR = 2.0  # measured / Eq (1) beyond this (or below its inverse): not a solitary wave

@@ -252,3 +252,14 @@ def test_a_full_disk_is_one_line_naming_the_path(tmp_path, limit, argv, folder):
     meta = tmp_path / folder / "study.json"
     if meta.exists():
         assert json.loads(meta.read_text())["shots"] == 8
+
+
+def test_a_value_that_starts_with_a_dash_says_how_to_give_it(capsys):
+    with pytest.raises(SystemExit) as exc:  # argparse's own error
+        main(["analyze", "x.isf", "--gauge-distance", "-4mm"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err == ("rig analyze: error: argument --gauge-distance: expected one argument (a value that starts "
+                   "with '-' is written --gauge-distance=VALUE)")
+    assert main(["analyze", "x.isf", "--gauge-distance=-4mm"]) == 2
+    assert "--gauge-distance = -0.004: a finite number > 0 m" in capsys.readouterr().err
