@@ -103,8 +103,9 @@ def test_shot_json_keys(capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["scenario"] == "steel21_magnetic" and out["seed"] == 2
     assert set(out["solver"]) == {"method", "dt_s", "steps", "wall_s", "energy_error", "momentum_error",
-                                  "accuracy", "error_estimate"}
+                                  "accuracy", "error_estimate", "bodies_stepped"}
     assert out["solver"]["error_estimate"] <= out["solver"]["accuracy"]  # the contract, as the shot reports it
+    assert 1 <= out["solver"]["bodies_stepped"] <= 1 + 21 + 1 + 1  # striker, beads, magnetic bead, wall at most
     assert set(out["channels"]) == {"CH1", "CH2", "CH3"}
     assert out["channels"]["CH3"]["connected"] == "wall_sensor"
 
