@@ -101,6 +101,8 @@ def cmd_analyze(args) -> list:
     """The analysis table, each channel's SNR and, under each source, why any figure is
     missing. Exit 0 when at least one source gave a speed, 1 when none did (as `rig verify`
     with bad shots); a mistake in the flags or files is exit 2 (main)."""
+    from pathlib import Path
+
     from rig.experiment.analyze import AnalyzeOptions, analyze_paths, real_file_flags
 
     options = AnalyzeOptions(files=tuple(args.files), shot=args.shot, gauge_distance=args.gauge_distance,
@@ -124,7 +126,8 @@ def cmd_analyze(args) -> list:
               f"{'pulses':>6s} {'FWHM us':>8s} {'Eq1 m/s':>8s}")
         for r in results:
             fwhm = None if r["duration_s"] is None else r["duration_s"] * 1e6
-            src = r["source"] if len(r["source"]) <= 40 else "..." + r["source"][-37:]
+            src = ", ".join(Path(part).name for part in r["source"].split(", "))  # the files' names (JSON: paths)
+            src = src if len(src) <= 40 else src[:37] + "..."
             print(f"{src:40s} {fmt(r['speed_m_per_s'], '.1f'):>8s} "
                   f"{fmt(r['speed_xcorr_m_per_s'], '.1f'):>8s} {fmt(r['amplitude_N'], '.3f'):>8s} "
                   f"{fmt(r['averaged_amplitude_N'], '.3f'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
