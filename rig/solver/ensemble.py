@@ -17,7 +17,7 @@ from rig.solver.kernels.ensemble import integrate_ensemble
 from rig.solver.methods import DEFAULT_METHOD
 from rig.solver.methods import method as get_method
 from rig.solver.problem import ProblemArrays
-from rig.solver.run import check_interval, time_grid
+from rig.solver.run import check_interval, check_record, time_grid
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import DIAGNOSTICS, KernelReport, SolverStats
 from rig.solver.stepsize import Stepping, viscous_rate
@@ -85,6 +85,7 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
         raise invalid("t_end/dt", (t_end, stepping.dt), "both > 0 s")
     ch_slot, ch_weight = save.channels(p0.offset)
     n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), save.sample_interval)
+    check_record(p0, save, n_out * problems.shots, 0)
     sub = stepping.substeps(step, m.drifts)
     n = problems.shots
     if width is None:

@@ -4,11 +4,12 @@ its report turned into a Solution (the accuracy control of rig/solver/control.py
 from __future__ import annotations
 
 import math
+import os
 import time
 
 import numpy as np
 
-from rig.errors import RigError
+from rig.errors import RigError, invalid
 from rig.solver.kernels.integrators import integrate
 from rig.solver.methods import Method
 from rig.solver.problem import ChainProblem
@@ -42,6 +43,23 @@ def frame_origin(chain) -> np.ndarray:
     return np.concatenate(([-top], x_eq))
 
 
+def check_record(problem: ChainProblem, save: SaveAt, n_out: int, n_frames: int) -> None:
+    """Refuse, naming the field, a probe of a contact this chain does not have (its slot
+    would be read outside the kernels' arrays) and a record larger than this machine's
+    memory (n_out samples per channel, n_frames frames of every body)."""
+    lo, hi = 1 - problem.offset, problem.n_bodies - 1 - problem.offset
+    for name, probe in save.probes.items():
+        for k, w in zip(probe.contacts, probe.weights):
+            if w != 0.0 and not lo <= k <= hi:
+                raise invalid(f"save[{name!r}]", f"contact {k}", f"contacts {lo}..{hi} of this chain")
+    need = 8.0 * (len(save.names) * n_out + n_frames * problem.n_bodies)
+    have = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    if need > have:
+        raise RigError(f"the record would take {need / 1e9:.3g} GB ({n_out} samples per channel, {n_frames} "
+                       f"frames), more than this machine's {have / 1e9:.3g} GB: give save a longer "
+                       f"sample_interval or frame_interval, or a shorter t_end")
+
+
 class Unstable(RigError):
     """An integration that blew up (an overlap beyond half a bead radius): the step is too
     large. Carries the stepping that failed."""
@@ -60,12 +78,13 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     ch_slot, ch_weight = save.channels(problem.offset)
     n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), save.sample_interval)
     sub = stepping.substeps(step, m.drifts)
-    out = np.zeros((len(save.names), n_out))
     if save.frame_interval is not None:
         n_frames = int(math.floor(t_end / save.frame_interval * (1 + 1e-12))) + 1
         frame_dt = save.frame_interval
     else:
         n_frames, frame_dt = 0, 1.0
+    check_record(problem, save, n_out, n_frames)
+    out = np.zeros((len(save.names), n_out))
     frames = np.zeros((n_frames, problem.n_bodies))
     u = problem.u0.copy()
     v = problem.v0.copy()

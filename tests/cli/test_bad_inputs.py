@@ -76,7 +76,7 @@ CASES = [
     (["shot", S, *_set("solver.accuracy=nan")], "accuracy"),
     (["shot", S, *_set("solver.duration=0")], "solver.duration"),
     (["shot", S, *_set("solver.duration=-2 ms")], "solver.duration"),
-    (["shot", S, *_set("solver.accuracy=5")], "solver.accuracy = 5.0: relative accuracy target in [1e-14, 0.1]"),
+    (["shot", S, *_set("solver.accuracy=5")], "solver.accuracy = 5.0: relative accuracy target in [1e-10, 0.1]"),
     (["shot", S, *_set("scope.channels.CH1.volts_per_div=0")],
      "scope.channels.CHn.volts_per_div = 0.0: allowed 0.000999 <= volts_per_div <= 10.01 (V/div)"),
     (["shot", S, *_set("solver.duration=1000 s")], "--allow-large"),

@@ -80,3 +80,34 @@ def test_bad_chain_inputs():
         solve(ptfe_rig(n=3), 1e-4, method="rk4")
     with pytest.raises(RigError, match="accuracy"):
         solve(ptfe_rig(n=3), 1e-4, accuracy=2.0)
+
+
+def test_what_a_solve_is_given_is_checked_in_one_line():
+    """A new user's trial: probes of contacts the chain does not have recorded 0 N (the
+    kernel read outside its arrays), a dict for save or a float head gave tracebacks, a
+    record larger than the machine was a MemoryError, numpy's scalars were refused, and
+    accuracy below 1e-10 ran the control for minutes."""
+    from rig.model.chain import Probe
+    from rig.solver.stepsize import Stepping
+
+    c, big = ptfe_rig(n=20), ptfe_rig(n=60)
+    for kw, message in [
+        (dict(save=SaveAt({"x": big.contact_probe(50)})), "save['x'] = 'contact 50': contacts 0..21 of this chain"),
+        (dict(save=SaveAt({"x": Probe((-1,), (1.0,))})), "save['x'] = 'contact -1': contacts 0..21"),
+        (dict(save={"x": c.contact_probe(1)}), "save = 'dict': a SaveAt"),
+        (dict(save=SaveAt({"c": c.contact_probe(5)}, sample_interval=1e-16)), "more than this machine's"),
+        (dict(save=SaveAt({"c": c.contact_probe(5)}, frame_interval=1e-14)), "frames), more than this machine's"),
+        (dict(accuracy=1e-13), "accuracy = 1e-13: relative accuracy target in [1e-10, 0.1]"),
+        (dict(dt=True), "dt = True: time step must be a finite number > 0 s"),
+    ]:
+        with pytest.raises(RigError) as exc:
+            solve(c, 2e-4, **kw)
+        assert message in str(exc.value), (kw, str(exc.value))
+    for kw, message in [(dict(head=2.0), "dt.head = 2.0"), (dict(head=-1), "dt.head = -1"),
+                        (dict(head=1, inner_dt=0.0), "dt.inner_dt = 0.0"),
+                        (dict(head=1, inner_dt=float("nan")), "dt.inner_dt = nan")]:
+        with pytest.raises(RigError) as exc:
+            Stepping(2e-8, **kw)
+        assert message in str(exc.value)
+    sol = solve(c, np.float32(2e-4), save=SaveAt({"c": c.contact_probe(5)}), dt=np.float64(1e-7), estimate=False)
+    assert sol.stats.steps == 2000
