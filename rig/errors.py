@@ -20,5 +20,5 @@ def lookup(registry: dict, name, field: str, kind: type):
         return name
     key = str(name).strip().lower()
     if key not in registry:
-        raise invalid(field, name, f"known {field.split('.')[-1]}s: {', '.join(sorted(registry))}")
+        raise invalid(field, name, f"known {field.split('.')[-1].lstrip('-')}s: {', '.join(sorted(registry))}")
     return registry[key]

@@ -24,6 +24,11 @@ def _registry():
     return pint.UnitRegistry(cache_folder=":auto:")
 
 
+def is_real(x) -> bool:
+    """A real number, numpy's scalars included, and not a bool (True is not 1 s)."""
+    return isinstance(x, numbers.Real) and not isinstance(x, bool)
+
+
 def quantity(value, unit: str, field: str, *, bare_ok: bool = False) -> float:
     """Return ``value`` expressed in ``unit`` (an SI unit such as "m", "kg", "Pa").
 

@@ -34,22 +34,21 @@ def median_cpu(fn, repeats: int):
 
 
 
-def in_motion(p) -> np.ndarray:
-    """Initial velocities (m/s) that set every bead of problem ``p`` moving (the striker's
-    as it is; each bead 1e-4 m/s up or down, seeded): the kernel figures time every body
-    of every step, where a struck chain at rest would have the solver integrate only the
-    bodies the pulse has reached (rig/solver/kernels/integrators.py)."""
+def in_motion(p):
+    """Problem ``p`` with every bead moving at the start (the striker as it is; each bead
+    1e-4 m/s up or down, seeded): the kernel figures time every body of every step, where a
+    struck chain at rest would have the solver integrate only the bodies the pulse has
+    reached (rig/solver/kernels/integrators.py)."""
     v0 = p.v0.copy()
     beads = slice(p.offset, p.offset + p.chain.n_beads)
     v0[beads] = 1e-4 * np.random.default_rng(7).choice((-1.0, 1.0), size=p.chain.n_beads)
-    return v0
+    return dataclasses.replace(p, v0=v0)
 
 
 # The kernel figure, as a program both this revision and a baseline run: public API only
 # (and in_motion's source, prepended).
 KERNEL_SNIPPET = """
-import dataclasses, inspect, json, statistics, time
-import numpy as np
+import inspect, json, statistics, time
 from rig import Bead, Chain, ChainProblem, SaveAt, Striker, Wall, solve
 from rig.solver.stepsize import contact_time_scale
 quiet = {"estimate": False} if "estimate" in inspect.signature(solve).parameters else {}
@@ -58,8 +57,7 @@ for n, steps, repeats in SIZES:
     bead = Bead(material="steel316", diameter="4.76 mm", mass="0.4501 g")
     c = Chain([bead] * n, striker=Striker("steel316", "0.4501 g", "0.44 m/s"), wall=Wall(), gravity=0,
               top_force=2.38)
-    p = ChainProblem.from_chain(c)
-    p = dataclasses.replace(p, v0=in_motion(p))
+    p = in_motion(ChainProblem.from_chain(c))
     save = SaveAt({"c": c.contact_probe(min(500, n // 2))}, sample_interval=1e-6)
     dt = contact_time_scale(p) / 8
     solve(p, 2 * dt, save=save, dt=dt, **quiet)
@@ -80,7 +78,8 @@ def kernel_figures(repeats: int, rounds: int, baseline: str | None, progress=Non
     from rig.bench.baseline import ROOT, checkout, measure
 
     sizes = tuple((n, steps, min(r, repeats)) for n, steps, r in KERNEL_SIZES)
-    snippet = f"import numpy as np\nSIZES = {sizes!r}\n" + inspect.getsource(in_motion) + KERNEL_SNIPPET
+    snippet = f"import dataclasses\nimport numpy as np\nSIZES = {sizes!r}\n" + inspect.getsource(in_motion) + \
+        KERNEL_SNIPPET
     runs = {"current": [], "baseline": []}
     with checkout(baseline) if baseline else contextlib.nullcontext() as tree:
         for k in range(rounds):
@@ -120,8 +119,7 @@ def scaling(chain, progress=None) -> dict:
         if progress:
             progress(f"scaling: {n} beads")
         c = chain(2.38, n)
-        p = ChainProblem.from_chain(c)
-        p = dataclasses.replace(p, v0=in_motion(p))
+        p = in_motion(ChainProblem.from_chain(c))
         save = SaveAt({"c": c.contact_probe(SCALING_PROBE)}, SAMPLE_INTERVAL)
         steps = max(100, int(2e7 / n))
         span = steps * stepping.dt

@@ -19,7 +19,6 @@ The published ``ptfe52_gravity`` scene with each model switched on by its scene 
 """
 from __future__ import annotations
 
-import dataclasses
 import statistics
 import time
 
@@ -69,8 +68,7 @@ def _per_step(cases: dict, rounds: int, progress) -> dict:
     setups = {}
     for name, ov in cases.items():
         r = _rig(ov, LONG_BEADS)
-        p = ChainProblem.from_chain(r.chain)
-        p = dataclasses.replace(p, v0=in_motion(p))
+        p = in_motion(ChainProblem.from_chain(r.chain))
         setups[name] = (p, r.save_at(contacts=False, averages=True))
     dt = contact_time_scale(setups["hertz"][0]) / 8
     for p, save in setups.values():  # compile outside the clock

@@ -25,8 +25,8 @@ from instruments.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.plausibility import Limits
 from instruments.records import ScopeRecord
 from instruments.report import SPEED_FIGURES, Report
-from rig.errors import RigError, invalid
-from rig.model.materials import MATERIALS, material
+from rig.errors import RigError, invalid, lookup
+from rig.model.materials import MATERIALS, Material, material
 from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed
 
 
@@ -62,8 +62,8 @@ class AnalyzeOptions:
                                            ("--f0", self.f0, True, "N"), ("--diameter", self.diameter, False, "m")):
             if value is not None and not (math.isfinite(value) and (value >= 0 if zero_ok else value > 0)):
                 raise invalid(flag, value, f"a finite number {'>= 0' if zero_ok else '> 0'}{' ' + unit if unit else ''}")
-        if self.material is not None and str(self.material).strip().lower() not in MATERIALS:
-            raise invalid("--material", self.material, f"known materials: {', '.join(sorted(MATERIALS))}")
+        if self.material is not None:
+            lookup(MATERIALS, self.material, "--material", Material)  # an unknown name: one line naming the known
 
 
 THEORY_FACTOR = 2.0  # measured / Eq (1) beyond this (or below its inverse): not a solitary wave

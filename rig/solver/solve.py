@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import math
-import numbers
 
 import numpy as np
 
@@ -15,6 +14,7 @@ from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution
 from rig.solver.stepsize import Stepping, checked_accuracy, stability_limit
+from rig.units import is_real
 
 
 def problem_of(chain_or_problem) -> ChainProblem:
@@ -45,7 +45,7 @@ def solve(problem: ChainProblem | Chain, t_end: float, *, save: SaveAt | None = 
     save = SaveAt() if save is None else save
     if not isinstance(save, SaveAt):
         raise invalid("save", type(save).__name__, "a SaveAt: SaveAt({name: probe}, sample_interval=...)")
-    if not _real(t_end) or not math.isfinite(t_end) or t_end <= 0:
+    if not is_real(t_end) or not math.isfinite(t_end) or t_end <= 0:
         raise invalid("t_end", t_end, "end time must be a finite number > 0 s")
     t_end = float(t_end)
     if dt is None:
@@ -55,10 +55,8 @@ def solve(problem: ChainProblem | Chain, t_end: float, *, save: SaveAt | None = 
         return controlled_solve(problem, t_end, save, m, checked_accuracy(accuracy))
     if accuracy is not None:
         raise invalid("dt", dt, "give either dt or accuracy, not both")
-    if not isinstance(dt, Stepping) and not (_real(dt) and math.isfinite(dt) and dt > 0):
-        raise invalid("dt", dt, "time step must be a finite number > 0 s")
-    stepping = dt if isinstance(dt, Stepping) else Stepping(float(dt))
-    if not (_real(stepping.dt) and math.isfinite(stepping.dt) and stepping.dt > 0):
+    stepping = dt if isinstance(dt, Stepping) else Stepping(float(dt) if is_real(dt) else dt)
+    if not (is_real(stepping.dt) and math.isfinite(stepping.dt) and stepping.dt > 0):
         raise invalid("dt", dt, "time step must be a finite number > 0 s")
     limit = stability_limit(problem, m, stepping.head)
     if stepping.dt > limit:
@@ -68,11 +66,6 @@ def solve(problem: ChainProblem | Chain, t_end: float, *, save: SaveAt | None = 
             f"or leave dt unset to choose it from the accuracy target")
     _check_head(problem, stepping.head)
     return estimated_solve(problem, t_end, save, m, stepping, estimate)
-
-
-def _real(x) -> bool:
-    """A real number (numpy's scalars too), not a bool."""
-    return isinstance(x, numbers.Real) and not isinstance(x, bool)
 
 
 def _check_head(problem: ChainProblem, head: int):

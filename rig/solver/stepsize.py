@@ -43,6 +43,7 @@ from rig.memo import computed_once
 from rig.model.contact import contact_stiffness
 from rig.solver.methods import Method
 from rig.theory.longwave import sonic_vacuum_speed, sound_speed
+from rig.units import is_real
 
 DEFAULT_ACCURACY = 1e-4
 HEAD_RATIO = 0.5   # a leading contact with tau < HEAD_RATIO x median tau is integrated apart
@@ -62,9 +63,9 @@ class Stepping:
     inner_dt: float = math.inf
 
     def __post_init__(self):
-        if isinstance(self.head, bool) or not isinstance(self.head, numbers.Integral) or self.head < 0:
+        if not is_real(self.head) or not isinstance(self.head, numbers.Integral) or self.head < 0:
             raise invalid("dt.head", self.head, "the head's contacts: a whole number >= 0")
-        if isinstance(self.inner_dt, bool) or not isinstance(self.inner_dt, numbers.Real) or not self.inner_dt > 0:
+        if not is_real(self.inner_dt) or not self.inner_dt > 0:
             raise invalid("dt.inner_dt", self.inner_dt, "the head's substep: a number > 0 s (inf: none)")
 
     def substeps(self, step: float, drifts) -> np.ndarray:
@@ -236,8 +237,7 @@ def checked_accuracy(accuracy: float | None, field: str = "accuracy") -> float:
     """The accuracy target of a solve: DEFAULT_ACCURACY when None; refused outside
     [FINEST_ACCURACY, 0.1] (relative force error), the message naming ``field``."""
     accuracy = DEFAULT_ACCURACY if accuracy is None else accuracy
-    if not (isinstance(accuracy, numbers.Real) and not isinstance(accuracy, bool)
-            and FINEST_ACCURACY <= accuracy <= 0.1):
+    if not (is_real(accuracy) and FINEST_ACCURACY <= accuracy <= 0.1):
         raise invalid(field, accuracy, f"relative accuracy target in [{FINEST_ACCURACY:g}, 0.1]")
     return float(accuracy)
 

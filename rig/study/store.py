@@ -70,7 +70,8 @@ class Store:
         """Create the folder, or check that it holds this very study (to resume it)."""
         meta = self.folder / "study.json"
         spec = {"digest": self.study.digest(), **self.study.spec()}
-        if meta.exists():
+        fresh = not meta.exists()
+        if not fresh:
             try:
                 old = json.loads(meta.read_text())
             except (ValueError, OSError) as exc:
@@ -86,7 +87,7 @@ class Store:
             raise RigError(f"{self.folder} holds finished batches but no study.json: they belong to a study that "
                            f"cannot be checked; give another --out or remove {self.folder}")
         self.batches.mkdir(parents=True, exist_ok=True)
-        if not meta.exists():
+        if fresh:
             atomic_write(meta, lambda tmp: Path(tmp).write_text(json.dumps(spec, indent=1)))
         return self
 

@@ -21,7 +21,7 @@ from instruments.jit import jit
 from rig.model.contact import HERTZ, POWER
 from rig.solver.kernels.dissipation import dissipate, holder_factors
 from rig.solver.kernels.forces import contact_force, power, state_sums
-from rig.solver.kernels.integrators import rest_from
+from rig.solver.kernels.integrators import rest_from, still_from
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
 
@@ -109,19 +109,6 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
         if i >= 1:
             _contact_row(u, A, d0, load, f, i)
     _other_laws(u, A, d0, load, f, expo, law, start, reach)
-
-
-@jit
-def _still_rows(u, v, u_rest, lo, hi):
-    """integrators.still_from over every shot: the first row r in [lo, hi] from which rows
-    r..hi-1 of every shot are where they rest with v = 0."""
-    r = hi
-    while r > lo:
-        for s in range(u.shape[1]):
-            if v[r - 1, s] != 0.0 or u[r - 1, s] != u_rest[r - 1, s]:
-                return r
-        r -= 1
-    return r
 
 
 @jit
@@ -237,7 +224,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
             _kick_drift(u, v, invm, f, pending, 0.0, head, reach)
             pending = 0.0
         if still < nb:
-            still = _still_rows(u, v, u_rest, still, reach)
+            still = still_from(u, v, u_rest, still, reach)
         if dissipative:
             dissipate(u, v, mass, invm, A, d0, con, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
                       work, lost, j_visc, j_holder)

@@ -60,10 +60,13 @@ def rest_from(v, invm, f, first):
 
 @jit(inline="always")
 def still_from(u, v, u_rest, lo, hi):
-    """The first body r in [lo, hi] from which bodies r..hi-1 are where they rest (u =
-    u_rest) with v = 0."""
+    """The first body r in [lo, hi] from which bodies r..hi-1 of every shot are where they
+    rest (u = u_rest) with v = 0; arrays (bodies, shots), a single shot's as (bodies, 1)."""
     r = hi
-    while r > lo and v[r - 1] == 0.0 and u[r - 1] == u_rest[r - 1]:
+    while r > lo:
+        for s in range(u.shape[1]):
+            if v[r - 1, s] != 0.0 or u[r - 1, s] != u_rest[r - 1, s]:
+                return r
         r -= 1
     return r
 
@@ -128,7 +131,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
     w_sched = 0.0
 
     u2, v2, im2, f2, A2, d02, load2 = heads
-    u_rest = u.copy()
+    u_rest = u2.copy()
     first = max(head + 1, sched_body + 1 if has_sched else 1)
     still = rest_from(v, invm, f, first) if front and not dissipative else nb
     d_old = np.zeros((n_ch, ch_slot.shape[1], 1))  # overlaps (m) and rates (m/s) the channels read
@@ -181,7 +184,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
             closing_kick(v, invm, f, pending, head, reach)
             pending = 0.0
         if still < nb:
-            still = still_from(u, v, u_rest, still, reach)
+            still = still_from(u2, v2, u_rest, still, reach)
         if dissipative:
             dissipate(u2, v2, m2, im2, A2, d02, con3, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
                       work, lost, j_visc, j_holder)

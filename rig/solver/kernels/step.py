@@ -96,7 +96,7 @@ BLOCK = 2048  # bodies per block of a step's wavefront (their arrays stay in the
 def step(u, v, invm, f, A, d0, load, law, expo, a_coef, b_coef, dt, t, pending, head, sub,
           sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach):
     """One step of the composition (its closing kick owed), bodies 0..reach-1, every stage.
-    ``reach``: the bodies beyond it are still at rest and unforced (integrators.quiet_from):
+    ``reach``: the bodies beyond it are still at rest and unforced (integrators.rest_from):
     the step would leave them bit for bit as they are.
 
     Stage s on body i needs slot i + 1 at stage s - 1 and leaves slot i at stage s, so
