@@ -3,8 +3,9 @@ fires. Every shot's draws, gauges and scope run on a few threads (``acquire``: c
 per-shot functions, acquisition.shot_draws and acquisition.one_shot), every shot's analysis
 in one compiled loop (``analysed``): the very functions PiezoGauge.read,
 Oscilloscope.acquire and the pipeline run for one shot, so a shot of a batch has the bits
-it has alone. Each shot's random numbers come from its own generator, seeded by its seed,
-in the order a lone shot draws them (acquisition.shot_draws)."""
+it has alone. Each shot's random numbers come from its own generator, seeded by its seed
+(pcg64: np.random.default_rng(seed)'s numbers, compiled), in the order a lone shot draws
+them (acquisition.shot_draws)."""
 from __future__ import annotations
 
 import math
@@ -14,7 +15,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ._kernels import acquisition, batch_analysis, pulses
+from ._kernels import acquisition, batch_analysis, pcg64, pulses
 from .frontend import highpass_coefficients
 from .oscilloscope import CODE_MAX, CODE_MIN, Oscilloscope
 from .pipeline import Setup, report_of
@@ -126,18 +127,18 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
         z_scope = np.empty((C, L if scope.noise_floor else 0))
         shift, scale = np.empty(G), np.empty(G)
         for s in range(lo, hi):
-            gen = np.random.default_rng(int(seeds[s]))
-            phase = acquisition.shot_draws(gen, cal, mis, noisy, drawn[s], z_gauge, dx, bool(scope.noise_floor),
+            state = pcg64.seeded(int(seeds[s]))  # np.random.default_rng(seed)'s numbers, compiled
+            phase = acquisition.shot_draws(state, cal, mis, noisy, drawn[s], z_gauge, dx, bool(scope.noise_floor),
                                            z_scope[:drawn_rows])
             acquisition.shot_settings(drawn[s], replace[s], sens, delayed, speed[s], shift, scale)
             st, t_cross, x_zero = record(s, z_gauge, np.empty((G, 0)), phase, z_scope, shift, scale)
             n_pad = acquisition.samples_before_input(st, t_cross, x_zero, h)
             if n_pad:  # a record that starts before the impact, again with the inputs at rest before it
-                if scope.noise_floor:
-                    gen.standard_normal((C - drawn_rows) * L)  # the noise of the channels not read, in its turn
+                if scope.noise_floor:  # the noise of the channels not read, in its turn
+                    pcg64.normals(state, np.empty((C - drawn_rows) * L))
                 z_rest = np.zeros((G, n_pad))
                 for g in rested:  # drawn after the shot's other draws, in the displayed channels' order
-                    z_rest[g] = gen.standard_normal(n_pad)
+                    pcg64.normals(state, z_rest[g])
                 st, t_cross, x_zero = record(s, z_gauge, z_rest, phase, z_scope, shift, scale)
             status[s], times[s, 0], times[s, 1] = st, t_cross, x_zero
 

@@ -2,7 +2,7 @@
 oscilloscope's acquisition. PiezoGauge.read and Oscilloscope.acquire run them for one shot;
 the batched instruments (instruments/batch.py) run them (``one_shot``) for every shot of a
 study, on a few threads: the same code, so the same bits. Random draws come in as arrays, drawn
-beforehand from each shot's generator in a fixed order (``shot_draws``).
+beforehand from each shot's generator in a fixed order (``shot_draws``, pcg64).
 """
 import math
 
@@ -10,6 +10,7 @@ import numpy as np
 
 from instruments.jit import jit
 
+from . import pcg64
 from .filters import pole_step
 from .quantiser import quantise
 from .resample import at_positions, read_at
@@ -171,23 +172,20 @@ def shot_settings(draws, fixed, sensitivity, delayed, speed, shift, scale):
 
 
 @jit(nogil=True)
-def shot_draws(g, calibration_error, misalignment_sd, noisy, draws, z_gauge, phase_span, scope_noisy, z_scope):
-    """One shot's random draws from its generator g, in the order a shot takes them: for
-    each gauge (the bead gauges by name, then the wall sensor) its gain factor
-    1 + calibration_error z and position error misalignment_sd z (draws[:, 0], draws[:, 1]),
-    then its noise (z_gauge[k], where noisy[k]); then the scope's clock phase
-    uniform(0, phase_span) (returned) and each displayed channel's noise (z_scope, where
-    scope_noisy). numba's Generator gives numpy's numbers, draw for draw. It runs without
-    Python's lock, so the shots of a batch draw on several threads at once."""
+def shot_draws(st, calibration_error, misalignment_sd, noisy, draws, z_gauge, phase_span, scope_noisy, z_scope):
+    """One shot's random draws from its generator's state st (pcg64.seeded(seed): the
+    numbers of np.random.default_rng(seed)), in the order a shot takes them: for each gauge
+    (the bead gauges by name, then the wall sensor) its gain factor 1 + calibration_error z
+    and position error misalignment_sd z (draws[:, 0], draws[:, 1]), then its noise
+    (z_gauge[k], where noisy[k]); then the scope's clock phase uniform(0, phase_span)
+    (returned) and each displayed channel's noise (z_scope, where scope_noisy). It runs
+    without Python's lock, so the shots of a batch draw on several threads at once."""
     for k in range(draws.shape[0]):
-        draws[k, 0] = 1.0 + calibration_error[k] * g.standard_normal()
-        draws[k, 1] = misalignment_sd[k] * g.standard_normal()
+        draws[k, 0] = 1.0 + calibration_error[k] * pcg64.standard_normal(st)
+        draws[k, 1] = misalignment_sd[k] * pcg64.standard_normal(st)
         if noisy[k]:
-            for i in range(z_gauge.shape[1]):
-                z_gauge[k, i] = g.standard_normal()
-    phase = g.uniform(0.0, phase_span)
+            pcg64.normals(st, z_gauge[k])
+    phase = 0.0 + phase_span * pcg64.next_double(st)  # Generator.uniform(0, span): low + span x random
     if scope_noisy:
-        for c in range(z_scope.shape[0]):
-            for i in range(z_scope.shape[1]):
-                z_scope[c, i] = g.standard_normal()
+        pcg64.normals(st, z_scope)
     return phase
