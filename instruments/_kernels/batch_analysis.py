@@ -11,7 +11,8 @@ from numba import prange
 from instruments.jit import jit
 
 from .acquisition import OK
-from .pulses import conditioned, leading_pair, noise_level
+from .filters import undo_highpass_into
+from .pulses import baseline_mean, leading_pair, noise_level
 
 
 @jit
@@ -23,11 +24,14 @@ def analyse_shot(codes, time0, dx, n_pre, ymult, yoff, yzero, roles, tau, sens, 
     f = np.empty((2, codes.shape[1]))
     for r in range(2):
         c = roles[r]
-        volts = yzero[c] + ymult[c] * (codes[c].astype(np.float64) - yoff[c])
-        f[r] = conditioned(volts, n_pre, dx, tau[r], sens[r])
+        volts = f[r]
+        for k in range(codes.shape[1]):  # the codes' volts (records.ScopeRecord's operations)
+            volts[k] = yzero[c] + ymult[c] * (np.float64(codes[c, k]) - yoff[c])
+        undo_highpass_into(volts, baseline_mean(volts, n_pre), dx, tau[r], sens[r], volts)  # conditioned, in place
         sigma[r] = noise_level(f[r], n_pre, abs(ymult[c]) / sens[r])
-        if not np.all(np.isfinite(f[r])):
-            return False
+        for k in range(codes.shape[1]):
+            if not math.isfinite(volts[k]):
+                return False
     leading_pair(t, f[0], f[1], sigma[0], sigma[1], rules, answer)
     return True
 

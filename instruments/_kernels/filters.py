@@ -31,12 +31,24 @@ def undo_highpass(y, h, tau):
     """x[n] = y[n] + (1/tau) sum_{k<=n} h (y[k] + y[k-1]) / 2 (trapezoid rule): the input of
     a one-pole RC high-pass from its output. The same operations as
     y + scipy.integrate.cumulative_trapezoid(y, dx=h, initial=0) / tau, in one pass."""
-    n = y.shape[0]
-    x = np.empty(n)
-    acc = 0.0
-    if n:
-        x[0] = y[0] + acc / tau
-    for k in range(1, n):
-        acc = acc + h * (y[k] + y[k - 1]) / 2.0
-        x[k] = y[k] + acc / tau
+    x = np.empty(y.shape[0])
+    undo_highpass_into(y, 0.0, h, tau, 1.0, x)  # less 0, over 1: the same numbers
     return x
+
+
+@jit
+def undo_highpass_into(y, level, h, tau, scale, out):
+    """out[n] = x[n] / scale, x undo_highpass's input of the RC high-pass (tau s; 0: none,
+    x = y - level) whose output is y - level: one pass, with undo_highpass's operations in
+    its order. out may be y itself."""
+    acc = 0.0
+    before = 0.0
+    for k in range(y.shape[0]):
+        yk = y[k] - level
+        if tau > 0.0:
+            if k:
+                acc = acc + h * (yk + before) / 2.0
+            out[k] = (yk + acc / tau) / scale
+        else:
+            out[k] = yk / scale
+        before = yk

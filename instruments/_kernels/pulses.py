@@ -11,7 +11,7 @@ import numpy as np
 from instruments.jit import jit
 
 from .crossings import level_bracket
-from .filters import undo_highpass
+from .filters import undo_highpass_into
 from .parabola import parabola
 from .peaks import local_maxima, thin_by_distance, widths_at
 from .prominence import prominent
@@ -97,17 +97,20 @@ def median(x):
     """The median of x (numpy's: the middle value, or the mean of the two middle ones; nan
     where x is empty or holds a nan)."""
     n = x.shape[0]
-    if n == 0 or np.isnan(x).any():
+    if n == 0:
         return math.nan
+    for v in x:
+        if math.isnan(v):
+            return math.nan
     k = n // 2
     upper = kth_smallest(x, k)
     if n % 2:
         return upper
     below, lower = 0, -np.inf  # the (k - 1)-th: upper again unless k values lie below it
-    for v in x:
-        if v < upper:
-            below += 1
-            lower = max(lower, v)
+    for v in x:  # without a branch: noise is below or not at random
+        is_below = v < upper
+        below += is_below
+        lower = max(lower, v if is_below else -np.inf)
     return ((upper if below < k else lower) + upper) / 2.0
 
 
@@ -127,10 +130,9 @@ def noise_level(y, n_pre, step):
 def conditioned(volts, n_pre, h, tau, sensitivity):
     """Dynamic force (N) of a channel: volts less their pre-trigger mean, the RC high-pass
     of time constant tau (s; 0: none) undone, over the sensitivity (V/N)."""
-    v = volts - baseline_mean(volts, n_pre)
-    if tau > 0.0:
-        v = undo_highpass(v, h, tau)
-    return v / sensitivity
+    out = np.empty(volts.shape[0])
+    undo_highpass_into(volts, baseline_mean(volts, n_pre), h, tau, sensitivity, out)
+    return out
 
 
 @jit

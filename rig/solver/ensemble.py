@@ -7,6 +7,7 @@ same numbers to the last bit.
 """
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 
@@ -19,15 +20,17 @@ from rig.solver.methods import method as get_method
 from rig.solver.problem import ProblemArrays
 from rig.solver.run import check_interval, check_record, time_grid
 from rig.solver.saveat import SaveAt
-from rig.solver.solution import DIAGNOSTICS, KernelReport, SolverStats
+from rig.solver.solution import DIAGNOSTICS, KernelReport, SolverStats, Status
 from rig.solver.stepsize import Stepping, viscous_rate
 
 
 @dataclass(frozen=True, eq=False)
 class EnsembleSolution:
     """records: (shots, probes, samples) (N), the probes in the SaveAt's order, each shot's
-    record contiguous; forces: {probe: (shots, samples)}, views of it; reports: what the
-    kernel reported of each shot (energy and momentum errors, wall impulse, status)."""
+    record contiguous; forces: {probe: (shots, samples)}, views of it; diagnostics:
+    (DIAGNOSTICS, shots), the kernel's report of every shot, each as a KernelReport in
+    ``reports`` (built when first asked for: a study reads ``succeeded`` and
+    ``energy_errors``, arrays, instead of 256 objects a batch)."""
 
     records: np.ndarray
     sample_interval: float
@@ -35,7 +38,7 @@ class EnsembleSolution:
     steps: int
     wall_s: float
     method: str
-    reports: tuple
+    diagnostics: np.ndarray
     names: tuple
 
     @property
@@ -44,7 +47,22 @@ class EnsembleSolution:
 
     @property
     def shots(self) -> int:
-        return len(self.reports)
+        return self.diagnostics.shape[1]
+
+    @functools.cached_property
+    def reports(self) -> tuple:
+        """Each shot's KernelReport (energy and momentum errors, wall impulse, status)."""
+        return tuple(KernelReport.of(self.diagnostics[:, j]) for j in range(self.shots))
+
+    @property
+    def succeeded(self) -> np.ndarray:
+        """(shots,) bool: the shots whose status is Status.SUCCESS."""
+        return self.diagnostics[KernelReport.STATUS] == Status.SUCCESS
+
+    @property
+    def energy_errors(self) -> np.ndarray:
+        """(shots,): each shot's KernelReport.energy_error."""
+        return self.diagnostics[KernelReport.ENERGY_ERROR]
 
     def stats(self, j: int, accuracy: float | None = None, estimate: float | None = None,
               basis: str = "study pilot") -> SolverStats:
@@ -112,6 +130,5 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
                        check_interval(n_steps), stack("d_limit"), p0.wall_slot,
                        stack("energy_scale"), stack("momentum_scale"), diag)
     wall = time.perf_counter() - t0
-    diag = np.moveaxis(diag, 0, -2).reshape(DIAGNOSTICS, n_chunks * width)[:, :n]
-    reports = tuple(KernelReport.of(diag[:, j]) for j in range(n))
-    return EnsembleSolution(out, save.sample_interval, step, n_steps, wall, m.name, reports, save.names)
+    diag = np.ascontiguousarray(np.moveaxis(diag, 0, -2).reshape(DIAGNOSTICS, n_chunks * width)[:, :n])
+    return EnsembleSolution(out, save.sample_interval, step, n_steps, wall, m.name, diag, save.names)

@@ -39,6 +39,8 @@ class KernelReport:
     dissipated_energy_J: float
     bodies_stepped: float  # the bodies a step integrated, on average (the front; all of them at most)
 
+    ENERGY_ERROR, STATUS = 0, 3  # where a diagnostics array holds them (the fields' order)
+
     @classmethod
     def of(cls, diag) -> "KernelReport":
         return cls(float(diag[0]), float(diag[1]), float(diag[2]), Status(int(diag[3])),

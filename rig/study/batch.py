@@ -158,15 +158,16 @@ def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
     records = instrument_batch.acquire(forces, h, wiring, [drawn[j][2] for j in keep], sub.fixed, speeds,
                                        read=(setup.upper.channel, setup.lower.channel))  # what the analysis reads
     reports = instrument_batch.analysed(records, setup)
+    succeeded, energy_errors = ens.succeeded, ens.energy_errors
     for e, j in enumerate(keep):
-        if ens.reports[e].status is not Status.SUCCESS:
+        if not succeeded[e]:
             out["failure"][j] = UNSTABLE
             continue
         if records.status[e] == instrument_batch.PAST_INPUT:  # the scope's record ends after the simulated window
             out["failure"][j] = SHORT_WINDOW
             continue
         triggered = records.status[e] == instrument_batch.OK
-        _outputs(out, j, reports[e], None, ens.reports[e].energy_error, ens.dt, triggered)
+        _outputs(out, j, reports[e], None, float(energy_errors[e]), ens.dt, triggered)
 
 
 def _outputs(out: dict, j: int, m, t, energy_error: float, dt: float, triggered: bool):

@@ -40,3 +40,16 @@ def test_uniforms_are_generator_randoms():
     st = pcg64.seeded(99)
     got = np.array([pcg64.next_double(st) for _ in range(1000)])
     assert np.array_equal(got.view(np.uint64), gen.random(1000).view(np.uint64))
+
+
+
+def test_draws_in_pieces_are_the_draws_in_one():
+    # a block is drawn ahead: the state left after each piece must be its last draw's, so
+    # that pieces of any size (none too) go on with the stream where the last one ended
+    gen = np.random.default_rng(7)
+    st = pcg64.seeded(7)
+    for n in (1, 2, 0, 31, 32, 33, 5, 64, 1000):
+        z = np.empty(n)
+        pcg64.normals(st, z)
+        assert np.array_equal(z.view(np.uint64), gen.standard_normal(n).view(np.uint64))
+        assert _as_ints(st) == _state_of(gen)
