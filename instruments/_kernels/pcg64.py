@@ -110,22 +110,27 @@ def _mix(x, y):
     return r ^ (r >> XSHIFT)
 
 
-@jit(nogil=True)
-def seeded(seed):
-    """The PCG64 state (uint64[4]) of np.random.default_rng(seed), seed an integer in
-    [0, 2^63): SeedSequence(seed)'s pool of four 32-bit words mixed from the seed's words,
-    four uint64 drawn from it (128-bit seed, 128-bit stream), then PCG's seeding: s = 0,
-    c = 2 stream + 1, a step, s += seed, a step."""
-    words = (U(seed) & M32, U(seed) >> U(32))  # 0 where the seed fits 32 bits: numpy pads with 0
+@jit(inline="always")
+def seeded_by(entropy):
+    """(the PCG64 state (uint64[4]) of np.random.default_rng(SeedSequence) whose assembled
+    entropy is ``entropy`` (uint64 array of 32-bit words: the seed's, and where it has a
+    spawn key, padded with 0 to four words and followed by the key's), the sequence's
+    generate_state(1, uint64)[0]). The pool of four 32-bit words is hashed and mixed from
+    the words, four uint64 are drawn from it (128-bit seed, 128-bit stream), then PCG's
+    seeding: s = 0, c = 2 stream + 1, a step, s += seed, a step."""
     pool = np.empty(4, np.uint64)
     hc = INIT_A
     for i in range(4):
-        pool[i], hc = _hashmix(words[i] if i < 2 else U(0), hc)
+        pool[i], hc = _hashmix(entropy[i] if i < entropy.shape[0] else U(0), hc)
     for i_src in range(4):
         for i_dst in range(4):
             if i_src != i_dst:
                 h, hc = _hashmix(pool[i_src], hc)
                 pool[i_dst] = _mix(pool[i_dst], h)
+    for i_src in range(4, entropy.shape[0]):
+        for i_dst in range(4):
+            h, hc = _hashmix(entropy[i_src], hc)
+            pool[i_dst] = _mix(pool[i_dst], h)
     drawn = np.empty(4, np.uint64)
     hc = INIT_B
     for i in range(8):  # generate_state(4, uint64): eight 32-bit words, little-endian pairs
@@ -142,4 +147,34 @@ def seeded(seed):
     st[0] = st[0] + drawn[0] + (U(1) if lo < st[1] else U(0))
     st[1] = lo
     st[0], st[1] = lcg128(st[0], st[1], st[2], st[3])
-    return st
+    return st, drawn[0]
+
+
+@jit(nogil=True)
+def seeded(seed):
+    """The PCG64 state (uint64[4]) of np.random.default_rng(seed), seed an integer in
+    [0, 2^63) (its one or two 32-bit words are SeedSequence(seed)'s entropy)."""
+    entropy = np.empty(2, np.uint64)
+    entropy[0], entropy[1] = U(seed) & M32, U(seed) >> U(32)
+    return seeded_by(entropy[:1] if entropy[1] == U(0) else entropy)[0]
+
+
+@jit(nogil=True)
+def spawned_draws(run_entropy, first, uniform, counts, raw, heads):
+    """The draws of the streams np.random.default_rng(SeedSequence(seed, spawn_key=(i,)))
+    for i = first, first + 1, ...: row s of raw gets stream first + s's draws in turn,
+    counts[d] of each kind d, standard normals (Generator.standard_normal) or, where
+    uniform[d], uniforms in [0, 1) (Generator.random); heads[s] is that sequence's
+    generate_state(1, uint64)[0]. run_entropy: the seed's 32-bit words padded with 0 to
+    four (uint64 array), i < 2^32."""
+    n = run_entropy.shape[0]
+    entropy = np.empty(n + 1, np.uint64)
+    entropy[:n] = run_entropy
+    for s in range(raw.shape[0]):
+        entropy[n] = U(first + s)
+        st, heads[s] = seeded_by(entropy)
+        col = 0
+        for d in range(counts.shape[0]):
+            for _ in range(counts[d]):
+                raw[s, col] = next_double(st) if uniform[d] else standard_normal(st)
+                col += 1

@@ -33,7 +33,7 @@ from rig.solver.ensemble import solve_ensemble
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution
 from rig.solver.stepsize import Stepping, stepping_at
-from rig.study.batch import collector_paused, run_batch, shot_inputs
+from rig.study.batch import batch_inputs, collector_paused, run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
 from rig.study.mc_spec import DEFAULT_BATCH, Study
@@ -76,7 +76,7 @@ class Setting:
     def shots(self, study: Study, lo: int, hi: int) -> tuple:
         """(shots lo..hi-1 as the solver's arrays (rig/study/shots.py), their instruments' seeds)."""
         beads = self.nominal.rig.values["chain"]["beads"]
-        drawn = [shot_inputs(study, i, beads) for i in range(lo, hi)]
+        drawn = batch_inputs(study, lo, hi, beads)
         return shots_of(self.template, [x for x, *_ in drawn], [m for _, m, _ in drawn]), [s for *_, s in drawn]
 
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from instruments import batch as instrument_batch
+from instruments import streams
 from instruments.pipeline import analyze_record
 from rig.errors import RigError
 from rig.experiment.measure import setup_for
@@ -47,17 +48,31 @@ class BatchResult:
 
 def shot_inputs(study: Study, i: int, n_plain: int, design=None):
     """Shot i's inputs {key: value}, bead masses (or None) and instrument seed."""
-    child = np.random.SeedSequence(study.seed, spawn_key=(i,))
-    rng = np.random.default_rng(child)
-    x, masses = {}, None
-    for k, d in enumerate(study.dists):
-        if d.key == "chain.bead_mass":
-            masses = d.draw(rng, n_plain)
-            x[d.key] = float(np.mean(masses))
-        else:
-            x[d.key] = float(d.draw(rng)) if design is None else float(design[i, k])
-    seed = int(child.generate_state(1, np.uint64)[0] >> np.uint64(1))
-    return x, masses, seed
+    return batch_inputs(study, i, i + 1, n_plain, design)[0]
+
+
+def batch_inputs(study: Study, lo: int, hi: int, n_plain: int, design=None) -> list:
+    """(inputs {key: value}, bead masses or None, instrument seed) of shots lo..hi-1, each
+    drawn from its own stream, np.random.default_rng(SeedSequence(study.seed,
+    spawn_key=(i,))) (instruments.streams: every shot's draws in one compiled call, the
+    numbers that generator gives): in the study's key order, n_plain masses for
+    chain.bead_mass, one draw for any other key (none where the Sobol design sets it); the
+    instrument seed is the sequence's first 64 bits, halved."""
+    sizes = [n_plain if d.key == "chain.bead_mass" else int(design is None) for d in study.dists]
+    raw, heads = streams.spawned_draws(study.seed, lo, hi - lo, [d.standard for d in study.dists], sizes)
+    edges = np.cumsum([0, *sizes])
+    values = [d.from_standard(raw[:, a:b]) for d, a, b in zip(study.dists, edges, edges[1:])]
+    out = []
+    for s, i in enumerate(range(lo, hi)):
+        x, masses = {}, None
+        for k, (d, v) in enumerate(zip(study.dists, values)):
+            if d.key == "chain.bead_mass":
+                masses = v[s].copy()
+                x[d.key] = float(np.mean(masses))
+            else:
+                x[d.key] = float(v[s, 0]) if design is None else float(design[i, k])
+        out.append((x, masses, int(heads[s] >> np.uint64(1))))
+    return out
 
 
 def shot_rig(study: Study, x: dict, masses) -> tuple:
@@ -111,7 +126,7 @@ def _batch(study: Study, b: int) -> BatchResult:
     design = sobol_matrix(study)[0] if study.sobol else None
     out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
     out["failure"][:] = 0
-    drawn = [shot_inputs(study, i, base.values["chain"]["beads"], design) for i in range(lo, hi)]
+    drawn = batch_inputs(study, lo, hi, base.values["chain"]["beads"], design)
     seeds = [seed for *_, seed in drawn]
     xs = np.array([[x[k] for k in study.keys] for x, *_ in drawn], dtype=float).reshape(hi - lo, len(study.keys))
     template = nom.template(study.window)

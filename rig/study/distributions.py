@@ -119,17 +119,28 @@ class Distribution:
     def text(self) -> str:
         return f"{self.kind}({', '.join(f'{x:g}' for x in self.params)})"
 
-    def draw(self, rng: np.random.Generator, size=None):
+    @property
+    def standard(self) -> str:
+        """The standard draws a value is made of: "normal" (standard normals) or "uniform"
+        (in [0, 1))."""
+        return "uniform" if self.kind in ("uniform", "truncnormal") else "normal"
+
+    def from_standard(self, z: np.ndarray) -> np.ndarray:
+        """Values from standard draws z (``standard``), with the operations numpy's
+        Generator.normal, uniform and lognormal apply to theirs (loc + scale z,
+        low + (high - low) u, exp(mu + sigma z) by the C library's exp), so the values are
+        the ones those methods draw from the same stream; truncnormal: its ppf at u."""
         k, p = self.kind, self.params
         if k == "normal":
-            return rng.normal(p[0], p[1], size)
+            return p[0] + p[1] * z
         if k == "uniform":
-            return rng.uniform(p[0], p[1], size)
+            return p[0] + (p[1] - p[0]) * z
         if k == "lognormal":
             s2 = math.log1p((p[1] / p[0]) ** 2)
-            return rng.lognormal(math.log(p[0]) - 0.5 * s2, math.sqrt(s2), size)
+            mu, sigma = math.log(p[0]) - 0.5 * s2, math.sqrt(s2)
+            return np.array([math.exp(mu + sigma * v) for v in np.ravel(z)]).reshape(np.shape(z))
         a, b = (p[2] - p[0]) / p[1], (p[3] - p[0]) / p[1]
-        return stats.truncnorm.ppf(rng.uniform(size=size), a, b, loc=p[0], scale=p[1])
+        return stats.truncnorm.ppf(z, a, b, loc=p[0], scale=p[1])
 
     def salib(self):
         """(dist name, bounds) in SALib's terms, for Sobol sampling."""
