@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ._kernels import acquisition, batch_analysis, pcg64, pulses
+from ._kernels import acquisition, batch_analysis, pulses
 from .frontend import highpass_coefficients
 from .oscilloscope import CODE_MAX, CODE_MIN, Oscilloscope
 from .pipeline import Setup, report_of
@@ -86,8 +86,9 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
     have in a whole record.
 
     The shots are shared out over numba's number of threads; each thread takes its shots
-    one by one: the shot's draws into the thread's own noise buffers (they stay in cache),
-    then its gauges and scope (acquisition.one_shot), both compiled without Python's lock."""
+    one by one in one compiled call without Python's lock (acquisition.shots): the shot's
+    draws into the thread's own noise buffers (they stay in cache), then its gauges and
+    scope (acquisition.one_shot)."""
     S, G, n_in = forces.shape
     settings = [s for _, s, _ in wiring.gauges]
     scope = wiring.scope
@@ -114,33 +115,15 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
     names = wiring.channels
     reads = np.array([read is None or ch in read or c == front.source for c, ch in enumerate(names)], np.bool_)
     drawn_rows = int(np.flatnonzero(reads)[-1]) + 1 if scope.noise_floor else 0  # scope noise drawn with the shot
-    rested = [g for g in wired if g >= 0 and settings[g].noise]  # the inputs with noise before the impact
-
-    def record(s, z_gauge, z_rest, phase, z_scope, shift, scale):
-        return acquisition.one_shot(forces[s], float(h), shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired,
-                                    front.probe, front.ac, front.lowpass, front.source, front.level, front.rising,
-                                    phase, front.n_pre, dx, front.offset, front.ymult, front.yoff, front.sd, z_scope,
-                                    float(CODE_MIN), float(CODE_MAX), codes[s], over[s], reads)
+    rested = np.array([g for g in wired if g >= 0 and settings[g].noise], np.int64)  # noisy before the impact
+    gauges = (cal, mis, noisy, sens, delayed, gauge_filter, noise_sd)
+    panel = (wired, front.probe, front.ac, front.lowpass, front.source, front.level, front.rising, front.n_pre, dx,
+             front.offset, front.ymult, front.yoff, front.sd, float(CODE_MIN), float(CODE_MAX), bool(scope.noise_floor))
+    seeds = np.asarray(seeds, np.int64)
 
     def shots_from(lo: int, hi: int) -> None:
-        z_gauge = np.empty((G, n_in)) if noisy.all() else np.zeros((G, n_in))  # a noise-free gauge's row stays 0
-        z_scope = np.empty((C, L if scope.noise_floor else 0))
-        shift, scale = np.empty(G), np.empty(G)
-        for s in range(lo, hi):
-            state = pcg64.seeded(int(seeds[s]))  # np.random.default_rng(seed)'s numbers, compiled
-            phase = acquisition.shot_draws(state, cal, mis, noisy, drawn[s], z_gauge, dx, bool(scope.noise_floor),
-                                           z_scope[:drawn_rows])
-            acquisition.shot_settings(drawn[s], replace[s], sens, delayed, speed[s], shift, scale)
-            st, t_cross, x_zero = record(s, z_gauge, np.empty((G, 0)), phase, z_scope, shift, scale)
-            n_pad = acquisition.samples_before_input(st, t_cross, x_zero, h)
-            if n_pad:  # a record that starts before the impact, again with the inputs at rest before it
-                if scope.noise_floor:  # the noise of the channels not read, in its turn
-                    pcg64.normals(state, np.empty((C - drawn_rows) * L))
-                z_rest = np.zeros((G, n_pad))
-                for g in rested:  # drawn after the shot's other draws, in the displayed channels' order
-                    pcg64.normals(state, z_rest[g])
-                st, t_cross, x_zero = record(s, z_gauge, z_rest, phase, z_scope, shift, scale)
-            status[s], times[s, 0], times[s, 1] = st, t_cross, x_zero
+        acquisition.shots(lo, hi, seeds, forces, float(h), speed, replace, gauges, panel, reads, drawn_rows, rested,
+                          codes, over, status, times, drawn)
 
     threads = min(numba.get_num_threads(), S)
     if threads > 1:
@@ -169,7 +152,7 @@ def analysed(records: Records, setup: Setup) -> list:
                                  front.yoff, front.offset, roles, np.array([g.tau_s or 0.0 for g in gauges]),
                                  np.array([g.sensitivity_V_per_N for g in gauges]), setup.rules.as_tuple(), answer,
                                  sigma, finite)
-    L = records.codes.shape[2]
+    ticks = dx * np.arange(records.codes.shape[2])  # each record's sample times from its first
     out = []
     for s in range(S):
         rep = Report(beta=setup.beta, static_force_N=setup.static_force_N)
@@ -179,7 +162,7 @@ def analysed(records: Records, setup: Setup) -> list:
         elif not finite[s]:
             out.append(rep.refuse("samples that are not finite numbers"))
         else:
-            t = records.times[s, 1] + dx * np.arange(L)
+            t = records.times[s, 1] + ticks
             noise = {r: None if math.isnan(sigma[s, k]) else float(sigma[s, k])
                      for k, r in enumerate(("upper", "lower"))}
             clipped = tuple(channels[c] for c in roles if records.over[s, c])

@@ -102,7 +102,8 @@ def scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult
     return OK, t_cross, x_zero
 
 
-def samples_before_input(status, t_cross, x_zero, h) -> int:
+@jit
+def samples_before_input(status, t_cross, x_zero, h):
     """How many input samples (every h s) to put before the input's start so that a record
     whose first sample lies before it (t_cross + x_zero < 0 s: a pre-trigger longer than
     the time from the impact to the trigger) reads the input at rest there, with a margin
@@ -189,3 +190,46 @@ def shot_draws(st, calibration_error, misalignment_sd, noisy, draws, z_gauge, ph
     if scope_noisy:
         pcg64.normals(st, z_scope)
     return phase
+
+
+@jit(nogil=True)
+def shots(first, last, seeds, forces, h, speed, fixed, gauges, scope, reads, drawn_rows, rested, codes, over, status,
+          times, drawn):
+    """Shots first..last-1 of a batch (instruments/batch.acquire), one after another
+    without Python's lock: each shot's draws from its seed (pcg64.seeded: numpy's
+    default_rng(seed), shot_draws), its gauges' settings (shot_settings, fixed: the draws
+    that replace the drawn ones), its record (one_shot) and, for a record that starts
+    before the impact, the noise of the channels not read and the inputs' rest noise in
+    their turn (the gauges ``rested``) and the record again. gauges: (calibration errors,
+    misalignment sds, noisy, sensitivities, delayed, high-pass coefficients, noise sds);
+    scope: (wired, probe, ac, lowpass, source, level, rising, n_pre, dt, offset, ymult,
+    yoff, noise sd, lowest code, highest code, scope noise on). Fills codes, over, status,
+    times (the trigger crossing, the first sample) and drawn (gain factor, position error)."""
+    cal, mis, noisy, sens, delayed, gauge_filter, noise_sd = gauges
+    wired, probe, ac, lowpass, source, level, rising, n_pre, dt, offset, ymult, yoff, sd, lo, hi, noisy_scope = scope
+    G, n_in = forces.shape[1], forces.shape[2]
+    C, L = codes.shape[1], codes.shape[2]
+    z_gauge = np.zeros((G, n_in))  # a noise-free gauge's row stays 0
+    z_scope = np.empty((C, L if noisy_scope else 0))
+    z_none = np.empty((G, 0))
+    shift, scale = np.empty(G), np.empty(G)
+    for s in range(first, last):
+        st = pcg64.seeded(seeds[s])
+        phase = shot_draws(st, cal, mis, noisy, drawn[s], z_gauge, dt, noisy_scope, z_scope[:drawn_rows])
+        shot_settings(drawn[s], fixed[s], sens, delayed, speed[s], shift, scale)
+        z_rest = z_none
+        for attempt in range(2):
+            done, t_cross, x_zero = one_shot(forces[s], h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired,
+                                             probe, ac, lowpass, source, level, rising, phase, n_pre, dt, offset, ymult,
+                                             yoff, sd, z_scope, lo, hi, codes[s], over[s], reads)
+            n_pad = samples_before_input(done, t_cross, x_zero, h) if attempt == 0 else 0
+            if not n_pad:
+                break
+            if noisy_scope:  # the noise of the channels not read, in its turn
+                pcg64.normals(st, np.empty((C - drawn_rows) * L))
+            z_rest = np.zeros((G, n_pad))
+            for g in rested:  # drawn after the shot's other draws, in the displayed channels' order
+                pcg64.normals(st, z_rest[g])
+        status[s] = done
+        times[s, 0] = t_cross
+        times[s, 1] = x_zero
