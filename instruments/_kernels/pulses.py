@@ -197,10 +197,17 @@ def refine(t, f, i, top):
 @jit
 def correlate(a, b, c):
     """c[k] += sum_j a[j] b[j + k] for every lag k < c.shape[0], each sum taken over j in
-    order. The loop over lags vectorises; four j at a time keep c in registers four times
-    as long (half the time of one j at a time) and add in the same order, so the same bits."""
+    order. The loop over lags vectorises; eight j at a time keep c in registers eight times
+    as long and add in the same order, so the same bits."""
     K = c.shape[0]
     j = 0
+    while j + 8 <= a.shape[0]:
+        a0, a1, a2, a3, a4, a5, a6, a7 = a[j], a[j + 1], a[j + 2], a[j + 3], a[j + 4], a[j + 5], a[j + 6], a[j + 7]
+        w = b[j:j + K + 7]
+        for k in range(K):
+            c[k] = (((((((c[k] + w[k] * a0) + w[k + 1] * a1) + w[k + 2] * a2) + w[k + 3] * a3) + w[k + 4] * a4)
+                     + w[k + 5] * a5) + w[k + 6] * a6) + w[k + 7] * a7
+        j += 8
     while j + 4 <= a.shape[0]:
         a0, a1, a2, a3 = a[j], a[j + 1], a[j + 2], a[j + 3]
         w = b[j:j + K + 3]
