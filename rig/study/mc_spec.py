@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import numbers
 from dataclasses import asdict, dataclass
 
 from rig.errors import invalid
@@ -42,6 +43,9 @@ class Study:
             raise invalid("--window", self.window, f"one of {', '.join(WINDOWS)}")
         if not isinstance(self.shots, int) or self.shots < 1:
             raise invalid("--shots", self.shots, "a whole number >= 1")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, numbers.Integral) or not 0 <= self.seed < 2**63:
+            raise invalid("--seed", self.seed, "a whole number from 0 to 2^63 - 1")
+        object.__setattr__(self, "seed", int(self.seed))  # numpy's integers too, stored as a plain int
         if self.batch < 1:
             raise invalid("--batch", self.batch, "a whole number >= 1")
         if self.accuracy is not None:  # what solve accepts

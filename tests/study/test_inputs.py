@@ -66,3 +66,15 @@ def test_a_sobol_design_sets_the_keys_but_the_masses_are_still_drawn():
         x, masses, instrument_seed = _numpy_inputs(study, i, 52, design)
         assert _same(list(got[i][0].values()), list(x.values())) and _same(got[i][1], masses)
         assert got[i][2] == instrument_seed
+
+
+@pytest.mark.parametrize("seed", [-1, 2**63, True, 1.5, "3"])
+def test_a_seed_no_stream_can_have_is_refused_in_one_line(seed):
+    from rig.errors import RigError
+
+    with pytest.raises(RigError, match=r"--seed = .*: a whole number from 0 to 2\^63 - 1"):
+        Study("ptfe52_magnetic", tuple(parse_vary(VARY[:1])), 4, seed=seed)
+
+
+def test_numpys_integers_are_taken_as_seeds():
+    assert Study("ptfe52_magnetic", tuple(parse_vary(VARY[:1])), 4, seed=np.int64(9)).seed == 9
