@@ -15,7 +15,7 @@ import numpy as np
 from instruments import batch as instrument_batch
 from instruments import streams
 from instruments.pipeline import analyze_record
-from rig.errors import RigError
+from rig.errors import RigError, invalid
 from rig.experiment.measure import setup_for
 from rig.experiment.shot import Rig
 from rig.solver.ensemble import solve_ensemble
@@ -58,6 +58,8 @@ def batch_inputs(study: Study, lo: int, hi: int, n_plain: int, design=None) -> l
     numbers that generator gives): in the study's key order, n_plain masses for
     chain.bead_mass, one draw for any other key (none where the Sobol design sets it); the
     instrument seed is the sequence's first 64 bits, halved."""
+    if not 0 <= lo <= hi <= study.shots:
+        raise invalid("shots", f"{lo}..{hi - 1}", f"shots of the study, 0..{study.shots - 1}")
     sizes = [n_plain if d.key == "chain.bead_mass" else int(design is None) for d in study.dists]
     raw, heads = streams.spawned_draws(study.seed, lo, hi - lo, [d.standard for d in study.dists], sizes)
     edges = np.cumsum([0, *sizes])
@@ -236,5 +238,7 @@ def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dic
 
 def refire(study: Study, i: int) -> dict:
     """Shot i alone, with its stored step: the same outputs as in the study."""
+    if not 0 <= i < study.shots:
+        raise invalid("shot", i, f"a shot of the study, 0..{study.shots - 1}")
     r = run_batch(study, i // study.batch)
     return {k: v[i - r.index[0]] for k, v in r.outputs.items()}

@@ -79,9 +79,9 @@ class Distribution:
             raise invalid(f"--vary {key}", text, "normal(MEAN, SD), truncnormal(MEAN, SD, LO, HI), "
                                                    "uniform(LO, HI) or lognormal(MEAN, SD)")
         kind = m.group(1).lower()
-        args = [a for a in (x.strip() for x in m.group(2).split(",")) if a]
-        if len(args) != _ARITY[kind]:
-            raise invalid(f"--vary {key}", text, f"{kind} takes {_ARITY[kind]} arguments")
+        args = [x.strip() for x in m.group(2).split(",")]
+        if len(args) != _ARITY[kind] or not all(args):
+            raise invalid(f"--vary {key}", text, f"{kind} takes {_ARITY[kind]} arguments, none of them empty")
         unit = key_unit(key)
         vals = tuple(_value(a, unit, key) for a in args)
         d = cls(key, kind, vals)
@@ -100,6 +100,8 @@ class Distribution:
             raise invalid(field, self.text(), "needs LO < HI")
         if k == "lognormal" and not p[0] > 0:
             raise invalid(field, self.text(), "a lognormal needs MEAN > 0")
+        if k == "lognormal" and not p[1] / p[0] < 1e100:  # its log's variance, log(1 + (SD/MEAN)^2), must be finite
+            raise invalid(field, self.text(), "a lognormal needs SD < 1e100 MEAN")
         support = {"normal": (p[0] - 8 * p[1], p[0] + 8 * p[1]) if k == "normal" else None,
                    "truncnormal": (p[2], p[3]) if k == "truncnormal" else None,
                    "uniform": (p[0], p[1]) if k == "uniform" else None,
@@ -110,11 +112,11 @@ class Distribution:
             below = False
         if below or above:
             unit = key_unit(self.key)
-            allowed = (f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if math.isinf(hi) else ']'}"
-                       + ("" if unit is float else f" {unit}"))
+            allowed = f"{'(' if lo_open else '['}{lo:g}, {hi:g})" + ("" if unit is float else f" {unit}")
+            remedy = ("truncate it (truncnormal) or use a lognormal" if k in ("normal", "lognormal")
+                      else "keep LO and HI inside it")
             raise invalid(field, self.text(), f"can draw values outside the allowed range {allowed} "
-                                              f"(the values in SI units); truncate it (truncnormal) "
-                                              f"or use a lognormal")
+                                              f"(the values in SI units); {remedy}")
 
     def text(self) -> str:
         return f"{self.kind}({', '.join(f'{x:g}' for x in self.params)})"
@@ -158,14 +160,26 @@ class Distribution:
 def _value(text: str, unit, key):
     if unit is float:
         try:
-            return float(text)
+            x = float(text)
         except ValueError:
-            raise invalid(f"--vary {key}", text, "a number") from None
+            raise invalid(f"--vary {key}", text, "a finite number") from None
+        if not math.isfinite(x):
+            raise invalid(f"--vary {key}", text, "a finite number")
+        return x
     return quantity(text, unit, f"--vary {key}")
 
 
 def parse_vary(items) -> list:
     """["KEY=DIST", ...] -> [Distribution]; one distribution per key."""
+    allowed = 'a list of KEY=DIST texts, e.g. ["striker.velocity=normal(0.89 m/s, 0.01 m/s)"]'
+    if isinstance(items, str):
+        raise invalid("--vary", items, allowed)
+    try:
+        items = list(items)
+    except TypeError:
+        raise invalid("--vary", items, allowed) from None
+    if not all(isinstance(item, str) for item in items):
+        raise invalid("--vary", items, allowed)
     out, seen = [], set()
     for item in items:
         if "=" not in item:
@@ -173,6 +187,9 @@ def parse_vary(items) -> list:
         key, spec = (s.strip() for s in item.split("=", 1))
         if key in seen:
             raise invalid("--vary", key, "given twice")
+        if key.split(".")[0] == "solver":
+            raise invalid("--vary", key, "a key of the scene's parts or gauges: every shot of a study takes the "
+                                         "study's own solver settings (--accuracy, --window)")
         seen.add(key)
         out.append(Distribution.parse(key, spec))
     return out

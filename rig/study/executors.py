@@ -108,6 +108,9 @@ def _dask(study, store, todo, scheduler, workers, tick, watch: WorkerWatch):
             client = Client(scheduler, timeout=10)
         except OSError as exc:
             raise RigError(f"--scheduler {scheduler}: no Dask scheduler answers there ({exc})") from None
+        except ValueError as exc:  # an address Dask cannot read: no port, an unknown scheme
+            raise RigError(f"--scheduler = {scheduler!r}: allowed 'local' or a scheduler's address such as "
+                           f"tcp://HOST:PORT ({exc})") from None
     try:
         pending = {client.submit(run_batch, study, b, pure=False) for b in todo}
         while pending:

@@ -6,10 +6,12 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import numbers
 from dataclasses import asdict, dataclass
 
 from rig.errors import invalid
+from rig.study.distributions import Distribution
 
 WINDOWS = ("leading", "record")
 OUTPUTS = ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_amplitude_N",
@@ -41,13 +43,18 @@ class Study:
     def __post_init__(self):
         if self.window not in WINDOWS:
             raise invalid("--window", self.window, f"one of {', '.join(WINDOWS)}")
-        if not isinstance(self.shots, int) or self.shots < 1:
-            raise invalid("--shots", self.shots, "a whole number >= 1")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, numbers.Integral) or not 0 <= self.seed < 2**63:
-            raise invalid("--seed", self.seed, "a whole number from 0 to 2^63 - 1")
-        object.__setattr__(self, "seed", int(self.seed))  # numpy's integers too, stored as a plain int
-        if self.batch < 1:
-            raise invalid("--batch", self.batch, "a whole number >= 1")
+        for field, name, lo, hi, allowed in (("shots", "--shots", 1, 2**32, "a whole number from 1 to 2^32"),
+                                             ("seed", "--seed", 0, 2**63 - 1, "a whole number from 0 to 2^63 - 1"),
+                                             ("batch", "--batch", 1, math.inf, "a whole number >= 1")):
+            value = getattr(self, field)
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not lo <= value <= hi:
+                raise invalid(name, value, allowed)
+            object.__setattr__(self, field, int(value))  # numpy's integers too, stored as plain ints
+        if not all(isinstance(d, Distribution) for d in self.dists):
+            raise invalid("dists", self.dists, "Distributions (rig.study.distributions.parse_vary)")
+        drawn = set(self.keys) & {o.split("=", 1)[0].strip() for o in self.overrides}
+        if drawn:
+            raise invalid("--set", ", ".join(sorted(drawn)), "a key that --vary does not draw (give it once)")
         if self.accuracy is not None:  # what solve accepts
             from rig.solver.stepsize import checked_accuracy
 
@@ -72,4 +79,6 @@ class Study:
 
     def shots_of(self, b: int) -> range:
         """The shots of batch b: shot i always belongs to batch i // batch."""
+        if isinstance(b, bool) or not isinstance(b, numbers.Integral) or not 0 <= b < self.n_batches:
+            raise invalid("batch", b, f"a whole number from 0 to {self.n_batches - 1} (the study's batches)")
         return range(b * self.batch, min(self.shots, (b + 1) * self.batch))

@@ -35,12 +35,55 @@ def _outputs(folder):
     ("chain.bead_mass=normal(0.1226 g, 0.1 g)", "outside the allowed range (0, inf) kg (the values in SI units)"),
     ("gauges.middle.gain=normal(1, 0.05)", "no gauge 'middle'"),
     ("striker.velocity=normal(0.89, 0.01)", "unit is required"),
+    ("gauges.upper.gain=normal(nan, 0.05)", "a finite number"),  # a nan gain had meant "the scene's own draw"
+    ("gauges.upper.gain=uniform(0.5, inf)", "a finite number"),
+    ("gauges.upper.gain=lognormal(1, 1e200)", "a lognormal needs SD < 1e100 MEAN"),  # had overflowed mid-run
+    ("solver.accuracy=uniform(1e-6, 2e-6)", "the study's own solver settings"),  # had been drawn and ignored
+    ("striker.velocity=normal(0.89 m/s,, 0.01 m/s)", "none of them empty"),
+    ("chain.poisson_ratio=truncnormal(0.4, 0.05, 0.3, 0.5)", "range (-1, 0.5) (the values in SI units); keep LO"),
 ])
 def test_bad_distributions_fail_before_any_shot(tmp_path, capsys, spec, message):
     out = tmp_path / "study"
     assert main(["mc", "ptfe52_magnetic", "--shots", "10", "--vary", spec, "--out", str(out), "--quiet"]) == 2
     assert message in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("extra,message", [
+    (["--set", "striker.velocity=1"], "--set = 'striker.velocity': a key that --vary does not draw"),
+    (["--scheduler", "tcp://nohost"], "--scheduler = 'tcp://nohost': allowed 'local' or a scheduler's address"),
+])
+def test_a_study_that_cannot_mean_what_it_says_is_refused_in_one_line(tmp_path, capsys, extra, message):
+    if "--scheduler" in extra:
+        pytest.importorskip("dask.distributed")
+    argv = ["mc", "ptfe52_magnetic", "--shots", "4", "--vary", VARY[0], "--out", str(tmp_path / "s"), "--quiet"]
+    assert main(argv + extra) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+
+
+def test_the_python_api_refuses_what_no_study_has_in_one_line():
+    from instruments.errors import InstrumentError
+    from instruments.streams import spawned_draws
+    from rig.errors import RigError
+    from rig.study.batch import batch_inputs, shot_inputs
+
+    study = Study("ptfe52_magnetic", tuple(parse_vary(VARY[:1])), 10, batch=4)
+    for call, message in ((lambda: run_batch(study, 3), "batch = 3: a whole number from 0 to 2"),
+                          (lambda: refire(study, 10), "shot = 10: a shot of the study, 0..9"),
+                          (lambda: shot_inputs(study, 10, 52), "shots of the study, 0..9"),
+                          (lambda: batch_inputs(study, 5, 3, 52), "shots of the study, 0..9"),
+                          (lambda: Study("ptfe52_magnetic", study.dists, 10, batch=2.5), "--batch = 2.5"),
+                          (lambda: parse_vary(VARY[0]), "a list of KEY=DIST texts")):
+        with pytest.raises(RigError, match=message):
+            call()
+    # a negative size had written past the rows' ends (the interpreter aborted)
+    for args, message in (((["normal", "normal"], [5, -3]), "size = -3"),
+                          ((["normal"], [1, 2]), "two sequences of one length"),
+                          (("normal", [1]), "two sequences of one length")):
+        with pytest.raises(InstrumentError, match=message):
+            spawned_draws(1, 0, 2, *args)
+    assert Study("ptfe52_magnetic", study.dists, np.int64(10), batch=np.int64(4)).digest() == study.digest()
 
 
 @pytest.mark.slow
