@@ -20,6 +20,7 @@ the rounds and the median of the per-round ratios.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 import statistics
 import tempfile
@@ -130,7 +131,9 @@ STAGES = {"inputs": "each shot's inputs drawn, the shots' arrays built",
 
 def _stages(study: Study, batches: int = 4) -> dict:
     """Wall time per shot (us) of each stage of a batch, run in turn as run_batch runs them
-    (numba's threads, Python's cycle collector paused; after WARM_UP batches)."""
+    (numba's threads, Python's cycle collector paused; after WARM_UP batches of the study,
+    which is made long enough to hold them)."""
+    study = dataclasses.replace(study, shots=max(study.shots, (WARM_UP + batches) * BATCH))
     setting = Setting.of(study)
     template = setting.template
     wiring = wiring_of(template)
