@@ -24,9 +24,17 @@ def _registry():
     return pint.UnitRegistry(cache_folder=":auto:")
 
 
+MAX_SEED = 2**63 - 1  # seeds are stored as signed 64-bit integers
+
+
 def is_real(x) -> bool:
     """A real number, numpy's scalars included, and not a bool (True is not 1 s)."""
     return isinstance(x, numbers.Real) and not isinstance(x, bool)
+
+
+def is_whole(x) -> bool:
+    """A whole number, numpy's integers included, and not a bool."""
+    return isinstance(x, numbers.Integral) and not isinstance(x, bool)
 
 
 def quantity(value, unit: str, field: str, *, bare_ok: bool = False) -> float:

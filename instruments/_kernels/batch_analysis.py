@@ -28,7 +28,7 @@ def analyse_shot(codes, time0, dx, n_pre, ymult, yoff, yzero, roles, tau, sens, 
         for k in range(codes.shape[1]):  # the codes' volts (records.ScopeRecord's operations)
             volts[k] = yzero[c] + ymult[c] * (np.float64(codes[c, k]) - yoff[c])
         undo_highpass_into(volts, baseline_mean(volts, n_pre), dx, tau[r], sens[r], volts)  # conditioned, in place
-        sigma[r] = noise_level(f[r], n_pre, abs(ymult[c]) / sens[r])
+        sigma[r] = noise_level(volts, n_pre, abs(ymult[c]) / sens[r])
         for k in range(codes.shape[1]):
             if not math.isfinite(volts[k]):
                 return False

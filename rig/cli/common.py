@@ -6,7 +6,7 @@ import contextlib
 import math
 import sys
 
-MAX_SEED = 2**63 - 1  # seeds are stored as signed 64-bit integers
+from rig.units import MAX_SEED
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -28,7 +28,7 @@ from rig.solver.ensemble import solve_ensemble
 from rig.solver.methods import method as get_method
 from rig.solver.problem import ChainProblem
 from rig.solver.run import Unstable
-from rig.solver.solution import Solution, Status
+from rig.solver.solution import Solution
 from rig.solver.stepsize import accuracy_step, checked_accuracy, head_contacts, largest_step, stepping_at
 
 PILOT_BASIS = "fit pilot"
@@ -133,7 +133,7 @@ def solve_rigs(rigs: list, pilot: Pilot | None = None) -> list:
         acc = checked_accuracy(r0.solver.accuracy)
         ens = solve_ensemble([problems[i] for i in members], t_end, save=r0.save_at(), dt=stepping, method=m.name)
         for e, i in enumerate(members):
-            if ens.reports[e].status is not Status.SUCCESS:
+            if not ens.succeeded[e]:
                 continue
             forces = {name: a[e] for name, a in ens.forces.items()}
             stats = ens.stats(e, acc) if pilot is None else ens.stats(e, acc, pilot.estimate, PILOT_BASIS)

@@ -54,7 +54,7 @@ class EnsembleSolution:
         """Each shot's KernelReport (energy and momentum errors, wall impulse, status)."""
         return tuple(KernelReport.of(self.diagnostics[:, j]) for j in range(self.shots))
 
-    @property
+    @functools.cached_property
     def succeeded(self) -> np.ndarray:
         """(shots,) bool: the shots whose status is Status.SUCCESS."""
         return self.diagnostics[KernelReport.STATUS] == Status.SUCCESS

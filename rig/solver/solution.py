@@ -43,7 +43,7 @@ class KernelReport:
 
     @classmethod
     def of(cls, diag) -> "KernelReport":
-        return cls(float(diag[0]), float(diag[1]), float(diag[2]), Status(int(diag[3])),
+        return cls(float(diag[cls.ENERGY_ERROR]), float(diag[1]), float(diag[2]), Status(int(diag[cls.STATUS])),
                    int(diag[4]), float(diag[5]), float(diag[6]), float(diag[7]) / max(int(diag[4]), 1))
 
 

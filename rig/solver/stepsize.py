@@ -33,7 +33,6 @@ taus (away from the resonances of multiple time stepping).
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,7 +42,7 @@ from rig.memo import computed_once
 from rig.model.contact import contact_stiffness
 from rig.solver.methods import Method
 from rig.theory.longwave import sonic_vacuum_speed, sound_speed
-from rig.units import is_real
+from rig.units import is_real, is_whole
 
 DEFAULT_ACCURACY = 1e-4
 HEAD_RATIO = 0.5   # a leading contact with tau < HEAD_RATIO x median tau is integrated apart
@@ -63,7 +62,7 @@ class Stepping:
     inner_dt: float = math.inf
 
     def __post_init__(self):
-        if not is_real(self.head) or not isinstance(self.head, numbers.Integral) or self.head < 0:
+        if not is_whole(self.head) or self.head < 0:
             raise invalid("dt.head", self.head, "the head's contacts: a whole number >= 0")
         if not is_real(self.inner_dt) or not self.inner_dt > 0:
             raise invalid("dt.inner_dt", self.inner_dt, "the head's substep: a number > 0 s (inf: none)")

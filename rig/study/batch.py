@@ -21,7 +21,7 @@ from rig.experiment.shot import Rig
 from rig.solver.ensemble import solve_ensemble
 from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
-from rig.solver.solution import Solution, Status
+from rig.solver.solution import Solution
 from rig.solver.stepsize import stepping_at
 from rig.study.mc_spec import FAILURES, OUTPUTS, Study
 from rig.study.nominal import copied_table, nominal
@@ -213,7 +213,7 @@ def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dic
     beta, F0 = nom.calibration
     setup = setup_for(template, beta, F0)
     for e, ((j, rig), p) in enumerate(zip(rigs.items(), problems)):
-        if ens.reports[e].status is not Status.SUCCESS:
+        if not ens.succeeded[e]:
             out["failure"][j] = UNSTABLE
             continue
         stats = ens.stats(e, pilot.accuracy, pilot.error_estimate)

@@ -138,11 +138,16 @@ class Distribution:
         if k == "uniform":
             return p[0] + (p[1] - p[0]) * z
         if k == "lognormal":
-            s2 = math.log1p((p[1] / p[0]) ** 2)
-            mu, sigma = math.log(p[0]) - 0.5 * s2, math.sqrt(s2)
+            mu, sigma = self._log_params()
             return np.array([math.exp(mu + sigma * v) for v in np.ravel(z)]).reshape(np.shape(z))
         a, b = (p[2] - p[0]) / p[1], (p[3] - p[0]) / p[1]
         return stats.truncnorm.ppf(z, a, b, loc=p[0], scale=p[1])
+
+    def _log_params(self) -> tuple:
+        """A lognormal's (mu, sigma): the mean and sd of its log, from its MEAN and SD."""
+        mean, sd = self.params
+        s2 = math.log1p((sd / mean) ** 2)
+        return math.log(mean) - 0.5 * s2, math.sqrt(s2)
 
     def salib(self):
         """(dist name, bounds) in SALib's terms, for Sobol sampling."""
@@ -152,8 +157,7 @@ class Distribution:
         if k == "normal":
             return "norm", [p[0], p[1]]
         if k == "lognormal":
-            s2 = math.log1p((p[1] / p[0]) ** 2)
-            return "lognorm", [math.log(p[0]) - 0.5 * s2, math.sqrt(s2)]
+            return "lognorm", list(self._log_params())
         return "truncnorm", [p[2], p[3], p[0], p[1]]
 
 

@@ -7,11 +7,11 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import numbers
 from dataclasses import asdict, dataclass
 
 from rig.errors import invalid
 from rig.study.distributions import Distribution
+from rig.units import MAX_SEED, is_whole
 
 WINDOWS = ("leading", "record")
 OUTPUTS = ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_amplitude_N",
@@ -44,10 +44,10 @@ class Study:
         if self.window not in WINDOWS:
             raise invalid("--window", self.window, f"one of {', '.join(WINDOWS)}")
         for field, name, lo, hi, allowed in (("shots", "--shots", 1, 2**32, "a whole number from 1 to 2^32"),
-                                             ("seed", "--seed", 0, 2**63 - 1, "a whole number from 0 to 2^63 - 1"),
+                                             ("seed", "--seed", 0, MAX_SEED, "a whole number from 0 to 2^63 - 1"),
                                              ("batch", "--batch", 1, math.inf, "a whole number >= 1")):
             value = getattr(self, field)
-            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not lo <= value <= hi:
+            if not is_whole(value) or not lo <= value <= hi:
                 raise invalid(name, value, allowed)
             object.__setattr__(self, field, int(value))  # numpy's integers too, stored as plain ints
         if not all(isinstance(d, Distribution) for d in self.dists):
@@ -79,6 +79,6 @@ class Study:
 
     def shots_of(self, b: int) -> range:
         """The shots of batch b: shot i always belongs to batch i // batch."""
-        if isinstance(b, bool) or not isinstance(b, numbers.Integral) or not 0 <= b < self.n_batches:
+        if not is_whole(b) or not 0 <= b < self.n_batches:
             raise invalid("batch", b, f"a whole number from 0 to {self.n_batches - 1} (the study's batches)")
         return range(b * self.batch, min(self.shots, (b + 1) * self.batch))
