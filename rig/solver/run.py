@@ -11,6 +11,7 @@ import numpy as np
 
 from rig.errors import RigError, invalid
 from rig.solver.kernels.integrators import integrate
+from rig.solver.kernels.layout import working_arrays
 from rig.solver.methods import Method
 from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
@@ -86,12 +87,12 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     check_record(problem, save, n_out, n_frames)
     out = np.zeros((len(save.names), n_out))
     frames = np.zeros((n_frames, problem.n_bodies))
-    u = problem.u0.copy()
-    v = problem.v0.copy()
+    invm, A, d0, load, u, v, f = working_arrays(problem.invm, problem.A, problem.d0, problem.load, problem.u0,
+                                                problem.v0, np.zeros(problem.n_bodies + 1))
     diag = np.zeros(DIAGNOSTICS)
     check_every = check_interval(n_steps)
 
-    args = (problem.mass, problem.invm, problem.bias, problem.load, problem.A, problem.d0, problem.law,
+    args = (f, problem.mass, invm, problem.bias, load, A, d0, problem.law,
             np.stack((problem.expo, problem.damping, problem.dashpot)), np.stack((problem.drag, problem.friction)),
             problem.slip_speed, viscous_rate(problem), np.array(m.drifts), np.array(m.kicks), step)
     mid = (stepping.head, sub)

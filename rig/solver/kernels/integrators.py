@@ -72,7 +72,7 @@ def still_from(u, v, u_rest, lo, hi):
 
 
 @jit
-def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_rate,
+def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_rate,
               a_coef, b_coef, dt, n_steps, head, sub,
               sched_body, sched_t, sched_f,
               ch_slot, ch_weight, sample_dt, out,
@@ -80,6 +80,8 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
               check_every, d_limit, wall_slot, e_ref, p_ref, diag, front):
     """Integrate n_steps of size dt in place; fill out (n_ch, n_out) and frames (n_fr, nb).
 
+    f (size nb + 1): the contact forces' work array (layout.working_arrays places it with
+    u, v and the parameters the passes read).
     law: the contact code (forces.py) with con (3, nb): each slot's exponent, damping
     time (s) and dashpot (kg/s); onsite (2, nb): each body's drag rate (1/s) and friction
     deceleration (m/s^2), smoothed over slip (m/s); viscous_rate (1/s): a bound on the
@@ -95,7 +97,7 @@ def integrate(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, visco
     every step (the same bits).
     """
     nb = u.shape[0]
-    f = np.zeros(nb + 1)
+    f[:] = 0.0
     f[nb] = -load[nb]
     n_drift = a_coef.shape[0]
     n_ch = ch_slot.shape[0]

@@ -15,6 +15,7 @@ import numpy as np
 from instruments.jit import jit
 from rig.model.contact import POWER
 from rig.solver.kernels.forces import other_law
+from rig.solver.kernels.layout import LINE
 from rig.solver.kernels.multirate import head_flow
 
 
@@ -134,6 +135,8 @@ def step(u, v, invm, f, A, d0, load, law, expo, a_coef, b_coef, dt, t, pending, 
                     v[0] = v0
                     u[0] += h * v0
                     lo = 1
-            if hi > lo:
-                fused_run(u, v, invm, f, A, d0, load, hb, h, lo, hi, law, expo)
+            if hi > lo:  # from the first cache line on, the vector loads are aligned (layout.py)
+                line = min(hi, (lo + LINE - 1) // LINE * LINE)
+                fused_run(u, v, invm, f, A, d0, load, hb, h, lo, line, law, expo)
+                fused_run(u, v, invm, f, A, d0, load, hb, h, line, hi, law, expo)
             ts += h
