@@ -29,6 +29,17 @@ def test_working_arrays_are_separate_copies_at_their_page_offsets():
     assert all(np.array_equal(a, b) for a, b in zip(arrays, kept)), "working_arrays wrote to the caller's arrays"
 
 
+def test_no_array_starts_just_below_a_stored_one():
+    """The page offsets keep every array (invm, A, d0, load, u, v, f) out of the 640 bytes
+    below a stored one (u, v, f), modulo a page: the module doc's rule."""
+    stored = PAGE_OFFSETS[4:]
+    for s in stored:
+        for other in PAGE_OFFSETS:
+            if other != s:
+                assert (s - other) % PAGE > 640, (s, other)
+    assert all(o % 64 == 0 for o in PAGE_OFFSETS) and len(set(PAGE_OFFSETS)) == 7
+
+
 @pytest.mark.parametrize("nb,width", [(55, 128), (3, 8), (1001, 40)])
 def test_a_chunk_of_the_batched_kernel_gets_the_same_layout(nb, width):
     rng = np.random.default_rng(5)

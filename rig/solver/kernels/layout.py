@@ -9,13 +9,15 @@ things about their addresses cost time without changing a bit of the result:
   every load and store with an array whose element 0 starts a cache line (the batched
   kernel's rows of 8 to 128 shots start lines when the array does).
 - 4 KiB aliasing. The core matches a load against the stores in flight by the low 12 bits
-  of their addresses: a load whose address lies a little above a recent store's modulo
-  4096 bytes waits for that store as if it depended on it. Arrays from the allocator fall
-  anywhere modulo 4096 (numpy's large ones all 16 bytes past a page): where a loaded array
-  started a few hundred bytes below a stored one, the single-shot passes took up to 1.6x
-  as long (the 1,000-bead benchmark chain). ``working_arrays`` places the seven arrays in
-  one page-aligned workspace at fixed offsets in a 4 KiB page (PAGE_OFFSETS): no array
-  starts within 640 bytes (80 bodies, more than the stores in flight) below a stored one.
+  of their addresses: a load from an address 4096 k bytes away from a recent store's waits
+  for that store as if it read what it wrote. A pass that stores array S at body i and
+  loads array L at a later body j so meets S's store where L starts 8 (j - i) bytes below
+  S modulo 4096. Arrays from the allocator fall anywhere modulo 4096 (numpy's large ones
+  all 16 bytes past a page, the same offset): where a loaded array started a few hundred
+  bytes below a stored one, the single-shot passes took up to 1.6x as long (the 1,000-bead
+  benchmark chain). ``working_arrays`` places the seven arrays in one page-aligned
+  workspace at fixed offsets in a 4 KiB page (PAGE_OFFSETS): no array starts within 640
+  bytes (80 bodies, more than the stores in flight) below a stored one.
 """
 import numpy as np
 
