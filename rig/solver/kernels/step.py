@@ -61,18 +61,24 @@ def fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, expo):
 
     The index is unsigned: with a signed start known only at run time numba keeps its
     negative-index wraparound in the loop and LLVM no longer vectorises it
-    (tests/solver/test_vectorised.py guards this)."""
+    (tests/solver/test_vectorised.py guards this). The bodies up to the first multiple of
+    LINE run first: the vector loop then starts on a cache line of arrays placed by
+    layout.py (one call for both parts: each call of an inlined function costs atomic
+    reference counts of its arrays)."""
     one = np.uint64(1)
     u_prev = u[lo - 1]
-    for i in range(np.uint64(lo), np.uint64(hi)):
-        vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
-        v[i] = vi
-        ui = u[i] + ha * vi
-        u[i] = ui
-        d = d0[i] + u_prev - ui
-        d = d if d > 0.0 else 0.0
-        f[i] = A[i] * d * math.sqrt(d) - load[i]
-        u_prev = ui
+    line = min(hi, (lo + LINE - 1) // LINE * LINE)
+    for part in range(2):  # bodies up to the first cache line, then the rest from it (aligned, layout.py)
+        start, stop = (lo, line) if part == 0 else (line, hi)
+        for i in range(np.uint64(start), np.uint64(stop)):
+            vi = v[i] + hb * (f[i] - f[i + one]) * invm[i]
+            v[i] = vi
+            ui = u[i] + ha * vi
+            u[i] = ui
+            d = d0[i] + u_prev - ui
+            d = d if d > 0.0 else 0.0
+            f[i] = A[i] * d * math.sqrt(d) - load[i]
+            u_prev = ui
     if law == POWER:  # not in the loop: a pow there (even behind a branch) stops it vectorising
         other_law(u, A, d0, load, f, expo, lo, hi)
 
@@ -125,7 +131,8 @@ def step(u, v, invm, f, A, d0, load, law, expo, a_coef, b_coef, dt, t, pending, 
             if k == n_blocks - 1 and wall_slot > 0:
                 impulses[0] += hb * f[wall_slot]
             if k == 0:
-                impulses[1] += external_kick(v, invm, hb, ts, sched_body, sched_t, sched_f)
+                if sched_t.shape[0] > 0:  # entered only with a schedule: the inlined kick's reference counts
+                    impulses[1] += external_kick(v, invm, hb, ts, sched_body, sched_t, sched_f)
                 if head > 0:
                     v[head] += hb * (0.0 - f[head + 1]) * invm[head]
                     head_flow(u2, v2, im2, f2, A2, d02, load2, head, a_coef, b_coef, h, sub[s], h_work, h_busy)
@@ -135,8 +142,6 @@ def step(u, v, invm, f, A, d0, load, law, expo, a_coef, b_coef, dt, t, pending, 
                     v[0] = v0
                     u[0] += h * v0
                     lo = 1
-            if hi > lo:  # from the first cache line on, the vector loads are aligned (layout.py)
-                line = min(hi, (lo + LINE - 1) // LINE * LINE)
-                fused_run(u, v, invm, f, A, d0, load, hb, h, lo, line, law, expo)
-                fused_run(u, v, invm, f, A, d0, load, hb, h, line, hi, law, expo)
+            if hi > lo:
+                fused_run(u, v, invm, f, A, d0, load, hb, h, lo, hi, law, expo)
             ts += h
