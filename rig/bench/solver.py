@@ -194,7 +194,11 @@ def _interpolate(points, e):
     return math.exp(math.log(c0) + w * (math.log(c1) - math.log(c0)))
 
 
-def run(quick: bool = False, peers: bool = False, baseline: str | None = None, progress=None) -> dict:
+def run(quick: bool = False, peers: bool = False, baseline: str | None = None, progress=None,
+        kernel_rounds: int | None = None) -> dict:
+    """The work-precision rows and their equal-error table, the kernel figure (with
+    ``baseline`` in turns, over ``kernel_rounds`` rounds: default 3, 1 with ``quick``), the
+    cost per simulated second from 1e3 to 1e6 beads and the optional models' costs."""
     divisions = QUICK["divisions"] if quick else DIVISIONS
     settings = QUICK["settings"] if quick else SETTINGS
     names = QUICK["scenarios"] if quick else tuple(SCENARIOS)
@@ -216,7 +220,7 @@ def run(quick: bool = False, peers: bool = False, baseline: str | None = None, p
     return dict(rows=median_rows(per_round), at_equal_error=equal_error_rounds(per_round), rounds=rounds,
                 notes=notes, machine=machine(), beads=N_BEADS, probe_contact=PROBE,
                 # three repeats even when quick: a lone first solve in a fresh process ran at twice the cost
-                kernel=kernel_figures(3 if quick else 5, 1 if quick else 3, baseline, progress),
+                kernel=kernel_figures(3 if quick else 5, kernel_rounds or (1 if quick else 3), baseline, progress),
                 scaling=None if quick else scaling(chain, progress), models=models.run(quick, progress))
 
 

@@ -5,7 +5,9 @@ import math
 import sys
 
 from rig.cli.common import quantity_arg as _q
-from rig.errors import RigError
+from rig.errors import RigError, invalid
+
+MAX_ROUNDS = 100  # rounds of rig bench's figures measured in turns with a baseline
 
 
 def cmd_theory(args) -> dict:
@@ -56,14 +58,21 @@ def cmd_bench(args) -> dict:
         raise RigError(f"--peers: only rig bench solver has peers (not {args.what})")
     if args.baseline and args.what not in ("solver", "mc"):
         raise RigError(f"--baseline {args.baseline}: only rig bench solver and rig bench mc measure a baseline")
+    if args.rounds is not None:
+        if args.what not in ("solver", "mc"):
+            raise RigError(f"--rounds {args.rounds}: only rig bench solver and rig bench mc take rounds")
+        if not 1 <= args.rounds <= MAX_ROUNDS:
+            raise invalid("--rounds", args.rounds, f"a whole number of rounds from 1 to {MAX_ROUNDS}")
     kw = {}
     if args.what in ("solver", "accuracy", "models", "fit"):
         kw = {"quick": args.quick,
               "progress": None if args.json else (lambda msg: print(f"  running {msg}", file=sys.stderr, flush=True))}
     if args.what == "solver":
-        kw.update(peers=args.peers, baseline=args.baseline)
+        kw.update(peers=args.peers, baseline=args.baseline, kernel_rounds=args.rounds)
     if args.what == "mc" and args.baseline:
         kw["baseline"] = args.baseline
+    if args.what == "mc" and args.rounds is not None:
+        kw["rounds"] = args.rounds
     result = module.run(**kw)
     if not args.json:
         if args.what == "solver":

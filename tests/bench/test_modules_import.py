@@ -37,3 +37,24 @@ def test_the_mc_benchmarks_stages_run_on_a_small_study(monkeypatch):
     for key in ("solver_kernel_shots_per_s", "solver_shots_per_s", "pipeline_shots_per_s",
                 *(f"stage_{k}_us_per_shot" for k in mc.STAGES)):
         assert figures[key] > 0, key
+
+
+@pytest.mark.parametrize("what,argv,expected", [
+    ("mc", [], {}),
+    ("mc", ["--rounds", "7"], {"rounds": 7}),
+    ("mc", ["--rounds", "2", "--baseline", "HEAD"], {"rounds": 2, "baseline": "HEAD"}),
+    ("solver", ["--rounds", "5", "--quick"], {"kernel_rounds": 5, "quick": True}),
+    ("solver", [], {"kernel_rounds": None}),
+])
+def test_rounds_reach_the_benchmark(monkeypatch, what, argv, expected):
+    """rig bench's --rounds is passed to the benchmark it names (the run itself replaced)."""
+    from rig.cli import main
+
+    module = importlib.import_module(f"rig.bench.{what}")
+    seen = {}
+    monkeypatch.setattr(module, "run", lambda **kw: seen.update(kw) or {})
+    assert main(["bench", what, *argv, "--json"]) == 0
+    for key, value in expected.items():
+        assert seen[key] == value, key
+    if what == "mc" and "--rounds" not in argv:
+        assert "rounds" not in seen  # mc.run's own default

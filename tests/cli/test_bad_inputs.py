@@ -157,6 +157,10 @@ CASES = [
     (["theory"], "--f0"),
     # bench and the parser
     (["bench", "nosuch"], "nosuch"),
+    (["bench", "mc", "--rounds", "0"], "--rounds"),
+    (["bench", "solver", "--rounds", "101"], "--rounds"),
+    (["bench", "mc", "--rounds", "two"], "--rounds"),
+    (["bench", "shot", "--rounds", "2"], "--rounds"),
     (["nosuch"], "nosuch"),
     # analyze, import, verify, ls (the archive and the analysis)
     (["analyze", "{d}/missing.isf", "--gauge-distance", "43 mm"], "missing.isf"),
