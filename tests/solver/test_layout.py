@@ -7,7 +7,7 @@ from conftest import ptfe_rig
 import rig.solver.run as run
 from rig import Bead, Chain, ChainProblem, SaveAt, Striker, Wall
 from rig.bench.kernel_cost import in_motion
-from rig.solver.kernels.layout import PAGE, PAGE_OFFSETS, chunk_arrays, working_arrays
+from rig.solver.kernels.layout import PAGE, PAGE_OFFSETS, working_arrays
 from rig.solver.methods import method
 from rig.solver.stepsize import Stepping, contact_time_scale, stepping_at
 
@@ -38,19 +38,6 @@ def test_no_array_starts_just_below_a_stored_one():
             if other != s:
                 assert (s - other) % PAGE > 640, (s, other)
     assert all(o % 64 == 0 for o in PAGE_OFFSETS) and len(set(PAGE_OFFSETS)) == 7
-
-
-@pytest.mark.parametrize("nb,width", [(55, 128), (3, 8), (1001, 40)])
-def test_a_chunk_of_the_batched_kernel_gets_the_same_layout(nb, width):
-    rng = np.random.default_rng(5)
-    arrays = [rng.standard_normal((nb + (k == 3), width)) for k in range(6)]  # load has a row more
-    out = chunk_arrays(*arrays)
-    assert len(out) == 7
-    for k, x in enumerate(out):
-        assert x.ctypes.data % PAGE == PAGE_OFFSETS[k] and x.flags.c_contiguous
-        assert np.array_equal(x, arrays[k]) if k < 6 else (x.shape == (nb + 1, width) and not x.any())
-        for y in out[k + 1:]:
-            assert not np.shares_memory(x, y)
 
 
 def _misplaced(*arrays):

@@ -22,7 +22,6 @@ from rig.model.contact import HERTZ, POWER
 from rig.solver.kernels.dissipation import dissipate, holder_factors
 from rig.solver.kernels.forces import contact_force, power, state_sums
 from rig.solver.kernels.integrators import rest_from, still_from
-from rig.solver.kernels.layout import chunk_arrays
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
 
@@ -265,18 +264,15 @@ def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, law, con, onsite, sl
     (chunks, 3, bodies, width) and onsite (chunks, 2, bodies, width) as in the single-shot
     kernel; out is (shots, channels, samples), each shot's record contiguous, chunk k
     holding shots k width .. (k + 1) width - 1 (fill past the last shot); diag is
-    (chunks, DIAGNOSTICS, width) as in the single-shot kernel. Each chunk runs on copies of
-    its arrays that layout.chunk_arrays places in memory."""
+    (chunks, DIAGNOSTICS, width) as in the single-shot kernel."""
     n_chunks, nb, W = u.shape
     n_ch = ch_slot.shape[0]
     for k in prange(n_chunks):
-        invm_k, A_k, d0_k, load_k, u_k, v_k, f = chunk_arrays(invm[k], A[k], d0[k], load[k], u[k], v[k])
+        f = np.zeros((nb + 1, W))
         d_old = np.zeros((n_ch, ch_slot.shape[1], W))
         r_old = np.zeros((n_ch, ch_slot.shape[1], W))
         d_new = np.zeros((n_ch, ch_slot.shape[1], W))
         r_new = np.zeros((n_ch, ch_slot.shape[1], W))
-        _chunk(u_k, v_k, mass[k], invm_k, bias[k], load_k, A_k, d0_k, law, con[k], onsite[k], slip,
+        _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], law, con[k], onsite[k], slip,
                viscous_rate, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, k * W,
                check_every, d_limit[k], wall_slot, e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)
-        u[k] = u_k
-        v[k] = v_k
