@@ -44,6 +44,17 @@ def machine(cpuinfo: str = "/proc/cpuinfo") -> str:
     return f"{model}, {vector} ({os.cpu_count()} cores), {platform.system()} {platform.machine()}"
 
 
+def check_revision(rev: str) -> None:
+    """Refuse, before anything is measured, a revision this checkout cannot check out."""
+    if not (ROOT / ".git").exists():
+        raise RigError(f"--baseline {rev}: the rig is not run from a git checkout, so no other revision is at hand")
+    done = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--verify", "--quiet", f"{rev}^{{commit}}"],
+                          capture_output=True, text=True)
+    if done.returncode:
+        raise RigError(f"--baseline {rev}: no such revision in this checkout (a commit, a tag or a branch: "
+                       f"git log --oneline lists them)")
+
+
 @contextlib.contextmanager
 def checkout(rev: str):
     """A temporary worktree of revision ``rev`` of this checkout (its path), removed after."""

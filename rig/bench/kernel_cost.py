@@ -88,7 +88,7 @@ def kernel_figures(repeats: int, rounds: int, baseline: str | None, progress=Non
             runs["current"].append(measure(ROOT, snippet))
             if tree is not None:
                 runs["baseline"].append(measure(tree, snippet))
-    out = {"beads": [n for n, *_ in KERNEL_SIZES], "baseline_rev": baseline}
+    out = {"beads": [n for n, *_ in KERNEL_SIZES], "baseline_rev": baseline, "rounds": rounds}
     for who, rs in runs.items():
         if rs:
             out[who] = {str(n): statistics.median(r[str(n)] for r in rs) for n, *_ in KERNEL_SIZES}

@@ -239,7 +239,8 @@ def table(result: dict) -> str:
             ratio = f"{r['ratio_to_srkn6b']:7.1f} x" if r["ratio_to_srkn6b"] else "      -"
             lines.append(f"  {r['scenario']:14s} {r['method']:18s} error {r['error']:.0e}  {r['cpu_s']:8.4f} s {ratio}")
     k = result["kernel"]
-    lines += ["", "Whole srkn6b step, ns per bead per force evaluation (CPU, medians of rounds):"]
+    lines += ["", f"Whole srkn6b step, ns per bead per force evaluation (CPU, medians of "
+                  f"{k['rounds']} round(s)):"]
     for n in k["beads"]:
         base = (f"   baseline {k['baseline_rev']}: {k['baseline'][str(n)]:.2f}, ratio {k['ratio'][str(n)]:.2f}"
                 if "baseline" in k else "")

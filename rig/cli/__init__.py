@@ -20,6 +20,7 @@ from rig.cli.common import (
     os_error_line,
     positive_seconds,
     quantity_type,
+    rounds_arg,
     seed_arg,
 )
 from rig.errors import Interrupted, RigError
@@ -175,10 +176,10 @@ def build_parser() -> argparse.ArgumentParser:
                     help="solver: also scipy's DOP853, a numba-compiled DOP853 and LAMMPS (when installed)")
     be.add_argument("--baseline", metavar="REV",
                     help="solver, mc: measure git revision REV of this checkout too, in turns with the current code")
-    be.add_argument("--rounds", type=int, metavar="N",
-                    help="solver, mc: rounds of the figures measured in turns with --baseline (solver: its kernel "
-                         "figure; default 3, --quick 1 for the solver); more rounds steady the ratios on a "
-                         "machine whose speed swings")
+    be.add_argument("--rounds", type=rounds_arg, metavar="N",
+                    help="solver, mc: rounds, 1 to 100, of the figures that run in turns with --baseline (solver: "
+                         "its kernel figure only, default 3, 1 with --quick; mc: every figure, default 3); more "
+                         "rounds steady the ratios on a machine whose speed swings")
     return ap
 
 

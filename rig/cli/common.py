@@ -120,6 +120,20 @@ def check_size(estimate, args, what: str):
         print(f"{what} needs {estimate.describe()}", file=sys.stderr, flush=True)
 
 
+MAX_ROUNDS = 100  # rounds of rig bench's figures measured in turns with a baseline
+
+
+def rounds_arg(text: str) -> int:
+    """rig bench --rounds: a whole number from 1 to MAX_ROUNDS."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if not 1 <= value <= MAX_ROUNDS:
+        raise argparse.ArgumentTypeError(f"{text!r}: a whole number of rounds from 1 to {MAX_ROUNDS}")
+    return value
+
+
 def count_arg(text: str) -> int:
     """A whole number >= 1."""
     try:

@@ -7,8 +7,6 @@ import sys
 from rig.cli.common import quantity_arg as _q
 from rig.errors import RigError, invalid
 
-MAX_ROUNDS = 100  # rounds of rig bench's figures measured in turns with a baseline
-
 
 def cmd_theory(args) -> dict:
     from rig.model.contact import hertz_constant
@@ -60,9 +58,11 @@ def cmd_bench(args) -> dict:
         raise RigError(f"--baseline {args.baseline}: only rig bench solver and rig bench mc measure a baseline")
     if args.rounds is not None:
         if args.what not in ("solver", "mc"):
-            raise RigError(f"--rounds {args.rounds}: only rig bench solver and rig bench mc take rounds")
-        if not 1 <= args.rounds <= MAX_ROUNDS:
-            raise invalid("--rounds", args.rounds, f"a whole number of rounds from 1 to {MAX_ROUNDS}")
+            raise invalid("--rounds", args.rounds, "only rig bench solver and rig bench mc take rounds")
+    if args.baseline:
+        from rig.bench.baseline import check_revision
+
+        check_revision(args.baseline)
     kw = {}
     if args.what in ("solver", "accuracy", "models", "fit"):
         kw = {"quick": args.quick,

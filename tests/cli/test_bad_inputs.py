@@ -161,6 +161,9 @@ CASES = [
     (["bench", "solver", "--rounds", "101"], "--rounds"),
     (["bench", "mc", "--rounds", "two"], "--rounds"),
     (["bench", "shot", "--rounds", "2"], "--rounds"),
+    (["bench", "mc", "--rounds", "1.5"], "--rounds"),
+    (["bench", "solver", "--quick", "--baseline", "nosuchrev"], "nosuchrev"),
+    (["bench", "mc", "--baseline", "nosuchrev"], "nosuchrev"),
     (["nosuch"], "nosuch"),
     # analyze, import, verify, ls (the archive and the analysis)
     (["analyze", "{d}/missing.isf", "--gauge-distance", "43 mm"], "missing.isf"),
