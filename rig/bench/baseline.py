@@ -58,8 +58,7 @@ def check_revision(rev: str) -> None:
 @contextlib.contextmanager
 def checkout(rev: str):
     """A temporary worktree of revision ``rev`` of this checkout (its path), removed after."""
-    if not (ROOT / ".git").exists():
-        raise RigError(f"--baseline {rev}: the rig is not run from a git checkout, so no other revision is at hand")
+    check_revision(rev)
     folder = Path(tempfile.mkdtemp(prefix="rig-baseline-")) / "tree"
     done = subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(folder), rev],
                           capture_output=True, text=True)

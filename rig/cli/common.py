@@ -20,15 +20,21 @@ class OneLineParser(argparse.ArgumentParser):
         sys.exit(2)
 
 
+def whole_number(text: str, low: int, high: float, allowed: str) -> int:
+    """The command-line whole number ``text`` in [low, high]; else argparse's refusal
+    ``'TEXT': allowed``."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: {allowed}") from None
+    if not low <= value <= high:
+        raise argparse.ArgumentTypeError(f"{text!r}: {allowed}")
+    return value
+
+
 def seed_arg(text: str) -> int:
     """A seed: a whole number from 0 to 2^63 - 1."""
-    try:
-        seed = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: a whole number from 0 to {MAX_SEED}") from None
-    if not 0 <= seed <= MAX_SEED:
-        raise argparse.ArgumentTypeError(f"{text!r}: a whole number from 0 to {MAX_SEED}")
-    return seed
+    return whole_number(text, 0, MAX_SEED, f"a whole number from 0 to {MAX_SEED}")
 
 
 def quantity_arg(text: str, unit: str, field: str) -> float:
@@ -125,24 +131,12 @@ MAX_ROUNDS = 100  # rounds of rig bench's figures measured in turns with a basel
 
 def rounds_arg(text: str) -> int:
     """rig bench --rounds: a whole number from 1 to MAX_ROUNDS."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if not 1 <= value <= MAX_ROUNDS:
-        raise argparse.ArgumentTypeError(f"{text!r}: a whole number of rounds from 1 to {MAX_ROUNDS}")
-    return value
+    return whole_number(text, 1, MAX_ROUNDS, f"a whole number of rounds from 1 to {MAX_ROUNDS}")
 
 
 def count_arg(text: str) -> int:
     """A whole number >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r}: a whole number >= 1")
-    return value
+    return whole_number(text, 1, math.inf, "a whole number >= 1")
 
 
 @contextlib.contextmanager

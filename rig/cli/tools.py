@@ -56,9 +56,8 @@ def cmd_bench(args) -> dict:
         raise RigError(f"--peers: only rig bench solver has peers (not {args.what})")
     if args.baseline and args.what not in ("solver", "mc"):
         raise RigError(f"--baseline {args.baseline}: only rig bench solver and rig bench mc measure a baseline")
-    if args.rounds is not None:
-        if args.what not in ("solver", "mc"):
-            raise invalid("--rounds", args.rounds, "only rig bench solver and rig bench mc take rounds")
+    if args.rounds is not None and args.what not in ("solver", "mc"):
+        raise invalid("--rounds", args.rounds, "only rig bench solver and rig bench mc take rounds")
     if args.baseline:
         from rig.bench.baseline import check_revision
 
