@@ -26,20 +26,21 @@ def _isf_independent(path):
 def _csv_independent(path):
     """numpy on the data rows: the DPO/MSO/TBS layout's columns after its TIME row, or the
     TDS1000/2000 layout's fourth and fifth columns of every six-column block (one block per
-    channel, side by side)."""
+    channel, side by side). Scopes print times with a float32's digits (or nine): the printed
+    column lies within a float32's spacing at the largest time of the uniform grid the header
+    gives."""
     lines = path.read_text().splitlines()
     title = next((i for i, line in enumerate(lines) if line.split(",")[0].strip().upper() == "TIME"), None)
     if title is None:
         blocks = (len(lines[0].split(",")) + 1) // 6
         table = np.loadtxt(lines, delimiter=",", usecols=[6 * b + c for b in range(blocks) for c in (3, 4)], ndmin=2)
-        # these scopes print times with a float32's digits: the printed column lies within a
-        # float32's spacing at the largest time of the uniform grid the header gives
-        eps = np.spacing(np.float32(np.max(np.abs(table[:, 0]))))
-        return [(table[:, 2 * b], table[:, 2 * b + 1]) for b in range(blocks)], 0.0, float(eps)
+        eps = float(np.spacing(np.float32(np.max(np.abs(table[:, 0])))))
+        return [(table[:, 2 * b], table[:, 2 * b + 1]) for b in range(blocks)], 0.0, eps
     ncol = len([c for c in lines[title].split(",") if c.strip()])
     table = np.loadtxt([line for line in lines[title + 1:] if line.strip()], delimiter=",",
                        usecols=range(ncol), ndmin=2)
-    return [(table[:, 0], table[:, k]) for k in range(1, ncol)], 0.0, 0.0
+    eps = float(np.spacing(np.float32(np.max(np.abs(table[:, 0])))))
+    return [(table[:, 0], table[:, k]) for k in range(1, ncol)], 0.0, eps
 
 
 def _wfm_independent(path):
