@@ -112,13 +112,28 @@ def _read_dpo(path, rows, start) -> list:
     if any(len(r) != 1 + len(names) for r in data):
         raise InstrumentError(f"{path}: a data row has fewer columns than the TIME row")
     table = np.array(data)
-    t = table[:, 0]
     zero = header.get("Zero Index", [None])[0]
     units = header.get("Vertical Units", [])
     interval = header.get("Sample Interval", [None])[0]
     fmt = header.get("Point Format", [None])[0]
+    t = _zero_index_times(path, table[:, 0], zero, interval)
     return [_waveform(path, name.upper(), t, table[:, 1 + k], zero, units[k] if k < len(units) else "V",
                       interval, fmt) for k, name in enumerate(names)]
+
+
+def _zero_index_times(path, t, zero, interval):
+    """The times the 4/5/6 Series header gives, -Zero Index x Sample Interval + n x Sample
+    Interval (the column prints nine digits; the header's fractional Zero Index has more),
+    where the header has both and agrees with the column to a tenth of a sample; the column
+    where the header lacks either; a one-line refusal where they disagree."""
+    if zero in (None, "") or interval in (None, "") or not (_is_float(zero) and _is_float(interval)):
+        return t
+    dt = float(interval)
+    grid = -float(zero) * dt + dt * np.arange(t.size)
+    if not (dt > 0 and np.max(np.abs(grid - t)) < 0.1 * dt):
+        raise InstrumentError(f"{path}: Zero Index = {zero} and Sample Interval = {interval} put the first sample "
+                              f"at {grid[0]:.9g} s, the TIME column at {t[0]:.9g} s: they must agree")
+    return grid
 
 
 def _read_tds(path, rows) -> list:

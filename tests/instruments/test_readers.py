@@ -102,6 +102,7 @@ def test_dpo_csv_layout(tmp_path):
     (TDS.replace("Record Length,5", "Record Length,7"), "Record Length says 7 points"),
     (TDS.replace("Sample Interval,1e-06", "Sample Rate,1e-06"), "Sample Interval"),
     (DPO.replace("TIME,CH1,CH2", "TIME"), "names no channel"),
+    (DPO.replace("Zero Index,2", "Zero Index,7"), "Zero Index = 7 and Sample Interval = 1e-06 put the first sample"),
     ("a,b\n1,2\n", "neither Tektronix CSV layout"),
 ])
 def test_malformed_csv(tmp_path, text, message):
