@@ -28,7 +28,9 @@ _FOREIGN = (
     ("a Rigol .wfm waveform", lambda h: h[:2] in (b"\xa5\xa5", b"\xa1\xa5", b"\x01\xff")),
     ("a Yokogawa .wfm/.wvf waveform", lambda h: b"$PublicInfo" in h or all(
         k in h for k in (b"NR_PT:", b"XIN:", b"YMU:"))),
-    ("a Rohde & Schwarz waveform", lambda h: h.lstrip().startswith(b"<?xml") and b"RohdeSchwarz" in h),
+    # the .bin metadata of an R&S .bin / .Wfm.bin pair: XML with the eRS_ enumerations
+    ("a Rohde & Schwarz waveform (.bin XML header)", lambda h: h.lstrip().startswith(b"<?xml") and (
+        b"RohdeSchwarz" in h or b"eRS_" in h)),
     ("a Siglent SDS .bin waveform", lambda h: _siglent_bin(h)),
     ("a zip archive (PicoScope .psdata / .pssettings files are zip archives)", lambda h: h[:4] == b"PK\x03\x04"),
     # DS1000Z/DS2000/DS4000: "X,CH1,...,Start,Increment," or, without the X column,
@@ -58,6 +60,18 @@ def _siglent_bin(head: bytes) -> bool:
         if not (0 < value < 1e6 and magnitude <= 16 and unit <= 23):
             return False
     return True
+
+
+# R&S .Wfm.bin payload: uint32 format code (0 int8, 1 int16, 4 float32, 6 x/y float32
+# pairs), uint32 record length, then record length x bytes per value x channels (1 to 4)
+_RS_WIDTH = {0: 1, 1: 2, 4: 4, 6: 8}
+
+
+def _rs_payload(head: bytes, size: int) -> bool:
+    if len(head) < 8:
+        return False
+    code, length = struct.unpack_from("<2I", head, 0)
+    return code in _RS_WIDTH and length > 0 and any(size - 8 == length * _RS_WIDTH[code] * k for k in (1, 2, 3, 4))
 
 
 def _hdf5_kind(path: Path) -> str:
@@ -115,6 +129,8 @@ def identify(path) -> str:
     for name, test in _FOREIGN:
         if test(head):
             raise InstrumentError(f"{path}: {name}; {READABLE}")
+    if _rs_payload(head, path.stat().st_size):
+        raise InstrumentError(f"{path}: a Rohde & Schwarz .Wfm.bin waveform payload; {READABLE}")
     text = b"\0" not in head[:512]
     what = "a text file in no scope format the rig knows" if text else "a binary file in no scope format the rig knows"
     raise InstrumentError(f"{path}: {what}; {READABLE}")
