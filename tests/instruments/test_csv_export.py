@@ -1,12 +1,9 @@
 """The CSV export as a 4/5/6 Series scope writes it: one file per channel, a fractional Zero
 Index, read back to the sample by this project's reader, by numpy and by Tektronix's own
 reader (tm_data_types, in its own interpreter: it pins numpy < 2)."""
-import json
-import os
-import subprocess
-
 import numpy as np
 import pytest
+from tektronix_reader import read_with_tm_data_types
 
 from instruments.formats import read_record, read_waveforms
 from instruments.formats.tek_csv import write_csv
@@ -58,37 +55,24 @@ def test_our_export_reads_back_to_a_millionth_of_a_sample(tmp_path):
         assert back.preamble.trigger_index == 500
 
 
-TMDT = """
-import json, sys
-import numpy as np
-import tm_data_types as tm
-out = []
-for path in sys.argv[1:]:
-    w = tm.read_file(path)
-    out.append({"source": w.source_name, "zero_index": float(w.trigger_index),
-                "t": np.asarray(w.normalized_horizontal_values, dtype=float).tolist(),
-                "v": np.asarray(w.normalized_vertical_values, dtype=float).tolist()})
-print(json.dumps(out))
-"""
-
-
 def test_tektronix_own_reader_puts_every_sample_where_we_do(tmp_path):
-    python = os.environ.get("RIG_TMDT_PYTHON")
-    if not python or not os.path.exists(python):
-        pytest.skip("set RIG_TMDT_PYTHON to an interpreter with tm_data_types (it pins numpy < 2): "
-                    "python3 -m venv /tmp/tmdt && /tmp/tmdt/bin/pip install tm_data_types")
     shot = _shot()
     paths = write_csv(shot, tmp_path, "shot")
-    run = subprocess.run([python, "-c", TMDT, *map(str, paths)], capture_output=True, text=True, timeout=120)
-    assert run.returncode == 0, run.stderr[-2000:]
-    theirs = json.loads(run.stdout)
+    theirs = read_with_tm_data_types(paths)
     assert [t["source"] for t in theirs] == ["CH1", "CH2"]  # one waveform per channel, each named
     for w, t in zip(shot.values(), theirs):
         assert t["zero_index"] == pytest.approx(500 + FRACTION, abs=1e-9)
-        assert np.max(np.abs(np.asarray(t["t"]) - w.time())) < 1e-6 * DT
+        assert np.max(np.abs(t["t"] - w.time())) < 1e-6 * DT
         # tm_data_types keeps volts as int16 codes over the record's span
-        span = np.ptp(w.volts())
-        assert np.max(np.abs(np.asarray(t["v"]) - w.volts())) < span / 65535
+        assert np.max(np.abs(t["v"] - w.volts())) < np.ptp(w.volts()) / 65535
+
+
+def test_tektronix_own_reader_reads_a_real_four_five_six_series_csv_as_we_do(realdata):
+    path = realdata / "tmdt_MSO64_analog_waveform.csv"
+    (ours,) = read_waveforms(path)
+    (theirs,) = read_with_tm_data_types([path])
+    assert theirs["source"] == ours.channel == "REF7"
+    assert np.max(np.abs(theirs["t"] - ours.time())) < 1e-6 * ours.preamble.x_increment
 
 
 def test_a_read_real_record_exports_and_reads_back(realdata, tmp_path):

@@ -5,6 +5,7 @@ import struct
 
 import numpy as np
 import pytest
+from tektronix_reader import read_with_tm_data_types
 
 from instruments.errors import InstrumentError
 from instruments.formats import identify, read_waveforms
@@ -171,6 +172,14 @@ def test_tektronix_wfm_agrees_with_tektronix_own_reader(realdata):
     theirs = tm.read_file(str(realdata / "tekpce_sample_1.wfm"))
     assert np.array_equal(np.asarray(theirs.y_axis_values), w.codes)
     assert float(theirs.y_axis_spacing) == w.preamble.y_multiplier
+
+
+def test_tektronix_wfm_agrees_with_tektronix_own_reader_in_its_own_interpreter(realdata):
+    path = realdata / "tekpce_sample_1.wfm"
+    (w,) = read_waveforms(path)
+    (theirs,) = read_with_tm_data_types([path])
+    assert np.array_equal(theirs["codes"], w.codes) and theirs["spacing"] == w.preamble.y_multiplier
+    assert np.max(np.abs(theirs["t"] - w.time())) < 1e-6 * w.preamble.x_increment
 
 
 @pytest.mark.parametrize("head, name", [
