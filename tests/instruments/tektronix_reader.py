@@ -30,7 +30,7 @@ def read_with_tm_data_types(paths) -> list:
     python = os.environ.get("RIG_TMDT_PYTHON")
     if not python or not os.path.exists(python):
         pytest.skip("set RIG_TMDT_PYTHON to an interpreter with tm_data_types (it pins numpy < 2): "
-                    "python3 -m venv /tmp/tmdt && /tmp/tmdt/bin/pip install tm_data_types")
+                    "python3 -m venv tmdt && tmdt/bin/pip install tm_data_types")
     run = subprocess.run([python, "-c", _SCRIPT, *map(str, paths)], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr[-2000:]
     return [{**w, **{k: np.asarray(w[k]) for k in ("codes", "t", "v")}} for w in json.loads(run.stdout)]

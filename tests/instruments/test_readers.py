@@ -178,6 +178,13 @@ def test_a_fastframe_wfm_is_refused_by_name(realdata, tmp_path):
         read_waveforms(p)
 
 
+def test_a_wfm_in_hertz_is_refused_as_a_spectrum(realdata, tmp_path):
+    # WFM#002/#003: the implicit dimension's units, char[20] at byte 508
+    p = _wfm(realdata, tmp_path, "fft.wfm", {508: b"Hz\0"})
+    with pytest.raises(InstrumentError, match="a frequency-domain record .*WFM implicit dimension units = 'Hz'"):
+        read_waveforms(p)
+
+
 def test_an_iq_wfm_is_refused_by_name(realdata, tmp_path):
     # an IQ capture is told by the IQ_ keys of the tekmeta block after the curve
     key = b"IQ_centerFrequency"
