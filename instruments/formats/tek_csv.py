@@ -15,6 +15,7 @@ The export is the 4/5/6 Series layout, one file per channel, with the fractional
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -101,7 +102,7 @@ def _is_float(c):
 
 def _read_dpo(path, rows, start) -> list:
     header = {r[0].strip(): [c.strip() for c in r[1:]] for r in rows[:start] if r and r[0].strip()}
-    time_axis(path, "Horizontal Units", header.get("Horizontal Units", ["s"])[0])
+    time_axis(path, "Horizontal Units", (header.get("Horizontal Units") or ["s"])[0])
     names = [c.strip() for c in rows[start][1:] if c.strip()]
     if not names:
         raise InstrumentError(f"{path}: the TIME row names no channel")
@@ -143,7 +144,10 @@ def _read_tds(path, rows) -> list:
     if not blocks or len(rows[0]) < blocks[-1] + 5:
         raise InstrumentError(f"{path}: row 1: expected blocks of six columns (TDS layout), "
                               f"found {len(rows[0])} columns")
-    return [_read_tds_block(path, rows, b) for b in blocks]
+    waves = [_read_tds_block(path, rows, b) for b in blocks]
+    names = [w.channel for w in waves]  # blocks naming no source are called after the file: number them
+    return [w if names.count(w.channel) == 1 else replace(w, channel=f"{w.channel}#{k + 1}")
+            for k, w in enumerate(waves)]
 
 
 def _read_tds_block(path, rows, b: int) -> Waveform:

@@ -139,6 +139,12 @@ def test_every_tds_block_is_a_channel(tmp_path, channels):
         assert w.preamble.y_unit == "V" and w.preamble.trigger_index == 2  # "Volts"; 2.5 -> sample 2
 
 
+def test_tds_blocks_naming_no_source_are_numbered(tmp_path):
+    p = tmp_path / "scope-2.csv"
+    p.write_text(_tds_blocks(("CH1", "CH2", "CH3"), n=12).replace("Source,", "Sourc,"))
+    assert [w.channel for w in read_csv(p)] == ["SCOPE_2#1", "SCOPE_2#2", "SCOPE_2#3"]
+
+
 def test_a_tds_block_with_a_short_record_names_its_column(tmp_path):
     lines = _tds_blocks(("CH1", "CH2"), n=12).splitlines()
     lines[0] = lines[0].replace(",Record Length,12,", ",Record Length,13,")  # the second block's
