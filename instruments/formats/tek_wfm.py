@@ -74,8 +74,7 @@ def read_wfm(path) -> list:
     data = path.read_bytes()
     check_header(path, data)
     try:
-        wfm = Wfm.from_file(str(path), "TEK")
-        ch = wfm.channels[0]
+        ch = Wfm.from_file(str(path), "TEK").channels[0]
     except Exception as exc:  # the library's own errors name no file
         detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise InstrumentError(f"{path}: not a readable Tektronix .wfm analog record ({detail})") from None
