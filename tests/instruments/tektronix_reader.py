@@ -24,13 +24,36 @@ print(json.dumps(out))
 """
 
 
-def read_with_tm_data_types(paths) -> list:
-    """For each file, what tm_data_types reads: {source, zero_index, spacing, codes, t, v}
-    (numpy arrays for the last four but spacing)."""
+_WRITE_IQ = """
+import sys
+import numpy as np
+import tm_data_types as tm
+w = tm.IQWaveform()
+w.interleaved_iq_axis_values = np.tile(np.array([1, 2, 3, 4], dtype=np.int16), 100)
+w.iq_axis_spacing, w.x_axis_spacing = 1e-3, 1e-6
+w.meta_info = tm.IQWaveformMetaInfo(iq_center_frequency=1e9, iq_fft_length=1024, iq_resolution_bandwidth=1e3,
+                                    iq_span=1e6, iq_window_type="Blackharris", iq_sample_rate=1.25e6)
+tm.write_file(sys.argv[1], w)
+"""
+
+
+def _run(script: str, *args) -> str:
     python = os.environ.get("RIG_TMDT_PYTHON")
     if not python or not os.path.exists(python):
         pytest.skip("set RIG_TMDT_PYTHON to an interpreter with tm_data_types (it pins numpy < 2): "
                     "python3 -m venv tmdt && tmdt/bin/pip install tm_data_types")
-    run = subprocess.run([python, "-c", _SCRIPT, *map(str, paths)], capture_output=True, text=True, timeout=300)
+    run = subprocess.run([python, "-c", script, *map(str, args)], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr[-2000:]
-    return [{**w, **{k: np.asarray(w[k]) for k in ("codes", "t", "v")}} for w in json.loads(run.stdout)]
+    return run.stdout
+
+
+def read_with_tm_data_types(paths) -> list:
+    """For each file, what tm_data_types reads: {source, zero_index, spacing, codes, t, v}
+    (numpy arrays for the last four but spacing)."""
+    out = json.loads(_run(_SCRIPT, *paths))
+    return [{**w, **{k: np.asarray(w[k]) for k in ("codes", "t", "v")}} for w in out]
+
+
+def write_iq_wfm(path) -> None:
+    """An IQ .wfm as Tektronix's own writer makes it (interleaved I/Q, tekmeta IQ_ keys)."""
+    _run(_WRITE_IQ, path)

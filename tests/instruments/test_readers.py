@@ -201,6 +201,14 @@ def test_an_iq_wfm_is_refused_by_name(realdata, tmp_path):
         read_waveforms(p)
 
 
+def test_an_iq_wfm_written_by_tektronix_own_writer_is_refused_by_name(tmp_path):
+    from tektronix_reader import write_iq_wfm
+
+    write_iq_wfm(tmp_path / "iq.wfm")
+    with pytest.raises(InstrumentError, match="an IQ waveform"):
+        read_waveforms(tmp_path / "iq.wfm")
+
+
 @pytest.mark.parametrize("data_type, what", [(6, "a digital waveform"),
                                              (5, r"a waveform database \(pixel map\) record"),
                                              (9, "an unknown data type 9")])
