@@ -33,15 +33,21 @@ def check_one_time_base(record: ScopeRecord) -> None:
     """InstrumentError in one line unless every channel of ``record`` has the first one's
     time base (points, sample interval, first sample's time), as the analysis of one shot
     needs; it names the two files (or channels) and their time bases."""
-    waves = list(record.waveforms.values())
-    for w in waves[1:]:
-        a, b = waves[0].preamble, w.preamble
-        if (a.points, a.x_increment, a.x_zero) != (b.points, b.x_increment, b.x_zero):
-            def where(x):
-                return f"{x.preamble.extra.get('source', 'the record')} ({x.channel})"
+    first, *others = record.waveforms.values()
+    for w in others:
+        if _time_base(w) != _time_base(first):
+            raise InstrumentError(f"{_origin(first)} and {_origin(w)} have different time bases: "
+                                  f"{_said(first)}, {_said(w)}; the channels of one shot share one time base")
 
-            def base(p):
-                return f"{p.points} points at {p.x_increment:.6g} s from {p.x_zero:.9g} s"
 
-            raise InstrumentError(f"{where(waves[0])} and {where(w)} have different time bases: {base(a)}, "
-                                  f"{base(b)}; the channels of one shot share one time base")
+def _time_base(w) -> tuple:
+    return w.preamble.points, w.preamble.x_increment, w.preamble.x_zero
+
+
+def _origin(w) -> str:
+    return f"{w.preamble.extra.get('source', 'the record')} ({w.channel})"
+
+
+def _said(w) -> str:
+    n, dt, t0 = _time_base(w)
+    return f"{n} points at {dt:.6g} s from {t0:.9g} s"
