@@ -41,6 +41,7 @@ DATA_TYPE = 122  # int32: 2 vector (analog), 6 digital
 VECTOR, DIGITAL, FASTFRAME = 2, 6, 1
 DATA_TYPES = {0: "a scalar measurement", 1: "a scalar constant", 4: "an invalid-data record",
               5: "a waveform database (pixel map) record", DIGITAL: "a digital waveform"}
+VERSIONS = (b":WFM#001", b":WFM#002", b":WFM#003")
 _IQ_KEY = re.compile(rb"IQ_(centerFrequency|fftLength|rbw|span|windowType|sampleRate)")
 _TEKMETA = b"tekmeta!"
 
@@ -50,6 +51,12 @@ def check_header(path, data: bytes) -> None:
     if len(data) < DATA_TYPE + 4 or data[:2] not in (b"\x0f\x0f", b"\xf0\xf0"):
         return  # the legacy LLWFM files and short files are left to the parser's own checks
     order = "<" if data[:2] == b"\x0f\x0f" else ">"
+    if data[2:10] not in VERSIONS:
+        raise InstrumentError(f"{path}: WFM version string = {data[2:10]!r}: the rig reads "
+                              f"{', '.join(v.decode() for v in VERSIONS)}")
+    if data[BYTES_PER_POINT] not in (1, 2):
+        raise InstrumentError(f"{path}: WFM bytes per point = {data[BYTES_PER_POINT]}: the rig reads integer codes "
+                              f"of 1 or 2 bytes (4 or 8 bytes: int32 or floating-point values)")
     (frames,) = struct.unpack_from(f"{order}I", data, FAST_FRAMES_MINUS_ONE)
     (set_type,) = struct.unpack_from(f"{order}i", data, SET_TYPE)
     (data_type,) = struct.unpack_from(f"{order}i", data, DATA_TYPE)

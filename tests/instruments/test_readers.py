@@ -184,6 +184,13 @@ def test_a_fastframe_wfm_is_refused_by_name(realdata, tmp_path):
         read_waveforms(p)
 
 
+@pytest.mark.parametrize("change, message", [({2: b":WFM#004"}, "WFM version string = b':WFM#004'"),
+                                             ({15: b"\x04"}, "WFM bytes per point = 4")])
+def test_a_wfm_of_another_version_or_width_is_refused(realdata, tmp_path, change, message):
+    with pytest.raises(InstrumentError, match=message):
+        read_waveforms(_wfm(realdata, tmp_path, "x.wfm", change))
+
+
 def test_a_wfm_in_hertz_is_refused_as_a_spectrum(realdata, tmp_path):
     # WFM#002/#003: the implicit dimension's units, char[20] at byte 508
     p = _wfm(realdata, tmp_path, "fft.wfm", {508: b"Hz\0"})
