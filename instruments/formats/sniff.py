@@ -7,7 +7,9 @@ signatures are those the makers' own programmer manuals give (and RigolWFM's det
 uses): LeCroy's WAVEDESC block, Tektronix's byte-order word and ":WFM#00n" version string,
 Keysight's "AG" cookie and Infiniium HDF5 groups, Rigol's 0xA5A5 / 0xA1A5 / "RG0n" magics
 and CSV title rows, Siglent's channel-on flags and volt/div records, PicoScope's zip
-container and CSV title/units rows, Yokogawa's ASCII keys.
+container and CSV title/units rows, Yokogawa's ASCII keys, R&S's XML header (its eRS_
+enumerations) and .Wfm.bin payload header (format code and record length that match the
+file's size).
 """
 from __future__ import annotations
 
@@ -31,7 +33,7 @@ _FOREIGN = (
     # the .bin metadata of an R&S .bin / .Wfm.bin pair: XML with the eRS_ enumerations
     ("a Rohde & Schwarz waveform (.bin XML header)", lambda h: h.lstrip().startswith(b"<?xml") and (
         b"RohdeSchwarz" in h or b"eRS_" in h)),
-    ("a Siglent SDS .bin waveform", lambda h: _siglent_bin(h)),
+    ("a Siglent SDS .bin waveform", lambda h: _siglent_bin(h)),  # defined below
     ("a zip archive (PicoScope .psdata / .pssettings files are zip archives)", lambda h: h[:4] == b"PK\x03\x04"),
     # DS1000Z/DS2000/DS4000: "X,CH1,...,Start,Increment," or, without the X column,
     # "CH1,CH2,Start,Increment,"; DS1000E/D: "X,CH1," then "Second,Volt,"
