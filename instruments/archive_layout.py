@@ -35,7 +35,8 @@ their scaling), scene_text (TOML as fired), settings (JSON, SI). instrument/osci
 the raw ADC codes (units 'counts'; volts where a file held volts only) on the dimension
 'sample', the attribute 'preamble' is the channel's Tektronix scaling (JSON): volts = y_zero +
 y_multiplier * (codes - y_offset), time = x_zero + x_increment * n (s from the trigger).
-data/ (NXdata, the default plot): CHn in volts (float64) against time (float64, s).
+data/ (NXdata, the default plot): CHn in volts (float64) against time (float64, s); the
+first channel is its signal, the others its auxiliary_signals.
 truth/ (virtual shots): facts (JSON) and forces/ (NXdata): the noise-free forces (N) against
 their own time (s), stored once per scene under shared/ and hard-linked. Every array is
 chunked with fletcher32; each entry's and each shared group's 'checksums' table holds the
@@ -172,6 +173,8 @@ def _write_forces(s, e: Entry, where: str):
         axis = forces.create_dataset("sample", data=np.arange(n, dtype=np.int64), **_chunks(n))
     axis.make_scale(axis.name.rsplit("/", 1)[1])
     forces.attrs.update({"signal": names[0] if names else "", "axes": [axis.name.rsplit("/", 1)[1]]})
+    if len(names) > 1:
+        forces.attrs["auxiliary_signals"] = names[1:]
     for name in names:
         d = forces.create_dataset(name, data=np.asarray(e.truth[name], dtype=np.float64), **_chunks(n))
         d.attrs["units"] = "N"
@@ -183,6 +186,8 @@ def _write_record(g, record: ScopeRecord):
     data = _group(g, "data", "NXdata")
     chans = sorted(record.waveforms)
     data.attrs.update({"signal": chans[0].replace("#", "_") if chans else "", "axes": ["time"]})
+    if len(chans) > 1:  # NeXus: the other channels, plotted with the signal by viewers (silx, nexpy)
+        data.attrs["auxiliary_signals"] = [ch.replace("#", "_") for ch in chans[1:]]
     for ch in chans:
         if not NAME.match(ch.replace("#", "_")):
             raise InstrumentError(f"channel {ch!r}: allowed letters, digits, '_' and '#'")

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import InstrumentError
 from ..records import Preamble, Waveform
+from .checks import channel_name, time_axis
 
 # every spelling real scopes use, long and short, to one canonical key
 _ALIASES = {"BYT_NR": "BYT_NR", "BYT_N": "BYT_NR", "BIT_NR": "BIT_NR", "BIT_N": "BIT_NR",
@@ -39,13 +40,21 @@ def _num(x: float) -> str:
     return f"{x:.10E}"
 
 
+def waveform_id(w: Waveform) -> str:
+    """The WFID a scope writes, naming the source first ("CH1, DC coupling, ..."): the
+    record's own where it names its channel, else the channel before it."""
+    wfid = w.preamble.waveform_id.replace('"', "'")
+    return wfid if wfid.upper().replace(" ", "").startswith(w.channel.upper()) else \
+        ", ".join(filter(None, (w.channel, wfid)))
+
+
 def isf_bytes(w: Waveform) -> bytes:
     """The bytes of an ISF file holding one channel's codes."""
     p = w.preamble
     nbytes = p.byte_count
     codes = np.asarray(w.codes).astype(">i1" if nbytes == 1 else ">i2")
     header = (f":WFMPRE:BYT_NR {nbytes};BIT_NR {8 * nbytes};ENCDG BIN;BN_FMT RI;BYT_OR MSB;"
-              f"NR_PT {p.points};WFID \"{p.waveform_id}\";PT_FMT {p.point_format};XUNIT \"{p.x_unit}\";"
+              f"NR_PT {p.points};WFID \"{waveform_id(w)}\";PT_FMT {p.point_format};XUNIT \"{p.x_unit}\";"
               f"XINCR {_num(p.x_increment)};XZERO {_num(p.x_zero)};PT_OFF 0;"
               f"YUNIT \"{p.y_unit}\";YMULT {_num(p.y_multiplier)};YOFF {_num(p.y_offset)};"
               f"YZERO {_num(p.y_zero)};:CURVE ")
@@ -144,6 +153,7 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
     dx = _number(h, "XINCR", path)
     if not (np.isfinite(dx) and dx > 0):
         raise InstrumentError(f"{path}: XINCR = {dx!r}: the sample interval must be a finite number > 0 s")
+    x_unit = time_axis(path, "XUNIT", h.get("XUNIT", "s"))
     x0 = _number(h, "XZERO", path)
     pt_off = _number(h, "PT_OFF", path, int) if "PT_OFF" in h else 0
     first = x0 - dx * pt_off  # t = XZERO + XINCR (n - PT_OFF)
@@ -151,13 +161,15 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
     wfid = h.get("WFID", "")
     m = _CHANNEL.match(wfid)
     name = f"{m.group(1).upper()}{m.group(2)}" if m else Path(path).stem  # no source named: the file
+    name_in_file = name
     envelope = h.get("PT_FMT", "Y").upper() in ("ENV", "ENVELOPE")
     if index:
         name = f"{name}#{index + 1}"
+    name = channel_name(name)
     pre = Preamble(points=codes.size, x_increment=dx, x_zero=first, trigger_index=trigger,
                    y_multiplier=_number(h, "YMULT", path), y_offset=_number(h, "YOFF", path),
                    y_zero=_number(h, "YZERO", path), byte_count=codes.dtype.itemsize,
-                   x_unit=h.get("XUNIT", "s"), y_unit=h.get("YUNIT", "V"), waveform_id=wfid,
+                   x_unit=x_unit, y_unit=h.get("YUNIT", "V"), waveform_id=wfid,
                    point_format="ENV" if envelope else "Y",
-                   extra={"source": str(path), "record": index + 1})
+                   extra={"source": str(path), "record": index + 1, "name_in_file": name_in_file})
     return Waveform(name, pre, codes=codes)

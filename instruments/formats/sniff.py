@@ -5,11 +5,16 @@ one-line refusal, so that a user who hands over a LeCroy or Rigol file learns wh
 and what the rig reads, instead of a parse error from deep inside a reader. The
 signatures are those the makers' own programmer manuals give (and RigolWFM's detector
 uses): LeCroy's WAVEDESC block, Tektronix's byte-order word and ":WFM#00n" version string,
-Keysight's "AG" cookie, Rigol's 0xA5A5 / 0xA1A5 / "RG0n" magics, Yokogawa's ASCII keys.
+Keysight's "AG" cookie and Infiniium HDF5 groups, Rigol's 0xA5A5 / 0xA1A5 / "RG0n" magics
+and CSV title rows, Siglent's channel-on flags and volt/div records, PicoScope's zip
+container and CSV title/units rows, Yokogawa's ASCII keys, R&S's XML header (its eRS_
+enumerations) and .Wfm.bin payload header (format code and record length that match the
+file's size).
 """
 from __future__ import annotations
 
 import re
+import struct
 from pathlib import Path
 
 from ..errors import InstrumentError
@@ -25,12 +30,64 @@ _FOREIGN = (
     ("a Rigol .wfm waveform", lambda h: h[:2] in (b"\xa5\xa5", b"\xa1\xa5", b"\x01\xff")),
     ("a Yokogawa .wfm/.wvf waveform", lambda h: b"$PublicInfo" in h or all(
         k in h for k in (b"NR_PT:", b"XIN:", b"YMU:"))),
-    ("a Rohde & Schwarz waveform", lambda h: h.lstrip().startswith(b"<?xml") and b"RohdeSchwarz" in h),
-    ("an HDF5 file (a rig archive? use rig analyze/verify/ls on .h5 files)",
-     lambda h: h[:8] == b"\x89HDF\r\n\x1a\n"),
-    ("a Rigol CSV export", lambda h: re.match(rb"\s*X,(CH\d,|D\d+,|MATH\d?,)+.*Start,Increment", h) is not None),
+    # the .bin metadata of an R&S .bin / .Wfm.bin pair: XML with the eRS_ enumerations
+    ("a Rohde & Schwarz waveform (.bin XML header)", lambda h: h.lstrip().startswith(b"<?xml") and (
+        b"RohdeSchwarz" in h or b"eRS_" in h)),
+    ("a Siglent SDS .bin waveform", lambda h: _siglent_bin(h)),  # defined below
+    ("a zip archive (PicoScope .psdata / .pssettings files are zip archives)", lambda h: h[:4] == b"PK\x03\x04"),
+    # DS1000Z/DS2000/DS4000: "X,CH1,...,Start,Increment," or, without the X column,
+    # "CH1,CH2,Start,Increment,"; DS1000E/D: "X,CH1," then "Second,Volt,"
+    ("a Rigol CSV export", lambda h: re.match(
+        rb"\s*(X,)?(CH\d,|D\d+,|MATH\d?,)+\s*Start,Increment", h) is not None or re.match(
+        rb"\s*X,(CH\d,?)+\s*\r?\n\s*Second,", h) is not None),
     ("a Keysight/Agilent CSV export", lambda h: re.match(rb"\s*x-axis,\d", h) is not None),
+    # PicoScope 6/7: "Time,Channel A,Channel B" then the units "(ms),(V),(mV)"
+    ("a PicoScope CSV export", lambda h: re.match(
+        rb"\s*Time,Channel [A-H](,Channel [A-H])*\s*\r?\n\s*\((s|ms|us|\xb5s|\xc2\xb5s|ns|ps)\),\(", h) is not None),
 )
+# Siglent SDS1000X-E (and later revisions'): four int32 channel-on flags (0/1, one or more
+# on), then each channel's volt/div as a 'data with unit' record: float64 value, uint32
+# magnitude (0..16), uint32 unit (0..23)
+_SIGLENT_FLAGS, _SIGLENT_VDIV, _SIGLENT_RECORD = 0x00, 0x10, 16
+
+
+def _siglent_bin(head: bytes) -> bool:
+    if len(head) < _SIGLENT_VDIV + 4 * _SIGLENT_RECORD:
+        return False
+    flags = struct.unpack_from("<4I", head, _SIGLENT_FLAGS)
+    if not (set(flags) <= {0, 1} and any(flags)):
+        return False
+    for k in range(4):
+        value, magnitude, unit = struct.unpack_from("<dII", head, _SIGLENT_VDIV + k * _SIGLENT_RECORD)
+        if not (0 < value < 1e6 and magnitude <= 16 and unit <= 23):
+            return False
+    return True
+
+
+# R&S .Wfm.bin payload: uint32 format code (0 int8, 1 int16, 4 float32, 6 x/y float32
+# pairs), uint32 record length, then record length x bytes per value x channels (1 to 4)
+_RS_WIDTH = {0: 1, 1: 2, 4: 4, 6: 8}
+
+
+def _rs_payload(head: bytes, size: int) -> bool:
+    if len(head) < 8:
+        return False
+    code, length = struct.unpack_from("<2I", head, 0)
+    return code in _RS_WIDTH and length > 0 and any(size - 8 == length * _RS_WIDTH[code] * k for k in (1, 2, 3, 4))
+
+
+def _hdf5_kind(path: Path) -> str:
+    """What an HDF5 file is: a Keysight Infiniium waveform ('Waveforms' or 'Frame' group),
+    or another HDF5 file (a rig archive is read by the archive commands, not as a scope file)."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            if "Waveforms" in f or "Frame" in f:
+                return "a Keysight Infiniium HDF5 waveform"
+    except OSError:
+        pass
+    return "an HDF5 file (a rig archive? use rig analyze/verify/ls on .h5 files)"
 
 
 def tektronix_kind(head: bytes) -> str | None:
@@ -69,9 +126,13 @@ def identify(path) -> str:
     kind = tektronix_kind(head)
     if kind:
         return kind
+    if head[:8] == b"\x89HDF\r\n\x1a\n":
+        raise InstrumentError(f"{path}: {_hdf5_kind(path)}; {READABLE}")
     for name, test in _FOREIGN:
         if test(head):
             raise InstrumentError(f"{path}: {name}; {READABLE}")
+    if _rs_payload(head, path.stat().st_size):
+        raise InstrumentError(f"{path}: a Rohde & Schwarz .Wfm.bin waveform payload; {READABLE}")
     text = b"\0" not in head[:512]
     what = "a text file in no scope format the rig knows" if text else "a binary file in no scope format the rig knows"
     raise InstrumentError(f"{path}: {what}; {READABLE}")

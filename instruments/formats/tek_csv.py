@@ -1,58 +1,74 @@
-"""Tektronix CSV, DPO/MSO layout: a header block of "name,value" rows, then TIME,CH1,...
+"""Tektronix CSV, every layout Tektronix scopes write:
 
-All channels of one acquisition share the time base, so they go into one file. Volts are
-written with 10 significant digits (an 8-bit code is reproduced exactly).
+- 4/5/6 Series, DPO/MSO, TBS1000C: "name,value" header rows (per-channel cells side by
+  side where a file holds several channels), then a "TIME,CH1,..." row and the data columns;
+- TDS1000/2000, TBS1000B: blocks of six columns, one block per channel (one to four side
+  by side, separated by an empty column, or one file per channel): the header cells (Record
+  Length, Sample Interval, Trigger Point, Source, Vertical Units, Horizontal Units, ...) in
+  the block's first two (three, with a units column) beside time and volts in its fourth
+  and fifth.
+
+A spectrum (MATH FFT: Horizontal Units Hz) is refused by name, never read as a time record.
+The export is the 4/5/6 Series layout, one file per channel, with the fractional Zero Index
+(the trigger's place in samples) those scopes write, so that Tektronix's own reader
+(tm_data_types) puts every sample where this reader does.
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InstrumentError
 from ..records import Preamble, Waveform
+from .checks import channel_name, time_axis
+
+TDS_BLOCK = 6  # columns per channel in the TDS1000/2000 layout
+_UNITS = {"volts": "V", "volt": "V", "v": "V"}
 
 
 def write_csv(waveforms: dict, directory, stem: str) -> list:
-    """Write ``<stem>.csv`` with every channel; returns [path]."""
-    chans = list(waveforms)
-    ws = [waveforms[c] for c in chans]
-    p0 = ws[0].preamble
-    rows = [
-        ("Model", p0.extra.get("model", "")),
-        ("Waveform Type", "ANALOG"),
-        ("Point Format", p0.point_format),
-        ("Horizontal Units", p0.x_unit),
-        ("Horizontal Scale", f"{p0.x_increment * p0.points / 10:.6g}"),
-        ("Sample Interval", f"{p0.x_increment:.10g}"),
-        ("Record Length", str(p0.points)),
-        ("Zero Index", str(p0.trigger_index)),
-        ("Vertical Units", ",".join(w.preamble.y_unit for w in ws)),
-        ("Vertical Scale", ",".join(f"{w.preamble.extra.get('volts_per_div', '')}" for w in ws)),
-        ("Vertical Offset", ",".join(f"{w.preamble.y_zero:.6g}" for w in ws)),
-        ("Vertical Position", ",".join(f"{w.preamble.extra.get('position_div', 0):.6g}" for w in ws)),
-        ("Probe Attenuation", ",".join(f"{w.preamble.extra.get('probe', 1):.6g}" for w in ws)),
-        ("Label", ",".join(w.preamble.waveform_id.replace(",", ";") for w in ws)),
-    ]
-    t = ws[0].time()
-    data = np.column_stack([t] + [w.volts() for w in ws])
-    path = Path(directory) / f"{stem}.csv"
-    with open(path, "w", newline="") as fh:
-        for name, value in rows:
-            fh.write(f"{name},{value}\n")
-        fh.write("\nTIME," + ",".join(chans) + "\n")
-        np.savetxt(fh, data, delimiter=",", fmt="%.10g")
-    return [path]
+    """Write ``<stem>_<CH>.csv`` per channel in the 4/5/6 Series layout; returns the paths.
+
+    The layout names no scope model (the virtual scope's model writes another layout).
+    Times are written to 17 significant digits (they read back bit for bit), volts to 10 (an
+    8-bit code is reproduced exactly); Zero Index = -x_zero / x_increment, fractional where
+    the first sample is not on a multiple of the sample interval from the trigger."""
+    out = []
+    for ch, w in waveforms.items():
+        p = w.preamble
+        rows = [
+            ("Waveform Type", "ANALOG"),
+            ("Point Format", p.point_format),
+            ("Horizontal Units", p.x_unit),
+            ("Horizontal Scale", f"{p.x_increment * p.points / 10:.10g}"),
+            ("Sample Interval", f"{p.x_increment:.17g}"),
+            ("Record Length", str(p.points)),
+            ("Zero Index", f"{-p.x_zero / p.x_increment:.10f}"),
+            ("Gating", "0.0% to 100.0%"),
+            ("Probe Attenuation", f"{p.extra.get('probe', 1):.6g}"),
+            ("Vertical Units", p.y_unit),
+            ("Vertical Offset", f"{p.y_zero:.10g}"),
+            ("Vertical Scale", f"{p.extra.get('volts_per_div', '')}"),
+            ("Vertical Position", f"{p.extra.get('position_div', 0):.6g}"),
+            ("", ""),
+            ("", ""),
+            ("Label", p.waveform_id.replace(",", ";")),
+        ]
+        path = Path(directory) / f"{stem}_{ch}.csv"
+        with open(path, "w", newline="") as fh:
+            for name, value in rows:
+                fh.write(f"{name},{value}\n" if name else "\n")
+            fh.write(f"TIME,{ch}\n")
+            for t, v in zip(w.time(), w.volts()):
+                fh.write(f"{t:.17g},{v:.10g}\n")
+        out.append(path)
+    return out
 
 
 def read_csv(path) -> list:
-    """Waveforms from a Tektronix CSV file, either layout:
-
-    - DPO/MSO: "name,value" header rows, then a "TIME,CH1,..." row and the data columns;
-    - TDS1000/2000: six columns per row, the header cells (Record Length, Sample Interval,
-      Trigger Point, Source, Vertical Units, ...) in the first two beside time and volts
-      in the fourth and fifth; one channel per file.
-    """
+    """Every channel of a Tektronix CSV file, in either layout (module docstring)."""
     path = Path(path)
     try:
         lines = path.read_text(errors="strict").splitlines()
@@ -63,7 +79,7 @@ def read_csv(path) -> list:
     if start is not None:
         return _read_dpo(path, rows, start)
     if rows and len(rows[0]) >= 5:
-        return [_read_tds(path, rows)]
+        return _read_tds(path, rows)
     raise InstrumentError(f"{path}: neither Tektronix CSV layout (no TIME column header, "
                           f"and not the six-column TDS layout)")
 
@@ -86,6 +102,7 @@ def _is_float(c):
 
 def _read_dpo(path, rows, start) -> list:
     header = {r[0].strip(): [c.strip() for c in r[1:]] for r in rows[:start] if r and r[0].strip()}
+    time_axis(path, "Horizontal Units", (header.get("Horizontal Units") or ["s"])[0])
     names = [c.strip() for c in rows[start][1:] if c.strip()]
     if not names:
         raise InstrumentError(f"{path}: the TIME row names no channel")
@@ -96,33 +113,64 @@ def _read_dpo(path, rows, start) -> list:
     if any(len(r) != 1 + len(names) for r in data):
         raise InstrumentError(f"{path}: a data row has fewer columns than the TIME row")
     table = np.array(data)
-    t = table[:, 0]
     zero = header.get("Zero Index", [None])[0]
     units = header.get("Vertical Units", [])
     interval = header.get("Sample Interval", [None])[0]
     fmt = header.get("Point Format", [None])[0]
+    t = _zero_index_times(path, table[:, 0], zero, interval)
     return [_waveform(path, name.upper(), t, table[:, 1 + k], zero, units[k] if k < len(units) else "V",
                       interval, fmt) for k, name in enumerate(names)]
 
 
-def _read_tds(path, rows) -> Waveform:
+def _zero_index_times(path, t, zero, interval):
+    """The times the 4/5/6 Series header gives, -Zero Index x Sample Interval + n x Sample
+    Interval (the column prints nine digits; the header's fractional Zero Index has more),
+    where the header has both and agrees with the column to a tenth of a sample; the column
+    where the header lacks either; a one-line refusal where they disagree."""
+    if zero in (None, "") or interval in (None, "") or not (_is_float(zero) and _is_float(interval)):
+        return t
+    dt = float(interval)
+    grid = -float(zero) * dt + dt * np.arange(t.size)
+    if not (dt > 0 and np.max(np.abs(grid - t)) < 0.1 * dt):
+        raise InstrumentError(f"{path}: Zero Index = {zero} and Sample Interval = {interval} put the first sample "
+                              f"at {grid[0]:.9g} s, the TIME column at {t[0]:.9g} s: they must agree")
+    return grid
+
+
+def _read_tds(path, rows) -> list:
+    """One Waveform per six-column block; a block starts where the first row has a header
+    name (Record Length) in its first cell."""
+    blocks = [b for b in range(0, len(rows[0]), TDS_BLOCK) if rows[0][b].strip()]
+    if not blocks or len(rows[0]) < blocks[-1] + 5:
+        raise InstrumentError(f"{path}: row 1: expected blocks of six columns (TDS layout), "
+                              f"found {len(rows[0])} columns")
+    waves = [_read_tds_block(path, rows, b) for b in blocks]
+    names = [w.channel for w in waves]  # blocks naming no source are called after the file: number them
+    return [w if names.count(w.channel) == 1 else replace(w, channel=f"{w.channel}#{k + 1}")
+            for k, w in enumerate(waves)]
+
+
+def _read_tds_block(path, rows, b: int) -> Waveform:
     header, t, v = {}, [], []
-    for i, r in enumerate(rows):
+    for i, row in enumerate(rows):
+        r = row[b:b + 5]
         if len(r) < 5:
             if any(c.strip() for c in r):
-                raise InstrumentError(f"{path}: row {i + 1}: expected six columns (TDS layout)")
+                raise InstrumentError(f"{path}: row {i + 1}, column {b + 1}: expected six columns (TDS layout)")
             continue
         if r[0].strip():
             header[r[0].strip()] = r[1].strip()
         tv = _floats(path, [r[3], r[4]], i)
         t.append(tv[0])
         v.append(tv[1])
+    where = f"column {b + 1}" if b else "TDS layout"
     for key in ("Record Length", "Sample Interval"):
         if key not in header:
-            raise InstrumentError(f"{path}: header field {key!r} missing (TDS layout)")
+            raise InstrumentError(f"{path}: header field {key!r} missing ({where})")
+    time_axis(path, "Horizontal Units", header.get("Horizontal Units", "s"))
     n = int(float(header["Record Length"]))
     if n != len(t):
-        raise InstrumentError(f"{path}: Record Length says {n} points but the file holds {len(t)}")
+        raise InstrumentError(f"{path}: Record Length says {n} points but the file holds {len(t)} ({where})")
     name = header.get("Source", Path(path).stem).upper()
     return _waveform(path, name, np.array(t), np.array(v), header.get("Trigger Point"),
                      header.get("Vertical Units", "V"), header["Sample Interval"], header.get("Pt Fmt"))
@@ -130,7 +178,9 @@ def _read_tds(path, rows) -> Waveform:
 
 def _waveform(path, name, t, v, trigger, unit, interval=None, point_format=None) -> Waveform:
     """A volts-only Waveform; the sample interval from the header where it is given; an
-    envelope where the header's point format says ENV or PEAK (detect)."""
+    envelope where the header's point format says ENV or PEAK (detect). The channel is
+    called after its source (or the file), made a name the archive stores; the name as
+    the file gives it is kept in the preamble's extra."""
     try:
         dt = float(interval) if interval not in (None, "") else float(np.median(np.diff(t)))
     except ValueError:
@@ -139,9 +189,14 @@ def _waveform(path, name, t, v, trigger, unit, interval=None, point_format=None)
         raise InstrumentError(f"{path}: Sample Interval = {interval!r}: must be a finite number > 0 s")
     if not np.all(np.diff(t) > 0):
         raise InstrumentError(f"{path}: the time column does not increase")
-    idx = int(float(trigger)) if trigger not in (None, "") else int(np.clip(round(-t[0] / dt), 0, t.size - 1))
+    try:
+        idx = (int(round(float(trigger))) if trigger not in (None, "")
+               else int(np.clip(round(-t[0] / dt), 0, t.size - 1)))
+    except ValueError:
+        raise InstrumentError(f"{path}: trigger position = {trigger!r} is not a number") from None
+    unit = _UNITS.get((unit or "V").strip().lower(), (unit or "V").strip())
     pre = Preamble(points=t.size, x_increment=dt, x_zero=float(t[0]), trigger_index=idx,
-                   y_multiplier=1.0, y_offset=0.0, y_zero=0.0, byte_count=0, y_unit=unit or "V",
+                   y_multiplier=1.0, y_offset=0.0, y_zero=0.0, byte_count=0, y_unit=unit,
                    point_format="ENV" if (point_format or "Y").strip().upper().startswith(("ENV", "PEAK")) else "Y",
-                   extra={"source": str(path)})
-    return Waveform(name, pre, samples=v)
+                   extra={"source": str(path), "name_in_file": name})
+    return Waveform(channel_name(name), pre, samples=v)

@@ -55,7 +55,7 @@ def cmd_import(args) -> dict:
     from pathlib import Path
 
     from instruments.archive import Archive, Entry, raw_digest
-    from instruments.formats import read_record, read_waveforms
+    from instruments.formats import check_one_time_base, read_record, read_waveforms
 
     groups = [args.files] if args.together else [[f] for f in args.files]
     entries = []
@@ -73,6 +73,8 @@ def cmd_import(args) -> dict:
                                        f"of one shot have different names; import these files as separate shots "
                                        f"(without --together)")
                     seen[w.channel] = f
+        if args.together:
+            check_one_time_base(record)  # the analysis of one shot needs one time base: refuse now, not then
         entries.append(Entry(record, False, scene="",
                              settings={"source_files": [str(Path(f).resolve().name) for f in files]},
                              start_time=mtime, file_modification_time=mtime,

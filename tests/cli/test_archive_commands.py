@@ -265,3 +265,39 @@ def test_a_sweep_point_that_cannot_be_fired_says_what_was_kept(tmp_path, capsys)
     assert err.startswith("rig sweep: error: point 2 of 3: unstable at every step") and "\n" not in err
     assert err.endswith(f"(the shots of the 1 before it are in {out})")
     assert Archive(out).ids() == [1]
+
+
+def test_a_two_channel_tds_csv_imports_lists_and_analyses_both_channels(tmp_path, capsys, realdata):
+    # TDS2000C/TBS1000B: CH1 and CH2 as two six-column blocks side by side in one file
+    f, archive = str(realdata / "acruz_TDS2000C_2ch_ROD_PIEZO_1.csv"), str(tmp_path / "a.h5")
+    assert main(["import", f, "--into", archive, "--json"]) == 0
+    capsys.readouterr()
+    assert main(["ls", archive, "--json"]) == 0
+    (row,) = json.loads(capsys.readouterr().out)
+    assert row["channels"] == ["CH1", "CH2"]
+    back = Archive(archive).read(1).record
+    table = np.loadtxt(f, delimiter=",", usecols=(4, 10))
+    assert np.array_equal(back["CH1"].volts(), table[:, 0]) and np.array_equal(back["CH2"].volts(), table[:, 1])
+    main(["analyze", f, "--gauge-distance", "43.1 mm", "--json"])
+    (result,) = json.loads(capsys.readouterr().out)
+    assert set(result["snr"]) == {"CH1", "CH2"}  # both channels analysed, not "the record holds CH1"
+
+
+def test_import_together_refuses_files_of_different_time_bases(tmp_path, capsys, realdata):
+    a, b = str(realdata / "pchem_TDS2001C_F0000CH1.CSV"), str(realdata / "accel_TEK00000.CSV")
+    b_copy = tmp_path / "accel_CH2.csv"  # its channel renamed, so that only the time bases differ
+    b_copy.write_text(Path(b).read_text().replace("TIME,CH1", "TIME,CH2"))
+    assert main(["import", "--together", a, str(b_copy), "--into", str(tmp_path / "a.h5")]) == 2
+    (err,) = capsys.readouterr().err.strip().splitlines()
+    assert a in err and str(b_copy) in err and "different time bases" in err
+    assert "2500 points at 1e-09 s" in err and "2000 points at 0.0008 s" in err
+    assert not (tmp_path / "a.h5").exists()
+
+
+def test_a_wfm_whose_name_has_a_hyphen_and_a_space_imports(tmp_path, capsys, realdata):
+    f = tmp_path / "Tek000-ch1 copy.wfm"
+    f.write_bytes((realdata / "tekpce_sample_1.wfm").read_bytes())
+    assert main(["import", str(f), "--into", str(tmp_path / "a.h5"), "--json"]) == 0
+    capsys.readouterr()
+    assert main(["ls", str(tmp_path / "a.h5"), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)[0]["channels"] == ["Tek000_ch1_copy"]

@@ -76,12 +76,13 @@ def test_truth_holds_gauge_forces_and_positions():
 
 def test_isf_and_csv_round_trip_through_rigolwfm(tmp_path):
     rigolwfm = pytest.importorskip("RigolWFM.wfm")
+    rigolwfm_isf = pytest.importorskip("RigolWFM.isf")
     assert main(["shot", "ptfe52_magnetic", "--seed", "3", "--export", str(tmp_path), "--format", "isf"]) == 0
     assert main(["shot", "ptfe52_magnetic", "--seed", "3", "--export", str(tmp_path), "--format", "csv"]) == 0
     shot = Rig.from_scene("ptfe52_magnetic").fire(seed=3)
-    table = np.loadtxt(tmp_path / "ptfe52_magnetic_seed3.csv", delimiter=",",
-                       skiprows=_header_rows(tmp_path / "ptfe52_magnetic_seed3.csv"))
-    for k, ch in enumerate(("CH1", "CH2", "CH3")):
+    for ch in ("CH1", "CH2", "CH3"):  # the CSV export: one file per channel, as 4/5/6 Series scopes write
+        csv = tmp_path / f"ptfe52_magnetic_seed3_{ch}.csv"
+        table = np.loadtxt(csv, delimiter=",", skiprows=_header_rows(csv))
         ours = shot.scope[ch]
         theirs = rigolwfm.Wfm.from_file(str(tmp_path / f"ptfe52_magnetic_seed3_{ch}.isf"), "ISF").channels[0]
         assert len(theirs.volts) == ours.preamble.points
@@ -89,8 +90,10 @@ def test_isf_and_csv_round_trip_through_rigolwfm(tmp_path):
         tol = 1e-4 * ours.preamble.y_multiplier
         assert np.allclose(theirs.volts, ours.volts(), rtol=0, atol=tol)
         assert np.allclose(theirs.times, ours.time(), rtol=0, atol=1e-12)
-        assert np.allclose(table[:, 1 + k], theirs.volts, rtol=0, atol=tol)  # the CSV agrees
-    assert np.allclose(table[:, 0], shot.scope["CH1"].time(), rtol=0, atol=1e-12)
+        assert np.allclose(table[:, 1], theirs.volts, rtol=0, atol=tol)  # the CSV agrees
+        assert np.allclose(table[:, 0], ours.time(), rtol=0, atol=1e-6 * ours.preamble.x_increment)
+        isf = rigolwfm_isf.from_file(str(tmp_path / f"ptfe52_magnetic_seed3_{ch}.isf"))
+        assert isf.header.trace_label.startswith(f"{ch}, ")  # the WFID names the channel first
 
 
 def _header_rows(path: Path) -> int:

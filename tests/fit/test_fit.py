@@ -155,9 +155,9 @@ def test_trace_fit_of_a_csv_export_is_the_fit_of_its_record(tmp_path):
     from instruments.formats.tek_csv import write_csv
 
     shot = Rig.from_scene(SCENE).fire(seed=3)
-    (path,) = write_csv(shot.scope.waveforms, tmp_path, "shot")
+    paths = write_csv(shot.scope.waveforms, tmp_path, "shot")  # one file per channel
     params = parse_parameters(["chain.youngs_modulus=0.5 GPa:3 GPa"])
-    direct, exported = (fit(TraceObjective(SCENE, params, [rec])) for rec in (shot.scope, read_record([path])))
+    direct, exported = (fit(TraceObjective(SCENE, params, [rec])) for rec in (shot.scope, read_record(paths)))
     assert exported.chi2_reduced == pytest.approx(direct.chi2_reduced, rel=1e-3)
     assert abs(exported.estimate[0] - direct.estimate[0]) < 0.01 * direct.std[0]
     assert exported.std[0] == pytest.approx(direct.std[0], rel=1e-3)

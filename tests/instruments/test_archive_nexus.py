@@ -43,6 +43,7 @@ def test_names_classes_and_entry_fields(archive):
         shot = f["shot_000001"]
         data = shot["data"]
         assert data.attrs["NX_class"] == "NXdata" and data.attrs["signal"] == "CH1"
+        assert list(data.attrs["auxiliary_signals"]) == ["CH2"]  # every other channel, for viewers
         assert list(data.attrs["axes"]) == ["time"]
         assert data["CH1"].dtype == np.float64 and data["CH1"].attrs["units"] == "V"
         assert data["time"].dtype == np.float64 and data["time"].attrs["units"] == "s"
@@ -52,6 +53,21 @@ def test_names_classes_and_entry_fields(archive):
         assert forces["time"].attrs["units"] == "s" and forces["time"][1] == pytest.approx(1e-6, rel=1e-12)
         assert forces[forces.attrs["signal"]].attrs["units"] == "N"
         assert set(f["shot_000004/data"]) == {"CH1", "CH1_2", "time"}  # the second record of CH1
+        assert list(f["shot_000004/data"].attrs["auxiliary_signals"]) == ["CH1_2"]
+        assert list(forces.attrs["auxiliary_signals"]) == [n for n in ("upper_average_force", "wall_force")
+                                                           if n != forces.attrs["signal"]]
+
+
+def test_the_auxiliary_signals_are_covered_by_the_digests(archive, tmp_path):
+    import shutil
+
+    copy = tmp_path / "copy.h5"
+    shutil.copy(archive, copy)
+    assert Archive(copy).verify()["bad"] == []
+    with h5py.File(copy, "r+") as f:
+        f["shot_000001/data"].attrs["auxiliary_signals"] = ["CH3"]
+    (bad,) = Archive(copy).verify()["bad"]
+    assert bad["shot"] == 1 and bad["where"].endswith("data@auxiliary_signals"), bad
 
 
 def test_open_datatree_opens_the_whole_archive(archive):

@@ -1,0 +1,31 @@
+"""What every scope-file reader checks alike: that a record runs in time (its horizontal
+unit is seconds), and a channel name the archive can store, made from whatever the file
+gives (a source like "CH1", or a file name like "Tek000-ch1 (2)")."""
+from __future__ import annotations
+
+import re
+
+from ..errors import InstrumentError
+
+SECONDS = ("s", "sec", "second", "seconds")
+
+
+def time_axis(path, field: str, unit: str) -> str:
+    """'s' where the record's horizontal unit ``unit`` (named ``field`` in the file) is
+    seconds; otherwise InstrumentError in one line: a spectrum (hertz) is named as the
+    frequency-domain record it is, never read as a time record holding hertz."""
+    u = (unit or "s").strip().strip('"')
+    if u.lower() in SECONDS:
+        return "s"
+    what = ("a frequency-domain record (an FFT/MATH spectrum)" if u.lower() in ("hz", "hertz")
+            else "not a time record")
+    raise InstrumentError(f"{path}: {what}: {field} = {u!r}; the rig reads time records "
+                          f"(horizontal unit s)")
+
+
+def channel_name(text: str) -> str:
+    """A channel name the archive stores (letters, digits, '_' and '#', not starting with a
+    digit), made from ``text``: every other character becomes '_', and a leading digit
+    gets 'CH_' before it. "Tek000-ch1" -> "Tek000_ch1", "2024 run 3" -> "CH_2024_run_3"."""
+    name = re.sub(r"[^A-Za-z0-9_#]", "_", text.strip()) or "CH"
+    return f"CH_{name}" if name[0].isdigit() or name[0] == "#" else name
