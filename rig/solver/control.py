@@ -23,6 +23,17 @@ h (accuracy / (3 e(h)))^(1/P_CONTROL); at most MAX_ATTEMPTS solves in all. Of th
 done, the one returned is the cheapest whose estimate is in that band (else within the
 accuracy, else the most accurate). A study calibrates its step once, from its nominal shot
 (rig/study/nominal.py), and its shots reuse it without companions.
+
+Bound. The control's work is bounded before it starts: its tries and their companions
+together take at most WORK_BUDGET solves at its first step (in steps), so no try goes
+finer than the budget left allows. The measured scenes settle between 0.07 and 1.9 times
+the first step at 3 to 15 solves of the final one (docs/solver.md): 0.07 costs about 45
+solves of the first step. A record whose error does not fall with the step (a contact that
+closes or not by a hair, a chain far outside the rule's range) would otherwise shrink the
+step 16 times per try, each try 16 times dearer (a steel chain with PTFE's bead mass: 4
+minutes and counting). Where the budget ends above the accuracy, ``solve`` refuses
+(AccuracyNotReached, naming the accuracy, the estimate reached and the step), and a caller
+that bounds the step itself (a fit's pilot) takes the best try with its estimate.
 """
 from __future__ import annotations
 
@@ -30,12 +41,13 @@ import math
 import time
 from dataclasses import replace
 
+from rig.errors import RigError
 from rig.solver.methods import Method
 from rig.solver.problem import ChainProblem
-from rig.solver.run import Unstable, integrate_at
+from rig.solver.run import Unstable, integrate_at, time_grid
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution, relative_error
-from rig.solver.stepsize import Stepping, default_step, largest_step
+from rig.solver.stepsize import COARSEST_ACCURACY, Stepping, default_step, largest_step
 
 RICHARDSON = 10.0    # e(h) / e(h/2), order ~3.3: the median over the measured problems (docs/solver.md)
 P_CONTROL = 3.0      # the order the control assumes when it moves the step
@@ -43,6 +55,11 @@ TARGET = 1.0 / 3.0   # aimed-at error, as a fraction of the accuracy setting
 ACCEPT_LOW, ACCEPT_HIGH = 0.2, 0.5  # estimates in this band (x accuracy) end the control
 MAX_ATTEMPTS = 5
 COMPANION = 2        # the companion takes this many steps for each of the solution's
+WORK_BUDGET = 96.0   # the control's steps, companions included, in solves at its first step
+
+
+class AccuracyNotReached(RigError):
+    """The accuracy control's work budget ran out with its estimate above the accuracy."""
 
 
 def companion_estimate(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, stepping: Stepping,
@@ -76,35 +93,57 @@ def estimated_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method
 
 
 def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, accuracy: float,
-                     shortest: float = 0.0) -> Solution:
+                     shortest: float = 0.0, strict: bool = True) -> Solution:
     """The solve meeting ``accuracy`` (module doc): tries at most MAX_ATTEMPTS steps, none
-    shorter than ``shortest`` (s; a caller's bound on the cost: the solve at that step is
-    then returned with its estimate, above the accuracy)."""
+    shorter than ``shortest`` (s; a caller's bound on the cost) and all of them, companions
+    included, within WORK_BUDGET solves at the first step. Where the bound ends the control
+    above the accuracy: AccuracyNotReached if ``strict``, else the most accurate try,
+    its estimate above the accuracy."""
     t0 = time.process_time()
     first = default_step(problem, m, accuracy, t_end)
     longest = largest_step(problem, m, t_end)
     dt = max(min(first.dt, longest), shortest)
+    budget = WORK_BUDGET * time_grid(t_end, dt, t_end)[0]  # steps
+    spent = 0
     tried = []  # (solution, estimate, basis)
     for _ in range(MAX_ATTEMPTS):
         stepping = Stepping(dt, first.head, first.inner_dt * dt / first.dt)
         try:
             sol = integrate_at(problem, t_end, save, m, stepping, accuracy)
         except Unstable:
+            spent += time_grid(t_end, dt, t_end)[0]
             dt *= 0.5
             continue
         est, basis = companion_estimate(problem, t_end, save, m, stepping, sol)
+        spent += sol.stats.steps * (1 + COMPANION)
         tried.append((sol, est, basis))
         if est is None or ACCEPT_LOW * accuracy <= est <= ACCEPT_HIGH * accuracy:
             break
         if est < ACCEPT_LOW * accuracy and dt >= longest:
             break  # as coarse as the chain allows
-        if est > ACCEPT_HIGH * accuracy and dt <= shortest:
-            break  # as fine as the caller allows
-        dt = max(min(_next_step(tried, TARGET * accuracy), longest), shortest)
+        affordable = t_end * (1 + COMPANION) / (budget - spent) if budget > spent else math.inf
+        finer = max(min(_next_step(tried, TARGET * accuracy), longest), shortest, affordable)
+        if est > ACCEPT_HIGH * accuracy and finer >= dt:
+            break  # as fine as the caller or the budget allows
+        dt = finer
     if not tried:
         raise Unstable(f"unstable at every step tried down to dt = {2 * dt:.4g} s", stepping)
     sol, est, basis = _choice(tried, accuracy)
+    if strict and est is not None and est > accuracy:
+        raise AccuracyNotReached(_not_reached(tried, accuracy, first.dt))
     return with_estimate(sol, est, basis, len(tried), time.process_time() - t0)
+
+
+def _not_reached(tried: list, accuracy: float, first: float) -> str:
+    """One line: the accuracy, the best estimate reached, the steps tried and the way out."""
+    best = min(t[1] for t in tried if t[1] is not None)
+    steps = sorted(t[0].stats.dt_s for t in tried)
+    way_out = f", or ask for accuracy >= {best:.2g}" if best <= COARSEST_ACCURACY else ""
+    return (f"accuracy = {accuracy:g}: not reached within the accuracy control's bound ({MAX_ATTEMPTS} "
+            f"tries, {WORK_BUDGET:g} solves' work at its first step): the error estimate stayed at {best:.2g} or more "
+            f"over {len(tried)} tries from dt = {steps[-1]:.3g} s down to {steps[0]:.3g} s "
+            f"({steps[0] / first:.2g} of the first step); it does not fall with the step as it should, so "
+            f"a finer one would not meet it either: check the scene's values{way_out}")
 
 
 def _next_step(tried: list, target: float) -> float:
