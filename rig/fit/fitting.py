@@ -203,14 +203,13 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
     (model,) = cache.get([theta(res.x)])
     r = objective.residuals(model, res.x[P:])
     J = jac(res.x)
-    unseen(params, J)
     chi2 = float(r @ r)
     dof = int(r.size - x0.size)
     cov_n = np.linalg.pinv(J.T @ J)
     cov_n = cov_n * max(1.0, chi2 / dof if dof > 0 else 1.0)
     sd_n = np.sqrt(np.clip(np.diag(cov_n)[:P], 0.0, None))
     est = theta(res.x)
-    std = sd_n * span
+    std = np.where(np.any(J[:, :P], axis=0), sd_n * span, math.inf)  # a zero column: no information, not sd 0
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov_n[:P, :P] / np.outer(sd_n, sd_n)
     ci = np.column_stack((np.maximum(est - 1.96 * std, lo), np.minimum(est + 1.96 * std, lo + span)))

@@ -142,12 +142,14 @@ def test_a_value_at_its_bound_is_flagged_naming_the_bound(tmp_path, capsys, curv
 def test_real_records_that_are_no_impact_are_refused_or_flagged(tmp_path, capsys, realdata):
     """Real single-channel records read as the upper gauge; the old fits reported E with
     an sd of 0 or passing its bounds, wrote a fitted scene and exited 0. An accelerometer
-    record: E moves its residuals by far less than one sd across its bounds: refused. A
-    TDS2001C record: E is determined, but chi2/dof ~ 760 rules the model out."""
+    record: at the result E's sd is 100 times its bounds' span: undetermined. A TDS2001C
+    record: E is determined, but chi2/dof ~ 760 rules the model out."""
     code, err, out = _fit(tmp_path, capsys, ["--records", str(realdata / "accel_TEK00000.CSV")], E)
-    assert code == 2
-    _one_line(err, "--param = 'chain.youngs_modulus': the data do not see it")
-    _refused(out)
+    block = json.loads((out / "fit.json").read_text())
+    assert code == 1 and "the data do not determine chain.youngs_modulus" in err
+    assert block["undetermined"] == ["chain.youngs_modulus"] and block["fitted_scene"] is None
+    assert block["parameters"]["chain.youngs_modulus"]["std"] > 2.5e9  # not the old sd of 0
+    assert not (out / "fitted.toml").exists()
     code, err, out = _fit(tmp_path, capsys, ["--records", str(realdata / "pchem_TDS2001C_F0000CH1.CSV")], E)
     block = json.loads((out / "fit.json").read_text())
     assert code == 1 and "the model does not describe the data" in err
