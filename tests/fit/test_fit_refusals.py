@@ -155,3 +155,28 @@ def test_real_records_that_are_no_impact_are_refused_or_flagged(tmp_path, capsys
     assert code == 1 and "the model does not describe the data" in err
     assert block["plausible"] is False and block["chi2_reduced"] > 100 and block["fitted_scene"] is None
     assert not (out / "fitted.toml").exists()
+
+
+def test_the_same_shot_twice_in_the_records_is_refused():
+    """Two channels with the same samples (an archive holding the same shot twice)."""
+    from rig.fit.checks import check_distinct_channels
+    from rig.fit.traces import Channel
+
+    t = np.linspace(-1e-4, 1e-3, 200)
+    one = Channel(0, "CH1", t, np.sin(1e4 * t), 1e-3, 0.05, 0.0)
+    check_distinct_channels([one, Channel(1, "CH1", t, np.sin(1e4 * t) + 1e-3, 1e-3, 0.05, 0.0)])
+    with pytest.raises(RigError, match=r"records = 'record 2 CH1': the same samples as record 1 CH1"):
+        check_distinct_channels([one, Channel(1, "CH1", t, np.sin(1e4 * t), 1e-3, 0.05, 0.0)])
+
+
+def test_as_many_points_as_parameters_fits_but_says_chi2_is_undefined(tmp_path, capsys, curve):
+    """One point, one parameter: no degrees of freedom. chi2/dof and p are null (not NaN in
+    the JSON), plausibility is not judged, and the fit says why."""
+    pts = _points(tmp_path, [(curve.force[1], curve.speed[1])])
+    code, err, out = _fit(tmp_path, capsys, ["--points", str(pts)], E, stale=False)
+    block = json.loads((out / "fit.json").read_text())
+    assert block["dof"] == 0 and block["chi2_reduced"] is None and block["p_value"] is None
+    assert block["plausible"] is None and block["interval_scale"] == 1.0
+    assert any("chi2/dof and p are undefined" in w for w in block["warnings"])
+    lo, hi = block["parameters"]["chain.youngs_modulus"]["ci95"]
+    assert lo <= 1.1e9 <= hi
