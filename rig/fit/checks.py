@@ -1,12 +1,15 @@
 """What a fit refuses, and what it flags, so that it never reports what the data cannot
 say with full confidence.
 
-Before any solve: a bound the scene or the solver cannot take (a modulus of 1e300 Pa has
-no contact time scale), fewer data than fitted parameters, the same data twice (it
-would narrow the intervals by sqrt(2) without a new measurement). At the Jacobian: a
-parameter whose column is zero (the data do not depend on it: its sd would come out 0
-from the pseudo-inverse). At the result: chi2/dof far above 1 (the intervals are widened
-by sqrt(chi2/dof), and the fit is reported as not plausible), a parameter at a bound.
+Refused (RigError, one line) before any solve: a bound the scene or the solver cannot take
+(a modulus of 1e300 Pa has no contact time scale), fewer data than fitted parameters, the
+same data twice (it would narrow the intervals by sqrt(2) without a new measurement). At
+the first Jacobian: a parameter that moves the residuals by less than one standard
+deviation across its whole bounds (the data do not see it; an exactly zero column gave an
+sd of 0 from the pseudo-inverse). Flagged at the result: chi2/dof far above 1 (p below
+IMPLAUSIBLE_P: the intervals are widened by sqrt(chi2/dof), and the fit is not plausible),
+an sd wider than the bounds (undetermined), a value at a bound. A flagged fit writes no
+fitted scene (``unusable``).
 """
 from __future__ import annotations
 
@@ -102,13 +105,16 @@ def unseen(params: tuple, J: np.ndarray) -> None:
                                             "so its value cannot be fitted; leave it out")
 
 
+def _misfit(result) -> str:
+    return f"the model does not describe the data (chi2/dof {result.chi2_reduced:.3g}, p = {result.p_value:.2g})"
+
+
 def unusable(result) -> str:
     """Why a converged fit does not stand for the scene ('' where it does): rig fit then
     writes no fitted scene and exits 1."""
     why = []
     if result.plausible is False:
-        why.append(f"the model does not describe the data (chi2/dof {result.chi2_reduced:.3g}, "
-                   f"p = {result.p_value:.2g})")
+        why.append(_misfit(result))
     if result.undetermined:
         why.append(f"the data do not determine {', '.join(result.undetermined)}")
     return "; ".join(why)
@@ -121,9 +127,8 @@ def result_warnings(result, params: tuple) -> list:
     if result.dof == 0:
         out.append("as many data as parameters: chi2/dof and p are undefined, and the intervals rest on "
                    "the data's stated uncertainties alone")
-    elif not result.plausible:
-        out.append(f"the model does not describe the data (chi2/dof {result.chi2_reduced:.3g}, "
-                   f"p = {result.p_value:.2g}): the fit is not plausible; its intervals, widened by "
+    elif result.plausible is False:
+        out.append(f"{_misfit(result)}: the fit is not plausible; its intervals, widened by "
                    f"sqrt(chi2/dof) = {result.interval_scale:.3g}, treat a systematic misfit as noise")
     for p, sd in zip(params, result.std):
         if p.key in result.undetermined:
