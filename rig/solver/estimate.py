@@ -1,6 +1,6 @@
 """How big and how long a solve will be, before it runs: memory from the output grid
-(recorded channels x samples), time from the step rule (steps x bodies x a measured cost
-per body-step). The command line refuses a run beyond LIMIT_BYTES or LIMIT_SECONDS unless
+(recorded channels x samples), time from the step rule (steps x (bodies x a measured cost
+per body-step + a step's own cost)). The command line refuses a run beyond LIMIT_BYTES or LIMIT_SECONDS unless
 the user confirms it (``--allow-large``)."""
 from __future__ import annotations
 
@@ -15,6 +15,9 @@ from rig.solver.run import time_grid
 from rig.solver.stepsize import checked_accuracy, default_step
 
 NS_PER_BODY_STEP = 7.0  # srkn6b's whole step, one core: 6 force evaluations of about 1.2 ns per body
+NS_PER_STEP = 2000.0  # a step's own cost whatever the chain: the head's substeps, recording, the checks
+# (1.4 to 2.7 us a step beside the bodies' on ptfe52_gravity, ptfe52_magnetic and steel21_gravity; the
+# bodies' 7 ns alone had their solves 4 to 18 times dearer than estimated)
 CONTROL_WORK = 6.0  # a controlled solve in solves at its final step: about 2 tries, each with a companion at dt/2
 COPIES = 4  # the output grid, the truth, the instruments' inputs and their conditioning
 LIMIT_BYTES = 2e9
@@ -73,6 +76,6 @@ def estimate_solve(problem: ChainProblem, t_end: float, channels: int, sample_in
     its pilot's step)."""
     stepping = default_step(problem, get_method(method), checked_accuracy(accuracy), t_end)
     steps, _, samples = time_grid(t_end, min(stepping.dt, t_end), sample_interval)  # the grid solve takes
-    one = steps * problem.moving_bodies * NS_PER_BODY_STEP * 1e-9  # s
+    one = steps * (problem.moving_bodies * NS_PER_BODY_STEP + NS_PER_STEP) * 1e-9  # s
     return RunEstimate(8.0 * samples * max(channels, 1) * COPIES, one * (CONTROL_WORK if controlled else 1.0),
                        steps, problem.moving_bodies, samples, one * WORK_BUDGET if controlled else math.nan)

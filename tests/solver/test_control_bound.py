@@ -16,11 +16,10 @@ from rig.solver.run import time_grid
 from rig.solver.stepsize import default_step
 
 HARD = ("ptfe52_magnetic", ["chain.material=steel316"])  # steel beads of PTFE's mass: 4 minutes unbounded
-SLOWER = 20.0
-"""The estimate's cost per body-step is the kernel bench's whole step; this chain's head
-substeps and its 30001-sample record take up to about 5 times more, and the test machine
-may be shared: the time allowed is this many times the estimate's bound (plus a second of
-loading), still far below the minutes the unbounded control took."""
+SLOWER = 2.0
+"""The test machine may be shared: the CPU time allowed is twice the estimate's bound (the
+control's work budget at the estimate's cost per step), far below the minutes the
+unbounded control took."""
 
 
 def _rig():
@@ -36,7 +35,7 @@ def test_the_hard_override_ends_within_its_estimate_and_names_the_accuracy():
     with pytest.raises(AccuracyNotReached, match=r"accuracy = 0\.0001: not reached; the error estimate stayed at 0\.\d+ .*"
                        r"lowered it by less than 2 times"):
         rig.solution()
-    assert time.process_time() - t0 < SLOWER * estimate.bound_seconds + 1.0
+    assert time.process_time() - t0 < SLOWER * estimate.bound_seconds < 60.0
 
 
 def test_a_lenient_caller_gets_the_best_try_flagged_by_its_estimate():
