@@ -129,7 +129,9 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
         affordable = t_end * (1 + COMPANION) / (budget - spent) if budget > spent else math.inf
         finer = max(min(_next_step(tried, TARGET * accuracy), longest), shortest, affordable)
         if est > ACCEPT_HIGH * accuracy and not _falls(tried):
-            stop = f"steps down to {dt / first.dt:.2g} of the first that lowered it by less than {NO_FALL:g} times"
+            coarsest = max(t[0].stats.dt_s for t in tried)
+            stop = (f"a step {coarsest / dt:.3g} times finer, which lowered it by less than {NO_FALL:g} times "
+                    f"(the error does not fall with the step)")
             break
         if est > ACCEPT_HIGH * accuracy and finer >= dt:
             stop = ("its step floor" if finer == shortest else
