@@ -8,7 +8,7 @@ the first Jacobian: a parameter that moves the residuals by less than one standa
 deviation across its whole bounds (the data do not see it; an exactly zero column gave an
 sd of 0 from the pseudo-inverse). Flagged at the result: chi2/dof far above 1 (p below
 IMPLAUSIBLE_P: the intervals are widened by sqrt(chi2/dof), and the fit is not plausible),
-an sd wider than the bounds (undetermined), a value at a bound. A flagged fit writes no
+a 95% interval past both bounds (undetermined), a value at a bound. A flagged fit writes no
 fitted scene (``unusable``).
 """
 from __future__ import annotations
@@ -132,8 +132,9 @@ def result_warnings(result, params: tuple) -> list:
                    f"sqrt(chi2/dof) = {result.interval_scale:.3g}, treat a systematic misfit as noise")
     for p, sd in zip(params, result.std):
         if p.key in result.undetermined:
-            out.append(f"the data do not determine {p.key}: its sd {sd:.2g} is wider than its bounds "
-                       f"({p.hi - p.lo:.2g} apart)")
+            unit = "" if p.unit == "1" else f" {p.unit}"
+            out.append(f"the data do not determine {p.key}: its sd {sd:.2g}{unit} puts its 95% interval past "
+                       f"both of its bounds ({p.shown(p.lo)}, {p.shown(p.hi)})")
     for p, e in zip(params, result.estimate):
         if p.key in result.at_bound:
             side, bound = ("lower", p.lo) if abs(e - p.lo) <= abs(e - p.hi) else ("upper", p.hi)

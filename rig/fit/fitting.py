@@ -71,10 +71,11 @@ class FitResult:
 
     @property
     def undetermined(self) -> tuple:
-        """The keys whose sd is wider than their bounds' span: the data do not determine them
-        (alone, or apart from a correlated partner: ``correlated_pairs``)."""
-        span = self.bounds[:, 1] - self.bounds[:, 0]
-        return tuple(k for k, sd, w in zip(self.keys, self.std, span) if not sd <= w)
+        """The keys whose 95% interval, estimate +- 1.96 sd, reaches past both of their
+        bounds: the data do not narrow them inside the bounds (alone, or apart from a
+        correlated partner: ``correlated_pairs``); an sd wider than the span always does."""
+        return tuple(k for k, e, sd, (lo, hi) in zip(self.keys, self.estimate, self.std, self.bounds)
+                     if not (e - 1.96 * sd > lo or e + 1.96 * sd < hi))
 
     @property
     def usable(self) -> bool:

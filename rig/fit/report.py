@@ -19,8 +19,8 @@ def summary(result: FitResult, objective, fitted_scene) -> dict:
     "residual_rms_relative", "converged", "plausible", "interval_scale", "warnings",
     "fitted_scene", "numerics", ...}. converged: the optimiser's; plausible: the chi2's
     verdict on the model (None without degrees of freedom); interval_scale: sqrt(chi2/dof)
-    where above 1, the factor already in the sds; undetermined: keys whose sd passes their
-    bounds; unusable: why a converged fit writes no fitted scene (None where it does);
+    where above 1, the factor already in the sds; undetermined: keys whose 95% interval
+    passes both their bounds; unusable: why a converged fit writes no fitted scene (None where it does);
     warnings: rig.fit.checks.result_warnings.
     chi2_reduced and p_value are None where undefined (no degrees of freedom)."""
     return {
