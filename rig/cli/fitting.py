@@ -9,6 +9,9 @@ def _records(args) -> list:
     from instruments.formats import read_record
 
     if args.records:
+        from rig.fit.checks import check_distinct_files
+
+        check_distinct_files("--records", args.records)
         return [read_record(args.records)]
     from instruments.archive import Archive
 
@@ -54,13 +57,11 @@ def cmd_fit(args) -> dict:
             unit = "" if p["unit"] == "1" else f" {p['unit']}"
             print(f"{k:28s} {p['estimate']:.6g} +- {p['std']:.2g}{unit}   95%: [{p['ci95'][0]:.6g}, "
                   f"{p['ci95'][1]:.6g}]{'  AT BOUND' if k in block['at_bound'] else ''}")
-        print(f"chi2/dof {block['chi2_reduced']:.3f} (p = {block['p_value']:.3g}), BIC {block['bic']:.2f}, "
-              f"residual rms {block['residual_rms_relative']:.2%}")
-        for q in params:
-            sd = block["parameters"][q.key]["std"]
-            if not sd <= q.hi - q.lo:
-                print(f"warning: the data do not determine {q.key}: its sd {sd:.2g} is wider than its bounds "
-                      f"({q.hi - q.lo:.2g} apart)")
+        goodness = ("chi2/dof undefined (no degrees of freedom)" if block["chi2_reduced"] is None else
+                    f"chi2/dof {block['chi2_reduced']:.3f} (p = {block['p_value']:.3g})")
+        print(f"{goodness}, BIC {block['bic']:.2f}, residual rms {block['residual_rms_relative']:.2%}")
+        for line in block["warnings"]:
+            print(f"warning: {line}")
         for pair in block["highly_correlated"]:
             print(f"warning: {pair['keys'][0]} and {pair['keys'][1]} cannot be told apart "
                   f"(correlation {pair['correlation']:+.3f}); their intervals are wide for that reason")
@@ -75,10 +76,6 @@ def cmd_fit(args) -> dict:
         elif not num["within_accuracy"]:
             print("warning: the model's error estimate exceeds the scene's accuracy setting; "
                   "set a smaller solver.accuracy (--set) and fit again")
-        if block["p_value"] is not None and block["p_value"] < 1e-3:
-            print(f"warning: the model does not describe the data (chi2/dof {block['chi2_reduced']:.3g}, "
-                  f"p = {block['p_value']:.2g}): the misfit is systematic, and the intervals, widened by "
-                  f"sqrt(chi2/dof), treat it as noise")
         post = block.get("posterior")
         if post:
             print(f"posterior ({post['walkers']} walkers x {post['steps']} steps, acceptance "
@@ -99,6 +96,10 @@ def cmd_fit(args) -> dict:
               + (f", fitted.toml (rig shot {block['fitted_scene']})" if block["fitted_scene"] else ""))
     if not block["converged"]:
         print(f"rig fit: error: the fit did not converge ({block['message']}); no fitted scene written",
+              file=sys.stderr)
+        args.exit_code = 1
+    elif block["unusable"]:
+        print(f"rig fit: error: the fit converged, but {block['unusable']}; no fitted scene written",
               file=sys.stderr)
         args.exit_code = 1
     return block

@@ -110,6 +110,12 @@ def read_points(path) -> Points:
             j = int(np.flatnonzero(arr[name] <= 0)[0])
             raise invalid(f"--points {path} line {lines[j + 1]} {name}", float(arr[name][j]),
                           "> 0 (forces, speeds and uncertainties)")
+    first = {}
+    for j, values in enumerate(zip(*(arr[n] for n in names))):
+        if values in first:
+            raise invalid(f"--points {path} line {lines[j + 1]}", ",".join(rows[j + 1]),
+                          f"repeats line {first[values]}: the same point counted twice would narrow the intervals")
+        first[values] = lines[j + 1]
     keys = [n for n in names if n not in POINT_COLUMNS]
     configs = tuple(tuple(f"{k}={float(arr[k][j])!r}" for k in keys) for j in range(len(rows) - 1))
     return Points(arr["F_d"], arr["F_d_sd"], arr["V_s"], arr["V_s_sd"], configs, str(path))

@@ -91,7 +91,7 @@ def calibrate(rigs: list, window_s: float = math.inf) -> Pilot:
     for r, p in zip(rigs, _problems(rigs)):
         m, acc, t_end = get_method(r.solver.method), checked_accuracy(r.solver.accuracy), r.solver.duration
         rule = accuracy_step(p, m, acc, t_end, head_contacts(p))
-        sol = controlled_solve(p, t_end, r.save_at(), m, acc, shortest=MIN_STEP_FACTOR * rule)
+        sol = controlled_solve(p, t_end, r.save_at(), m, acc, shortest=MIN_STEP_FACTOR * rule, strict=False)
         factors.append(sol.stats.dt_s / rule)
         if sol.stats.error_estimate is not None:
             estimates.append(sol.stats.error_estimate)

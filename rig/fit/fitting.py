@@ -25,6 +25,7 @@ import numpy as np
 from scipy import optimize, stats
 
 from rig.errors import RigError
+from rig.fit.checks import IMPLAUSIBLE_P, check_data_count, unseen
 
 FD_STEP = 0.01
 """Finite-difference step, as a fraction of each parameter's bound interval: large enough
@@ -58,6 +59,7 @@ class FitResult:
     eta: np.ndarray = field(default_factory=lambda: np.zeros(0))
     model: object = None
     replayed: int = 0  # candidates read back from the cache of an earlier run (evaluations: solved in this one)
+    bounds: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (lo, hi) of each parameter, SI
 
     @property
     def chi2_reduced(self) -> float:
@@ -66,6 +68,31 @@ class FitResult:
     @property
     def p_value(self) -> float:
         return float(stats.chi2.sf(self.chi2, self.dof)) if self.dof > 0 else math.nan
+
+    @property
+    def undetermined(self) -> tuple:
+        """The keys whose 95% interval, estimate +- 1.96 sd, reaches past both of their
+        bounds: the data do not narrow them inside the bounds (alone, or apart from a
+        correlated partner: ``correlated_pairs``); an sd wider than the span always does."""
+        return tuple(k for k, e, sd, (lo, hi) in zip(self.keys, self.estimate, self.std, self.bounds)
+                     if not (e - 1.96 * sd > lo or e + 1.96 * sd < hi))
+
+    @property
+    def usable(self) -> bool:
+        """Whether the result stands for the scene: converged, plausible (or nothing to judge
+        it by) and every parameter determined. Only then is a fitted scene written."""
+        return self.converged and self.plausible is not False and not self.undetermined
+
+    @property
+    def interval_scale(self) -> float:
+        """The factor the sds and intervals were widened by: sqrt(chi2/dof) where above 1."""
+        return math.sqrt(max(1.0, self.chi2_reduced)) if self.dof > 0 else 1.0
+
+    @property
+    def plausible(self) -> bool | None:
+        """Whether the model can describe the data: chi2's p-value >= IMPLAUSIBLE_P (None
+        without degrees of freedom: nothing to judge by)."""
+        return None if self.dof <= 0 else self.p_value >= IMPLAUSIBLE_P
 
     @property
     def bic(self) -> float:
@@ -139,6 +166,7 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
     lo = np.array([p.lo for p in params])
     span = np.array([p.hi - p.lo for p in params])
     eta0, eta_lo, eta_hi = objective.nuisance_start()
+    check_data_count(objective.n_data, P, eta0.size, objective.data_name)
     x0 = np.concatenate((np.clip((objective.start() - lo) / span, 0.0, 1.0), eta0))
     bounds = (np.concatenate((np.zeros(P), eta_lo)), np.concatenate((np.ones(P), eta_hi)))
     cache = EvaluationCache(objective, cache_folder)
@@ -164,6 +192,8 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
             below = objective.residuals(models[1 + P + k], x[P:]) if down[k] else r0
             J[:, k] = (objective.residuals(models[1 + k], x[P:]) - below) / (up[k] - down[k])
         J[:, P:] = objective.nuisance_jacobian(models[0], x[P:])
+        if count["batches"] == 1:
+            unseen(params, J)  # at the start: before the optimiser spends evaluations on it
         tell(f"fit: Jacobian {count['batches']}: chi2 {float(r0 @ r0):.6g}, "
              + ", ".join(p.key + " " + p.shown(v) for p, v in zip(params, theta(x)))
              + f" ({cache.solved} candidates solved)")
@@ -180,7 +210,7 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
     cov_n = cov_n * max(1.0, chi2 / dof if dof > 0 else 1.0)
     sd_n = np.sqrt(np.clip(np.diag(cov_n)[:P], 0.0, None))
     est = theta(res.x)
-    std = sd_n * span
+    std = np.where(np.any(J[:, :P], axis=0), sd_n * span, math.inf)  # a zero column: no information, not sd 0
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov_n[:P, :P] / np.outer(sd_n, sd_n)
     ci = np.column_stack((np.maximum(est - 1.96 * std, lo), np.minimum(est + 1.96 * std, lo + span)))
@@ -188,7 +218,7 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
     converged = bool(res.success and res.status > 0 and np.all(np.isfinite(std)))
     return FitResult(tuple(p.key for p in params), tuple(p.unit for p in params), est, std, ci, corr, r, chi2, dof,
                      converged, str(res.message), cache.solved, at_bound, objective.nuisance_report(res.x[P:]),
-                     res.x[P:].copy(), model, cache.replayed)
+                     res.x[P:].copy(), model, cache.replayed, np.column_stack((lo, lo + span)))
 
 
 def stderr_progress(text: str):

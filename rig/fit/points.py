@@ -17,6 +17,7 @@ import numpy as np
 
 from rig.errors import RigError
 from rig.experiment import scene as scene_io
+from rig.fit.checks import at_values, check_bounds
 from rig.fit.data import Points
 from rig.fit.evaluate import Curve, Pilot, calibrate, curves, leading_window, numerics, shot_rigs
 from rig.fit.parameters import law_overrides
@@ -60,6 +61,7 @@ class PointObjective:
         v0 = scene_io.load(scene, self.overrides).values["striker"]["velocity"]
         self.velocities = v0 * np.array(VELOCITY_FACTORS)
         self._start = start_values(scene, self.overrides, params)
+        check_bounds(scene, self.overrides, self.params, self._start)
 
     def shots(self, theta, duration: float = float("inf")) -> list:
         """The rigs of candidate ``theta``'s shots, each configuration at each velocity,
@@ -71,11 +73,16 @@ class PointObjective:
     def pilot(self) -> Pilot:
         """The fit's numerics, calibrated once on the start values' shots over their
         leading window (rig.fit.evaluate)."""
-        rigs = self.shots(self._start)
+        start = at_values(self.params, self._start)
+        overrides = [self.candidate_overrides(self._start, c) for c in self.configs]
+        rigs, _, refused = shot_rigs(self.scene, overrides, self.velocities)
         if not rigs:
-            raise RigError("the scene refuses the fit's start values")
-        window = leading_window(rigs)
-        return calibrate(self.shots(self._start, window), window)
+            raise RigError(f"the scene refuses the fit's start values ({start}): {refused[0]}")
+        try:
+            window = leading_window(rigs)
+            return calibrate(self.shots(self._start, window), window)
+        except RigError as exc:
+            raise RigError(f"at the fit's start values ({start}): {exc}") from None
 
     def spec(self) -> dict:
         """What the fit's evaluations depend on (the key of its cache), the pilot's numerics
@@ -93,6 +100,15 @@ class PointObjective:
 
     def start(self) -> np.ndarray:
         return self._start
+
+    @property
+    def n_data(self) -> int:
+        """The measured values the fit compares: one speed per point."""
+        return self.points.n
+
+    @property
+    def data_name(self) -> str:
+        return f"--points {self.points.source}"
 
     def candidate_overrides(self, theta, config) -> list:
         return self.overrides + [q.override(x) for q, x in zip(self.params, theta)] + list(config)

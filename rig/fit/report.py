@@ -9,13 +9,20 @@ from pathlib import Path
 import numpy as np
 
 from rig.experiment import scene as scene_io
+from rig.fit.checks import result_warnings, unusable
 from rig.fit.fitting import FitResult
 from rig.fit.points import PointObjective
 
 
 def summary(result: FitResult, objective, fitted_scene) -> dict:
     """The --json block: {"parameters": {KEY: {"estimate", "std", "ci95", "unit"}}, "correlation",
-    "residual_rms_relative", "converged", "fitted_scene", "numerics", ...}."""
+    "residual_rms_relative", "converged", "plausible", "interval_scale", "warnings",
+    "fitted_scene", "numerics", ...}. converged: the optimiser's; plausible: the chi2's
+    verdict on the model (None without degrees of freedom); interval_scale: sqrt(chi2/dof)
+    where above 1, the factor already in the sds; undetermined: keys whose 95% interval
+    passes both their bounds; unusable: why a converged fit writes no fitted scene (None where it does);
+    warnings: rig.fit.checks.result_warnings.
+    chi2_reduced and p_value are None where undefined (no degrees of freedom)."""
     return {
         "parameters": {k: {"estimate": float(e), "std": float(s), "ci95": [float(lo), float(hi)], "unit": u}
                        for k, u, e, s, (lo, hi) in zip(result.keys, result.units, result.estimate, result.std,
@@ -26,13 +33,20 @@ def summary(result: FitResult, objective, fitted_scene) -> dict:
         "converged": result.converged,
         "message": result.message,
         "at_bound": list(result.at_bound),
-        "chi2": result.chi2, "dof": result.dof, "chi2_reduced": result.chi2_reduced,
-        "p_value": result.p_value, "bic": result.bic,
+        "chi2": result.chi2, "dof": result.dof, "chi2_reduced": _finite_or_none(result.chi2_reduced),
+        "p_value": _finite_or_none(result.p_value), "bic": result.bic,
+        "plausible": result.plausible, "interval_scale": result.interval_scale,
+        "undetermined": list(result.undetermined), "unusable": unusable(result) or None,
+        "warnings": result_warnings(result, objective.params),
         "evaluations": result.evaluations, "evaluations_replayed": result.replayed,
         "nuisance": result.nuisance,
         "fitted_scene": None if fitted_scene is None else str(fitted_scene),
         "numerics": objective.numerics(result.estimate),
     }
+
+
+def _finite_or_none(x: float):
+    return float(x) if np.isfinite(x) else None
 
 
 def fitted_scene_text(scene: str, overrides: list, result: FitResult) -> str:

@@ -16,7 +16,9 @@ def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 40
     """Fit ``objective`` and write the folder ``out`` (rig.fit.report); returns the JSON
     block. Evaluations are cached in out/evaluations/: the same command run again after an
     interruption replays them instead of solving them again. A fit that did not converge
-    writes everything but the fitted scene. posterior_steps > 0: a converged fit's posterior
+    writes everything but the fitted scene, and so does one whose model cannot describe the
+    data or leaves a parameter undetermined (FitResult.usable); a refused one (RigError)
+    leaves the folder as it was. posterior_steps > 0: a converged fit's posterior
     is then sampled (rig.fit.posterior: ``walkers``, default 4 per parameter and at least
     8, drawn from ``seed``) into the block's "posterior" and out/posterior.png."""
     out = Path(out)
@@ -29,7 +31,7 @@ def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 40
     stale = out / "fitted.toml"
     if stale.exists():
         stale.unlink()  # a fitted scene from an earlier fit must not outlive a failed one
-    if result.converged:
+    if result.usable:
         text = report.fitted_scene_text(scene, objective.overrides, result)
         tmp = out / "fitted.part.toml"
         tmp.write_text(text)

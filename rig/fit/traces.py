@@ -25,6 +25,7 @@ import numpy as np
 from instruments.gauges import GaugeDraw, PiezoGauge
 from rig.errors import RigError
 from rig.experiment.shot import Rig
+from rig.fit.checks import at_values, check_bounds, check_distinct_channels
 from rig.fit.evaluate import Pilot, calibrate, numerics, solve_rigs
 from rig.fit.parameters import law_overrides
 from rig.fit.points import start_values
@@ -124,11 +125,18 @@ class TraceObjective:
         self.scene, self.params = scene, tuple(params)
         self.overrides = list(overrides) + law_overrides(params)
         self._start = start_values(scene, self.overrides, params)
+        check_bounds(scene, self.overrides, self.params, self._start)
         rig = self.rig_of(self._start)
-        self.pilot: Pilot = calibrate([rig])  # the fit's numerics, calibrated on its start (rig.fit.evaluate)
+        start = at_values(self.params, self._start)
+        try:
+            self.pilot: Pilot = calibrate([rig])  # the fit's numerics, calibrated on its start (rig.fit.evaluate)
+        except RigError as exc:
+            raise RigError(f"at the fit's start values ({start}): {exc}") from None
         if not solve_rigs([rig], self.pilot)[0]:
-            raise RigError("the scene's own shot blew up; check the scene before fitting it")
+            raise RigError(f"the scene's own shot blew up at the fit's start values ({start}); check the scene "
+                           "before fitting it")
         self.channels = channels_of(rig, records)
+        check_distinct_channels(self.channels)
         self.records = sorted({c.record for c in self.channels})
         self.gauges = [k for k, c in enumerate(self.channels) if c.delay_sd > 0]
         self.trigger = rig.scope.trigger
@@ -163,6 +171,13 @@ class TraceObjective:
 
     def start(self) -> np.ndarray:
         return self._start
+
+    @property
+    def n_data(self) -> int:
+        """The measured values the fit compares: the records' samples."""
+        return sum(c.t.size for c in self.channels)
+
+    data_name = "the records"
 
     def evaluate(self, thetas: list) -> list:
         rigs = [self.rig_of(t) for t in thetas]

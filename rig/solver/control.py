@@ -23,6 +23,20 @@ h (accuracy / (3 e(h)))^(1/P_CONTROL); at most MAX_ATTEMPTS solves in all. Of th
 done, the one returned is the cheapest whose estimate is in that band (else within the
 accuracy, else the most accurate). A study calibrates its step once, from its nominal shot
 (rig/study/nominal.py), and its shots reuse it without companions.
+
+Bound. The control's work is bounded before it starts: its tries and their companions
+together take at most WORK_BUDGET solves at its first step (in steps), so no try goes
+finer than the budget left allows; and it stops where its finest try, at least 4 times
+finer than its coarsest, brought the estimate down by less than NO_FALL (the error does
+not fall with the step).
+The measured scenes settle between 0.07 and 1.9 times the first step at 3 to 15 solves of
+the final one (docs/solver.md); a dashpot chain held to 1e-6 needs 1/420 of it (about 1500
+solves of the first step). A record whose error does not fall (a steel chain with PTFE's
+bead mass: 0.57 at every step) had the control shrink the step 16 times per try, each try
+16 times dearer, for minutes. Where the control stops above the accuracy, ``solve``
+refuses (AccuracyNotReached, naming the accuracy, the estimate reached and the steps
+tried), and a caller that bounds the step itself (a fit's pilot) takes the best try with
+its estimate.
 """
 from __future__ import annotations
 
@@ -30,12 +44,13 @@ import math
 import time
 from dataclasses import replace
 
+from rig.errors import RigError
 from rig.solver.methods import Method
 from rig.solver.problem import ChainProblem
-from rig.solver.run import Unstable, integrate_at
+from rig.solver.run import Unstable, integrate_at, time_grid
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution, relative_error
-from rig.solver.stepsize import Stepping, default_step, largest_step
+from rig.solver.stepsize import COARSEST_ACCURACY, Stepping, default_step, largest_step
 
 RICHARDSON = 10.0    # e(h) / e(h/2), order ~3.3: the median over the measured problems (docs/solver.md)
 P_CONTROL = 3.0      # the order the control assumes when it moves the step
@@ -43,6 +58,12 @@ TARGET = 1.0 / 3.0   # aimed-at error, as a fraction of the accuracy setting
 ACCEPT_LOW, ACCEPT_HIGH = 0.2, 0.5  # estimates in this band (x accuracy) end the control
 MAX_ATTEMPTS = 5
 COMPANION = 2        # the companion takes this many steps for each of the solution's
+WORK_BUDGET = 2048.0  # the control's steps, companions included, in solves at its first step
+NO_FALL = 2.0        # a step 4+ times finer whose estimate fell by less than this: the error does not fall
+
+
+class AccuracyNotReached(RigError):
+    """The accuracy control's work budget ran out with its estimate above the accuracy."""
 
 
 def companion_estimate(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, stepping: Stepping,
@@ -76,35 +97,77 @@ def estimated_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method
 
 
 def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, accuracy: float,
-                     shortest: float = 0.0) -> Solution:
+                     shortest: float = 0.0, strict: bool = True) -> Solution:
     """The solve meeting ``accuracy`` (module doc): tries at most MAX_ATTEMPTS steps, none
-    shorter than ``shortest`` (s; a caller's bound on the cost: the solve at that step is
-    then returned with its estimate, above the accuracy)."""
+    shorter than ``shortest`` (s; a caller's bound on the cost) and all of them, companions
+    included, within WORK_BUDGET solves at the first step. Where the bound ends the control
+    above the accuracy: AccuracyNotReached if ``strict``, else the most accurate try,
+    its estimate above the accuracy."""
     t0 = time.process_time()
     first = default_step(problem, m, accuracy, t_end)
     longest = largest_step(problem, m, t_end)
     dt = max(min(first.dt, longest), shortest)
+    budget = WORK_BUDGET * time_grid(t_end, dt, t_end)[0]  # steps
+    spent = 0
+    stop = f"{MAX_ATTEMPTS} tries"  # what ended the control, should it end above the accuracy
     tried = []  # (solution, estimate, basis)
     for _ in range(MAX_ATTEMPTS):
         stepping = Stepping(dt, first.head, first.inner_dt * dt / first.dt)
         try:
             sol = integrate_at(problem, t_end, save, m, stepping, accuracy)
         except Unstable:
+            spent += time_grid(t_end, dt, t_end)[0]
             dt *= 0.5
             continue
         est, basis = companion_estimate(problem, t_end, save, m, stepping, sol)
+        spent += sol.stats.steps * (1 + COMPANION)
         tried.append((sol, est, basis))
         if est is None or ACCEPT_LOW * accuracy <= est <= ACCEPT_HIGH * accuracy:
             break
         if est < ACCEPT_LOW * accuracy and dt >= longest:
             break  # as coarse as the chain allows
-        if est > ACCEPT_HIGH * accuracy and dt <= shortest:
-            break  # as fine as the caller allows
-        dt = max(min(_next_step(tried, TARGET * accuracy), longest), shortest)
+        affordable = t_end * (1 + COMPANION) / (budget - spent) if budget > spent else math.inf
+        finer = max(min(_next_step(tried, TARGET * accuracy), longest), shortest, affordable)
+        if est > ACCEPT_HIGH * accuracy and not _falls(tried):
+            coarsest = max(t[0].stats.dt_s for t in tried)
+            stop = (f"a step {coarsest / dt:.3g} times finer, which lowered it by less than {NO_FALL:g} times "
+                    f"(the error does not fall with the step)")
+            break
+        if est > ACCEPT_HIGH * accuracy and finer >= dt:
+            stop = ("its step floor" if finer == shortest else
+                    f"its work budget ({WORK_BUDGET:g} solves at its first step)")
+            break
+        dt = finer
     if not tried:
         raise Unstable(f"unstable at every step tried down to dt = {2 * dt:.4g} s", stepping)
     sol, est, basis = _choice(tried, accuracy)
+    if strict and est is not None and est > accuracy:
+        raise AccuracyNotReached(_not_reached(tried, accuracy, first.dt, stop))
     return with_estimate(sol, est, basis, len(tried), time.process_time() - t0)
+
+
+def _not_reached(tried: list, accuracy: float, first: float, stop: str) -> str:
+    """One line: the accuracy, the best estimate reached, the steps tried, what stopped the
+    control and the way out."""
+    best = min(t[1] for t in tried if t[1] is not None)
+    steps = sorted(t[0].stats.dt_s for t in tried)
+    way_out = f", or ask for accuracy >= {best:.2g}" if best <= COARSEST_ACCURACY else ""
+    return (f"accuracy = {accuracy:g}: not reached; the error estimate stayed at {best:.2g} or more over "
+            f"{len(tried)} tries from dt = {steps[-1]:.3g} s down to {steps[0]:.3g} s ({steps[0] / first:.2g} of "
+            f"the first step) and the accuracy control stopped at {stop}: check the scene's values{way_out}")
+
+
+def _falls(tried: list) -> bool:
+    """Whether the error falls with the step over the tries: False where the finest try (at
+    least 4 times finer than the coarsest) brought the estimate down by less than NO_FALL
+    (a method of order 3 would have taken 64 or more). Coarsest against finest, not the
+    last two: a record whose error lingers on a plateau over a few steps before it falls
+    again (a contact that closes or not by a hair, docs/solver.md) is not stopped by it."""
+    known = [(t[0].stats.dt_s, t[1]) for t in tried if t[1] is not None]
+    if len(known) < 2:
+        return True
+    (a, ea), (b, eb) = max(known), min(known)
+    return not (b <= a / 4 and eb * NO_FALL > ea)
 
 
 def _next_step(tried: list, target: float) -> float:

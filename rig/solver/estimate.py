@@ -1,18 +1,23 @@
 """How big and how long a solve will be, before it runs: memory from the output grid
-(recorded channels x samples), time from the step rule (steps x bodies x a measured cost
-per body-step). The command line refuses a run beyond LIMIT_BYTES or LIMIT_SECONDS unless
+(recorded channels x samples), time from the step rule (steps x (bodies x a measured cost
+per body-step + a step's own cost)). The command line refuses a run beyond LIMIT_BYTES or LIMIT_SECONDS unless
 the user confirms it (``--allow-large``)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from rig.errors import RigError
+from rig.solver.control import WORK_BUDGET
 from rig.solver.methods import method as get_method
 from rig.solver.problem import ChainProblem
 from rig.solver.run import time_grid
 from rig.solver.stepsize import checked_accuracy, default_step
 
 NS_PER_BODY_STEP = 7.0  # srkn6b's whole step, one core: 6 force evaluations of about 1.2 ns per body
+NS_PER_STEP = 2000.0  # a step's own cost whatever the chain: the head's substeps, recording, the checks
+# (1.4 to 2.7 us a step beside the bodies' on ptfe52_gravity, ptfe52_magnetic and steel21_gravity; the
+# bodies' 7 ns alone had their solves 4 to 18 times dearer than estimated)
 CONTROL_WORK = 6.0  # a controlled solve in solves at its final step: about 2 tries, each with a companion at dt/2
 COPIES = 4  # the output grid, the truth, the instruments' inputs and their conditioning
 LIMIT_BYTES = 2e9
@@ -30,17 +35,26 @@ class RunEstimate:
     steps: int
     bodies: int
     samples: int
+    most_seconds: float = math.nan  # the bound: the accuracy control's work budget spent (nan: seconds)
+
+    @property
+    def bound_seconds(self) -> float:
+        """The most seconds of solving the run may take: the accuracy control gives up
+        (rig/solver/control.py, WORK_BUDGET) before it spends more."""
+        return self.seconds if math.isnan(self.most_seconds) else self.most_seconds
 
     def times(self, runs: int, kept: int) -> "RunEstimate":
         """``runs`` such solves one after another, ``kept`` of them held in memory at once."""
-        return RunEstimate(self.bytes * kept, self.seconds * runs, self.steps, self.bodies, self.samples)
+        return RunEstimate(self.bytes * kept, self.seconds * runs, self.steps, self.bodies, self.samples,
+                           self.most_seconds * runs)
 
     @property
     def large(self) -> bool:
         return self.bytes > LIMIT_BYTES or self.seconds > LIMIT_SECONDS
 
     def describe(self) -> str:
-        return (f"about {self.bytes / 1e9:.3g} GB and {self.seconds:.3g} s of solving "
+        bound = f", at most {self.bound_seconds:.3g} s" if self.bound_seconds > self.seconds else ""
+        return (f"about {self.bytes / 1e9:.3g} GB and {self.seconds:.3g} s of solving{bound} "
                 f"({self.steps} steps x {self.bodies} bodies, {self.samples} samples per channel)")
 
     def refuse_unless(self, allowed: bool, what: str):
@@ -57,11 +71,11 @@ def estimate_solve(problem: ChainProblem, t_end: float, channels: int, sample_in
                    method: str, accuracy: float | None = None, controlled: bool = True) -> RunEstimate:
     """The estimate of ``solve(problem, t_end, ...)`` recording ``channels`` channels every
     ``sample_interval`` (s), with the step the solver would start from for ``accuracy``
-    (the accuracy control's tries and companions counted as CONTROL_WORK solves; one
-    solve where ``controlled`` is False: a study's shots reuse its pilot's step)."""
+    (the accuracy control's tries and companions counted as CONTROL_WORK solves, and at
+    most its WORK_BUDGET; one solve where ``controlled`` is False: a study's shots reuse
+    its pilot's step)."""
     stepping = default_step(problem, get_method(method), checked_accuracy(accuracy), t_end)
     steps, _, samples = time_grid(t_end, min(stepping.dt, t_end), sample_interval)  # the grid solve takes
-    bodies = problem.moving_bodies
-    return RunEstimate(8.0 * samples * max(channels, 1) * COPIES,
-                       steps * bodies * NS_PER_BODY_STEP * 1e-9 * (CONTROL_WORK if controlled else 1.0),
-                       steps, bodies, samples)
+    one = steps * (problem.moving_bodies * NS_PER_BODY_STEP + NS_PER_STEP) * 1e-9  # s
+    return RunEstimate(8.0 * samples * max(channels, 1) * COPIES, one * (CONTROL_WORK if controlled else 1.0),
+                       steps, problem.moving_bodies, samples, one * WORK_BUDGET if controlled else math.nan)

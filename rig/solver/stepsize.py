@@ -230,14 +230,15 @@ def stepping_at(p, dt: float, head: int | None = None) -> Stepping:
 FINEST_ACCURACY = 1e-10  # below it the estimate cannot tell the error from rounding: a channel the pulse
 # has not reached is measured against 1e-6 of the largest peak (solution.relative_error), and its
 # float64 wobble of an ulp is already 1e-10 of that; the control would shrink the step for minutes
+COARSEST_ACCURACY = 0.1  # a force error of 10%: beyond it a record says nothing about the pulse
 
 
 def checked_accuracy(accuracy: float | None, field: str = "accuracy") -> float:
     """The accuracy target of a solve: DEFAULT_ACCURACY when None; refused outside
-    [FINEST_ACCURACY, 0.1] (relative force error), the message naming ``field``."""
+    [FINEST_ACCURACY, COARSEST_ACCURACY] (relative force error), the message naming ``field``."""
     accuracy = DEFAULT_ACCURACY if accuracy is None else accuracy
-    if not (is_real(accuracy) and FINEST_ACCURACY <= accuracy <= 0.1):
-        raise invalid(field, accuracy, f"relative accuracy target in [{FINEST_ACCURACY:g}, 0.1]")
+    if not (is_real(accuracy) and FINEST_ACCURACY <= accuracy <= COARSEST_ACCURACY):
+        raise invalid(field, accuracy, f"relative accuracy target in [{FINEST_ACCURACY:g}, {COARSEST_ACCURACY:g}]")
     return float(accuracy)
 
 

@@ -38,6 +38,12 @@ class PulseObjective:
     def start(self):
         return np.array([148.0])
 
+    data_name = "the pulse"
+
+    @property
+    def n_data(self):
+        return self.data.size
+
     def evaluate(self, thetas):
         return [pulse(float(t[0])) for t in thetas]
 

@@ -130,7 +130,7 @@ def test_trace_fit_recovers_modulus_and_damping_from_one_shot(tmp_path):
     """A virtual shot with the scene's instrument errors, fitted back from its scope record:
     the true values lie in the 95% intervals, the gains the shot drew are recovered."""
     true = ["chain.youngs_modulus=1.2e9", "chain.contact_law=dashpot", "chain.contact_damping=0.4",
-            "solver.accuracy=1e-6"]
+            "solver.accuracy=1e-5"]  # 1e-6 is not reached: 2.1e-6 after 1/420 of the first step
     shot = Rig.from_scene(SCENE, true).fire(seed=3)
     params = parse_parameters(["chain.youngs_modulus=0.5 GPa:3 GPa", "chain.contact_damping=0.05 kg/s:2 kg/s"])
     obj = TraceObjective(SCENE, params, [shot.scope], ["solver.accuracy=1e-5"])

@@ -1,0 +1,77 @@
+"""The accuracy control's bound: a run whose error does not fall with the step ends within
+the work its estimate announced, and says which accuracy it could not reach."""
+import time
+
+import pytest
+
+from rig.cli import main
+from rig.experiment.scene import load
+from rig.experiment.shot import Rig
+from rig.solver.estimate import CONTROL_WORK
+from rig.solver import control
+from rig.solver.control import WORK_BUDGET, AccuracyNotReached, controlled_solve
+from rig.solver.methods import method
+from rig.solver.problem import ChainProblem
+from rig.solver.run import time_grid
+from rig.solver.stepsize import default_step
+
+HARD = ("ptfe52_magnetic", ["chain.material=steel316"])  # steel beads of PTFE's mass: 4 minutes unbounded
+SLOWER = 2.0
+"""The test machine may be shared: the CPU time allowed is twice the estimate's bound (the
+control's work budget at the estimate's cost per step), far below the minutes the
+unbounded control took."""
+
+
+def _rig():
+    return Rig(load(*HARD))
+
+
+def test_the_hard_override_ends_within_its_estimate_and_names_the_accuracy():
+    rig = _rig()
+    estimate = rig.estimate()
+    assert estimate.seconds < estimate.bound_seconds == pytest.approx(estimate.seconds * WORK_BUDGET / CONTROL_WORK)
+    Rig.from_scene("ptfe52_magnetic").solution()  # the kernels compiled or loaded, outside the timing
+    t0 = time.process_time()
+    with pytest.raises(AccuracyNotReached, match=r"accuracy = 0\.0001: not reached; the error estimate stayed at 0\.\d+ .*"
+                       r"a step 16 times finer, which lowered it by less than 2 times"):
+        rig.solution()
+    assert time.process_time() - t0 < SLOWER * estimate.bound_seconds < 60.0
+
+
+def test_a_lenient_caller_gets_the_best_try_flagged_by_its_estimate():
+    rig = _rig()
+    p, m, s = ChainProblem.from_chain(rig.chain), method(rig.solver.method), rig.solver
+    sol = controlled_solve(p, s.duration, rig.save_at(), m, s.accuracy, strict=False)
+    first = default_step(p, m, s.accuracy, s.duration).dt
+    assert sol.stats.error_estimate > 1000 * s.accuracy  # above the setting, and it says so
+    assert sol.stats.attempts == 2 and sol.stats.dt_s == pytest.approx(first / 16, rel=1e-3)  # not 16 x 16 times finer
+
+
+def test_the_control_spends_at_most_its_work_budget(monkeypatch):
+    """A dashpot chain held to 1e-6, whose error does fall, but only at about 1/420 of the
+    first step: with a budget of 64 solves of the first step, the control stops within it
+    and names it."""
+    rig = Rig.from_scene("ptfe20_gravity", ["chain.youngs_modulus=1.2e9", "chain.contact_law=dashpot",
+                                            "chain.contact_damping=0.4", "solver.accuracy=1e-6"])
+    p, m, s = ChainProblem.from_chain(rig.chain), method(rig.solver.method), rig.solver
+    steps = []
+    solve_at = control.integrate_at
+
+    def counted(*args, **kw):
+        sol = solve_at(*args, **kw)
+        steps.append(sol.stats.steps)
+        return sol
+
+    monkeypatch.setattr(control, "WORK_BUDGET", 64.0)
+    monkeypatch.setattr(control, "integrate_at", counted)
+    with pytest.raises(AccuracyNotReached, match=r"accuracy = 1e-06: not reached; .*its work budget \(64 solves"):
+        control.controlled_solve(p, s.duration, rig.save_at(), m, s.accuracy)
+    first = time_grid(s.duration, default_step(p, m, s.accuracy, s.duration).dt, s.duration)[0]
+    assert len(steps) >= 4 and sum(steps) <= 64 * first  # tries and their companions
+    assert max(steps) > 16 * first  # it went as fine as the budget let it
+
+
+def test_the_command_line_refuses_it_in_one_line(capsys):
+    assert main(["shot", *HARD[0:1], "--set", HARD[1][0], "--json"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "accuracy = 0.0001: not reached" in err and "Traceback" not in err
