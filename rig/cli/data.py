@@ -7,7 +7,7 @@ from rig.errors import RigError
 
 def cmd_verify(args) -> dict:
     """Every shot's checksums; a bad row names the shot (or the shots of a shared group) and
-    the dataset or attribute. Exit 1 if any is bad."""
+    the dataset or attribute, or the path of an object added or deleted. Exit 1 if any is bad."""
     from pathlib import Path
 
     from instruments.archive import Archive
@@ -28,6 +28,9 @@ def cmd_verify(args) -> dict:
             parts = 3 if b["where"].startswith("/shared/") else 2 if b["where"].startswith("/shot_") else 1
             item = b["where"].split("/", parts)[-1]  # the dataset or attribute within its group
             what = b["reason"]
+            if what.startswith(("added: ", "missing: ")):  # the reason names the path
+                print(f"  {who}: {what}")
+                continue
             for head in (f"{item}: ", f"attribute {item}: "):
                 what = what.removeprefix(head)  # the path names it already
             print(f"  {who}: {b['where']}: {what}")
