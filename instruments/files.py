@@ -1,0 +1,104 @@
+"""Files written whole or not at all, and a folder held by one process at a time.
+
+Every file the rig writes (scope exports, caches, studies, fits, figures, scenes) goes
+through ``atomic_write``: it is written to a temporary file in the same folder, flushed to
+disk (fsync) and renamed over its name (``os.replace``, atomic on one file system), then the
+folder is synced. A full disk, a killed process or a power cut leaves the old file or the
+new one, never a truncated or empty one; the temporary file is removed when the write
+fails. ``atomic_writes`` does the same for several files at once: all of them are written
+before any is renamed, so a failure leaves none of them new.
+
+``folder_lock`` holds an exclusive ``flock`` on a lock file in a folder for the life of a
+run; the OS releases it when the process ends, killed or not, so a dead holder never blocks.
+The file names the holder (pid, host, start), which a refusal quotes.
+"""
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import os
+import socket
+import tempfile
+import time
+from pathlib import Path
+
+from .errors import InstrumentError
+
+
+def atomic_write(path, write) -> Path:
+    """``write(temporary path)``, flushed to disk, then renamed to ``path``; returns ``path``.
+    The file gets the mode a plain ``open`` would give it (0666 less the umask)."""
+    return atomic_writes({path: write})[0]
+
+
+def atomic_writes(writes: dict) -> list:
+    """{path: write} as ``atomic_write`` does one, all written before any is renamed: a
+    failure while writing leaves none of them new. Returns the paths."""
+    temporaries = {}
+    try:
+        for path, write in writes.items():
+            path = Path(path)
+            temporaries[path] = tmp = _temporary(path)
+            write(tmp)
+            _fsync(tmp)
+        for path, tmp in temporaries.items():
+            os.replace(tmp, path)
+    except BaseException:
+        for tmp in temporaries.values():
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        raise
+    for folder in {p.parent for p in temporaries}:
+        with contextlib.suppress(OSError):
+            _fsync(folder)
+    return list(temporaries)
+
+
+def write_text(path, text: str) -> Path:
+    """``text`` (UTF-8) as the whole of ``path``, atomically."""
+    return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+
+
+def _temporary(path: Path) -> str:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    mask = os.umask(0)
+    os.umask(mask)
+    os.chmod(tmp, 0o666 & ~mask)  # mkstemp's 0600 would make every written file private
+    return tmp
+
+
+def _fsync(path):
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def folder_lock(folder, name: str, what: str):
+    """Hold ``folder/name`` exclusively while the block runs. Held by another live process:
+    one InstrumentError naming the folder, the holder (pid, host, since) and ``what`` to do."""
+    lock = Path(folder) / name
+    try:
+        fh = open(lock, "a+")  # noqa: SIM115 - closed below, which releases the lock
+    except OSError as exc:
+        raise InstrumentError(f"{lock}: cannot create the lock file ({exc.strerror})") from None
+    with fh:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            fh.seek(0)
+            holder = " ".join(fh.read().split()) or "a process that has not written its name yet"
+            raise InstrumentError(f"{Path(folder)}: in use by another run ({holder}); {what}") from None
+        try:
+            with contextlib.suppress(OSError):  # the name is for a refusal's message; a full disk stops the run later
+                fh.seek(0)
+                fh.truncate()
+                fh.write(f"pid {os.getpid()} on {socket.gethostname()} since "
+                         f"{time.strftime('%Y-%m-%dT%H:%M:%S%z')}\n")
+                fh.flush()
+            yield lock
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
