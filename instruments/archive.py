@@ -6,7 +6,9 @@ attribute) are refused with a line that says to run ``rig upgrade``, which rewri
 (``Archive.upgrade``, through instruments/archive_legacy.py).
 
 Appends are transactions. Under an exclusive lock (``ARCHIVE.h5.lock``) the archive is
-copied to a temporary file beside it, the new shots are written there, the copy is flushed
+copied to a temporary file beside it, the new shots are written into that copy's image in
+memory and the image over the copy (HDF5 writes no file itself: an HDF5 write that fails on
+a full disk leaves the library in a state that can crash the process), the copy is flushed
 to disk (fsync), and ``os.replace`` puts it in place atomically; then the directory is
 synced. A writer killed at any moment, a power loss or a full disk leaves either the old
 archive or the new one, never a mix, and a stale temporary file is removed by the next
@@ -32,6 +34,7 @@ from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_ent
 from .archive_reader import read_entry
 from .archive_verify import addresses, check, root_seal, shot_names
 from .errors import InstrumentError
+from .files import hdf5_image
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
     import h5py
@@ -68,8 +71,6 @@ class Archive:
 
     def _transaction(self, write, copy: bool) -> list:
         """Write into a copy of the archive (or a new file), then put it in place."""
-        import h5py
-
         fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp", dir=self.path.parent)
         os.close(fd)
         try:
@@ -81,8 +82,9 @@ class Archive:
                 umask = os.umask(0)
                 os.umask(umask)
                 os.chmod(tmp, (os.stat(self.path).st_mode if self.path.exists() else 0o666 & ~umask) & 0o7777)
-            with h5py.File(tmp, "a", libver=("v110", "latest")) as f:
-                ids = write(f)
+            image = Path(tmp).read_bytes() if copy else None
+            data, ids = hdf5_image(write, image, libver=("v110", "latest"))  # HDF5 itself writes no file
+            Path(tmp).write_bytes(data)  # a full disk fails here, in one OSError
             _fsync(tmp)
             os.replace(tmp, self.path)
             _fsync_dir(self.path.parent)

@@ -8,6 +8,11 @@ new one, never a truncated or empty one; the temporary file is removed when the 
 fails. ``atomic_writes`` does the same for several files at once: all of them are written
 before any is renamed, so a failure leaves none of them new.
 
+HDF5 files are built in memory (``hdf5_image``, HDF5's core driver) and their bytes written
+by Python: HDF5 that fails part-way through a write to disk is left in a broken state (h5py
+then prints tracebacks while it cleans up, and a process can crash), where a failed write
+of plain bytes is one OSError.
+
 ``folder_lock`` holds an exclusive ``flock`` on a lock file in a folder for the life of a
 run; the OS releases it when the process ends, killed or not, so a dead holder never blocks.
 The file names the holder (pid, host, start), which a refusal quotes.
@@ -15,6 +20,7 @@ The file names the holder (pid, host, start), which a refusal quotes.
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import os
 import socket
@@ -27,14 +33,16 @@ from .errors import InstrumentError
 
 def atomic_write(path, write) -> Path:
     """``write(temporary path)``, flushed to disk, then renamed to ``path``; returns ``path``.
-    The file gets the mode a plain ``open`` would give it (0666 less the umask)."""
+    The file gets the mode a plain ``open`` would give it (0666 less the umask); the
+    temporary's name ends in ``path``'s suffix (".tmp.mp4"), for writers that choose the
+    format by it."""
     return atomic_writes({path: write})[0]
 
 
 def atomic_writes(writes: dict) -> list:
     """{path: write} as ``atomic_write`` does one, all written before any is renamed: a
     failure while writing leaves none of them new. Returns the paths."""
-    temporaries = {}
+    temporaries, path = {}, None
     try:
         for path, write in writes.items():
             path = Path(path)
@@ -43,15 +51,53 @@ def atomic_writes(writes: dict) -> list:
             _fsync(tmp)
         for path, tmp in temporaries.items():
             os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         for tmp in temporaries.values():
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
+        if isinstance(exc, OSError):  # named by the file meant, not its temporary (h5py, numpy name none)
+            raise OSError(exc.errno, cause(exc), str(path)) from None
         raise
     for folder in {p.parent for p in temporaries}:
         with contextlib.suppress(OSError):
             _fsync(folder)
     return list(temporaries)
+
+
+def cause(exc: OSError) -> str:
+    """An I/O failure's cause in one line: the OS's words where it has an errno (ENOSPC: 'No
+    space left on device'), else the first line of its message."""
+    if exc.errno in errno.errorcode:
+        return os.strerror(exc.errno)
+    return (str(exc).splitlines() or [type(exc).__name__])[0] or type(exc).__name__
+
+
+def hdf5_image(fill, image: bytes | None = None, libver: tuple = ("earliest", "latest")) -> tuple:
+    """(the bytes of an HDF5 file, what ``fill`` returned): ``fill(h5py.File)`` on a new
+    file in memory, or on a copy of ``image`` (an HDF5 file's bytes). Nothing is written to
+    disk here. The memory it takes is about twice the file's size."""
+    import uuid
+
+    import h5py
+
+    fapl = h5py.h5p.create(h5py.h5p.FILE_ACCESS)
+    fapl.set_fapl_core(backing_store=False)
+    fapl.set_libver_bounds(*(getattr(h5py.h5f, f"LIBVER_{v.upper()}") for v in libver))
+    name = f"in-memory-{uuid.uuid4().hex}".encode()  # HDF5 takes two files of one name for one
+    if image:
+        fapl.set_file_image(image)
+        fid = h5py.h5f.open(name, h5py.h5f.ACC_RDWR, fapl=fapl)
+    else:
+        fid = h5py.h5f.create(name, h5py.h5f.ACC_TRUNC, fapl=fapl)
+    with h5py.File(fid) as f:
+        out = fill(f)
+        f.flush()
+        return f.id.get_file_image(), out
+
+
+def write_hdf5(path, fill) -> Path:
+    """The HDF5 file ``path`` as ``fill(h5py.File)`` makes it, whole or not at all."""
+    return atomic_write(path, lambda tmp: Path(tmp).write_bytes(hdf5_image(fill)[0]))
 
 
 def write_text(path, text: str) -> Path:
@@ -60,7 +106,7 @@ def write_text(path, text: str) -> Path:
 
 
 def _temporary(path: Path) -> str:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp" + path.suffix)
     os.close(fd)
     mask = os.umask(0)
     os.umask(mask)

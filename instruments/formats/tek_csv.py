@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InstrumentError
+from ..files import atomic_write
 from ..records import Preamble, Waveform
 
 
@@ -36,13 +37,14 @@ def write_csv(waveforms: dict, directory, stem: str) -> list:
     ]
     t = ws[0].time()
     data = np.column_stack([t] + [w.volts() for w in ws])
-    path = Path(directory) / f"{stem}.csv"
-    with open(path, "w", newline="") as fh:
-        for name, value in rows:
-            fh.write(f"{name},{value}\n")
-        fh.write("\nTIME," + ",".join(chans) + "\n")
-        np.savetxt(fh, data, delimiter=",", fmt="%.10g")
-    return [path]
+    def write(tmp):
+        with open(tmp, "w", newline="") as fh:
+            for name, value in rows:
+                fh.write(f"{name},{value}\n")
+            fh.write("\nTIME," + ",".join(chans) + "\n")
+            np.savetxt(fh, data, delimiter=",", fmt="%.10g")
+
+    return [atomic_write(Path(directory) / f"{stem}.csv", write)]
 
 
 def read_csv(path) -> list:

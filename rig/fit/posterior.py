@@ -173,6 +173,7 @@ def draw(path: Path, post: Posterior):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from rig.viz.figures import save
 
     P = len(post.keys)
     fig, axes = plt.subplots(P, P, figsize=(2.4 * P + 1, 2.4 * P + 1), squeeze=False)
@@ -195,5 +196,5 @@ def draw(path: Path, post: Posterior):
     fig.suptitle(f"posterior: {post.walkers} walkers x {post.steps} steps (first {post.burn} discarded), "
                  f"acceptance {post.acceptance:.2f}", fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save(fig, path, dpi=120)
     plt.close(fig)

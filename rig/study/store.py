@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from instruments.files import atomic_write, folder_lock, write_text
+from instruments.files import folder_lock, write_hdf5, write_text
 from rig.errors import RigError
 from rig.study.batch import BatchResult
 from rig.study.mc_spec import OUTPUTS, Study
@@ -98,8 +98,6 @@ class Store:
         return {int(p.stem.split("_")[1]) for p in self.batches.glob("batch_*.h5")}
 
     def write(self, result: BatchResult):
-        import h5py
-
         if result.traces:
             from instruments.archive import Archive
 
@@ -108,15 +106,14 @@ class Store:
             archive.unlink(missing_ok=True)  # left by an interrupted run: that batch did not finish
             Archive(archive).append(list(result.traces))
 
-        def write(tmp):
-            with h5py.File(tmp, "w") as f:
-                f["index"] = result.index
-                f["inputs"] = result.inputs
-                f["seeds"] = result.seeds
-                for k, v in result.outputs.items():
-                    f[f"outputs/{k}"] = v
+        def write(f):
+            f["index"] = result.index
+            f["inputs"] = result.inputs
+            f["seeds"] = result.seeds
+            for k, v in result.outputs.items():
+                f[f"outputs/{k}"] = v
 
-        atomic_write(self.batches / f"batch_{result.batch:06d}.h5", write)
+        write_hdf5(self.batches / f"batch_{result.batch:06d}.h5", write)
 
     def collect(self) -> StudyResults:
         """Every finished shot, in shot order."""
@@ -137,22 +134,19 @@ class Store:
 
     def consolidate(self, results: StudyResults, report: dict) -> Path:
         """DIR/study.h5: every shot's inputs, outputs and seed, and the report."""
-        import h5py
+        def write(f):
+            f.attrs["study"] = json.dumps(self.study.spec())
+            f.attrs["report"] = json.dumps(report, default=float)
+            f["shot"] = results.index
+            f["seed"] = results.seeds
+            f["seed"].attrs["description"] = ("instrument seed; inputs come from SeedSequence(study seed, "
+                                              "spawn_key=(shot,))")
+            for k, key in enumerate(self.study.keys):
+                f[f"inputs/{key}"] = results.inputs[:, k]
+            for k, v in results.outputs.items():
+                f[f"outputs/{k}"] = v
 
-        def write(tmp):
-            with h5py.File(tmp, "w") as f:
-                f.attrs["study"] = json.dumps(self.study.spec())
-                f.attrs["report"] = json.dumps(report, default=float)
-                f["shot"] = results.index
-                f["seed"] = results.seeds
-                f["seed"].attrs["description"] = ("instrument seed; inputs come from SeedSequence(study seed, "
-                                                  "spawn_key=(shot,))")
-                for k, key in enumerate(self.study.keys):
-                    f[f"inputs/{key}"] = results.inputs[:, k]
-                for k, v in results.outputs.items():
-                    f[f"outputs/{k}"] = v
-
-        return atomic_write(self.folder / "study.h5", write)
+        return write_hdf5(self.folder / "study.h5", write)
 
 
 def _output(part: dict, key: str) -> np.ndarray:
