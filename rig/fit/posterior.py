@@ -17,6 +17,7 @@ start in a ball of 0.1 sd about the least-squares estimate, drawn from ``seed``.
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib.util
 import json
@@ -28,7 +29,7 @@ from pathlib import Path
 import numpy as np
 from scipy import optimize
 
-from rig.errors import RigError
+from rig.errors import Interrupted, RigError
 from rig.fit.fitting import FitResult
 
 BURN_FRACTION = 0.5  # the first half of the chain is discarded as burn-in
@@ -161,10 +162,34 @@ def _run_chain(objective, x_hat, sd, folder, walkers, steps, seed, log_prob, tel
         sampler.random_state = np.random.RandomState(seed).get_state()
     else:
         start = backend.get_last_sample()  # the walkers and the generator's state where they stopped
-    for k, _ in enumerate(sampler.sample(start, iterations=max(0, steps - done)), start=done + 1):
-        if k % 10 == 0 or k == steps:
-            tell(k)
+    with _ctrl_c_between_steps() as asked:
+        for k, _ in enumerate(sampler.sample(start, iterations=max(0, steps - done)), start=done + 1):
+            if k % 10 == 0 or k == steps:
+                tell(k)
+            if asked():
+                raise Interrupted(f"interrupted: {k} of {steps} steps of the chain are kept in "
+                                  f"{folder / 'posterior.h5'}; run the same command again to continue it")
     return backend
+
+
+@contextlib.contextmanager
+def _ctrl_c_between_steps():
+    """Ctrl-C (SIGINT) ends the sampling after the step under way, whose walkers are then
+    stored: a KeyboardInterrupt raised inside emcee's call of the likelihood made emcee
+    print its own traceback. Yields a function: whether Ctrl-C was pressed. Outside the
+    main thread (no signal handler there) Ctrl-C is left as it is."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield lambda: False
+        return
+    pressed = []
+    before = signal.signal(signal.SIGINT, lambda signum, frame: pressed.append(signum))
+    try:
+        yield lambda: bool(pressed)
+    finally:
+        signal.signal(signal.SIGINT, before)
 
 
 def draw(path: Path, post: Posterior):
