@@ -76,6 +76,16 @@ def hdf5_image(fill, image: bytes | None = None, libver: tuple = ("earliest", "l
     """(the bytes of an HDF5 file, what ``fill`` returned): ``fill(h5py.File)`` on a new
     file in memory, or on a copy of ``image`` (an HDF5 file's bytes). Nothing is written to
     disk here. The memory it takes is about twice the file's size."""
+    with hdf5_in_memory(image, libver) as f:
+        out = fill(f)
+        f.flush()
+        return f.id.get_file_image(), out
+
+
+@contextlib.contextmanager
+def hdf5_in_memory(image: bytes | None = None, libver: tuple = ("earliest", "latest")):
+    """A new HDF5 file open in memory (HDF5's core driver, no file behind it), or a copy of
+    ``image``; ``f.id.get_file_image()`` gives its bytes."""
     import uuid
 
     import h5py
@@ -90,9 +100,7 @@ def hdf5_image(fill, image: bytes | None = None, libver: tuple = ("earliest", "l
     else:
         fid = h5py.h5f.create(name, h5py.h5f.ACC_TRUNC, fapl=fapl)
     with h5py.File(fid) as f:
-        out = fill(f)
-        f.flush()
-        return f.id.get_file_image(), out
+        yield f
 
 
 def write_hdf5(path, fill) -> Path:

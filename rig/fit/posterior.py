@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 from scipy import optimize
 
+from instruments.files import cause
 from rig.errors import Interrupted, RigError
 from rig.fit.fitting import FitResult
 
@@ -122,7 +123,7 @@ def sample(objective, result: FitResult, folder, walkers: int, steps: int, seed:
                                                                              f"({solved[0]} candidates solved)"))
         total = int(backend.iteration)
     except OSError as exc:
-        raise RigError(f"{folder / 'posterior.h5'}: cannot write the chain ({exc.strerror or exc})") from None
+        raise RigError(f"{folder / 'posterior.h5'}: {cause(exc)}") from None
     burn = int(BURN_FRACTION * total)
     chain = backend.get_chain(discard=burn, flat=True)
     if chain.shape[0] == 0:
@@ -152,7 +153,7 @@ def _run_chain(objective, x_hat, sd, folder, walkers, steps, seed, log_prob, tel
     P = len(objective.params)
     tag = hashlib.sha256(json.dumps([objective.spec(), walkers, seed], sort_keys=True,
                                     default=float).encode()).hexdigest()[:16]
-    backend = emcee.backends.HDFBackend(str(folder / "posterior.h5"), name=f"chain_{tag}")
+    backend = _backend(str(folder / "posterior.h5"), f"chain_{tag}")
     done = int(backend.iteration) if backend.initialized else 0
     sampler = emcee.EnsembleSampler(walkers, P, log_prob, vectorize=True, backend=backend)
     if done == 0:
@@ -170,6 +171,30 @@ def _run_chain(objective, x_hat, sd, folder, walkers, steps, seed, log_prob, tel
                 raise Interrupted(f"interrupted: {k} of {steps} steps of the chain are kept in "
                                   f"{folder / 'posterior.h5'}; run the same command again to continue it")
     return backend
+
+
+def _backend(path: str, name: str):
+    """emcee's HDF backend on ``path``, each change of which (a step, the chain's storage
+    grown) is made in memory and the file then replaced whole (instruments.files): HDF5
+    writing in place on a full disk had crashed the process."""
+    import emcee
+
+    from instruments.files import atomic_write, hdf5_in_memory
+
+    class WholeFileBackend(emcee.backends.HDFBackend):
+        def open(self, mode="r"):
+            return super().open(mode) if mode == "r" else self._changed()
+
+        @contextlib.contextmanager
+        def _changed(self):
+            stored = Path(self.filename)
+            with hdf5_in_memory(stored.read_bytes() if stored.exists() else None) as f:
+                yield f
+                f.flush()
+                image = f.id.get_file_image()
+            atomic_write(stored, lambda tmp: Path(tmp).write_bytes(image))
+
+    return WholeFileBackend(path, name=name)
 
 
 @contextlib.contextmanager
