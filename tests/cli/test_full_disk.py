@@ -113,3 +113,34 @@ def test_a_full_disk_is_one_line_leaves_nothing_broken_and_a_second_run_succeeds
     assert again.returncode in ((0, 1) if argv[0] == "fit" else (0,)), again.stderr
     assert "Traceback" not in again.stderr
     _check_left(tmp_path)
+
+
+@pytest.fixture
+def small_disk(tmp_path, request):
+    """A real file system of ``request.param`` (tmpfs, "16k"): writes past it fail with ENOSPC."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={request.param}", "tmpfs", str(disk)],
+                       capture_output=True, text=True)
+    if r.returncode:
+        pytest.skip(f"cannot mount a tmpfs here ({r.stderr.strip() or 'mount failed'}): the file-size-limit cases "
+                    "above cover the same writes")
+    yield disk
+    subprocess.run(["umount", "-l", str(disk)], capture_output=True)
+
+
+@pytest.mark.parametrize("case,small_disk", [("shot --export", "16k"), ("shot --out", "64k"), ("mc --out", "64k"),
+                                             ("import", "16k"), ("fit, the cache", "16k")], indirect=["small_disk"])
+def test_a_real_full_disk_is_one_line_and_the_command_succeeds_once_there_is_room(small_disk, realdata, case):
+    _, argv = CASES[case]
+    if argv[0] == "fit":
+        (small_disk / "points.csv").write_text(POINTS)
+    r = _run(argv, small_disk, realdata)
+    assert r.returncode == 2, r.stderr
+    line = _one_line(r.stderr)
+    assert line.startswith(f"rig {argv[0]}: error: {small_disk}") and line.endswith(": No space left on device"), line
+    _check_left(small_disk)
+    subprocess.run(["mount", "-o", "remount,size=64m", str(small_disk)], check=True)  # room made
+    again = _run(argv, small_disk, realdata)
+    assert again.returncode in ((0, 1) if argv[0] == "fit" else (0,)), again.stderr
+    _check_left(small_disk)
