@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 from .archive_digest import damage, linked_groups
 from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_entry
 from .archive_reader import read_entry
-from .archive_verify import addresses, check, root_seal, shot_names
+from .archive_verify import addresses, check, root_seal, sealed_members, shot_names
 from .errors import InstrumentError
 from .files import hdf5_image
 
@@ -68,6 +68,24 @@ class Archive:
                 entries = [read_legacy_entry(f[n], self.path) for n in shot_names(f)]
             self._drop_stale_temporaries()
             return len(self._transaction(lambda f: self._write(f, entries, [e.shot_id for e in entries]), False))
+
+    def record_members(self) -> bool:
+        """Record the root's member lists in an archive sealed before they were (root table
+        version 1, instruments/archive_verify.py), after checking it whole: True where they
+        were recorded now, False where they already were. A damaged archive is refused
+        (InstrumentError): recording its members would accept what was added or deleted."""
+        with self._lock():
+            with self._open() as f:
+                if sealed_members(f):
+                    return False
+                bad = check(f)["bad"]
+            if bad:
+                raise InstrumentError(f"{self.path}: {len(bad)} problem{'' if len(bad) == 1 else 's'} (first: "
+                                      f"{bad[0]['where']}: {bad[0]['reason']}); `rig verify` lists them; the "
+                                      "member lists are recorded only in an archive that verifies")
+            self._drop_stale_temporaries()
+            self._transaction(lambda f: root_seal(f) or [], True)
+            return True
 
     def _transaction(self, write, copy: bool) -> list:
         """Write into a copy of the archive (or a new file), then put it in place."""

@@ -39,14 +39,18 @@ def cmd_verify(args) -> dict:
 
 
 def cmd_upgrade(args) -> dict:
-    """Rewrite an archive of an older layout in the current one (one transaction)."""
+    """Rewrite an archive of an older layout in the current one (one transaction); in one of
+    the current layout sealed before the root's member lists were, record them."""
     from instruments.archive import Archive
 
-    n = Archive(args.archive).upgrade()
+    archive = Archive(args.archive)
+    n = archive.upgrade()
+    members = n == 0 and archive.record_members()
     if not args.json:
         print(f"{args.archive}: {n} shots rewritten in the current layout" if n else
-              f"{args.archive}: already in the current layout")
-    return {"archive": args.archive, "upgraded": n}
+              f"{args.archive}: the root's member lists recorded (its shots were in the current layout)" if members
+              else f"{args.archive}: already in the current layout")
+    return {"archive": args.archive, "upgraded": n, "members_recorded": members}
 
 
 def cmd_import(args) -> dict:

@@ -82,3 +82,32 @@ def test_an_archive_sealed_before_member_lists_still_verifies_and_gets_them_on_a
     assert a.verify() == {"shots": 3, "ok": 3, "bad": []}
     report = _edit(a, lambda f: f.create_dataset("foo", data=1.0))
     assert [b["reason"] for b in report["bad"]] == ["added: /foo"]
+
+
+def test_upgrade_records_the_member_lists_of_an_old_sealed_archive_that_verifies(tmp_path, capsys):
+    from rig.cli import main
+
+    a = Archive(tmp_path / "old.h5")
+    shutil.copyfile(OLD, a.path)
+    before = a.digests()
+    assert main(["upgrade", str(a.path), "--json"]) == 0
+    assert '"members_recorded": true' in capsys.readouterr().out
+    assert a.digests() == before and a.verify() == {"shots": 2, "ok": 2, "bad": []}
+    report = _edit(a, lambda f: f.__delitem__("shot_000002"))  # now a deleted shot is named
+    assert [b["reason"] for b in report["bad"]] == ["missing: /shot_000002"]
+    assert main(["upgrade", str(tmp_path / "old.h5")]) == 0  # the second time: nothing to do
+    assert capsys.readouterr().out.endswith("already in the current layout\n")
+
+
+def test_upgrade_refuses_to_record_the_members_of_a_damaged_old_archive(tmp_path, capsys):
+    from rig.cli import main
+
+    a = Archive(tmp_path / "old.h5")
+    shutil.copyfile(OLD, a.path)
+    with h5py.File(a.path, "a") as f:
+        del f["shot_000001/title"]
+    pristine = a.path.read_bytes()
+    assert main(["upgrade", str(a.path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "/shot_000001/title" in err and "verifies" in err, err
+    assert a.path.read_bytes() == pristine
