@@ -21,7 +21,6 @@ the archive is left as it was.
 from __future__ import annotations
 
 import contextlib
-import errno
 import fcntl
 import os
 import shutil
@@ -34,7 +33,8 @@ from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_ent
 from .archive_reader import read_entry
 from .archive_verify import addresses, check, root_seal, sealed_members, shot_names
 from .errors import InstrumentError
-from .files import hdf5_image
+from .files import cause, hdf5_image
+from .files import fsync as _fsync  # a name of this module's own: the crash tests stop a writer after it
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
     import h5py
@@ -111,7 +111,7 @@ class Archive:
                 os.unlink(tmp)
             if isinstance(exc, (InstrumentError, KeyboardInterrupt, SystemExit)) or not isinstance(exc, Exception):
                 raise
-            raise InstrumentError(f"{self.path}: cannot append: {_cause(exc)}") from None
+            raise InstrumentError(f"{self.path}: cannot append: {cause(exc)}") from None
         return ids
 
     def _write(self, f, entries, ids=None) -> list:
@@ -160,7 +160,7 @@ class Archive:
             f = h5py.File(path, "r")
             creator, version = f.attrs.get("creator"), f.attrs.get("layout_version")
         except Exception as exc:  # noqa: BLE001 - any failure of a damaged file
-            raise InstrumentError(f"{path}: cannot be opened as HDF5 (truncated or damaged?): {_cause(exc)}") from None
+            raise InstrumentError(f"{path}: cannot be opened as HDF5 (truncated or damaged?): {cause(exc)}") from None
         if creator != "sonic-rig":
             study = "study" in f.attrs and "outputs" in f  # a Monte Carlo study's results (rig mc)
             f.close()
@@ -192,7 +192,7 @@ class Archive:
             except InstrumentError:
                 raise
             except Exception as exc:  # noqa: BLE001 - a damaged file, one line
-                raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({_cause(exc)})") from None
+                raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({cause(exc)})") from None
             if verify and raw_digest(e.record) != stored_raw_digest(f[name]):
                 raise InstrumentError(f"{self.path}: shot {shot_id}: raw_sha256 does not match the raw data")
             return e
@@ -234,7 +234,7 @@ class Archive:
                 return check(f)
             except Exception as exc:  # noqa: BLE001 - a safety net: damage is a finding, never a crash
                 return {"shots": 0, "ok": 0, "bad": [{"shot": None, "shots": [], "where": str(self.path),
-                                                      "reason": f"unreadable ({_cause(exc)})"}]}
+                                                      "reason": f"unreadable ({cause(exc)})"}]}
 
     def digests(self) -> dict:
         """{shot id: the SHA-256 of its raw data}, as stored (no shot read)."""
@@ -251,7 +251,7 @@ class Archive:
                 try:
                     e = read_entry(f[name], self.path, with_truth=False)
                 except Exception as exc:  # noqa: BLE001 - a damaged shot, one row
-                    rows.append({"shot": int(name.split("_", 1)[1]), "damaged": f"unreadable ({_cause(exc)})"})
+                    rows.append({"shot": int(name.split("_", 1)[1]), "damaged": f"unreadable ({cause(exc)})"})
                     continue
                 rows.append({"shot": e.shot_id, "title": e.title, "start_time": e.start_time,
                              "start_time_source": e.start_time_source, "simulated": e.simulated,
@@ -267,24 +267,9 @@ def stored_raw_digest(g) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
-def _cause(exc) -> str:
-    """An exception as one line: the OS's words for an I/O error (ENOSPC: 'No space left on device')."""
-    if isinstance(exc, OSError) and exc.errno is not None:
-        return os.strerror(exc.errno) if exc.errno in errno.errorcode else str(exc)
-    return (str(exc).splitlines() or [type(exc).__name__])[0] or type(exc).__name__
-
-
 def _id_range(f) -> str:
     ids = [int(n.split("_", 1)[1]) for n in shot_names(f)]
     return f"{ids[0]}..{ids[-1]}" if ids else "none"
-
-
-def _fsync(path):
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
 
 
 def _fsync_dir(path):

@@ -48,7 +48,7 @@ def atomic_writes(writes: dict) -> list:
             path = Path(path)
             temporaries[path] = tmp = _temporary(path)
             write(tmp)
-            _fsync(tmp)
+            fsync(tmp)
         for path, tmp in temporaries.items():
             os.replace(tmp, path)
     except BaseException as exc:
@@ -60,14 +60,14 @@ def atomic_writes(writes: dict) -> list:
         raise
     for folder in {p.parent for p in temporaries}:
         with contextlib.suppress(OSError):
-            _fsync(folder)
+            fsync(folder)
     return list(temporaries)
 
 
-def cause(exc: OSError) -> str:
-    """An I/O failure's cause in one line: the OS's words where it has an errno (ENOSPC: 'No
-    space left on device'), else the first line of its message."""
-    if exc.errno in errno.errorcode:
+def cause(exc: BaseException) -> str:
+    """A failure's cause in one line: the OS's words for an I/O error with an errno (ENOSPC:
+    'No space left on device'), else the first line of its message."""
+    if isinstance(exc, OSError) and exc.errno in errno.errorcode:
         return os.strerror(exc.errno)
     return (str(exc).splitlines() or [type(exc).__name__])[0] or type(exc).__name__
 
@@ -122,7 +122,8 @@ def _temporary(path: Path) -> str:
     return tmp
 
 
-def _fsync(path):
+def fsync(path):
+    """Flush ``path`` (a file or a folder) to disk."""
     fd = os.open(path, os.O_RDONLY)
     try:
         os.fsync(fd)
