@@ -134,13 +134,10 @@ def fsync(path):
 @contextlib.contextmanager
 def folder_lock(folder, name: str, what: str):
     """Hold ``folder/name`` exclusively while the block runs. Held by another live process:
-    one InstrumentError naming the folder, the holder (pid, host, since) and ``what`` to do."""
+    one InstrumentError naming the folder, the holder (pid, host, since) and ``what`` to do.
+    A lock file that cannot be opened (no permission, a read-only disk) is an OSError."""
     lock = Path(folder) / name
-    try:
-        fh = open(lock, "a+")  # noqa: SIM115 - closed below, which releases the lock
-    except OSError as exc:
-        raise InstrumentError(f"{lock}: cannot create the lock file ({exc.strerror})") from None
-    with fh:
+    with open(lock, "a+") as fh:  # an OSError names the lock file; closing it releases the lock
         try:
             fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:

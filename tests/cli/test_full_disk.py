@@ -144,3 +144,15 @@ def test_a_real_full_disk_is_one_line_and_the_command_succeeds_once_there_is_roo
     again = _run(argv, small_disk, realdata)
     assert again.returncode in ((0, 1) if argv[0] == "fit" else (0,)), again.stderr
     _check_left(small_disk)
+
+
+@pytest.mark.parametrize("case,small_disk", [("shot --export", "1m"), ("mc --out", "1m"), ("shot --out", "1m")],
+                         indirect=["small_disk"])
+def test_a_read_only_disk_is_one_line(small_disk, realdata, case):
+    _, argv = CASES[case]
+    (small_disk / "study").mkdir()  # a folder that exists, on a disk that takes no write
+    subprocess.run(["mount", "-o", "remount,ro", str(small_disk)], check=True)
+    r = _run(argv, small_disk, realdata)
+    assert r.returncode == 2, r.stderr
+    line = _one_line(r.stderr)
+    assert line.startswith(f"rig {argv[0]}: error: {small_disk}") and "Read-only file system" in line, line
