@@ -75,7 +75,8 @@ def cause(exc: BaseException) -> str:
 def hdf5_image(fill, image: bytes | None = None, libver: tuple = ("earliest", "latest")) -> tuple:
     """(the bytes of an HDF5 file, what ``fill`` returned): ``fill(h5py.File)`` on a new
     file in memory, or on a copy of ``image`` (an HDF5 file's bytes). Nothing is written to
-    disk here. The memory it takes is about twice the file's size."""
+    disk here. The memory it takes is two to three times the file's size (``image``, HDF5's
+    copy of it, the bytes returned)."""
     with hdf5_in_memory(image, libver) as f:
         out = fill(f)
         f.flush()
