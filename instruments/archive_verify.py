@@ -130,28 +130,28 @@ def check(f: h5py.File) -> dict:
 
 def named(problems: list, prefix: str) -> list:
     """archive_digest.damage's lines for the group at ``prefix``, with each object added or
-    deleted named by its path ("missing: /shot_000003/data/CH2") and the lines it alone
-    explains left out: the member list of its group, its own attributes and members."""
+    deleted (a dataset, or a group: its member-list row "X/") named once by its path
+    ("missing: /shot_000003/data/CH2") and the lines it alone explains left out: the member
+    list of its group, its own attributes and members."""
     moved = {}
     for p in problems:
         head, _, what = p.partition(": ")
-        if not head.startswith("attribute ") and not head.endswith("/") and \
-                (what == "missing" or what.startswith(_ADDED)):
-            moved[head] = "missing" if what == "missing" else "added"
+        if not head.startswith("attribute ") and head != "/" and (what == "missing" or what.startswith(_ADDED)):
+            moved[head.rstrip("/")] = "missing" if what == "missing" else "added"
     if not moved:
         return problems
+    inside = lambda item: any(item.startswith((k + "/", k + "@")) for k in moved)  # noqa: E731
     parents = {(k.rsplit("/", 1)[0] + "/") if "/" in k else "/" for k in moved}
     out = []
     for p in problems:
         head, _, what = p.partition(": ")
         item = head.removeprefix("attribute ")
-        if item in moved and not head.startswith("attribute "):
-            if not any(item.startswith(k + "/") for k in moved):
-                out.append(f"{moved[item]}: {prefix}/{item}")
-        elif item in parents and what.startswith("damaged"):
-            continue  # the member list that changed with it
-        elif not any(item.startswith(k + "/") or item.startswith(k + "@") for k in moved):
-            out.append(p)
+        own = None if head.startswith("attribute ") else item.rstrip("/")
+        if own in moved:
+            if not inside(own):  # not inside another object added or deleted
+                out.append(f"{moved[own]}: {prefix}/{own}")
+        elif not inside(item) and not (item in parents and what.startswith("damaged")):
+            out.append(p)  # not explained by what was added or deleted
     return out
 
 
