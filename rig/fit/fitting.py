@@ -115,7 +115,7 @@ class EvaluationCache:
                 self.solved += 1
                 if self.folder is not None:  # whole or not at all: a full disk leaves no broken entry
                     arrays = self.objective.pack(model)
-                    atomic_write(self._path(k), lambda tmp: _savez(tmp, arrays))
+                    atomic_write(self._path(k), lambda tmp, arrays=arrays: _savez(tmp, arrays))
         return [self.memory[k] for k in keys]
 
     def _replay(self, key: tuple) -> bool:

@@ -223,6 +223,7 @@ def draw(path: Path, post: Posterior):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     from rig.viz.figures import save
 
     P = len(post.keys)

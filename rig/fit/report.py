@@ -83,6 +83,7 @@ def draw(path: Path, objective, result: FitResult):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     from rig.viz.figures import save
 
     model = result.model

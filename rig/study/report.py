@@ -52,6 +52,7 @@ def figures(folder, results, keys, theory_curve=None):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     from rig.viz.figures import save
 
     out = results.outputs

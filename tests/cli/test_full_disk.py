@@ -17,7 +17,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from test_bad_inputs import DISK_FULL, S, VEL, _one_line
+from test_bad_inputs import DISK_FULL, VEL, S, _one_line
 
 from instruments.archive import Archive
 from instruments.formats.isf import read_isf
@@ -51,7 +51,7 @@ CASES = {
 def _run(argv, d: Path, realdata, limit=None):
     argv = [a.replace("{d}", str(d)).replace("{realdata}", str(realdata)) for a in argv]
     code = DISK_FULL if limit else "import sys\nfrom rig.cli import main\nsys.exit(main(sys.argv[2:]))\n"
-    return subprocess.run([sys.executable, "-c", code, str(limit or 0), *argv], capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-c", code, str(limit or 0), *argv], check=False, capture_output=True, text=True,
                           cwd=d, timeout=600)
 
 
@@ -121,12 +121,12 @@ def small_disk(tmp_path, request):
     disk = tmp_path / "disk"
     disk.mkdir()
     r = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={request.param}", "tmpfs", str(disk)],
-                       capture_output=True, text=True)
+                       check=False, capture_output=True, text=True)
     if r.returncode:
         pytest.skip(f"cannot mount a tmpfs here ({r.stderr.strip() or 'mount failed'}): the file-size-limit cases "
                     "above cover the same writes")
     yield disk
-    subprocess.run(["umount", "-l", str(disk)], capture_output=True)
+    subprocess.run(["umount", "-l", str(disk)], check=False, capture_output=True)
 
 
 @pytest.mark.parametrize("case,small_disk", [("shot --export", "16k"), ("shot --out", "64k"), ("mc --out", "64k"),
