@@ -23,6 +23,7 @@ import importlib.util
 import json
 import logging
 import math
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -176,10 +177,21 @@ def _run_chain(objective, x_hat, sd, folder, walkers, steps, seed, log_prob, tel
 def _backend(path: str, name: str):
     """emcee's HDF backend on ``path``, each change of which (a step, the chain's storage
     grown) is made in memory and the file then replaced whole (instruments.files): HDF5
-    writing in place on a full disk had crashed the process."""
+    writing in place on a full disk had crashed the process. A file there that cannot be
+    read (cut short by an older version, damaged) is dropped with a note on stderr, and
+    the chain starts again."""
     import emcee
+    import h5py
 
     from instruments.files import atomic_write, hdf5_in_memory
+
+    try:
+        if Path(path).exists():
+            h5py.File(path, "r").close()
+    except Exception as exc:  # noqa: BLE001 - any unreadable file
+        why = " ".join(f"{type(exc).__name__} {exc}".split())
+        print(f"{path}: unreadable ({why}); dropped, the chain starts again", file=sys.stderr, flush=True)
+        Path(path).unlink()
 
     class WholeFileBackend(emcee.backends.HDFBackend):
         def open(self, mode="r"):

@@ -336,3 +336,18 @@ def test_ctrl_c_while_the_posterior_samples_is_one_line_and_keeps_the_chain(tmp_
     with h5py.File(tmp_path / "fit" / "posterior.h5", "r") as f:
         (chain,) = f.values()
         assert int(chain.attrs["iteration"]) == kept >= 20  # every step it says it kept is stored
+
+
+def test_a_chain_file_that_cannot_be_read_is_dropped_and_sampled_again(tmp_path, capsys):
+    pytest.importorskip("emcee")
+    pts = _virtual_points(tmp_path)
+    argv = ["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+            "--out", str(tmp_path / "fit"), "--json", "--quiet", "--posterior", "4", "--walkers", "4", "--seed", "3"]
+    assert main(argv) == 0
+    first = json.loads(capsys.readouterr().out)["posterior"]
+    chain = tmp_path / "fit" / "posterior.h5"
+    chain.write_bytes(chain.read_bytes()[:1000])  # cut short
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    assert captured.err.startswith(f"{chain}: unreadable (") and "dropped, the chain starts again" in captured.err
+    assert json.loads(captured.out)["posterior"] == first  # the same seed: the same chain, sampled again
