@@ -6,7 +6,9 @@ attribute) are refused with a line that says to run ``rig upgrade``, which rewri
 (``Archive.upgrade``, through instruments/archive_legacy.py).
 
 Appends are transactions. Under an exclusive lock (``ARCHIVE.h5.lock``) the archive is
-copied to a temporary file beside it, the new shots are written there, the copy is flushed
+copied to a temporary file beside it, the new shots are written into that copy's image in
+memory and the image over the copy (HDF5 writes no file itself: an HDF5 write that fails on
+a full disk leaves the library in a state that can crash the process), the copy is flushed
 to disk (fsync), and ``os.replace`` puts it in place atomically; then the directory is
 synced. A writer killed at any moment, a power loss or a full disk leaves either the old
 archive or the new one, never a mix, and a stale temporary file is removed by the next
@@ -19,7 +21,6 @@ the archive is left as it was.
 from __future__ import annotations
 
 import contextlib
-import errno
 import fcntl
 import os
 import shutil
@@ -30,8 +31,10 @@ from typing import TYPE_CHECKING
 from .archive_digest import damage, linked_groups
 from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_entry
 from .archive_reader import read_entry
-from .archive_verify import addresses, check, root_seal, shot_names
+from .archive_verify import addresses, check, root_seal, sealed_members, shot_names
 from .errors import InstrumentError
+from .files import cause, hdf5_image
+from .files import fsync as _fsync  # a name of this module's own: the crash tests stop a writer after it
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
     import h5py
@@ -66,10 +69,26 @@ class Archive:
             self._drop_stale_temporaries()
             return len(self._transaction(lambda f: self._write(f, entries, [e.shot_id for e in entries]), False))
 
+    def record_members(self) -> bool:
+        """Record the root's member lists in an archive sealed before they were (root table
+        version 1, instruments/archive_verify.py), after checking it whole: True where they
+        were recorded now, False where they already were. A damaged archive is refused
+        (InstrumentError): recording its members would accept what was added or deleted."""
+        with self._lock():
+            with self._open() as f:
+                if sealed_members(f):
+                    return False
+                bad = check(f)["bad"]
+            if bad:
+                raise InstrumentError(f"{self.path}: {len(bad)} problem{'' if len(bad) == 1 else 's'} (first: "
+                                      f"{bad[0]['where']}: {bad[0]['reason']}); `rig verify` lists them; the "
+                                      "member lists are recorded only in an archive that verifies")
+            self._drop_stale_temporaries()
+            self._transaction(lambda f: root_seal(f) or [], True)
+            return True
+
     def _transaction(self, write, copy: bool) -> list:
         """Write into a copy of the archive (or a new file), then put it in place."""
-        import h5py
-
         fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp", dir=self.path.parent)
         os.close(fd)
         try:
@@ -81,8 +100,9 @@ class Archive:
                 umask = os.umask(0)
                 os.umask(umask)
                 os.chmod(tmp, (os.stat(self.path).st_mode if self.path.exists() else 0o666 & ~umask) & 0o7777)
-            with h5py.File(tmp, "a", libver=("v110", "latest")) as f:
-                ids = write(f)
+            image = Path(tmp).read_bytes() if copy else None
+            data, ids = hdf5_image(write, image, libver=("v110", "latest"))  # HDF5 itself writes no file
+            Path(tmp).write_bytes(data)  # a full disk fails here, in one OSError
             _fsync(tmp)
             os.replace(tmp, self.path)
             _fsync_dir(self.path.parent)
@@ -91,7 +111,7 @@ class Archive:
                 os.unlink(tmp)
             if isinstance(exc, (InstrumentError, KeyboardInterrupt, SystemExit)) or not isinstance(exc, Exception):
                 raise
-            raise InstrumentError(f"{self.path}: cannot append: {_cause(exc)}") from None
+            raise InstrumentError(f"{self.path}: cannot append: {cause(exc)}") from None
         return ids
 
     def _write(self, f, entries, ids=None) -> list:
@@ -140,7 +160,7 @@ class Archive:
             f = h5py.File(path, "r")
             creator, version = f.attrs.get("creator"), f.attrs.get("layout_version")
         except Exception as exc:  # noqa: BLE001 - any failure of a damaged file
-            raise InstrumentError(f"{path}: cannot be opened as HDF5 (truncated or damaged?): {_cause(exc)}") from None
+            raise InstrumentError(f"{path}: cannot be opened as HDF5 (truncated or damaged?): {cause(exc)}") from None
         if creator != "sonic-rig":
             study = "study" in f.attrs and "outputs" in f  # a Monte Carlo study's results (rig mc)
             f.close()
@@ -172,7 +192,7 @@ class Archive:
             except InstrumentError:
                 raise
             except Exception as exc:  # noqa: BLE001 - a damaged file, one line
-                raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({_cause(exc)})") from None
+                raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({cause(exc)})") from None
             if verify and raw_digest(e.record) != stored_raw_digest(f[name]):
                 raise InstrumentError(f"{self.path}: shot {shot_id}: raw_sha256 does not match the raw data")
             return e
@@ -214,7 +234,7 @@ class Archive:
                 return check(f)
             except Exception as exc:  # noqa: BLE001 - a safety net: damage is a finding, never a crash
                 return {"shots": 0, "ok": 0, "bad": [{"shot": None, "shots": [], "where": str(self.path),
-                                                      "reason": f"unreadable ({_cause(exc)})"}]}
+                                                      "reason": f"unreadable ({cause(exc)})"}]}
 
     def digests(self) -> dict:
         """{shot id: the SHA-256 of its raw data}, as stored (no shot read)."""
@@ -231,7 +251,7 @@ class Archive:
                 try:
                     e = read_entry(f[name], self.path, with_truth=False)
                 except Exception as exc:  # noqa: BLE001 - a damaged shot, one row
-                    rows.append({"shot": int(name.split("_", 1)[1]), "damaged": f"unreadable ({_cause(exc)})"})
+                    rows.append({"shot": int(name.split("_", 1)[1]), "damaged": f"unreadable ({cause(exc)})"})
                     continue
                 rows.append({"shot": e.shot_id, "title": e.title, "start_time": e.start_time,
                              "start_time_source": e.start_time_source, "simulated": e.simulated,
@@ -247,24 +267,9 @@ def stored_raw_digest(g) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
-def _cause(exc) -> str:
-    """An exception as one line: the OS's words for an I/O error (ENOSPC: 'No space left on device')."""
-    if isinstance(exc, OSError) and exc.errno is not None:
-        return os.strerror(exc.errno) if exc.errno in errno.errorcode else str(exc)
-    return (str(exc).splitlines() or [type(exc).__name__])[0] or type(exc).__name__
-
-
 def _id_range(f) -> str:
     ids = [int(n.split("_", 1)[1]) for n in shot_names(f)]
     return f"{ids[0]}..{ids[-1]}" if ids else "none"
-
-
-def _fsync(path):
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
 
 
 def _fsync_dir(path):

@@ -1,10 +1,19 @@
-"""Checking an open archive: the root's attributes, each shared group once, then each shot,
-against their tables of SHA-256 checksums (instruments/archive_digest.py). Every problem is
-a row naming the shot (or the shots of a shared group) and the dataset or attribute; a
-damaged file gives rows, never an exception."""
+"""Checking an open archive: the root's attributes and member lists, each shared group once,
+then each shot, against their tables of SHA-256 checksums (instruments/archive_digest.py).
+Every problem is a row naming the shot (or the shots of a shared group) and the dataset or
+attribute; an object added or deleted anywhere is named by its path ("added: /foo",
+"missing: /shot_000003/data/CH2"); a damaged file gives rows, never an exception.
+
+The root's table has two versions. Version 1 (archives written before the member lists were
+recorded): the attribute ``checksums``, {attribute: SHA-256} of the root's other attributes.
+Version 2 adds the attribute ``members``, the names in the root group and in ``/shared`` (the
+two groups that no table of their own covers); its SHA-256 is a row of ``checksums`` like
+any attribute's. An archive without ``members`` is checked as version 1; its next append
+(or ``rig upgrade``) writes version 2."""
 from __future__ import annotations
 
 import json
+import re
 from typing import TYPE_CHECKING
 
 from .archive_digest import address, damage, linked_groups, sha
@@ -13,11 +22,44 @@ if TYPE_CHECKING:
     import h5py
 
 ROOT_TABLE = "checksums"  # root attribute: {attribute: SHA-256} of the root's other attributes
+MEMBERS = "members"  # root attribute (version 2): {"/": root's member names, "/shared": shared's}
+_ADDED = "not in the table of checksums"  # how archive_digest.damage words an added item
 
 
 def root_seal(f: h5py.File):
-    """Write the root's table (after its other attributes)."""
+    """Write the root's member lists and its table (after its other attributes)."""
+    f.attrs[MEMBERS] = json.dumps(_members(f), sort_keys=True)
     f.attrs[ROOT_TABLE] = json.dumps(_root_rows(f), sort_keys=True)
+
+
+def sealed_members(f: h5py.File) -> bool:
+    """Whether the root's table is of version 2 (it records the member lists)."""
+    return MEMBERS in f.attrs
+
+
+def _members(f) -> dict:
+    out = {"/": sorted(f)}
+    if "shared" in f:
+        out["/shared"] = sorted(f["shared"])
+    return out
+
+
+def member_changes(f: h5py.File) -> tuple:
+    """(added, missing): the paths ("/foo", "/shot_000002") of the objects added to or
+    deleted from the root or /shared since the root was sealed; ([], []) for a version-1
+    table. Raises on an unreadable member list (the caller reports it)."""
+    if not sealed_members(f):
+        return [], []
+    stored, now = json.loads(f.attrs[MEMBERS]), _members(f)
+    added, missing = [], []
+    for group in sorted(set(stored) | set(now)):
+        before, after = set(stored.get(group, [])), set(now.get(group, []))
+        prefix = group.rstrip("/") + "/"
+        added += [prefix + n for n in sorted(after - before)]
+        missing += [prefix + n for n in sorted(before - after)]
+    parents = set(added) | set(missing)  # a whole /shared added or deleted: its members are not listed again
+    drop = lambda p: p.rsplit("/", 1)[0] in parents  # noqa: E731
+    return [p for p in added if not drop(p)], [p for p in missing if not drop(p)]
 
 
 def root_damage(f: h5py.File) -> list:
@@ -43,38 +85,92 @@ def shot_names(f: h5py.File) -> list:
 
 
 def check(f: h5py.File) -> dict:
-    """{"shots", "ok", "bad"}: bad rows {"shot", "shots", "where", "reason"}."""
+    """{"shots", "ok", "bad"}: bad rows {"shot", "shots", "where", "reason"}; "shots" counts
+    the shots the root lists, a deleted shot (bad) included."""
     bad = [_row(None, "/" + _item(r), r) for r in root_damage(f)]
     try:
         names = shot_names(f)
+        added, missing = member_changes(f)
     except Exception as exc:  # noqa: BLE001
         return {"shots": 0, "ok": 0, "bad": bad + [_row(None, "/", f"the root group is unreadable ({_line(exc)})")]}
-    shared, problems, linked = _shared_groups(f, bad)
-    users, shot_bad = {}, set()
+    for path in added:
+        bad.append(_row(None, path, f"added: {path}"))
+    names = [n for n in names if "/" + n not in added]  # a group added at the root is no shot
+    shot_bad = {_shot_id(p) for p in missing if _shot_id(p) is not None}
+    for path in missing:
+        bad.append(_row(_shot_id(path), path, f"missing: {path}"))
+    shared, problems, linked = _shared_groups(f, bad, added)
+    users = {}
     for name in names:
         shot_id = int(name.split("_", 1)[1])
         try:
             g = f[name]
-            found = damage(g, linked)
+            found = named(damage(g, linked), f"/{name}")
             for key in linked_groups(g, "/shared/"):
                 users.setdefault(key, []).append(shot_id)
         except Exception as exc:  # noqa: BLE001
             found = [f"unreadable ({_line(exc)})"]
         for p in found:
-            bad.append(_row(shot_id, f"/{name}/{_item(p)}".rstrip("/"), p))
+            bad.append(_row(shot_id, _where(p, f"/{name}"), p))
             shot_bad.add(shot_id)
+    for path in missing:  # a deleted shared group: the shots that linked to it
+        key = path.removeprefix("/shared/")
+        if path.startswith("/shared/") and key in users:
+            problems[key] = [f"missing: {path}"]
+            bad[:] = [b for b in bad if b["where"] != path]
     for key, found in problems.items():
         ids = sorted(users.get(key, []))
         shot_bad.update(ids)
         for p in found:
-            bad.append({"shot": None, "shots": ids, "where": f"/shared/{key}/{_item(p)}".rstrip("/"),
+            bad.append({"shot": None, "shots": ids, "where": _where(p, f"/shared/{key}"),
                         "reason": f"{p} (shared by shot{'' if len(ids) == 1 else 's'} {', '.join(map(str, ids)) or '-'})"})
-    return {"shots": len(names), "ok": len(names) - len(shot_bad), "bad": bad}
+    listed = len(names) + sum(1 for p in missing if _shot_id(p) is not None)
+    return {"shots": listed, "ok": listed - len(shot_bad), "bad": bad}
 
 
-def _shared_groups(f, bad) -> tuple:
+def named(problems: list, prefix: str) -> list:
+    """archive_digest.damage's lines for the group at ``prefix``, with each object added or
+    deleted (a dataset, or a group: its member-list row "X/") named once by its path
+    ("missing: /shot_000003/data/CH2") and the lines it alone explains left out: the member
+    list of its group, its own attributes and members."""
+    moved = {}
+    for p in problems:
+        head, _, what = p.partition(": ")
+        if not head.startswith("attribute ") and head != "/" and (what == "missing" or what.startswith(_ADDED)):
+            moved[head.rstrip("/")] = "missing" if what == "missing" else "added"
+    if not moved:
+        return problems
+    inside = lambda item: any(item.startswith((k + "/", k + "@")) for k in moved)  # noqa: E731
+    parents = {(k.rsplit("/", 1)[0] + "/") if "/" in k else "/" for k in moved}
+    out = []
+    for p in problems:
+        head, _, what = p.partition(": ")
+        item = head.removeprefix("attribute ")
+        own = None if head.startswith("attribute ") else item.rstrip("/")
+        if own in moved:
+            if not inside(own):  # not inside another object added or deleted
+                out.append(f"{moved[own]}: {prefix}/{own}")
+        elif not inside(item) and not (item in parents and what.startswith("damaged")):
+            out.append(p)  # not explained by what was added or deleted
+    return out
+
+
+def _where(problem: str, prefix: str) -> str:
+    """The path a problem line is about, inside the group at ``prefix``."""
+    if problem.startswith(("added: ", "missing: ")):
+        return problem.split(": ", 1)[1]
+    return f"{prefix}/{_item(problem)}".rstrip("/")
+
+
+def _shot_id(path: str):
+    """The shot a root path names ("/shot_000002" -> 2), else None."""
+    match = re.fullmatch(r"/shot_(\d+)", path)
+    return int(match.group(1)) if match else None
+
+
+def _shared_groups(f, bad, added=()) -> tuple:
     """({key: group} of the readable shared groups, {key: problems} of the damaged ones,
-    {address: path} of every object in them)."""
+    {address: path} of every object in them); groups in ``added`` (root paths) are left out."""
     shared, problems, linked = {}, {}, {}
     try:
         keys = sorted(f["shared"]) if "shared" in f else []
@@ -82,9 +178,11 @@ def _shared_groups(f, bad) -> tuple:
         bad.append(_row(None, "/shared", f"unreadable ({_line(exc)})"))
         return shared, problems, linked
     for key in keys:
+        if f"/shared/{key}" in added:
+            continue
         try:
             group = f["shared"][key]
-            found = damage(group, {})
+            found = named(damage(group, {}), f"/shared/{key}")
             linked.update(addresses(group))
             shared[key] = group
         except Exception as exc:  # noqa: BLE001

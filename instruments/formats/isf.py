@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InstrumentError
+from ..files import atomic_writes
 from ..records import Preamble, Waveform
 from .checks import channel_name, time_axis
 
@@ -64,13 +65,14 @@ def isf_bytes(w: Waveform) -> bytes:
 
 
 def write_isf(waveforms: dict, directory, stem: str) -> list:
-    """Write one ISF file per channel, ``<stem>_<CH>.isf``; returns the paths."""
-    out = []
-    for ch, w in waveforms.items():
-        path = Path(directory) / f"{stem}_{ch}.isf"
-        path.write_bytes(isf_bytes(w))
-        out.append(path)
-    return out
+    """Write one ISF file per channel, ``<stem>_<CH>.isf``, all or none of them
+    (instruments.files); returns the paths."""
+    return atomic_writes({Path(directory) / f"{stem}_{ch}.isf": _bytes_writer(isf_bytes(w))
+                          for ch, w in waveforms.items()})
+
+
+def _bytes_writer(data: bytes):
+    return lambda tmp: Path(tmp).write_bytes(data)
 
 
 def read_isf(path) -> list:

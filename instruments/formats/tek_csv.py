@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InstrumentError
+from ..files import atomic_writes
 from ..records import Preamble, Waveform
 from .checks import channel_name, time_axis
 
@@ -29,42 +30,47 @@ _UNITS = {"volts": "V", "volt": "V", "v": "V"}
 
 
 def write_csv(waveforms: dict, directory, stem: str) -> list:
-    """Write ``<stem>_<CH>.csv`` per channel in the 4/5/6 Series layout; returns the paths.
+    """Write ``<stem>_<CH>.csv`` per channel in the 4/5/6 Series layout, all or none of them
+    (instruments.files); returns the paths.
 
     The layout names no scope model (the virtual scope's model writes another layout).
     Times are written to 17 significant digits (they read back bit for bit), volts to 10 (an
     8-bit code is reproduced exactly); Zero Index = -x_zero / x_increment, fractional where
     the first sample is not on a multiple of the sample interval from the trigger."""
-    out = []
-    for ch, w in waveforms.items():
-        p = w.preamble
-        rows = [
-            ("Waveform Type", "ANALOG"),
-            ("Point Format", p.point_format),
-            ("Horizontal Units", p.x_unit),
-            ("Horizontal Scale", f"{p.x_increment * p.points / 10:.10g}"),
-            ("Sample Interval", f"{p.x_increment:.17g}"),
-            ("Record Length", str(p.points)),
-            ("Zero Index", f"{-p.x_zero / p.x_increment:.10f}"),
-            ("Gating", "0.0% to 100.0%"),
-            ("Probe Attenuation", f"{p.extra.get('probe', 1):.6g}"),
-            ("Vertical Units", p.y_unit),
-            ("Vertical Offset", f"{p.y_zero:.10g}"),
-            ("Vertical Scale", f"{p.extra.get('volts_per_div', '')}"),
-            ("Vertical Position", f"{p.extra.get('position_div', 0):.6g}"),
-            ("", ""),
-            ("", ""),
-            ("Label", p.waveform_id.replace(",", ";")),
-        ]
-        path = Path(directory) / f"{stem}_{ch}.csv"
+    return atomic_writes({Path(directory) / f"{stem}_{ch}.csv": _channel_writer(w, ch) for ch, w in waveforms.items()})
+
+
+def _channel_writer(w: Waveform, ch: str):
+    """write(path) of one channel's file."""
+    p = w.preamble
+    rows = [
+        ("Waveform Type", "ANALOG"),
+        ("Point Format", p.point_format),
+        ("Horizontal Units", p.x_unit),
+        ("Horizontal Scale", f"{p.x_increment * p.points / 10:.10g}"),
+        ("Sample Interval", f"{p.x_increment:.17g}"),
+        ("Record Length", str(p.points)),
+        ("Zero Index", f"{-p.x_zero / p.x_increment:.10f}"),
+        ("Gating", "0.0% to 100.0%"),
+        ("Probe Attenuation", f"{p.extra.get('probe', 1):.6g}"),
+        ("Vertical Units", p.y_unit),
+        ("Vertical Offset", f"{p.y_zero:.10g}"),
+        ("Vertical Scale", f"{p.extra.get('volts_per_div', '')}"),
+        ("Vertical Position", f"{p.extra.get('position_div', 0):.6g}"),
+        ("", ""),
+        ("", ""),
+        ("Label", p.waveform_id.replace(",", ";")),
+    ]
+
+    def write(path):
         with open(path, "w", newline="") as fh:
             for name, value in rows:
                 fh.write(f"{name},{value}\n" if name else "\n")
             fh.write(f"TIME,{ch}\n")
             for t, v in zip(w.time(), w.volts()):
                 fh.write(f"{t:.17g},{v:.10g}\n")
-        out.append(path)
-    return out
+
+    return write
 
 
 def read_csv(path) -> list:

@@ -7,7 +7,7 @@ from rig.errors import RigError
 
 def cmd_verify(args) -> dict:
     """Every shot's checksums; a bad row names the shot (or the shots of a shared group) and
-    the dataset or attribute. Exit 1 if any is bad."""
+    the dataset or attribute, or the path of an object added or deleted. Exit 1 if any is bad."""
     from pathlib import Path
 
     from instruments.archive import Archive
@@ -28,6 +28,9 @@ def cmd_verify(args) -> dict:
             parts = 3 if b["where"].startswith("/shared/") else 2 if b["where"].startswith("/shot_") else 1
             item = b["where"].split("/", parts)[-1]  # the dataset or attribute within its group
             what = b["reason"]
+            if what.startswith(("added: ", "missing: ")):  # the reason names the path
+                print(f"  {who}: {what}")
+                continue
             for head in (f"{item}: ", f"attribute {item}: "):
                 what = what.removeprefix(head)  # the path names it already
             print(f"  {who}: {b['where']}: {what}")
@@ -36,14 +39,18 @@ def cmd_verify(args) -> dict:
 
 
 def cmd_upgrade(args) -> dict:
-    """Rewrite an archive of an older layout in the current one (one transaction)."""
+    """Rewrite an archive of an older layout in the current one (one transaction); in one of
+    the current layout sealed before the root's member lists were, record them."""
     from instruments.archive import Archive
 
-    n = Archive(args.archive).upgrade()
+    archive = Archive(args.archive)
+    n = archive.upgrade()
+    members = n == 0 and archive.record_members()
     if not args.json:
         print(f"{args.archive}: {n} shots rewritten in the current layout" if n else
-              f"{args.archive}: already in the current layout")
-    return {"archive": args.archive, "upgraded": n}
+              f"{args.archive}: the root's member lists recorded (its shots were in the current layout)" if members
+              else f"{args.archive}: already in the current layout")
+    return {"archive": args.archive, "upgraded": n, "members_recorded": members}
 
 
 def cmd_import(args) -> dict:

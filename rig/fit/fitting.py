@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 from scipy import optimize, stats
 
+from instruments.files import atomic_write
 from rig.errors import RigError
 from rig.fit.checks import IMPLAUSIBLE_P, check_data_count, unseen
 
@@ -132,22 +133,32 @@ class EvaluationCache:
         for k in dict.fromkeys(keys):
             if k in self.memory:
                 continue
-            if self.folder is not None and self._path(k).is_file():
-                with np.load(self._path(k)) as z:
-                    self.memory[k] = self.objective.unpack({n: z[n] for n in z.files})
-                self.replayed += 1
+            if self.folder is not None and self._path(k).is_file() and self._replay(k):
                 continue
             todo.append(k)
         if todo:
             for k, model in zip(todo, self.objective.evaluate([np.array(k) for k in todo])):
                 self.memory[k] = model
                 self.solved += 1
-                if self.folder is not None:
-                    try:
-                        np.savez(self._path(k), **self.objective.pack(model))
-                    except OSError as exc:
-                        raise RigError(f"fit cache {self.folder}: cannot write ({exc.strerror})") from None
+                if self.folder is not None:  # whole or not at all: a full disk leaves no broken entry
+                    arrays = self.objective.pack(model)
+                    atomic_write(self._path(k), lambda tmp, arrays=arrays: _savez(tmp, arrays))
         return [self.memory[k] for k in keys]
+
+    def _replay(self, key: tuple) -> bool:
+        """Read a stored candidate back; one that cannot be read (left by an older version
+        cut short, or damaged) is dropped with a note on stderr and solved again (False)."""
+        path = self._path(key)
+        try:
+            with np.load(path) as z:
+                self.memory[key] = self.objective.unpack({n: z[n] for n in z.files})
+        except Exception as exc:  # noqa: BLE001 - any unreadable entry: EOFError, BadZipFile, KeyError, ...
+            why = " ".join(f"{type(exc).__name__} {exc}".split())
+            print(f"fit cache {path}: unreadable ({why}); dropped, solved again", file=sys.stderr, flush=True)
+            path.unlink(missing_ok=True)
+            return False
+        self.replayed += 1
+        return True
 
 
 def difference_steps(x: np.ndarray, central: bool) -> tuple:
@@ -219,6 +230,11 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
     return FitResult(tuple(p.key for p in params), tuple(p.unit for p in params), est, std, ci, corr, r, chi2, dof,
                      converged, str(res.message), cache.solved, at_bound, objective.nuisance_report(res.x[P:]),
                      res.x[P:].copy(), model, cache.replayed, np.column_stack((lo, lo + span)))
+
+
+def _savez(path, arrays: dict):
+    with open(path, "wb") as fh:  # a handle: np.savez would add ".npz" to a name without it
+        np.savez(fh, **arrays)
 
 
 def stderr_progress(text: str):

@@ -17,18 +17,21 @@ start in a ball of 0.1 sd about the least-squares estimate, drawn from ``seed``.
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib.util
 import json
 import logging
 import math
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from scipy import optimize
 
-from rig.errors import RigError
+from instruments.files import cause
+from rig.errors import Interrupted, RigError
 from rig.fit.fitting import FitResult
 
 BURN_FRACTION = 0.5  # the first half of the chain is discarded as burn-in
@@ -121,7 +124,7 @@ def sample(objective, result: FitResult, folder, walkers: int, steps: int, seed:
                                                                              f"({solved[0]} candidates solved)"))
         total = int(backend.iteration)
     except OSError as exc:
-        raise RigError(f"{folder / 'posterior.h5'}: cannot write the chain ({exc.strerror or exc})") from None
+        raise RigError(f"{folder / 'posterior.h5'}: {cause(exc)}") from None
     burn = int(BURN_FRACTION * total)
     chain = backend.get_chain(discard=burn, flat=True)
     if chain.shape[0] == 0:
@@ -151,7 +154,7 @@ def _run_chain(objective, x_hat, sd, folder, walkers, steps, seed, log_prob, tel
     P = len(objective.params)
     tag = hashlib.sha256(json.dumps([objective.spec(), walkers, seed], sort_keys=True,
                                     default=float).encode()).hexdigest()[:16]
-    backend = emcee.backends.HDFBackend(str(folder / "posterior.h5"), name=f"chain_{tag}")
+    backend = _backend(str(folder / "posterior.h5"), f"chain_{tag}")
     done = int(backend.iteration) if backend.initialized else 0
     sampler = emcee.EnsembleSampler(walkers, P, log_prob, vectorize=True, backend=backend)
     if done == 0:
@@ -161,10 +164,69 @@ def _run_chain(objective, x_hat, sd, folder, walkers, steps, seed, log_prob, tel
         sampler.random_state = np.random.RandomState(seed).get_state()
     else:
         start = backend.get_last_sample()  # the walkers and the generator's state where they stopped
-    for k, _ in enumerate(sampler.sample(start, iterations=max(0, steps - done)), start=done + 1):
-        if k % 10 == 0 or k == steps:
-            tell(k)
+    with _ctrl_c_between_steps() as asked:
+        for k, _ in enumerate(sampler.sample(start, iterations=max(0, steps - done)), start=done + 1):
+            if k % 10 == 0 or k == steps:
+                tell(k)
+            if asked():
+                raise Interrupted(f"interrupted: {k} of {steps} steps of the chain are kept in "
+                                  f"{folder / 'posterior.h5'}; run the same command again to continue it")
     return backend
+
+
+def _backend(path: str, name: str):
+    """emcee's HDF backend on ``path``, each change of which (a step, the chain's storage
+    grown) is made in memory and the file then replaced whole (instruments.files): HDF5
+    writing in place on a full disk had crashed the process. A file there that cannot be
+    read (cut short by an older version, damaged) is dropped with a note on stderr, and
+    the chain starts again."""
+    import emcee
+    import h5py
+
+    from instruments.files import atomic_write, hdf5_in_memory
+
+    try:
+        if Path(path).exists():
+            h5py.File(path, "r").close()
+    except Exception as exc:  # noqa: BLE001 - any unreadable file
+        why = " ".join(f"{type(exc).__name__} {exc}".split())
+        print(f"{path}: unreadable ({why}); dropped, the chain starts again", file=sys.stderr, flush=True)
+        Path(path).unlink()
+
+    class WholeFileBackend(emcee.backends.HDFBackend):
+        def open(self, mode="r"):
+            return super().open(mode) if mode == "r" else self._changed()
+
+        @contextlib.contextmanager
+        def _changed(self):
+            stored = Path(self.filename)
+            with hdf5_in_memory(stored.read_bytes() if stored.exists() else None) as f:
+                yield f
+                f.flush()
+                image = f.id.get_file_image()
+            atomic_write(stored, lambda tmp: Path(tmp).write_bytes(image))
+
+    return WholeFileBackend(path, name=name)
+
+
+@contextlib.contextmanager
+def _ctrl_c_between_steps():
+    """Ctrl-C (SIGINT) ends the sampling after the step under way, whose walkers are then
+    stored: a KeyboardInterrupt raised inside emcee's call of the likelihood made emcee
+    print its own traceback. Yields a function: whether Ctrl-C was pressed. Outside the
+    main thread (no signal handler there) Ctrl-C is left as it is."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield lambda: False
+        return
+    pressed = []
+    before = signal.signal(signal.SIGINT, lambda signum, frame: pressed.append(signum))
+    try:
+        yield lambda: bool(pressed)
+    finally:
+        signal.signal(signal.SIGINT, before)
 
 
 def draw(path: Path, post: Posterior):
@@ -173,6 +235,8 @@ def draw(path: Path, post: Posterior):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from rig.viz.figures import save
 
     P = len(post.keys)
     fig, axes = plt.subplots(P, P, figsize=(2.4 * P + 1, 2.4 * P + 1), squeeze=False)
@@ -195,5 +259,5 @@ def draw(path: Path, post: Posterior):
     fig.suptitle(f"posterior: {post.walkers} walkers x {post.steps} steps (first {post.burn} discarded), "
                  f"acceptance {post.acceptance:.2f}", fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save(fig, path, dpi=120)
     plt.close(fig)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from instruments.files import atomic_write
 from rig.experiment import scene as scene_io
 from rig.fit.checks import result_warnings, unusable
 from rig.fit.fitting import FitResult
@@ -66,6 +67,10 @@ def fitted_scene_text(scene: str, overrides: list, result: FitResult) -> str:
 
 
 def write_residuals(path: Path, objective, result: FitResult):
+    atomic_write(path, lambda tmp: _residuals(tmp, objective, result))
+
+
+def _residuals(path, objective, result: FitResult):
     model = result.model
     with open(path, "w", newline="") as fh:
         wr = csv.writer(fh)
@@ -92,6 +97,8 @@ def draw(path: Path, objective, result: FitResult):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from rig.viz.figures import save
 
     model = result.model
     if isinstance(objective, PointObjective):
@@ -124,5 +131,5 @@ def draw(path: Path, objective, result: FitResult):
                       for k, u, e, s in zip(result.keys, result.units, result.estimate, result.std))
     fig.suptitle(title, fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    save(fig, path, dpi=130)
     plt.close(fig)

@@ -2,9 +2,9 @@
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
+from instruments.files import atomic_write, write_text
 from rig.errors import RigError
 from rig.experiment import scene as scene_io
 from rig.fit import report
@@ -33,15 +33,12 @@ def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 40
         stale.unlink()  # a fitted scene from an earlier fit must not outlive a failed one
     if result.usable:
         text = report.fitted_scene_text(scene, objective.overrides, result)
-        tmp = out / "fitted.part.toml"
-        tmp.write_text(text)
-        try:
+
+        def write(tmp):
+            Path(tmp).write_text(text)
             scene_io.load(tmp)  # the written scene must load as it is
-        except RigError:
-            tmp.unlink()
-            raise
-        os.replace(tmp, stale)
-        fitted = stale
+
+        fitted = atomic_write(stale, write)
     block = report.summary(result, objective, fitted)
     if posterior_steps and result.converged:
         from rig.fit import posterior
@@ -52,5 +49,5 @@ def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 40
         posterior.draw(out / "posterior.png", post)
     report.write_residuals(out / "residuals.csv", objective, result)
     report.draw(out / "fit.png", objective, result)
-    (out / "fit.json").write_text(json.dumps(block, indent=1, default=float))
+    write_text(out / "fit.json", json.dumps(block, indent=1, default=float))
     return block

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from instruments.files import write_text
 from rig.errors import Interrupted, RigError
 from rig.experiment.measure import midway_static_force
 from rig.study.executors import DEFAULT_WORKER_TIMEOUT, run_study
@@ -17,7 +18,7 @@ from rig.study.mc_spec import Study
 from rig.study.nominal import nominal
 from rig.study.report import failures, figures, jcgm101
 from rig.study.sobol import sobol_indices, sobol_matrix
-from rig.study.store import Store, StudyResults, atomic_write
+from rig.study.store import Store, StudyResults
 from rig.theory.longwave import solitary_wave_speed
 
 
@@ -50,22 +51,23 @@ def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None,
     batch's shots; ``on_start(done)`` how many shots were already stored; on Dask the study
     stops after ``worker_timeout`` s without a live worker."""
     check(study)
-    store = Store(folder, study).open()
-    done = sum(len(study.shots_of(b)) for b in store.done())
-    if on_start:
-        on_start(done)
-    t0 = time.perf_counter()
-    try:
-        run_study(study, store, workers, scheduler, progress, worker_timeout)
-    except KeyboardInterrupt:
-        kept = sum(len(study.shots_of(b)) for b in store.done())
-        raise Interrupted(f"interrupted: {kept} of {study.shots} shots are kept in {folder}; "
-                       f"run the same command again to resume") from None
-    ran = study.shots - done
-    elapsed = time.perf_counter() - t0
-    results = store.collect()
-    report = summarise(study, results, ran / elapsed if ran else None)
-    write_report(Path(folder), study, store, results, report)
+    with Store(folder, study).held() as store:  # one run at a time into a folder
+        store.open()
+        done = sum(len(study.shots_of(b)) for b in store.done())
+        if on_start:
+            on_start(done)
+        t0 = time.perf_counter()
+        try:
+            run_study(study, store, workers, scheduler, progress, worker_timeout)
+        except KeyboardInterrupt:
+            kept = sum(len(study.shots_of(b)) for b in store.done())
+            raise Interrupted(f"interrupted: {kept} of {study.shots} shots are kept in {folder}; "
+                              f"run the same command again to resume") from None
+        ran = study.shots - done
+        elapsed = time.perf_counter() - t0
+        results = store.collect()
+        report = summarise(study, results, ran / elapsed if ran else None)
+        write_report(Path(folder), study, store, results, report)
     return StudyRun(report, ran)
 
 
@@ -99,4 +101,4 @@ def write_report(folder: Path, study: Study, store: Store, results: StudyResults
     figures(folder, results, study.keys,
             (F, solitary_wave_speed(m.E, m.nu, m.rho, bead.diameter, F0, F0 + F), f"Eq (1), F_0 = {F0:.3g} N"))
     store.consolidate(results, report)
-    atomic_write(folder / "report.json", lambda tmp: Path(tmp).write_text(json.dumps(report, indent=1)))
+    write_text(folder / "report.json", json.dumps(report, indent=1))

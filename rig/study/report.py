@@ -53,6 +53,8 @@ def figures(folder, results, keys, theory_curve=None):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from rig.viz.figures import save
+
     out = results.outputs
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
     for ax, key, label in ((axes[0], "speed_m_per_s", "measured speed V_s (m/s)"),
@@ -66,7 +68,7 @@ def figures(folder, results, keys, theory_curve=None):
         ax.set_ylabel("shots")
         ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(folder / "histograms.png", dpi=120)
+    save(fig, folder / "histograms.png", dpi=120)
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(5.6, 4.2))
     ax.plot(out["amplitude_N"], out["speed_m_per_s"], "C0.", ms=3, alpha=0.5, label="virtual shots (measured)")
@@ -79,5 +81,5 @@ def figures(folder, results, keys, theory_curve=None):
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(folder / "speed_vs_amplitude.png", dpi=120)
+    save(fig, folder / "speed_vs_amplitude.png", dpi=120)
     plt.close(fig)

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from instruments.analysis import PeakRules, find_pulses, leading
+from instruments.files import atomic_write, write_text
 from instruments.pipeline import reflection_time, solitary_train
 from rig.errors import invalid
 from rig.experiment.measure import midway_static_force, setup_for, shot_blocks
@@ -125,7 +126,7 @@ def reproduce(study: str, out, progress=None) -> dict:
     for spec in figure_specs(results, rigs):
         figures.draw(out, spec)
     tick("figures")
-    (out / "results.json").write_text(json.dumps(results, indent=1, sort_keys=True))
+    write_text(out / "results.json", json.dumps(results, indent=1, sort_keys=True))
     return results
 
 
@@ -186,10 +187,14 @@ def _wall_peak(rig: Rig) -> float:
 
 def _write_tables(out: Path, results):
     rows = results["table1"]
-    with open(out / "table1.csv", "w", newline="") as fh:
-        wr = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        wr.writeheader()
-        wr.writerows(rows)
+
+    def table_csv(tmp):
+        with open(tmp, "w", newline="") as fh:
+            wr = csv.DictWriter(fh, fieldnames=list(rows[0]))
+            wr.writeheader()
+            wr.writerows(rows)
+
+    atomic_write(out / "table1.csv", table_csv)
     lines = ["| chain | precompression | F_0 (N) | F_m numerics (N) | F_m virtual exp. (N) | "
              "V_s virtual exp. (m/s) | V_s numerics (m/s) | V_s Eq (1) (m/s) | c0 Eq (2) (m/s) | c0 published (m/s) |",
              "|---|---|---|---|---|---|---|---|---|---|"]
@@ -199,8 +204,8 @@ def _write_tables(out: Path, results):
                      f"{r['Vs_experiment_m_per_s']:.1f} ± {r['Vs_experiment_sd_m_per_s']:.1f} | "
                      f"{r['Vs_numerics_m_per_s']:.1f} | {r['Vs_eq1_m_per_s']:.1f} | {r['c0_eq2_m_per_s']:.1f} | "
                      f"{r['c0_published_m_per_s']:.1f} |")
-    (out / "table1.md").write_text(
-        f"Table 1, reproduced: virtual experiment (mean ± sd over {SEEDS} shots), numerics (noise-free truth), "
+    write_text(
+        out / "table1.md", f"Table 1, reproduced: virtual experiment (mean ± sd over {SEEDS} shots), numerics (noise-free truth), "
         "long-wave theory at the numerics' F_m.\n\n" + "\n".join(lines) + "\n")
     s = results["summary"]
     body = ["# Summary", ""]
@@ -208,4 +213,4 @@ def _write_tables(out: Path, results):
     body += ["", "Striker mass sweep on the 52-bead PTFE chain without its magnetic bead (gravity only):", "",
              "| striker / bead mass | solitary waves at the lower gauge |", "|---|---|"]
     body += [f"| {m['ratio']} | {m['pulses_lower_gauge']} |" for m in results["mass_ratio"]]
-    (out / "summary.md").write_text("\n".join(body) + "\n")
+    write_text(out / "summary.md", "\n".join(body) + "\n")

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from instruments.files import write_text
 from rig.experiment.shot import Rig
 from rig.fit.data import read_points
 from rig.fit.evaluate import calibrate, curves, solve_rigs
@@ -156,8 +157,8 @@ def reproduce_fitted(out, progress=None) -> dict:
         "steel": steel,
         "published": PUBLISHED,
     }
-    (out / "fitted.json").write_text(json.dumps(fitted, indent=1, default=float))
-    (out / "fitted.md").write_text(_markdown(fitted))
+    write_text(out / "fitted.json", json.dumps(fitted, indent=1, default=float))
+    write_text(out / "fitted.md", _markdown(fitted))
     return fitted
 
 

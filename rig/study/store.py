@@ -1,18 +1,19 @@
 """Where a Monte Carlo study keeps its work: DIR/study.json (the study), DIR/batches/
 batch_NNNNNN.h5 (one per finished batch), for a study with traces DIR/traces/
 batch_NNNNNN.h5 (a shot archive per batch, written before the batch counts as finished),
-and at the end DIR/study.h5. Every file appears whole or not at all (written beside, then
-renamed), so a killed or failed run can always be resumed by running it again."""
+and at the end DIR/study.h5. Every file appears whole or not at all (instruments.files), so
+a killed or failed run can always be resumed by running it again. DIR/study.lock is held by
+the run that writes the folder (``Store.held``): a second run into it is refused."""
 from __future__ import annotations
 
+import contextlib
 import json
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from instruments.files import folder_lock, write_hdf5, write_text
 from rig.errors import RigError
 from rig.study.batch import BatchResult
 from rig.study.mc_spec import OUTPUTS, Study
@@ -26,25 +27,6 @@ class StudyResults:
     inputs: np.ndarray
     seeds: np.ndarray
     outputs: dict
-
-
-def atomic_write(path: Path, write) -> Path:
-    """``write(temporary path)``, flushed to disk, then renamed to ``path`` (atomic); the
-    temporary file is removed when anything fails."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    mask = os.umask(0)
-    os.umask(mask)
-    os.chmod(tmp, 0o666 & ~mask)  # mkstemp's 0600 would make every study file private
-    try:
-        write(tmp)
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
 
 
 class Store:
@@ -65,6 +47,15 @@ class Store:
         except (OSError, ValueError, AttributeError):
             return None
         return batch if isinstance(batch, int) and not isinstance(batch, bool) and batch >= 1 else None
+
+    @contextlib.contextmanager
+    def held(self):
+        """The folder, held by this run for as long as the block runs: another run into it
+        (same folder, any study) is refused in one line naming the holder. The OS releases
+        the hold when this process ends, killed or not."""
+        self.folder.mkdir(parents=True, exist_ok=True)
+        with folder_lock(self.folder, "study.lock", "wait for it to end, or give another --out"):
+            yield self
 
     def open(self) -> "Store":
         """Create the folder, or check that it holds this very study (to resume it)."""
@@ -88,7 +79,7 @@ class Store:
                            f"cannot be checked; give another --out or remove {self.folder}")
         self.batches.mkdir(parents=True, exist_ok=True)
         if fresh:
-            atomic_write(meta, lambda tmp: Path(tmp).write_text(json.dumps(spec, indent=1)))
+            write_text(meta, json.dumps(spec, indent=1))
         return self
 
     def _other_study(self, old: dict, spec: dict) -> str:
@@ -107,8 +98,6 @@ class Store:
         return {int(p.stem.split("_")[1]) for p in self.batches.glob("batch_*.h5")}
 
     def write(self, result: BatchResult):
-        import h5py
-
         if result.traces:
             from instruments.archive import Archive
 
@@ -117,15 +106,14 @@ class Store:
             archive.unlink(missing_ok=True)  # left by an interrupted run: that batch did not finish
             Archive(archive).append(list(result.traces))
 
-        def write(tmp):
-            with h5py.File(tmp, "w") as f:
-                f["index"] = result.index
-                f["inputs"] = result.inputs
-                f["seeds"] = result.seeds
-                for k, v in result.outputs.items():
-                    f[f"outputs/{k}"] = v
+        def write(f):
+            f["index"] = result.index
+            f["inputs"] = result.inputs
+            f["seeds"] = result.seeds
+            for k, v in result.outputs.items():
+                f[f"outputs/{k}"] = v
 
-        atomic_write(self.batches / f"batch_{result.batch:06d}.h5", write)
+        write_hdf5(self.batches / f"batch_{result.batch:06d}.h5", write)
 
     def collect(self) -> StudyResults:
         """Every finished shot, in shot order."""
@@ -146,22 +134,19 @@ class Store:
 
     def consolidate(self, results: StudyResults, report: dict) -> Path:
         """DIR/study.h5: every shot's inputs, outputs and seed, and the report."""
-        import h5py
+        def write(f):
+            f.attrs["study"] = json.dumps(self.study.spec())
+            f.attrs["report"] = json.dumps(report, default=float)
+            f["shot"] = results.index
+            f["seed"] = results.seeds
+            f["seed"].attrs["description"] = ("instrument seed; inputs come from SeedSequence(study seed, "
+                                              "spawn_key=(shot,))")
+            for k, key in enumerate(self.study.keys):
+                f[f"inputs/{key}"] = results.inputs[:, k]
+            for k, v in results.outputs.items():
+                f[f"outputs/{k}"] = v
 
-        def write(tmp):
-            with h5py.File(tmp, "w") as f:
-                f.attrs["study"] = json.dumps(self.study.spec())
-                f.attrs["report"] = json.dumps(report, default=float)
-                f["shot"] = results.index
-                f["seed"] = results.seeds
-                f["seed"].attrs["description"] = ("instrument seed; inputs come from SeedSequence(study seed, "
-                                                  "spawn_key=(shot,))")
-                for k, key in enumerate(self.study.keys):
-                    f[f"inputs/{key}"] = results.inputs[:, k]
-                for k, v in results.outputs.items():
-                    f[f"outputs/{k}"] = v
-
-        return atomic_write(self.folder / "study.h5", write)
+        return write_hdf5(self.folder / "study.h5", write)
 
 
 def _output(part: dict, key: str) -> np.ndarray:

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from instruments.files import atomic_write
 from rig.errors import RigError, invalid
 
 FORMATS = (".mp4", ".gif", ".png")
@@ -229,22 +230,29 @@ def animate(rig, out, frames: int = 100, exaggerate: float | None = None, seed: 
     traces = _Traces(shot.scope, rig.solver.duration)
     still = out.suffix.lower() == ".png"
     order = [_still_frame(rig, fr)] if still else range(len(fr.times))
-    try:
+    def encoded() -> bytes:
+        """The image or movie, encoded in memory: a writer that fails on a full disk
+        retries its flush when it is collected, a traceback after the error line."""
+        import io
+
         import imageio.v2 as imageio
 
+        buf, kind = io.BytesIO(), out.suffix.lower()
         if still:
             k = order[0]
-            imageio.imwrite(out, np.vstack([view.render(fr, k), traces.render(fr.times[k])]))
+            imageio.imwrite(buf, np.vstack([view.render(fr, k), traces.render(fr.times[k])]), format=kind)
         else:
-            kw = {"fps": FPS, "macro_block_size": 8} if out.suffix.lower() == ".mp4" else {"duration": 1000 / FPS, "loop": 0}
-            with imageio.get_writer(out, **kw) as writer:
+            kw = {"fps": FPS, "macro_block_size": 8} if kind == ".mp4" else {"duration": 1000 / FPS, "loop": 0}
+            with imageio.get_writer(buf, format=kind, **kw) as writer:
                 for k in order:
                     writer.append_data(np.vstack([view.render(fr, k), traces.render(fr.times[k])]))
                     if progress:
                         progress()
-    except Exception:
-        Path(out).unlink(missing_ok=True)  # no half-written movie left behind
-        raise
+        return buf.getvalue()
+
+    try:
+        data = encoded()
+        atomic_write(out, lambda tmp: Path(tmp).write_bytes(data))  # no half-written movie, an earlier one kept
     finally:
         view.close()
     return {"out": str(out), "frames": 1 if still else len(fr.times), "exaggerate": x, "seed": shot.seed,

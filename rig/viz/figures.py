@@ -26,6 +26,15 @@ def draw(folder, spec: FigureSpec) -> Path:
     return path
 
 
+def save(fig, path, dpi: int):
+    """``fig`` as the image ``path`` (its format from the suffix), written whole or not at
+    all (instruments.files)."""
+    from instruments.files import atomic_write
+
+    path = Path(path)
+    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=dpi))
+
+
 def _plt():
     import matplotlib
 
@@ -53,7 +62,7 @@ def speed_vs_force(path, title, series, theory):
     ax.legend(fontsize=7, loc="lower right")
     ax.grid(alpha=0.3, which="both")
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    save(fig, path, dpi=130)
     plt.close(fig)
 
 
@@ -79,7 +88,7 @@ def traces(path, title, panels):
         ax.set_xlabel("time (ms)")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save(fig, path, dpi=120)
     plt.close(fig)
 
 
@@ -96,7 +105,7 @@ def beta_curve(path, fr, beta, points):
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, which="both")
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    save(fig, path, dpi=130)
     plt.close(fig)
 
 
@@ -112,5 +121,5 @@ def pulse_vs_solitary(path, title, curves):
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    save(fig, path, dpi=130)
     plt.close(fig)

@@ -44,6 +44,23 @@ def test_rig_shot_out_then_ls_and_verify(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out) == {"shots": 2, "ok": 2, "bad": []}
 
 
+
+def test_verify_names_an_added_and_a_deleted_object(tmp_path, capsys):
+    import h5py
+
+    path = tmp_path / "a.h5"
+    Archive(path).append([shot_entry(Rig.from_scene("steel21_gravity").fire(seed=s)) for s in (1, 2, 3)])
+    with h5py.File(path, "a") as f:
+        f.create_dataset("foo", data=1.0)  # once passed verify: the root's member list was not digested
+        del f["shot_000002"]  # once passed too
+        del f["shot_000003/data/CH2"]  # once named only through data/time@REFERENCE_LIST
+    assert main(["verify", str(path)]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == f"{path}: 3 shots, 1 ok, 2 bad (4 problems)", out
+    assert out[1:4] == ["  archive: added: /foo", "  shot 2: missing: /shot_000002",
+                        "  shot 3: missing: /shot_000003/data/CH2"], out
+    assert out[4].startswith("  shot 3: /shot_000003/data/time@REFERENCE_LIST: damaged"), out
+
 def test_real_files_import_into_the_same_layout(tmp_path, capsys, realdata):
     path = str(tmp_path / "real.h5")
     files = [str(realdata / "tek_16bit_dpo.isf"), str(realdata / "tek_8bit_two_records.isf")]

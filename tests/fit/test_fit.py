@@ -279,3 +279,75 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, argv, match):
     assert main(["fit", SCENE, "--out", str(tmp_path / "o")] + argv) == 2
     err = capsys.readouterr().err.strip()
     assert match in err and len(err.splitlines()) == 1
+
+
+def test_a_cache_entry_that_cannot_be_read_is_dropped_and_solved_again(tmp_path, capsys):
+    # a full disk once left a 0-byte entry, and every later run of the command died with EOFError
+    pts = _virtual_points(tmp_path)
+    argv = ["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+            "--out", str(tmp_path / "fit"), "--json", "--quiet"]
+    assert main(argv) == 0
+    first = json.loads(capsys.readouterr().out)
+    entries = sorted((tmp_path / "fit" / "evaluations").glob("*.npz"))
+    assert len(entries) == first["evaluations"] >= 3
+    entries[0].write_bytes(b"")  # as a full disk left it
+    entries[1].write_bytes(entries[1].read_bytes()[:100])  # cut short
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    again = json.loads(captured.out)
+    notes = [line for line in captured.err.splitlines() if "dropped, solved again" in line]
+    assert len(notes) == 2 and all(line.startswith("fit cache ") for line in notes), captured.err
+    assert {line.split(": ", 1)[0].removeprefix("fit cache ") for line in notes} == {str(p) for p in entries[:2]}
+    assert again["evaluations"] == 2 and again["evaluations_replayed"] == first["evaluations"] - 2
+    assert again["parameters"] == first["parameters"]  # the same fit, bit for bit
+    for p in entries:
+        with np.load(p) as z:  # whole again
+            assert z.files
+
+
+def test_ctrl_c_while_the_posterior_samples_is_one_line_and_keeps_the_chain(tmp_path):
+    # Ctrl-C inside emcee's call of the likelihood once printed emcee's traceback first
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    pytest.importorskip("emcee")
+    pts = _virtual_points(tmp_path)
+    argv = ["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+            "--out", str(tmp_path / "fit"), "--posterior", "100000", "--walkers", "4", "--seed", "3"]
+    p = subprocess.Popen([sys.executable, "-m", "rig.cli", *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    err = []
+    for line in p.stderr:  # the progress lines, until the chain has taken 20 steps
+        err.append(line)
+        if line.startswith("posterior: step 20/"):
+            p.send_signal(signal.SIGINT)
+            break
+    rest, tail = p.communicate(timeout=300)
+    lines = [line for line in "".join(err[-1:]).splitlines() + tail.splitlines() if line.strip()]
+    assert p.returncode == 130, tail
+    assert "Traceback" not in tail and "emcee" not in rest + tail, tail
+    assert lines[-1].startswith("rig fit: error: interrupted: ") and "steps of the chain are kept in" in lines[-1]
+    assert all(line.startswith("posterior: step") for line in lines[:-1]), lines  # nothing but progress before it
+    kept = int(lines[-1].split("interrupted: ")[1].split()[0])
+    import h5py
+
+    with h5py.File(tmp_path / "fit" / "posterior.h5", "r") as f:
+        (chain,) = f.values()
+        assert int(chain.attrs["iteration"]) == kept >= 20  # every step it says it kept is stored
+
+
+def test_a_chain_file_that_cannot_be_read_is_dropped_and_sampled_again(tmp_path, capsys):
+    pytest.importorskip("emcee")
+    pts = _virtual_points(tmp_path)
+    argv = ["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+            "--out", str(tmp_path / "fit"), "--json", "--quiet", "--posterior", "4", "--walkers", "4", "--seed", "3"]
+    assert main(argv) == 0
+    first = json.loads(capsys.readouterr().out)["posterior"]
+    chain = tmp_path / "fit" / "posterior.h5"
+    chain.write_bytes(chain.read_bytes()[:1000])  # cut short
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    assert captured.err.startswith(f"{chain}: unreadable (") and "dropped, the chain starts again" in captured.err
+    assert json.loads(captured.out)["posterior"] == first  # the same seed: the same chain, sampled again

@@ -332,3 +332,42 @@ def test_a_small_study_is_sized_by_its_shots_not_its_batch(tmp_path, capsys):
     out = tmp_path / "s"
     assert main(["mc", "ptfe52_magnetic", "--shots", "4", "--vary", VARY[0], "--out", str(out), "--quiet",
                  "--json", "--batch", "99999"]) == 0
+
+
+HOLD = """
+import sys, time
+from rig.study.store import Store
+from rig.study.mc_spec import Study
+from rig.study.distributions import parse_vary
+study = Study("ptfe52_magnetic", tuple(parse_vary([sys.argv[2]])), 4, seed=3, batch=2)
+with Store(sys.argv[1], study).held():
+    print("held", flush=True)
+    time.sleep(600)
+"""
+
+
+def test_a_second_run_into_a_held_folder_is_refused_and_a_killed_holder_blocks_nothing(tmp_path, capsys):
+    # two `rig mc` into one --out once both ran, the second redoing the first's shots
+    import os
+    import signal
+    import socket
+    import subprocess
+    import sys
+
+    out = tmp_path / "s"
+    holder = subprocess.Popen([sys.executable, "-c", HOLD, str(out), VARY[0]], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        argv = ["mc", "ptfe52_magnetic", "--shots", "4", "--batch", "2", "--vary", VARY[0], "--out", str(out), "--quiet"]
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith(f"rig mc: error: {out}: in use by another run (pid {holder.pid} "
+                                                       f"on {socket.gethostname()} since "), err
+        assert err.rstrip().endswith("wait for it to end, or give another --out")
+        assert not (out / "batches").exists() or not list((out / "batches").iterdir())  # it fired nothing
+    finally:
+        os.kill(holder.pid, signal.SIGKILL)  # a killed run: its lock file stays, naming a dead pid
+        holder.wait()
+    assert f"pid {holder.pid} " in (out / "study.lock").read_text()
+    assert main(argv) == 0
+    assert capsys.readouterr().out.startswith("4 shots (4 run now, ")

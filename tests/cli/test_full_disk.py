@@ -1,0 +1,158 @@
+"""A full disk under every command that writes: one line naming the path and the cause,
+exit 2, no traceback, nothing truncated or empty left behind, and the same command run
+again once there is room succeeds.
+
+The disk is made full the way tests/cli/test_bad_inputs.py does it: a file-size limit on
+the command's process (RLIMIT_FSIZE), which makes every write past the limit fail with
+EFBIG ("File too large") as ENOSPC would. Each limit is below the size of what the
+command writes, so the failure comes from a real write in the middle of it."""
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from test_bad_inputs import DISK_FULL, VEL, S, _one_line
+
+from instruments.archive import Archive
+from instruments.formats.isf import read_isf
+
+LAYOUT1 = Path(__file__).parents[1] / "instruments" / "data" / "layout1.h5"
+POINTS = "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n0.5,0.05,130,4\n0.9,0.09,150,4.5\n1.6,0.16,175,5\n"
+FIT = ["fit", "ptfe20_gravity", "--points", "{d}/points.csv", "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+       "--out", "{d}/fit", "--quiet"]
+SMALL = ["--set", "chain.beads=20", "--set", "gauges.upper.bead=6", "--set", "gauges.lower.bead=12",
+         "--set", "solver.duration=0.5 ms", "--set", "scope.record_length=2000"]
+
+CASES = {
+    "shot --export": (1000, ["shot", S, "--seed", "1", "--export", "{d}/shots"]),
+    "shot --out": (20000, ["shot", S, "--seed", "1", "--out", "{d}/a.h5"]),
+    "sweep --out": (20000, ["sweep", S, "--vary", "striker.velocity=0.6:0.9:2", "--out", "{d}/s.h5", "--quiet"]),
+    "mc --out": (3000, ["mc", S, "--shots", "8", "--batch", "4", "--vary", VEL, "--out", "{d}/study", "--quiet"]),
+    "mc --out, two workers": (3000, ["mc", S, "--shots", "8", "--batch", "4", "--vary", VEL, "--out", "{d}/study",
+                                     "--quiet", "--workers", "2"]),
+    "mc --out, the report": (20000, ["mc", S, "--shots", "8", "--batch", "4", "--vary", VEL, "--out", "{d}/study",
+                                     "--quiet"]),
+    "import": (5000, ["import", "{realdata}/tek_16bit_dpo.isf", "--into", "{d}/a.h5"]),
+    "upgrade": (LAYOUT1.stat().st_size + 2000, ["upgrade", "{d}/old.h5"]),
+    "fit, the cache": (300, FIT),
+    "fit, the report": (8000, FIT),
+    "fit --posterior, the chain": (3000, [*FIT, "--posterior", "40", "--walkers", "4"]),
+    "reproduce --out": (3000, ["reproduce", "daraio2006", "--out", "{d}/r", "--quiet"]),
+    "animate --out": (2000, ["animate", S, *SMALL, "--frames", "4", "--out", "{d}/a.gif", "--quiet"]),
+}
+
+
+def _run(argv, d: Path, realdata, limit=None):
+    argv = [a.replace("{d}", str(d)).replace("{realdata}", str(realdata)) for a in argv]
+    code = DISK_FULL if limit else "import sys\nfrom rig.cli import main\nsys.exit(main(sys.argv[2:]))\n"
+    return subprocess.run([sys.executable, "-c", code, str(limit or 0), *argv], check=False, capture_output=True, text=True,
+                          cwd=d, timeout=600)
+
+
+def whole(path: Path):
+    """Fail unless ``path`` is a whole file of its kind (what a reader of it needs)."""
+    kind = path.suffix.lower()
+    assert path.stat().st_size > 0, f"{path}: empty"
+    if kind == ".h5":
+        with h5py.File(path, "r") as f:
+            archive = f.attrs.get("creator") == "sonic-rig" and f.attrs.get("layout_version") == 2
+        if archive:
+            assert Archive(path).verify()["bad"] == [], path
+    elif kind == ".isf":
+        assert read_isf(path)
+    elif kind == ".json":
+        json.loads(path.read_text())
+    elif kind == ".npz":
+        with np.load(path) as z:
+            [z[n] for n in z.files]
+    elif kind in (".png", ".gif"):
+        from PIL import Image
+
+        with Image.open(path) as im:
+            im.load()
+    else:
+        path.read_text()
+
+
+def _check_left(d: Path):
+    for p in d.rglob("*"):
+        if p.is_file():
+            assert ".tmp" not in p.name, f"{p}: a temporary file left behind"
+            if p.suffix != ".lock":  # a lock file holds no data
+                whole(p)
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_a_full_disk_is_one_line_leaves_nothing_broken_and_a_second_run_succeeds(tmp_path, realdata, case):
+    limit, argv = CASES[case]
+    if argv[0] == "animate":
+        pytest.importorskip("pyvista")
+    if argv[0] == "upgrade":
+        shutil.copyfile(LAYOUT1, tmp_path / "old.h5")
+    if argv[0] == "fit":
+        (tmp_path / "points.csv").write_text(POINTS)
+        if case != "fit, the cache":  # the cache filled by a first run: this one writes the scene and report first
+            assert _run(FIT, tmp_path, realdata).returncode in (0, 1)
+    before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file() and p.suffix != ".lock"}
+    r = _run(argv, tmp_path, realdata, limit)
+    assert r.returncode == 2, r.stderr
+    line = _one_line(r.stderr)
+    assert line.startswith(f"rig {argv[0]}: error: {tmp_path}") and line.endswith(": File too large"), line
+    _check_left(tmp_path)
+    if argv[0] == "shot" and "--export" in argv:  # several files: all of them or none
+        assert not list((tmp_path / "shots").glob("*.isf"))
+    for p in (p for p in before if p.suffix == ".h5"):
+        assert p.read_bytes() == before[p], f"{p}: changed by a failed write"
+    again = _run(argv, tmp_path, realdata)
+    assert again.returncode in ((0, 1) if argv[0] == "fit" else (0,)), again.stderr
+    assert "Traceback" not in again.stderr
+    _check_left(tmp_path)
+
+
+@pytest.fixture
+def small_disk(tmp_path, request):
+    """A real file system of ``request.param`` (tmpfs, "16k"): writes past it fail with ENOSPC."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={request.param}", "tmpfs", str(disk)],
+                       check=False, capture_output=True, text=True)
+    if r.returncode:
+        pytest.skip(f"cannot mount a tmpfs here ({r.stderr.strip() or 'mount failed'}): the file-size-limit cases "
+                    "above cover the same writes")
+    yield disk
+    subprocess.run(["umount", "-l", str(disk)], check=False, capture_output=True)
+
+
+@pytest.mark.parametrize("case,small_disk", [("shot --export", "16k"), ("shot --out", "64k"), ("mc --out", "64k"),
+                                             ("import", "16k"), ("fit, the cache", "16k")], indirect=["small_disk"])
+def test_a_real_full_disk_is_one_line_and_the_command_succeeds_once_there_is_room(small_disk, realdata, case):
+    _, argv = CASES[case]
+    if argv[0] == "fit":
+        (small_disk / "points.csv").write_text(POINTS)
+    r = _run(argv, small_disk, realdata)
+    assert r.returncode == 2, r.stderr
+    line = _one_line(r.stderr)
+    assert line.startswith(f"rig {argv[0]}: error: {small_disk}") and line.endswith(": No space left on device"), line
+    _check_left(small_disk)
+    subprocess.run(["mount", "-o", "remount,size=64m", str(small_disk)], check=True)  # room made
+    again = _run(argv, small_disk, realdata)
+    assert again.returncode in ((0, 1) if argv[0] == "fit" else (0,)), again.stderr
+    _check_left(small_disk)
+
+
+@pytest.mark.parametrize("case,small_disk", [("shot --export", "1m"), ("mc --out", "1m"), ("shot --out", "1m")],
+                         indirect=["small_disk"])
+def test_a_read_only_disk_is_one_line(small_disk, realdata, case):
+    _, argv = CASES[case]
+    (small_disk / "study").mkdir()  # a folder that exists, on a disk that takes no write
+    subprocess.run(["mount", "-o", "remount,ro", str(small_disk)], check=True)
+    r = _run(argv, small_disk, realdata)
+    assert r.returncode == 2, r.stderr
+    line = _one_line(r.stderr)
+    assert line.startswith(f"rig {argv[0]}: error: {small_disk}") and "Read-only file system" in line, line
