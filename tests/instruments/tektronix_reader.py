@@ -40,6 +40,8 @@ tm.write_file(sys.argv[1], w)
 def _run(script: str, *args) -> str:
     python = os.environ.get("RIG_TMDT_PYTHON")
     if not python or not os.path.exists(python):
+        if os.environ.get("CI", "").lower() in ("1", "true", "yes"):
+            pytest.fail("RIG_TMDT_PYTHON names no interpreter (.ci/run makes one): CI must compare with tm_data_types")
         pytest.skip("set RIG_TMDT_PYTHON to an interpreter with tm_data_types (it pins numpy < 2): "
                     "python3 -m venv tmdt && tmdt/bin/pip install tm_data_types")
     run = subprocess.run([python, "-c", script, *map(str, args)], capture_output=True, text=True, timeout=300)

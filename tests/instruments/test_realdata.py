@@ -164,16 +164,6 @@ def test_tektronix_wfm_reads_as_codes_with_their_scaling(realdata):
     assert (w.codes.min(), w.codes.max()) == (-83, 99)  # a sine-like record, not a constant
 
 
-def test_tektronix_wfm_agrees_with_tektronix_own_reader(realdata):
-    # tm_data_types pins numpy < 2 and numba < 0.61, so it is no dependency: this cross-check
-    # runs where it is installed (pip install --no-deps tm_data_types bidict pydantic ...)
-    tm = pytest.importorskip("tm_data_types")
-    (w,) = read_waveforms(realdata / "tekpce_sample_1.wfm")
-    theirs = tm.read_file(str(realdata / "tekpce_sample_1.wfm"))
-    assert np.array_equal(np.asarray(theirs.y_axis_values), w.codes)
-    assert float(theirs.y_axis_spacing) == w.preamble.y_multiplier
-
-
 def test_tektronix_wfm_agrees_with_tektronix_own_reader_in_its_own_interpreter(realdata):
     path = realdata / "tekpce_sample_1.wfm"
     (w,) = read_waveforms(path)
