@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rig.errors import RigError, invalid
-from rig.units import quantity
+from rig.units import check_digits, number, quantity, whole
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -153,25 +153,25 @@ def _spec_for(parts):
 
 
 def _typed(value: str, spec, key):
+    """An override's text as its TOML value: a bool, a whole number, a number, or a
+    quantity's text (a plain number taken in the key's SI unit)."""
     if spec is bool:
         if value.lower() not in ("true", "false"):
             raise invalid(key, value, "true or false")
         return value.lower() == "true"
     if spec is int:
-        try:
-            return int(value)
-        except ValueError:
-            raise invalid(key, value, "a whole number") from None
+        return whole(value, key)
     if spec is float:
-        try:
-            return float(value)
-        except ValueError:
-            raise invalid(key, value, "a number") from None
+        return number(value, key)
     if isinstance(spec, str):  # a quantity: a plain number is in SI
+        check_digits(value, key)
         try:
-            return f"{float(value)!r} {spec}"
+            x = float(value)
         except ValueError:
-            return value
+            return value  # text with a unit, for quantity()
+        if not math.isfinite(x):
+            raise invalid(key, value, f"a finite number (plain number: {spec})")
+        return f"{x!r} {spec}"
     return value
 
 
