@@ -2,13 +2,15 @@
 from __future__ import annotations
 
 from rig.cli.common import check_size, missing_lines, progress_bar, writing_to
-from rig.errors import RigError
+from rig.errors import RigError, invalid
 
 
 def cmd_shot(args) -> dict:
     """Fire one virtual shot of a scene; print a summary or JSON; export scope files."""
     from rig.experiment.scene import load
 
+    if args.format is not None and not args.export:
+        raise invalid("--format", args.format, "needs --export DIR (the format of the scope files it writes)")
     scene = load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
     from pathlib import Path
 
@@ -27,7 +29,7 @@ def cmd_shot(args) -> dict:
         folder = Path(args.export)
         with writing_to(folder):
             folder.mkdir(parents=True, exist_ok=True)
-            paths = WRITERS[args.format](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
+            paths = WRITERS[args.format or "isf"](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
         out["exported"] = [str(p) for p in paths]
     if args.out:
         from instruments.archive import Archive
@@ -118,6 +120,9 @@ def cmd_animate(args) -> dict:
     from rig.viz.animate import check_output, require_renderer
 
     check_output(args.out)  # before anything is computed
+    still = args.out.lower().endswith(".png")
+    if still and args.frames is not None:
+        raise invalid("--frames", args.frames, f"a movie's (.mp4, .gif); {args.out} is one still")
     scene = load(args.scene, args.set or ())
     require_renderer(args.out)
     from rig.experiment.shot import Rig
@@ -125,10 +130,10 @@ def cmd_animate(args) -> dict:
 
     rig = Rig(scene)
     check_size(rig.estimate(), args, "this movie")
-    still = args.out.lower().endswith(".png")
-    with progress_bar(args.quiet or still, total=None if still else args.frames, desc="animate",
+    frames = 100 if args.frames is None else args.frames
+    with progress_bar(args.quiet or still, total=None if still else frames, desc="animate",
                       unit="frame") as bar:
-        out = animate(rig, args.out, frames=args.frames, exaggerate=args.exaggerate, seed=args.seed,
+        out = animate(rig, args.out, frames=frames, exaggerate=args.exaggerate, seed=args.seed,
                       progress=bar.update)
     if not args.json:
         print(f"wrote {out['out']}: {out['frames']} frame(s), displacements x {out['exaggerate']:.3g}, "

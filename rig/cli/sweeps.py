@@ -13,11 +13,15 @@ MAX_SWEEP_POINTS = 10_000  # more needs --allow-large (each point's shot is kept
 def cmd_sweep(args) -> dict:
     from rig.experiment.scene import load
 
+    if len(args.vary) > 1:
+        raise RigError(f"--vary given {len(args.vary)} times ({', '.join(v.split('=')[0] for v in args.vary)}): "
+                       "a sweep varies one key; run one sweep per key")
+
     scene = load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
     from rig.experiment.shot import Rig
     from rig.study.sweep import Vary, run_sweep
 
-    vary = Vary.parse(args.vary, None if args.allow_large else MAX_SWEEP_POINTS)
+    vary = Vary.parse(args.vary[0], None if args.allow_large else MAX_SWEEP_POINTS)
     n = len(vary.values)
     check_size(Rig(scene).estimate().times(n, n), args, f"this sweep of {n} points")  # every point is kept
     with progress_bar(args.quiet, total=len(vary.values), desc=f"sweep {vary.key}", unit="shot") as bar:

@@ -52,6 +52,8 @@ def cmd_bench(args) -> dict:
     import importlib
 
     module = importlib.import_module(f"rig.bench.{args.what}")
+    if args.quick and args.what not in ("solver", "accuracy", "models", "fit"):
+        raise RigError(f"--quick: only rig bench solver, accuracy, models and fit have a quick form (not {args.what})")
     if args.peers and args.what != "solver":
         raise RigError(f"--peers: only rig bench solver has peers (not {args.what})")
     if args.baseline and args.what not in ("solver", "mc"):
