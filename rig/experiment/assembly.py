@@ -27,6 +27,8 @@ class Assembly:
     """
 
     def __init__(self, scene: Scene, bead_masses=None, like: Assembly | None = None):
+        if not isinstance(scene, Scene):
+            raise invalid("scene", scene, "a Scene (rig.experiment.scene.load); Rig.from_scene takes a name or path")
         self.scene = scene
         self.bead_masses = None if bead_masses is None else [float(m) for m in bead_masses]
         self._build(like)
@@ -61,6 +63,11 @@ class Assembly:
                     raise RigError(f"gauges.{on[g.bead]} and gauges.{g.name} are both on bead {g.bead - first + 1} "
                                    f"(from the top): each gauge needs a bead of its own")
                 on[g.bead] = g.name
+            named = {g.name: g for g in self.gauges}
+            if "upper" in named and "lower" in named and named["upper"].bead > named["lower"].bead:
+                raise RigError(f"gauges.upper is on bead {named['upper'].bead - first + 1} and gauges.lower on bead "
+                               f"{named['lower'].bead - first + 1} (from the top): the upper gauge is the one the "
+                               "pulse reaches first; swap their beads")
         for g in self.gauges:
             beads[g.bead] = GaugeBead.like(beads[g.bead], mass=g.mass)
         self.striker = like.striker if shared("striker") else Striker(**v["striker"])
@@ -91,6 +98,8 @@ class Assembly:
         if not shared("gauges", "chain", "wall_sensor", "scope"):
             self._check_connections()
         self.solver = like.solver if shared("solver") else SolverSettings.from_table(v["solver"])
+        if not shared("scope", "solver"):
+            self._check_record()
 
     def _beads(self, table: dict) -> tuple:
         """(the chain's beads, 1 if the top one is the magnetic bead else 0)."""
@@ -156,6 +165,24 @@ class Assembly:
         if src not in used:
             raise invalid("scope.trigger.source", src,
                           f"triggers on an unconnected channel (connected: {', '.join(used) or 'none'})")
+
+    def _check_record(self):
+        """Scope settings that can give no record of this solve, refused before it runs."""
+        tb, tr, s = self.scope.timebase, self.scope.trigger, self.solver
+        span = tb.record_length * tb.sample_interval
+        after = (1 - tr.pre_trigger) * span
+        settings = (f"scope.record_length = {tb.record_length} x scope.sample_interval = {tb.sample_interval:g} s, "
+                    f"{1 - tr.pre_trigger:.0%} after the trigger")
+        if after > s.duration:
+            raise RigError(f"the scope records {after:.4g} s after its trigger ({settings}), longer than the "
+                           f"simulated solver.duration = {s.duration:g} s: lengthen solver.duration or shorten "
+                           "the record")
+        if span < 2 * s.sample_interval:
+            raise RigError(f"the scope record spans {span:.4g} s ({settings}), less than two samples of its input "
+                           f"(solver.sample_interval = {s.sample_interval:g} s): a longer scope.sample_interval")
+        if tr.slope == "rising" and tr.level <= 0:
+            raise invalid("scope.trigger.level", f"{tr.level:g} V", "a rising trigger needs a level above the "
+                                                                   "gauges' rest at 0 V, e.g. '30 mV'")
 
     def wiring(self) -> dict:
         """{scope channel: what is connected to it ("gauges.NAME" or "wall_sensor")}."""

@@ -10,6 +10,7 @@ is taken in the key's SI unit (m/s here).
 from __future__ import annotations
 
 import math
+import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,6 +53,8 @@ PUBLISHED_SCENES = Path(__file__).resolve().parent.parent / "scenes"  # package 
 
 def find_scene(name_or_path) -> Path:
     """A path to a .toml file, or the name of a published scene (rig/scenes/, e.g. ptfe52_magnetic)."""
+    if not isinstance(name_or_path, (str, os.PathLike)) or not str(name_or_path).strip():
+        raise invalid("scene", name_or_path, "a scene file's path or a published scene's name, e.g. ptfe52_magnetic")
     p = Path(name_or_path)
     if p.is_file():
         return p
@@ -98,7 +101,12 @@ def read_raw(name_or_path) -> tuple:
 def load(name_or_path, overrides=()) -> Scene:
     """Parse, override and validate a scene file (a path, or a published scene's name)."""
     text, raw = read_raw(name_or_path)
+    allowed = 'a list of "key=value" texts, e.g. ["striker.velocity=1.2 m/s"]'
+    if isinstance(overrides, (str, bytes)) or not hasattr(overrides, "__iter__"):
+        raise invalid("overrides", overrides, allowed)
     overrides = tuple(overrides)
+    if not all(isinstance(item, str) for item in overrides):
+        raise invalid("overrides", overrides, allowed)
     for item in overrides:
         apply_override(raw, item)
     values = convert(raw)

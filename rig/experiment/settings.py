@@ -45,6 +45,9 @@ class SolverSettings:
         d = self.duration
         if d is None or not (isinstance(d, (int, float)) and math.isfinite(d) and d > 0):
             raise invalid("solver.duration", d, "simulated time > 0 s, e.g. '4 ms'")
+        h = self.sample_interval
+        if isinstance(h, (int, float)) and h > 0 and not h < d:
+            raise invalid("solver.sample_interval", f"{h:g} s", f"shorter than solver.duration = {d:g} s")
         if self.accuracy is not None:
             checked_accuracy(self.accuracy, "solver.accuracy")
 

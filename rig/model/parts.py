@@ -132,6 +132,9 @@ class GaugeBead(Bead):
         return cls(bead.material, bead.diameter, caps_mass=mass - PZT_PLATE_MASS)
 
 
+MIN_STRIKER_VELOCITY = 1e-6  # m/s: at 1e-9 the energy error was 3.6e4 kinetic energies; 1e-300 squared to 0 J
+
+
 @dataclass(frozen=True)
 class Striker(_Part):
     """A cylinder dropped flat face first on the top bead with ``velocity`` (m/s, > 0).
@@ -149,6 +152,10 @@ class Striker(_Part):
     def __post_init__(self):
         self._convert("striker")
         self._positive("striker", "mass", "velocity", "diameter")
+        if self.velocity < MIN_STRIKER_VELOCITY:
+            raise invalid("striker.velocity", f"{self.velocity:g} m/s",
+                          f"at least {MIN_STRIKER_VELOCITY:g} m/s: slower, the striker's kinetic energy drowns in the "
+                          "rounding of the chain's static energy")
         if not self.gap >= 0:
             raise invalid("striker.gap", self.gap,
                           "the striker would overlap the top bead; allowed: gap >= 0 m")
