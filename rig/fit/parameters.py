@@ -34,7 +34,10 @@ def parse_parameter(text: str) -> FitParameter:
     if "=" not in text:
         raise invalid("--param", text, "needs bounds: KEY=LO:HI, e.g. chain.youngs_modulus=0.4 GPa:2 GPa")
     key, bounds = (s.strip() for s in text.split("=", 1))
-    spec = key_spec(key)
+    try:
+        spec = key_spec(key)
+    except RigError as exc:
+        raise RigError(f"--param {exc}") from None
     if spec is float:
         unit = "1"
     elif isinstance(spec, str):
