@@ -17,6 +17,7 @@ from rig.model.materials import Material, material
 from rig.model.parts import Bead, GaugeBead, MagneticBead, Striker, Wall
 
 REQUIRED_TABLES = ("chain", "striker", "holder", "wall", "scope", "solver")
+MAX_BEADS = 10_000_000  # a list of 1e9 beads is 8 GB before the tube's length could refuse it
 
 
 SCENE_NAMES = {"E": "youngs_modulus", "nu": "poisson_ratio"}
@@ -135,8 +136,8 @@ class Assembly:
         """(the chain's beads, 1 if the top one is the magnetic bead else 0)."""
         c = dict(table)
         n = c.pop("beads", None)
-        if not isinstance(n, int) or n < 1:
-            raise invalid("chain.beads", n, "a whole number of beads >= 1")
+        if not isinstance(n, int) or not 1 <= n <= MAX_BEADS:
+            raise invalid("chain.beads", n, f"a whole number of beads from 1 to {MAX_BEADS:,}")
         first = 1 if c.pop("magnetic_bead", False) else 0
         with scene_key("chain"):
             mat = material(c.get("material"))
