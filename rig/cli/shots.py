@@ -120,9 +120,6 @@ def cmd_animate(args) -> dict:
     from rig.viz.animate import check_output, require_renderer
 
     check_output(args.out)  # before anything is computed
-    still = args.out.lower().endswith(".png")
-    if still and args.frames is not None:
-        raise invalid("--frames", args.frames, f"a movie's (.mp4, .gif); {args.out} is one still")
     scene = load(args.scene, args.set or ())
     require_renderer(args.out)
     from rig.experiment.shot import Rig
@@ -130,10 +127,10 @@ def cmd_animate(args) -> dict:
 
     rig = Rig(scene)
     check_size(rig.estimate(), args, "this movie")
-    frames = 100 if args.frames is None else args.frames
-    with progress_bar(args.quiet or still, total=None if still else frames, desc="animate",
+    still = args.out.lower().endswith(".png")
+    with progress_bar(args.quiet or still, total=None if still else args.frames, desc="animate",
                       unit="frame") as bar:
-        out = animate(rig, args.out, frames=frames, exaggerate=args.exaggerate, seed=args.seed,
+        out = animate(rig, args.out, frames=args.frames, exaggerate=args.exaggerate, seed=args.seed,
                       progress=bar.update)
     if not args.json:
         print(f"wrote {out['out']}: {out['frames']} frame(s), displacements x {out['exaggerate']:.3g}, "

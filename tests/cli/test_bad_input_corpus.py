@@ -154,7 +154,6 @@ def _flag_cases():
         (["bench", "shot", "--peers"], "--peers"),
         (["bench", "fit", "--baseline", "HEAD"], "--baseline"),
         (["bench", "models", "--rounds", "2"], "--rounds"),
-        (["animate", S, "--out", "{d}/still.png", "--frames", "10"], "--frames"),
         (["analyze", "x.isf", "--shot", "1"], "--shot"),
         (["analyze", "x.isf", "--shot", "-1"], "--shot"),
         (["analyze", "x.isf", "--shot", "1,0"], "--shot"),
