@@ -126,6 +126,7 @@ def cmd_animate(args) -> dict:
     from rig.viz.animate import animate
 
     rig = Rig(scene)
+    rig.check_record()  # the movie's traces are the shot's scope record
     check_size(rig.estimate(), args, "this movie")
     still = args.out.lower().endswith(".png")
     with progress_bar(args.quiet or still, total=None if still else args.frames, desc="animate",

@@ -129,8 +129,6 @@ class Assembly:
             self._check_connections()
         with scene_key("solver"):
             self.solver = like.solver if shared("solver") else SolverSettings.from_table(v["solver"])
-        if not shared("scope", "solver"):
-            self._check_record()
 
     def _beads(self, table: dict) -> tuple:
         """(the chain's beads, 1 if the top one is the magnetic bead else 0)."""
@@ -207,8 +205,10 @@ class Assembly:
             raise invalid("scope.trigger.source", src,
                           f"triggers on an unconnected channel (connected: {', '.join(used) or 'none'})")
 
-    def _check_record(self):
-        """Scope settings that can give no record of this solve, refused before it runs."""
+    def check_record(self):
+        """Refuse scope settings that can give no record of this rig's solve (RigError naming
+        them), before it runs: a shot fires only after this (a fit's windowed solves, which
+        read no scope, do not ask)."""
         tb, tr, s = self.scope.timebase, self.scope.trigger, self.solver
         span = tb.record_length * tb.sample_interval
         after = (1 - tr.pre_trigger) * span

@@ -143,6 +143,7 @@ class Rig(Assembly):
             seed = fresh_seed()
         if not isinstance(seed, (int, np.integer)) or seed < 0:
             raise invalid("seed", seed, "a whole number >= 0")
+        self.check_record()
         rng = np.random.default_rng(int(seed))
         forces = self.truth()
         h = forces.sample_interval

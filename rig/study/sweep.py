@@ -110,6 +110,7 @@ def run_sweep(scene, vary: Vary, overrides=(), seed: int = 0, progress=None, arc
     for v in vary.values:  # assemble (validate) every point before firing any
         try:
             rigs.append(Rig.from_scene(scene, list(overrides) + [vary.override(v)]))
+            rigs[-1].check_record()
         except ValueError as exc:
             raise RigError(f"--vary {vary.key} = {v:g}: {exc}") from None
     points, entries = [], []
