@@ -4,6 +4,7 @@ twice, a trigger on a connected channel)."""
 from __future__ import annotations
 
 import contextlib
+import math
 
 from instruments.errors import InstrumentError
 from instruments.gauges import GaugeSettings
@@ -36,7 +37,8 @@ def scene_key(table: str, prefix: str = ""):
         if not sep or " " in field or field.startswith(f"{table}."):  # not that form, or named already
             raise
         name = field.split(".")[-1].split("[")[0]
-        raise type(exc)(f"{table}.{prefix}{SCENE_NAMES.get(name, name)} = {rest}") from None
+        key = table if name == table.split(".")[-1] else f"{table}.{prefix}{SCENE_NAMES.get(name, name)}"
+        raise type(exc)(f"{key} = {rest}") from None
 
 
 class Assembly:
@@ -221,6 +223,11 @@ class Assembly:
         if span < 2 * s.sample_interval:
             raise RigError(f"the scope record spans {span:.4g} s ({settings}), less than two samples of its input "
                            f"(solver.sample_interval = {s.sample_interval:g} s): a longer scope.sample_interval")
+        st, g = self.striker, self.holder.gravity
+        if st.gap >= st.velocity * s.duration + 0.5 * g * s.duration**2:  # no impact within the solve
+            reach = st.gap / st.velocity if g == 0 else (math.sqrt(st.velocity**2 + 2 * g * st.gap) - st.velocity) / g
+            raise RigError(f"striker.gap = {st.gap:g} m at striker.velocity = {st.velocity:g} m/s: the striker "
+                           f"reaches the top bead after {reach:.4g} s, not within solver.duration = {s.duration:g} s")
         if tr.slope == "rising" and tr.level <= 0:
             raise invalid("scope.trigger.level", f"{tr.level:g} V", "a rising trigger needs a level above the "
                                                                    "gauges' rest at 0 V, e.g. '30 mV'")

@@ -148,6 +148,7 @@ def _flag_cases():
         (["mc", S, "--shots", "8", "--vary", VEL, "--worker-timeout", "5", "--out", out], "--worker-timeout"),
         (["mc", S, "--shots", "8", "--vary", VEL, "--workers", "2", "--scheduler", "tcp://127.0.0.1:1", "--out", out],
          "--workers"),
+        (["import", "a.isf", "--together", "--into", "a.h5"], "--together"),
         (["bench", "shot", "--quick"], "--quick"),
         (["bench", "archive", "--quick"], "--quick"),
         (["bench", "startup", "--quick"], "--quick"),

@@ -74,6 +74,10 @@ def test_a_sweep_of_a_gauge_bead_fires_each_point_and_says_why_a_point_has_no_fi
                                     "of its input (solver.sample_interval = 1e-07 s)"),
     ("solver.sample_interval=1 s", "solver.sample_interval = '1 s': shorter than solver.duration = 0.003 s"),
     ("striker.velocity=1e-300 m/s", "striker.velocity = '1e-300 m/s': at least 1e-06 m/s"),
+    # had exited 0 with "no rising crossing of 0.03 V on CH1 in 0.003 s": the striker falls 1 m first
+    ("striker.gap=1 m", "striker.gap = 1 m at striker.velocity = 0.89 m/s: the striker reaches the top bead after "
+                        "0.3699 s, not within solver.duration = 0.003 s"),
+    ("magnet.position=1 m", "magnet = ['force', 'position']: give exactly one of force, position, schedule"),
 ])
 def test_a_setting_that_can_give_no_record_names_itself_before_anything_is_solved(capsys, monkeypatch, item, line):
     import rig.solver.control
