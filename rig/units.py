@@ -79,6 +79,18 @@ def whole(text, field: str, allowed: str = "a whole number") -> int:
     return int(value)
 
 
+def typed_quantity(text: str, unit: str | None, field: str) -> float:
+    """A value as typed on the command line: a plain number is taken in ``unit`` (SI), text
+    with a unit is converted to it; ``unit`` None: a plain number only."""
+    check_digits(text, field)
+    try:
+        float(text)
+    except ValueError:
+        if unit is not None:
+            return quantity(text, unit, field)
+    return number(text, field, "a finite number" + (f" (plain number: {unit})" if unit else ""))
+
+
 def quantity(value, unit: str, field: str, *, bare_ok: bool = False) -> float:
     """Return ``value`` expressed in ``unit`` (an SI unit such as "m", "kg", "Pa").
 
@@ -169,4 +181,4 @@ def _parse(text: str, unit: str, field: str) -> float:
     return float(f"{si:.15g}")
 
 
-__all__ = ["RigError", "number", "quantity", "whole"]
+__all__ = ["RigError", "number", "quantity", "typed_quantity", "whole"]

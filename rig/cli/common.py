@@ -47,26 +47,15 @@ def seed_arg(text: str) -> int:
     return whole_number(text, 0, MAX_SEED, f"a whole number from 0 to {MAX_SEED}")
 
 
-def quantity_arg(text: str, unit: str, field: str) -> float:
-    """A command-line quantity: a plain number is taken in ``unit``; else text with a unit."""
-    from rig.units import check_digits, number, quantity
-
-    check_digits(text, field)
-    try:
-        float(text)
-    except ValueError:
-        return quantity(text, unit, field)
-    return number(text, field, f"a finite number (plain number: {unit})")
-
-
 def quantity_type(unit: str, field: str):
     """An argparse type for a quantity in ``unit`` (a plain number is taken in ``unit``);
     a mistake is reported as the field, the value and what is allowed."""
     def parse(text: str) -> float:
         from rig.errors import RigError
+        from rig.units import typed_quantity
 
         try:
-            return quantity_arg(text, unit, field)
+            return typed_quantity(text, unit, field)
         except RigError as exc:
             raise refusal(exc, field) from None
 

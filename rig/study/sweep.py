@@ -15,7 +15,7 @@ from rig.experiment.entry import shot_entry
 from rig.experiment.measure import shot_blocks
 from rig.experiment.scene import schema_node
 from rig.experiment.shot import Rig, ShotRecord
-from rig.units import check_digits, number, quantity, whole
+from rig.units import typed_quantity, whole
 
 
 @dataclass(frozen=True)
@@ -37,7 +37,7 @@ class Vary:
         if len(parts) != 3:
             raise invalid("--vary", text, "expected KEY=START:STOP:COUNT")
         unit = _unit_of(key)
-        start, stop = (_number(p, unit, key) for p in parts[:2])
+        start, stop = (typed_quantity(p, unit, f"--vary {key}") for p in parts[:2])
         count = whole(parts[2], f"--vary {key} COUNT", "a whole number >= 1")
         if count < 1:
             raise invalid(f"--vary {key} COUNT", count, "a whole number >= 1")
@@ -76,18 +76,6 @@ def _unit_of(key: str):
     if not isinstance(node, str):
         raise invalid("--vary", key, "only numeric keys can be swept")
     return node
-
-
-def _number(text: str, unit, key) -> float:
-    """START or STOP: a plain number (in the key's SI unit), or a quantity with its unit."""
-    field = f"--vary {key}"
-    check_digits(text, field)
-    try:
-        float(text)
-    except ValueError:
-        if unit is not None:
-            return quantity(text, unit, field)
-    return number(text, field)
 
 
 @dataclass(frozen=True, eq=False)
