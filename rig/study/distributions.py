@@ -81,7 +81,7 @@ class Distribution:
         kind = m.group(1).lower()
         args = [x.strip() for x in m.group(2).split(",")]
         if len(args) != _ARITY[kind] or not all(args):
-            if len(args) > _ARITY[kind]:  # "normal(0,89 m/s, 0,01 m/s)": commas inside numbers
+            if len(re.split(r",\s+", m.group(2))) == _ARITY[kind]:  # "normal(0,89 m/s, 0,01 m/s)"
                 check_digits(text, f"--vary {key}")
             raise invalid(f"--vary {key}", text, f"{kind} takes {_ARITY[kind]} arguments, none of them empty")
         unit = key_unit(key)

@@ -94,3 +94,16 @@ def test_a_late_trigger_names_its_channel_and_the_duration(capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith("rig shot: error: the scope triggered late, on CH1 (gauges.upper, scope.trigger.level = "
                           "0.03 V): scope record ends ") and "lengthen solver.duration = 0.003 s" in err
+
+
+@pytest.mark.parametrize("text,why", [
+    ("striker.velocity=normal(0,89 m/s, 0,01 m/s)", "use a decimal point"),  # commas inside both numbers
+    ("gauges.upper.gain=lognormal(1, 0,6)", "use a decimal point"),
+    ("striker.velocity=normal(0.89,0.01,1)", "normal takes 2 arguments"),  # a third argument, not a comma
+])
+def test_a_distribution_tells_a_decimal_comma_from_a_wrong_count_of_arguments(text, why):
+    from rig.study.distributions import parse_vary
+
+    with pytest.raises(RigError, match=why):
+        parse_vary([text])
+    assert parse_vary(["gauges.upper.gain=lognormal(1,0.6)"])[0].params == (1.0, 0.6)  # commas without spaces
