@@ -314,3 +314,16 @@ def test_a_wrong_argument_to_the_api_raises_one_line(case):
         call()
     message = str(exc.value)
     assert "\n" not in message and needle in message, message
+
+
+@pytest.mark.parametrize("name,defect", [
+    ("one_point.isf", "NR_PT = 1: a record needs at least 2 points"),  # had been "another time base than ..."
+    ("ymult_zero.isf", "YMULT = 0.0: the volts per code must be a finite number other than 0"),
+    ("ymult_nan.isf", "YMULT = nan"),
+])
+def test_a_record_without_a_time_base_or_a_scale_names_the_header_field(tmp_path, capsys, name, defect):
+    path = tmp_path / name
+    path.write_bytes(SCOPE_FILES[name])
+    assert _run(["analyze", str(path), "--gauge-distance", "43 mm"], tmp_path) == 2
+    line = _line(capsys)
+    assert str(path) in line and defect in line, line
