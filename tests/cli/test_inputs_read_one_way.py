@@ -107,3 +107,14 @@ def test_a_distribution_tells_a_decimal_comma_from_a_wrong_count_of_arguments(te
     with pytest.raises(RigError, match=why):
         parse_vary([text])
     assert parse_vary(["gauges.upper.gain=lognormal(1,0.6)"])[0].params == (1.0, 0.6)  # commas without spaces
+
+
+def test_a_record_shorter_than_the_pulse_between_the_gauges_says_so(capsys):
+    # 12500 samples of 0.1 ns span 1.25 us; the pulse takes about 187 us from bead 20 to bead 29 (had said
+    # "no pulse stands 8 times above the pre-trigger noise", which never named the setting)
+    assert main(["shot", S, "--seed", "1", "--set", "scope.sample_interval=1e-10", "--json"]) == 0
+    measured = json.loads(capsys.readouterr().out)["measured"]
+    assert measured["speed_m_per_s"] is None and measured["reasons"]
+    for why in measured["reasons"].values():
+        assert why.startswith("the scope record spans 1.25e-06 s (scope.record_length = 12500 x "
+                              "scope.sample_interval = 1e-10 s), shorter than the pulse's 0.000187 s")
