@@ -37,6 +37,60 @@ def is_whole(x) -> bool:
     return isinstance(x, numbers.Integral) and not isinstance(x, bool)
 
 
+_DECIMAL_COMMA = re.compile(r"\d,\d")
+_GROUPED = re.compile(r"\d(?:[_'’\u00a0\u202f]|\s+)\d")  # 1_000, 1'000, 1 000
+
+
+def check_digits(text: str, field: str):
+    """Refuse a decimal comma ("1,2") or a thousands separator ("1 000", "1_000", "1'000")
+    in the text of a number or a quantity, naming ``field``: Python and pint would read
+    "1,2" as 12 and "1 200" as 1 x 200."""
+    if _DECIMAL_COMMA.search(text):
+        raise invalid(field, text, "use a decimal point and no thousands separator (1.2, 1200)")
+    if _GROUPED.search(text):
+        raise invalid(field, text, "one number, no thousands separator (1200)")
+
+
+def number(text, field: str, allowed: str = "a finite number") -> float:
+    """The plain number ``text`` (no unit) as a float: a decimal point, no thousands
+    separator, finite; else RigError ``field = text: allowed``."""
+    if is_real(text):
+        value = float(text)
+    elif isinstance(text, str):
+        check_digits(text, field)
+        try:
+            value = float(text)
+        except ValueError:
+            raise invalid(field, text, allowed) from None
+    else:
+        raise invalid(field, text, allowed)
+    if not math.isfinite(value):
+        raise invalid(field, text, allowed)
+    return value
+
+
+def whole(text, field: str, allowed: str = "a whole number") -> int:
+    """The whole number ``text`` ("30", "30.0" or "3e1" is 30; "2.5" is refused)."""
+    if is_whole(text):
+        return int(text)
+    value = number(text, field, allowed)
+    if value != int(value):
+        raise invalid(field, text, allowed)
+    return int(value)
+
+
+def typed_quantity(text: str, unit: str | None, field: str) -> float:
+    """A value as typed on the command line: a plain number is taken in ``unit`` (SI), text
+    with a unit is converted to it; ``unit`` None: a plain number only."""
+    check_digits(text, field)
+    try:
+        float(text)
+    except ValueError:
+        if unit is not None:
+            return quantity(text, unit, field)
+    return number(text, field, "a finite number" + (f" (plain number: {unit})" if unit else ""))
+
+
 def quantity(value, unit: str, field: str, *, bare_ok: bool = False) -> float:
     """Return ``value`` expressed in ``unit`` (an SI unit such as "m", "kg", "Pa").
 
@@ -106,6 +160,7 @@ def _fast(text: str, unit: str):
 
 
 def _parse(text: str, unit: str, field: str) -> float:
+    check_digits(text, field)
     fast = _fast(text, unit)
     if fast is not None:
         return fast
@@ -126,4 +181,4 @@ def _parse(text: str, unit: str, field: str) -> float:
     return float(f"{si:.15g}")
 
 
-__all__ = ["RigError", "quantity"]
+__all__ = ["RigError", "number", "quantity", "typed_quantity", "whole"]

@@ -137,6 +137,8 @@ def _read_curve(data: bytes, at: int, header: dict, path):
     start = at + 1 + n
     nbytes = _number(header, "BYT_NR", path, int)
     points = _number(header, "NR_PT", path, int)
+    if points < 2:
+        raise InstrumentError(f"{path}: NR_PT = {points}: a record needs at least 2 points (one has no time base)")
     if nbytes not in (1, 2):
         raise InstrumentError(f"{path}: BYT_NR = {nbytes}: only 1 or 2 bytes per point are defined")
     if count != points * nbytes:
@@ -156,6 +158,9 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
     if not (np.isfinite(dx) and dx > 0):
         raise InstrumentError(f"{path}: XINCR = {dx!r}: the sample interval must be a finite number > 0 s")
     x_unit = time_axis(path, "XUNIT", h.get("XUNIT", "s"))
+    ymult = _number(h, "YMULT", path)
+    if not (np.isfinite(ymult) and ymult != 0):
+        raise InstrumentError(f"{path}: YMULT = {ymult!r}: the volts per code must be a finite number other than 0")
     x0 = _number(h, "XZERO", path)
     pt_off = _number(h, "PT_OFF", path, int) if "PT_OFF" in h else 0
     first = x0 - dx * pt_off  # t = XZERO + XINCR (n - PT_OFF)
@@ -169,7 +174,7 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
         name = f"{name}#{index + 1}"
     name = channel_name(name)
     pre = Preamble(points=codes.size, x_increment=dx, x_zero=first, trigger_index=trigger,
-                   y_multiplier=_number(h, "YMULT", path), y_offset=_number(h, "YOFF", path),
+                   y_multiplier=ymult, y_offset=_number(h, "YOFF", path),
                    y_zero=_number(h, "YZERO", path), byte_count=codes.dtype.itemsize,
                    x_unit=x_unit, y_unit=h.get("YUNIT", "V"), waveform_id=wfid,
                    point_format="ENV" if envelope else "Y",

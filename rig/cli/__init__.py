@@ -18,6 +18,7 @@ from rig.cli.common import (
     count_arg,
     fraction_arg,
     os_error_line,
+    plain,
     positive_seconds,
     quantity_type,
     rounds_arg,
@@ -51,7 +52,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="override a scene key, e.g. striker.velocity=1.2 (plain numbers in SI)")
     sh.add_argument("--seed", type=seed_arg, help="seed of every random draw (default: a fresh one, printed)")
     sh.add_argument("--export", metavar="DIR", help="write the scope records to DIR")
-    sh.add_argument("--format", choices=["isf", "csv"], default="isf", help="scope file format (default isf)")
+    sh.add_argument("--format", choices=["isf", "csv"], help="with --export: scope file format (default isf)")
     sh.add_argument("--out", metavar="ARCHIVE.h5", help="append the shot to an HDF5 archive")
     allow_large(sh)
 
@@ -68,8 +69,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     sw = _command(sub, "sweep", "one shot per value of a scene key", sweeps.cmd_sweep)
     sw.add_argument("scene")
-    sw.add_argument("--vary", required=True, metavar="KEY=START:STOP:COUNT",
-                    help="e.g. striker.velocity=0.3:1.5:7 (plain numbers in the key's SI unit)")
+    sw.add_argument("--vary", required=True, action="append", metavar="KEY=START:STOP:COUNT",
+                    help="the one key to sweep, e.g. striker.velocity=0.3:1.5:7 (plain numbers in the key's SI unit)")
     sw.add_argument("--set", action="append", metavar="KEY=VALUE", help="other overrides")
     sw.add_argument("--seed", type=seed_arg, default=0, help="the sweep's seed (default 0)")
     sw.add_argument("--out", metavar="ARCHIVE.h5", help="append every shot to an archive")
@@ -81,8 +82,9 @@ def build_parser() -> argparse.ArgumentParser:
     an.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene key")
     an.add_argument("--seed", type=seed_arg, help="seed of the instruments' draws (default: a fresh one, printed)")
     an.add_argument("--out", required=True, metavar="FILE", help="FILE.mp4, FILE.gif or FILE.png (one still)")
-    an.add_argument("--frames", type=int, default=100, help="frames over the scene's duration (default 100)")
-    an.add_argument("--exaggerate", type=float,
+    an.add_argument("--frames", type=plain(int), default=100,
+                    help="frames over the scene's duration (default 100)")
+    an.add_argument("--exaggerate", type=plain(float),
                     help="displacement factor (default: the largest displacement shown as 1/3 diameter)")
     an.add_argument("--quiet", action="store_true", help="no progress bar")
     allow_large(an)
@@ -101,7 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
                          "(a dimensionless key: plain numbers, e.g. chain.contact_exponent=1.2:2.4)")
     fi.add_argument("--records", nargs="+", metavar="FILE", help="one shot's scope files (ISF, CSV, WFM)")
     fi.add_argument("--archive", metavar="A.h5", help="an archive: every shot (or --shot N)")
-    fi.add_argument("--shot", type=int, help="with --archive: one shot")
+    fi.add_argument("--shot", type=count_arg, help="with --archive: one shot")
     fi.add_argument("--points", metavar="TABLE.csv",
                     help="measured points: columns 'F_d [N]', 'F_d_sd [N]', 'V_s [m/s]', 'V_s_sd [m/s]' "
                          "and scene keys per row, e.g. 'magnet.force [N]'")
@@ -113,7 +115,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="then sample the posterior by MCMC for STEPS steps (needs the extra: "
                          "pip install 'sonic-rig[posterior]'); resumes in DIR/posterior.h5")
     fi.add_argument("--walkers", type=count_arg, help="with --posterior: walkers (default 4 per parameter, at least 8)")
-    fi.add_argument("--seed", type=seed_arg, default=0, help="with --posterior: the walkers' seed (default 0)")
+    fi.add_argument("--seed", type=seed_arg, help="with --posterior: the walkers' seed (default 0)")
     fi.add_argument("--quiet", action="store_true", help="no progress lines")
 
     mc = _command(sub, "mc", "Monte Carlo study over many virtual shots", study.cmd_mc)
@@ -126,8 +128,9 @@ def build_parser() -> argparse.ArgumentParser:
     mc.add_argument("--seed", type=seed_arg, default=0, help="the study's seed (default 0)")
     mc.add_argument("--batch", type=count_arg, help="shots per batch (default 256; resuming a study in --out: "
                                                     "its own)")
-    mc.add_argument("--accuracy", type=float, help="solver accuracy (default: the scene's)")
-    mc.add_argument("--workers", type=count_arg, default=1, help="local worker processes (default 1)")
+    mc.add_argument("--accuracy", type=plain(float), help="solver accuracy (default: the scene's)")
+    mc.add_argument("--workers", type=count_arg,
+                    help="local worker processes, or with --scheduler local the cluster's (default 1)")
     mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")
     mc.add_argument("--sobol", action="store_true", help="Sobol design and indices (needs SALib)")
     mc.add_argument("--truth", action="store_true", help="also analyse each shot's noise-free truth (slower)")
@@ -140,7 +143,7 @@ def build_parser() -> argparse.ArgumentParser:
     mc.add_argument("--quiet", action="store_true", help="no progress bar")
     mc.add_argument("--max-failed", type=fraction_arg, default=0.05, metavar="PERCENT",
                     help="fail the study (exit 1) when more shots than this fail (default 5%%)")
-    mc.add_argument("--worker-timeout", type=positive_seconds, default=300.0, metavar="SECONDS",
+    mc.add_argument("--worker-timeout", type=positive_seconds, metavar="SECONDS",
                     help="with --scheduler: stop when no Dask worker is alive for this long (default 300)")
     allow_large(mc)
 
@@ -148,7 +151,7 @@ def build_parser() -> argparse.ArgumentParser:
                                   "and why any figure is missing (exit 1 when no source gives a speed)",
                   data.cmd_analyze)
     an.add_argument("files", nargs="+", metavar="FILE", help=".isf, .csv, .wfm (Tektronix) or .h5 (an archive)")
-    an.add_argument("--shot", type=int,
+    an.add_argument("--shot", type=plain(int),
                     help="one shot of an archive, by its number (shots are numbered from 1; default: every shot)")
     an.add_argument("--gauge-distance", type=quantity_type("m", "--gauge-distance"),
                     help="distance between the two gauges (plain number: m), for real files")
@@ -157,7 +160,8 @@ def build_parser() -> argparse.ArgumentParser:
     an.add_argument("--sensitivity", type=quantity_type("V/N", "--sensitivity"),
                     help="gauge sensitivity, e.g. '0.05 V/N' (plain number: V/N; default 1: volts)")
     an.add_argument("--tau", type=quantity_type("s", "--tau"), help="gauge RC time constant to invert (s)")
-    an.add_argument("--beta", type=float, default=1.0, help="beta = F_d / F_m,e, dimensionless, > 0 (default 1)")
+    an.add_argument("--beta", type=plain(float), default=1.0,
+                    help="beta = F_d / F_m,e, dimensionless, > 0 (default 1)")
     an.add_argument("--f0", type=quantity_type("N", "--f0"), default=0.0, help="precompression F_0 (N)")
     an.add_argument("--diameter", type=quantity_type("m", "--diameter"), default=4.76e-3,
                     help="bead diameter (plain number: m; default 4.76 mm)")
@@ -171,7 +175,7 @@ def build_parser() -> argparse.ArgumentParser:
     be.add_argument("what", choices=["solver", "accuracy", "models", "fit", "shot", "archive", "pipeline", "mc",
                                      "animate", "startup"],
                     help="what to benchmark")
-    be.add_argument("--quick", action="store_true", help="fewer settings, one repeat")
+    be.add_argument("--quick", action="store_true", help="solver, accuracy, models, fit: fewer settings, one repeat")
     be.add_argument("--peers", action="store_true",
                     help="solver: also scipy's DOP853, a numba-compiled DOP853 and LAMMPS (when installed)")
     be.add_argument("--baseline", metavar="REV",

@@ -23,13 +23,23 @@ class OneLineParser(argparse.ArgumentParser):
 def whole_number(text: str, low: int, high: float, allowed: str) -> int:
     """The command-line whole number ``text`` in [low, high]; else argparse's refusal
     ``'TEXT': allowed``."""
+    from rig.errors import RigError
+    from rig.units import whole
+
     try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: {allowed}") from None
+        value = whole(text, "value", allowed)
+    except RigError as exc:
+        raise refusal(exc, "value") from None
     if not low <= value <= high:
         raise argparse.ArgumentTypeError(f"{text!r}: {allowed}")
     return value
+
+
+def refusal(exc, field: str, text: str | None = None) -> argparse.ArgumentTypeError:
+    """argparse's refusal of an option's value from a RigError ``field = value: why``: the
+    option's name is argparse's to print; ``text`` (if given) is the value as typed."""
+    why = str(exc).removeprefix(f"{field} = ")
+    return argparse.ArgumentTypeError(why if text is None else f"{text!r}: {why.split(': ', 1)[-1]}")
 
 
 def seed_arg(text: str) -> int:
@@ -37,30 +47,17 @@ def seed_arg(text: str) -> int:
     return whole_number(text, 0, MAX_SEED, f"a whole number from 0 to {MAX_SEED}")
 
 
-def quantity_arg(text: str, unit: str, field: str) -> float:
-    """A command-line quantity: a plain number is taken in ``unit``; else text with a unit."""
-    from rig.errors import invalid
-    from rig.units import quantity
-
-    try:
-        value = float(text)
-    except ValueError:
-        value = quantity(text, unit, field)
-    if not math.isfinite(value):
-        raise invalid(field, text, f"a finite number (plain number: {unit})")
-    return value
-
-
 def quantity_type(unit: str, field: str):
     """An argparse type for a quantity in ``unit`` (a plain number is taken in ``unit``);
     a mistake is reported as the field, the value and what is allowed."""
     def parse(text: str) -> float:
         from rig.errors import RigError
+        from rig.units import typed_quantity
 
         try:
-            return quantity_arg(text, unit, field)
+            return typed_quantity(text, unit, field)
         except RigError as exc:
-            raise argparse.ArgumentTypeError(str(exc).removeprefix(f"{field} = ")) from None
+            raise refusal(exc, field) from None
 
     parse.__name__ = f"quantity in {unit}"
     return parse
@@ -97,22 +94,47 @@ def allow_large(parser):
 
 def fraction_arg(text: str) -> float:
     """A share: '5%' or 0.05, from 0 to 1 (100%)."""
+    from rig.errors import RigError
+    from rig.units import number
+
+    allowed = "a share from 0% to 100%, e.g. 5% or 0.05"
     try:
-        value = float(text[:-1]) / 100 if text.endswith("%") else float(text)
-    except ValueError:
-        value = math.nan
+        value = number(text[:-1], "value", allowed) / 100 if text.endswith("%") else number(text, "value", allowed)
+    except RigError as exc:
+        raise refusal(exc, "value", text) from None
     if not 0 <= value <= 1:
-        raise argparse.ArgumentTypeError(f"{text!r}: a share from 0% to 100%, e.g. 5% or 0.05")
+        raise argparse.ArgumentTypeError(f"{text!r}: {allowed}")
     return value
+
+
+def plain(convert):
+    """An argparse type: ``convert`` (int or float) of a text that has no decimal comma and
+    no thousands separator (Python's int and float read "1_000"); the range is the
+    library's to check, which names the option."""
+    def parse(text: str):
+        from rig.errors import RigError
+        from rig.units import check_digits
+
+        try:
+            check_digits(text, "value")
+        except RigError as exc:
+            raise refusal(exc, "value") from None
+        return convert(text)
+
+    parse.__name__ = convert.__name__  # argparse's "invalid float value: 'x'"
+    return parse
 
 
 def positive_seconds(text: str) -> float:
     """A time in seconds > 0 (a plain number)."""
+    from rig.errors import RigError
+    from rig.units import number
+
     try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not 0 < value < math.inf:
+        value = number(text, "value", "a number of seconds > 0")
+    except RigError as exc:
+        raise refusal(exc, "value") from None
+    if not 0 < value:
         raise argparse.ArgumentTypeError(f"{text!r}: a number of seconds > 0")
     return value
 

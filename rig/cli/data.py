@@ -64,6 +64,8 @@ def cmd_import(args) -> dict:
     from instruments.archive import Archive, Entry, raw_digest
     from instruments.formats import check_one_time_base, read_record, read_waveforms
 
+    if args.together and len(args.files) < 2:
+        raise RigError(f"--together: the channels of one shot in two or more files; {args.files[0]} is one")
     groups = [args.files] if args.together else [[f] for f in args.files]
     entries = []
     for files in groups:

@@ -22,7 +22,7 @@ def _records(args) -> list:
 
 def cmd_fit(args) -> dict:
     from rig.cli.common import writing_to
-    from rig.errors import RigError
+    from rig.errors import RigError, invalid
     from rig.experiment import scene as scene_io
     from rig.fit.fitting import stderr_progress
     from rig.fit.parameters import parse_parameters
@@ -32,6 +32,11 @@ def cmd_fit(args) -> dict:
     if len(sources) != 1:
         raise RigError("no data to fit: give one of --records FILES, --archive A.h5 or --points TABLE.csv"
                        if not sources else f"give one kind of data, not {' and '.join('--' + s for s in sources)}")
+    if args.shot is not None and not args.archive:
+        raise invalid("--shot", args.shot, f"picks one shot of --archive A.h5, not of --{sources[0]}")
+    for option, value in (("--walkers", args.walkers), ("--seed", args.seed)):
+        if value is not None and not args.posterior:
+            raise invalid(option, value, "needs --posterior STEPS (it is the MCMC sampler's)")
     params = parse_parameters(args.param)
     if args.posterior:
         from rig.fit.posterior import check
@@ -51,7 +56,7 @@ def cmd_fit(args) -> dict:
     progress = None if args.quiet else stderr_progress
     with writing_to(args.out):
         block = run_fit(args.scene, objective, args.out, progress, args.max_evaluations, args.posterior,
-                        args.walkers, args.seed)
+                        args.walkers, args.seed or 0)
     if not args.json:
         for k, p in block["parameters"].items():
             unit = "" if p["unit"] == "1" else f" {p['unit']}"

@@ -2,13 +2,15 @@
 from __future__ import annotations
 
 from rig.cli.common import check_size, missing_lines, progress_bar, writing_to
-from rig.errors import RigError
+from rig.errors import RigError, invalid
 
 
 def cmd_shot(args) -> dict:
     """Fire one virtual shot of a scene; print a summary or JSON; export scope files."""
     from rig.experiment.scene import load
 
+    if args.format is not None and not args.export:
+        raise invalid("--format", args.format, "needs --export DIR (the format of the scope files it writes)")
     scene = load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
     from pathlib import Path
 
@@ -27,7 +29,7 @@ def cmd_shot(args) -> dict:
         folder = Path(args.export)
         with writing_to(folder):
             folder.mkdir(parents=True, exist_ok=True)
-            paths = WRITERS[args.format](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
+            paths = WRITERS[args.format or "isf"](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
         out["exported"] = [str(p) for p in paths]
     if args.out:
         from instruments.archive import Archive
@@ -124,6 +126,7 @@ def cmd_animate(args) -> dict:
     from rig.viz.animate import animate
 
     rig = Rig(scene)
+    rig.check_record()  # the movie's traces are the shot's scope record
     check_size(rig.estimate(), args, "this movie")
     still = args.out.lower().endswith(".png")
     with progress_bar(args.quiet or still, total=None if still else args.frames, desc="animate",

@@ -4,14 +4,22 @@ from __future__ import annotations
 import sys
 
 from rig.cli.common import check_size, progress_bar, writing_to
+from rig.errors import invalid
 
 
 def cmd_mc(args) -> dict:
     """Parse the study, run it with a progress bar, print its summary."""
     from rig.experiment.scene import load
 
+    remote = args.scheduler not in (None, "local")
+    if args.worker_timeout is not None and not args.scheduler:
+        raise invalid("--worker-timeout", args.worker_timeout, "needs --scheduler (it watches the Dask workers)")
+    if args.workers is not None and remote:
+        raise invalid("--workers", args.workers, f"the workers of --scheduler {args.scheduler} are the cluster's; "
+                                                 "--workers sizes a local run or --scheduler local")
     load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
     from rig.study.distributions import parse_vary
+    from rig.study.executors import DEFAULT_WORKER_TIMEOUT
     from rig.study.mc_run import run_to
     from rig.study.mc_spec import DEFAULT_BATCH, Study
     from rig.study.sobol import sobol_shots
@@ -37,7 +45,8 @@ def cmd_mc(args) -> dict:
             bar.update(done)
 
         with writing_to(args.out):
-            run = run_to(args.out, study, args.workers, args.scheduler, bar.update, started, args.worker_timeout)
+            run = run_to(args.out, study, args.workers or 1, args.scheduler, bar.update, started,
+                         args.worker_timeout or DEFAULT_WORKER_TIMEOUT)
     if not args.json:
         print_study(run.report, run.ran_now, args.out)
     failed = run.report["failed"]

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rig.cli.common import check_size, progress_bar, writing_to
+from rig.cli.common import check_size, missing_lines, progress_bar, writing_to
 from rig.cli.shots import shot_summary
 from rig.errors import Interrupted, RigError
 
@@ -13,11 +13,15 @@ MAX_SWEEP_POINTS = 10_000  # more needs --allow-large (each point's shot is kept
 def cmd_sweep(args) -> dict:
     from rig.experiment.scene import load
 
+    if len(args.vary) > 1:
+        raise RigError(f"--vary given {len(args.vary)} times ({', '.join(v.split('=')[0] for v in args.vary)}): "
+                       "a sweep varies one key; run one sweep per key")
+
     scene = load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
     from rig.experiment.shot import Rig
     from rig.study.sweep import Vary, run_sweep
 
-    vary = Vary.parse(args.vary, None if args.allow_large else MAX_SWEEP_POINTS)
+    vary = Vary.parse(args.vary[0], None if args.allow_large else MAX_SWEEP_POINTS)
     n = len(vary.values)
     check_size(Rig(scene).estimate().times(n, n), args, f"this sweep of {n} points")  # every point is kept
     with progress_bar(args.quiet, total=len(vary.values), desc=f"sweep {vary.key}", unit="shot") as bar:
@@ -45,23 +49,35 @@ def cmd_sweep(args) -> dict:
         one["value"] = p.value
         out["points"].append(one)
     if not args.json:
-        fmt = lambda v, spec: "-".rjust(int(spec.split(".")[0])) if v is None else format(v, spec)  # noqa: E731
-        print(f"{vary.key:>18s} | {'truth F_d N':>11s} {'V_s m/s':>8s} | {'measured F_d N':>14s} "
-              f"{'V_s m/s':>8s} | {'Eq (1) m/s':>10s}")
-        clipped = []
-        for p in out["points"]:
-            t, m = p["truth"], p["measured"]
-            print(f"{p['value']:18.6g} | {fmt(t['amplitude_N'], '11.3f')} {fmt(t['speed_m_per_s'], '8.1f')} | "
-                  f"{fmt(m['amplitude_N'], '14.3f')} {fmt(m['speed_m_per_s'], '8.1f')} | "
-                  f"{fmt(p['theory']['speed_m_per_s'], '10.1f')}"
-                  f"{'  CLIPPED: ' + ','.join(c) if (c := [k for k, v in p['channels'].items() if v['clipped']]) else ''}")
-            clipped += [p["value"]] if any(v["clipped"] for v in p["channels"].values()) else []
-        if clipped:
-            print(f"clipped scope channels at {vary.key} = {', '.join(f'{v:g}' for v in clipped)}: a clipped "
-                  f"gauge channel gives no measured figure; raise scope.channels.CHn.volts_per_div")
+        print_sweep(vary.key, out["points"])
         if args.out:
             print(f"appended {len(points)} shots to {args.out}")
     return out
+
+
+def print_sweep(key: str, points: list):
+    """The sweep's table: truth, measured and Eq (1) per point, and under a point that has
+    no measured speed, why (the analysis' reasons)."""
+    fmt = lambda v, spec: "-".rjust(int(spec.split(".")[0])) if v is None else format(v, spec)  # noqa: E731
+    print(f"{key:>18s} | {'truth F_d N':>11s} {'V_s m/s':>8s} | {'measured F_d N':>14s} "
+          f"{'V_s m/s':>8s} | {'Eq (1) m/s':>10s}")
+    clipped = []
+    for p in points:
+        t, m = p["truth"], p["measured"]
+        if t is None:
+            print(f"{p['value']:18.6g} | speeds and amplitudes need two gauge beads")
+            continue
+        chans = [k for k, v in p["channels"].items() if v["clipped"]]
+        print(f"{p['value']:18.6g} | {fmt(t['amplitude_N'], '11.3f')} {fmt(t['speed_m_per_s'], '8.1f')} | "
+              f"{fmt(m['amplitude_N'], '14.3f')} {fmt(m['speed_m_per_s'], '8.1f')} | "
+              f"{fmt(p['theory']['speed_m_per_s'], '10.1f')}" + (f"  CLIPPED: {','.join(chans)}" if chans else ""))
+        if m["speed_m_per_s"] is None:
+            why = missing_lines(m["reasons"]) or [f"no result: {p['no_trigger_reason'] or 'no reason given'}"]
+            print(f"{'':18s}   measured: {'; '.join(why)}")
+        clipped += [p["value"]] if chans else []
+    if clipped:
+        print(f"clipped scope channels at {key} = {', '.join(f'{v:g}' for v in clipped)}: a clipped "
+              f"gauge channel gives no measured figure; raise scope.channels.CHn.volts_per_div")
 
 
 def cmd_reproduce(args) -> dict:

@@ -4,8 +4,8 @@ from __future__ import annotations
 import math
 import sys
 
-from rig.cli.common import quantity_arg as _q
 from rig.errors import RigError, invalid
+from rig.units import typed_quantity
 
 
 def cmd_theory(args) -> dict:
@@ -15,8 +15,8 @@ def cmd_theory(args) -> dict:
     from rig.theory.solitary import MIN_FORCE_RATIO, solitary_wave
 
     m = material(args.material)
-    a = _q(args.diameter, "m", "--diameter")
-    F0 = _q(args.f0, "N", "--f0")
+    a = typed_quantity(args.diameter, "m", "--diameter")
+    F0 = typed_quantity(args.f0, "N", "--f0")
     if not a > 0:
         raise RigError(f"--diameter = {args.diameter!r}: must be > 0 m")
     if not 0 <= F0 < math.inf:
@@ -26,7 +26,7 @@ def cmd_theory(args) -> dict:
            "speed_m_per_s": None, "sonic_vacuum_speed_m_per_s": None,
            "discrete_speed_m_per_s": None}
     if args.fm is not None:
-        Fm = _q(args.fm, "N", "--fm")
+        Fm = typed_quantity(args.fm, "N", "--fm")
         if not Fm > F0:
             raise RigError(f"--fm = {args.fm!r}: the maximum force must exceed --f0 = {F0} N")
         out["fm_N"] = Fm
@@ -52,6 +52,8 @@ def cmd_bench(args) -> dict:
     import importlib
 
     module = importlib.import_module(f"rig.bench.{args.what}")
+    if args.quick and args.what not in ("solver", "accuracy", "models", "fit"):
+        raise RigError(f"--quick: only rig bench solver, accuracy, models and fit have a quick form (not {args.what})")
     if args.peers and args.what != "solver":
         raise RigError(f"--peers: only rig bench solver has peers (not {args.what})")
     if args.baseline and args.what not in ("solver", "mc"):

@@ -3,6 +3,10 @@ checked (every gauge and the wall sensor on a channel of the scope, no channel t
 twice, a trigger on a connected channel)."""
 from __future__ import annotations
 
+import contextlib
+import math
+
+from instruments.errors import InstrumentError
 from instruments.gauges import GaugeSettings
 from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from rig.errors import RigError, invalid
@@ -14,6 +18,27 @@ from rig.model.materials import Material, material
 from rig.model.parts import Bead, GaugeBead, MagneticBead, Striker, Wall
 
 REQUIRED_TABLES = ("chain", "striker", "holder", "wall", "scope", "solver")
+MAX_BEADS = 10_000_000  # a list of 1e9 beads is 8 GB before the tube's length could refuse it
+
+
+SCENE_NAMES = {"E": "youngs_modulus", "nu": "poisson_ratio"}
+"""A part's own name of a field where the scene's key differs (a material's E and nu)."""
+
+
+@contextlib.contextmanager
+def scene_key(table: str, prefix: str = ""):
+    """Name the scene's key in a part's refusal: a part knows its field as 'bead.diameter',
+    'material' or 'material[ptfe].E', the scene as 'chain.diameter', 'chain.material',
+    'chain.youngs_modulus' (``prefix``: 'magnetic_' for the magnetic bead's keys)."""
+    try:
+        yield
+    except (RigError, InstrumentError) as exc:
+        field, sep, rest = str(exc).partition(" = ")
+        if not sep or " " in field or field.startswith(f"{table}."):  # not that form, or named already
+            raise
+        name = field.split(".")[-1].split("[")[0]
+        key = table if name == table.split(".")[-1] else f"{table}.{prefix}{SCENE_NAMES.get(name, name)}"
+        raise type(exc)(f"{key} = {rest}") from None
 
 
 class Assembly:
@@ -27,6 +52,8 @@ class Assembly:
     """
 
     def __init__(self, scene: Scene, bead_masses=None, like: Assembly | None = None):
+        if not isinstance(scene, Scene):
+            raise invalid("scene", scene, "a Scene (rig.experiment.scene.load); Rig.from_scene takes a name or path")
         self.scene = scene
         self.bead_masses = None if bead_masses is None else [float(m) for m in bead_masses]
         self._build(like)
@@ -40,6 +67,7 @@ class Assembly:
         return self.scene.values
 
     def _build(self, like: Assembly | None):
+        """The parts and instruments, each refusal naming the scene's key (scene_key)."""
         v = self.values
         for table in REQUIRED_TABLES:
             if table not in v:
@@ -48,7 +76,8 @@ class Assembly:
         def shared(*tables):  # built from the very same tables as like's: take like's
             return like is not None and all(v.get(t) is like.values.get(t) for t in tables)
 
-        self.holder = like.holder if shared("holder") else Holder(**v["holder"])
+        with scene_key("holder"):
+            self.holder = like.holder if shared("holder") else Holder(**v["holder"])
         beads, first = self._beads(v["chain"])
         if shared("gauges", "chain"):
             self.gauges = like.gauges
@@ -61,17 +90,26 @@ class Assembly:
                     raise RigError(f"gauges.{on[g.bead]} and gauges.{g.name} are both on bead {g.bead - first + 1} "
                                    f"(from the top): each gauge needs a bead of its own")
                 on[g.bead] = g.name
+            named = {g.name: g for g in self.gauges}
+            if "upper" in named and "lower" in named and named["upper"].bead > named["lower"].bead:
+                raise RigError(f"gauges.upper is on bead {named['upper'].bead - first + 1} and gauges.lower on bead "
+                               f"{named['lower'].bead - first + 1} (from the top): the upper gauge is the one the "
+                               "pulse reaches first; swap their beads")
         for g in self.gauges:
-            beads[g.bead] = GaugeBead.like(beads[g.bead], mass=g.mass)
-        self.striker = like.striker if shared("striker") else Striker(**v["striker"])
+            with scene_key(f"gauges.{g.name}"):
+                beads[g.bead] = GaugeBead.like(beads[g.bead], mass=g.mass)
+        with scene_key("striker"):
+            self.striker = like.striker if shared("striker") else Striker(**v["striker"])
         self.holder.check(beads, self.striker)
         if shared("magnet"):
             self.magnet = like.magnet
         else:
-            self.magnet = RingMagnet(**v["magnet"]) if "magnet" in v else None
+            with scene_key("magnet"):
+                self.magnet = RingMagnet(**v["magnet"]) if "magnet" in v else None
         if self.magnet is not None and not first:
             raise invalid("magnet", "set", "a ring magnet needs chain.magnetic_bead = true")
-        wall = like.chain.wall if shared("wall") else Wall(**v["wall"])
+        with scene_key("wall"):
+            wall = like.chain.wall if shared("wall") else Wall(**v["wall"])
         c, h = v["chain"], self.holder
         self.chain = Chain(beads, striker=self.striker, wall=wall, gravity=h.gravity,
                            top_force=self.magnet.top_force() if self.magnet else 0.0,
@@ -84,32 +122,36 @@ class Assembly:
             self.wall_sensor = like.wall_sensor
         elif "wall_sensor" in v:
             ws = dict(v["wall_sensor"])
-            self.wall_sensor = WallWiring(ws.pop("channel", None), GaugeSettings(misalignment_sd=0.0, **ws))
+            with scene_key("wall_sensor"):
+                self.wall_sensor = WallWiring(ws.pop("channel", None), GaugeSettings(misalignment_sd=0.0, **ws))
         else:
             self.wall_sensor = None
         self.scope = like.scope if shared("scope") else self._scope(v["scope"])
         if not shared("gauges", "chain", "wall_sensor", "scope"):
             self._check_connections()
-        self.solver = like.solver if shared("solver") else SolverSettings.from_table(v["solver"])
+        with scene_key("solver"):
+            self.solver = like.solver if shared("solver") else SolverSettings.from_table(v["solver"])
 
     def _beads(self, table: dict) -> tuple:
         """(the chain's beads, 1 if the top one is the magnetic bead else 0)."""
         c = dict(table)
         n = c.pop("beads", None)
-        if not isinstance(n, int) or n < 1:
-            raise invalid("chain.beads", n, "a whole number of beads >= 1")
+        if not isinstance(n, int) or not 1 <= n <= MAX_BEADS:
+            raise invalid("chain.beads", n, f"a whole number of beads from 1 to {MAX_BEADS:,}")
         first = 1 if c.pop("magnetic_bead", False) else 0
-        mat = material(c.get("material"))
-        if "youngs_modulus" in c or "poisson_ratio" in c:
-            mat = Material(mat.name, c.get("youngs_modulus", mat.E), c.get("poisson_ratio", mat.nu), mat.rho,
-                           mat.source + "; elastic constants set by the scene")
-        plain = Bead(mat, c.get("diameter"), c.get("mass"))
+        with scene_key("chain"):
+            mat = material(c.get("material"))
+            if "youngs_modulus" in c or "poisson_ratio" in c:
+                mat = Material(mat.name, c.get("youngs_modulus", mat.E), c.get("poisson_ratio", mat.nu), mat.rho,
+                               mat.source + "; elastic constants set by the scene")
+            plain = Bead(mat, c.get("diameter"), c.get("mass"))
         magnetic = MagneticBead()
         if "magnetic_youngs_modulus" in c or "magnetic_poisson_ratio" in c:
             m = magnetic.material
-            magnetic = MagneticBead(Material(m.name, c.get("magnetic_youngs_modulus", m.E),
-                                             c.get("magnetic_poisson_ratio", m.nu), m.rho,
-                                             m.source + "; elastic constants set by the scene"))
+            with scene_key("chain", "magnetic_"):
+                magnetic = MagneticBead(Material(m.name, c.get("magnetic_youngs_modulus", m.E),
+                                                 c.get("magnetic_poisson_ratio", m.nu), m.rho,
+                                                 m.source + "; elastic constants set by the scene"))
         if self.bead_masses is None:
             plain_beads = [plain] * n
         else:
@@ -122,8 +164,11 @@ class Assembly:
     def _gauge(name: str, g: dict, first: int, total: int) -> GaugeWiring:
         field = f"gauges.{name}"
         bead, from_wall = g.pop("bead", None), g.pop("from_wall", None)
-        if (bead is None) == (from_wall is None):
+        if bead is None and from_wall is None:
             raise invalid(field, None, "give exactly one of bead (from the top) or from_wall")
+        if bead is not None and from_wall is not None:
+            raise invalid(f"{field}.from_wall", from_wall, f"give exactly one of bead (from the top, here {bead}) "
+                                                          "or from_wall")
         plain = total - first
         count = bead if bead is not None else from_wall
         if not 1 <= count <= plain:
@@ -131,15 +176,20 @@ class Assembly:
             raise invalid(f"{field}.{key}", count, f"the chain has beads 1..{plain} (magnetic bead not counted)")
         index = first + bead - 1 if bead is not None else total - from_wall
         mass = g.pop("mass", None)
-        return GaugeWiring(name, index, g.pop("channel", None), GaugeSettings(**g), mass)
+        with scene_key(field):
+            return GaugeWiring(name, index, g.pop("channel", None), GaugeSettings(**g), mass)
 
     @staticmethod
     def _scope(s: dict) -> Oscilloscope:
         s = dict(s)
-        channels = {ch: ChannelSettings(**cs) for ch, cs in s.pop("channels", {}).items()}
+        channels = {}
+        for ch, cs in s.pop("channels", {}).items():
+            with scene_key(f"scope.channels.{ch}"):
+                channels[ch] = ChannelSettings(**cs)
         trigger = Trigger(**s.pop("trigger", {}))
         timebase = Timebase(s.pop("sample_interval", 1e-7), s.pop("record_length", 20000))
-        return Oscilloscope(channels=channels, timebase=timebase, trigger=trigger, **s)
+        with scene_key("scope"):
+            return Oscilloscope(channels=channels, timebase=timebase, trigger=trigger, **s)
 
     def _check_connections(self):
         used = {}
@@ -156,6 +206,31 @@ class Assembly:
         if src not in used:
             raise invalid("scope.trigger.source", src,
                           f"triggers on an unconnected channel (connected: {', '.join(used) or 'none'})")
+
+    def check_record(self):
+        """Refuse scope settings that can give no record of this rig's solve (RigError naming
+        them), before it runs: a shot fires only after this (a fit's windowed solves, which
+        read no scope, do not ask)."""
+        tb, tr, s = self.scope.timebase, self.scope.trigger, self.solver
+        span = tb.record_length * tb.sample_interval
+        after = (1 - tr.pre_trigger) * span
+        settings = (f"scope.record_length = {tb.record_length} x scope.sample_interval = {tb.sample_interval:g} s, "
+                    f"{1 - tr.pre_trigger:.0%} after the trigger")
+        if after > s.duration:
+            raise RigError(f"the scope records {after:.4g} s after its trigger ({settings}), longer than the "
+                           f"simulated solver.duration = {s.duration:g} s: lengthen solver.duration or shorten "
+                           "the record")
+        if span < 2 * s.sample_interval:
+            raise RigError(f"the scope record spans {span:.4g} s ({settings}), less than two samples of its input "
+                           f"(solver.sample_interval = {s.sample_interval:g} s): a longer scope.sample_interval")
+        st, g = self.striker, self.holder.gravity
+        if st.gap >= st.velocity * s.duration + 0.5 * g * s.duration**2:  # no impact within the solve
+            reach = st.gap / st.velocity if g == 0 else (math.sqrt(st.velocity**2 + 2 * g * st.gap) - st.velocity) / g
+            raise RigError(f"striker.gap = {st.gap:g} m at striker.velocity = {st.velocity:g} m/s: the striker "
+                           f"reaches the top bead after {reach:.4g} s, not within solver.duration = {s.duration:g} s")
+        if tr.slope == "rising" and tr.level <= 0:
+            raise invalid("scope.trigger.level", f"{tr.level:g} V", "a rising trigger needs a level above the "
+                                                                   "gauges' rest at 0 V, e.g. '30 mV'")
 
     def wiring(self) -> dict:
         """{scope channel: what is connected to it ("gauges.NAME" or "wall_sensor")}."""

@@ -116,7 +116,25 @@ def shot_blocks(rig, shot) -> dict:
     m = pick(measured)
     m["speed_xcorr_m_per_s"] = _clean(measured.speed_xcorr_m_per_s)
     m["reasons"] = dict(measured.reasons)  # why each missing figure is missing
+    short = short_record(rig, truth)
+    if short and m["speed_m_per_s"] is None:  # the root cause, named by its settings
+        m["reasons"] = {figure: short for figure in m["reasons"]}
     return {"truth": pick(truth), "measured": m, "theory": theory_block(rig, truth)}
+
+
+def short_record(rig, truth: Report) -> str | None:
+    """Why no measured speed can come from a scope record shorter than the truth's pulse
+    takes from the upper gauge to the lower (s), naming the settings; None otherwise."""
+    setup = setup_for(rig)
+    if not truth.speed_m_per_s:
+        return None
+    travel = (setup.lower.position_m - setup.upper.position_m) / truth.speed_m_per_s
+    tb = rig.scope.timebase
+    span = tb.record_length * tb.sample_interval
+    if span >= travel:
+        return None
+    return (f"the scope record spans {span:.3g} s (scope.record_length = {tb.record_length} x scope.sample_interval "
+            f"= {tb.sample_interval:g} s), shorter than the pulse's {travel:.3g} s from gauge to gauge")
 
 
 def _clean(v):

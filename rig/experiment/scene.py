@@ -10,12 +10,13 @@ is taken in the key's SI unit (m/s here).
 from __future__ import annotations
 
 import math
+import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from rig.errors import RigError, invalid
-from rig.units import quantity
+from rig.units import check_digits, number, quantity, whole
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -52,6 +53,8 @@ PUBLISHED_SCENES = Path(__file__).resolve().parent.parent / "scenes"  # package 
 
 def find_scene(name_or_path) -> Path:
     """A path to a .toml file, or the name of a published scene (rig/scenes/, e.g. ptfe52_magnetic)."""
+    if not isinstance(name_or_path, (str, os.PathLike)) or not str(name_or_path).strip():
+        raise invalid("scene", name_or_path, "a scene file's path or a published scene's name, e.g. ptfe52_magnetic")
     p = Path(name_or_path)
     if p.is_file():
         return p
@@ -98,7 +101,12 @@ def read_raw(name_or_path) -> tuple:
 def load(name_or_path, overrides=()) -> Scene:
     """Parse, override and validate a scene file (a path, or a published scene's name)."""
     text, raw = read_raw(name_or_path)
+    allowed = 'a list of "key=value" texts, e.g. ["striker.velocity=1.2 m/s"]'
+    if isinstance(overrides, (str, bytes)) or not hasattr(overrides, "__iter__"):
+        raise invalid("overrides", overrides, allowed)
     overrides = tuple(overrides)
+    if not all(isinstance(item, str) for item in overrides):
+        raise invalid("overrides", overrides, allowed)
     for item in overrides:
         apply_override(raw, item)
     values = convert(raw)
@@ -153,25 +161,25 @@ def _spec_for(parts):
 
 
 def _typed(value: str, spec, key):
+    """An override's text as its TOML value: a bool, a whole number, a number, or a
+    quantity's text (a plain number taken in the key's SI unit)."""
     if spec is bool:
         if value.lower() not in ("true", "false"):
             raise invalid(key, value, "true or false")
         return value.lower() == "true"
     if spec is int:
-        try:
-            return int(value)
-        except ValueError:
-            raise invalid(key, value, "a whole number") from None
+        return whole(value, key)
     if spec is float:
-        try:
-            return float(value)
-        except ValueError:
-            raise invalid(key, value, "a number") from None
+        return number(value, key)
     if isinstance(spec, str):  # a quantity: a plain number is in SI
+        check_digits(value, key)
         try:
-            return f"{float(value)!r} {spec}"
+            x = float(value)
         except ValueError:
-            return value
+            return value  # text with a unit, for quantity()
+        if not math.isfinite(x):
+            raise invalid(key, value, f"a finite number (plain number: {spec})")
+        return f"{x!r} {spec}"
     return value
 
 

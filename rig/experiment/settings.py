@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 from instruments.gauges import GaugeSettings
 from rig.errors import invalid
+from rig.solver.methods import method
 from rig.solver.stepsize import checked_accuracy
 
 
@@ -45,6 +46,12 @@ class SolverSettings:
         d = self.duration
         if d is None or not (isinstance(d, (int, float)) and math.isfinite(d) and d > 0):
             raise invalid("solver.duration", d, "simulated time > 0 s, e.g. '4 ms'")
+        method(self.method)
+        h = self.sample_interval
+        if not (isinstance(h, (int, float)) and 0 < h < math.inf):
+            raise invalid("solver.sample_interval", h, "the output grid's interval, > 0 s, e.g. '0.1 us'")
+        if not h < d:
+            raise invalid("solver.sample_interval", f"{h:g} s", f"shorter than solver.duration = {d:g} s")
         if self.accuracy is not None:
             checked_accuracy(self.accuracy, "solver.accuracy")
 

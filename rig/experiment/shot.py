@@ -143,6 +143,7 @@ class Rig(Assembly):
             seed = fresh_seed()
         if not isinstance(seed, (int, np.integer)) or seed < 0:
             raise invalid("seed", seed, "a whole number >= 0")
+        self.check_record()
         rng = np.random.default_rng(int(seed))
         forces = self.truth()
         h = forces.sample_interval
@@ -164,8 +165,11 @@ class Rig(Assembly):
             rest[self.wall_sensor.channel] = self.wall_sensor.settings.noise
         try:
             record = self.scope.acquire(inputs, h, rng, rest)
-        except ValueError as exc:
-            raise RigError(f"{exc} (solver.duration = {self.solver.duration:g} s)") from None
+        except ValueError as exc:  # the record would run past the simulated input: a late trigger
+            tr = self.scope.trigger
+            raise RigError(f"the scope triggered late, on {tr.source} ({self.wiring().get(tr.source)}, "
+                           f"scope.trigger.level = {tr.level:g} V): {exc}; lengthen solver.duration = "
+                           f"{self.solver.duration:g} s, or trigger on a gauge the pulse reaches sooner") from None
         truth_analysis = self.truth_analysis().as_dict() if truth and len(self.gauges) >= 2 else None
         return ShotRecord(self.name, self.scene.text, self.scene.overrides, int(seed), self.values, record,
                           forces, self.solution().stats, draws, truth_analysis)

@@ -24,7 +24,7 @@ import numpy as np
 
 from rig.errors import RigError, invalid
 from rig.experiment.scene import schema_node
-from rig.units import quantity
+from rig.units import check_digits, quantity
 
 POINT_COLUMNS = {"F_d": "N", "F_d_sd": "N", "V_s": "m/s", "V_s_sd": "m/s"}
 _HEADER = re.compile(r"^\s*([A-Za-z_][\w.]*)\s*(?:\[(.+)\])?\s*$")
@@ -97,6 +97,7 @@ def read_points(path) -> Points:
         if len(row) != len(columns):
             raise invalid(f"--points {path} line {i}", ",".join(row), f"{len(columns)} values")
         for (name, unit, si), cell in zip(columns, row):
+            check_digits(cell, f"--points {path} line {i} {name}")
             try:
                 x = float(cell) if si == "1" else quantity(f"{cell.strip()} {unit}", si, name)
             except (ValueError, RigError):

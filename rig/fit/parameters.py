@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 from rig.errors import RigError, invalid
 from rig.experiment.scene import key_spec
-from rig.units import quantity
+from rig.units import check_digits, number, quantity
 
 POSITIVE_LAW_KEYS = {"chain.damping_time": "kuwabara-kono", "chain.contact_damping": "dashpot"}
 """Keys that switch their contact law on (the law needs them > 0)."""
@@ -34,7 +34,10 @@ def parse_parameter(text: str) -> FitParameter:
     if "=" not in text:
         raise invalid("--param", text, "needs bounds: KEY=LO:HI, e.g. chain.youngs_modulus=0.4 GPa:2 GPa")
     key, bounds = (s.strip() for s in text.split("=", 1))
-    spec = key_spec(key)
+    try:
+        spec = key_spec(key)
+    except RigError as exc:
+        raise RigError(f"--param {exc}") from None
     if spec is float:
         unit = "1"
     elif isinstance(spec, str):
@@ -46,18 +49,17 @@ def parse_parameter(text: str) -> FitParameter:
     lo_text, hi_text = (s.strip() for s in bounds.split(":"))
     values = []
     for name, t in (("LO", lo_text), ("HI", hi_text)):
+        field = f"--param {key} {name}"
+        check_digits(t, field)
         if unit == "1":
-            try:
-                values.append(float(t))
-            except ValueError:
-                raise invalid(f"--param {key} {name}", t, "a number (this key has no unit)") from None
+            values.append(number(t, field, "a finite number (this key has no unit)"))
+            continue
+        try:
+            float(t)
+        except ValueError:
+            values.append(quantity(t, unit, field))
         else:
-            try:
-                float(t)
-            except ValueError:
-                values.append(quantity(t, unit, f"--param {key} {name}"))
-            else:
-                raise invalid(f"--param {key} {name}", t, f"bounds need units, e.g. '{t} {unit}'")
+            raise invalid(field, t, f"bounds need units, e.g. '{t} {unit}'")
     lo, hi = values
     if not lo < hi:
         raise invalid(f"--param {key}", bounds, "needs LO < HI, the lower bound first")

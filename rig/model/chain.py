@@ -77,6 +77,8 @@ class Chain:
                  contact_law: str = "hertz", damping_time=0.0, contact_damping=0.0,
                  contact_exponent: float = 1.5, reference_force=1.0,
                  drag=0.0, friction=0.0, slip_speed=1e-3):
+        if isinstance(beads, (str, bytes)) or not hasattr(beads, "__iter__"):
+            raise invalid("chain.beads", beads, "a list of Beads")
         beads = list(beads)
         if not beads:
             raise invalid("chain.beads", beads, "a chain needs at least one bead")

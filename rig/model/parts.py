@@ -12,7 +12,7 @@ from dataclasses import dataclass, fields
 
 from rig.errors import invalid
 from rig.model.materials import Material, material
-from rig.units import quantity
+from rig.units import is_real, quantity
 
 # Published PTFE gauge bead (Daraio et al. 2006): caps 0.093 g, plate 0.023 g, of a 0.1226 g bead.
 PTFE_GAUGE_CAPS_FRACTION = 0.093 / 0.1226
@@ -45,7 +45,7 @@ class _Part:
     def _positive(self, prefix: str, *names):
         for name in names:
             value = getattr(self, name)
-            if not value > 0:
+            if not (is_real(value) and value > 0):
                 raise invalid(f"{prefix}.{name}", value, f"must be > 0 {_UNITS[name]}")
 
 
@@ -132,6 +132,9 @@ class GaugeBead(Bead):
         return cls(bead.material, bead.diameter, caps_mass=mass - PZT_PLATE_MASS)
 
 
+MIN_STRIKER_VELOCITY = 1e-6  # m/s: at 1e-9 the energy error was 3.6e4 kinetic energies; 1e-300 squared to 0 J
+
+
 @dataclass(frozen=True)
 class Striker(_Part):
     """A cylinder dropped flat face first on the top bead with ``velocity`` (m/s, > 0).
@@ -149,6 +152,10 @@ class Striker(_Part):
     def __post_init__(self):
         self._convert("striker")
         self._positive("striker", "mass", "velocity", "diameter")
+        if self.velocity < MIN_STRIKER_VELOCITY:
+            raise invalid("striker.velocity", f"{self.velocity:g} m/s",
+                          f"at least {MIN_STRIKER_VELOCITY:g} m/s: slower, the striker's kinetic energy drowns in the "
+                          "rounding of the chain's static energy")
         if not self.gap >= 0:
             raise invalid("striker.gap", self.gap,
                           "the striker would overlap the top bead; allowed: gap >= 0 m")
@@ -178,7 +185,8 @@ class Wall(_Part):
     def __post_init__(self):
         self._convert("wall")
         if (self.plate_mass is None) != (self.rod_stiffness is None):
-            raise invalid("wall.plate_mass", self.plate_mass,
+            given = "plate_mass" if self.rod_stiffness is None else "rod_stiffness"
+            raise invalid(f"wall.{given}", getattr(self, given),
                           "a compliant wall needs both plate_mass and rod_stiffness (or neither: rigid)")
         if self.compliant:
             self._positive("wall", "plate_mass", "rod_stiffness")

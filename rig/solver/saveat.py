@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rig.errors import invalid
+from rig.model.chain import Probe
+from rig.units import is_real
 
 
 @dataclass(frozen=True)
@@ -24,9 +26,12 @@ class SaveAt:
     frame_interval: float | None = None
 
     def __post_init__(self):
-        if not (self.sample_interval > 0 and math.isfinite(self.sample_interval)):
+        if not (isinstance(self.probes, dict) and all(isinstance(k, str) and isinstance(p, Probe)
+                                                      for k, p in self.probes.items())):
+            raise invalid("save.probes", self.probes, "{name: Probe}, e.g. {'c5': chain.contact_probe(5)}")
+        if not (is_real(self.sample_interval) and self.sample_interval > 0 and math.isfinite(self.sample_interval)):
             raise invalid("save.sample_interval", self.sample_interval, "must be > 0 s")
-        if self.frame_interval is not None and not self.frame_interval > 0:
+        if self.frame_interval is not None and not (is_real(self.frame_interval) and self.frame_interval > 0):
             raise invalid("save.frame_interval", self.frame_interval, "must be > 0 s or None")
 
     @property

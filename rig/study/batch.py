@@ -28,7 +28,7 @@ from rig.study.nominal import copied_table, nominal
 from rig.study.shots import array_keys, shots_of, wave_speeds, wiring_of
 from rig.study.sobol import sobol_matrix
 
-IMPOSSIBLE, UNSTABLE, NO_TRIGGER, SHORT_WINDOW, NON_FINITE = range(1, len(FAILURES))
+IMPOSSIBLE, UNSTABLE, NO_TRIGGER, SHORT_WINDOW, NON_FINITE, CLIPPED = range(1, len(FAILURES))
 
 
 @dataclass(frozen=True, eq=False)
@@ -175,6 +175,7 @@ def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
     records = instrument_batch.acquire(forces, h, wiring, [drawn[j][2] for j in keep], sub.fixed, speeds,
                                        read=(setup.upper.channel, setup.lower.channel))  # what the analysis reads
     reports = instrument_batch.analysed(records, setup)
+    roles = [records.wiring.channels.index(setup.upper.channel), records.wiring.channels.index(setup.lower.channel)]
     succeeded, energy_errors = ens.succeeded, ens.energy_errors
     for e, j in enumerate(keep):
         if not succeeded[e]:
@@ -184,12 +185,13 @@ def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
             out["failure"][j] = SHORT_WINDOW
             continue
         triggered = records.status[e] == instrument_batch.OK
-        _outputs(out, j, reports[e], None, float(energy_errors[e]), ens.dt, triggered)
+        _outputs(out, j, reports[e], None, float(energy_errors[e]), ens.dt, triggered,
+                 bool(records.over[e, roles].any()))
 
 
-def _outputs(out: dict, j: int, m, t, energy_error: float, dt: float, triggered: bool):
+def _outputs(out: dict, j: int, m, t, energy_error: float, dt: float, triggered: bool, clipped: bool):
     """Shot j's outputs from its measured Report m (and truth Report t, or None), and its
-    failure, if any."""
+    failure, if any (``clipped``: a gauge channel the analysis reads ran off the scope's range)."""
     for key, val in (("speed_m_per_s", m.speed_m_per_s), ("speed_xcorr_m_per_s", m.speed_xcorr_m_per_s),
                      ("amplitude_N", m.amplitude_N), ("averaged_amplitude_N", m.averaged_amplitude_N),
                      ("truth_speed_m_per_s", t and t.speed_m_per_s), ("truth_amplitude_N", t and t.amplitude_N),
@@ -198,7 +200,7 @@ def _outputs(out: dict, j: int, m, t, energy_error: float, dt: float, triggered:
     if not triggered:
         out["failure"][j] = NO_TRIGGER
     elif not (np.isfinite(out["speed_m_per_s"][j]) and np.isfinite(out["amplitude_N"][j])):
-        out["failure"][j] = NON_FINITE
+        out["failure"][j] = CLIPPED if clipped else NON_FINITE
 
 
 def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dict, traces: list, lo: int):
@@ -232,8 +234,10 @@ def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dic
             traces.append(replace(entry, truth_key=None, facts=replace(entry.facts, study_shot=lo + j,
                                                                        study=study.digest(), analysis=calibration)))
         m = analyze_record(shot.scope, setup, train=False)  # leading pulse only
+        waves = shot.scope.waveforms
+        clipped = any(waves[ch].overrange for ch in (setup.upper.channel, setup.lower.channel) if ch in waves)
         _outputs(out, j, m, rig.truth_analysis() if study.truth else None, stats.energy_error, ens.dt,
-                 shot.scope.triggered)
+                 shot.scope.triggered, clipped)
 
 
 def refire(study: Study, i: int) -> dict:

@@ -21,7 +21,7 @@ from scipy import stats
 
 from rig.errors import invalid
 from rig.experiment.scene import schema_node
-from rig.units import quantity
+from rig.units import check_digits, number, quantity
 
 EXTRA_KEYS = {"chain.bead_mass": "kg", "chain.youngs_modulus": "Pa", "chain.poisson_ratio": float}
 GAUGE_KEYS = {"gain": float, "misalignment": "m"}
@@ -81,6 +81,8 @@ class Distribution:
         kind = m.group(1).lower()
         args = [x.strip() for x in m.group(2).split(",")]
         if len(args) != _ARITY[kind] or not all(args):
+            if len(re.split(r",\s+", m.group(2))) == _ARITY[kind]:  # "normal(0,89 m/s, 0,01 m/s)"
+                check_digits(text, f"--vary {key}")
             raise invalid(f"--vary {key}", text, f"{kind} takes {_ARITY[kind]} arguments, none of them empty")
         unit = key_unit(key)
         vals = tuple(_value(a, unit, key) for a in args)
@@ -163,13 +165,7 @@ class Distribution:
 
 def _value(text: str, unit, key):
     if unit is float:
-        try:
-            x = float(text)
-        except ValueError:
-            raise invalid(f"--vary {key}", text, "a finite number") from None
-        if not math.isfinite(x):
-            raise invalid(f"--vary {key}", text, "a finite number")
-        return x
+        return number(text, f"--vary {key}")
     return quantity(text, unit, f"--vary {key}")
 
 

@@ -20,7 +20,9 @@ OUTPUTS = ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_ampl
 FAILURES = ("none", "impossible inputs (the rig refuses them)", "solver unstable",
             "the scope did not trigger",
             "the scope record ends after the simulated window (--window record simulates the whole record)",
-            "non-finite measured speed or amplitude")
+            "non-finite measured speed or amplitude",
+            "a gauge channel clipped (its signal ran off the scope's range: raise scope.channels.CHn.volts_per_div)")
+# the order is the stored one: a new reason goes at the end
 
 
 DEFAULT_BATCH = 256  # shots per batch: a batch's fixed costs (threads, arrays) spread over more shots

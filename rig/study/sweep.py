@@ -15,6 +15,7 @@ from rig.experiment.entry import shot_entry
 from rig.experiment.measure import shot_blocks
 from rig.experiment.scene import schema_node
 from rig.experiment.shot import Rig, ShotRecord
+from rig.units import typed_quantity, whole
 
 
 @dataclass(frozen=True)
@@ -36,11 +37,8 @@ class Vary:
         if len(parts) != 3:
             raise invalid("--vary", text, "expected KEY=START:STOP:COUNT")
         unit = _unit_of(key)
-        start, stop = (_number(p, unit, key) for p in parts[:2])
-        try:
-            count = int(parts[2])
-        except ValueError:
-            raise invalid(f"--vary {key} COUNT", parts[2], "a whole number >= 1") from None
+        start, stop = (typed_quantity(p, unit, f"--vary {key}") for p in parts[:2])
+        count = whole(parts[2], f"--vary {key} COUNT", "a whole number >= 1")
         if count < 1:
             raise invalid(f"--vary {key} COUNT", count, "a whole number >= 1")
         if max_count is not None and count > max_count:
@@ -49,11 +47,21 @@ class Vary:
             raise invalid(f"--vary {key}", spec, "START must not exceed STOP")
         if count == 1 and start != stop:
             raise invalid(f"--vary {key}", spec, "one point needs START = STOP")
-        return cls(key, tuple(float(v) for v in np.linspace(start, stop, count)))
+        values = tuple(float(v) for v in np.linspace(start, stop, count))
+        if schema_node(key) is int:  # chain.beads, gauges.NAME.bead, scope.record_length
+            off = [v for v in values if abs(v - round(v)) > 1e-9 * max(1.0, abs(v))]
+            if off:
+                raise invalid(f"--vary {key}", spec, f"a whole-number key, and the point {off[0]:g} is not whole: "
+                                                     "choose START, STOP and COUNT that give whole numbers")
+            values = tuple(float(round(v)) for v in values)
+        return cls(key, values)
 
     def override(self, value) -> str:
+        """The --set text of one point."""
         unit = _unit_of(self.key)
-        return f"{self.key}={value!r}" if unit is None else f"{self.key}={value!r} {unit}"
+        if unit is None:
+            return f"{self.key}={int(value) if schema_node(self.key) is int else value!r}"
+        return f"{self.key}={value!r} {unit}"
 
 
 def _unit_of(key: str):
@@ -68,17 +76,6 @@ def _unit_of(key: str):
     if not isinstance(node, str):
         raise invalid("--vary", key, "only numeric keys can be swept")
     return node
-
-
-def _number(text: str, unit, key) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        if unit is None:
-            raise invalid(f"--vary {key}", text, "a number") from None
-        from rig.units import quantity
-
-        return quantity(text, unit, f"--vary {key}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -101,6 +98,7 @@ def run_sweep(scene, vary: Vary, overrides=(), seed: int = 0, progress=None, arc
     for v in vary.values:  # assemble (validate) every point before firing any
         try:
             rigs.append(Rig.from_scene(scene, list(overrides) + [vary.override(v)]))
+            rigs[-1].check_record()
         except ValueError as exc:
             raise RigError(f"--vary {vary.key} = {v:g}: {exc}") from None
     points, entries = [], []

@@ -78,7 +78,7 @@ CASES = [
     (["shot", S, *_set("solver.duration=-2 ms")], "solver.duration"),
     (["shot", S, *_set("solver.accuracy=5")], "solver.accuracy = 5.0: relative accuracy target in [1e-10, 0.1]"),
     (["shot", S, *_set("scope.channels.CH1.volts_per_div=0")],
-     "scope.channels.CHn.volts_per_div = 0.0: allowed 0.000999 <= volts_per_div <= 10.01 (V/div)"),
+     "scope.channels.CH1.volts_per_div = 0.0: allowed 0.000999 <= volts_per_div <= 10.01 (V/div)"),
     (["shot", S, *_set("solver.duration=1000 s")], "--allow-large"),
     (["shot", S, *_set("solver.sample_interval=0")], "sample_interval"),
     (["shot", S, *_set("scope.sample_interval=-1")], "scope.sample_interval"),

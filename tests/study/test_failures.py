@@ -23,6 +23,11 @@ WIDE = ["--vary", "striker.velocity=truncnormal(0.89 m/s, 0.3 m/s, 0.05 m/s, 3 m
         "--vary", "gauges.upper.gain=lognormal(1, 0.6)"]
 
 
+FAILURES_BEFORE = ("none", "impossible inputs (the rig refuses them)", "solver unstable", "the scope did not trigger",
+                   "the scope record ends after the simulated window (--window record simulates the whole record)",
+                   "non-finite measured speed or amplitude")  # stored as indices: a reason is added, never moved
+
+
 def _mc(folder, *extra):
     return ["mc", "ptfe52_magnetic", "--shots", "32", "--batch", "16", *WIDE, "--out", str(folder),
             "--quiet", *extra]
@@ -37,6 +42,11 @@ def test_a_wide_study_counts_its_failed_shots_and_fails_past_the_threshold(tmp_p
     assert sum(failed["reasons"].values()) == failed["count"]
     assert set(failed["reasons"]) <= set(FAILURES[1:])
     assert any("--window record" in why for why in failed["reasons"])  # the realistic cause, named
+    # a gain drawn up to 3x runs the upper gauge off the scope's range: counted as clipped (it had been
+    # "non-finite measured speed or amplitude"), the report's keys kept
+    assert set(failed) == {"count", "share", "reasons"}
+    clipped = next(why for why in FAILURES if "clipped" in why)
+    assert failed["reasons"].get(clipped, 0) > 0 and FAILURES[:6] == FAILURES_BEFORE
     assert report["speed_m_per_s"]["trials"] == report["shots"] - failed["count"]  # left out visibly
     err = [line for line in cap.err.splitlines() if line.strip()]
     assert len(err) == 1 and "--max-failed" in err[0] and f"{failed['count']} of 32" in err[0]

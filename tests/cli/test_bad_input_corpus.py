@@ -1,0 +1,329 @@
+"""The generated bad-input corpus: every scene key with the values that are wrong for it,
+every command's options with wrong values and combinations that would be ignored, the
+Python API's constructors with wrong types, and damaged scope files.
+
+A case on the command line ends in exactly one line on stderr that names the field (or
+the file), exit 2, no traceback; a case of the API raises RigError or InstrumentError with
+a one-line message naming the field. Every case is refused before anything is solved: the
+solver's entry points are replaced by a trap for the whole module, which also keeps the
+corpus fast (tests/cli/test_bad_inputs.py holds the hand-written cases, some of which
+solve)."""
+from __future__ import annotations
+
+import math
+import re
+
+import pytest
+
+from instruments.errors import InstrumentError
+from rig.cli import main
+from rig.errors import RigError
+from rig.experiment.scene import SCHEMA
+
+S = "ptfe52_magnetic"
+VEL = "striker.velocity=normal(0.89 m/s, 0.01 m/s)"
+YM = "chain.youngs_modulus=0.4 GPa:2 GPa"
+
+
+def _keys(node=SCHEMA, prefix=""):
+    """(dotted key, spec) of every scene key, '*' tables taken as this scene's gauges.upper
+    and scope.channels.CH1."""
+    for name, spec in node.items():
+        name = {"gauges.*": "gauges.upper", "scope.channels.*": "scope.channels.CH1"}.get(prefix + name, prefix + name)
+        if isinstance(spec, dict):
+            yield from _keys(spec, name + ".")
+        else:
+            yield name, spec
+
+
+WRONG_UNIT = {"kg": "1 m", "m": "1 kg"}  # a quantity of another dimension
+POSITIVE = {"chain.diameter", "chain.mass", "chain.reference_force", "chain.youngs_modulus",
+            "chain.magnetic_youngs_modulus", "striker.mass", "striker.velocity", "striker.diameter",
+            "holder.bore", "holder.outer_diameter", "holder.length", "wall.plate_mass", "wall.rod_stiffness",
+            "wall_sensor.sensitivity", "gauges.upper.sensitivity", "gauges.upper.mass", "scope.sample_interval",
+            "scope.channels.CH1.volts_per_div", "solver.duration", "solver.sample_interval",
+            "scope.channels.CH1.bandwidth"}
+"""Quantity keys that are refused at 0 and below."""
+CHOICES = ("chain.material", "chain.contact_law", "striker.material", "wall.material", "scope.mode",
+           "scope.trigger.source", "scope.trigger.slope", "scope.channels.CH1.coupling",
+           "solver.method", "gauges.upper.channel", "wall_sensor.channel")
+"""Text keys with a fixed set of values."""
+
+
+def _scene_cases():
+    """(--set item, what the line must name) for every key and its wrong values."""
+    for key, spec in _keys():
+        if isinstance(spec, str):  # a quantity
+            bad = ["nan", "inf", "-inf", "abc", "", "1,2", f"1,5 {spec}", f"1 200 {spec}", "1_000", "1e999",
+                   f"nan {spec}", WRONG_UNIT.get(spec, "1 kg")]
+            bad += ["0", "-1", f"-3 {spec}"] if key in POSITIVE else []
+        elif spec is int:
+            bad = ["2.5", "abc", "", "1,0", "1 000", "nan", "inf", "-1", "0", "true"]
+        elif spec is float:
+            bad = ["abc", "", "0,5", "nan", "inf", "1 m", "1_0"]
+        elif spec is bool:
+            bad = ["maybe", "1", "", "yes"]
+        elif key in CHOICES:
+            bad = ["nosuch", ""]
+        else:
+            continue
+        for value in bad:
+            yield f"{key}={value}", key
+
+
+SCENE_CASES = list(_scene_cases())
+
+
+def _flag_cases():
+    """(argv, what the line must name): each command's options with wrong values, and options
+    given where they do nothing."""
+    out = "{d}/o"
+    cases = []
+    comma = ["1,5", "1 000", "1_000", "nan", "abc", "", "-1"]
+    for count in comma + ["0", "2.5"]:
+        cases += [(["mc", S, "--shots", count, "--vary", VEL, "--out", out], "--shots"),
+                  (["mc", S, "--shots", "8", "--batch", count, "--vary", VEL, "--out", out], "--batch"),
+                  (["mc", S, "--shots", "8", "--workers", count, "--vary", VEL, "--out", out], "--workers"),
+                  (["fit", S, "--param", YM, "--points", "p.csv", "--max-evaluations", count, "--out", out],
+                   "--max-evaluations"),
+                  (["fit", S, "--param", YM, "--points", "p.csv", "--posterior", count, "--out", out], "--posterior"),
+                  (["bench", "mc", "--rounds", count], "--rounds")]
+    for seed in comma + ["2.5", str(2**63)]:
+        cases += [(["shot", S, "--seed", seed], "--seed"), (["sweep", S, "--vary", "striker.velocity=1:2:2",
+                                                           "--seed", seed], "--seed"),
+                  (["mc", S, "--shots", "8", "--vary", VEL, "--seed", seed, "--out", out], "--seed"),
+                  (["animate", S, "--out", "{d}/m.gif", "--seed", seed], "--seed")]
+    for share in ["5,5%", "1 0%", "nan", "abc", "", "-1%", "101%", "1.5"]:
+        cases.append((["mc", S, "--shots", "8", "--vary", VEL, "--max-failed", share, "--out", out], "--max-failed"))
+    for seconds in ["1,5", "0", "-1", "nan", "inf", "abc", ""]:
+        cases.append((["mc", S, "--shots", "8", "--vary", VEL, "--scheduler", "local", "--worker-timeout", seconds,
+                       "--out", out], "--worker-timeout"))
+    for value in ["1,5", "1_0", "abc", "", "nan", "0", "-1", "1e-20", "1"]:
+        cases.append((["mc", S, "--shots", "8", "--vary", VEL, "--accuracy", value, "--out", out], "accuracy"))
+    for value in ["1,5", "1_0", "abc", "", "nan", "inf", "0", "-2"]:
+        cases += [(["animate", S, "--out", "{d}/m.gif", "--exaggerate", value], "--exaggerate"),
+                  (["analyze", "x.isf", "--beta", value], "--beta")]
+    for value in ["1,5", "1_0", "abc", "", "0", "1", "-2", "2.5"]:
+        cases.append((["animate", S, "--out", "{d}/m.gif", "--frames", value], "--frames"))
+    for flag, unit in (("--gauge-distance", "m"), ("--sensitivity", "V/N"), ("--tau", "s"), ("--f0", "N"),
+                       ("--diameter", "m")):
+        for value in ["1,5", f"1,5 {unit}", f"1 200 {unit}", "1_0", "abc", "", "nan", "1 J"]:
+            cases.append((["analyze", "x.isf", f"{flag}={value}"], flag))
+    for flag in ("--f0", "--fm", "--diameter"):
+        for value in ["1,5", "1,5 N", "1 200", "1_0", "abc", "nan", "1 s"]:
+            argv = ["theory", "--f0", "1", flag, value] if flag != "--f0" else ["theory", "--f0", value]
+            cases.append((argv, flag))
+    for value in ["striker.velocity=0,3:1.5:7", "striker.velocity=0.3:1,5:7", "striker.velocity=0.3:1.5:7,0",
+                  "striker.velocity=0.3 m/s:1 200 m/s:3", "striker.velocity=0.3:1.5:1_0",
+                  "striker.velocity=0.3 kg:1.5 kg:3", "striker.velocity=0.3:1.5:-2", "striker.velocity=:1:3",
+                  "striker.velocity=0.3:1.5:3:4", "chain.beads=20:30:4", "chain.beads=20.5:30:3",
+                  "gauges.upper.bead=3:5:4", "scope.record_length=1000.5:2000:3", "chain.material=1:2:3",
+                  "chain.poisson_ratio=0,2:0.3:2", "chain.poisson_ratio=a:b:2", "striker.velocity=inf:1:2",
+                  "solver.duration=0:1:2", "nosuch.key=1:2:3", "chain=1:2:3"]:
+        cases.append((["sweep", S, "--vary", value], "--vary"))
+    for value in ["striker.velocity=normal(0,89 m/s, 0,01 m/s)", "striker.velocity=normal(0.89 m/s, 0,01 m/s)",
+                  "striker.velocity=normal(0.89, 0.01)", "striker.velocity=normal(1 200 m/s, 1 m/s)",
+                  "striker.velocity=uniform(1 m/s)", "striker.velocity=uniform(2 m/s, 1 m/s)",
+                  "striker.velocity=normal(nan m/s, 1 m/s)", "striker.velocity=weibull(1, 2)",
+                  "striker.velocity=normal(0.89 m/s, 0 m/s)", "gauges.upper.gain=lognormal(1, 0,6)",
+                  "gauges.upper.gain=lognormal(1,5, 0.6)", "gauges.upper.gain=lognormal(-1, 0.6)",
+                  "chain.bead_mass=normal(0.1226 g, 1 m)", "solver.accuracy=normal(1e-4, 1e-5)",
+                  "striker.velocity", "=normal(1, 1)", "striker.velocity=truncnormal(1 m/s, 1 m/s, 2 m/s, 1 m/s)"]:
+        cases.append((["mc", S, "--shots", "8", "--vary", value, "--out", out], "--vary"))
+    for value in ["chain.youngs_modulus=0,4 GPa:2 GPa", "chain.youngs_modulus=0.4 GPa:2,0 GPa",
+                  "chain.youngs_modulus=1 200 MPa:2 GPa", "chain.youngs_modulus=0.4:2", "chain.youngs_modulus=2 GPa:1 GPa",
+                  "chain.youngs_modulus=0.4 GPa", "chain.youngs_modulus=0.4 m:2 m", "chain.contact_exponent=1,2:2.4",
+                  "chain.contact_exponent=1.2:2,4", "chain.contact_exponent=a:b", "chain.contact_exponent=1.2 m:2",
+                  "chain.material=a:b", "nosuch=1:2", "chain.damping_time=0 s:1 ms", "chain.youngs_modulus=nan GPa:2 GPa"]:
+        cases.append((["fit", S, "--param", value, "--points", "p.csv", "--out", out], "--param"))
+    # options given where they do nothing
+    cases += [
+        (["shot", S, "--format", "csv"], "--format"),
+        (["sweep", S, "--vary", "striker.velocity=0.3:1:2", "--vary", "chain.beads=20:30:3"], "--vary"),
+        (["fit", S, "--param", YM, "--points", "p.csv", "--shot", "2", "--out", out], "--shot"),
+        (["fit", S, "--param", YM, "--records", "a.isf", "--shot", "1", "--out", out], "--shot"),
+        (["fit", S, "--param", YM, "--points", "p.csv", "--walkers", "8", "--out", out], "--walkers"),
+        (["fit", S, "--param", YM, "--points", "p.csv", "--seed", "3", "--out", out], "--seed"),
+        (["fit", S, "--param", YM, "--points", "p.csv", "--archive", "a.h5", "--out", out], "--archive"),
+        (["mc", S, "--shots", "8", "--vary", VEL, "--worker-timeout", "5", "--out", out], "--worker-timeout"),
+        (["mc", S, "--shots", "8", "--vary", VEL, "--workers", "2", "--scheduler", "tcp://127.0.0.1:1", "--out", out],
+         "--workers"),
+        (["import", "a.isf", "--together", "--into", "a.h5"], "--together"),
+        (["bench", "shot", "--quick"], "--quick"),
+        (["bench", "archive", "--quick"], "--quick"),
+        (["bench", "startup", "--quick"], "--quick"),
+        (["bench", "shot", "--peers"], "--peers"),
+        (["bench", "fit", "--baseline", "HEAD"], "--baseline"),
+        (["bench", "models", "--rounds", "2"], "--rounds"),
+        (["analyze", "x.isf", "--shot", "1"], "--shot"),
+        (["analyze", "x.isf", "--shot", "-1"], "--shot"),
+        (["analyze", "x.isf", "--shot", "1,0"], "--shot"),
+    ]
+    return cases
+
+
+FLAG_CASES = _flag_cases()
+
+
+def _isf(points=4, ymult="1E-3", xincr="1E-6", nr_pt=None, byt_nr="1", curve=None, header_extra="") -> bytes:
+    """An ISF file (8-bit codes) whose fields a case spoils."""
+    data = bytes(range(points)) if curve is None else curve
+    nr = points if nr_pt is None else nr_pt
+    head = (f':WFMPRE:BYT_NR {byt_nr};BIT_NR 8;ENCDG BIN;BN_FMT RI;BYT_OR MSB;NR_PT {nr};WFID "Ch1, DC coupling";'
+            f'PT_FMT Y;XUNIT "s";XINCR {xincr};XZERO 0;PT_OFF 0;YUNIT "V";YMULT {ymult};YOFF 0;YZERO 0;'
+            f'{header_extra}:CURVE #{len(str(len(data)))}{len(data)}')
+    return head.encode() + data
+
+
+CSV_HEAD = "Record Length,4,,\nSample Interval,1e-06,,\nTrigger Point,0,,\nSource,CH1,,\n"
+SCOPE_FILES = {
+    "one_point.isf": _isf(points=1),
+    "ymult_zero.isf": _isf(ymult="0"),
+    "ymult_nan.isf": _isf(ymult="NAN"),
+    "ymult_text.isf": _isf(ymult="abc"),
+    "xincr_zero.isf": _isf(xincr="0"),
+    "xincr_negative.isf": _isf(xincr="-1E-6"),
+    "xincr_text.isf": _isf(xincr="fast"),
+    "byt_nr_3.isf": _isf(byt_nr="3"),
+    "nr_pt_mismatch.isf": _isf(nr_pt=8),
+    "nr_pt_text.isf": _isf(nr_pt="many"),
+    "truncated.isf": _isf(points=100)[:-50],
+    "no_curve.isf": _isf().split(b":CURVE")[0],
+    "bad_block.isf": _isf().replace(b":CURVE #14", b":CURVE #x4"),
+    "not_ascii.isf": b":WFMPRE:BYT_NR 1;\xff\xfe\x00;NR_PT 4:CURVE #14abcd",
+    "missing_ymult.isf": _isf().replace(b"YMULT 1E-3;", b""),
+    "empty.isf": b"",
+    "text_in_data.csv": (CSV_HEAD + ",,0.0,0.1\n,,1e-6,abc\n,,2e-6,0.2\n,,3e-6,0.3\n").encode(),
+    "empty.csv": b"",
+    "only_header.csv": CSV_HEAD.encode(),
+    "binary.csv": bytes(range(256)) * 8,
+    "nan_time.csv": (CSV_HEAD + ",,nan,0.0\n,,nan,0.1\n,,nan,0.2\n,,nan,0.3\n").encode(),
+    "one_row.csv": (CSV_HEAD.replace("Record Length,4", "Record Length,1") + ",,0.0,0.1\n").encode(),
+    "junk.wfm": b"\x00\x01garbage" * 64,
+}
+FILE_CASES = [(cmd, name) for name in SCOPE_FILES for cmd in ("analyze", "import")]
+
+
+@pytest.fixture(autouse=True)
+def no_solve(monkeypatch):
+    """A bad input is refused before anything is solved: every solver entry point is a trap."""
+    import rig.fit.evaluate
+    import rig.solver.control
+    import rig.study.batch
+
+    def trap(*args, **kwargs):
+        raise AssertionError("solved: a bad input must be refused before any solve")
+
+    monkeypatch.setattr(rig.solver.control, "integrate_at", trap)
+    for module in (rig.fit.evaluate, rig.study.batch):
+        monkeypatch.setattr(module, "solve_ensemble", trap)
+
+
+def _line(capsys) -> str:
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert len(lines) == 1, f"expected one line on stderr, got {len(lines)}:\n{err}"
+    assert "Traceback" not in err
+    return lines[0]
+
+
+def _run(argv, d) -> int:
+    try:
+        return main([a.replace("{d}", str(d)) for a in argv])
+    except SystemExit as exc:  # argparse's own refusal
+        return exc.code
+
+
+def test_the_corpus_holds_300_cases_over_every_command_and_key():
+    total = len(SCENE_CASES) + len(FLAG_CASES) + len(FILE_CASES) + len(API_CASES)
+    assert total >= 300, total
+    keys = {k for k, spec in _keys() if isinstance(spec, str) or spec in (int, float, bool)}
+    assert keys <= {key for _, key in SCENE_CASES}  # every numeric and true/false key
+    assert {argv[0] for argv, _ in FLAG_CASES} >= {"shot", "sweep", "mc", "fit", "animate", "analyze", "theory",
+                                                    "bench"}
+
+
+@pytest.mark.parametrize("item,key", SCENE_CASES, ids=[c[0] for c in SCENE_CASES])
+def test_a_wrong_scene_value_is_one_line_naming_its_key(tmp_path, monkeypatch, capsys, item, key):
+    monkeypatch.chdir(tmp_path)
+    assert _run(["shot", S, "--set", item], tmp_path) == 2
+    line = _line(capsys)
+    assert key in line, line
+    value = item.split("=", 1)[1]
+    if re.search(r"\d,\d", value):
+        assert "use a decimal point" in line, line
+    elif re.search(r"\d[ _]\d", value):
+        assert "no thousands separator" in line, line
+
+
+@pytest.mark.parametrize("argv,needle", FLAG_CASES, ids=[" ".join(c[0])[:80] for c in FLAG_CASES])
+def test_a_wrong_option_is_one_line_naming_it(tmp_path, monkeypatch, capsys, argv, needle):
+    monkeypatch.chdir(tmp_path)
+    assert _run(argv, tmp_path) == 2
+    line = _line(capsys)
+    assert needle in line, line
+
+
+@pytest.mark.parametrize("command,name", FILE_CASES, ids=[f"{c} {n}" for c, n in FILE_CASES])
+def test_a_damaged_scope_file_is_one_line_naming_it(tmp_path, monkeypatch, capsys, command, name):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / name).write_bytes(SCOPE_FILES[name])
+    argv = [command, name] + (["--into", "a.h5"] if command == "import" else ["--gauge-distance", "43 mm"])
+    assert _run(argv, tmp_path) == 2
+    line = _line(capsys)
+    assert name in line, line
+    assert not (tmp_path / "a.h5").exists() or command != "import"  # nothing half-imported
+
+
+def _api_cases():
+    """(callable, what the message must name)."""
+    from rig.experiment.shot import Rig
+    from rig.model.chain import Chain
+    from rig.model.parts import Bead, Striker, Wall
+    from rig.solver.saveat import SaveAt
+    from rig.solver.solve import solve
+
+    chain = lambda: Chain([Bead("ptfe", 4.76e-3)] * 5, striker=Striker(), wall=Wall())  # noqa: E731
+    cases = [(lambda a=a: Rig.from_scene(a), "scene") for a in (None, 3, 2.5, "", [S], b"ptfe52_magnetic")]
+    cases += [(lambda o=o: Rig.from_scene(S, o), "overrides") for o in (None, "striker.velocity=1", [1], [None])]
+    cases += [(lambda s=s: Rig(s), "scene") for s in (None, S, {})]
+    cases += [(lambda v=v: Striker(velocity=v), "striker.velocity") for v in (0, -1, math.nan, math.inf, 1e-300, "1,2 m/s",
+                                                                          "1 kg", None, True)]
+    cases += [(lambda v=v: Striker(mass=v), "striker.mass") for v in (0, -1, math.nan, "0,47 g", "1 m")]
+    cases += [(lambda v=v: Bead("ptfe", v), "diameter") for v in (0, -1, math.nan, "4,76 mm", "1 kg", None)]
+    cases += [(lambda v=v: Bead(v, 4.76e-3), "material") for v in ("wood", 3, None)]
+    cases += [(lambda b=b: Chain(b), "beads") for b in ([], None, 3, ["ptfe"])]
+    cases += [(lambda t=t: solve(chain(), t), "t_end") for t in (0, -1, math.nan, math.inf, "1 ms", None)]
+    cases += [(lambda m=m: solve(chain(), 1e-4, method=m), "method") for m in ("euler", 3)]
+    cases += [(lambda a=a: solve(chain(), 1e-4, accuracy=a), "accuracy") for a in (0, -1, math.nan, 5, "1e-4")]
+    cases += [(lambda s=s: solve(chain(), 1e-4, save=s), "save") for s in ("all", 3, {"c": 1})]
+    cases += [(lambda h=h: SaveAt({"c": chain().contact_probe(2)}, sample_interval=h), "sample_interval")
+              for h in (0, -1, math.nan, math.inf, "1 us", None)]
+    cases += [(lambda p=p: SaveAt(p), "probes") for p in (None, 3, "c", {"c": 3})]
+    cases += [(lambda x=x: Chain([Bead("ptfe", 4.76e-3)] * 5, striker=x), "striker") for x in ("fast", 3)]
+    return cases
+
+
+API_CASES = _api_cases()
+
+
+@pytest.mark.parametrize("case", range(len(API_CASES)))
+def test_a_wrong_argument_to_the_api_raises_one_line(case):
+    call, needle = API_CASES[case]
+    with pytest.raises((RigError, InstrumentError)) as exc:
+        call()
+    message = str(exc.value)
+    assert "\n" not in message and needle in message, message
+
+
+@pytest.mark.parametrize("name,defect", [
+    ("one_point.isf", "NR_PT = 1: a record needs at least 2 points"),  # had been "another time base than ..."
+    ("ymult_zero.isf", "YMULT = 0.0: the volts per code must be a finite number other than 0"),
+    ("ymult_nan.isf", "YMULT = nan"),
+])
+def test_a_record_without_a_time_base_or_a_scale_names_the_header_field(tmp_path, capsys, name, defect):
+    path = tmp_path / name
+    path.write_bytes(SCOPE_FILES[name])
+    assert _run(["analyze", str(path), "--gauge-distance", "43 mm"], tmp_path) == 2
+    line = _line(capsys)
+    assert str(path) in line and defect in line, line
