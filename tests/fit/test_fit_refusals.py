@@ -90,7 +90,7 @@ def test_the_same_record_twice_is_refused(tmp_path, capsys):
     from instruments.formats.tek_csv import write_csv
     from rig.experiment.shot import Rig
 
-    (path,) = write_csv(Rig.from_scene(SCENE).fire(seed=3).scope.waveforms, tmp_path, "shot")
+    path = write_csv(Rig.from_scene(SCENE).fire(seed=3).scope.waveforms, tmp_path, "shot")[0]  # one file a channel
     copy = tmp_path / "copy.csv"
     shutil.copy(path, copy)
     for files in ([path, path], [path, copy]):
