@@ -96,7 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="also fit the PTFE model to the published experiment (Table 1) and compare its shots")
     rp.add_argument("--quiet", action="store_true", help="no progress bar")
 
-    fi = _command(sub, "fit", "fit scene keys to measured points or scope records", fitting.cmd_fit)
+    fi = _command(sub, "fit", "fit scene keys to measured points, scope records or observations", fitting.cmd_fit)
     fi.add_argument("scene", help="the model: a scene file, or a published scene's name")
     fi.add_argument("--param", action="append", metavar="KEY=LO:HI",
                     help="a scene key to fit with its bounds in units, e.g. 'chain.youngs_modulus=0.4 GPa:2 GPa' "
@@ -107,6 +107,9 @@ def build_parser() -> argparse.ArgumentParser:
     fi.add_argument("--points", metavar="TABLE.csv",
                     help="measured points: columns 'F_d [N]', 'F_d_sd [N]', 'V_s [m/s]', 'V_s_sd [m/s]' "
                          "and scene keys per row, e.g. 'magnet.force [N]'")
+    fi.add_argument("--observations", metavar="FILE.toml",
+                    help="observed figures of shots ([[observation]] kind, value, sd, scene, set, gauge: a speed, "
+                         "a gauge reading's peak, fwhm, duration, pulses, wall_peak, tail, ratio)")
     fi.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides of the scene")
     fi.add_argument("--out", required=True, metavar="DIR",
                     help="folder for fit.json, residuals.csv, fit.png, fitted.toml; its evaluations/ resume a fit")

@@ -28,9 +28,10 @@ def cmd_fit(args) -> dict:
     from rig.fit.parameters import parse_parameters
     from rig.fit.run import run_fit
 
-    sources = [s for s in ("records", "archive", "points") if getattr(args, s)]
+    sources = [s for s in ("records", "archive", "points", "observations") if getattr(args, s)]
     if len(sources) != 1:
-        raise RigError("no data to fit: give one of --records FILES, --archive A.h5 or --points TABLE.csv"
+        raise RigError("no data to fit: give one of --records FILES, --archive A.h5, --points TABLE.csv or "
+                       "--observations FILE.toml"
                        if not sources else f"give one kind of data, not {' and '.join('--' + s for s in sources)}")
     if args.shot is not None and not args.archive:
         raise invalid("--shot", args.shot, f"picks one shot of --archive A.h5, not of --{sources[0]}")
@@ -44,7 +45,13 @@ def cmd_fit(args) -> dict:
         check(args.walkers, len(params))
     overrides = list(args.set or [])
     scene_io.load(args.scene, overrides)  # the scene and its overrides, checked before any work
-    if args.points:
+    if args.observations:
+        from rig.fit.observations.objective import ObservationObjective
+        from rig.fit.observations.reading import read_observations
+
+        observations = read_observations(args.observations, args.scene)
+        objective = ObservationObjective(args.scene, params, observations, overrides, args.observations)
+    elif args.points:
         from rig.fit.data import read_points
         from rig.fit.points import PointObjective
 

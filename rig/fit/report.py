@@ -12,6 +12,7 @@ from instruments.files import atomic_write
 from rig.experiment import scene as scene_io
 from rig.fit.checks import result_warnings, unusable
 from rig.fit.fitting import FitResult
+from rig.fit.observations.objective import ObservationObjective
 from rig.fit.points import PointObjective
 
 
@@ -74,7 +75,10 @@ def _residuals(path, objective, result: FitResult):
     model = result.model
     with open(path, "w", newline="") as fh:
         wr = csv.writer(fh)
-        if isinstance(objective, PointObjective):
+        if isinstance(objective, ObservationObjective):
+            wr.writerow(objective.ROW_HEADER)
+            wr.writerows(objective.rows(model, result.residuals))
+        elif isinstance(objective, PointObjective):
             p = objective.points
             V, _ = objective.model_speeds(model)
             wr.writerow(["F_d [N]", "V_s [m/s]", "V_s model [m/s]", "relative (model / measured - 1)",
@@ -101,7 +105,17 @@ def draw(path: Path, objective, result: FitResult):
     from rig.viz.figures import save
 
     model = result.model
-    if isinstance(objective, PointObjective):
+    if isinstance(objective, ObservationObjective):
+        fig, ax = plt.subplots(figsize=(6.4, 0.8 + 0.35 * len(objective.observations)))
+        y = np.arange(len(objective.observations))[::-1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ax.errorbar(np.ones(y.size), y, xerr=objective.sd / np.abs(objective.value), fmt="o", color="0.4",
+                        capsize=2, label="observed (1 sd)")
+            ax.plot(model / objective.value, y, "D", color="C3", label="fitted model")
+        ax.set_yticks(y, [f"{o.kind} {o.gauge} {o.shot.scene}".strip() for o in objective.observations], fontsize=7)
+        ax.set_xlabel("figure / observed value")
+        ax.legend(fontsize=7)
+    elif isinstance(objective, PointObjective):
         p = objective.points
         fig, ax = plt.subplots(figsize=(6.4, 4.6))
         for c, (config, curve) in enumerate(zip(objective.configs, model)):

@@ -1,0 +1,160 @@
+"""Figures of a force signal, pure numpy on (t, f): t the sample times (s, uniform), f a
+dynamic force (N, its static value removed: baseline 0). Each returns nan where the figure
+is not defined on the signal (no pulse, a pulse cut off by the record's end), never None.
+
+The leading pulse is the measurement pipeline's (instruments.analysis: the first pulse
+above 30% of the record's largest, its peak time and amplitude from a parabola through its
+top), so these figures and `rig shot`'s analysis agree on which pulse they describe.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from instruments.analysis import Pulse, find_pulses, leading
+
+DURATION_LEVEL = 0.1
+"""A pulse's full duration runs from its rise through this fraction of its amplitude."""
+TRAIN_HEIGHT = 0.1
+"""A pulse of a train stands at least this fraction of the leading pulse's amplitude."""
+TRAIN_DIP = 0.5
+"""Two maxima are two pulses where the signal between them falls below this fraction of
+the smaller one (a shoulder or a ripple on one pulse is not a second pulse)."""
+TAIL_LEVEL = 0.01
+"""The tail begins where the leading pulse has fallen to this fraction of its amplitude
+(or at its first minimum, where that comes first): the pipeline's base level."""
+TAIL_WINDOW = 100e-6
+"""s: the running mean that the tail's excursion is measured about."""
+TAIL_SPAN = 400e-6
+"""s: how long after the leading pulse's end the tail is examined."""
+
+
+def leading_pulse(t: np.ndarray, f: np.ndarray) -> Pulse | None:
+    """The pipeline's leading pulse of f (None where f has no pulse)."""
+    f = np.ascontiguousarray(f, dtype=float)
+    return leading(find_pulses(np.asarray(t, dtype=float), f)) if f.size >= 3 else None
+
+
+def peak(t: np.ndarray, f: np.ndarray) -> float:
+    """The leading pulse's amplitude (f's unit, from the parabola through its top)."""
+    p = leading_pulse(t, f)
+    return math.nan if p is None else p.amplitude
+
+
+def fwhm(t: np.ndarray, f: np.ndarray) -> float:
+    """The leading pulse's full width at half its amplitude (s; the crossings of 50% of the
+    amplitude, interpolated linearly between samples)."""
+    p = leading_pulse(t, f)
+    return math.nan if p is None else p.fwhm
+
+
+def _top_index(t: np.ndarray, f: np.ndarray, p: Pulse) -> int:
+    """The sample of p's maximum."""
+    h = t[1] - t[0]
+    i = int(np.clip(np.rint((p.time - t[0]) / h), 0, f.size - 1))
+    lo, hi = max(i - 3, 0), min(i + 4, f.size)
+    return lo + int(np.argmax(f[lo:hi]))
+
+
+def _crossing(t: np.ndarray, f: np.ndarray, k: int, level: float) -> float:
+    """Where f crosses ``level`` between samples k and k + 1 (s, linear)."""
+    return float(t[k] + (level - f[k]) / (f[k + 1] - f[k]) * (t[k + 1] - t[k]))
+
+
+def pulse_span(t: np.ndarray, f: np.ndarray, level: float = DURATION_LEVEL) -> tuple:
+    """(start, end) of the leading pulse (s): start where it rises through ``level`` x its
+    amplitude, end the earlier of where it falls through that level and its first minimum
+    after the peak (a parabola's vertex through the minimum's samples: in a train the next
+    pulse rises before this one has fallen). (nan, nan) where the record has no pulse or cuts
+    it off."""
+    t, f = np.asarray(t, dtype=float), np.asarray(f, dtype=float)
+    p = leading_pulse(t, f)
+    if p is None:
+        return math.nan, math.nan
+    i, cut = _top_index(t, f, p), level * p.amplitude
+    below = np.flatnonzero(f[:i + 1] <= cut)
+    if not below.size:
+        return math.nan, math.nan
+    start = _crossing(t, f, int(below[-1]), cut)
+    after = f[i:]
+    fall = np.flatnonzero(after <= cut)
+    end = _crossing(t, f, i + int(fall[0]) - 1, cut) if fall.size else math.inf
+    d = np.diff(after)
+    turn = np.flatnonzero((d[:-1] <= 0) & (d[1:] > 0))
+    if turn.size:
+        m = i + int(turn[0]) + 1  # the first sample after the peak with f rising after it
+        den = f[m - 1] - 2.0 * f[m] + f[m + 1]
+        shift = 0.5 * (f[m - 1] - f[m + 1]) / den if den > 0 else 0.0
+        end = min(end, float(t[m] + shift * (t[1] - t[0])))
+    return (start, end) if math.isfinite(end) else (math.nan, math.nan)
+
+
+def full_duration(t: np.ndarray, f: np.ndarray, level: float = DURATION_LEVEL) -> float:
+    """The leading pulse's full duration (s): from its rise through ``level`` (10%) of its
+    amplitude to the earlier of its fall through that level and its first minimum after
+    the peak (pulse_span)."""
+    start, end = pulse_span(t, f, level)
+    return end - start
+
+
+def pulses_in_train(t: np.ndarray, f: np.ndarray, until: float = math.inf, height: float = TRAIN_HEIGHT,
+                    dip: float = TRAIN_DIP) -> float:
+    """How many pulses the train has, the leading one included, up to time ``until`` (s):
+    local maxima from the leading pulse on that stand at least ``height`` (10%) of the
+    leading pulse's amplitude, each counted where the signal fell below ``dip`` (50%) of
+    the smaller of it and the last counted pulse in between (else it is the same pulse: a
+    higher crest of it replaces the last one). Pulses before the leading one (a precursor
+    below 30% of the largest) are not counted. nan without a pulse."""
+    t, f = np.asarray(t, dtype=float), np.asarray(f, dtype=float)
+    p = leading_pulse(t, f)
+    if p is None:
+        return math.nan
+    i = _top_index(t, f, p)
+    stop = int(np.searchsorted(t, until, side="right")) if math.isfinite(until) else f.size
+    seg = f[i:stop]
+    tops = 1 + np.flatnonzero((seg[1:-1] > seg[:-2]) & (seg[1:-1] >= seg[2:]))
+    count, last = 1, 0
+    for k in tops:
+        low = float(np.min(seg[last:k]))
+        if seg[k] >= height * p.amplitude and low <= dip * min(seg[last], seg[k]):
+            count, last = count + 1, k
+        elif seg[k] > seg[last] and low > dip * min(seg[last], seg[k]):
+            last = k
+    return float(count)
+
+
+def tail_excursion(t: np.ndarray, f: np.ndarray, until: float = math.inf, window: float = TAIL_WINDOW,
+                   span: float = TAIL_SPAN) -> float:
+    """The oscillating tail after the leading pulse, relative to that pulse: over the
+    ``span`` (400 us) after the pulse's end (pulse_span at TAIL_LEVEL, 1%: the earlier of its
+    fall to 1% and its first minimum; at most to ``until``, s), half the
+    peak-to-peak excursion of f about its centred running mean over ``window`` (100 us),
+    divided by the leading pulse's amplitude. A sine of amplitude a on a slow drift gives
+    a / amplitude (the mean follows a drift that is linear over the window). nan where the
+    tail is shorter than the window or there is no pulse."""
+    t, f = np.asarray(t, dtype=float), np.asarray(f, dtype=float)
+    p = leading_pulse(t, f)
+    _, end = pulse_span(t, f, TAIL_LEVEL)
+    if p is None or not math.isfinite(end):
+        return math.nan
+    h = t[1] - t[0]
+    seg = f[(t >= end) & (t <= min(end + span, until))]
+    n = 2 * int(round(0.5 * window / h)) + 1
+    if seg.size <= n:
+        return math.nan
+    c = np.concatenate(([0.0], np.cumsum(seg)))
+    mean = (c[n:] - c[:-n]) / n
+    r = seg[n // 2: n // 2 + mean.size] - mean
+    return float(0.5 * (np.max(r) - np.min(r)) / p.amplitude)
+
+
+def pulse_speed(t: np.ndarray, f_from: np.ndarray, f_to: np.ndarray, distance: float) -> float:
+    """The leading pulse's speed (m/s) over ``distance`` (m) from the bead of f_from to the
+    bead of f_to: the distance over the time between the leading pulse's peaks (the
+    pipeline's time of flight between maxima, Daraio et al. 2006). nan where either has no
+    pulse or they come in the wrong order."""
+    a, b = leading_pulse(t, f_from), leading_pulse(t, f_to)
+    if a is None or b is None or not b.time > a.time:
+        return math.nan
+    return float(distance / (b.time - a.time))
