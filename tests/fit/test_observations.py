@@ -194,3 +194,11 @@ def test_bad_files_and_combinations_are_one_line_exit_2(tmp_path, capsys, text, 
     for w in words:
         assert w in err, (w, err)
     assert not (folder / "fit.json").exists()
+
+
+def test_a_missing_observations_file_is_one_line_exit_2(tmp_path, capsys):
+    missing = tmp_path / "none.toml"
+    code = main(["fit", SCENE, "--observations", str(missing), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+                 "--out", str(tmp_path / "fit")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "--observations" in err and "cannot read" in err, err
