@@ -12,7 +12,7 @@ from instruments.files import atomic_write
 from rig.experiment import scene as scene_io
 from rig.fit.checks import result_warnings, unusable
 from rig.fit.fitting import FitResult
-from rig.fit.observations.objective import ObservationObjective
+from rig.fit.observations.objective import NO_FIGURE, ObservationObjective
 from rig.fit.points import PointObjective
 
 
@@ -23,9 +23,10 @@ def summary(result: FitResult, objective, fitted_scene) -> dict:
     verdict on the model (None without degrees of freedom); interval_scale: sqrt(chi2/dof)
     where above 1, the factor already in the sds; undetermined: keys whose 95% interval
     passes both their bounds; unusable: why a converged fit writes no fitted scene (None where it does);
-    warnings: rig.fit.checks.result_warnings.
+    warnings: rig.fit.checks.result_warnings; observations (an observations fit): each
+    observation's observed value, sd, model figure (None where it has none) and residual.
     chi2_reduced and p_value are None where undefined (no degrees of freedom)."""
-    return {
+    block = {
         "parameters": {k: {"estimate": float(e), "std": float(s), "ci95": [float(lo), float(hi)], "unit": u}
                        for k, u, e, s, (lo, hi) in zip(result.keys, result.units, result.estimate, result.std,
                                                         result.ci95)},
@@ -45,6 +46,12 @@ def summary(result: FitResult, objective, fitted_scene) -> dict:
         "fitted_scene": None if fitted_scene is None else str(fitted_scene),
         "numerics": objective.numerics(result.estimate),
     }
+    if isinstance(objective, ObservationObjective):
+        block["observations"] = objective.figures(result.model, result.residuals)
+        block["warnings"] += [f"{o['observation']}: the fitted model gives no {o['kind']} (a shot refused or blown "
+                              f"up, or no pulse to measure); its residual counts as {NO_FIGURE:g} sd"
+                              for o in block["observations"] if o["model"] is None]
+    return block
 
 
 def _finite_or_none(x: float):
@@ -106,14 +113,13 @@ def draw(path: Path, objective, result: FitResult):
 
     model = result.model
     if isinstance(objective, ObservationObjective):
-        fig, ax = plt.subplots(figsize=(6.4, 0.8 + 0.35 * len(objective.observations)))
+        fig, ax = plt.subplots(figsize=(6.4, 1.2 + 0.35 * len(objective.observations)))
         y = np.arange(len(objective.observations))[::-1]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ax.errorbar(np.ones(y.size), y, xerr=objective.sd / np.abs(objective.value), fmt="o", color="0.4",
-                        capsize=2, label="observed (1 sd)")
-            ax.plot(model / objective.value, y, "D", color="C3", label="fitted model")
-        ax.set_yticks(y, [f"{o.kind} {o.gauge} {o.shot.scene}".strip() for o in objective.observations], fontsize=7)
-        ax.set_xlabel("figure / observed value")
+        ax.axvspan(-1.0, 1.0, color="0.85", label="observed +- 1 sd")
+        ax.plot(np.clip(result.residuals, -10.0, 10.0), y, "D", color="C3", label="fitted model")
+        ax.set_yticks(y, [" ".join(x for x in (o.kind, o.of, o.gauge, o.shot.scene) if x)
+                          for o in objective.observations], fontsize=7)
+        ax.set_xlabel("(model - observed) / sd  (clipped at +-10)")
         ax.legend(fontsize=7)
     elif isinstance(objective, PointObjective):
         p = objective.points

@@ -137,6 +137,9 @@ def test_fit_recovers_the_modulus_from_its_own_figures(tmp_path, capsys, truths)
     assert abs(e["estimate"] - E_TRUE) < 0.02 * E_TRUE, e  # noise-free figures: the optimum is the truth
     assert e["ci95"][1] - e["ci95"][0] < 0.5 * (3e9 - 0.5e9), e
     assert block["chi2_reduced"] < 0.1 and block["fitted_scene"], block
+    figures = block["observations"]
+    assert [o["kind"] for o in figures] == ["speed", "duration", "wall_peak", "ratio of peak"]
+    assert all(abs(o["model"] / o["observed"] - 1) < 0.02 for o in figures), figures
     rows = (folder / "residuals.csv").read_text().splitlines()
     assert len(rows) == 1 + len(entries) and "ratio of peak" in rows[-1]
 
@@ -185,6 +188,7 @@ def test_bad_observations_are_one_line_exit_2(tmp_path, capsys, entry, words):
     (_toml([GOOD]), ["chain.youngs_modulus=3 GPa:0.5 GPa"], (), ["chain.youngs_modulus", "LO < HI"]),
     (_toml([GOOD]), ["chain.youngs_modulus=0.5 GPa:3 GPa", "chain.contact_exponent=1.2:2.4"], (),
      ["1 data for 2 --param"]),
+    (_toml([GOOD]), ["scope.noise_floor=0.1 mV:1 mV"], (), ["scope.noise_floor", "the data do not see it"]),
     (_toml([GOOD]), ["chain.youngs_modulus=0.5 GPa:3 GPa"], ("--points", "p.csv"),
      ["--points and --observations"]),
 ])

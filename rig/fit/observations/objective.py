@@ -134,6 +134,13 @@ class ObservationObjective:
                  + ("" if o.over is None else f" / {o.over.label()}"), o.unit, o.value, o.sd, float(m), float(r)]
                 for o, m, r in zip(self.observations, model, residuals)]
 
+    def figures(self, model, residuals) -> list:
+        """[{observation, kind, gauge, shot, unit, observed, sd, model, residual}] for fit.json
+        (model None where the fitted model gives no figure)."""
+        return [dict(zip(("observation", "kind", "gauge", "shot", "unit", "observed", "sd", "model", "residual"),
+                         row[:7] + [row[7] if math.isfinite(row[7]) else None, row[8]]))
+                for row in self.rows(model, residuals)]
+
     ROW_HEADER = ["observation", "kind", "gauge", "shot", "unit", "observed", "sd", "model",
                   "normalised (model - observed) / sd"]
 
