@@ -38,17 +38,50 @@ def is_whole(x) -> bool:
 
 
 _DECIMAL_COMMA = re.compile(r"\d,\d")
-_GROUPED = re.compile(r"\d(?:[_'’\u00a0\u202f]|\s+)\d")  # 1_000, 1'000, 1 000
+_SEPARATOR = r"(?:[_'’\u00a0\u202f]|\s+)"
+_GROUPED = re.compile(rf"\d{_SEPARATOR}\d")  # 1_000, 1'000, 1 000
+_NUMBER_TEXT = r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?"
+_UNIT_FACTOR = r"[^\W\d_]+(?:\s*(?:\^|\*\*)\s*[-+]?[0-9]+(?:\.[0-9]+)?)?"
+_UNIT_TEXT = rf"{_UNIT_FACTOR}(?:\s*[*/]\s*{_UNIT_FACTOR}|\s+{_UNIT_FACTOR})*"
+_PLAIN = re.compile(rf"\s*({_NUMBER_TEXT})\s*$")
+_QUANTITY = re.compile(rf"\s*({_NUMBER_TEXT})\s*({_UNIT_TEXT})\s*$")
 
 
 def check_digits(text: str, field: str):
     """Refuse a decimal comma ("1,2") or a thousands separator ("1 000", "1_000", "1'000")
     in the text of a number or a quantity, naming ``field``: Python and pint would read
-    "1,2" as 12 and "1 200" as 1 x 200."""
+    "1,2" as 12 and "1 200" as 1 x 200. The example given is the text's own number
+    written without the separator."""
     if _DECIMAL_COMMA.search(text):
         raise invalid(field, text, "use a decimal point and no thousands separator (1.2, 1200)")
-    if _GROUPED.search(text):
-        raise invalid(field, text, "one number, no thousands separator (1200)")
+    grouped = _GROUPED.search(text)
+    if grouped:
+        run = re.search(rf"[0-9]+(?:{_SEPARATOR}[0-9]+)+", text[grouped.start():])
+        example = re.sub(_SEPARATOR, "", run.group(0)) if run else "1200"
+        raise invalid(field, text, f"one number, no thousands separator ({example})")
+
+
+def is_number(text) -> bool:
+    """``text`` is one plain number as the rig reads it: an optional sign, ASCII digits with
+    at most one decimal point, an optional exponent that is a whole number ("1.5e-3");
+    no unit, no expression ("2*0.5", "1.2.3"), no other script's digits."""
+    return isinstance(text, str) and _PLAIN.match(text) is not None
+
+
+def split_quantity(text: str, field: str, unit: str) -> tuple:
+    """(number text, unit text) of a quantity's text: ONE number (``is_number``) followed
+    by a unit expression of unit names joined by '*', '/' or spaces, each with an optional
+    exponent after '^' or '**' ("m/s", "N/m^1.5", "kg m^-3", "µs"); anything else
+    ("2.3.8 N", "0.5(2) m", "1e-1.5 m/s", "2*0.5 m") is refused naming ``field``."""
+    check_digits(text, field)
+    m = _QUANTITY.match(text)
+    if not m:
+        raise invalid(field, text, f"not a quantity: one number and a unit, e.g. '1.5 {unit}' (digits 0-9, one decimal point, "
+                                   "a whole-number exponent; no arithmetic)")
+    if m.end(1) == m.start(2) and m.group(2)[0] in "jJ":  # Python and pint read "5J" as 5j
+        raise invalid(field, text, f"not a quantity: '{m.group(0).strip()}' reads as a complex number; "
+                                   f"a space between the number and the unit: '{m.group(1)} {m.group(2)}'")
+    return m.group(1), m.group(2)
 
 
 def number(text, field: str, allowed: str = "a finite number") -> float:
@@ -58,10 +91,9 @@ def number(text, field: str, allowed: str = "a finite number") -> float:
         value = float(text)
     elif isinstance(text, str):
         check_digits(text, field)
-        try:
-            value = float(text)
-        except ValueError:
-            raise invalid(field, text, allowed) from None
+        if not is_number(text):
+            raise invalid(field, text, allowed)
+        value = float(text)
     else:
         raise invalid(field, text, allowed)
     if not math.isfinite(value):
@@ -83,11 +115,8 @@ def typed_quantity(text: str, unit: str | None, field: str) -> float:
     """A value as typed on the command line: a plain number is taken in ``unit`` (SI), text
     with a unit is converted to it; ``unit`` None: a plain number only."""
     check_digits(text, field)
-    try:
-        float(text)
-    except ValueError:
-        if unit is not None:
-            return quantity(text, unit, field)
+    if unit is not None and not is_number(text):
+        return quantity(text, unit, field)
     return number(text, field, "a finite number" + (f" (plain number: {unit})" if unit else ""))
 
 
@@ -121,7 +150,6 @@ _UNITS = {"m": (1.0, (0, 1, 0, 0)), "g": (1e-3, (1, 0, 0, 0)), "s": (1.0, (0, 0,
           "Hz": (1.0, (0, 0, -1, 0)), "A": (1.0, (0, 0, 0, 1)), "J": (1.0, (1, 2, -2, 0))}
 _PREFIXES = {"": 1.0, "G": 1e9, "M": 1e6, "k": 1e3, "c": 1e-2, "m": 1e-3, "u": 1e-6, "µ": 1e-6,
              "μ": 1e-6, "n": 1e-9, "p": 1e-12}
-_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)\s*$")
 _FACTOR = re.compile(r"([A-Za-zµμ]+)(?:(?:\^|\*\*)(-?\d+))?$")
 
 
@@ -148,27 +176,27 @@ def _si(unit: str):
     return factor, tuple(dims)
 
 
-def _fast(text: str, unit: str):
-    """The SI value of ``text`` by the table, or None where pint must decide."""
-    m = _NUMBER.match(text)
-    if not m or (m.end(1) == m.start(2) and m.group(2)[0] in "jJ"):  # pint reads "5J" as Python's 5j
-        return None
-    have, want = _si(m.group(2)), _si(unit)
+def _fast(value: str, unit_text: str, unit: str):
+    """The SI value of the number ``value`` in ``unit_text`` by the table, or None where
+    pint must decide."""
+    have, want = _si(unit_text), _si(unit)
     if have is None or want is None or have[1] != want[1]:
         return None
-    return float(f"{float(m.group(1)) * have[0] / want[0]:.15g}")
+    return float(f"{float(value) * have[0] / want[0]:.15g}")
 
 
 def _parse(text: str, unit: str, field: str) -> float:
-    check_digits(text, field)
-    fast = _fast(text, unit)
+    if is_number(text):
+        raise invalid(field, text, f"a unit is required, e.g. '{text.strip()} {unit}'")
+    value, unit_text = split_quantity(text, field, unit)
+    fast = _fast(value, unit_text, unit)
     if fast is not None:
         return fast
     import pint
 
     ureg = _registry()
     try:
-        q = ureg.Quantity(text.strip())
+        q = ureg.Quantity(f"{value} {unit_text}")
     except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError) as exc:
         raise invalid(field, text, f"not a quantity in {unit} ({exc})") from None
     if q.unitless:
@@ -181,4 +209,4 @@ def _parse(text: str, unit: str, field: str) -> float:
     return float(f"{si:.15g}")
 
 
-__all__ = ["RigError", "number", "quantity", "typed_quantity", "whole"]
+__all__ = ["RigError", "is_number", "number", "quantity", "split_quantity", "typed_quantity", "whole"]

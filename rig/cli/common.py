@@ -108,15 +108,15 @@ def fraction_arg(text: str) -> float:
 
 
 def plain(convert):
-    """An argparse type: ``convert`` (int or float) of a text that has no decimal comma and
-    no thousands separator (Python's int and float read "1_000"); the range is the
-    library's to check, which names the option."""
+    """An argparse type: ``convert`` (int or float) of a text that is one plain number as
+    ``rig.units.number`` reads it (Python's int and float read "1_000", "١" and " inf "); the
+    range is the library's to check, which names the option."""
     def parse(text: str):
         from rig.errors import RigError
-        from rig.units import check_digits
+        from rig.units import number
 
         try:
-            check_digits(text, "value")
+            number(text, "value", "one plain number (digits 0-9, one decimal point, a whole-number exponent)")
         except RigError as exc:
             raise refusal(exc, "value") from None
         return convert(text)

@@ -24,7 +24,7 @@ import numpy as np
 
 from rig.errors import RigError, invalid
 from rig.experiment.scene import schema_node
-from rig.units import check_digits, quantity
+from rig.units import check_digits, is_number, quantity
 
 POINT_COLUMNS = {"F_d": "N", "F_d_sd": "N", "V_s": "m/s", "V_s_sd": "m/s"}
 _HEADER = re.compile(r"^\s*([A-Za-z_][\w.]*)\s*(?:\[(.+)\])?\s*$")
@@ -99,8 +99,10 @@ def read_points(path) -> Points:
         for (name, unit, si), cell in zip(columns, row):
             check_digits(cell, f"--points {path} line {i} {name}")
             try:
+                if not is_number(cell):
+                    raise RigError(cell)
                 x = float(cell) if si == "1" else quantity(f"{cell.strip()} {unit}", si, name)
-            except (ValueError, RigError):
+            except RigError:
                 raise invalid(f"--points {path} line {i} {name}", cell, f"a number in {unit or 'no unit'}") from None
             if not math.isfinite(x):
                 raise invalid(f"--points {path} line {i} {name}", cell, "a finite number")

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 from rig.errors import RigError, invalid
 from rig.experiment.scene import key_spec
-from rig.units import check_digits, number, quantity
+from rig.units import check_digits, is_number, number, quantity
 
 POSITIVE_LAW_KEYS = {"chain.damping_time": "kuwabara-kono", "chain.contact_damping": "dashpot"}
 """Keys that switch their contact law on (the law needs them > 0)."""
@@ -54,12 +54,9 @@ def parse_parameter(text: str) -> FitParameter:
         if unit == "1":
             values.append(number(t, field, "a finite number (this key has no unit)"))
             continue
-        try:
-            float(t)
-        except ValueError:
-            values.append(quantity(t, unit, field))
-        else:
+        if is_number(t):
             raise invalid(field, t, f"bounds need units, e.g. '{t} {unit}'")
+        values.append(quantity(t, unit, field))
     lo, hi = values
     if not lo < hi:
         raise invalid(f"--param {key}", bounds, "needs LO < HI, the lower bound first")

@@ -36,6 +36,9 @@ def _keys(node=SCHEMA, prefix=""):
             yield name, spec
 
 
+NOT_ONE_NUMBER = ["2.3.8", "1.000.000", "2*0.5", "1/2", "0.5(2)", "2**-1", "1e-1.5", "\u0661", "\uff11"]
+"""Texts that are not one number (several dots, arithmetic, a fractional exponent, digits of
+another script): they had been read as a product (2.3 x 0.8), an expression or a 1."""
 WRONG_UNIT = {"kg": "1 m", "m": "1 kg"}  # a quantity of another dimension
 POSITIVE = {"chain.diameter", "chain.mass", "chain.reference_force", "chain.youngs_modulus",
             "chain.magnetic_youngs_modulus", "striker.mass", "striker.velocity", "striker.diameter",
@@ -57,10 +60,11 @@ def _scene_cases():
             bad = ["nan", "inf", "-inf", "abc", "", "1,2", f"1,5 {spec}", f"1 200 {spec}", "1_000", "1e999",
                    f"nan {spec}", WRONG_UNIT.get(spec, "1 kg")]
             bad += ["0", "-1", f"-3 {spec}"] if key in POSITIVE else []
+            bad += [f"{text} {spec}" for text in NOT_ONE_NUMBER]
         elif spec is int:
-            bad = ["2.5", "abc", "", "1,0", "1 000", "nan", "inf", "-1", "0", "true"]
+            bad = ["2.5", "abc", "", "1,0", "1 000", "nan", "inf", "-1", "0", "true"] + NOT_ONE_NUMBER
         elif spec is float:
-            bad = ["abc", "", "0,5", "nan", "inf", "1 m", "1_0"]
+            bad = ["abc", "", "0,5", "nan", "inf", "1 m", "1_0"] + NOT_ONE_NUMBER
         elif spec is bool:
             bad = ["maybe", "1", "", "yes"]
         elif key in CHOICES:
@@ -136,6 +140,25 @@ def _flag_cases():
                   "chain.contact_exponent=1.2:2,4", "chain.contact_exponent=a:b", "chain.contact_exponent=1.2 m:2",
                   "chain.material=a:b", "nosuch=1:2", "chain.damping_time=0 s:1 ms", "chain.youngs_modulus=nan GPa:2 GPa"]:
         cases.append((["fit", S, "--param", value, "--points", "p.csv", "--out", out], "--param"))
+    for text in NOT_ONE_NUMBER:  # one number in every command, every kind of value
+        cases += [(["shot", S, "--set", f"magnet.force={text} N"], "magnet.force"),
+                  (["sweep", S, "--vary", "striker.velocity=0.3:1.5:3", "--set", f"magnet.force={text} N"],
+                   "magnet.force"),
+                  (["mc", S, "--shots", "8", "--vary", VEL, "--set", f"striker.mass={text} g", "--out", out],
+                   "striker.mass"),
+                  (["fit", S, "--param", YM, "--points", "p.csv", "--set", f"magnet.force={text} N", "--out", out],
+                   "magnet.force"),
+                  (["animate", S, "--out", "{d}/m.gif", "--set", f"striker.velocity={text} m/s"], "striker.velocity"),
+                  (["theory", "--f0", "1", "--diameter", f"{text} mm"], "--diameter"),
+                  (["theory", "--f0", f"{text}"], "--f0"),
+                  (["analyze", "x.isf", f"--gauge-distance={text} mm"], "--gauge-distance"),
+                  (["analyze", "x.isf", f"--beta={text}"], "--beta"),
+                  (["animate", S, "--out", "{d}/m.gif", "--frames", text], "--frames"),
+                  (["mc", S, "--shots", "8", "--vary", f"striker.velocity=normal({text} m/s, 0.01 m/s)", "--out", out],
+                   "--vary"),
+                  (["sweep", S, "--vary", f"striker.velocity={text}:1.5:3"], "--vary"),
+                  (["fit", S, "--param", f"chain.youngs_modulus={text} GPa:4 GPa", "--points", "p.csv", "--out", out],
+                   "--param")]
     # options given where they do nothing
     cases += [
         (["shot", S, "--format", "csv"], "--format"),
@@ -254,6 +277,7 @@ def test_a_wrong_scene_value_is_one_line_naming_its_key(tmp_path, monkeypatch, c
         assert "use a decimal point" in line, line
     elif re.search(r"\d[ _]\d", value):
         assert "no thousands separator" in line, line
+        assert re.sub(r"(\d)[ _](?=\d)", r"\1", value).split()[0] in line, line  # the example is its own number
 
 
 @pytest.mark.parametrize("argv,needle", FLAG_CASES, ids=[" ".join(c[0])[:80] for c in FLAG_CASES])
