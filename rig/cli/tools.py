@@ -9,10 +9,14 @@ from rig.units import typed_quantity
 
 
 def cmd_theory(args) -> dict:
+    """The long-wave speeds, Eqs (2), (1), (4), and the exact discrete solitary wave's (in
+    the long-wave theory's frame, contacts per second times the diameter, so that its ratio
+    to Eq (4) depends on F_m/F_0 alone). A figure that cannot be computed is null, with its
+    reason in "reasons" (and a line of the text output)."""
     from rig.model.contact import hertz_constant
     from rig.model.materials import material
     from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed, sound_speed
-    from rig.theory.solitary import MIN_FORCE_RATIO, solitary_wave
+    from rig.theory.solitary import MIN_FORCE_RATIO, overlap_reason, solitary_wave
 
     m = material(args.material)
     a = typed_quantity(args.diameter, "m", "--diameter")
@@ -21,30 +25,51 @@ def cmd_theory(args) -> dict:
         raise RigError(f"--diameter = {args.diameter!r}: must be > 0 m")
     if not 0 <= F0 < math.inf:
         raise RigError(f"--f0 = {args.f0!r}: precompression must be >= 0 N")
-    out = {"material": m.name, "diameter_m": a, "f0_N": F0, "fm_N": None,
-           "sound_speed_m_per_s": float(sound_speed(m.E, m.nu, m.rho, a, F0)),
-           "speed_m_per_s": None, "sonic_vacuum_speed_m_per_s": None,
-           "discrete_speed_m_per_s": None}
-    if args.fm is not None:
-        Fm = typed_quantity(args.fm, "N", "--fm")
-        if not Fm > F0:
-            raise RigError(f"--fm = {args.fm!r}: the maximum force must exceed --f0 = {F0} N")
+    A = hertz_constant(m.E, m.nu, a / 2, m.E, m.nu, a / 2)
+    out = {"material": m.name, "diameter_m": a, "f0_N": F0, "fm_N": None, "sound_speed_m_per_s": None,
+           "speed_m_per_s": None, "sonic_vacuum_speed_m_per_s": None, "discrete_speed_m_per_s": None,
+           "discrete_lab_speed_m_per_s": None, "reasons": {}}
+    reasons = out["reasons"]
+    static = overlap_reason(A, a, F0)
+    if static:
+        reasons["sound_speed_m_per_s"] = f"--f0: {static}"
+    else:
+        out["sound_speed_m_per_s"] = float(sound_speed(m.E, m.nu, m.rho, a, F0))
+    wave_keys = ("speed_m_per_s", "sonic_vacuum_speed_m_per_s", "discrete_speed_m_per_s",
+                 "discrete_lab_speed_m_per_s")
+    Fm = None if args.fm is None else typed_quantity(args.fm, "N", "--fm")
+    dynamic = overlap_reason(A, a, Fm) if Fm is not None else None
+    if Fm is None:
+        reasons.update(dict.fromkeys(wave_keys, "no --fm (the wave's maximum force) given"))
+    elif not F0 < Fm < math.inf:
+        raise RigError(f"--fm = {args.fm!r}: the maximum force must exceed --f0 = {F0} N and be finite")
+    elif dynamic:
+        out["fm_N"] = Fm
+        reasons.update(dict.fromkeys(wave_keys, f"--fm: {dynamic}"))
+    else:
         out["fm_N"] = Fm
         out["sonic_vacuum_speed_m_per_s"] = float(sonic_vacuum_speed(m.E, m.nu, m.rho, a, Fm))
         out["speed_m_per_s"] = (float(solitary_wave_speed(m.E, m.nu, m.rho, a, F0, Fm)) if F0 > 0
                                 else out["sonic_vacuum_speed_m_per_s"])
-        if F0 == 0 or Fm >= MIN_FORCE_RATIO * F0:
-            A = hertz_constant(m.E, m.nu, a / 2, m.E, m.nu, a / 2)
-            mass = m.rho * math.pi * a**3 / 6
-            out["discrete_speed_m_per_s"] = solitary_wave(mass, A, a, Fm, F0).speed
+        if Fm >= MIN_FORCE_RATIO * F0:
+            wave = solitary_wave(m.rho * math.pi * a**3 / 6, A, a, Fm, F0)
+            out["discrete_speed_m_per_s"], out["discrete_lab_speed_m_per_s"] = wave.long_wave_speed, wave.speed
+        else:
+            reasons.update(dict.fromkeys(wave_keys[2:], (
+                f"Fm/F0 = {Fm / F0:.4g} is below {MIN_FORCE_RATIO}: a wide, weakly nonlinear wave the discrete "
+                "computation does not reach; Eq (1) describes it")))
     if not args.json:
-        print(f"{m.name}, diameter {a * 1e3:g} mm, F0 = {F0:g} N" + (f", Fm = {out['fm_N']:g} N" if args.fm else ""))
-        rows = [("sound speed c0, Eq (2)", out["sound_speed_m_per_s"]),
-                ("solitary wave speed, Eq (1)", out["speed_m_per_s"]),
-                ("sonic-vacuum speed, Eq (4)", out["sonic_vacuum_speed_m_per_s"]),
-                ("exact discrete solitary wave", out["discrete_speed_m_per_s"])]
-        for label, v in rows:
+        print(f"{m.name}, diameter {a * 1e3:g} mm, F0 = {F0:g} N" + (f", Fm = {Fm:g} N" if Fm is not None else ""))
+        rows = [("sound speed c0, Eq (2)", "sound_speed_m_per_s"),
+                ("solitary wave speed, Eq (1)", "speed_m_per_s"),
+                ("sonic-vacuum speed, Eq (4)", "sonic_vacuum_speed_m_per_s"),
+                ("exact discrete solitary wave", "discrete_speed_m_per_s"),
+                ("  the same in the laboratory", "discrete_lab_speed_m_per_s")]
+        for label, key in rows:
+            v = out[key]
             print(f"  {label:30s} {'-' if v is None else f'{v:9.2f} m/s'}")
+        for why in dict.fromkeys(reasons.values()):
+            print(f"  -: {why}")
     return out
 
 

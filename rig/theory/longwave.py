@@ -40,7 +40,9 @@ def solitary_wave_speed(E, nu, rho, a, F0, Fm):
     Tends to Eq (2) as f_r -> 1 and to Eq (4) as f_r -> infinity. Requires Fm > F0 > 0.
     Evaluated in the cancellation-free form with x = f_r^(1/3), using
     3 + 2x^5 - 5x^2 = (x-1)^2 (2x^3 + 4x^2 + 6x + 3) and x^2 - 1 = (x-1)(x+1):
-    V_s = pre * sqrt((4/15) (2x^3 + 4x^2 + 6x + 3)) / (x + 1).
+    V_s = pre * sqrt((4/15) (2x^3 + 4x^2 + 6x + 3)) / (x + 1), written with y = 1/x in (0, 1),
+    which overflows at no f_r: V_s = 0.9314 S Fm^(1/6) sqrt((4/15) (2 + 4y + 6y^2 + 3y^3)) / (1 + y),
+    S the stiffness group of Eqs (2) and (4).
     """
     F0 = np.asarray(F0, dtype=float)
     Fm = np.asarray(Fm, dtype=float)
@@ -48,10 +50,9 @@ def solitary_wave_speed(E, nu, rho, a, F0, Fm):
         raise invalid("F0", F0, "Eq (1) needs a precompression > 0 N (use Eq (4) for F0 = 0)")
     if np.any(Fm <= F0):
         raise invalid("Fm", Fm, "the maximum force must exceed the precompression F0")
-    fr = Fm / F0
-    pre = 0.9314 * (4.0 * E**2 * F0 / (a**2 * rho**3 * (1.0 - nu**2) ** 2)) ** (1.0 / 6.0)
-    x = np.cbrt(fr)
-    return pre * np.sqrt(4.0 / 15.0 * (((2.0 * x + 4.0) * x + 6.0) * x + 3.0)) / (x + 1.0)
+    y = np.cbrt(F0 / Fm)
+    pre = 0.9314 * _stiffness_group(E, nu, rho, a) * Fm ** (1.0 / 6.0)
+    return pre * np.sqrt(4.0 / 15.0 * (((3.0 * y + 6.0) * y + 4.0) * y + 2.0)) / (1.0 + y)
 
 
 # Power-law contact F = A delta^n (Hertz: n = 3/2), Nesterenko, Dynamics of Heterogeneous

@@ -29,6 +29,7 @@ from rig.errors import RigError, invalid
 
 _POINTS_PER_BEAD = 32
 MIN_FORCE_RATIO = 1.05  # Fm / F0 below which the iteration converges too slowly
+MAX_STRAIN = 0.1  # contact overlap / diameter beyond which a small-overlap contact law says nothing
 
 
 def _grid(n_beads: float):
@@ -54,8 +55,9 @@ def _peak(xi, y):
 class SolitaryWave:
     """A stationary solitary wave of a uniform chain.
 
-    speed (m/s), contacts_per_s (1/s), xi (bead numbers), force (N, whole contact force
-    profile along xi, at t = 0), F0, Fm (N), spacing (m).
+    speed (m/s, in the laboratory: contacts_per_s times the precompressed spacing),
+    contacts_per_s (1/s), xi (bead numbers), force (N, whole contact force profile along
+    xi, at t = 0), F0, Fm (N), spacing (m, diameter less the static overlap), diameter (m).
     """
 
     speed: float
@@ -65,6 +67,14 @@ class SolitaryWave:
     F0: float
     Fm: float
     spacing: float
+    diameter: float
+
+    @property
+    def long_wave_speed(self) -> float:
+        """The speed (m/s) as the long-wave theory counts it, Eqs (1), (2) and (4): contacts
+        per second times the bead diameter (the chain's Lagrangian coordinate). It scales
+        exactly as those equations do, so its ratio to them depends on F_m/F_0 alone."""
+        return self.contacts_per_s * self.diameter
 
     @property
     def beta(self) -> float:
@@ -83,42 +93,62 @@ class SolitaryWave:
         return float(above[-1] - above[0])
 
 
+def overlap_reason(A: float, diameter: float, force: float, n: float = 1.5) -> str | None:
+    """Why the contact law cannot carry ``force`` (N) between beads of ``diameter`` (m) with
+    contact constant A (N/m^n), or None: its overlap (force/A)^(1/n) passes MAX_STRAIN of
+    the diameter, where a contact law of small overlaps (Hertz) and every speed built on it
+    say nothing about the beads."""
+    strain = math.exp((math.log(force) - math.log(A)) / n - math.log(diameter)) if force > 0 else 0.0
+    if strain <= MAX_STRAIN:
+        return None
+    return (f"at {force:.4g} N the contacts overlap by {strain:.3g} of the {diameter:.4g} m diameter; the contact "
+            f"law holds for small overlaps only (at most {MAX_STRAIN:g} of it)")
+
+
 def solitary_wave(mass: float, A: float, diameter: float, Fm: float, F0: float = 0.0,
                   tol: float = 1e-13, n: float = 1.5) -> SolitaryWave:
     """The exact discrete solitary wave of amplitude Fm (N) on a uniform chain of beads of
     mass (kg), contact law F = A delta^n (A in N/m^n; Hertz: n = 3/2) and diameter (m),
-    precompressed by F0 (N). A linear contact (n = 1) has no solitary wave: 1 < n <= 3."""
+    precompressed by F0 (N). A linear contact (n = 1) has no solitary wave: 1 < n <= 3.
+
+    It is solved in dimensionless form, the overlap w in units of its amplitude w_max and
+    forces in units of Fm, so that the iteration and its tolerance do not depend on the
+    scale of the chain: c^2 = mu_1 Fm (1 - q)^n / (m w_max), q = (F0/Fm)^(1/n), mu_1 the
+    eigenvalue at unit amplitude."""
     if not 1.0 < n <= 3.0:
         raise invalid("n", n, "the contact exponent must be in (1, 3]")
-    for name, val in (("mass", mass), ("A", A), ("diameter", diameter)):
-        if not val > 0:
-            raise invalid(name, val, "must be > 0")
-    if not F0 >= 0:
+    for name, val in (("mass", mass), ("A", A), ("diameter", diameter), ("Fm", Fm)):
+        if not 0 < val < math.inf:
+            raise invalid(name, val, "must be > 0 and finite")
+    if not 0 <= F0 < math.inf:
         raise invalid("F0", F0, "precompression must be >= 0 N")
     if not Fm >= F0 * MIN_FORCE_RATIO:
         raise invalid("Fm", Fm, f"the discrete solitary wave is computed for Fm >= "
                                 f"{MIN_FORCE_RATIO} F0 = {MIN_FORCE_RATIO * F0:.4g} N (closer to F0 it "
                                 f"is a wide, weakly nonlinear wave: use Eq (1) or power_law_wave_speed)")
-    r0 = (F0 / A) ** (1.0 / n)  # 1.0 / 1.5 is the same double as 2.0 / 3.0
-    w_max = (Fm / A) ** (1.0 / n) - r0
-    fr = Fm / F0 if F0 > 0 else math.inf
+    q = (F0 / Fm) ** (1.0 / n)  # r0 / (r0 + w_max); 1.0 / 1.5 is the same double as 2.0 / 3.0
+    s = q / (1.0 - q)  # r0 / w_max
+    log_w_max = (math.log(Fm) - math.log(A)) / n + math.log1p(-q)  # w_max = (Fm/A)^(1/n) - r0, in m
     # the wave widens like 1/sqrt(f_r - 1) towards the sound speed: size the domain for it
-    xi, sinc2 = _grid(48 if fr > 2 else 64 / math.sqrt(fr - 1))
-    g0 = r0**n
-    w = w_max * np.exp(-(xi / 2.0) ** 2)
+    fr_less_1 = (Fm - F0) / F0 if F0 > 0 else math.inf
+    xi, sinc2 = _grid(48 if fr_less_1 > 1 else 64 / math.sqrt(fr_less_1))
+    g0 = s**n
+    u = np.exp(-(xi / 2.0) ** 2)
     for _ in range(20000):
-        P = np.fft.irfft(sinc2 * np.fft.rfft(np.maximum(r0 + w, 0.0) ** n - g0), len(w))
-        mu = _peak(xi, P) / w_max
-        w_new = P / mu
-        done = np.max(np.abs(w_new - w)) < tol * w_max
-        w = w_new
+        P = np.fft.irfft(sinc2 * np.fft.rfft(np.maximum(s + u, 0.0) ** n - g0), len(u))
+        mu = _peak(xi, P)
+        u_new = P / mu
+        done = np.max(np.abs(u_new - u)) < tol
+        u = u_new
         if done:
             break
     else:
         raise RigError(f"the discrete solitary wave (Fm = {Fm:.4g} N, F0 = {F0:.4g} N) did not converge")
-    c = math.sqrt(mu * A / mass)
-    return SolitaryWave(c * (diameter - r0), c, xi, A * np.maximum(r0 + w, 0.0) ** n, F0, Fm,
-                        diameter - r0)
+    scale = Fm * (1.0 - q) ** n  # A w_max^n, N
+    c = math.sqrt(mu * scale / mass) * math.exp(-0.5 * log_w_max)
+    r0 = s * math.exp(log_w_max)
+    return SolitaryWave(c * (diameter - r0), c, xi, scale * np.maximum(s + u, 0.0) ** n, F0, Fm,
+                        diameter - r0, diameter)
 
 
 def beta(force_ratio: float, n: float = 1.5) -> float:

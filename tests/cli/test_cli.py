@@ -27,6 +27,40 @@ def test_theory_without_fm_prints_only_the_sound_speed(capsys):
     assert out["speed_m_per_s"] is None and out["discrete_speed_m_per_s"] is None
 
 
+def test_theory_discrete_over_eq4_is_one_ratio_at_every_diameter(capsys):
+    ratios = []
+    for diameter in ("0.01 mm", "0.1 mm", "4.76 mm", "10 cm"):  # forces with the bead's cross-section
+        scale = (float(diameter.split()[0]) * (1 if diameter.endswith("cm") else 0.1) / 0.476) ** 2
+        out = _json(capsys, "theory", "--diameter", diameter, "--f0", str(0.062 * scale), "--fm", str(20 * scale),
+                    "--json")
+        ratios.append(out["discrete_speed_m_per_s"] / out["sonic_vacuum_speed_m_per_s"])
+        assert out["discrete_lab_speed_m_per_s"] < out["discrete_speed_m_per_s"]  # the spacing is a - overlap
+    assert max(ratios) - min(ratios) < 1e-3 * ratios[0], ratios
+    assert ratios[0] == pytest.approx(1.0287, abs=1e-3)
+
+
+@pytest.mark.parametrize("argv,keys,why", [
+    (["--diameter", "1e-30", "--f0", "0.062", "--fm", "20"], ["sound_speed_m_per_s", "discrete_speed_m_per_s"],
+     "overlap"),
+    (["--diameter", "1um", "--f0", "0.062", "--fm", "20"], ["speed_m_per_s", "discrete_speed_m_per_s"], "overlap"),
+    (["--f0", "1e-300", "--fm", "1e300"], ["sonic_vacuum_speed_m_per_s", "discrete_speed_m_per_s"], "overlap"),
+    (["--f0", "19.99", "--fm", "20"], ["discrete_speed_m_per_s"], "Fm/F0 = 1.001"),
+    (["--f0", "1"], ["speed_m_per_s", "discrete_speed_m_per_s"], "no --fm"),
+])
+def test_theory_gives_the_reason_of_every_figure_it_cannot_compute(capsys, argv, keys, why):
+    """A figure is a speed the chain can have or null with its reason: never a negative
+    speed, a blank without a word or a warning on stderr."""
+    out = _json(capsys, "theory", *argv, "--json")
+    for key in keys:
+        assert out[key] is None and why in out["reasons"][key], out
+    for key, value in out.items():
+        if key.endswith("_m_per_s"):
+            assert (value is None) == (key in out["reasons"]) and (value is None or value > 0), out
+    assert main(["theory", *argv]) == 0
+    captured = capsys.readouterr()
+    assert why in captured.out and captured.err == ""
+
+
 @pytest.mark.parametrize("argv,field", [
     (["theory", "--material", "wood", "--f0", "1"], "material"),
     (["theory", "--f0", "-1"], "--f0"),

@@ -59,3 +59,39 @@ def test_beta_curve_from_the_discrete_chain():
     assert all(b2 > b1 for b1, b2 in zip(curve, curve[1:]))  # grows with F_m/F_0
     assert curve[0] == pytest.approx(1.008, abs=1e-3)  # long waves: gauge reads the contact
     assert curve[-1] == pytest.approx(1.414, abs=2e-3)  # sonic vacuum
+
+
+@pytest.mark.parametrize("F0,Fm", [(0.062, 20.0), (0.0, 5.0)])
+def test_the_discrete_wave_speed_scales_exactly_as_the_long_wave_one(F0, Fm):
+    """At fixed forces a chain of diameter a has c0, Eq (1) and Eq (4) proportional to
+    a^(-1/3); the discrete wave's beads per second times a scale the same way, so its ratio
+    to Eq (4) is one number from 10 um to 10 cm (it had drifted from 1.0287 at 10 cm to
+    0.98 at 0.1 mm and turned negative below, counted on the spacing a - overlap)."""
+    m = material("ptfe")
+    ratios = []
+    for a in (1e-5, 1e-4, 3e-4, 4.76e-3, 1e-2, 1e-1):
+        A = hertz_constant(m.E, m.nu, a / 2, m.E, m.nu, a / 2)
+        wave = solitary_wave(m.rho * math.pi * a**3 / 6, A, a, Fm, F0)
+        ratios.append(wave.long_wave_speed / sonic_vacuum_speed(m.E, m.nu, m.rho, a, Fm))
+    assert max(ratios) - min(ratios) < 1e-3 * ratios[0], ratios
+    assert 1.0 < ratios[0] < 1.04  # the discrete wave runs a little ahead of Eq (4)
+
+
+def test_the_discrete_wave_is_solved_at_any_scale():
+    """Solved in units of its own amplitude: the same wave at 1e-30 m and 1e30 m."""
+    unit = solitary_wave(1.0, 1.0, 1.0, 3.0, 1.0)
+    for k in (1e-30, 1e30):  # lengths times k, masses times k^3, forces times k^2: A times k^(1/2)
+        wave = solitary_wave(k**3, k**0.5, k, 3.0 * k**2, k**2)
+        assert wave.long_wave_speed == pytest.approx(unit.long_wave_speed, rel=1e-9)
+        assert wave.beta == pytest.approx(unit.beta, rel=1e-9)
+
+
+def test_eq1_at_force_ratios_that_overflow_a_power():
+    """Eq (1) at F_m/F_0 = 1e600 is Eq (4), with no overflow on the way."""
+    import warnings
+
+    m = material("ptfe")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        v = solitary_wave_speed(m.E, m.nu, m.rho, D, 1e-300, 1e300)
+    assert v == pytest.approx(sonic_vacuum_speed(m.E, m.nu, m.rho, D, 1e300), rel=1e-5)  # 0.9314 sqrt(8/15) = 0.6802
