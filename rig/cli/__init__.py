@@ -83,7 +83,8 @@ def build_parser() -> argparse.ArgumentParser:
     an.add_argument("--seed", type=seed_arg, help="seed of the instruments' draws (default: a fresh one, printed)")
     an.add_argument("--out", required=True, metavar="FILE", help="FILE.mp4, FILE.gif or FILE.png (one still)")
     an.add_argument("--frames", type=plain(int), default=100,
-                    help="frames over the scene's duration (default 100)")
+                    help="frames over the scene's duration (default 100); for a .png still, the instants "
+                         "it is picked from (the one nearest the leading pulse at the last gauge)")
     an.add_argument("--exaggerate", type=plain(float),
                     help="displacement factor (default: the largest displacement shown as 1/3 diameter)")
     an.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -63,6 +63,23 @@ def quantity_type(unit: str, field: str):
     return parse
 
 
+def scene_overrides(args, given_elsewhere: dict | None = None) -> tuple:
+    """The command's --set items, each key set once: a key set twice (where the last would
+    win silently), or a key that another option already gives (``given_elsewhere``: {key:
+    that option's words}, e.g. a swept or fitted key), is refused naming both."""
+    from rig.errors import invalid
+
+    items, first = tuple(args.set or ()), {}
+    for item in items:
+        key = item.split("=", 1)[0].strip()
+        if key in first:
+            raise invalid("--set", key, f"set twice ({first[key]!r} and {item!r}); set each key once")
+        if key in (given_elsewhere or {}):
+            raise invalid("--set", item, f"{given_elsewhere[key]} already gives {key}; give it once")
+        first[key] = item
+    return items
+
+
 @contextlib.contextmanager
 def progress_bar(quiet: bool = False, **kw):
     """A tqdm bar on stderr that shows itself only after a second (a mistake found at once

@@ -21,7 +21,7 @@ def _records(args) -> list:
 
 
 def cmd_fit(args) -> dict:
-    from rig.cli.common import writing_to
+    from rig.cli.common import scene_overrides, writing_to
     from rig.errors import RigError, invalid
     from rig.experiment import scene as scene_io
     from rig.fit.fitting import stderr_progress
@@ -43,7 +43,7 @@ def cmd_fit(args) -> dict:
         from rig.fit.posterior import check
 
         check(args.walkers, len(params))
-    overrides = list(args.set or [])
+    overrides = list(scene_overrides(args, {t.split("=", 1)[0].strip(): f"--param {t}" for t in args.param}))
     scene_io.load(args.scene, overrides)  # the scene and its overrides, checked before any work
     if args.observations:
         from rig.fit.observations.objective import ObservationObjective

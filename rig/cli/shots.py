@@ -1,7 +1,7 @@
 """`rig shot` and `rig animate`: one virtual shot, summarised, exported or rendered."""
 from __future__ import annotations
 
-from rig.cli.common import check_size, missing_lines, progress_bar, writing_to
+from rig.cli.common import check_size, missing_lines, progress_bar, scene_overrides, writing_to
 from rig.errors import RigError, invalid
 
 
@@ -11,7 +11,7 @@ def cmd_shot(args) -> dict:
 
     if args.format is not None and not args.export:
         raise invalid("--format", args.format, "needs --export DIR (the format of the scope files it writes)")
-    scene = load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
+    scene = load(args.scene, scene_overrides(args))  # a bad scene stops here, before numba is loaded
     from pathlib import Path
 
     from instruments.formats import WRITERS
@@ -120,7 +120,7 @@ def cmd_animate(args) -> dict:
     from rig.viz.animate import check_output, require_renderer
 
     check_output(args.out)  # before anything is computed
-    scene = load(args.scene, args.set or ())
+    scene = load(args.scene, scene_overrides(args))
     require_renderer(args.out)
     from rig.experiment.shot import Rig
     from rig.viz.animate import animate
@@ -134,6 +134,8 @@ def cmd_animate(args) -> dict:
         out = animate(rig, args.out, frames=args.frames, exaggerate=args.exaggerate, seed=args.seed,
                       progress=bar.update)
     if not args.json:
-        print(f"wrote {out['out']}: {out['frames']} frame(s), displacements x {out['exaggerate']:.3g}, "
+        what = (f"a still at t = {out['still_time_s'] * 1e3:.3f} ms, the nearest of {out['instants']} instants "
+                f"(--frames) to {out['still_at']}" if still else f"{out['frames']} frames")
+        print(f"wrote {out['out']}: {what}, displacements x {out['exaggerate']:.3g}, "
               f"seed {out['seed']}, {out['seconds']:.1f} s")
     return out

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from rig.cli.common import check_size, progress_bar, writing_to
+from rig.cli.common import check_size, progress_bar, scene_overrides, writing_to
 from rig.errors import invalid
 
 
@@ -17,7 +17,7 @@ def cmd_mc(args) -> dict:
     if args.workers is not None and remote:
         raise invalid("--workers", args.workers, f"the workers of --scheduler {args.scheduler} are the cluster's; "
                                                  "--workers sizes a local run or --scheduler local")
-    load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
+    load(args.scene, scene_overrides(args))  # a bad scene stops here, before numba is loaded
     from rig.study.distributions import parse_vary
     from rig.study.executors import DEFAULT_WORKER_TIMEOUT
     from rig.study.mc_run import run_to

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rig.cli.common import check_size, missing_lines, progress_bar, writing_to
+from rig.cli.common import check_size, missing_lines, progress_bar, scene_overrides, writing_to
 from rig.cli.shots import shot_summary
 from rig.errors import Interrupted, RigError
 
@@ -17,7 +17,9 @@ def cmd_sweep(args) -> dict:
         raise RigError(f"--vary given {len(args.vary)} times ({', '.join(v.split('=')[0] for v in args.vary)}): "
                        "a sweep varies one key; run one sweep per key")
 
-    scene = load(args.scene, args.set or ())  # a bad scene stops here, before numba is loaded
+    swept = args.vary[0].split("=", 1)[0].strip()
+    overrides = scene_overrides(args, {swept: f"--vary {args.vary[0]}"})
+    scene = load(args.scene, overrides)  # a bad scene stops here, before numba is loaded
     from rig.experiment.shot import Rig
     from rig.study.sweep import Vary, run_sweep
 
@@ -33,7 +35,7 @@ def cmd_sweep(args) -> dict:
                 bar.update()
 
             try:
-                points = run_sweep(args.scene, vary, args.set or (), args.seed, tick, args.out)
+                points = run_sweep(args.scene, vary, overrides, args.seed, tick, args.out)
             except KeyboardInterrupt:
                 kept = f"those points' shots are in {args.out}" if args.out else "nothing is kept (no --out)"
                 raise Interrupted(f"interrupted after {len(fired)} of {n} points: {kept}") from None

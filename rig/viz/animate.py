@@ -214,8 +214,11 @@ def default_exaggeration(frames: Frames, rig) -> float:
 
 def animate(rig, out, frames: int = 100, exaggerate: float | None = None, seed: int | None = None,
             progress=None) -> dict:
-    """Render the rig's shot to ``out`` (.mp4, .gif: ``frames`` frames; .png: the frame at
-    which the leading pulse passes the last gauge, else the middle one). Returns a summary."""
+    """Render the rig's shot to ``out`` (.mp4, .gif: ``frames`` frames; .png: one still, the
+    one of ``frames`` instants over the duration nearest the time the leading pulse passes
+    the last gauge, else the middle one). Returns a summary: "frames" written, "instants"
+    the shot was recorded at, and for a still its time "still_time_s" and why that one
+    ("still_at")."""
     out = check_output(out)
     if not isinstance(frames, int) or not 2 <= frames <= 10000:
         raise invalid("--frames", frames, "a whole number of frames from 2 to 10000")
@@ -229,7 +232,11 @@ def animate(rig, out, frames: int = 100, exaggerate: float | None = None, seed: 
     view = _View(rig, fr, x)
     traces = _Traces(shot.scope, rig.solver.duration)
     still = out.suffix.lower() == ".png"
-    order = [_still_frame(rig, fr)] if still else range(len(fr.times))
+    if still:
+        k, still_at = _still_frame(rig, fr)
+        order = [k]
+    else:
+        order = range(len(fr.times))
     def encoded() -> bytes:
         """The image or movie, encoded in memory: a writer that fails on a full disk
         retries its flush when it is collected, a traceback after the error line."""
@@ -255,15 +262,21 @@ def animate(rig, out, frames: int = 100, exaggerate: float | None = None, seed: 
         atomic_write(out, lambda tmp: Path(tmp).write_bytes(data))  # no half-written movie, an earlier one kept
     finally:
         view.close()
-    return {"out": str(out), "frames": 1 if still else len(fr.times), "exaggerate": x, "seed": shot.seed,
-            "duration_s": rig.solver.duration, "seconds": time.perf_counter() - t_start}
+    summary = {"out": str(out), "frames": 1 if still else len(fr.times), "instants": len(fr.times),
+               "exaggerate": x, "seed": shot.seed, "duration_s": rig.solver.duration,
+               "seconds": time.perf_counter() - t_start}
+    if still:
+        summary.update(still_time_s=float(fr.times[order[0]]), still_at=still_at)
+    return summary
 
 
-def _still_frame(rig, fr: Frames) -> int:
+def _still_frame(rig, fr: Frames) -> tuple:
+    """(index of the still among the frames' instants, the time it stands for, in words)."""
     lead = rig.truth_analysis().leading if len(rig.gauges) >= 2 else {}
     last = lead.get("lower") or lead.get("upper")
     t = last["time"] if last else 0.5 * fr.times[-1]
-    return int(np.argmin(np.abs(fr.times - t)))
+    return int(np.argmin(np.abs(fr.times - t))), ("the leading pulse at the last gauge" if last
+                                                   else "the middle of the shot")
 
 
 def require_renderer(out: str | None = None):

@@ -181,7 +181,18 @@ def _flag_cases():
         (["analyze", "x.isf", "--shot", "1"], "--shot"),
         (["analyze", "x.isf", "--shot", "-1"], "--shot"),
         (["analyze", "x.isf", "--shot", "1,0"], "--shot"),
+        # a key given twice: the last had won silently, or the --set was ignored
+        (["sweep", S, "--vary", "striker.velocity=0.3:1.5:3", "--set", "striker.velocity=1 m/s"], "--vary"),
+        (["fit", S, "--param", "chain.youngs_modulus=0.2 GPa:4 GPa", "--set", "chain.youngs_modulus=1 GPa",
+          "--points", "p.csv", "--out", out], "--param"),
     ]
+    twice = ["--set", "striker.velocity=1", "--set", "striker.velocity = 2 m/s"]
+    cases += [(["shot", S, *twice], "set twice"),
+              (["sweep", S, "--vary", "chain.beads=20:30:3", *twice], "set twice"),
+              (["mc", S, "--shots", "8", "--vary", "striker.mass=normal(1.2 g, 0.01 g)", *twice, "--out", out],
+               "set twice"),
+              (["fit", S, "--param", YM, "--points", "p.csv", *twice, "--out", out], "set twice"),
+              (["animate", S, "--out", "{d}/m.gif", *twice], "set twice")]
     return cases
 
 

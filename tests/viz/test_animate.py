@@ -1,4 +1,5 @@
 """Off-screen animations: the frames themselves, the output checks, the lazy import."""
+import json
 import subprocess
 import sys
 
@@ -49,13 +50,22 @@ def test_colour_moves_down_the_chain_with_the_wave(movie):
     assert not np.array_equal(movie[3], movie[8])  # colours change as the pulse passes
 
 
-def test_still_png(tmp_path):
+def test_still_png(tmp_path, capsys):
+    """A still is one frame, picked among --frames instants: the line says so (it had said
+    "1 frame(s)" of a --frames 10)."""
     pytest.importorskip("pyvista")
     import imageio.v2 as imageio
 
     out = tmp_path / "still.png"
     assert main(["animate", "ptfe52_magnetic", *SMALL, "--seed", "1", "--frames", "10", "--out", str(out)]) == 0
     assert np.asarray(imageio.imread(out)).std() > 10
+    line = capsys.readouterr().out
+    assert "a still at t = " in line and "nearest of 10 instants (--frames)" in line, line
+    assert main(["animate", "ptfe52_magnetic", *SMALL, "--seed", "1", "--frames", "10", "--out", str(out),
+                 "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["frames"] == 1 and summary["instants"] == 10
+    assert 0 < summary["still_time_s"] < summary["duration_s"]
 
 
 @pytest.mark.parametrize("out,message", [("shot.avi", "ending in .mp4, .gif, .png"),
