@@ -68,6 +68,12 @@ def is_number(text) -> bool:
     return isinstance(text, str) and _PLAIN.match(text) is not None
 
 
+def is_non_finite(text) -> bool:
+    """``text`` names a number that is not finite ("nan", "inf", "-Infinity"): read right by
+    Python, refused as "a finite number" rather than as a mistyped one."""
+    return isinstance(text, str) and text.strip().lstrip("+-").lower() in ("nan", "inf", "infinity")
+
+
 def split_quantity(text: str, field: str, unit: str) -> tuple:
     """(number text, unit text) of a quantity's text: ONE number (``is_number``) followed
     by a unit expression of unit names joined by '*', '/' or spaces, each with an optional
@@ -91,7 +97,7 @@ def number(text, field: str, allowed: str = "a finite number") -> float:
         value = float(text)
     elif isinstance(text, str):
         check_digits(text, field)
-        if not is_number(text):
+        if not (is_number(text) or is_non_finite(text)):
             raise invalid(field, text, allowed)
         value = float(text)
     else:
@@ -115,7 +121,7 @@ def typed_quantity(text: str, unit: str | None, field: str) -> float:
     """A value as typed on the command line: a plain number is taken in ``unit`` (SI), text
     with a unit is converted to it; ``unit`` None: a plain number only."""
     check_digits(text, field)
-    if unit is not None and not is_number(text):
+    if unit is not None and not (is_number(text) or is_non_finite(text)):
         return quantity(text, unit, field)
     return number(text, field, "a finite number" + (f" (plain number: {unit})" if unit else ""))
 
@@ -209,4 +215,4 @@ def _parse(text: str, unit: str, field: str) -> float:
     return float(f"{si:.15g}")
 
 
-__all__ = ["RigError", "is_number", "number", "quantity", "split_quantity", "typed_quantity", "whole"]
+__all__ = ["RigError", "is_non_finite", "is_number", "number", "quantity", "split_quantity", "typed_quantity", "whole"]

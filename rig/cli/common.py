@@ -126,16 +126,19 @@ def fraction_arg(text: str) -> float:
 
 def plain(convert):
     """An argparse type: ``convert`` (int or float) of a text that is one plain number as
-    ``rig.units.number`` reads it (Python's int and float read "1_000", "١" and " inf "); the
-    range is the library's to check, which names the option."""
+    ``rig.units.is_number`` reads it (Python's int and float read "1_000" and "١"), or nan or
+    inf, which Python reads right; the range is the library's to check, which names the
+    option."""
     def parse(text: str):
         from rig.errors import RigError
-        from rig.units import number
+        from rig.units import check_digits, is_non_finite, is_number
 
         try:
-            number(text, "value", "one plain number (digits 0-9, one decimal point, a whole-number exponent)")
+            check_digits(text, "value")
         except RigError as exc:
             raise refusal(exc, "value") from None
+        if not (is_number(text) or is_non_finite(text)):
+            raise ValueError(text)  # argparse: "invalid float value: '2*0.5'"
         return convert(text)
 
     parse.__name__ = convert.__name__  # argparse's "invalid float value: 'x'"

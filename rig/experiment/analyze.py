@@ -4,6 +4,7 @@ Virtual shots in an archive carry what the analysis needs (gauge channels and no
 positions, sensitivities, RC time constants, beta and F_0 from their numerics). Real files
 need it from the command line: --gauge-distance, and optionally --sensitivity, --tau,
 --beta, --f0, --diameter; --material adds the long-wave Eq (1) speed beside each result.
+--f0 and --material work in newtons: they need --sensitivity (check_force_flags).
 
 Plausibility: the speed must be below the bar speed sqrt(E / rho) of the bead material
 (with --material; else of the fastest material in the table), and, with a material known
@@ -91,6 +92,8 @@ def analyze_paths(options: AnalyzeOptions) -> list:
                 shots.append((f"{a}#{i}", None))
                 unread[f"{a}#{i}"] = str(exc).removeprefix(f"{a}: ")
     real = bool(files) or not all(entry.simulated for _, entry in shots if entry is not None)
+    if real:
+        check_force_flags(options)
     results = []
     for source, entry in shots:
         if entry is None:
@@ -111,6 +114,19 @@ def analyze_paths(options: AnalyzeOptions) -> list:
 
 
 REAL_FILE_FLAGS = ("gauge_distance", "channels", "wall", "sensitivity", "tau", "beta", "f0", "diameter", "material")
+
+
+def check_force_flags(options: AnalyzeOptions):
+    """Refuse the flags that work in newtons (--f0 is added to the measured force, --material
+    puts the measured amplitude into Eq (1) and judges the speed by it) where a real record's
+    forces are its gauges' volts (no --sensitivity): volts taken as newtons."""
+    if options.sensitivity is not None:
+        return
+    given = [flag for flag, on in (("--f0", options.f0 > 0), ("--material", options.material is not None)) if on]
+    if given:
+        raise RigError(f"{' and '.join(given)} without --sensitivity: {'they need' if len(given) > 1 else 'it needs'} "
+                       f"the real record's forces in newtons, and without --sensitivity they are its gauges' volts; "
+                       f"give the gauges' --sensitivity, e.g. '0.05 V/N'")
 
 
 def real_file_flags(options: AnalyzeOptions) -> list:

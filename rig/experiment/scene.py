@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rig.errors import RigError, invalid
-from rig.units import check_digits, is_number, number, quantity, whole
+from rig.units import check_digits, is_non_finite, is_number, number, quantity, whole
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -173,7 +173,7 @@ def _typed(value: str, spec, key):
         return number(value, key)
     if isinstance(spec, str):  # a quantity: a plain number is in SI
         check_digits(value, key)
-        if not is_number(value):
+        if not (is_number(value) or is_non_finite(value)):
             return value  # text with a unit, for quantity()
         x = float(value)
         if not math.isfinite(x):

@@ -148,7 +148,7 @@ def test_every_real_file_is_a_clear_refusal(realdata, capsys):
             files = [str(path)] * (1 if len(read_record([path]).waveforms) > 1 else 2)
         except ValueError:  # a file the readers refuse is the readers' business (tests/instruments)
             files = [str(path)]
-        for material in ([], ["--material", "ptfe"]):
+        for material in ([], ["--material", "ptfe", "--sensitivity", "0.05 V/N"]):
             code, out, err = run(capsys, "analyze", *files, "--gauge-distance", "43.1 mm", *material)
             assert code in (1, 2), (path.name, out)
             if code == 2:
@@ -296,6 +296,27 @@ def test_the_force_columns_are_headed_with_their_unit(gauge_files, capsys):
         assert main(["analyze", *gauge_files, *flags]) == 0
         header = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("source"))
         assert f"F_d {unit}" in header and f"F_m,e {unit}" in header
+
+
+@pytest.mark.parametrize("flags,named", [(["--f0", "1 N"], "--f0 without --sensitivity"),
+                                         (["--material", "ptfe"], "--material without --sensitivity"),
+                                         (["--f0", "1", "--material", "ptfe"], "--f0 and --material without")])
+def test_flags_in_newtons_need_the_sensitivity_of_a_real_record(gauge_files, tmp_path, capsys, flags, named):
+    """Without --sensitivity a real record's forces are volts: --f0 had been added to them
+    (0.22 V + 1 N) and --material had put volts into Eq (1) and rejected a right speed; a
+    virtual shot beside them is no excuse, alone it refuses these flags as its own."""
+    code, _, err = run(capsys, "analyze", *gauge_files, "--gauge-distance", "40 mm", *flags)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and named in err and "--sensitivity" in err, err
+    path = str(tmp_path / "v.h5")
+    assert main(["shot", "ptfe52_magnetic", "--seed", "3", "--out", path]) == 0
+    capsys.readouterr()
+    code, _, err = run(capsys, "analyze", path, *gauge_files, "--gauge-distance", "40 mm", *flags)
+    assert code == 2 and named in err, err
+    code, _, err = run(capsys, "analyze", path, *flags)
+    assert code == 2 and "for real scope files only" in err, err
+    code, rows, _ = run(capsys, "analyze", path, *gauge_files, "--gauge-distance", "40 mm", "--sensitivity",
+                        "0.05 V/N", *flags)
+    assert code == 0 and rows[1]["force_unit"] == "N"
 
 
 def test_eq1_without_f0_says_it_assumes_no_precompression(gauge_files, capsys):
