@@ -154,6 +154,7 @@ class Archive:
         path = Path(path or self.path)
         if not path.exists():
             raise InstrumentError(f"{path}: no such archive")
+        check_archive_path(path)
         if not h5py.is_hdf5(path):
             raise InstrumentError(f"{path}: not an HDF5 file")
         try:
@@ -259,6 +260,14 @@ class Archive:
                              "channels": sorted(e.record.waveforms), "sources": e.settings.get("source_files", []),
                              "settings": e.settings.get("striker", {})})
         return rows
+
+
+def check_archive_path(path):
+    """InstrumentError where ``path`` cannot be an archive file because it is a directory
+    (HDF5 would say only that it is not an HDF5 file)."""
+    if Path(path).is_dir():
+        raise InstrumentError(f"{path}: is a directory; an archive is a file, e.g. "
+                              f"{os.path.join(os.path.normpath(path), 'shots.h5')}")
 
 
 def stored_raw_digest(g) -> str:

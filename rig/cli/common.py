@@ -63,6 +63,37 @@ def quantity_type(unit: str, field: str):
     return parse
 
 
+def folder_shown(path) -> str:
+    """A folder as printed: normalised, with one trailing separator ("fit1//" -> "fit1/")."""
+    import os
+
+    return os.path.join(os.path.normpath(path), "")
+
+
+def check_export_folder(path, flag: str):
+    """Refuse ``path`` as the folder ``flag`` writes into where it is an existing file (before
+    any work; mkdir would say only "File exists")."""
+    from pathlib import Path
+
+    from rig.errors import invalid
+
+    if Path(path).exists() and not Path(path).is_dir():
+        raise invalid(flag, str(path), "is a file, not a folder: name a folder (it is made if missing)")
+
+
+def check_archive_out(path, flag: str):
+    """Refuse ``path`` as the archive ``flag`` appends to where it is a directory, before any
+    work, naming the flag."""
+    from instruments.archive import check_archive_path
+    from instruments.errors import InstrumentError
+    from rig.errors import RigError
+
+    try:
+        check_archive_path(path)
+    except InstrumentError as exc:
+        raise RigError(f"{flag} {exc}") from None
+
+
 def scene_overrides(args, given_elsewhere: dict | None = None) -> tuple:
     """The command's --set items, each key set once: a key set twice (where the last would
     win silently), or a key that another option already gives (``given_elsewhere``: {key:

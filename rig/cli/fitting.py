@@ -21,7 +21,7 @@ def _records(args) -> list:
 
 
 def cmd_fit(args) -> dict:
-    from rig.cli.common import scene_overrides, writing_to
+    from rig.cli.common import folder_shown, scene_overrides, writing_to
     from rig.errors import RigError, invalid
     from rig.experiment import scene as scene_io
     from rig.fit.fitting import stderr_progress
@@ -104,7 +104,7 @@ def cmd_fit(args) -> dict:
                     taus = ", ".join(f"{t:.1f}" for t in post["autocorr_steps"])
                     why = f"fewer than 50 autocorrelation times ({taus} steps)"
                 print(f"  {kept} steps kept, {why}: the same command with more steps goes on with this chain")
-        print(f"wrote {args.out}/: fit.json, residuals.csv, fit.png" + (", posterior.png" if post else "")
+        print(f"wrote {folder_shown(args.out)}: fit.json, residuals.csv, fit.png" + (", posterior.png" if post else "")
               + (f", fitted.toml (rig shot {block['fitted_scene']})" if block["fitted_scene"] else ""))
     if not block["converged"]:
         print(f"rig fit: error: the fit did not converge ({block['message']}); no fitted scene written",

@@ -1,7 +1,7 @@
 """`rig shot` and `rig animate`: one virtual shot, summarised, exported or rendered."""
 from __future__ import annotations
 
-from rig.cli.common import check_size, missing_lines, progress_bar, scene_overrides, writing_to
+from rig.cli.common import check_archive_out, check_export_folder, check_size, missing_lines, progress_bar, scene_overrides, writing_to
 from rig.errors import RigError, invalid
 
 
@@ -11,6 +11,10 @@ def cmd_shot(args) -> dict:
 
     if args.format is not None and not args.export:
         raise invalid("--format", args.format, "needs --export DIR (the format of the scope files it writes)")
+    if args.export:
+        check_export_folder(args.export, "--export")
+    if args.out:
+        check_archive_out(args.out, "--out")
     scene = load(args.scene, scene_overrides(args))  # a bad scene stops here, before numba is loaded
     from pathlib import Path
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rig.cli.common import check_size, missing_lines, progress_bar, scene_overrides, writing_to
+from rig.cli.common import check_archive_out, check_size, folder_shown, missing_lines, progress_bar, scene_overrides, writing_to
 from rig.cli.shots import shot_summary
 from rig.errors import Interrupted, RigError
 
@@ -17,6 +17,8 @@ def cmd_sweep(args) -> dict:
         raise RigError(f"--vary given {len(args.vary)} times ({', '.join(v.split('=')[0] for v in args.vary)}): "
                        "a sweep varies one key; run one sweep per key")
 
+    if args.out:
+        check_archive_out(args.out, "--out")
     swept = args.vary[0].split("=", 1)[0].strip()
     overrides = scene_overrides(args, {swept: f"--vary {args.vary[0]}"})
     scene = load(args.scene, overrides)  # a bad scene stops here, before numba is loaded
@@ -108,6 +110,6 @@ def cmd_reproduce(args) -> dict:
         print((Path(args.out) / "table1.md").read_text())
         if args.fitted:
             print((Path(args.out) / "fitted.md").read_text())
-        print(f"wrote {args.out}/: table1.md, table1.csv, summary.md, results.json and the figures"
+        print(f"wrote {folder_shown(args.out)}: table1.md, table1.csv, summary.md, results.json and the figures"
               + (", fitted.md, fitted.json" if args.fitted else ""))
     return block

@@ -227,3 +227,33 @@ def test_any_interrupted_command_is_one_line_and_exit_130(monkeypatch, capsys):
     monkeypatch.setattr(tools, "cmd_theory", interrupted)
     assert main(["theory", "--f0", "1"]) == 130
     assert capsys.readouterr().err.strip() == "rig theory: error: interrupted"
+
+
+@pytest.mark.parametrize("typed,shown", [("fit1/", "fit1/"), ("fit1//", "fit1/"), ("fit1", "fit1/"),
+                                         ("a/./b/", "a/b/")])
+def test_a_printed_folder_has_one_trailing_separator(typed, shown):
+    from rig.cli.common import folder_shown
+
+    assert folder_shown(typed) == shown.replace("/", __import__("os").sep)
+
+
+def test_an_archive_or_export_path_of_the_wrong_kind_is_named_before_the_shot(tmp_path, capsys, monkeypatch):
+    """--out DIR had said "not an HDF5 file" after solving, --export FILE "File exists"."""
+    import rig.solver.control
+
+    def trap(*a, **k):
+        raise AssertionError("solved before refusing the output path")
+
+    monkeypatch.setattr(rig.solver.control, "integrate_at", trap)
+    a_file = tmp_path / "notes.txt"
+    a_file.write_text("x")
+    for argv, words in ((["shot", "ptfe52_magnetic", "--out", str(tmp_path)], "--out"),
+                        (["sweep", "ptfe52_magnetic", "--vary", "striker.velocity=0.3:1:2", "--out", str(tmp_path)],
+                         "--out"),
+                        (["shot", "ptfe52_magnetic", "--export", str(a_file)], "--export")):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and words in err[0], err
+        assert ("is a directory" if words == "--out" else "is a file, not a folder") in err[0], err
+    assert main(["ls", str(tmp_path)]) == 2
+    assert "is a directory" in capsys.readouterr().err
