@@ -43,8 +43,20 @@ def cmd_fit(args) -> dict:
         from rig.fit.posterior import check
 
         check(args.walkers, len(params))
-    overrides = list(scene_overrides(args, {t.split("=", 1)[0].strip(): f"--param {t}" for t in args.param}))
+    fitted = {t.split("=", 1)[0].strip(): f"--param {t}" for t in args.param}
+    overrides = list(scene_overrides(args, fitted))
     scene_io.load(args.scene, overrides)  # the scene and its overrides, checked before any work
+    points = None
+    if args.points:
+        from rig.fit.data import read_points
+
+        points = read_points(args.points)
+        columns = {item.split("=", 1)[0]: f"--points {args.points} (its column, row by row)"
+                   for config in points.configs for item in config}
+        both = sorted(set(fitted) & set(columns))
+        if both:
+            raise invalid("--param", both[0], f"{columns[both[0]]} already gives it: a fitted key cannot also be fixed")
+        scene_overrides(args, columns)
     if args.observations:
         from rig.fit.observations.objective import ObservationObjective
         from rig.fit.observations.reading import read_observations
@@ -52,10 +64,9 @@ def cmd_fit(args) -> dict:
         observations = read_observations(args.observations, args.scene)
         objective = ObservationObjective(args.scene, params, observations, overrides, args.observations)
     elif args.points:
-        from rig.fit.data import read_points
         from rig.fit.points import PointObjective
 
-        objective = PointObjective(args.scene, params, read_points(args.points), overrides)
+        objective = PointObjective(args.scene, params, points, overrides)
     else:
         from rig.fit.traces import TraceObjective
 

@@ -180,3 +180,18 @@ def test_as_many_points_as_parameters_fits_but_says_chi2_is_undefined(tmp_path, 
     assert any("chi2/dof and p are undefined" in w for w in block["warnings"])
     lo, hi = block["parameters"]["chain.youngs_modulus"]["ci95"]
     assert lo <= 1.1e9 <= hi
+
+
+@pytest.mark.parametrize("flags,words", [
+    (["--set", "magnet.force=2 N"], ["--set", "magnet.force", "its column"]),
+    (["--param", "magnet.force=1 N:3 N"], ["--param", "magnet.force", "cannot also be fixed"]),
+])
+def test_a_key_the_points_set_row_by_row_is_not_also_set_or_fitted(tmp_path, capsys, flags, words):
+    """A --points column sets its key for each row, after --set: a --set of it had been
+    dropped silently, and a fitted key overwritten by the column."""
+    path = tmp_path / "points.csv"
+    path.write_text(HEAD.rstrip("\n") + ",magnet.force [N]\n" + "2,0.2,150,4.5,2.38\n3,0.3,170,5.1,4.25\n")
+    code, err, out = _fit(tmp_path, capsys, ["--points", str(path), *flags], "chain.youngs_modulus=0.4 GPa:2 GPa")
+    assert code == 2
+    _one_line(err, *words)
+    _refused(out)
