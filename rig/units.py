@@ -80,10 +80,12 @@ def split_quantity(text: str, field: str, unit: str) -> tuple:
     exponent after '^' or '**' ("m/s", "N/m^1.5", "kg m^-3", "µs"); anything else
     ("2.3.8 N", "0.5(2) m", "1e-1.5 m/s", "2*0.5 m") is refused naming ``field``."""
     check_digits(text, field)
+    if is_non_finite(text.split()[0] if text.split() else text):
+        raise invalid(field, text, "must be a finite number")
     m = _QUANTITY.match(text)
     if not m:
-        raise invalid(field, text, f"not a quantity: one number and a unit, e.g. '1.5 {unit}' (digits 0-9, one decimal point, "
-                                   "a whole-number exponent; no arithmetic)")
+        raise invalid(field, text, f"not a quantity: one number and a unit, e.g. '1.5 {unit}' (digits 0-9, one "
+                                   "decimal point, a whole-number exponent; no arithmetic)")
     if m.end(1) == m.start(2) and m.group(2)[0] in "jJ":  # Python and pint read "5J" as 5j
         raise invalid(field, text, f"not a quantity: '{m.group(0).strip()}' reads as a complex number; "
                                    f"a space between the number and the unit: '{m.group(1)} {m.group(2)}'")
@@ -215,4 +217,5 @@ def _parse(text: str, unit: str, field: str) -> float:
     return float(f"{si:.15g}")
 
 
-__all__ = ["RigError", "is_non_finite", "is_number", "number", "quantity", "split_quantity", "typed_quantity", "whole"]
+__all__ = ["RigError", "is_non_finite", "is_number", "number", "quantity", "split_quantity", "typed_quantity",
+           "whole"]
