@@ -40,6 +40,7 @@ def is_whole(x) -> bool:
 _DECIMAL_COMMA = re.compile(r"\d,\d")
 _SEPARATOR = r"(?:[_'’\u00a0\u202f]|\s+)"
 _GROUPED = re.compile(rf"\d{_SEPARATOR}\d")  # 1_000, 1'000, 1 000
+_GROUPED_RUN = re.compile(rf"[0-9]+(?:{_SEPARATOR}[0-9]+)+")  # the whole run of grouped digits
 _NUMBER_TEXT = r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?"
 _UNIT_FACTOR = r"[^\W\d_]+(?:\s*(?:\^|\*\*)\s*[-+]?[0-9]+(?:\.[0-9]+)?)?"
 _UNIT_TEXT = rf"{_UNIT_FACTOR}(?:\s*[*/]\s*{_UNIT_FACTOR}|\s+{_UNIT_FACTOR})*"
@@ -54,9 +55,8 @@ def check_digits(text: str, field: str):
     written without the separator."""
     if _DECIMAL_COMMA.search(text):
         raise invalid(field, text, "use a decimal point and no thousands separator (1.2, 1200)")
-    grouped = _GROUPED.search(text)
-    if grouped:
-        run = re.search(rf"[0-9]+(?:{_SEPARATOR}[0-9]+)+", text[grouped.start():])
+    if _GROUPED.search(text):
+        run = _GROUPED_RUN.search(text)
         example = re.sub(_SEPARATOR, "", run.group(0)) if run else "1200"
         raise invalid(field, text, f"one number, no thousands separator ({example})")
 
