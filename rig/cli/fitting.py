@@ -25,7 +25,7 @@ def cmd_fit(args) -> dict:
     from rig.errors import RigError, invalid
     from rig.experiment import scene as scene_io
     from rig.fit.fitting import stderr_progress
-    from rig.fit.parameters import parse_parameters
+    from rig.fit.parameters import POSITIVE_LAW_KEYS, parse_parameters
     from rig.fit.run import run_fit
 
     sources = [s for s in ("records", "archive", "points", "observations") if getattr(args, s)]
@@ -45,6 +45,13 @@ def cmd_fit(args) -> dict:
         check(args.walkers, len(params))
     fitted = {t.split("=", 1)[0].strip(): f"--param {t}" for t in args.param}
     overrides = list(scene_overrides(args, fitted))
+    for p in params:  # a fitted damping switches its contact law on, after --set
+        law = POSITIVE_LAW_KEYS.get(p.key)
+        for item in overrides:
+            key, _, value = item.partition("=")
+            if law and key.strip() == "chain.contact_law" and value.strip().lower() != law:
+                raise invalid("--set", item, f"--param {p.key} fits the {law} law's damping and switches "
+                                             f"chain.contact_law to {law}; leave the --set out")
     scene_io.load(args.scene, overrides)  # the scene and its overrides, checked before any work
     points = None
     if args.points:

@@ -185,6 +185,8 @@ def _flag_cases():
         (["sweep", S, "--vary", "striker.velocity=0.3:1.5:3", "--set", "striker.velocity=1 m/s"], "--vary"),
         (["fit", S, "--param", "chain.youngs_modulus=0.2 GPa:4 GPa", "--set", "chain.youngs_modulus=1 GPa",
           "--points", "p.csv", "--out", out], "--param"),
+        (["fit", S, "--param", "chain.damping_time=0.1 ms:1 ms", "--set", "chain.contact_law=hertz", "--points",
+          "p.csv", "--out", out], "switches chain.contact_law to kuwabara-kono"),
     ]
     twice = ["--set", "striker.velocity=1", "--set", "striker.velocity = 2 m/s"]
     cases += [(["shot", S, *twice], "set twice"),
