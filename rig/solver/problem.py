@@ -121,7 +121,7 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     live = np.isfinite(chain.contact_constants()) & (slot > 0) & (slot < nb)
     A[:, slot[live]], d0[:, slot[live]], f0[:, slot[live]] = A_c[:, live], d_c[:, live], F_c[:, live]
     expo[:, slot[live]] = expo_c[live]
-    tau_c, mu_c = chain.contact_dissipation()
+    tau_c, mu_c = chain.contact_dissipation()[:2]
     damping[:, slot[live]], dashpot[:, slot[live]] = tau_c[live], mu_c[live]
     d_limit[:, slot[live]] = 0.5 * near[live]
     if off:
