@@ -9,10 +9,10 @@ their parameters from here.
 from __future__ import annotations
 
 from rig.errors import invalid, lookup
-from rig.model.laws import dashpot, hertz, kuwabara_kono
+from rig.model.laws import dashpot, hertz, kuwabara_kono, powerlaw_dashpot
 from rig.model.laws.law import HERTZ, KUWABARA_KONO, POWER, ContactLaw, LawParameter, ViscousTerms
 
-LAWS = (hertz.LAW, kuwabara_kono.LAW, dashpot.LAW)
+LAWS = (hertz.LAW, kuwabara_kono.LAW, dashpot.LAW, powerlaw_dashpot.LAW)
 
 CONTACT_LAWS: dict[str, ContactLaw] = {law.name: law for law in LAWS}
 
