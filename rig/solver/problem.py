@@ -146,8 +146,8 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
         e_scale = np.where(e_scale == 0.0, 1.0, e_scale)
         p_scale = np.sqrt(2.0 * mass.sum(axis=1) * e_scale)
     return dict(mass=mass, invm=invm, bias=bias, load=load, A=A, expo=expo, d0=d0, f0=f0, damping=damping,
-                dashpot=dashpot, dashpot_exponent=dashpot_exponent, d_limit=d_limit, drag=drag, friction=friction, u0=u0, v0=v0,
-                energy_scale=e_scale, momentum_scale=p_scale)
+                dashpot=dashpot, dashpot_exponent=dashpot_exponent, d_limit=d_limit, drag=drag, friction=friction,
+                u0=u0, v0=v0, energy_scale=e_scale, momentum_scale=p_scale)
 
 
 REST_TOLERANCE = 1e-12  # a body's net force at rest below this x its loads is rounding, not physics

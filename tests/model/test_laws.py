@@ -1,5 +1,7 @@
 """The contact-law registry (rig.model.laws): one module per law, and everything that
 names a law's parameters reads them from it."""
+import pickle
+
 import pytest
 
 from rig import Bead, RigError, Wall
@@ -18,7 +20,8 @@ def test_registry_is_what_contact_reexports():
     assert CONTACT_LAWS == {law.name: law for law in LAWS}
     assert contact_law("Dashpot") is CONTACT_LAWS["dashpot"]
     assert CONTACT_LAWS["hertz"].code == HERTZ and not CONTACT_LAWS["hertz"].dissipative
-    assert CONTACT_LAWS["kuwabara-kono"].code == KUWABARA_KONO and CONTACT_LAWS["kuwabara-kono"].parameter == "damping_time"
+    kk = CONTACT_LAWS["kuwabara-kono"]
+    assert kk.code == KUWABARA_KONO and kk.parameter == "damping_time" and kk.dissipative
     for law in LAWS:  # every law says its equation and where it comes from
         assert "=" in law.description or "A delta^n" in law.description
 
@@ -61,3 +64,12 @@ def test_chain_takes_every_parameter_as_an_attribute():
 def test_fit_bounds_outside_the_law_are_refused_before_solving():
     with pytest.raises(RigError, match=r"chain.contact_exponent = 0.5: a number in \[1, 3\]"):
         parse_parameter("chain.contact_exponent=0.5:2")
+
+
+def test_laws_and_chains_pickle():
+    """A study's worker processes receive chains (spawn): every law travels by reference."""
+    for law in LAWS:
+        assert pickle.loads(pickle.dumps(law)) == law
+    c = pickle.loads(pickle.dumps(chain(contact_law="powerlaw-dashpot", dashpot_gamma=0.5, dashpot_exponent=0.7)))
+    assert c.law == CONTACT_LAWS["powerlaw-dashpot"]
+    assert c.contact_dissipation()[2].min() == pytest.approx(0.7, rel=1e-15)

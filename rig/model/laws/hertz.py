@@ -7,7 +7,7 @@ describes a contact that departs from it (a polymer's modulus that depends on st
 strain rate, rough surfaces), A_n matched to Hertz at reference_force
 (rig.model.contact.power_law_constant). Conservative.
 """
-from rig.model.laws.law import ELASTIC, HERTZ, ContactLaw, LawParameter
+from rig.model.laws.law import ELASTIC, HERTZ, ContactLaw, LawParameter, ViscousTerms
 
 ELASTIC_PARAMETERS = (
     LawParameter("contact_exponent", "1", 1.0, 3.0, 1.5,
@@ -18,7 +18,13 @@ ELASTIC_PARAMETERS = (
 )
 """Every law's elastic parameters (scene keys of [chain])."""
 
+
+def viscous_terms(values: dict) -> ViscousTerms:
+    """No viscous term: an elastic contact."""
+    return ELASTIC
+
+
 LAW = ContactLaw(
     "hertz",
     "elastic F = A delta^n: Hertz's law at n = 3/2 (the default), a power law otherwise (conservative)",
-    (), lambda values: ELASTIC, HERTZ)
+    (), viscous_terms, HERTZ)
