@@ -1,12 +1,14 @@
 """The contact-law registry (rig.model.laws): one module per law, and everything that
 names a law's parameters reads them from it."""
 import pickle
+from pathlib import Path
 
 import pytest
 
 from rig import Bead, RigError, Wall
 from rig.experiment.scene import SCHEMA, key_spec
-from rig.fit.parameters import law_overrides, parse_parameter
+from rig.experiment.shot import Rig
+from rig.fit.parameters import law_overrides, parse_parameter, parse_parameters
 from rig.model.chain import Chain
 from rig.model.contact import CONTACT_LAWS, HERTZ, KUWABARA_KONO, contact_law
 from rig.model.laws import LAWS, OWNER, PARAMETERS
@@ -73,3 +75,22 @@ def test_laws_and_chains_pickle():
     c = pickle.loads(pickle.dumps(chain(contact_law="powerlaw-dashpot", dashpot_gamma=0.5, dashpot_exponent=0.7)))
     assert c.law == CONTACT_LAWS["powerlaw-dashpot"]
     assert c.contact_dissipation()[2].min() == pytest.approx(0.7, rel=1e-15)
+
+
+def test_a_fitted_law_key_builds_its_chain():
+    """rig fit's overrides of a candidate (law_overrides + each key's --set text) assemble
+    the scene's chain with that law and those values."""
+    params = parse_parameters(["chain.dashpot_gamma=0.05:2", "chain.dashpot_exponent=0.3:2"])
+    sets = law_overrides(params) + [p.override(v) for p, v in zip(params, (0.4, 0.6))]
+    c = Rig.from_scene("ptfe20_gravity", sets).chain
+    assert c.law.name == "powerlaw-dashpot" and (c.dashpot_gamma, c.dashpot_exponent) == (0.4, 0.6)
+    assert {p.unit for p in params} == {"1"}
+
+
+def test_readme_names_every_law_and_key():
+    """The README's model table is written by hand: it must keep up with the registry."""
+    text = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    for law in LAWS:
+        assert f'"{law.name}"' in text or law.name == "hertz", law.name
+    for key in PARAMETERS:
+        assert f"chain.{key}" in text, key
