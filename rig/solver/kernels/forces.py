@@ -10,9 +10,9 @@ A contact at overlap d (m) closing at rate r = d' (m/s) pushes its two bodies ap
 for d > 0, and 0 otherwise (rig.model.laws: tau the Kuwabara-Kono damping time, mu a
 dashpot's coefficient, alpha its exponent, 1 for a linear one). Its elastic part is A d^n,
 its energy A d^(n+1) / (n+1); the rest, A tau d^(n-1) r + mu |r|^alpha sgn r, is viscous
-(dissipation.py integrates it). The law code is the
-problem's (rig.solver.problem.kernel_law): the kernels' force passes carry the elastic
-part, by the Hertz loops wherever every exponent is 3/2.
+(dissipation.py integrates it). The law code is the problem's
+(rig.solver.problem.kernel_law): the kernels' force passes carry the elastic part, by the
+Hertz loops wherever every exponent is 3/2.
 """
 import math
 

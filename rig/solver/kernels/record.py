@@ -65,8 +65,9 @@ def hermite(w, k, y0, r0, y1, r1):
 def recorded_force(w, col, x, c, s, ch_slot, ch_weight, A, con, law, d_old, r_old, d_new, r_new):
     """Channel c's force (N) in shot s at fraction x of a step, whose Hermite weights are
     column col of w: sum over its contacts of weight x the contact law (forces.contact_force;
-    con: (4, bodies, shots) exponents, damping times, dashpots and their exponents) at the interpolated overlap
-    d and the rate d' linear in the step (which only a law with viscous terms reads)."""
+    con: (4, bodies, shots) exponents, damping times, dashpots and their exponents) at the
+    interpolated overlap d and the rate d' linear in the step (which only a law with
+    viscous terms reads)."""
     y = 0.0
     for k in range(ch_slot.shape[1]):
         wk = ch_weight[c, k]
