@@ -14,6 +14,7 @@ from rig.experiment.scene import Scene
 from rig.experiment.settings import GaugeWiring, SolverSettings, WallWiring
 from rig.model.apparatus import Holder, RingMagnet
 from rig.model.chain import Chain
+from rig.model.laws import PARAMETERS as LAW_PARAMETERS
 from rig.model.materials import Material, material
 from rig.model.parts import Bead, GaugeBead, MagneticBead, Striker, Wall
 
@@ -113,10 +114,8 @@ class Assembly:
         c, h = v["chain"], self.holder
         self.chain = Chain(beads, striker=self.striker, wall=wall, gravity=h.gravity,
                            top_force=self.magnet.top_force() if self.magnet else 0.0,
-                           contact_law=c.get("contact_law", "hertz"), damping_time=c.get("damping_time", 0.0),
-                           contact_damping=c.get("contact_damping", 0.0),
-                           contact_exponent=c.get("contact_exponent", 1.5),
-                           reference_force=c.get("reference_force", 1.0),
+                           contact_law=c.get("contact_law", "hertz"),
+                           **{key: c[key] for key in LAW_PARAMETERS if key in c},
                            drag=h.drag, friction=h.friction, slip_speed=h.slip_speed)
         if shared("wall_sensor"):
             self.wall_sensor = like.wall_sensor

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rig.errors import RigError, invalid
+from rig.model.laws import PARAMETERS as LAW_PARAMETERS
 from rig.units import check_digits, is_non_finite, is_number, number, quantity, whole
 
 if sys.version_info >= (3, 11):
@@ -30,8 +31,8 @@ CHANNEL_KEYS = {"volts_per_div": "V", "position": float, "offset": "V", "couplin
 SCHEMA = {
     "scene": {"name": str, "description": str, "reference": str},
     "chain": {"material": str, "diameter": "m", "mass": "kg", "beads": int,
-              "magnetic_bead": bool, "contact_law": str, "damping_time": "s", "contact_damping": "kg/s",
-              "contact_exponent": float, "reference_force": "N",
+              "magnetic_bead": bool, "contact_law": str,
+              **{key: p.scene_spec for key, p in LAW_PARAMETERS.items()},  # the contact laws' (rig.model.laws)
               "youngs_modulus": "Pa", "poisson_ratio": float,
               "magnetic_youngs_modulus": "Pa", "magnetic_poisson_ratio": float},
     "striker": {"material": str, "mass": "kg", "velocity": "m/s", "diameter": "m", "gap": "m"},

@@ -5,9 +5,12 @@ from dataclasses import dataclass
 
 from rig.errors import RigError, invalid
 from rig.experiment.scene import key_spec
+from rig.model.laws import OWNER, PARAMETERS
 from rig.units import check_digits, is_number, number, quantity
 
-POSITIVE_LAW_KEYS = {"chain.damping_time": "kuwabara-kono", "chain.contact_damping": "dashpot"}
+LAW_KEYS = {PARAMETERS[key].field: law.name for key, law in OWNER.items()}
+"""The keys that belong to one contact law (rig.model.laws): fitting one selects that law."""
+POSITIVE_LAW_KEYS = {PARAMETERS[key].field: law.name for key, law in OWNER.items() if PARAMETERS[key].switch}
 """Keys that switch their contact law on (the law needs them > 0)."""
 
 
@@ -63,6 +66,10 @@ def parse_parameter(text: str) -> FitParameter:
     if key in POSITIVE_LAW_KEYS and lo <= 0:
         raise invalid(f"--param {key} LO", lo_text, f"> 0 (the {POSITIVE_LAW_KEYS[key]} law needs it; "
                                                    "leave the key out to fit without it)")
+    law_parameter = PARAMETERS.get(key.split(".", 1)[1]) if key.startswith("chain.") else None
+    if law_parameter is not None:  # both bounds inside what the contact law allows
+        for value in (lo, hi):
+            law_parameter.read(value)
     return FitParameter(key, lo, hi, unit)
 
 
@@ -79,7 +86,7 @@ def parse_parameters(texts) -> tuple:
 
 def law_overrides(params) -> list:
     """The contact-law switch a fitted key needs (chain.contact_law=...)."""
-    laws = {POSITIVE_LAW_KEYS[p.key] for p in params if p.key in POSITIVE_LAW_KEYS}
+    laws = {LAW_KEYS[p.key] for p in params if p.key in LAW_KEYS}
     if len(laws) > 1:
-        raise invalid("--param", sorted(laws), "one contact law at a time (damping_time or contact_damping)")
+        raise invalid("--param", sorted(laws), f"one contact law at a time (of {', '.join(sorted(LAW_KEYS))})")
     return [f"chain.contact_law={laws.pop()}"] if laws else []

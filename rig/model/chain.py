@@ -15,7 +15,8 @@ import numpy as np
 
 from rig.errors import invalid
 from rig.memo import computed_once
-from rig.model.contact import contact_law as lookup_law
+from rig.model.laws import contact_law as lookup_law
+from rig.model.laws import law_values
 from rig.model.parts import Bead, Striker, Wall
 from rig.model.statics import (
     contact_constants_of,
@@ -64,19 +65,20 @@ class Chain:
 
     gravity: acceleration along +x (m/s^2); 0 for a horizontal chain.
     top_force: constant force (N) or ForceSchedule pulling bead 0 down (the ring magnet).
-    contact_law: "hertz" (default, conservative), "kuwabara-kono" with damping_time (s),
-    or "dashpot" with contact_damping (kg/s) (rig.model.contact.CONTACT_LAWS); the contacts
-    that touch a bead of the chain's material follow it (follows_law), with the elastic
-    exponent contact_exponent (3/2: Hertz) matched to Hertz at reference_force (N).
+    contact_law: a law of rig.model.laws ("hertz", the default, conservative;
+    "kuwabara-kono" with damping_time (s); "dashpot" with contact_damping (kg/s);
+    "powerlaw-dashpot" with dashpot_gamma and dashpot_exponent); ``contact``: the laws'
+    parameters by scene key (rig.model.laws.PARAMETERS, each an attribute of the chain),
+    among them the elastic exponent contact_exponent (3/2: Hertz) matched to Hertz at
+    reference_force (N). The contacts that touch a bead of the chain's material follow the
+    law (follows_law).
     drag (kg/s), friction (N), slip_speed (m/s): what the holder's wall does to each bead
     (rig.model.apparatus.Holder); 0: nothing.
     """
 
     def __init__(self, beads, *, striker: Striker | None = None, wall: Wall | None = None,
                  gravity: float = STANDARD_GRAVITY, top_force=0.0,
-                 contact_law: str = "hertz", damping_time=0.0, contact_damping=0.0,
-                 contact_exponent: float = 1.5, reference_force=1.0,
-                 drag=0.0, friction=0.0, slip_speed=1e-3):
+                 contact_law: str = "hertz", drag=0.0, friction=0.0, slip_speed=1e-3, **contact):
         if isinstance(beads, (str, bytes)) or not hasattr(beads, "__iter__"):
             raise invalid("chain.beads", beads, "a list of Beads")
         beads = list(beads)
@@ -100,24 +102,9 @@ class Chain:
         else:
             self.top_force = quantity(top_force, "N", "chain.top_force", bare_ok=True)
         self.law = lookup_law(contact_law)
-        self.damping_time = quantity(damping_time, "s", "chain.damping_time", bare_ok=True)
-        self.contact_damping = quantity(contact_damping, "kg/s", "chain.contact_damping", bare_ok=True)
-        for name, unit in (("damping_time", "s"), ("contact_damping", "kg/s")):
-            if getattr(self, name) < 0:
-                raise invalid(f"chain.{name}", getattr(self, name), f"must be >= 0 {unit}")
-        if self.law.dissipative and getattr(self, self.law.parameter) == 0:
-            raise invalid(f"chain.{self.law.parameter}", getattr(self, self.law.parameter),
-                          f"contact law {self.law.name!r} needs it > 0")
-        for name in ("damping_time", "contact_damping"):
-            if name != self.law.parameter and getattr(self, name) != 0:
-                raise invalid(f"chain.{name}", getattr(self, name),
-                              f"belongs to another contact law than {self.law.name!r}; leave it 0")
-        if not (isinstance(contact_exponent, (int, float)) and 1.0 <= contact_exponent <= 3.0):
-            raise invalid("chain.contact_exponent", contact_exponent, "an exponent in [1, 3] (Hertz: 1.5)")
-        self.contact_exponent = float(contact_exponent)
-        self.reference_force = quantity(reference_force, "N", "chain.reference_force", bare_ok=True)
-        if not self.reference_force > 0:
-            raise invalid("chain.reference_force", reference_force, "must be > 0 N")
+        self.contact_parameters = law_values(self.law, contact)
+        for key, value in self.contact_parameters.items():  # chain.damping_time, chain.contact_exponent, ...
+            setattr(self, key, value)
         self.drag = quantity(drag, "kg/s", "holder.drag", bare_ok=True)
         self.friction = quantity(friction, "N", "holder.friction", bare_ok=True)
         self.slip_speed = quantity(slip_speed, "m/s", "holder.slip_speed", bare_ok=True)
@@ -162,10 +149,13 @@ class Chain:
         return n
 
     def contact_dissipation(self) -> np.ndarray:
-        """(2, contacts): each contact's Kuwabara-Kono damping time (s) and dashpot (kg/s),
-        0 where it does not follow the chain's law."""
+        """(3, contacts): each contact's viscous terms (rig.model.laws.ViscousTerms):
+        Kuwabara-Kono damping time (s), dashpot coefficient gamma (N (s/m)^alpha; kg/s for a
+        linear one) and exponent alpha; (0, 0, 1) where it does not follow the chain's law."""
         law = follows_law(self)
-        return np.array([np.where(law, self.damping_time, 0.0), np.where(law, self.contact_damping, 0.0)])
+        terms = self.law.viscous(self.contact_parameters)
+        return np.array([np.where(law, terms.damping_time, 0.0), np.where(law, terms.dashpot, 0.0),
+                         np.where(law, terms.dashpot_exponent, 1.0)])
 
     @property
     def initial_top_force(self) -> float:

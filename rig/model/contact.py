@@ -1,4 +1,4 @@
-"""Contact laws between neighbours: the Hertz law, a power law, and dissipative variants.
+"""Contact constants and the elastic law's forms (the laws themselves: rig.model.laws).
 
 Hertz (e.g. Johnson, *Contact Mechanics*, 1985)::
 
@@ -17,11 +17,10 @@ modulus stay two separate parameters.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-
 import numpy as np
 
-from rig.errors import invalid, lookup
+from rig.errors import invalid
+from rig.model import laws
 from rig.model.materials import Material
 
 
@@ -99,47 +98,7 @@ def power_law_constant(A_hertz, n, reference_force):
     return reference_force / delta_ref**n
 
 
-# The kernels' code of a chain's contact forces (rig/solver/kernels/forces.py), chosen from
-# its contacts (rig/solver/problem.py), not named by users: HERTZ, every contact elastic
-# Hertz; KUWABARA_KONO, every contact Hertz with viscous terms (Kuwabara-Kono's and/or a
-# dashpot), vectorised; POWER, any exponent per contact (scalar: a pow per contact).
-HERTZ = 0
-KUWABARA_KONO = 1
-POWER = 2
-
-
-@dataclass(frozen=True)
-class ContactLaw:
-    """A contact law between neighbours: what ``chain.contact_law`` names. Each has the
-    elastic part A delta^n (n = chain.contact_exponent, 3/2 by default) and its own
-    dissipative term (none for "hertz")."""
-
-    name: str
-    description: str
-    dissipative: bool
-    parameter: str | None  # the chain's parameter of the dissipative term
-
-
-CONTACT_LAWS: dict[str, ContactLaw] = {
-    law.name: law
-    for law in (
-        ContactLaw("hertz", "elastic F = A delta^n: Hertz's law at n = 3/2 (the default), a power law "
-                   "otherwise (conservative)", False, None),
-        ContactLaw(
-            "kuwabara-kono",
-            "viscoelastic F = A delta^(n-1) (delta + tau_d d(delta)/dt), never attractive (Kuwabara & Kono, "
-            "Jpn. J. Appl. Phys. 26, 1230 (1987); Brilliantov et al., Phys. Rev. E 53, 5382 (1996)); tau_d is "
-            "the material's damping time (chain.damping_time)", True, "damping_time"),
-        ContactLaw(
-            "dashpot",
-            "elastic A delta^n plus a dashpot mu d(delta)/dt while in contact, never attractive: damping "
-            "proportional to the relative velocity of the two beads (Herbold & Nesterenko, Phys. Rev. E 75, "
-            "021304 (2007); Rosas, Romero, Nesterenko & Lindenberg, Phys. Rev. Lett. 98, 164301 (2007)); mu "
-            "(kg/s) is chain.contact_damping", True, "contact_damping"),
-    )
-}
-
-
-def contact_law(name) -> ContactLaw:
-    """Look a contact law up by name (the scene key chain.contact_law)."""
-    return lookup(CONTACT_LAWS, name, "chain.contact_law", ContactLaw)
+# The laws themselves (names, equations, parameters, kernel codes) live one module each in
+# rig.model.laws; their registry is re-exported here, where the rig has always read it.
+CONTACT_LAWS, HERTZ, KUWABARA_KONO, POWER = laws.CONTACT_LAWS, laws.HERTZ, laws.KUWABARA_KONO, laws.POWER
+ContactLaw, contact_law = laws.ContactLaw, laws.contact_law

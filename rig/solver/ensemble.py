@@ -17,7 +17,7 @@ from rig.errors import RigError, invalid
 from rig.solver.kernels.ensemble import integrate_ensemble
 from rig.solver.methods import DEFAULT_METHOD
 from rig.solver.methods import method as get_method
-from rig.solver.problem import ProblemArrays
+from rig.solver.problem import CONTACT_ROWS, ProblemArrays
 from rig.solver.run import check_interval, check_record, time_grid
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import DIAGNOSTICS, KernelReport, SolverStats, Status
@@ -120,7 +120,7 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
     out = np.empty((n, len(save.names), n_out))  # the kernel writes every sample of every shot
     diag = np.zeros((n_chunks, DIAGNOSTICS, width))
     u, v = stack("u0"), stack("v0")
-    con = np.ascontiguousarray(np.stack([stack(k) for k in ("expo", "damping", "dashpot")], axis=1))
+    con = np.ascontiguousarray(np.stack([stack(k) for k in CONTACT_ROWS], axis=1))
     onsite = np.ascontiguousarray(np.stack([stack(k) for k in ("drag", "friction")], axis=1))
     t0 = time.perf_counter()
     integrate_ensemble(u, v, stack("mass"), stack("invm"), stack("bias"), stack("load"), stack("A"),

@@ -13,8 +13,11 @@ from rig.model.chain import Chain, ForceSchedule
 from rig.model.contact import HERTZ, KUWABARA_KONO, POWER
 from rig.model.statics import static_forces_of, static_overlaps_of
 
-PER_BODY = ("mass", "invm", "bias", "A", "expo", "d0", "f0", "damping", "dashpot", "d_limit", "drag", "friction",
-            "u0", "v0")
+PER_BODY = ("mass", "invm", "bias", "A", "expo", "d0", "f0", "damping", "dashpot", "dashpot_exponent", "d_limit",
+            "drag", "friction", "u0", "v0")
+CONTACT_ROWS = ("expo", "damping", "dashpot", "dashpot_exponent")
+"""The rows of the kernels' ``con`` array, each slot's law: exponent n, Kuwabara-Kono damping
+time tau (s), dashpot coefficient gamma (N (s/m)^alpha) and dashpot exponent alpha."""
 
 
 def kernel_law(expo, damping, dashpot) -> int:
@@ -58,6 +61,7 @@ class ProblemArrays(_ContactCodes):
     f0: np.ndarray
     damping: np.ndarray
     dashpot: np.ndarray
+    dashpot_exponent: np.ndarray
     d_limit: np.ndarray
     drag: np.ndarray
     friction: np.ndarray
@@ -113,6 +117,7 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     d_c = static_overlaps_of(A_c, F_c, expo_c)
     A, d0, f0 = np.zeros((S, nb)), np.zeros((S, nb)), np.zeros((S, nb))
     expo, damping, dashpot = np.full((S, nb), 1.5), np.zeros((S, nb)), np.zeros((S, nb))
+    dashpot_exponent = np.ones((S, nb))
     d_limit = np.full((S, nb), math.inf)
     radii = np.array([b.radius for b in chain.beads])
     near = np.minimum(np.append(math.inf, radii), np.append(radii, math.inf))  # contact k: beads k-1, k
@@ -121,8 +126,9 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     live = np.isfinite(chain.contact_constants()) & (slot > 0) & (slot < nb)
     A[:, slot[live]], d0[:, slot[live]], f0[:, slot[live]] = A_c[:, live], d_c[:, live], F_c[:, live]
     expo[:, slot[live]] = expo_c[live]
-    tau_c, mu_c = chain.contact_dissipation()
-    damping[:, slot[live]], dashpot[:, slot[live]] = tau_c[live], mu_c[live]
+    tau_c, gamma_c, alpha_c = chain.contact_dissipation()
+    damping[:, slot[live]], dashpot[:, slot[live]] = tau_c[live], gamma_c[live]
+    dashpot_exponent[:, slot[live]] = alpha_c[live]
     d_limit[:, slot[live]] = 0.5 * near[live]
     if off:
         d0[:, 1] = -chain.striker.gap
@@ -140,8 +146,8 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
         e_scale = np.where(e_scale == 0.0, 1.0, e_scale)
         p_scale = np.sqrt(2.0 * mass.sum(axis=1) * e_scale)
     return dict(mass=mass, invm=invm, bias=bias, load=load, A=A, expo=expo, d0=d0, f0=f0, damping=damping,
-                dashpot=dashpot, d_limit=d_limit, drag=drag, friction=friction, u0=u0, v0=v0,
-                energy_scale=e_scale, momentum_scale=p_scale)
+                dashpot=dashpot, dashpot_exponent=dashpot_exponent, d_limit=d_limit, drag=drag, friction=friction,
+                u0=u0, v0=v0, energy_scale=e_scale, momentum_scale=p_scale)
 
 
 REST_TOLERANCE = 1e-12  # a body's net force at rest below this x its loads is rounding, not physics
@@ -177,7 +183,8 @@ class ChainProblem(_ContactCodes):
     the constant force carried from above through each slot, N), drag (1/s) and friction
     (m/s^2): the holder's drag and Coulomb friction over the body's mass; and per contact
     slot (slot i joins bodies i-1 and i): A (N/m^n), expo (n), d0 (m), f0 (N), damping (s,
-    Kuwabara-Kono), dashpot (kg/s), d_limit (m, an overlap beyond which the integration is
+    Kuwabara-Kono), dashpot (gamma, N (s/m)^alpha: kg/s for a linear one), dashpot_exponent
+    (alpha, 1: linear), d_limit (m, an overlap beyond which the integration is
     declared unstable). u0, v0 the initial state (m, m/s). With a compliant wall the plate
     is a body and the rod the slot below it, to the wall's immovable body.
     """
@@ -194,6 +201,7 @@ class ChainProblem(_ContactCodes):
     f0: np.ndarray
     damping: np.ndarray
     dashpot: np.ndarray
+    dashpot_exponent: np.ndarray
     d_limit: np.ndarray
     drag: np.ndarray
     friction: np.ndarray

@@ -13,7 +13,7 @@ from rig.errors import RigError, invalid
 from rig.solver.kernels.integrators import integrate
 from rig.solver.kernels.layout import working_arrays
 from rig.solver.methods import Method
-from rig.solver.problem import ChainProblem
+from rig.solver.problem import CONTACT_ROWS, ChainProblem
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import DIAGNOSTICS, KernelReport, Solution, SolverStats, Status
 from rig.solver.stepsize import Stepping, viscous_rate
@@ -93,7 +93,7 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     check_every = check_interval(n_steps)
 
     args = (f, problem.mass, invm, problem.bias, load, A, d0, problem.law,
-            np.stack((problem.expo, problem.damping, problem.dashpot)), np.stack((problem.drag, problem.friction)),
+            np.stack([getattr(problem, k) for k in CONTACT_ROWS]), np.stack((problem.drag, problem.friction)),
             problem.slip_speed, viscous_rate(problem), np.array(m.drifts), np.array(m.kicks), step)
     mid = (stepping.head, sub)
     tail = (problem.sched_body, problem.sched_t, problem.sched_f,

@@ -162,15 +162,19 @@ def viscous_rate(p) -> float:
     """A bound (1/s) on the decay rates of the contacts' viscous flow (the dissipation's
     substeps, rig/solver/kernels/dissipation.py): Gershgorin's on M^-1 L, L the chain's
     Laplacian weighted by each contact's viscous coefficient c = mu + A tau d^(n-1) at
-    the peak-force estimate; 0 without viscous terms. A ChainProblem, or a batch's
-    ProblemArrays (the largest over its shots)."""
+    the peak-force estimate (a power-law dashpot's mu |d'|^(alpha-1) at the largest initial
+    speed, the striker's, or 1 m/s without one: the dissipation's substeps hold it stable
+    at any rate); 0 without viscous terms. A ChainProblem, or a batch's ProblemArrays (the
+    largest over its shots)."""
     if not (np.any(p.damping) or np.any(p.dashpot)):
         return 0.0
     live = p.A > 0
     F = peak_force_estimate(p)
+    speed = float(np.max(np.abs(p.v0))) or 1.0
     with np.errstate(invalid="ignore", divide="ignore"):
         d = np.where(live, (F / np.where(live, p.A, 1.0)) ** (1.0 / p.expo), 0.0)
-        c = np.where(live, p.dashpot + p.damping * p.A * d ** (p.expo - 1.0), 0.0)
+        dashpot = np.where(p.dashpot_exponent == 1.0, p.dashpot, p.dashpot * speed ** (p.dashpot_exponent - 1.0))
+        c = np.where(live, dashpot + p.damping * p.A * d ** (p.expo - 1.0), 0.0)
     c_below = np.zeros_like(c)
     c_below[..., :-1] = c[..., 1:]
     return float(np.max(2.0 * (c + c_below) * p.invm))

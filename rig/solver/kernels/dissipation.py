@@ -12,6 +12,16 @@ end) and E the flow of dv/dt = what dissipates, at fixed positions:
   forces.viscous_coefficient), never more pulling than the elastic force pushes
   (g >= -A d^n, so the whole contact force never attracts), taken by explicit midpoint
   (second-order Runge-Kutta) substeps short enough to be stable (``substeps``);
+- with a power-law dashpot (exponent alpha != 1), g = A tau d^(n-1) d' + mu |d'|^alpha
+  sgn d', whose coefficient c = A tau d^(n-1) + mu |d'|^(alpha-1) depends on the rate and,
+  for alpha < 1, grows without bound as d' -> 0 (the exact flow stops a lone contact's
+  relative motion in a finite time). The substeps' count takes c at the striker's speed
+  (stepsize.viscous_rate); each substep holds every contact's c to at most
+  1 / (2 h (1/m_1 + 1/m_2)) (h the substep, m_1, m_2 its bodies), where the midpoint rule
+  of the frozen coefficients is stable (Gershgorin: h x rate <= 2) and takes at most half
+  of a lone contact's relative speed: near d' = 0 the relative speed then decays
+  geometrically, substep by substep, instead of reversing (the flow's stop, to within a
+  speed (2 h mu (1/m_1 + 1/m_2))^(1/(1-alpha)) that vanishes with h);
 - each bead's drag and Coulomb friction (rig.model.apparatus.Holder), by their exact flows
   (``holder_flow``);
 
@@ -91,17 +101,38 @@ def _viscous(v, c, el, g, w, m):
 
 
 @jit
+def _viscous_power(v, c, dash, alpha, im, h, el, g, w, m):
+    """g[k]: each slot's viscous force (N) at velocities v with power-law dashpots (module
+    doc): (c + dash |r|^(alpha-1)) r, r the slot's closing rate, its coefficient held to at
+    most 1 / (2 h (invm above + invm below)), clipped at -el (c: Kuwabara-Kono's
+    coefficients, dash: the dashpots' mu where closed, 0 where open). Flat arrays as in _viscous."""
+    for k in range(np.uint64(w), np.uint64(m)):
+        r = v[k - w] - v[k]
+        a = abs(r)
+        ck = c[k] + dash[k] * a ** (alpha[k] - 1.0) if a > 0.0 else c[k]
+        stiff = 2.0 * h * ck * (im[k - w] + im[k])
+        if stiff > 1.0:
+            ck = ck / stiff
+        gi = ck * r
+        g[k] = gi if gi > -el[k] else -el[k]
+
+
+@jit
 def _contacts(u, v, invm, A, d0, con, t, n, wall_slot, work, j_wall):
     """V(t): n explicit midpoint substeps of the contacts' viscous flow; j_wall[s] += the
-    viscous impulse on the wall (N s). work: (4, bodies + 1, shots). The (bodies, shots)
+    viscous impulse on the wall (N s). work: (5, bodies + 1, shots). The (bodies, shots)
     arrays are C-contiguous and taken flat, row after row, so that the loops vectorise."""
     nb, W = u.shape
     w = np.uint64(W)
     m = nb * W
     uf, vf, im, Af, d0f = u.reshape(m), v.reshape(m), invm.reshape(m), A.reshape(m), d0.reshape(m)
-    ex, tau, mu = con[0].reshape(m), con[1].reshape(m), con[2].reshape(m)
+    ex, tau, mu, alpha = con[0].reshape(m), con[1].reshape(m), con[2].reshape(m), con[3].reshape(m)
     size = (nb + 1) * W
     c, el, g, v_half = work[0].reshape(size), work[1].reshape(size), work[2].reshape(size), work[3].reshape(size)
+    dash = work[4].reshape(size)
+    nonlinear = False
+    for k in range(w, np.uint64(m)):
+        nonlinear = nonlinear or (alpha[k] != 1.0 and mu[k] != 0.0)
     g[:W] = 0.0
     g[m:] = 0.0
     for k in range(w, np.uint64(m)):  # every slot as Hertz's (vectorised square roots), then the others
@@ -115,12 +146,23 @@ def _contacts(u, v, invm, A, d0, con, t, n, wall_slot, work, j_wall):
             d = d0f[k] + uf[k - w] - uf[k]
             c[k] = viscous_coefficient(d, Af[k], ex[k], tau[k], mu[k])
             el[k] = Af[k] * power(d, ex[k]) if d > 0.0 else 0.0
+    if nonlinear:  # c: Kuwabara-Kono's part alone, the dashpots apart
+        for k in range(w, np.uint64(m)):
+            d = d0f[k] + uf[k - w] - uf[k]
+            c[k] = viscous_coefficient(d, Af[k], ex[k], tau[k], 0.0)
+            dash[k] = mu[k] if d > 0.0 else 0.0
     h = t / n
     for _ in range(n):
-        _viscous(vf, c, el, g, w, m)
+        if nonlinear:
+            _viscous_power(vf, c, dash, alpha, im, h, el, g, w, m)
+        else:
+            _viscous(vf, c, el, g, w, m)
         for k in range(np.uint64(m)):
             v_half[k] = vf[k] + 0.5 * h * (g[k] - g[k + w]) * im[k]
-        _viscous(v_half, c, el, g, w, m)
+        if nonlinear:
+            _viscous_power(v_half, c, dash, alpha, im, h, el, g, w, m)
+        else:
+            _viscous(v_half, c, el, g, w, m)
         for k in range(np.uint64(m)):
             vf[k] += h * (g[k] - g[k + w]) * im[k]
         if wall_slot > 0:

@@ -137,7 +137,8 @@ def _record(out, lo, j0, nj, w, x, ch_slot, ch_weight, A, law, con, d_old, r_old
                             fk = wk * (a * d * math.sqrt(d))
                         else:
                             rate = (1.0 - x[m]) * r0 + x[m] * r1
-                            fc, _ = contact_force(d, rate, a, con[0, i, s], con[1, i, s], con[2, i, s], law)
+                            fc, _ = contact_force(d, rate, a, con[0, i, s], con[1, i, s], con[2, i, s],
+                                                  con[3, i, s], law)
                             fk = wk * fc
                         o[m] = fk if first else o[m] + fk
                     first = False
@@ -161,7 +162,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
             viscous = viscous or con[1, i, s] != 0.0 or con[2, i, s] != 0.0
             holder = holder or onsite[0, i, s] != 0.0 or onsite[1, i, s] != 0.0
     dissipative = viscous or holder
-    work = np.zeros((4, nb + 1, W))  # the dissipation's work arrays
+    work = np.zeros((5, nb + 1, W))  # the dissipation's work arrays
     hold = holder_factors(onsite, 0.5 * dt, viscous)  # E(dt/2)'s holder flows
     lost = np.zeros(W)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
     j_visc = np.zeros(W)

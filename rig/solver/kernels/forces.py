@@ -4,14 +4,15 @@ overlap (numba).
 A contact at overlap d (m) closing at rate r = d' (m/s) pushes its two bodies apart with
 
     HERTZ          F = A d^(3/2)
-    KUWABARA_KONO  F = max(A d^(1/2) (d + tau r) + mu r, 0)      (Hertz with viscous terms)
-    POWER          F = max(A d^(n-1) (d + tau r) + mu r, 0)      (any exponent n per contact)
+    KUWABARA_KONO  F = max(A d^(1/2) (d + tau r) + mu |r|^alpha sgn r, 0)   (Hertz with viscous terms)
+    POWER          F = max(A d^(n-1) (d + tau r) + mu |r|^alpha sgn r, 0)   (any exponent n per contact)
 
-for d > 0, and 0 otherwise (rig.model.contact: tau the Kuwabara-Kono damping time, mu a
-dashpot). Its elastic part is A d^n, its energy A d^(n+1) / (n+1); the rest, c r with
-c = mu + A tau d^(n-1), is viscous (dissipation.py integrates it). The law code is the
-problem's (rig.solver.problem.kernel_law): the kernels' force passes carry the elastic
-part, by the Hertz loops wherever every exponent is 3/2.
+for d > 0, and 0 otherwise (rig.model.laws: tau the Kuwabara-Kono damping time, mu a
+dashpot's coefficient, alpha its exponent, 1 for a linear one). Its elastic part is A d^n,
+its energy A d^(n+1) / (n+1); the rest, A tau d^(n-1) r + mu |r|^alpha sgn r, is viscous
+(dissipation.py integrates it). The law code is the problem's
+(rig.solver.problem.kernel_law): the kernels' force passes carry the elastic part, by the
+Hertz loops wherever every exponent is 3/2.
 """
 import math
 
@@ -45,8 +46,16 @@ def other_law(u, A, d0, load, f, expo, lo, hi):
             f[i] = A[i] * power(d if d > 0.0 else 0.0, n) - load[i]
 
 
+@jit(inline="always")
+def dashpot_rate(rate, alpha):
+    """|rate|^alpha sgn(rate) ((m/s)^alpha): the rate itself for a linear dashpot (alpha = 1), exactly."""
+    if alpha == 1.0:
+        return rate
+    return math.copysign(abs(rate) ** alpha, rate)
+
+
 @jit
-def contact_force(d, rate, A, n, tau, mu, law):
+def contact_force(d, rate, A, n, tau, mu, alpha, law):
     """(F, its elastic part) (N) of one contact at overlap d (m), closing at rate (m/s),
     by the law of code ``law`` (module doc)."""
     d = d if d > 0.0 else 0.0
@@ -55,11 +64,11 @@ def contact_force(d, rate, A, n, tau, mu, law):
         return el, el
     if law == KUWABARA_KONO:
         s = math.sqrt(d)
-        fi = A * s * (d + tau * rate) + (mu * rate if d > 0.0 else 0.0)
+        fi = A * s * (d + tau * rate) + (mu * dashpot_rate(rate, alpha) if d > 0.0 else 0.0)
         return (fi if fi > 0.0 else 0.0), A * s * d
     p = power(d, n)
     el = A * p
-    fi = A * (p + tau * rate * (p / d if d > 0.0 else 0.0)) + (mu * rate if d > 0.0 else 0.0)
+    fi = A * (p + tau * rate * (p / d if d > 0.0 else 0.0)) + (mu * dashpot_rate(rate, alpha) if d > 0.0 else 0.0)
     return (fi if fi > 0.0 else 0.0), el
 
 
@@ -85,7 +94,7 @@ def hertz_forces(u, A, d0, load, f):
 @jit(inline="always")
 def viscous_coefficient(d, A, n, tau, mu):
     """c = mu + A tau d^(n-1) (kg/s) of a contact at overlap d > 0 (its viscous force is
-    c d'); 0 for d <= 0."""
+    c d' with a linear dashpot mu); 0 for d <= 0."""
     if not d > 0.0:
         return 0.0
     if tau == 0.0:

@@ -82,8 +82,9 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, vi
 
     f (size nb + 1): the contact forces' work array (layout.working_arrays places it with
     u, v and the parameters the passes read).
-    law: the contact code (forces.py) with con (3, nb): each slot's exponent, damping
-    time (s) and dashpot (kg/s); onsite (2, nb): each body's drag rate (1/s) and friction
+    law: the contact code (forces.py) with con (4, nb): each slot's exponent, damping
+    time (s), dashpot coefficient and dashpot exponent (rig.solver.problem.CONTACT_ROWS);
+    onsite (2, nb): each body's drag rate (1/s) and friction
     deceleration (m/s^2), smoothed over slip (m/s); viscous_rate (1/s): a bound on the
     contacts' viscous decay rates (dissipation.substeps).
     diag (float64[8]) receives: max relative energy error, max relative momentum balance
@@ -115,9 +116,9 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, vi
     # (bodies, 1) views for the multirate head, the records and the dissipation (shared with the batched kernel)
     heads = (u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1)),
              A.reshape((nb, 1)), d0.reshape((nb, 1)), load.reshape((nb + 1, 1)))
-    con3 = con.reshape((3, nb, 1))
+    con3 = con.reshape((con.shape[0], nb, 1))
     hold = holder_factors(onsite.reshape((2, nb, 1)), 0.5 * dt, viscous)  # E(dt/2)'s holder flows
-    work = np.zeros((4, nb + 1, 1))  # the dissipation's work arrays
+    work = np.zeros((5, nb + 1, 1))  # the dissipation's work arrays
     lost = np.zeros(1)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
     j_visc = np.zeros(1)
     j_holder = np.zeros(1)

@@ -65,8 +65,9 @@ def hermite(w, k, y0, r0, y1, r1):
 def recorded_force(w, col, x, c, s, ch_slot, ch_weight, A, con, law, d_old, r_old, d_new, r_new):
     """Channel c's force (N) in shot s at fraction x of a step, whose Hermite weights are
     column col of w: sum over its contacts of weight x the contact law (forces.contact_force;
-    con: (3, bodies, shots) exponents, damping times, dashpots) at the interpolated overlap
-    d and the rate d' linear in the step (which only a law with viscous terms reads)."""
+    con: (4, bodies, shots) exponents, damping times, dashpots and their exponents) at the
+    interpolated overlap d and the rate d' linear in the step (which only a law with
+    viscous terms reads)."""
     y = 0.0
     for k in range(ch_slot.shape[1]):
         wk = ch_weight[c, k]
@@ -74,6 +75,6 @@ def recorded_force(w, col, x, c, s, ch_slot, ch_weight, A, con, law, d_old, r_ol
             i = ch_slot[c, k]
             d = hermite(w, col, d_old[c, k, s], r_old[c, k, s], d_new[c, k, s], r_new[c, k, s])
             rate = (1.0 - x) * r_old[c, k, s] + x * r_new[c, k, s]
-            fk, _ = contact_force(d, rate, A[i, s], con[0, i, s], con[1, i, s], con[2, i, s], law)
+            fk, _ = contact_force(d, rate, A[i, s], con[0, i, s], con[1, i, s], con[2, i, s], con[3, i, s], law)
             y += wk * fk
     return y

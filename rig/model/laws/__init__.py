@@ -1,0 +1,50 @@
+"""The contact laws between neighbours, one module each (its name, equation, reference,
+parameters and the viscous terms it hands the kernels), and their registry.
+
+A new law is a module here with a ``LAW`` (rig.model.laws.law.ContactLaw) added to LAWS;
+the scene keys of [chain] (rig.experiment.scene.SCHEMA), the chain's checks
+(rig.model.chain.Chain), the assembly and ``rig fit``'s keys (rig.fit.parameters) read
+their parameters from here.
+"""
+from __future__ import annotations
+
+from rig.errors import invalid, lookup
+from rig.model.laws import dashpot, hertz, kuwabara_kono, powerlaw_dashpot
+from rig.model.laws.law import HERTZ, KUWABARA_KONO, POWER, ContactLaw, LawParameter, ViscousTerms
+
+LAWS = (hertz.LAW, kuwabara_kono.LAW, dashpot.LAW, powerlaw_dashpot.LAW)
+
+CONTACT_LAWS: dict[str, ContactLaw] = {law.name: law for law in LAWS}
+
+PARAMETERS: dict[str, LawParameter] = {p.key: p for p in tuple(
+    q for law in LAWS for q in law.parameters) + hertz.ELASTIC_PARAMETERS}
+"""Every law's parameters by scene key (chain.<key>): each law's own, then the elastic ones."""
+
+OWNER: dict[str, ContactLaw] = {p.key: law for law in LAWS for p in law.parameters}
+"""The law each law-specific parameter belongs to."""
+
+__all__ = ["CONTACT_LAWS", "ContactLaw", "HERTZ", "KUWABARA_KONO", "LAWS", "LawParameter", "OWNER", "PARAMETERS",
+           "POWER", "ViscousTerms", "contact_law", "law_values"]
+
+
+def contact_law(name) -> ContactLaw:
+    """Look a contact law up by name (the scene key chain.contact_law)."""
+    return lookup(CONTACT_LAWS, name, "chain.contact_law", ContactLaw)
+
+
+def law_values(law: ContactLaw, given: dict) -> dict:
+    """Every parameter's SI value ({key: float}) for a chain of ``law``: ``given`` read and
+    checked (PARAMETERS), the others at their defaults. Refused, naming the key: an unknown
+    key, a value out of bounds, the law's switch left at 0, another law's parameter set."""
+    for key in given:
+        if key not in PARAMETERS:
+            raise invalid("chain", key, f"not a contact parameter; known: {', '.join(PARAMETERS)}")
+    values = {key: (p.read(given[key]) if key in given else p.default) for key, p in PARAMETERS.items()}
+    for key, other in OWNER.items():
+        p = PARAMETERS[key]
+        if other is not law and values[key] != p.default:
+            raise invalid(p.field, values[key], f"belongs to contact law {other.name!r}, not {law.name!r}; "
+                                                f"leave it {p.default:g}")
+        if other is law and p.switch and values[key] == 0:
+            raise invalid(p.field, values[key], f"contact law {law.name!r} needs it > 0")
+    return values
