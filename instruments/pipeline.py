@@ -26,7 +26,8 @@ from ._kernels.pulses import AMPLITUDE, BASE_WIDTH, FOUND, FWHM, LAG, PEAK, RISE
 from .analysis import MIN_BASELINE, PeakRules, Pulse, find_pulses, leading, noise_level
 from .errors import InstrumentError, check
 from .plausibility import Limits, record_doubt, speed_doubt
-from .records import ScopeRecord
+from .rails import clip_reason, rail
+from .records import ScopeRecord, time_base_mismatch
 from .report import SPEED_FIGURES, Report
 
 
@@ -77,7 +78,7 @@ class Setup:
 def record_forces(record: ScopeRecord, setup: Setup):
     """Calibrated dynamic forces (N) from a scope record: t (s from the trigger) and
     {"upper", "lower"[, "wall"]}: baseline from the pre-trigger samples, RC inverted."""
-    out, t, base = {}, None, None
+    out, t, first = {}, None, None
     for role in ("upper", "lower", "wall"):
         g = getattr(setup, role)
         if g is None:
@@ -87,11 +88,11 @@ def record_forces(record: ScopeRecord, setup: Setup):
                                   f"(channels: {', '.join(record.waveforms) or 'none'})")
         w = record.waveforms[g.channel]
         h = w.preamble.x_increment
-        p = w.preamble
+        mismatch = None if first is None else time_base_mismatch(first, w)
+        if mismatch:
+            raise InstrumentError(mismatch)
         if t is None:
-            t, base = w.time(), (p.points, p.x_increment, p.x_zero)
-        elif (p.points, p.x_increment, p.x_zero) != base:
-            raise InstrumentError(f"channel {g.channel} has another time base than the first gauge")
+            t, first = w.time(), w
         out[role] = pulses.conditioned(np.ascontiguousarray(w.volts(), dtype=float), int(w.preamble.trigger_index),
                                        float(h), float(g.tau_s or 0.0), float(g.sensitivity_V_per_N))
     return t, out
@@ -124,8 +125,8 @@ def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True
     train=False leaves the solitary train uncounted (pulses None): studies that need only
     the leading pulse skip the wall channel and two peak searches. noise: role -> noise (N;
     None: unmeasurable, and no pulse is accepted) for the SNR rule; None: noise-free
-    signals (the truth), no SNR rule; clipped: the gauge channels that ran off the scope's
-    range (report_of). The leading pulses and their delay come from the compiled
+    signals (the truth), no SNR rule; clipped: for each gauge channel that ran off the scope's
+    range, why (report_of). The leading pulses and their delay come from the compiled
     _kernels/pulses.leading_pair, as in a study's batched analysis."""
     sigma = {r: math.nan if noise is None or noise.get(r) is None else float(noise[r]) for r in ("upper", "lower")}
     answer = np.empty(pulses.ANSWER)
@@ -139,13 +140,15 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
               noise: dict | None, clipped: tuple = ()) -> Report:
     """The Report of leading_pair's answer (its layout in _kernels/pulses.py): every figure
     it allows, a reason for each it does not, the plausibility rules, and with ``train``
-    the solitary train counted on ``forces``. ``clipped``: the gauge channels whose record
-    ran off the scope's range (their pulses' tops are cut: no figure is given)."""
+    the solitary train counted on ``forces``. ``clipped``: for each gauge channel whose record
+    ran off the scope's range, why (rails.clip_reason: their pulses' tops are cut and flat,
+    so neither amplitude nor peak time is measured: no figure is given)."""
     rules, rep = setup.rules, Report(beta=setup.beta, static_force_N=setup.static_force_N)
     ch = {r: getattr(setup, r).channel for r in ("upper", "lower")}
     if clipped:
-        return rep.refuse(f"{', '.join(clipped)}: clipped: the signal ran off the scope's range, which cuts the "
-                          f"pulses' tops (a larger volts_per_div keeps them on screen)")
+        return rep.refuse(f"{'; '.join(clipped)}: the signal ran off the scope's range, "
+                          f"which cuts the pulses' tops, and a flat top leaves the peak time uncertain (a larger "
+                          f"volts_per_div keeps them on screen)")
     if answer[STATUS] == pulses.SAME_RECORD:
         return rep.refuse(f"{ch['upper']} and {ch['lower']} hold the same record (the same file twice?)")
     problems, lead = [], {}
@@ -262,6 +265,7 @@ def analyze_record(record: ScopeRecord, setup: Setup, train: bool = True) -> Rep
     if bad:
         return rep.refuse(f"{', '.join(bad)}: samples that are not finite numbers (a non-finite scale factor "
                           f"or sample in the file?)")
-    clipped = tuple(getattr(setup, r).channel for r in ("upper", "lower")
-                    if record.waveforms[getattr(setup, r).channel].overrange)
+    waves = [record.waveforms[getattr(setup, r).channel] for r in ("upper", "lower")]
+    clipped = tuple(filter(None, (clip_reason(w.channel, rail(w), w.preamble.x_increment, w.overrange)
+                                  for w in waves)))
     return analyze_forces(t, forces, setup, train, record_noise(record, setup, forces), clipped)

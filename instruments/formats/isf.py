@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import InstrumentError
 from ..files import atomic_writes
+from ..rails import flagged
 from ..records import Preamble, Waveform
 from .checks import channel_name, time_axis
 
@@ -179,4 +180,4 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
                    x_unit=x_unit, y_unit=h.get("YUNIT", "V"), waveform_id=wfid,
                    point_format="ENV" if envelope else "Y",
                    extra={"source": str(path), "record": index + 1, "name_in_file": name_in_file})
-    return Waveform(name, pre, codes=codes)
+    return flagged(Waveform(name, pre, codes=codes))
