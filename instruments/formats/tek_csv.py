@@ -78,7 +78,7 @@ def read_csv(path) -> list:
     """Every channel of a Tektronix CSV file, in either layout (module docstring)."""
     path = Path(path)
     try:
-        lines = path.read_text(errors="strict").splitlines()
+        lines = path.read_text(encoding="utf-8-sig", errors="strict").splitlines()  # a BOM, if any, dropped
     except UnicodeDecodeError:
         raise InstrumentError(f"{path}: not a text file (not a Tektronix CSV?)") from None
     rows = [line.split(",") for line in lines]
