@@ -162,7 +162,10 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
         if sigma is not None:
             rep.noise[ch[r]], rep.snr[ch[r]] = sigma, (peak / sigma if sigma > 0 else math.inf)
         if answer[1 + ROLE * k + FOUND] != 1.0:
-            if sigma is not None and peak < rules.snr * sigma:
+            if record_ends_in_pulse(forces.get(r), sigma, rules):
+                problems.append(f"{ch[r]}: the record ends during the pulse (at t = {float(t[-1]):.4g} s): a longer "
+                                f"record (scope.record_length) or a later trigger")
+            elif sigma is not None and peak < rules.snr * sigma:
                 problems.append(f"{ch[r]}: no pulse stands {rules.snr:g} times above the pre-trigger noise "
                                 f"({sigma:.3g} {setup.force_unit}): its highest excursion is "
                                 f"{rep.snr[ch[r]]:.3g} times the noise")
@@ -191,8 +194,16 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
         return rep.refuse(f"implausible speed: {doubt}", SPEED_FIGURES)
     rep.speed_m_per_s = distance / flight
     lag = float(answer[LAG])
-    rep.give("speed_xcorr_m_per_s", distance / lag if lag > 0 else math.nan,
-             "the cross-correlation of the leading pulses found no positive delay")
+    lower = forces.get("lower")
+    if lower is not None and float(lower[-1]) >= 0.5 * low.amplitude:
+        # the record ends before the lower pulse falls to half: its peak is in, its fall and the train are not
+        rep.refuse(f"{ch['lower']}: the record ends during the pulse (at t = {float(t[-1]):.4g} s), before it falls "
+                   f"to half its amplitude, which cuts the cross-correlation window and the train: a longer record "
+                   f"(scope.record_length) or a later trigger", ("speed_xcorr_m_per_s", "pulses"))
+        train = False
+    else:
+        rep.give("speed_xcorr_m_per_s", distance / lag if lag > 0 else math.nan,
+                 "the cross-correlation of the leading pulses found no positive delay")
     rep.give("width_diameters", up.fwhm * rep.speed_m_per_s / setup.bead_diameter_m, rep.reasons.get("duration_s", ""))
     if train:
         sigma = noise and noise.get("lower")
@@ -201,6 +212,22 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
     else:
         rep.refuse("the train was not counted (leading pulse only)", ("pulses",))
     return rep
+
+
+END_SAMPLES = 3  # the last samples that show a pulse still rising at the record's end
+
+
+def record_ends_in_pulse(f: np.ndarray | None, sigma: float | None, rules: PeakRules) -> bool:
+    """Whether a conditioned record ``f`` (baseline 0) ends inside its largest pulse: its
+    maximum among its last END_SAMPLES samples (still rising), or its last sample above
+    half its maximum (the pulse's fall cut), the maximum standing ``rules.snr`` noise
+    levels above the baseline where the noise ``sigma`` is known. False without a record."""
+    if f is None or f.size <= END_SAMPLES:
+        return False
+    peak = float(np.max(f))
+    if not peak > 0 or (sigma is not None and peak < rules.snr * sigma):
+        return False
+    return int(np.argmax(f)) >= f.size - END_SAMPLES or float(f[-1]) >= 0.5 * peak
 
 
 def _snr_floor(rules: PeakRules, peak: float, sigma: float | None) -> float | None:
