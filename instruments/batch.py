@@ -153,6 +153,7 @@ def analysed(records: Records, setup: Setup) -> list:
                                  front.yoff, front.offset, roles, np.array([g.tau_s or 0.0 for g in gauges]),
                                  np.array([g.sensitivity_V_per_N for g in gauges]), setup.rules.as_tuple(), answer,
                                  sigma, finite)
+    limits = {ch: scope.channels[ch].bandwidth for ch in (setup.upper.channel, setup.lower.channel)}
     ticks = dx * np.arange(records.codes.shape[2])  # each record's sample times from its first
     out = []
     for s in range(S):
@@ -168,5 +169,5 @@ def analysed(records: Records, setup: Setup) -> list:
                      for k, r in enumerate(("upper", "lower"))}
             clipped = tuple(filter(None, (clip_reason(channels[c], rail_of_codes(records.codes[s, c]), dx,
                                                       bool(records.over[s, c])) for c in roles)))
-            out.append(report_of(answer[s], t, {}, setup, False, noise, clipped))
+            out.append(report_of(answer[s], t, {}, setup, False, noise, clipped, limits))
     return out

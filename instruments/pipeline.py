@@ -120,29 +120,31 @@ def _code_step(w) -> float:
 
 
 def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True, noise: dict | None = None,
-                   clipped: tuple = ()) -> Report:
+                   clipped: tuple = (), bandwidth: dict | None = None) -> Report:
     """Speed, amplitudes, pulse count and widths from dynamic forces (baseline 0).
     train=False leaves the solitary train uncounted (pulses None): studies that need only
     the leading pulse skip the wall channel and two peak searches. noise: role -> noise (N;
     None: unmeasurable, and no pulse is accepted) for the SNR rule; None: noise-free
     signals (the truth), no SNR rule; clipped: for each gauge channel that ran off the scope's
-    range, why (report_of). The leading pulses and their delay come from the compiled
+    range, why (report_of); bandwidth: channel -> its bandwidth limit (Hz, report_of). The leading pulses and their delay come from the compiled
     _kernels/pulses.leading_pair, as in a study's batched analysis."""
     sigma = {r: math.nan if noise is None or noise.get(r) is None else float(noise[r]) for r in ("upper", "lower")}
     answer = np.empty(pulses.ANSWER)
     c = np.ascontiguousarray
     pulses.leading_pair(c(t, dtype=float), c(forces["upper"], dtype=float), c(forces["lower"], dtype=float),
                         sigma["upper"], sigma["lower"], setup.rules.as_tuple(), answer)
-    return report_of(answer, t, forces, setup, train, noise, clipped)
+    return report_of(answer, t, forces, setup, train, noise, clipped, bandwidth)
 
 
 def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, train: bool,
-              noise: dict | None, clipped: tuple = ()) -> Report:
+              noise: dict | None, clipped: tuple = (), bandwidth: dict | None = None) -> Report:
     """The Report of leading_pair's answer (its layout in _kernels/pulses.py): every figure
     it allows, a reason for each it does not, the plausibility rules, and with ``train``
     the solitary train counted on ``forces``. ``clipped``: for each gauge channel whose record
     ran off the scope's range, why (rails.clip_reason: their pulses' tops are cut and flat,
-    so neither amplitude nor peak time is measured: no figure is given)."""
+    so neither amplitude nor peak time is measured: no figure is given). ``bandwidth``:
+    channel -> its bandwidth limit (Hz; None or absent: none known), whose rise time must
+    stay within SLOW_FRACTION of the leading pulse's FWHM (too_slow)."""
     rules, rep = setup.rules, Report(beta=setup.beta, static_force_N=setup.static_force_N)
     ch = {r: getattr(setup, r).channel for r in ("upper", "lower")}
     if clipped:
@@ -177,6 +179,9 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
             rep.snr[ch[r]] = lead[r].amplitude / sigma
     if problems:
         return rep.refuse("; ".join(problems))
+    slow = [too_slow(ch[r], (bandwidth or {}).get(ch[r]), lead[r].fwhm) for r in ("upper", "lower")]
+    if any(slow):
+        return rep.refuse("; ".join(filter(None, slow)))
     up, low = lead["upper"], lead["lower"]
     if answer[STATUS] == pulses.SWAPPED:
         return rep.refuse(f"the lower gauge's pulse ({ch['lower']}, {low.time * 1e6:.4g} us) comes before or with "
@@ -212,6 +217,28 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
     else:
         rep.refuse("the train was not counted (leading pulse only)", ("pulses",))
     return rep
+
+
+RISE_PER_BANDWIDTH = 0.35  # a one-pole filter's 10-90% rise time x its -3 dB bandwidth
+# The most rise time per pulse FWHM: a Gaussian pulse through a one-pole filter whose rise
+# time is 1/3 of its FWHM comes out 5% lower and 5% wider, its peak 0.14 FWHM late; at 1/2
+# 10% and 10%, at 1 23% and 25% (numerical convolution). 5% is the amplitude's own error
+# budget; beyond it the filter, not the chain, sets the pulse.
+SLOW_FRACTION = 1 / 3
+
+
+def too_slow(channel: str, bandwidth_Hz: float | None, fwhm: float) -> str:
+    """Why a channel's bandwidth limit distorts its pulse of FWHM ``fwhm`` (s): its rise
+    time RISE_PER_BANDWIDTH / bandwidth beyond SLOW_FRACTION of the FWHM; '' otherwise
+    (no limit known, or no FWHM measured)."""
+    if not bandwidth_Hz or not math.isfinite(fwhm):
+        return ""
+    rise = RISE_PER_BANDWIDTH / bandwidth_Hz
+    if rise <= SLOW_FRACTION * fwhm:
+        return ""
+    return (f"{channel}: its bandwidth limit of {bandwidth_Hz:.6g} Hz rises in 0.35/B = {rise:.3g} s, more than "
+            f"1/3 of the measured pulse's FWHM ({fwhm:.3g} s): the filter lowers, widens and delays the pulse "
+            f"(5% at 1/3); a wider bandwidth (scope.channels.{channel}.bandwidth) or none")
 
 
 END_SAMPLES = 3  # the last samples that show a pulse still rising at the record's end
@@ -295,4 +322,5 @@ def analyze_record(record: ScopeRecord, setup: Setup, train: bool = True) -> Rep
     waves = [record.waveforms[getattr(setup, r).channel] for r in ("upper", "lower")]
     clipped = tuple(filter(None, (clip_reason(w.channel, rail(w), w.preamble.x_increment, w.overrange)
                                   for w in waves)))
-    return analyze_forces(t, forces, setup, train, record_noise(record, setup, forces), clipped)
+    limits = {w.channel: w.preamble.extra.get("bandwidth_Hz") for w in waves}
+    return analyze_forces(t, forces, setup, train, record_noise(record, setup, forces), clipped, limits)

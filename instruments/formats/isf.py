@@ -23,7 +23,7 @@ from ..errors import InstrumentError
 from ..files import atomic_writes
 from ..rails import flagged
 from ..records import Preamble, Waveform
-from .checks import channel_name, time_axis
+from .checks import bandwidth, channel_name, time_axis
 
 # every spelling real scopes use, long and short, to one canonical key
 _ALIASES = {"BYT_NR": "BYT_NR", "BYT_N": "BYT_NR", "BIT_NR": "BIT_NR", "BIT_N": "BIT_NR",
@@ -33,7 +33,8 @@ _ALIASES = {"BYT_NR": "BYT_NR", "BYT_N": "BYT_NR", "BIT_NR": "BIT_NR", "BIT_N": 
             "XUNIT": "XUNIT", "XUN": "XUNIT", "XINCR": "XINCR", "XIN": "XINCR",
             "XZERO": "XZERO", "XZE": "XZERO", "PT_OFF": "PT_OFF", "PT_O": "PT_OFF",
             "YUNIT": "YUNIT", "YUN": "YUNIT", "YMULT": "YMULT", "YMU": "YMULT",
-            "YOFF": "YOFF", "YOF": "YOFF", "YZERO": "YZERO", "YZE": "YZERO"}
+            "YOFF": "YOFF", "YOF": "YOFF", "YZERO": "YZERO", "YZE": "YZERO",
+            "FILTERF": "FILTERF", "FILTERFREQ": "FILTERF"}  # the channel's filter (bandwidth) frequency, Hz
 _REQUIRED = ("BYT_NR", "NR_PT", "XINCR", "XZERO", "YMULT", "YOFF", "YZERO")
 _CURVE = re.compile(rb":CURV(?:E)?\s+")
 # the end of an ASCII curve: the line's end, or the next record's header
@@ -219,5 +220,6 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
                    y_zero=_number(h, "YZERO", path), byte_count=codes.dtype.itemsize,
                    x_unit=x_unit, y_unit=h.get("YUNIT", "V"), waveform_id=wfid,
                    point_format="ENV" if envelope else "Y",
-                   extra={"source": str(path), "record": index + 1, "name_in_file": name_in_file})
+                   extra={"source": str(path), "record": index + 1, "name_in_file": name_in_file,
+                          **bandwidth(h.get("FILTERF"))})
     return flagged(Waveform(name, pre, codes=codes))

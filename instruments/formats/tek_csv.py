@@ -24,7 +24,7 @@ from ..errors import InstrumentError
 from ..files import atomic_writes
 from ..rails import flagged
 from ..records import Preamble, Waveform
-from .checks import channel_name, time_axis
+from .checks import bandwidth, channel_name, time_axis
 
 TDS_BLOCK = 6  # columns per channel in the TDS1000/2000 layout
 _UNITS = {"volts": "V", "volt": "V", "v": "V"}
@@ -126,7 +126,8 @@ def _read_dpo(path, rows, start) -> list:
     fmt = header.get("Point Format", [None])[0]
     return [_waveform(path, name.upper(), table[:, 0], table[:, 1 + k], zero, units[k] if k < len(units) else "V",
                       interval, fmt, _screen(*(_cell(header, key, k) for key in
-                                               ("Vertical Scale", "Vertical Offset", "Vertical Position"))), zero_index=True)
+                                               ("Vertical Scale", "Vertical Offset", "Vertical Position")))
+                      | bandwidth(_cell(header, "Filter Frequency", k)), zero_index=True)
             for k, name in enumerate(names)]
 
 
