@@ -19,7 +19,7 @@ from ._kernels import acquisition, batch_analysis, pulses
 from .frontend import highpass_coefficients
 from .oscilloscope import CODE_MAX, CODE_MIN, Oscilloscope
 from .pipeline import Setup, report_of
-from .rails import clip_reason, rail_of_codes
+from .rails import clipping, rail_of_codes
 from .records import ScopeRecord
 from .report import Report
 
@@ -167,7 +167,7 @@ def analysed(records: Records, setup: Setup) -> list:
             t = records.times[s, 1] + ticks
             noise = {r: None if math.isnan(sigma[s, k]) else float(sigma[s, k])
                      for k, r in enumerate(("upper", "lower"))}
-            clipped = tuple(filter(None, (clip_reason(channels[c], rail_of_codes(records.codes[s, c]), dx,
-                                                      bool(records.over[s, c])) for c in roles)))
+            clipped = tuple(filter(None, (clipping(channels[c], rail_of_codes(records.codes[s, c]), dx,
+                                                   bool(records.over[s, c])) for c in roles)))
             out.append(report_of(answer[s], t, {}, setup, False, noise, clipped, limits))
     return out

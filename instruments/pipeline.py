@@ -26,7 +26,7 @@ from ._kernels.pulses import AMPLITUDE, BASE_WIDTH, FOUND, FWHM, LAG, PEAK, RISE
 from .analysis import MIN_BASELINE, PeakRules, Pulse, find_pulses, leading, noise_level
 from .errors import InstrumentError, check
 from .plausibility import Limits, record_doubt, speed_doubt
-from .rails import clip_reason, rail
+from .rails import clipping, rail
 from .records import ScopeRecord, time_base_mismatch
 from .report import SPEED_FIGURES, Report
 
@@ -125,8 +125,8 @@ def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True
     train=False leaves the solitary train uncounted (pulses None): studies that need only
     the leading pulse skip the wall channel and two peak searches. noise: role -> noise (N;
     None: unmeasurable, and no pulse is accepted) for the SNR rule; None: noise-free
-    signals (the truth), no SNR rule; clipped: for each gauge channel that ran off the scope's
-    range, why (report_of); bandwidth: channel -> its bandwidth limit (Hz, report_of). The leading pulses and their delay come from the compiled
+    signals (the truth), no SNR rule; clipped: the rails.Clip of each gauge channel that ran
+    off the scope's range (report_of); bandwidth: channel -> its bandwidth limit (Hz, report_of). The leading pulses and their delay come from the compiled
     _kernels/pulses.leading_pair, as in a study's batched analysis."""
     sigma = {r: math.nan if noise is None or noise.get(r) is None else float(noise[r]) for r in ("upper", "lower")}
     answer = np.empty(pulses.ANSWER)
@@ -140,17 +140,54 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
               noise: dict | None, clipped: tuple = (), bandwidth: dict | None = None) -> Report:
     """The Report of leading_pair's answer (its layout in _kernels/pulses.py): every figure
     it allows, a reason for each it does not, the plausibility rules, and with ``train``
-    the solitary train counted on ``forces``. ``clipped``: for each gauge channel whose record
-    ran off the scope's range, why (rails.clip_reason: their pulses' tops are cut and flat,
-    so neither amplitude nor peak time is measured: no figure is given). ``bandwidth``:
-    channel -> its bandwidth limit (Hz; None or absent: none known), whose rise time must
-    stay within SLOW_FRACTION of the leading pulse's FWHM (too_slow)."""
+    the solitary train counted on ``forces``. ``clipped``: the rails.Clip of each gauge
+    channel whose record ran off the scope's range (with_clipping). ``bandwidth``: channel
+    -> its bandwidth limit (Hz; None or absent: none known), whose rise time must stay
+    within SLOW_FRACTION of the leading pulse's FWHM (too_slow)."""
+    return with_clipping(_report(answer, t, forces, setup, train, noise, bandwidth), clipped)
+
+
+CLIPPED_FIGURES = ("averaged_amplitude_N", "amplitude_N", "total_force_N", "duration_s", "base_duration_s",
+                   "width_diameters")
+# The most a flat top may move the speed: each peak time is uncertain by half its channel's
+# flat top (the parabola through a plateau finds its middle, which is the peak's time only for
+# a symmetric pulse), and the sum over the time of flight must stay below this.
+CLIPPED_SPEED = 0.01
+
+
+def with_clipping(rep: Report, clipped: tuple) -> Report:
+    """``rep`` with what clipped channels (rails.Clip) allow: no amplitude or width (the
+    pulses' tops are cut), and the speed figures only where the flat tops leave the peak
+    times certain to CLIPPED_SPEED of the flight time; each reason names the samples at
+    the rail."""
+    if not clipped:
+        return rep
+    cut = (f"{'; '.join(c.reason for c in clipped)}: the signal ran off the scope's range, which cuts the pulses' "
+           f"tops (a larger volts_per_div keeps them on screen)")
+    for name in CLIPPED_FIGURES:
+        setattr(rep, name, None)
+        rep.reasons[name] = cut
+    if rep.speed_m_per_s is None:
+        for name in SPEED_FIGURES:
+            rep.reasons[name] = f"{cut}; {rep.reasons[name]}" if name in rep.reasons else cut
+        return rep
+    flight = rep.leading["lower"]["time"] - rep.leading["upper"]["time"]
+    doubt = 0.5 * sum(c.flat_top_s for c in clipped)
+    if not doubt <= CLIPPED_SPEED * flight:  # nan (a flag without the samples): no speed either
+        said = (f"the flat tops leave the peak times uncertain by up to {doubt:.3g} s, {100 * doubt / flight:.2g}% "
+                f"of the {flight:.3g} s between the gauges" if math.isfinite(doubt) else
+                "a flat top leaves the peak time uncertain")
+        rep.refuse(f"{cut}, and {said}", SPEED_FIGURES)
+        for name in SPEED_FIGURES:
+            rep.reasons[name] = f"{cut}, and {said}"
+    return rep
+
+
+def _report(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, train: bool,
+            noise: dict | None, bandwidth: dict | None) -> Report:
+    """report_of without the clipping rule."""
     rules, rep = setup.rules, Report(beta=setup.beta, static_force_N=setup.static_force_N)
     ch = {r: getattr(setup, r).channel for r in ("upper", "lower")}
-    if clipped:
-        return rep.refuse(f"{'; '.join(clipped)}: the signal ran off the scope's range, "
-                          f"which cuts the pulses' tops, and a flat top leaves the peak time uncertain (a larger "
-                          f"volts_per_div keeps them on screen)")
     if answer[STATUS] == pulses.SAME_RECORD:
         return rep.refuse(f"{ch['upper']} and {ch['lower']} hold the same record (the same file twice?)")
     problems, lead = [], {}
@@ -320,7 +357,7 @@ def analyze_record(record: ScopeRecord, setup: Setup, train: bool = True) -> Rep
         return rep.refuse(f"{', '.join(bad)}: samples that are not finite numbers (a non-finite scale factor "
                           f"or sample in the file?)")
     waves = [record.waveforms[getattr(setup, r).channel] for r in ("upper", "lower")]
-    clipped = tuple(filter(None, (clip_reason(w.channel, rail(w), w.preamble.x_increment, w.overrange)
+    clipped = tuple(filter(None, (clipping(w.channel, rail(w), w.preamble.x_increment, w.overrange)
                                   for w in waves)))
     limits = {w.channel: w.preamble.extra.get("bandwidth_Hz") for w in waves}
     return analyze_forces(t, forces, setup, train, record_noise(record, setup, forces), clipped, limits)

@@ -109,12 +109,22 @@ def flagged(w):
     return w if w.overrange or not rail(w).clipped else replace(w, overrange=True)
 
 
-def clip_reason(channel: str, at: Rail, dx: float, overrange: bool = False) -> str:
-    """Why a channel's amplitude cannot be measured, '' where it is not clipped:
-    'CH1: clipped: 351 samples at the ADC's top, a flat top of 179 samples (3.58e-05 s)'
-    (``at``: its samples at the rail, ``dx``: the sample interval s; ``overrange``: the
-    scope's own flag, for a record whose samples no longer show it)."""
+@dataclass(frozen=True)
+class Clip:
+    """A gauge channel that ran off the scope's range: why, in one phrase ('CH1: clipped:
+    351 samples at the ADC's top, a flat top of 179 samples (3.58e-05 s)'), and how long
+    its longest flat top lasts (s; nan where only the scope's flag says so)."""
+
+    channel: str
+    reason: str
+    flat_top_s: float
+
+
+def clipping(channel: str, at: Rail, dx: float, overrange: bool = False) -> Clip | None:
+    """The Clip of a channel whose samples ``at`` sit at the rail (``dx``: the sample
+    interval, s), or that the scope flagged (``overrange``); None where it is on screen."""
     if not at.clipped:
-        return f"{channel}: clipped" if overrange else ""
-    return (f"{channel}: clipped: {at.describe()}, a flat top of {at.longest_run} samples "
-            f"({at.longest_run * dx:.3g} s)")
+        return Clip(channel, f"{channel}: clipped", float("nan")) if overrange else None
+    flat = at.longest_run * dx
+    return Clip(channel, f"{channel}: clipped: {at.describe()}, a flat top of {at.longest_run} samples ({flat:.3g} s)",
+                flat)
