@@ -126,7 +126,8 @@ def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True
     the leading pulse skip the wall channel and two peak searches. noise: role -> noise (N;
     None: unmeasurable, and no pulse is accepted) for the SNR rule; None: noise-free
     signals (the truth), no SNR rule; clipped: the rails.Clip of each gauge channel that ran
-    off the scope's range (report_of); bandwidth: channel -> its bandwidth limit (Hz, report_of). The leading pulses and their delay come from the compiled
+    off the scope's range (report_of); bandwidth: channel -> its bandwidth limit (Hz,
+    report_of). The leading pulses and their delay come from the compiled
     _kernels/pulses.leading_pair, as in a study's batched analysis."""
     sigma = {r: math.nan if noise is None or noise.get(r) is None else float(noise[r]) for r in ("upper", "lower")}
     answer = np.empty(pulses.ANSWER)

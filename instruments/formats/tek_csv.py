@@ -142,7 +142,8 @@ def _screen(scale, offset, position) -> dict:
     keeps it for instruments.rails; {} where the scale is missing or not a number."""
     if not _is_float(scale or "") or not all(_is_float(x) for x in (offset or "0", position or "0")):
         return {}
-    return {"volts_per_div": float(scale), "vertical_offset_V": float(offset or 0), "position_div": float(position or 0)}
+    return {"volts_per_div": float(scale), "vertical_offset_V": float(offset or 0),
+            "position_div": float(position or 0)}
 
 
 TIME_TOLERANCE = 0.1  # samples: the most the TIME column may differ from the header's time base

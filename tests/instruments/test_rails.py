@@ -97,7 +97,8 @@ def test_the_analysis_of_clipped_files_gives_no_amplitude_and_says_how_many_samp
     rep = analyze_record(read_record(paths), setup)
     n = int(np.count_nonzero(waves["CH1"].codes == 127))
     assert rep.amplitude_N is None and rep.speed_m_per_s is None
-    assert re.match(rf"CH1: clipped: {n} samples at the ADC's top, a flat top of \d+ samples", rep.reasons["amplitude_N"])
+    assert re.match(rf"CH1: clipped: {n} samples at the ADC's top, a flat top of \d+ samples",
+                    rep.reasons["amplitude_N"])
     assert "CH2: clipped" in rep.reasons["speed_m_per_s"]
     assert re.search(r"the flat tops leave the peak times uncertain by up to 2\.\d+e-05 s, 1\d% of the 0\.00019 s "
                      r"between the gauges", rep.reasons["speed_m_per_s"])
