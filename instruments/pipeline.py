@@ -28,7 +28,7 @@ from .errors import InstrumentError, check
 from .plausibility import Limits, record_doubt, speed_doubt
 from .rails import clipping, rail
 from .records import ScopeRecord, time_base_mismatch
-from .report import SPEED_FIGURES, Report
+from .report import FIGURES, SPEED_FIGURES, Report
 
 
 @dataclass(frozen=True)
@@ -160,27 +160,29 @@ def with_clipping(rep: Report, clipped: tuple) -> Report:
     """``rep`` with what clipped channels (rails.Clip) allow: no amplitude or width (the
     pulses' tops are cut), and the speed figures only where the flat tops leave the peak
     times certain to CLIPPED_SPEED of the flight time; each reason names the samples at
-    the rail."""
+    the rail, and where no figure is left, all share one reason."""
     if not clipped:
         return rep
     cut = (f"{'; '.join(c.reason for c in clipped)}: the signal ran off the scope's range, which cuts the pulses' "
            f"tops (a larger volts_per_div keeps them on screen)")
-    for name in CLIPPED_FIGURES:
-        setattr(rep, name, None)
-        rep.reasons[name] = cut
-    if rep.speed_m_per_s is None:
-        for name in SPEED_FIGURES:
+    if rep.speed_m_per_s is None:  # refused already: the clipping first
+        for name in FIGURES:
+            setattr(rep, name, None)
             rep.reasons[name] = f"{cut}; {rep.reasons[name]}" if name in rep.reasons else cut
         return rep
     flight = rep.leading["lower"]["time"] - rep.leading["upper"]["time"]
     doubt = 0.5 * sum(c.flat_top_s for c in clipped)
-    if not doubt <= CLIPPED_SPEED * flight:  # nan (a flag without the samples): no speed either
-        said = (f"the flat tops leave the peak times uncertain by up to {doubt:.3g} s, {100 * doubt / flight:.2g}% "
-                f"of the {flight:.3g} s between the gauges" if math.isfinite(doubt) else
-                "a flat top leaves the peak time uncertain")
-        rep.refuse(f"{cut}, and {said}", SPEED_FIGURES)
-        for name in SPEED_FIGURES:
-            rep.reasons[name] = f"{cut}, and {said}"
+    if doubt <= CLIPPED_SPEED * flight:
+        for name in CLIPPED_FIGURES:
+            setattr(rep, name, None)
+            rep.reasons[name] = cut
+        return rep
+    said = (f"the flat tops leave the peak times uncertain by up to {doubt:.3g} s, {100 * doubt / flight:.2g}% of the "
+            f"{flight:.3g} s between the gauges" if math.isfinite(doubt)  # nan: a flag without the samples
+            else "a flat top leaves the peak time uncertain")
+    for name in FIGURES:
+        setattr(rep, name, None)
+        rep.reasons[name] = f"{cut}, and {said}"
     return rep
 
 
