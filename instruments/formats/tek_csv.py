@@ -132,9 +132,10 @@ def _read_dpo(path, rows, start) -> list:
 
 
 def _cell(header: dict, key: str, k: int) -> str:
-    """Channel k's cell of a header row (the last one given where the row has fewer)."""
-    values = header.get(key) or [""]
-    return values[min(k, len(values) - 1)]
+    """Channel k's cell of a header row: its own, or where that is empty or missing the
+    last one given before it (an MSO3012 writes "Vertical Scale,0.05," for two channels)."""
+    given = [v for v in (header.get(key) or [])[:k + 1] if v]
+    return given[-1] if given else ""
 
 
 def _screen(scale, offset, position) -> dict:
