@@ -19,6 +19,7 @@ from ._kernels import acquisition, batch_analysis, pulses
 from .frontend import highpass_coefficients
 from .oscilloscope import CODE_MAX, CODE_MIN, Oscilloscope
 from .pipeline import Setup, report_of
+from .rails import clipping, rail_of_codes
 from .records import ScopeRecord
 from .report import Report
 
@@ -152,6 +153,7 @@ def analysed(records: Records, setup: Setup) -> list:
                                  front.yoff, front.offset, roles, np.array([g.tau_s or 0.0 for g in gauges]),
                                  np.array([g.sensitivity_V_per_N for g in gauges]), setup.rules.as_tuple(), answer,
                                  sigma, finite)
+    limits = {ch: scope.channels[ch].bandwidth for ch in (setup.upper.channel, setup.lower.channel)}
     ticks = dx * np.arange(records.codes.shape[2])  # each record's sample times from its first
     out = []
     for s in range(S):
@@ -165,6 +167,7 @@ def analysed(records: Records, setup: Setup) -> list:
             t = records.times[s, 1] + ticks
             noise = {r: None if math.isnan(sigma[s, k]) else float(sigma[s, k])
                      for k, r in enumerate(("upper", "lower"))}
-            clipped = tuple(channels[c] for c in roles if records.over[s, c])
-            out.append(report_of(answer[s], t, {}, setup, False, noise, clipped))
+            clipped = tuple(filter(None, (clipping(channels[c], rail_of_codes(records.codes[s, c]), dx,
+                                                   bool(records.over[s, c])) for c in roles)))
+            out.append(report_of(answer[s], t, {}, setup, False, noise, clipped, limits))
     return out

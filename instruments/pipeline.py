@@ -26,8 +26,9 @@ from ._kernels.pulses import AMPLITUDE, BASE_WIDTH, FOUND, FWHM, LAG, PEAK, RISE
 from .analysis import MIN_BASELINE, PeakRules, Pulse, find_pulses, leading, noise_level
 from .errors import InstrumentError, check
 from .plausibility import Limits, record_doubt, speed_doubt
-from .records import ScopeRecord
-from .report import SPEED_FIGURES, Report
+from .rails import clipping, rail
+from .records import ScopeRecord, time_base_mismatch
+from .report import FIGURES, SPEED_FIGURES, Report
 
 
 @dataclass(frozen=True)
@@ -77,7 +78,7 @@ class Setup:
 def record_forces(record: ScopeRecord, setup: Setup):
     """Calibrated dynamic forces (N) from a scope record: t (s from the trigger) and
     {"upper", "lower"[, "wall"]}: baseline from the pre-trigger samples, RC inverted."""
-    out, t, base = {}, None, None
+    out, t, first = {}, None, None
     for role in ("upper", "lower", "wall"):
         g = getattr(setup, role)
         if g is None:
@@ -87,11 +88,11 @@ def record_forces(record: ScopeRecord, setup: Setup):
                                   f"(channels: {', '.join(record.waveforms) or 'none'})")
         w = record.waveforms[g.channel]
         h = w.preamble.x_increment
-        p = w.preamble
+        mismatch = None if first is None else time_base_mismatch(first, w)
+        if mismatch:
+            raise InstrumentError(mismatch)
         if t is None:
-            t, base = w.time(), (p.points, p.x_increment, p.x_zero)
-        elif (p.points, p.x_increment, p.x_zero) != base:
-            raise InstrumentError(f"channel {g.channel} has another time base than the first gauge")
+            t, first = w.time(), w
         out[role] = pulses.conditioned(np.ascontiguousarray(w.volts(), dtype=float), int(w.preamble.trigger_index),
                                        float(h), float(g.tau_s or 0.0), float(g.sensitivity_V_per_N))
     return t, out
@@ -119,33 +120,77 @@ def _code_step(w) -> float:
 
 
 def analyze_forces(t: np.ndarray, forces: dict, setup: Setup, train: bool = True, noise: dict | None = None,
-                   clipped: tuple = ()) -> Report:
+                   clipped: tuple = (), bandwidth: dict | None = None) -> Report:
     """Speed, amplitudes, pulse count and widths from dynamic forces (baseline 0).
     train=False leaves the solitary train uncounted (pulses None): studies that need only
     the leading pulse skip the wall channel and two peak searches. noise: role -> noise (N;
     None: unmeasurable, and no pulse is accepted) for the SNR rule; None: noise-free
-    signals (the truth), no SNR rule; clipped: the gauge channels that ran off the scope's
-    range (report_of). The leading pulses and their delay come from the compiled
+    signals (the truth), no SNR rule; clipped: the rails.Clip of each gauge channel that ran
+    off the scope's range (report_of); bandwidth: channel -> its bandwidth limit (Hz,
+    report_of). The leading pulses and their delay come from the compiled
     _kernels/pulses.leading_pair, as in a study's batched analysis."""
     sigma = {r: math.nan if noise is None or noise.get(r) is None else float(noise[r]) for r in ("upper", "lower")}
     answer = np.empty(pulses.ANSWER)
     c = np.ascontiguousarray
     pulses.leading_pair(c(t, dtype=float), c(forces["upper"], dtype=float), c(forces["lower"], dtype=float),
                         sigma["upper"], sigma["lower"], setup.rules.as_tuple(), answer)
-    return report_of(answer, t, forces, setup, train, noise, clipped)
+    return report_of(answer, t, forces, setup, train, noise, clipped, bandwidth)
 
 
 def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, train: bool,
-              noise: dict | None, clipped: tuple = ()) -> Report:
+              noise: dict | None, clipped: tuple = (), bandwidth: dict | None = None) -> Report:
     """The Report of leading_pair's answer (its layout in _kernels/pulses.py): every figure
     it allows, a reason for each it does not, the plausibility rules, and with ``train``
-    the solitary train counted on ``forces``. ``clipped``: the gauge channels whose record
-    ran off the scope's range (their pulses' tops are cut: no figure is given)."""
+    the solitary train counted on ``forces``. ``clipped``: the rails.Clip of each gauge
+    channel whose record ran off the scope's range (with_clipping). ``bandwidth``: channel
+    -> its bandwidth limit (Hz; None or absent: none known), whose rise time must stay
+    within SLOW_FRACTION of the leading pulse's FWHM (too_slow)."""
+    return with_clipping(_report(answer, t, forces, setup, train, noise, bandwidth), clipped)
+
+
+CLIPPED_FIGURES = ("averaged_amplitude_N", "amplitude_N", "total_force_N", "duration_s", "base_duration_s",
+                   "width_diameters")
+# The most a flat top may move the speed: each peak time is uncertain by half its channel's
+# flat top (the parabola through a plateau finds its middle, which is the peak's time only for
+# a symmetric pulse), and the sum over the time of flight must stay below this.
+CLIPPED_SPEED = 0.01
+
+
+def with_clipping(rep: Report, clipped: tuple) -> Report:
+    """``rep`` with what clipped channels (rails.Clip) allow: no amplitude or width (the
+    pulses' tops are cut), and the speed figures only where the flat tops leave the peak
+    times certain to CLIPPED_SPEED of the flight time; each reason names the samples at
+    the rail, and where no figure is left, all share one reason."""
+    if not clipped:
+        return rep
+    cut = (f"{'; '.join(c.reason for c in clipped)}: the signal ran off the scope's range, which cuts the pulses' "
+           f"tops (a larger volts_per_div keeps them on screen)")
+    if rep.speed_m_per_s is None:  # refused already: the clipping first
+        for name in FIGURES:
+            setattr(rep, name, None)
+            rep.reasons[name] = f"{cut}; {rep.reasons[name]}" if name in rep.reasons else cut
+        return rep
+    flight = rep.leading["lower"]["time"] - rep.leading["upper"]["time"]
+    doubt = 0.5 * sum(c.flat_top_s for c in clipped)
+    if doubt <= CLIPPED_SPEED * flight:
+        for name in CLIPPED_FIGURES:
+            setattr(rep, name, None)
+            rep.reasons[name] = cut
+        return rep
+    said = (f"the flat tops leave the peak times uncertain by up to {doubt:.3g} s, {100 * doubt / flight:.2g}% of the "
+            f"{flight:.3g} s between the gauges" if math.isfinite(doubt)  # nan: a flag without the samples
+            else "a flat top leaves the peak time uncertain")
+    for name in FIGURES:
+        setattr(rep, name, None)
+        rep.reasons[name] = f"{cut}, and {said}"
+    return rep
+
+
+def _report(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, train: bool,
+            noise: dict | None, bandwidth: dict | None) -> Report:
+    """report_of without the clipping rule."""
     rules, rep = setup.rules, Report(beta=setup.beta, static_force_N=setup.static_force_N)
     ch = {r: getattr(setup, r).channel for r in ("upper", "lower")}
-    if clipped:
-        return rep.refuse(f"{', '.join(clipped)}: clipped: the signal ran off the scope's range, which cuts the "
-                          f"pulses' tops (a larger volts_per_div keeps them on screen)")
     if answer[STATUS] == pulses.SAME_RECORD:
         return rep.refuse(f"{ch['upper']} and {ch['lower']} hold the same record (the same file twice?)")
     problems, lead = [], {}
@@ -159,7 +204,10 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
         if sigma is not None:
             rep.noise[ch[r]], rep.snr[ch[r]] = sigma, (peak / sigma if sigma > 0 else math.inf)
         if answer[1 + ROLE * k + FOUND] != 1.0:
-            if sigma is not None and peak < rules.snr * sigma:
+            if record_ends_in_pulse(forces.get(r), sigma, rules):
+                problems.append(f"{ch[r]}: the record ends during the pulse (at t = {float(t[-1]):.4g} s): a longer "
+                                f"record (scope.record_length) or a later trigger")
+            elif sigma is not None and peak < rules.snr * sigma:
                 problems.append(f"{ch[r]}: no pulse stands {rules.snr:g} times above the pre-trigger noise "
                                 f"({sigma:.3g} {setup.force_unit}): its highest excursion is "
                                 f"{rep.snr[ch[r]]:.3g} times the noise")
@@ -171,6 +219,9 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
             rep.snr[ch[r]] = lead[r].amplitude / sigma
     if problems:
         return rep.refuse("; ".join(problems))
+    slow = [too_slow(ch[r], (bandwidth or {}).get(ch[r]), lead[r].fwhm) for r in ("upper", "lower")]
+    if any(slow):
+        return rep.refuse("; ".join(filter(None, slow)))
     up, low = lead["upper"], lead["lower"]
     if answer[STATUS] == pulses.SWAPPED:
         return rep.refuse(f"the lower gauge's pulse ({ch['lower']}, {low.time * 1e6:.4g} us) comes before or with "
@@ -188,8 +239,16 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
         return rep.refuse(f"implausible speed: {doubt}", SPEED_FIGURES)
     rep.speed_m_per_s = distance / flight
     lag = float(answer[LAG])
-    rep.give("speed_xcorr_m_per_s", distance / lag if lag > 0 else math.nan,
-             "the cross-correlation of the leading pulses found no positive delay")
+    lower = forces.get("lower")
+    if lower is not None and float(lower[-1]) >= 0.5 * low.amplitude:
+        # the record ends before the lower pulse falls to half: its peak is in, its fall and the train are not
+        rep.refuse(f"{ch['lower']}: the record ends during the pulse (at t = {float(t[-1]):.4g} s), before it falls "
+                   f"to half its amplitude, which cuts the cross-correlation window and the train: a longer record "
+                   f"(scope.record_length) or a later trigger", ("speed_xcorr_m_per_s", "pulses"))
+        train = False
+    else:
+        rep.give("speed_xcorr_m_per_s", distance / lag if lag > 0 else math.nan,
+                 "the cross-correlation of the leading pulses found no positive delay")
     rep.give("width_diameters", up.fwhm * rep.speed_m_per_s / setup.bead_diameter_m, rep.reasons.get("duration_s", ""))
     if train:
         sigma = noise and noise.get("lower")
@@ -198,6 +257,44 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
     else:
         rep.refuse("the train was not counted (leading pulse only)", ("pulses",))
     return rep
+
+
+RISE_PER_BANDWIDTH = 0.35  # a one-pole filter's 10-90% rise time x its -3 dB bandwidth
+# The most rise time per pulse FWHM: a Gaussian pulse through a one-pole filter whose rise
+# time is 1/3 of its FWHM comes out 5% lower and 5% wider, its peak 0.14 FWHM late; at 1/2
+# 10% and 10%, at 1 23% and 25% (numerical convolution). 5% is the amplitude's own error
+# budget; beyond it the filter, not the chain, sets the pulse.
+SLOW_FRACTION = 1 / 3
+
+
+def too_slow(channel: str, bandwidth_Hz: float | None, fwhm: float) -> str:
+    """Why a channel's bandwidth limit distorts its pulse of FWHM ``fwhm`` (s): its rise
+    time RISE_PER_BANDWIDTH / bandwidth beyond SLOW_FRACTION of the FWHM; '' otherwise
+    (no limit known, or no FWHM measured)."""
+    if not bandwidth_Hz or not math.isfinite(fwhm):
+        return ""
+    rise = RISE_PER_BANDWIDTH / bandwidth_Hz
+    if rise <= SLOW_FRACTION * fwhm:
+        return ""
+    return (f"{channel}: its bandwidth limit of {bandwidth_Hz:.6g} Hz rises in 0.35/B = {rise:.3g} s, more than "
+            f"1/3 of the measured pulse's FWHM ({fwhm:.3g} s): the filter lowers, widens and delays the pulse "
+            f"(5% at 1/3); a wider bandwidth (scope.channels.{channel}.bandwidth) or none")
+
+
+END_SAMPLES = 3  # the last samples that show a pulse still rising at the record's end
+
+
+def record_ends_in_pulse(f: np.ndarray | None, sigma: float | None, rules: PeakRules) -> bool:
+    """Whether a conditioned record ``f`` (baseline 0) ends inside its largest pulse: its
+    maximum among its last END_SAMPLES samples (still rising), or its last sample above
+    half its maximum (the pulse's fall cut), the maximum standing ``rules.snr`` noise
+    levels above the baseline where the noise ``sigma`` is known. False without a record."""
+    if f is None or f.size <= END_SAMPLES:
+        return False
+    peak = float(np.max(f))
+    if not peak > 0 or (sigma is not None and peak < rules.snr * sigma):
+        return False
+    return int(np.argmax(f)) >= f.size - END_SAMPLES or float(f[-1]) >= 0.5 * peak
 
 
 def _snr_floor(rules: PeakRules, peak: float, sigma: float | None) -> float | None:
@@ -262,6 +359,8 @@ def analyze_record(record: ScopeRecord, setup: Setup, train: bool = True) -> Rep
     if bad:
         return rep.refuse(f"{', '.join(bad)}: samples that are not finite numbers (a non-finite scale factor "
                           f"or sample in the file?)")
-    clipped = tuple(getattr(setup, r).channel for r in ("upper", "lower")
-                    if record.waveforms[getattr(setup, r).channel].overrange)
-    return analyze_forces(t, forces, setup, train, record_noise(record, setup, forces), clipped)
+    waves = [record.waveforms[getattr(setup, r).channel] for r in ("upper", "lower")]
+    clipped = tuple(filter(None, (clipping(w.channel, rail(w), w.preamble.x_increment, w.overrange)
+                                  for w in waves)))
+    limits = {w.channel: w.preamble.extra.get("bandwidth_Hz") for w in waves}
+    return analyze_forces(t, forces, setup, train, record_noise(record, setup, forces), clipped, limits)

@@ -81,3 +81,30 @@ class ScopeRecord:
 
     def __getitem__(self, channel: str) -> Waveform:
         return self.waveforms[channel]
+
+
+SAME_TIME = 1e-6  # samples: two channels whose sample times differ less than this share one time base
+
+
+def time_base_mismatch(a: Waveform, b: Waveform) -> str | None:
+    """None where ``a`` and ``b`` share one time base (the same points, and every sample
+    time within SAME_TIME of a sample of each other: a CSV prints times a binary file holds
+    exactly); otherwise one line naming both records (their source files, where read from
+    files) and their time bases."""
+    pa, pb = a.preamble, b.preamble
+    dt = min(pa.x_increment, pb.x_increment)
+    drift = abs(pa.x_zero - pb.x_zero) + abs(pa.x_increment - pb.x_increment) * max(pa.points - 1, 0)
+    if pa.points == pb.points and drift <= SAME_TIME * dt:
+        return None
+    return (f"{_origin(a)} and {_origin(b)} have different time bases: {_said(a)}, {_said(b)} "
+            f"(first samples {pb.x_zero - pa.x_zero:.3g} s apart); the channels of one shot share one time base")
+
+
+def _origin(w: Waveform) -> str:
+    source = w.preamble.extra.get("source")
+    return f"{source} ({w.channel})" if source else f"channel {w.channel}"
+
+
+def _said(w: Waveform) -> str:
+    p = w.preamble
+    return f"{p.points} points at {p.x_increment:.10g} s from {p.x_zero:.10g} s"

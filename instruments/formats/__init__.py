@@ -4,7 +4,7 @@ Tektronix's tm_data_types, the ``wfm`` extra). A file's format is told from its 
 from pathlib import Path
 
 from ..errors import InstrumentError
-from ..records import ScopeRecord
+from ..records import ScopeRecord, time_base_mismatch
 from .isf import read_isf, write_isf
 from .sniff import identify
 from .tek_csv import read_csv, write_csv
@@ -31,23 +31,11 @@ def read_record(paths) -> ScopeRecord:
 
 def check_one_time_base(record: ScopeRecord) -> None:
     """InstrumentError in one line unless every channel of ``record`` has the first one's
-    time base (points, sample interval, first sample's time), as the analysis of one shot
-    needs; it names the two files (or channels) and their time bases."""
+    time base (records.time_base_mismatch: points, sample interval, first sample's time),
+    as the analysis of one shot needs; it names the two files (or channels) and their time
+    bases."""
     first, *others = record.waveforms.values()
     for w in others:
-        if _time_base(w) != _time_base(first):
-            raise InstrumentError(f"{_origin(first)} and {_origin(w)} have different time bases: "
-                                  f"{_said(first)}, {_said(w)}; the channels of one shot share one time base")
-
-
-def _time_base(w) -> tuple:
-    return w.preamble.points, w.preamble.x_increment, w.preamble.x_zero
-
-
-def _origin(w) -> str:
-    return f"{w.preamble.extra.get('source', 'the record')} ({w.channel})"
-
-
-def _said(w) -> str:
-    n, dt, t0 = _time_base(w)
-    return f"{n} points at {dt:.6g} s from {t0:.9g} s"
+        mismatch = time_base_mismatch(first, w)
+        if mismatch:
+            raise InstrumentError(mismatch)

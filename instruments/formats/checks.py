@@ -3,6 +3,7 @@ unit is seconds), and a channel name the archive can store, made from whatever t
 gives (a source like "CH1", or a file name like "Tek000-ch1 (2)")."""
 from __future__ import annotations
 
+import math
 import re
 
 from ..errors import InstrumentError
@@ -29,3 +30,14 @@ def channel_name(text: str) -> str:
     gets 'CH_' before it. "Tek000-ch1" -> "Tek000_ch1", "2024 run 3" -> "CH_2024_run_3"."""
     name = re.sub(r"[^A-Za-z0-9_#]", "_", text.strip()) or "CH"
     return f"CH_{name}" if name[0].isdigit() or name[0] == "#" else name
+
+
+def bandwidth(text) -> dict:
+    """{"bandwidth_Hz": B} from a header's filter frequency (ISF FILTERF, CSV "Filter
+    Frequency"), as the preamble's extra keeps a channel's bandwidth limit; {} where the
+    header gives none or no positive number."""
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        return {}
+    return {"bandwidth_Hz": value} if math.isfinite(value) and value > 0 else {}

@@ -7,8 +7,10 @@ PT_OFF is written 0 with XZERO the first sample's time, so readers that use
 t = XZERO + XINCR (n - PT_OFF) and readers that ignore PT_OFF agree.
 
 The reader takes what real scopes write: full (":WFMPRE:BYT_NR") or abbreviated
-(":WFMP:BYT_N") keywords, 8- or 16-bit, either byte order, sample (Y) or envelope (ENV)
-records, and several header+curve records back to back in one file (each is returned).
+(":WFMP:BYT_N") keywords, 8- or 16-bit, either byte order, binary or ASCII curves
+(ENCDG ASC: comma-separated codes; a header whose encoding contradicts its curve is
+refused), sample (Y) or envelope (ENV) records, and several header+curve records back to
+back in one file (each is returned).
 """
 from __future__ import annotations
 
@@ -19,8 +21,9 @@ import numpy as np
 
 from ..errors import InstrumentError
 from ..files import atomic_writes
+from ..rails import flagged
 from ..records import Preamble, Waveform
-from .checks import channel_name, time_axis
+from .checks import bandwidth, channel_name, time_axis
 
 # every spelling real scopes use, long and short, to one canonical key
 _ALIASES = {"BYT_NR": "BYT_NR", "BYT_N": "BYT_NR", "BIT_NR": "BIT_NR", "BIT_N": "BIT_NR",
@@ -30,9 +33,12 @@ _ALIASES = {"BYT_NR": "BYT_NR", "BYT_N": "BYT_NR", "BIT_NR": "BIT_NR", "BIT_N": 
             "XUNIT": "XUNIT", "XUN": "XUNIT", "XINCR": "XINCR", "XIN": "XINCR",
             "XZERO": "XZERO", "XZE": "XZERO", "PT_OFF": "PT_OFF", "PT_O": "PT_OFF",
             "YUNIT": "YUNIT", "YUN": "YUNIT", "YMULT": "YMULT", "YMU": "YMULT",
-            "YOFF": "YOFF", "YOF": "YOFF", "YZERO": "YZERO", "YZE": "YZERO"}
+            "YOFF": "YOFF", "YOF": "YOFF", "YZERO": "YZERO", "YZE": "YZERO",
+            "FILTERF": "FILTERF", "FILTERFREQ": "FILTERF"}  # the channel's filter (bandwidth) frequency, Hz
 _REQUIRED = ("BYT_NR", "NR_PT", "XINCR", "XZERO", "YMULT", "YOFF", "YZERO")
-_CURVE = re.compile(rb":CURV(?:E)?\s+#")
+_CURVE = re.compile(rb":CURV(?:E)?\s+")
+# the end of an ASCII curve: the line's end, or the next record's header
+_ASCII_END = re.compile(rb"[\r\n]|;?:(?:WFMP|WFMPRE|WFMO|WFMOUTPRE):")
 # the source named at the start of WFID: "Ch2, DC coupling, ...", "Math, ...", "Math1 ...", "Ref3"
 _CHANNEL = re.compile(r"^\s*(ch(?=\s*\d)|math|ref)\s*(\d*)", re.IGNORECASE)
 
@@ -89,7 +95,16 @@ def read_isf(path) -> list:
         if m is None:
             raise InstrumentError(f"{path}: no :CURVE block after byte {pos} (not an ISF file?)")
         header = _parse_header(data[pos:m.start()], path)
-        codes, pos = _read_curve(data, m.end(), header, path)
+        ascii_header = header.get("ENCDG", "BIN").upper().startswith("ASC")
+        binary_block = data[m.end():m.end() + 1] == b"#"
+        if ascii_header == binary_block:
+            said = (f"ENCDG {header['ENCDG']} (ASCII codes) over a binary '#' block" if ascii_header
+                    else f"ENCDG {header.get('ENCDG', 'BIN (not given)')} (binary) over a curve that is no '#' block")
+            raise InstrumentError(f"{path}: the header says {said} at byte {m.end()}: the header and the curve "
+                                  f"contradict each other (an ASCII curve is comma-separated codes, a binary one "
+                                  f"#<digits><length><bytes>)")
+        codes, pos = (_read_ascii_curve(data, m.end(), header, path) if ascii_header
+                      else _read_curve(data, m.end() + 1, header, path))
         out.append(_waveform(header, codes, path, len(out)))
         while pos < len(data) and data[pos:pos + 1] in (b"\n", b"\r", b" "):
             pos += 1
@@ -153,6 +168,33 @@ def _read_curve(data: bytes, at: int, header: dict, path):
     return codes, start + count
 
 
+def _read_ascii_curve(data: bytes, at: int, header: dict, path):
+    """The codes of an ASCII curve (ENCDG ASCii: comma-separated integers, as the
+    Tektronix programmer manuals define CURVe? with that encoding) and where it ends."""
+    end = _ASCII_END.search(data, at)
+    stop = end.start() if end else len(data)
+    text = data[at:stop].decode("ascii", "replace").strip()
+    nbytes = _number(header, "BYT_NR", path, int)
+    points = _number(header, "NR_PT", path, int)
+    if nbytes not in (1, 2):
+        raise InstrumentError(f"{path}: BYT_NR = {nbytes}: only 1 or 2 bytes per point are defined")
+    cells = [c.strip() for c in text.split(",")]
+    if not all(re.fullmatch(r"[-+]?\d+", c) for c in cells):
+        bad = next(c for c in cells if not re.fullmatch(r"[-+]?\d+", c))
+        raise InstrumentError(f"{path}: the ASCII curve holds {bad[:20]!r}, not a whole-number code")
+    if len(cells) != points:
+        raise InstrumentError(f"{path}: the ASCII curve holds {len(cells)} codes but the header says NR_PT = {points}")
+    if points < 2:
+        raise InstrumentError(f"{path}: NR_PT = {points}: a record needs at least 2 points (one has no time base)")
+    dtype = np.int8 if nbytes == 1 else np.int16
+    codes = np.array([int(c) for c in cells], dtype=np.int64)
+    info = np.iinfo(dtype)
+    if codes.min() < info.min or codes.max() > info.max:
+        raise InstrumentError(f"{path}: an ASCII code of {codes.min() if codes.min() < info.min else codes.max()} "
+                              f"does not fit BYT_NR = {nbytes} ({info.min} to {info.max})")
+    return codes.astype(dtype), stop
+
+
 def _waveform(h: dict, codes, path, index) -> Waveform:
     dx = _number(h, "XINCR", path)
     if not (np.isfinite(dx) and dx > 0):
@@ -178,5 +220,6 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
                    y_zero=_number(h, "YZERO", path), byte_count=codes.dtype.itemsize,
                    x_unit=x_unit, y_unit=h.get("YUNIT", "V"), waveform_id=wfid,
                    point_format="ENV" if envelope else "Y",
-                   extra={"source": str(path), "record": index + 1, "name_in_file": name_in_file})
-    return Waveform(name, pre, codes=codes)
+                   extra={"source": str(path), "record": index + 1, "name_in_file": name_in_file,
+                          **bandwidth(h.get("FILTERF"))})
+    return flagged(Waveform(name, pre, codes=codes))

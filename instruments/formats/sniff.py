@@ -41,10 +41,30 @@ _FOREIGN = (
         rb"\s*(X,)?(CH\d,|D\d+,|MATH\d?,)+\s*Start,Increment", h) is not None or re.match(
         rb"\s*X,(CH\d,?)+\s*\r?\n\s*Second,", h) is not None),
     ("a Keysight/Agilent CSV export", lambda h: re.match(rb"\s*x-axis,\d", h) is not None),
+    # Siglent SDS: "Record Length,Analog:1400,", ..., then "Second,Volt,"
+    ("a Siglent CSV export", lambda h: _siglent_csv(h)),  # defined below
+    # LeCroy WaveStudio / X-Stream: "LECROYWS...", "Segments,1,SegmentSize,...", then "Time,Ampl"
+    ("a LeCroy CSV export", lambda h: h.lstrip().upper().startswith(b"LECROY") or re.search(
+        rb"^\s*Segments,.*\r?\n(.*\r?\n){0,4}\s*Time,\s*Ampl", h, re.M) is not None),
     # PicoScope 6/7: "Time,Channel A,Channel B" then the units "(ms),(V),(mV)"
     ("a PicoScope CSV export", lambda h: re.match(
         rb"\s*Time,Channel [A-H](,Channel [A-H])*\s*\r?\n\s*\((s|ms|us|\xb5s|\xc2\xb5s|ns|ps)\),\(", h) is not None),
+    ("a semicolon-separated CSV with decimal commas (a spreadsheet's re-save? the rig reads the scope's own "
+     "CSV, comma-separated with decimal points)", lambda h: _decimal_comma_csv(h)),
 )
+
+
+def _siglent_csv(head: bytes) -> bool:
+    """Siglent's CSV header: values tagged "Analog:" or the "Second,Volt" units row."""
+    return re.search(rb"^\s*Record Length,\s*Analog:", head, re.M) is not None or re.search(
+        rb"^\s*Second,\s*Volt", head, re.M) is not None
+
+
+def _decimal_comma_csv(head: bytes) -> bool:
+    """Rows of numbers with decimal commas separated by semicolons ("-0,25;1,5E-3"), as a
+    spreadsheet in a European locale saves a CSV."""
+    rows = re.findall(rb"^\s*[-+]?\d+,\d+(?:[eE][-+]?\d+)?\s*;\s*[-+]?\d+(?:,\d+)?", head, re.M)
+    return len(rows) >= 2
 # Siglent SDS1000X-E (and later revisions'): four int32 channel-on flags (0/1, one or more
 # on), then each channel's volt/div as a 'data with unit' record: float64 value, uint32
 # magnitude (0..16), uint32 unit (0..23)
@@ -90,8 +110,13 @@ def _hdf5_kind(path: Path) -> str:
     return "an HDF5 file (a rig archive? use rig analyze/verify/ls on .h5 files)"
 
 
+BOM = b"\xef\xbb\xbf"  # UTF-8 byte-order mark, which some tools put before a CSV's first row
+
+
 def tektronix_kind(head: bytes) -> str | None:
-    """'isf', 'wfm' or 'csv' when the first bytes are a Tektronix file of that kind."""
+    """'isf', 'wfm' or 'csv' when the first bytes are a Tektronix file of that kind (a CSV
+    after a UTF-8 byte-order mark too)."""
+    head = head.removeprefix(BOM)
     if len(head) > 10 and head[0] in (0x0F, 0xF0) and head[1] in (0x0F, 0xF0) and head[3:7] == b"WFM#":
         return "wfm"
     if b"LLWFM" in head[:8]:
@@ -109,6 +134,8 @@ def _tek_csv(head: bytes) -> bool:
         text = head.decode("ascii")
     except UnicodeDecodeError:
         return False
+    if _siglent_csv(head):
+        return False  # Siglent's header rows have Tektronix's names
     first = [line.split(",")[0].strip() for line in text.splitlines()[:40]]
     known = {"Model", "Firmware Version", "Record Length", "Sample Interval", "Point Format", "Waveform Type",
              "Horizontal Units", "Trigger Point", "Source", "Vertical Units", "Label", "TIME"}

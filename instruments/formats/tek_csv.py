@@ -22,8 +22,9 @@ import numpy as np
 
 from ..errors import InstrumentError
 from ..files import atomic_writes
+from ..rails import flagged
 from ..records import Preamble, Waveform
-from .checks import channel_name, time_axis
+from .checks import bandwidth, channel_name, time_axis
 
 TDS_BLOCK = 6  # columns per channel in the TDS1000/2000 layout
 _UNITS = {"volts": "V", "volt": "V", "v": "V"}
@@ -77,7 +78,7 @@ def read_csv(path) -> list:
     """Every channel of a Tektronix CSV file, in either layout (module docstring)."""
     path = Path(path)
     try:
-        lines = path.read_text(errors="strict").splitlines()
+        lines = path.read_text(encoding="utf-8-sig", errors="strict").splitlines()  # a BOM, if any, dropped
     except UnicodeDecodeError:
         raise InstrumentError(f"{path}: not a text file (not a Tektronix CSV?)") from None
     rows = [line.split(",") for line in lines]
@@ -123,24 +124,56 @@ def _read_dpo(path, rows, start) -> list:
     units = header.get("Vertical Units", [])
     interval = header.get("Sample Interval", [None])[0]
     fmt = header.get("Point Format", [None])[0]
-    t = _zero_index_times(path, table[:, 0], zero, interval)
-    return [_waveform(path, name.upper(), t, table[:, 1 + k], zero, units[k] if k < len(units) else "V",
-                      interval, fmt) for k, name in enumerate(names)]
+    return [_waveform(path, name.upper(), table[:, 0], table[:, 1 + k], zero, units[k] if k < len(units) else "V",
+                      interval, fmt, _screen(*(_cell(header, key, k) for key in
+                                               ("Vertical Scale", "Vertical Offset", "Vertical Position")))
+                      | bandwidth(_cell(header, "Filter Frequency", k)), zero_index=True)
+            for k, name in enumerate(names)]
 
 
-def _zero_index_times(path, t, zero, interval):
-    """The times the 4/5/6 Series header gives, -Zero Index x Sample Interval + n x Sample
-    Interval (the column prints nine digits; the header's fractional Zero Index has more),
-    where the header has both and agrees with the column to a tenth of a sample; the column
-    where the header lacks either; a one-line refusal where they disagree."""
-    if zero in (None, "") or interval in (None, "") or not (_is_float(zero) and _is_float(interval)):
-        return t
-    dt = float(interval)
-    grid = -float(zero) * dt + dt * np.arange(t.size)
-    if not (dt > 0 and np.max(np.abs(grid - t)) < 0.1 * dt):
-        raise InstrumentError(f"{path}: Zero Index = {zero} and Sample Interval = {interval} put the first sample "
-                              f"at {grid[0]:.9g} s, the TIME column at {t[0]:.9g} s: they must agree")
-    return grid
+def _cell(header: dict, key: str, k: int) -> str:
+    """Channel k's cell of a header row: its own, or where that is empty or missing the
+    last one given before it (an MSO3012 writes "Vertical Scale,0.05," for two channels)."""
+    given = [v for v in (header.get(key) or [])[:k + 1] if v]
+    return given[-1] if given else ""
+
+
+def _screen(scale, offset, position) -> dict:
+    """The screen a header gives (V/div, offset V, position div), as the preamble's extra
+    keeps it for instruments.rails; {} where the scale is missing or not a number."""
+    if not _is_float(scale or "") or not all(_is_float(x) for x in (offset or "0", position or "0")):
+        return {}
+    return {"volts_per_div": float(scale), "vertical_offset_V": float(offset or 0),
+            "position_div": float(position or 0)}
+
+
+TIME_TOLERANCE = 0.1  # samples: the most the TIME column may differ from the header's time base
+
+
+def _time_base(path, t, interval, zero) -> tuple:
+    """(first sample's time s, sample interval s) of a record whose TIME column is ``t``:
+    the header's Sample Interval (the column's median step where it gives none) from the
+    column's first time, or from -Zero Index x Sample Interval where the header has a
+    Zero Index (4/5/6 Series: the column prints nine digits, the fractional Zero Index
+    more). Every layout alike: InstrumentError in one line where that time base and the
+    column differ by more than TIME_TOLERANCE of a sample anywhere in the record."""
+    if interval in (None, ""):
+        dt = float(np.median(np.diff(t)))
+    elif _is_float(interval):
+        dt = float(interval)
+    else:
+        raise InstrumentError(f"{path}: Sample Interval = {interval!r} is not a number")
+    if not (np.isfinite(dt) and dt > 0):
+        raise InstrumentError(f"{path}: Sample Interval = {interval!r}: must be a finite number > 0 s")
+    with_zero = zero not in (None, "") and _is_float(zero) and interval not in (None, "")
+    x0 = -float(zero) * dt if with_zero else float(t[0])
+    grid = x0 + dt * np.arange(t.size)
+    if np.max(np.abs(grid - t)) > TIME_TOLERANCE * dt:
+        said = f"Zero Index = {zero} and Sample Interval = {interval}" if with_zero else f"Sample Interval = {interval}"
+        raise InstrumentError(f"{path}: {said} put the first sample at {grid[0]:.9g} s and the last at "
+                              f"{grid[-1]:.9g} s, the TIME column at {t[0]:.9g} s and {t[-1]:.9g} s: they must "
+                              f"agree within {TIME_TOLERANCE:g} of a sample")
+    return x0, dt
 
 
 def _read_tds(path, rows) -> list:
@@ -179,30 +212,35 @@ def _read_tds_block(path, rows, b: int) -> Waveform:
         raise InstrumentError(f"{path}: Record Length says {n} points but the file holds {len(t)} ({where})")
     name = header.get("Source", Path(path).stem).upper()
     return _waveform(path, name, np.array(t), np.array(v), header.get("Trigger Point"),
-                     header.get("Vertical Units", "V"), header["Sample Interval"], header.get("Pt Fmt"))
+                     header.get("Vertical Units", "V"), header["Sample Interval"], header.get("Pt Fmt"),
+                     _screen(header.get("Vertical Scale"), _negated(header.get("Vertical Offset")), "0"))
 
 
-def _waveform(path, name, t, v, trigger, unit, interval=None, point_format=None) -> Waveform:
-    """A volts-only Waveform; the sample interval from the header where it is given; an
-    envelope where the header's point format says ENV or PEAK (detect). The channel is
-    called after its source (or the file), made a name the archive stores; the name as
-    the file gives it is kept in the preamble's extra."""
-    try:
-        dt = float(interval) if interval not in (None, "") else float(np.median(np.diff(t)))
-    except ValueError:
-        raise InstrumentError(f"{path}: Sample Interval = {interval!r} is not a number") from None
-    if not (np.isfinite(dt) and dt > 0):
-        raise InstrumentError(f"{path}: Sample Interval = {interval!r}: must be a finite number > 0 s")
+def _negated(cell):
+    """The TDS layout's Vertical Offset (V) as the screen's offset _screen takes: the TDS
+    scopes write the trace's position in volts, (V + offset) / (V/div) divisions from the
+    centre (a TDS2001C record at 20 mV/div, offset -43.2 mV spans 0.2 to 2.4 divisions)."""
+    return f"{-float(cell)!r}" if cell not in (None, "") and _is_float(cell) else cell
+
+
+def _waveform(path, name, t, v, trigger, unit, interval=None, point_format=None, screen=None,
+              zero_index=False) -> Waveform:
+    """A volts-only Waveform on the time base _time_base checks against the TIME column
+    (``trigger``: the Zero Index where ``zero_index``, else the trigger's sample); an
+    envelope where the header's point format says ENV or PEAK (detect); the screen
+    (``screen``, _screen) kept in extra and the over-range flag set where samples sit at
+    its edge (instruments.rails). The channel is called after its source (or the file),
+    made a name the archive stores; the name as the file gives it is kept in extra."""
     if not np.all(np.diff(t) > 0):
         raise InstrumentError(f"{path}: the time column does not increase")
-    try:
-        idx = (int(round(float(trigger))) if trigger not in (None, "")
-               else int(np.clip(round(-t[0] / dt), 0, t.size - 1)))
-    except ValueError:
-        raise InstrumentError(f"{path}: trigger position = {trigger!r} is not a number") from None
+    if trigger not in (None, "") and not _is_float(trigger):
+        raise InstrumentError(f"{path}: trigger position = {trigger!r} is not a number")
+    x0, dt = _time_base(path, t, interval, trigger if zero_index else None)
+    idx = (int(round(float(trigger))) if trigger not in (None, "") and not zero_index
+           else int(np.clip(round(-x0 / dt), 0, t.size - 1)))
     unit = _UNITS.get((unit or "V").strip().lower(), (unit or "V").strip())
-    pre = Preamble(points=t.size, x_increment=dt, x_zero=float(t[0]), trigger_index=idx,
+    pre = Preamble(points=t.size, x_increment=dt, x_zero=x0, trigger_index=idx,
                    y_multiplier=1.0, y_offset=0.0, y_zero=0.0, byte_count=0, y_unit=unit,
                    point_format="ENV" if (point_format or "Y").strip().upper().startswith(("ENV", "PEAK")) else "Y",
-                   extra={"source": str(path), "name_in_file": name})
-    return Waveform(channel_name(name), pre, samples=v)
+                   extra={"source": str(path), "name_in_file": name, **(screen or {})})
+    return flagged(Waveform(channel_name(name), pre, samples=v))

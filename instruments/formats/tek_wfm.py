@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InstrumentError
+from ..rails import flagged
 from ..records import Preamble, Waveform
 from .checks import channel_name, time_axis
 
@@ -107,7 +108,7 @@ def read_wfm(path) -> list:
                    trigger_index=int(np.clip(round(-x0 / dx), 0, volts.size - 1)),
                    y_multiplier=scale, y_offset=0.0, y_zero=offset, byte_count=np.dtype(dtype).itemsize,
                    extra={"source": str(path), "format": "Tektronix WFM", "name_in_file": name})
-    return [Waveform(channel_name(name), pre, codes=codes.astype(dtype))]
+    return [flagged(Waveform(channel_name(name), pre, codes=codes.astype(dtype)))]
 
 
 def _label(data: bytes) -> str:

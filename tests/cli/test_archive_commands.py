@@ -297,7 +297,11 @@ def test_a_two_channel_tds_csv_imports_lists_and_analyses_both_channels(tmp_path
     assert np.array_equal(back["CH1"].volts(), table[:, 0]) and np.array_equal(back["CH2"].volts(), table[:, 1])
     main(["analyze", f, "--gauge-distance", "43.1 mm", "--json"])
     (result,) = json.loads(capsys.readouterr().out)
-    assert set(result["snr"]) == {"CH1", "CH2"}  # both channels analysed, not "the record holds CH1"
+    # both channels analysed, not "the record holds CH1"; CH1 sits at 3.46 V, 6.9 divisions up at 0.5 V/div,
+    # for its last 1121 samples without the one-code flicker of its baseline: the ADC's rail
+    assert result["reasons"]["amplitude_N"].startswith("CH1: clipped: 1124 samples at the ADC's top")
+    assert "CH2" not in result["reasons"]["amplitude_N"]
+    assert not back["CH2"].overrange and back["CH1"].overrange
 
 
 def test_import_together_refuses_files_of_different_time_bases(tmp_path, capsys, realdata):

@@ -236,6 +236,18 @@ SCOPE_FILES = {
     "nan_time.csv": (CSV_HEAD + ",,nan,0.0\n,,nan,0.1\n,,nan,0.2\n,,nan,0.3\n").encode(),
     "one_row.csv": (CSV_HEAD.replace("Record Length,4", "Record Length,1") + ",,0.0,0.1\n").encode(),
     "junk.wfm": b"\x00\x01garbage" * 64,
+    # a header Sample Interval the TIME column contradicts, in each CSV layout
+    "interval_dpo.csv": b"Sample Interval,2e-06\nRecord Length,4\nTIME,CH1\n0,0.1\n1e-06,0.2\n2e-06,0.3\n3e-06,0.4\n",
+    "interval_tds.csv": (b"Record Length,4,,0.0,0.1\nSample Interval,2e-06,,1e-06,0.2\nTrigger Point,0,,2e-06,0.3\n"
+                         b"Source,CH1,,3e-06,0.4\n"),
+    # other makers' CSV exports, named; a spreadsheet's re-save, named
+    "siglent.csv": b"Record Length,Analog:4,\nSample Interval,Analog:1e-06,\nSecond,Volt,\n0,0.1,\n1e-06,0.2,\n",
+    "lecroy.csv": b"LECROYWS3024,23052,Waveform\nSegments,1,SegmentSize,4\nTime,Ampl\n0,0.1\n1e-06,0.2\n",
+    "resaved.csv": b"Sample Interval;0,000001\nTIME;CH1\n0,000000;0,1\n0,000001;0,2\n0,000002;0,3\n",
+    # an ISF header whose encoding contradicts its curve, both ways
+    "asc_over_bin.isf": _isf().replace(b"ENCDG BIN", b"ENCDG ASC"),
+    "bin_over_asc.isf": _isf().split(b"#14")[0] + b"1,2,3,4\n",
+    "ascii_curve_short.isf": _isf().replace(b"ENCDG BIN", b"ENCDG ASC").split(b"#14")[0] + b"1,2,3\n",
 }
 FILE_CASES = [(cmd, name) for name in SCOPE_FILES for cmd in ("analyze", "import")]
 
