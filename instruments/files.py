@@ -13,6 +13,9 @@ by Python: HDF5 that fails part-way through a write to disk is left in a broken 
 then prints tracebacks while it cleans up, and a process can crash), where a failed write
 of plain bytes is one OSError.
 
+``left_as_found`` removes what a block added to a folder when the block fails: a refused
+run leaves the folder (or its absence) as it was.
+
 ``folder_lock`` holds an exclusive ``flock`` on a lock file in a folder for the life of a
 run; the OS releases it when the process ends, killed or not, so a dead holder never blocks.
 The file names the holder (pid, host, start), which a refusal quotes.
@@ -112,6 +115,39 @@ def write_hdf5(path, fill) -> Path:
 def write_text(path, text: str) -> Path:
     """``text`` (UTF-8) as the whole of ``path``, atomically."""
     return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+
+
+@contextlib.contextmanager
+def left_as_found(folder, failures=(Exception,)):
+    """Run a block that writes under ``folder``; where it raises one of ``failures``, remove
+    every file and folder under ``folder`` that was not there before the block (and
+    ``folder`` itself, with the parents it was created with, where the block created it),
+    then re-raise. What was there before stays, as it is."""
+    folder = top = Path(folder).absolute()
+    while not top.parent.exists() and top.parent != top:  # the first of folder's missing parents
+        top = top.parent
+    before = tree(top)
+    try:
+        yield folder
+    except failures:
+        remove_added(top, before)
+        raise
+
+
+def tree(folder) -> set:
+    """Every path under ``folder`` and ``folder`` itself; empty where it does not exist."""
+    folder = Path(folder)
+    return {folder, *folder.rglob("*")} if folder.is_dir() else set()
+
+
+def remove_added(folder, before: set):
+    """Remove what is under ``folder`` (and ``folder``) now that is not in ``before`` (a
+    ``tree``): files first, then the folders left empty, deepest first. A folder that holds
+    something from before is kept; a path that cannot be removed is left."""
+    added = sorted(tree(folder) - set(before), key=lambda p: len(p.parts), reverse=True)
+    for path in added:
+        with contextlib.suppress(OSError):
+            path.rmdir() if path.is_dir() and not path.is_symlink() else path.unlink()
 
 
 def _temporary(path: Path) -> str:
