@@ -26,9 +26,10 @@ def cmd_shot(args) -> dict:
     if args.export:
         if not shot.scope.triggered:
             raise RigError(f"--export: nothing to export, the scope did not trigger ({shot.scope.reason})")
+        from instruments.files import made_folder
+
         folder = Path(args.export)
-        with writing_to(folder):
-            folder.mkdir(parents=True, exist_ok=True)
+        with writing_to(folder), made_folder(folder):  # a failed export leaves no folder it created
             paths = WRITERS[args.format or "isf"](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
         out["exported"] = [str(p) for p in paths]
     if args.out:
