@@ -1,7 +1,7 @@
 """`rig shot` and `rig animate`: one virtual shot, summarised, exported or rendered."""
 from __future__ import annotations
 
-from rig.cli.common import check_size, missing_lines, progress_bar, writing_to
+from rig.cli.common import check_size, flag_lines, missing_lines, progress_bar, writing_to
 from rig.errors import RigError, invalid
 
 
@@ -113,6 +113,9 @@ def print_blocks(t, m, th):
           f"cross-correlation speed {fmt(m['speed_xcorr_m_per_s'])} m/s")
     for line in missing_lines(m.get("reasons", {})):
         print(f"  measured: {line}")
+    for label, r in (("truth", t), ("measured", m)):
+        for line in flag_lines(r.get("flags", {})):
+            print(f"  {label}: {line}")
 
 
 def cmd_animate(args) -> dict:

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rig.cli.common import check_size, missing_lines, progress_bar, writing_to
+from rig.cli.common import check_size, flag_lines, missing_lines, progress_bar, writing_to
 from rig.cli.shots import shot_summary
 from rig.errors import Interrupted, RigError
 
@@ -78,6 +78,8 @@ def print_sweep(key: str, points: list):
         if m["speed_m_per_s"] is None:
             why = missing_lines(m["reasons"]) or [f"no result: {p['no_trigger_reason'] or 'no reason given'}"]
             print(f"{'':18s}   measured: {'; '.join(why)}")
+        for line in flag_lines(t.get("flags", {})):  # the truth's flags hold for the measured figures too
+            print(f"{'':18s}   {line}")
         clipped += [p["value"]] if chans else []
     if clipped:
         print(f"clipped scope channels at {key} = {', '.join(f'{v:g}' for v in clipped)}: a clipped "
