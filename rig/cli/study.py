@@ -39,7 +39,9 @@ def cmd_mc(args) -> dict:
             print(f"Sobol design over {len(dists)} inputs: {shots} shots "
                   f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
         held = min(study.batch, study.shots)  # the shots a batch holds at once
-        whole = nominal(study.scene, study.overrides).rig.estimate(controlled=False).times(study.shots, held)
+        rig = nominal(study.scene, study.overrides).rig
+        rig.check_record()  # settings that can give no record (or a made-up one) are refused before any solve
+        whole = rig.estimate(controlled=False).times(study.shots, held)
         check_size(whole, args, f"the study's {study.shots} shots (batches of {held} held at once)")
         with progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot") as bar:
             run = run_in(store, study, args.workers or 1, args.scheduler, bar.update, bar.update,
