@@ -5,7 +5,7 @@ import json
 from pathlib import Path
 
 from instruments.files import atomic_write, left_as_found, write_text
-from rig.errors import RigError
+from rig.errors import Interrupted, RigError
 from rig.experiment import scene as scene_io
 from rig.fit import report
 from rig.fit.fitting import fit
@@ -19,12 +19,13 @@ def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 40
     writes everything but the fitted scene, and so does one whose model cannot describe the
     data or leaves a parameter undetermined (FitResult.usable); a refused one (RigError)
     leaves the folder as it was: what this run added is removed (the folder too where
-    this run created it), what was there before is kept. An I/O failure (a full disk) keeps
-    the evaluations cached before it and removes the folders it left empty. posterior_steps > 0: a converged fit's posterior
+    this run created it), what was there before is kept. An I/O failure (a full disk) or an
+    interruption keeps what was cached before it (evaluations, the posterior's chain) and
+    removes only the folders it left empty. posterior_steps > 0: a converged fit's posterior
     is then sampled (rig.fit.posterior: ``walkers``, default 4 per parameter and at least
     8, drawn from ``seed``) into the block's "posterior" and out/posterior.png."""
-    with left_as_found(out, (RigError, OSError), keep=lambda exc: isinstance(exc, OSError)):  # a full disk: the
-        # evaluations cached before it stay, for the same command to resume from
+    kept = (OSError, Interrupted)  # a full disk, Ctrl-C: what was cached stays, for the same command to resume from
+    with left_as_found(out, (RigError, OSError), keep=lambda exc: isinstance(exc, kept)):
         return _fit_into(scene, objective, Path(out), progress, max_evaluations, posterior_steps, walkers, seed)
 
 
