@@ -88,3 +88,19 @@ def test_the_command_line_refuses_it_in_one_line_naming_the_duration_that_reache
                  "--set", f"scope.record_length={record}", "--json"]) == 0, capsys.readouterr().err
     out = json.loads(capsys.readouterr().out)
     assert out["solver"]["error_estimate"] <= 1e-4
+
+
+def test_the_error_over_time_ends_at_the_whole_records_error_and_cuts_where_it_should():
+    # two channels: a pulse at 1 ms, a second one at 2 ms where the solution drifts off
+    from rig.solver.control import error_over_time
+    from rig.solver.solution import relative_error
+    import numpy as np
+
+    t = np.arange(3000) * 1e-6
+    pulse = lambda t0: np.exp(-(((t - t0) / 5e-5) ** 2))  # noqa: E731
+    reference = {"a": 2.0 + pulse(1e-3), "b": 1.0 + 3 * pulse(2e-3)}
+    forces = {"a": reference["a"] + 1e-7 * pulse(1e-3), "b": reference["b"] + 1e-2 * (t > 2e-3)}
+    err = error_over_time(forces, reference)
+    assert err[-1] == pytest.approx(relative_error(forces, reference), rel=1e-12)
+    assert err[1500] == pytest.approx(1e-7, rel=1e-3)  # before the drift: channel a's error only
+    assert err[2500] == pytest.approx(1e-2 / 3, rel=1e-3)  # after it: channel b's against its peak
