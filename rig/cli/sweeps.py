@@ -43,7 +43,8 @@ def cmd_sweep(args) -> dict:
     out = {"points": []}
     for p in points:
         if p.shot is None:
-            one = {"truth": None, "measured": None, "theory": None}
+            one = {"scenario": p.rig.name, "seed": p.seed, "overrides": list(p.rig.scene.overrides),
+                   "truth": None, "measured": None, "theory": None}
         else:
             one = shot_summary(p.rig, p.shot)
             one.update(p.blocks)

@@ -80,13 +80,15 @@ def _unit_of(key: str):
 
 @dataclass(frozen=True, eq=False)
 class SweepPoint:
-    """One point of a sweep: its shot and figures, or (shot None) why it gave no record."""
+    """One point of a sweep: its shot and figures, or (shot None) why it gave no record and
+    the seed it was fired with (the same scene, overrides and seed fire it again alone)."""
 
     value: float
     rig: Rig
     shot: ShotRecord | None
     blocks: dict | None
     reason: str | None = None
+    seed: int | None = None
 
 
 def seeds_for(seed: int, count: int) -> list:
@@ -115,7 +117,7 @@ def run_sweep(scene, vary: Vary, overrides=(), seed: int = 0, progress=None, arc
             try:
                 shot = rig.fire(seed=s)
             except RigError as exc:
-                points.append(SweepPoint(v, rig, None, None, str(exc)))
+                points.append(SweepPoint(v, rig, None, None, str(exc), s))
             else:
                 points.append(SweepPoint(v, rig, shot, shot_blocks(rig, shot)))
                 entries.append(shot_entry(shot))

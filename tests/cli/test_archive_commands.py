@@ -283,6 +283,7 @@ def test_a_sweep_point_that_gives_no_record_is_a_row_with_its_reason_and_the_swe
     assert points[0]["reason"] is None and points[0]["truth"] is not None
     for p in points[1:]:
         assert p["reason"].startswith("unstable at every step") and p["truth"] is None and p["measured"] is None
+        assert p["overrides"][-1] == f"striker.velocity={p['value']!r} m/s" and isinstance(p["seed"], int)
     assert Archive(out).ids() == [1]
 
 
