@@ -184,16 +184,20 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
 def _not_reached(tried: list, accuracy: float, first: float, stop: str, t_end: float) -> str:
     """One line: the accuracy, the best estimate reached, the steps tried, what stopped the
     control, and the way out: where the most accurate try's error stays within the accuracy
-    over the record's first part and grows later (a long record of a stiff chain, whose
-    reflected waves make the solution's error grow with time), the duration that reaches
-    it at that step; and the accuracy the tries reach."""
+    over the record's first part and grows later (a long record of a stiff chain: after the
+    pulse's reflections its motion departs exponentially from any nearby one, so the error
+    grows tenfold every so often whatever the step), the duration that reaches it; and the
+    accuracy the tries reach."""
     sol, best, _, comp = min((t for t in tried if t[1] is not None), key=lambda t: t[1])
     steps = sorted(t[0].stats.dt_s for t in tried)
     ways = [f"a solver.accuracy of at least {best:.2g}"] if best <= COARSEST_ACCURACY else []
-    within = reached_until(sol, comp, accuracy)
-    if within is not None:
+    reach = reached_until(sol, comp, accuracy)
+    if reach is not None:
+        within, tenfold = reach
+        growth = (f", tenfold every {tenfold:.2g} s: the motion departs from any nearby one as the record goes on"
+                  if tenfold else "")
         ways.insert(0, f"a solver.duration of at most {within:.2g} s (the error stays within the accuracy until "
-                       "then and grows with time after)")
+                       f"then and grows with time{growth})")
     way_out = ": " + " or ".join(ways) if ways else ": check the scene's values"
     return (f"accuracy = {accuracy:g}: not reached; over solver.duration = {t_end:.3g} s the error estimate "
             f"stayed at {best:.2g} or more over {len(tried)} tries from dt = {steps[-1]:.3g} s down to "
@@ -201,17 +205,22 @@ def _not_reached(tried: list, accuracy: float, first: float, stop: str, t_end: f
             f"{stop}{way_out}")
 
 
-def reached_until(sol: Solution, comp, accuracy: float) -> float | None:
-    """The longest record (s from the impact) whose error estimate (``sol`` against its
-    companion ``comp``) is within ``accuracy``; None where there is no companion or only a
-    record shorter than a tenth of this one is (a shorter record is then no way out)."""
+def reached_until(sol: Solution, comp, accuracy: float) -> tuple | None:
+    """(the longest record, s from the impact, whose error estimate, ``sol`` against its
+    companion ``comp``, is within ``accuracy``; the time its error took to grow tenfold on
+    its way there, from accuracy / 100, or None where it did not rise that way). None where
+    there is no companion or only a record shorter than a tenth of this one is within the
+    accuracy (a shorter record is then no way out)."""
     if comp is None:
         return None
     err = error_over_time(sol.forces, comp.forces) * RICHARDSON / (RICHARDSON - 1.0)
     within = np.flatnonzero(err <= accuracy)  # the last: the longest record within it
     if within.size == 0 or within[-1] < err.size // 10:
         return None
-    return float(within[-1] * sol.sample_interval)
+    end = within[-1]
+    low = np.flatnonzero(err[:end] <= accuracy / 100)
+    tenfold = (end - low[-1]) * sol.sample_interval / 2 if low.size and low[-1] < end else None
+    return float(end * sol.sample_interval), tenfold
 
 
 def _falls(tried: list) -> bool:

@@ -82,6 +82,8 @@ def test_the_command_line_refuses_it_in_one_line_naming_the_duration_that_reache
     assert "over solver.duration = 0.003 s" in err and "check the scene's values" not in err, err
     duration = float(err.split("a solver.duration of at most ")[1].split(" s")[0])
     assert 0.3e-3 < duration < 3e-3, err
+    tenfold = float(err.split("tenfold every ")[1].split(" s")[0])  # exponential growth, as the record goes on
+    assert 0.02e-3 < tenfold < duration, err
     # the remedy holds: that duration (a scope record that fits in it) reaches the accuracy
     record = int(0.8 * duration / 0.2e-6)
     assert main(["shot", *HARD[0:1], "--set", HARD[1][0], "--set", f"solver.duration={duration}",
