@@ -33,7 +33,7 @@ from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_ent
 from .archive_reader import read_entry
 from .archive_verify import addresses, check, root_seal, sealed_members, shot_names
 from .errors import InstrumentError
-from .files import cause, hdf5_image
+from .files import cause, first_missing, hdf5_image, remove_empty
 from .files import fsync as _fsync  # a name of this module's own: the crash tests stop a writer after it
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
@@ -128,17 +128,34 @@ class Archive:
 
     @contextlib.contextmanager
     def _lock(self):
+        """Hold ``ARCHIVE.h5.lock`` while the block runs. Where the block fails, or the
+        archive does not exist after it, the lock file this run created is removed (and the
+        folders it created for an archive that does not exist): a failed write leaves
+        nothing behind."""
+        lock = self.path.with_name(self.path.name + ".lock")
+        top = first_missing(self.path.parent)
+        created = not lock.exists()
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
-            fh = open(self.path.with_name(self.path.name + ".lock"), "a")  # noqa: SIM115 - closed below
+            fh = open(lock, "a")  # noqa: SIM115 - closed below
         except OSError as exc:
+            if top is not None:
+                remove_empty(self.path.parent, top)
             raise InstrumentError(f"{self.path}: cannot write an archive there ({exc.strerror})") from None
-        with fh:
-            fcntl.flock(fh, fcntl.LOCK_EX)
-            try:
-                yield
-            finally:
-                fcntl.flock(fh, fcntl.LOCK_UN)
+        failed = True
+        try:
+            with fh:
+                fcntl.flock(fh, fcntl.LOCK_EX)
+                try:
+                    yield
+                    failed = False
+                finally:
+                    if created and (failed or not self.path.exists()):  # removed while still held
+                        lock.unlink(missing_ok=True)
+                    fcntl.flock(fh, fcntl.LOCK_UN)
+        finally:
+            if top is not None and not self.path.exists():
+                remove_empty(self.path.parent, top)
 
     def _drop_stale_temporaries(self):
         for stale in self.path.parent.glob(f".{self.path.name}.*.tmp"):

@@ -16,7 +16,7 @@ import json
 import re
 from typing import TYPE_CHECKING
 
-from .archive_digest import address, damage, linked_groups, sha
+from .archive_digest import TABLE, address, damage, linked_groups, sha
 
 if TYPE_CHECKING:
     import h5py
@@ -47,10 +47,16 @@ def _members(f) -> dict:
 def member_changes(f: h5py.File) -> tuple:
     """(added, missing): the paths ("/foo", "/shot_000002") of the objects added to or
     deleted from the root or /shared since the root was sealed; ([], []) for a version-1
-    table. Raises on an unreadable member list (the caller reports it)."""
-    if not sealed_members(f):
+    table. Where the member list itself is missing, unreadable or damaged (its SHA-256 is
+    not the one the root's table holds), what no checksum covers is named instead
+    (``uncovered``)."""
+    try:
+        stored = _member_list(f)
+    except ValueError:  # its own row (root_damage) says it is missing or damaged
+        return uncovered(f), []
+    if stored is None:
         return [], []
-    stored, now = json.loads(f.attrs[MEMBERS]), _members(f)
+    now = _members(f)
     added, missing = [], []
     for group in sorted(set(stored) | set(now)):
         before, after = set(stored.get(group, [])), set(now.get(group, []))
@@ -60,6 +66,45 @@ def member_changes(f: h5py.File) -> tuple:
     parents = set(added) | set(missing)  # a whole /shared added or deleted: its members are not listed again
     drop = lambda p: p.rsplit("/", 1)[0] in parents  # noqa: E731
     return [p for p in added if not drop(p)], [p for p in missing if not drop(p)]
+
+
+def _member_list(f) -> dict | None:
+    """The root's recorded member lists ({group: names}); None for a version-1 table.
+    ValueError where they are missing though the root's table names them, unreadable, or
+    not what the root's table holds the SHA-256 of."""
+    try:
+        rows = json.loads(f.attrs[ROOT_TABLE])
+    except Exception:  # noqa: BLE001 - the table's own row says why
+        rows = {}
+    if not sealed_members(f):
+        if MEMBERS in rows:
+            raise ValueError(f"@{MEMBERS} missing")
+        return None
+    if MEMBERS in rows and rows[MEMBERS] != _root_rows(f).get(MEMBERS):
+        raise ValueError(f"@{MEMBERS} damaged")
+    try:
+        stored = json.loads(f.attrs[MEMBERS])
+    except Exception as exc:  # noqa: BLE001
+        raise ValueError(f"@{MEMBERS} unreadable ({_line(exc)})") from None
+    if not isinstance(stored, dict):
+        raise ValueError(f"@{MEMBERS} is not a JSON object")
+    return stored
+
+
+def uncovered(f: h5py.File) -> list:
+    """The paths in the root and in /shared that no checksum covers, for an archive whose
+    member list cannot be trusted: at the root, what is neither /shared nor a shot group
+    with its own table; in /shared, a group no shot's table links to."""
+    linked, out = set(), []
+    for name in sorted(f):
+        obj = f[name]
+        if name.startswith("shot_") and hasattr(obj, "keys") and TABLE in obj:
+            linked |= linked_groups(obj, "/shared/")
+        elif name != "shared":
+            out.append(f"/{name}")
+    if "shared" in f and hasattr(f["shared"], "keys"):
+        out += [f"/shared/{k}" for k in sorted(f["shared"]) if k not in linked]
+    return out
 
 
 def root_damage(f: h5py.File) -> list:

@@ -13,6 +13,10 @@ by Python: HDF5 that fails part-way through a write to disk is left in a broken 
 then prints tracebacks while it cleans up, and a process can crash), where a failed write
 of plain bytes is one OSError.
 
+``left_as_found`` removes what a block added to a folder when the block fails: a refused
+run leaves the folder (or its absence) as it was; ``made_folder`` removes the folders a
+failed block created and left empty.
+
 ``folder_lock`` holds an exclusive ``flock`` on a lock file in a folder for the life of a
 run; the OS releases it when the process ends, killed or not, so a dead holder never blocks.
 The file names the holder (pid, host, start), which a refusal quotes.
@@ -112,6 +116,84 @@ def write_hdf5(path, fill) -> Path:
 def write_text(path, text: str) -> Path:
     """``text`` (UTF-8) as the whole of ``path``, atomically."""
     return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+
+
+@contextlib.contextmanager
+def left_as_found(folder, failures=(Exception,), keep=None):
+    """Run a block that writes under ``folder``; where it raises one of ``failures``, remove
+    every file and folder under ``folder`` that was not there before the block (and
+    ``folder`` itself, with the parents it was created with, where the block created it),
+    then re-raise. Where ``keep(exception)`` is true, the files it added stay (work a run
+    again resumes from) and only the folders it added and left empty go. What was there
+    before stays, as it is. Only for a folder the run owns: what another process adds there
+    meanwhile would be removed too."""
+    folder = Path(folder).absolute()
+    top = first_missing(folder) or folder
+    before = tree(top)
+    try:
+        yield folder
+    except failures as exc:
+        remove_added(top, before, files=keep is None or not keep(exc))
+        raise
+
+
+@contextlib.contextmanager
+def made_folder(folder):
+    """Create ``folder`` (with its parents) for a block; where the block fails, remove the
+    folders this created that it left empty (a shared folder that others write into too is
+    never emptied by this)."""
+    folder = Path(folder).absolute()
+    top = first_missing(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        yield folder
+    except BaseException:
+        if top is not None:
+            remove_empty(folder, top)
+        raise
+
+
+def first_missing(folder) -> Path | None:
+    """The outermost of ``folder`` and its parents that does not exist (what a
+    ``mkdir(parents=True)`` of it would create first); None where ``folder`` exists."""
+    folder = Path(folder).absolute()
+    if folder.exists():
+        return None
+    while not folder.parent.exists() and folder.parent != folder:
+        folder = folder.parent
+    return folder
+
+
+def remove_empty(folder, top):
+    """Remove ``folder`` and its parents up to ``top`` (one of them) while they are empty."""
+    folder, top = Path(folder).absolute(), Path(top).absolute()
+    for path in (folder, *folder.parents):
+        try:
+            path.rmdir()
+        except OSError:  # not empty (or gone): the folders above it hold it
+            return
+        if path == top:
+            return
+
+
+def tree(folder) -> set:
+    """Every path under ``folder`` and ``folder`` itself; empty where it does not exist."""
+    folder = Path(folder)
+    return {folder, *folder.rglob("*")} if folder.is_dir() else set()
+
+
+def remove_added(folder, before: set, files: bool = True):
+    """Remove what is under ``folder`` (and ``folder``) now that is not in ``before`` (a
+    ``tree``): files first (unless ``files`` is false), then the folders left empty,
+    deepest first. A folder that holds something from before is kept; a path that cannot be
+    removed is left."""
+    added = sorted(tree(folder) - set(before), key=lambda p: len(p.parts), reverse=True)
+    for path in added:
+        with contextlib.suppress(OSError):
+            if path.is_dir() and not path.is_symlink():
+                path.rmdir()
+            elif files:
+                path.unlink()
 
 
 def _temporary(path: Path) -> str:

@@ -233,3 +233,12 @@ def missing_lines(reasons: dict) -> list:
         why.setdefault(reason, []).append(figure)
     return [f"no {'result' if set(FIGURES) <= set(figures) else ', '.join(figures)}: {reason}"
             for reason, figures in why.items()]
+
+
+def flag_lines(flags: dict) -> list:
+    """One line per reason of a block's flagged figures ({figure: why they cannot be
+    trusted as they are}): "flagged F1, F2: reason"."""
+    why = {}
+    for figure, reason in flags.items():
+        why.setdefault(reason, []).append(figure)
+    return [f"flagged {', '.join(figures)}: {reason}" for reason, figures in why.items()]

@@ -1,7 +1,7 @@
 """`rig shot` and `rig animate`: one virtual shot, summarised, exported or rendered."""
 from __future__ import annotations
 
-from rig.cli.common import (check_archive_out, check_export_folder, check_size, missing_lines, progress_bar,
+from rig.cli.common import (check_archive_out, check_export_folder, check_size, flag_lines, missing_lines, progress_bar,
                             scene_overrides, writing_to)
 from rig.errors import RigError, invalid
 
@@ -31,9 +31,10 @@ def cmd_shot(args) -> dict:
     if args.export:
         if not shot.scope.triggered:
             raise RigError(f"--export: nothing to export, the scope did not trigger ({shot.scope.reason})")
+        from instruments.files import made_folder
+
         folder = Path(args.export)
-        with writing_to(folder):
-            folder.mkdir(parents=True, exist_ok=True)
+        with writing_to(folder), made_folder(folder):  # a failed export leaves no folder it created
             paths = WRITERS[args.format or "isf"](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
         out["exported"] = [str(p) for p in paths]
     if args.out:
@@ -117,6 +118,9 @@ def print_blocks(t, m, th):
           f"cross-correlation speed {fmt(m['speed_xcorr_m_per_s'])} m/s")
     for line in missing_lines(m.get("reasons", {})):
         print(f"  measured: {line}")
+    for label, r in (("truth", t), ("measured", m)):
+        for line in flag_lines(r.get("flags", {})):
+            print(f"  {label}: {line}")
 
 
 def cmd_animate(args) -> dict:

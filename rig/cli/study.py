@@ -20,32 +20,31 @@ def cmd_mc(args) -> dict:
     load(args.scene, scene_overrides(args))  # a bad scene stops here, before numba is loaded
     from rig.study.distributions import parse_vary
     from rig.study.executors import DEFAULT_WORKER_TIMEOUT
-    from rig.study.mc_run import run_to
+    from rig.study.mc_run import run_in
     from rig.study.mc_spec import DEFAULT_BATCH, Study
     from rig.study.sobol import sobol_shots
     from rig.study.store import Store
 
     dists = tuple(parse_vary(args.vary or []))
     shots = args.shots
+    batch = args.batch or Store.stored_batch(args.out) or DEFAULT_BATCH  # a study resumed keeps its batches
     if args.sobol:
         shots = sobol_shots(args.shots, len(dists))
-        if shots != args.shots and not args.json:
-            print(f"Sobol design over {len(dists)} inputs: {shots} shots "
-                  f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
-    batch = args.batch or Store.stored_batch(args.out) or DEFAULT_BATCH  # a study resumed keeps its batches
     study = Study(args.scene, dists, shots, args.seed, tuple(args.set or ()), batch, args.accuracy,
                   args.sobol, args.truth, args.window, args.traces)
     from rig.study.nominal import nominal
 
-    held = min(study.batch, study.shots)  # the shots a batch holds at once
-    whole = nominal(study.scene, study.overrides).rig.estimate(controlled=False).times(study.shots, held)
-    check_size(whole, args, f"the study's {study.shots} shots (batches of {held} held at once)")
-    with progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot") as bar:
-        def started(done):
-            bar.update(done)
-
-        with writing_to(args.out):
-            run = run_to(args.out, study, args.workers or 1, args.scheduler, bar.update, started,
+    with writing_to(args.out), Store(args.out, study).held() as store:  # held before anything is printed
+        if shots != args.shots and not args.json:
+            print(f"Sobol design over {len(dists)} inputs: {shots} shots "
+                  f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
+        held = min(study.batch, study.shots)  # the shots a batch holds at once
+        rig = nominal(study.scene, study.overrides).rig
+        rig.check_record()  # settings that can give no record (or a made-up one) are refused before any solve
+        whole = rig.estimate(controlled=False).times(study.shots, held)
+        check_size(whole, args, f"the study's {study.shots} shots (batches of {held} held at once)")
+        with progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot") as bar:
+            run = run_in(store, study, args.workers or 1, args.scheduler, bar.update, bar.update,
                          args.worker_timeout or DEFAULT_WORKER_TIMEOUT)
     if not args.json:
         print_study(run.report, run.ran_now, args.out)

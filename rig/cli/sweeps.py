@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rig.cli.common import (check_archive_out, check_size, folder_shown, missing_lines, progress_bar, scene_overrides,
+from rig.cli.common import (check_archive_out, check_size, flag_lines, folder_shown, missing_lines, progress_bar, scene_overrides,
                             writing_to)
 from rig.cli.shots import shot_summary
 from rig.errors import Interrupted, RigError
@@ -42,33 +42,38 @@ def cmd_sweep(args) -> dict:
             except KeyboardInterrupt:
                 kept = f"those points' shots are in {args.out}" if args.out else "nothing is kept (no --out)"
                 raise Interrupted(f"interrupted after {len(fired)} of {n} points: {kept}") from None
-            except RigError as exc:  # a point that cannot be fired, after others were
-                if not fired:
-                    raise
-                kept = f"the shots of the {len(fired)} before it are in {args.out}" if args.out else "nothing is kept"
-                raise RigError(f"point {len(fired) + 1} of {n}: {exc} ({kept})") from None
+    if all(p.shot is None for p in points):  # nothing measured: a failure, not a table of reasons
+        raise RigError(f"no point of the sweep gave a record; point 1 of {n} ({vary.key} = {points[0].value:g}): "
+                       f"{points[0].reason}")
     out = {"points": []}
     for p in points:
-        one = shot_summary(p.rig, p.shot)
-        one.update(p.blocks)
-        one["value"] = p.value
+        if p.shot is None:
+            one = {"scenario": p.rig.name, "seed": p.seed, "overrides": list(p.rig.scene.overrides),
+                   "truth": None, "measured": None, "theory": None}
+        else:
+            one = shot_summary(p.rig, p.shot)
+            one.update(p.blocks)
+        one["value"], one["reason"] = p.value, p.reason
         out["points"].append(one)
     if not args.json:
         print_sweep(vary.key, out["points"])
         if args.out:
-            print(f"appended {len(points)} shots to {args.out}")
+            print(f"appended {sum(p.shot is not None for p in points)} shots to {args.out}")
     return out
 
 
 def print_sweep(key: str, points: list):
     """The sweep's table: truth, measured and Eq (1) per point, and under a point that has
-    no measured speed, why (the analysis' reasons)."""
+    no measured speed, why (the analysis' reasons); a point that gave no record, why."""
     fmt = lambda v, spec: "-".rjust(int(spec.split(".")[0])) if v is None else format(v, spec)  # noqa: E731
     print(f"{key:>18s} | {'truth F_d N':>11s} {'V_s m/s':>8s} | {'measured F_d N':>14s} "
           f"{'V_s m/s':>8s} | {'Eq (1) m/s':>10s}")
     clipped = []
     for p in points:
         t, m = p["truth"], p["measured"]
+        if p["reason"] is not None:
+            print(f"{p['value']:18.6g} | no record: {p['reason']}")
+            continue
         if t is None:
             print(f"{p['value']:18.6g} | speeds and amplitudes need two gauge beads")
             continue
@@ -79,6 +84,8 @@ def print_sweep(key: str, points: list):
         if m["speed_m_per_s"] is None:
             why = missing_lines(m["reasons"]) or [f"no result: {p['no_trigger_reason'] or 'no reason given'}"]
             print(f"{'':18s}   measured: {'; '.join(why)}")
+        for line in flag_lines(t.get("flags", {})):  # the truth's flags hold for the measured figures too
+            print(f"{'':18s}   {line}")
         clipped += [p["value"]] if chans else []
     if clipped:
         print(f"clipped scope channels at {key} = {', '.join(f'{v:g}' for v in clipped)}: a clipped "

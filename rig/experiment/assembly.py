@@ -222,6 +222,11 @@ class Assembly:
         if span < 2 * s.sample_interval:
             raise RigError(f"the scope record spans {span:.4g} s ({settings}), less than two samples of its input "
                            f"(solver.sample_interval = {s.sample_interval:g} s): a longer scope.sample_interval")
+        if s.sample_interval > tb.sample_interval * (1 + 1e-9):  # the scope would make up its samples
+            raise RigError(f"solver.sample_interval = {s.sample_interval:g} s is coarser than scope.sample_interval "
+                           f"= {tb.sample_interval:g} s: the scope would read straight lines drawn between the "
+                           "solver's recorded forces (samples it never had, a pulse's peak cut); a "
+                           f"solver.sample_interval of at most {tb.sample_interval:g} s")
         st, g = self.striker, self.holder.gravity
         if st.gap >= st.velocity * s.duration + 0.5 * g * s.duration**2:  # no impact within the solve
             reach = st.gap / st.velocity if g == 0 else (math.sqrt(st.velocity**2 + 2 * g * st.gap) - st.velocity) / g

@@ -4,8 +4,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from instruments.files import atomic_write, write_text
-from rig.errors import RigError
+from instruments.files import atomic_write, left_as_found, write_text
+from rig.errors import Interrupted, RigError
 from rig.experiment import scene as scene_io
 from rig.fit import report
 from rig.fit.fitting import fit
@@ -18,10 +18,19 @@ def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 40
     interruption replays them instead of solving them again. A fit that did not converge
     writes everything but the fitted scene, and so does one whose model cannot describe the
     data or leaves a parameter undetermined (FitResult.usable); a refused one (RigError)
-    leaves the folder as it was. posterior_steps > 0: a converged fit's posterior
+    leaves the folder as it was: what this run added is removed (the folder too where
+    this run created it), what was there before is kept. An I/O failure (a full disk) or an
+    interruption keeps what was cached before it (evaluations, the posterior's chain) and
+    removes only the folders it left empty. posterior_steps > 0: a converged fit's posterior
     is then sampled (rig.fit.posterior: ``walkers``, default 4 per parameter and at least
     8, drawn from ``seed``) into the block's "posterior" and out/posterior.png."""
-    out = Path(out)
+    kept = (OSError, Interrupted)  # a full disk, Ctrl-C: what was cached stays, for the same command to resume from
+    with left_as_found(out, (RigError, OSError), keep=lambda exc: isinstance(exc, kept)):
+        return _fit_into(scene, objective, Path(out), progress, max_evaluations, posterior_steps, walkers, seed)
+
+
+def _fit_into(scene, objective, out: Path, progress, max_evaluations, posterior_steps, walkers, seed) -> dict:
+    """run_fit's work, writing into ``out``."""
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

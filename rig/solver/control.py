@@ -34,9 +34,16 @@ the final one (docs/solver.md); a dashpot chain held to 1e-6 needs 1/420 of it (
 solves of the first step). A record whose error does not fall (a steel chain with PTFE's
 bead mass: 0.57 at every step) had the control shrink the step 16 times per try, each try
 16 times dearer, for minutes. Where the control stops above the accuracy, ``solve``
-refuses (AccuracyNotReached, naming the accuracy, the estimate reached and the steps
-tried), and a caller that bounds the step itself (a fit's pilot) takes the best try with
+refuses (AccuracyNotReached, naming the accuracy, the duration, the estimate reached, the
+steps tried and a way out), and a caller that bounds the step itself (a fit's pilot) takes the best try with
 its estimate.
+
+Way out. The most accurate try and its companion give the error of every shorter record
+(``error_over_time``): where the error stays within the accuracy over the record's first
+part and grows with time after, the refusal names the longest solver.duration that
+reaches it (the steel chain above: within 1e-4 until 1.1 ms, 0.57 at 3 ms; 1.1 ms then
+passes at 2.3e-5); where the tries reach a usable error (COARSEST_ACCURACY), the
+solver.accuracy they reach.
 """
 from __future__ import annotations
 
@@ -44,12 +51,14 @@ import math
 import time
 from dataclasses import replace
 
+import numpy as np
+
 from rig.errors import RigError
 from rig.solver.methods import Method
 from rig.solver.problem import ChainProblem
 from rig.solver.run import Unstable, integrate_at, time_grid
 from rig.solver.saveat import SaveAt
-from rig.solver.solution import Solution, relative_error
+from rig.solver.solution import STATIC, Solution, relative_error
 from rig.solver.stepsize import COARSEST_ACCURACY, Stepping, default_step, largest_step
 
 RICHARDSON = 10.0    # e(h) / e(h/2), order ~3.3: the median over the measured problems (docs/solver.md)
@@ -71,14 +80,39 @@ def companion_estimate(problem: ChainProblem, t_end: float, save: SaveAt, m: Met
     """(estimate, basis) of the error of ``sol`` (solved with ``stepping``): a companion
     solve of the same channels (no frames) at half its step (and half the head's substep),
     e(h) = max |F_h - F_h/2| R / (R - 1). (None, why) where no estimate can be had."""
+    comp, basis = companion_solve(problem, t_end, save, m, stepping, sol)
+    return (None if comp is None else relative_error(sol.forces, comp.forces) * RICHARDSON / (RICHARDSON - 1.0),
+            basis)
+
+
+def companion_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, stepping: Stepping,
+                    sol: Solution) -> tuple:
+    """(the companion Solution at half ``sol``'s step, basis), or (None, why there is none)."""
     if not save.names:
         return None, "nothing recorded"
     companion = Stepping(sol.stats.dt_s / COMPANION, stepping.head, stepping.inner_dt / COMPANION)
     try:
-        comp = integrate_at(problem, t_end, SaveAt(save.probes, save.sample_interval), m, companion)
+        return integrate_at(problem, t_end, SaveAt(save.probes, save.sample_interval), m, companion), \
+            "companion at dt/2"
     except Unstable:
         return None, "the companion at dt/2 was unstable"
-    return relative_error(sol.forces, comp.forces) * RICHARDSON / (RICHARDSON - 1.0), "companion at dt/2"
+
+
+def error_over_time(forces: dict, reference: dict) -> np.ndarray:
+    """Element j: ``relative_error`` of the records cut after their sample j (the error a
+    solve of that shorter duration would show, each channel against its dynamic peak so
+    far; before any channel moves by more than STATIC of its force, against STATIC x that
+    force)."""
+    size = min((r.size for r in reference.values()), default=0)
+    if size == 0:
+        return np.zeros(0)
+    gaps = {k: np.maximum.accumulate(np.abs(forces[k][:size] - r[:size])) for k, r in reference.items()}
+    peaks = {k: np.maximum.accumulate(np.abs(r[:size] - r[0])) for k, r in reference.items()}
+    top = np.max(np.stack(list(peaks.values())), axis=0)
+    static = STATIC * np.max(np.stack([np.maximum.accumulate(np.abs(r[:size])) for r in reference.values()]), axis=0)
+    still = top <= static  # no pulse yet: the differences are rounding, measured against STATIC x the force
+    floor = np.maximum(np.where(still, static, 1e-6 * top), np.finfo(float).tiny)
+    return np.max(np.stack([gaps[k] / np.maximum(np.where(still, static, peaks[k]), floor) for k in gaps]), axis=0)
 
 
 def with_estimate(sol: Solution, estimate, basis: str, attempts: int, cpu_s: float) -> Solution:
@@ -119,9 +153,10 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
             spent += time_grid(t_end, dt, t_end)[0]
             dt *= 0.5
             continue
-        est, basis = companion_estimate(problem, t_end, save, m, stepping, sol)
+        comp, basis = companion_solve(problem, t_end, save, m, stepping, sol)
+        est = None if comp is None else relative_error(sol.forces, comp.forces) * RICHARDSON / (RICHARDSON - 1.0)
         spent += sol.stats.steps * (1 + COMPANION)
-        tried.append((sol, est, basis))
+        tried.append((sol, est, basis, comp))
         if est is None or ACCEPT_LOW * accuracy <= est <= ACCEPT_HIGH * accuracy:
             break
         if est < ACCEPT_LOW * accuracy and dt >= longest:
@@ -140,21 +175,52 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
         dt = finer
     if not tried:
         raise Unstable(f"unstable at every step tried down to dt = {2 * dt:.4g} s", stepping)
-    sol, est, basis = _choice(tried, accuracy)
+    sol, est, basis, _ = _choice(tried, accuracy)
     if strict and est is not None and est > accuracy:
-        raise AccuracyNotReached(_not_reached(tried, accuracy, first.dt, stop))
+        raise AccuracyNotReached(_not_reached(tried, accuracy, first.dt, stop, t_end))
     return with_estimate(sol, est, basis, len(tried), time.process_time() - t0)
 
 
-def _not_reached(tried: list, accuracy: float, first: float, stop: str) -> str:
+def _not_reached(tried: list, accuracy: float, first: float, stop: str, t_end: float) -> str:
     """One line: the accuracy, the best estimate reached, the steps tried, what stopped the
-    control and the way out."""
-    best = min(t[1] for t in tried if t[1] is not None)
+    control, and the way out: where the most accurate try's error stays within the accuracy
+    over the record's first part and grows later (a long record of a stiff chain: after the
+    pulse's reflections its motion departs exponentially from any nearby one, so the error
+    grows tenfold every so often whatever the step), the duration that reaches it; and the
+    accuracy the tries reach."""
+    sol, best, _, comp = min((t for t in tried if t[1] is not None), key=lambda t: t[1])
     steps = sorted(t[0].stats.dt_s for t in tried)
-    way_out = f", or ask for accuracy >= {best:.2g}" if best <= COARSEST_ACCURACY else ""
-    return (f"accuracy = {accuracy:g}: not reached; the error estimate stayed at {best:.2g} or more over "
-            f"{len(tried)} tries from dt = {steps[-1]:.3g} s down to {steps[0]:.3g} s ({steps[0] / first:.2g} of "
-            f"the first step) and the accuracy control stopped at {stop}: check the scene's values{way_out}")
+    ways = [f"a solver.accuracy of at least {best:.2g}"] if best <= COARSEST_ACCURACY else []
+    reach = reached_until(sol, comp, accuracy)
+    if reach is not None:
+        within, tenfold = reach
+        growth = (f", tenfold every {tenfold:.2g} s: the motion departs from any nearby one as the record goes on"
+                  if tenfold else "")
+        ways.insert(0, f"a solver.duration of at most {within:.2g} s (the error stays within the accuracy until "
+                       f"then and grows with time{growth})")
+    way_out = ": " + " or ".join(ways) if ways else ": check the scene's values"
+    return (f"accuracy = {accuracy:g}: not reached; over solver.duration = {t_end:.3g} s the error estimate "
+            f"stayed at {best:.2g} or more over {len(tried)} tries from dt = {steps[-1]:.3g} s down to "
+            f"{steps[0]:.3g} s ({steps[0] / first:.2g} of the first step) and the accuracy control stopped at "
+            f"{stop}{way_out}")
+
+
+def reached_until(sol: Solution, comp, accuracy: float) -> tuple | None:
+    """(the longest record, s from the impact, whose error estimate, ``sol`` against its
+    companion ``comp``, is within ``accuracy``; the time its error took to grow tenfold on
+    its way there, from accuracy / 100, or None where it did not rise that way). None where
+    there is no companion or only a record shorter than a tenth of this one is within the
+    accuracy (a shorter record is then no way out)."""
+    if comp is None:
+        return None
+    err = error_over_time(sol.forces, comp.forces) * RICHARDSON / (RICHARDSON - 1.0)
+    within = np.flatnonzero(err <= accuracy)  # the last: the longest record within it
+    if within.size == 0 or within[-1] < err.size // 10:
+        return None
+    end = within[-1]
+    low = np.flatnonzero(err[:end] <= accuracy / 100)
+    tenfold = (end - low[-1]) * sol.sample_interval / 2 if low.size and low[-1] < end else None
+    return float(end * sol.sample_interval), tenfold
 
 
 def _falls(tried: list) -> bool:

@@ -47,27 +47,34 @@ class StudyRun:
 
 def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None, progress=None,
            on_start=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> StudyRun:
-    """Run (or resume) ``study`` in ``folder``. ``progress(n)`` is told each finished
-    batch's shots; ``on_start(done)`` how many shots were already stored; on Dask the study
-    stops after ``worker_timeout`` s without a live worker."""
-    check(study)
+    """Run (or resume) ``study`` in ``folder``, held by this run (``Store.held``)."""
     with Store(folder, study).held() as store:  # one run at a time into a folder
-        store.open()
-        done = sum(len(study.shots_of(b)) for b in store.done())
-        if on_start:
-            on_start(done)
-        t0 = time.perf_counter()
-        try:
-            run_study(study, store, workers, scheduler, progress, worker_timeout)
-        except KeyboardInterrupt:
-            kept = sum(len(study.shots_of(b)) for b in store.done())
-            raise Interrupted(f"interrupted: {kept} of {study.shots} shots are kept in {folder}; "
-                              f"run the same command again to resume") from None
-        ran = study.shots - done
-        elapsed = time.perf_counter() - t0
-        results = store.collect()
-        report = summarise(study, results, ran / elapsed if ran else None)
-        write_report(Path(folder), study, store, results, report)
+        return run_in(store, study, workers, scheduler, progress, on_start, worker_timeout)
+
+
+def run_in(store: Store, study: Study, workers: int = 1, scheduler: str | None = None, progress=None,
+           on_start=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> StudyRun:
+    """Run (or resume) ``study`` in ``store``, a folder this run holds. ``progress(n)`` is
+    told each finished batch's shots; ``on_start(done)`` how many shots were already stored;
+    on Dask the study stops after ``worker_timeout`` s without a live worker."""
+    check(study)
+    folder = store.folder
+    store.open()
+    done = sum(len(study.shots_of(b)) for b in store.done())
+    if on_start:
+        on_start(done)
+    t0 = time.perf_counter()
+    try:
+        run_study(study, store, workers, scheduler, progress, worker_timeout)
+    except KeyboardInterrupt:
+        kept = sum(len(study.shots_of(b)) for b in store.done())
+        raise Interrupted(f"interrupted: {kept} of {study.shots} shots are kept in {folder}; "
+                          f"run the same command again to resume") from None
+    ran = study.shots - done
+    elapsed = time.perf_counter() - t0
+    results = store.collect()
+    report = summarise(study, results, ran / elapsed if ran else None)
+    write_report(Path(folder), study, store, results, report)
     return StudyRun(report, ran)
 
 

@@ -80,10 +80,15 @@ def _unit_of(key: str):
 
 @dataclass(frozen=True, eq=False)
 class SweepPoint:
+    """One point of a sweep: its shot and figures, or (shot None) why it gave no record and
+    the seed it was fired with (the same scene, overrides and seed fire it again alone)."""
+
     value: float
     rig: Rig
-    shot: ShotRecord
-    blocks: dict
+    shot: ShotRecord | None
+    blocks: dict | None
+    reason: str | None = None
+    seed: int | None = None
 
 
 def seeds_for(seed: int, count: int) -> list:
@@ -93,7 +98,12 @@ def seeds_for(seed: int, count: int) -> list:
 
 
 def run_sweep(scene, vary: Vary, overrides=(), seed: int = 0, progress=None, archive=None) -> list:
-    """Fire one shot per value; archive them (if given) even when a later point fails."""
+    """Fire one shot per value; archive those that gave a record (if an archive is given),
+    even when the sweep is interrupted.
+
+    A point that fires but gives no record (the solver or the scope refuses it: a RigError
+    raised by the shot, after every point was assembled) is a point with its reason, and
+    the sweep goes on to the next value."""
     rigs = []
     for v in vary.values:  # assemble (validate) every point before firing any
         try:
@@ -104,9 +114,13 @@ def run_sweep(scene, vary: Vary, overrides=(), seed: int = 0, progress=None, arc
     points, entries = [], []
     try:
         for v, rig, s in zip(vary.values, rigs, seeds_for(seed, len(rigs))):
-            shot = rig.fire(seed=s)
-            points.append(SweepPoint(v, rig, shot, shot_blocks(rig, shot)))
-            entries.append(shot_entry(shot))
+            try:
+                shot = rig.fire(seed=s)
+            except RigError as exc:
+                points.append(SweepPoint(v, rig, None, None, str(exc), s))
+            else:
+                points.append(SweepPoint(v, rig, shot, shot_blocks(rig, shot)))
+                entries.append(shot_entry(shot))
             if progress:
                 progress()
     finally:

@@ -272,16 +272,29 @@ def test_one_shot_of_files_that_hold_the_same_channel_is_refused(tmp_path, capsy
     assert "import these files as separate shots (without --together)" in err and not into.exists()
 
 
-def test_a_sweep_point_that_cannot_be_fired_says_what_was_kept(tmp_path, capsys):
-    # the second point is far outside the contact law: the refusal names the point and
-    # says that the first point's shot is already in the archive
+def test_a_sweep_point_that_gives_no_record_is_a_row_with_its_reason_and_the_sweep_goes_on(tmp_path, capsys):
+    # the last two points are far outside the contact law: each is a row with the solver's
+    # reason, the first point's shot is archived, and the sweep exits 0 (one point measured)
     out = tmp_path / "sw.h5"
     assert main(["sweep", "ptfe52_magnetic", "--vary", "striker.velocity=50:300:3", "--out", str(out),
+                 "--quiet", "--json"]) == 0
+    points = json.loads(capsys.readouterr().out)["points"]
+    assert [p["value"] for p in points] == [50.0, 175.0, 300.0]
+    assert points[0]["reason"] is None and points[0]["truth"] is not None
+    for p in points[1:]:
+        assert p["reason"].startswith("unstable at every step") and p["truth"] is None and p["measured"] is None
+        assert p["overrides"][-1] == f"striker.velocity={p['value']!r} m/s" and isinstance(p["seed"], int)
+    assert Archive(out).ids() == [1]
+
+
+def test_a_sweep_where_no_point_gives_a_record_fails_with_one_line(tmp_path, capsys):
+    out = tmp_path / "sw.h5"
+    assert main(["sweep", "ptfe52_magnetic", "--vary", "striker.velocity=200:300:2", "--out", str(out),
                  "--quiet"]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith("rig sweep: error: point 2 of 3: unstable at every step") and "\n" not in err
-    assert err.endswith(f"(the shots of the 1 before it are in {out})")
-    assert Archive(out).ids() == [1]
+    assert err.startswith("rig sweep: error: no point of the sweep gave a record; point 1 of 2 "
+                          "(striker.velocity = 200): unstable at every step") and "\n" not in err
+    assert not out.exists()
 
 
 def test_a_two_channel_tds_csv_imports_lists_and_analyses_both_channels(tmp_path, capsys, realdata):

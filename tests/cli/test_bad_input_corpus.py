@@ -159,6 +159,15 @@ def _flag_cases():
                   (["sweep", S, "--vary", f"striker.velocity={text}:1.5:3"], "--vary"),
                   (["fit", S, "--param", f"chain.youngs_modulus={text} GPa:4 GPa", "--points", "p.csv", "--out", out],
                    "--param")]
+    # a solver.sample_interval coarser than the scope's: the scope would read lines drawn between the solver's
+    # samples (had exited 0 with F_d 21 % low); refused before anything is solved, by every command that fires
+    for value in ["0.5 us", "20 us", "50 us", "1 ms"]:
+        cases += [(["shot", S, "--set", f"solver.sample_interval={value}"], "solver.sample_interval"),
+                  (["sweep", S, "--vary", "striker.velocity=0.5:1:2", "--set", f"solver.sample_interval={value}"],
+                   "solver.sample_interval"),
+                  (["mc", S, "--shots", "8", "--vary", VEL, "--set", f"solver.sample_interval={value}", "--out", out],
+                   "solver.sample_interval")]
+    cases.append((["sweep", S, "--vary", "solver.sample_interval=0.1 us:50 us:3"], "solver.sample_interval"))
     # options given where they do nothing
     cases += [
         (["shot", S, "--format", "csv"], "--format"),

@@ -5,7 +5,9 @@ again once there is room succeeds.
 The disk is made full the way tests/cli/test_bad_inputs.py does it: a file-size limit on
 the command's process (RLIMIT_FSIZE), which makes every write past the limit fail with
 EFBIG ("File too large") as ENOSPC would. Each limit is below the size of what the
-command writes, so the failure comes from a real write in the middle of it."""
+command writes, so the failure comes from a real write in the middle of it. A failed run
+leaves nothing new but whole files: no folder it created empty, no 0-byte file, no lock
+file."""
 from __future__ import annotations
 
 import json
@@ -31,11 +33,15 @@ SMALL = ["--set", "chain.beads=20", "--set", "gauges.upper.bead=6", "--set", "ga
 
 CASES = {
     "shot --export": (1000, ["shot", S, "--seed", "1", "--export", "{d}/shots"]),
+    "shot --export csv, a new folder": (1000, ["shot", S, "--seed", "1", "--export", "{d}/new/exp", "--format",
+                                              "csv"]),
     "shot --out": (20000, ["shot", S, "--seed", "1", "--out", "{d}/a.h5"]),
     "sweep --out": (20000, ["sweep", S, "--vary", "striker.velocity=0.6:0.9:2", "--out", "{d}/s.h5", "--quiet"]),
     "mc --out": (3000, ["mc", S, "--shots", "8", "--batch", "4", "--vary", VEL, "--out", "{d}/study", "--quiet"]),
     "mc --out, two workers": (3000, ["mc", S, "--shots", "8", "--batch", "4", "--vary", VEL, "--out", "{d}/study",
                                      "--quiet", "--workers", "2"]),
+    "mc --traces": (3000, ["mc", S, "--shots", "8", "--batch", "4", "--vary", VEL, "--traces", "--out",
+                           "{d}/study", "--quiet"]),
     "mc --out, the report": (20000, ["mc", S, "--shots", "8", "--batch", "4", "--vary", VEL, "--out", "{d}/study",
                                      "--quiet"]),
     "import": (5000, ["import", "{realdata}/tek_16bit_dpo.isf", "--into", "{d}/a.h5"]),
@@ -80,12 +86,17 @@ def whole(path: Path):
         path.read_text()
 
 
-def _check_left(d: Path):
+def _check_left(d: Path, before: set | None = None):
+    """Every file under ``d`` whole; after a failed run (``before``: the paths there before
+    it), nothing new but whole files: no lock file, no empty folder."""
     for p in d.rglob("*"):
         if p.is_file():
             assert ".tmp" not in p.name, f"{p}: a temporary file left behind"
             if p.suffix != ".lock":  # a lock file holds no data
                 whole(p)
+    for p in set(d.rglob("*")) - (before if before is not None else set(d.rglob("*"))):
+        assert p.suffix != ".lock", f"{p}: a lock file left behind by a failed run"
+        assert not (p.is_dir() and not any(p.iterdir())), f"{p}: an empty folder left behind by a failed run"
 
 
 @pytest.mark.parametrize("case", CASES)
@@ -100,13 +111,14 @@ def test_a_full_disk_is_one_line_leaves_nothing_broken_and_a_second_run_succeeds
         if case != "fit, the cache":  # the cache filled by a first run: this one writes the scene and report first
             assert _run(FIT, tmp_path, realdata).returncode in (0, 1)
     before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file() and p.suffix != ".lock"}
+    there = set(tmp_path.rglob("*"))
     r = _run(argv, tmp_path, realdata, limit)
     assert r.returncode == 2, r.stderr
     line = _one_line(r.stderr)
     assert line.startswith(f"rig {argv[0]}: error: {tmp_path}") and line.endswith(": File too large"), line
-    _check_left(tmp_path)
-    if argv[0] == "shot" and "--export" in argv:  # several files: all of them or none
-        assert not list((tmp_path / "shots").glob("*.isf"))
+    _check_left(tmp_path, there)
+    if argv[0] == "shot" and "--export" in argv:  # several files: all of them or none, and no new empty folder
+        assert not list(tmp_path.rglob("*.isf")) and not list(tmp_path.rglob("*.csv"))
     for p in (p for p in before if p.suffix == ".h5"):
         assert p.read_bytes() == before[p], f"{p}: changed by a failed write"
     again = _run(argv, tmp_path, realdata)
@@ -129,17 +141,19 @@ def small_disk(tmp_path, request):
     subprocess.run(["umount", "-l", str(disk)], check=False, capture_output=True)
 
 
-@pytest.mark.parametrize("case,small_disk", [("shot --export", "16k"), ("shot --out", "64k"), ("mc --out", "64k"),
+@pytest.mark.parametrize("case,small_disk", [("shot --export", "16k"), ("shot --export csv, a new folder", "16k"),
+                                             ("shot --out", "64k"), ("mc --out", "64k"), ("mc --traces", "64k"),
                                              ("import", "16k"), ("fit, the cache", "16k")], indirect=["small_disk"])
 def test_a_real_full_disk_is_one_line_and_the_command_succeeds_once_there_is_room(small_disk, realdata, case):
     _, argv = CASES[case]
     if argv[0] == "fit":
         (small_disk / "points.csv").write_text(POINTS)
+    there = set(small_disk.rglob("*"))
     r = _run(argv, small_disk, realdata)
     assert r.returncode == 2, r.stderr
     line = _one_line(r.stderr)
     assert line.startswith(f"rig {argv[0]}: error: {small_disk}") and line.endswith(": No space left on device"), line
-    _check_left(small_disk)
+    _check_left(small_disk, there)
     subprocess.run(["mount", "-o", "remount,size=64m", str(small_disk)], check=True)  # room made
     again = _run(argv, small_disk, realdata)
     assert again.returncode in ((0, 1) if argv[0] == "fit" else (0,)), again.stderr

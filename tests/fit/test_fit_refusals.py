@@ -48,8 +48,10 @@ def _fit(tmp_path, capsys, data, *params, stale=True):
 
 
 def _refused(out):
-    """Nothing written: the earlier fit's scene is still there, as it was."""
+    """Nothing written: the earlier fit's scene is still there, as it was, and nothing else
+    (no evaluations/ cache of the refused run)."""
     assert (out / "fitted.toml").read_text() == EARLIER and not (out / "fit.json").exists()
+    assert sorted(p.name for p in out.rglob("*")) == ["fitted.toml"]
 
 
 def _one_line(err, *words):
@@ -75,6 +77,19 @@ def test_fewer_data_than_parameters_is_refused_before_any_solve(tmp_path, capsys
     _one_line(err, "1 data for 2 --param keys")
     assert not (out / "evaluations").exists()  # nothing solved
     _refused(out)
+
+
+def test_a_refused_fit_into_a_new_folder_leaves_no_folder(tmp_path, capsys, curve):
+    """Refused before any solve (too few data) and after its evaluations (a parameter the
+    data do not see): the --out folder that did not exist does not exist after."""
+    out = tmp_path / "new" / "fit"
+    few = _points(tmp_path, [(1.0, 100.0)], "few.csv")
+    unseen = _points(tmp_path, zip(curve.force, curve.speed))
+    for data, param in ((few, "chain.contact_exponent=1.2:2"), (unseen, "striker.velocity=0.5 m/s:1.5 m/s")):
+        assert main(["fit", SCENE, "--points", str(data), "--param", E, "--param", param, "--out", str(out),
+                     "--quiet"]) == 2
+        capsys.readouterr()
+        assert not out.exists() and not out.parent.exists()
 
 
 def test_the_same_point_twice_is_refused_naming_both_lines(tmp_path):

@@ -114,3 +114,26 @@ def test_upgrade_refuses_to_record_the_members_of_a_damaged_old_archive(tmp_path
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "/shot_000001/title" in err and "verifies" in err, err
     assert a.path.read_bytes() == pristine
+
+
+MEMBER_LIST_LOST = {
+    "the member list deleted": lambda f: f.attrs.__delitem__("members"),
+    "the member list rewritten to name what was added": lambda f: f.attrs.__setitem__(
+        "members", f.attrs["members"].replace('"/": [', '"/": ["bar", ').replace('"/shared": [', '"/shared": ["x", ')),
+    "the member list unreadable": lambda f: f.attrs.__setitem__("members", "{not json"),
+}
+
+
+@pytest.mark.parametrize("what", MEMBER_LIST_LOST)
+def test_without_a_trustworthy_member_list_what_no_checksum_covers_is_still_named(archive, what):
+    def change(f):
+        f.create_group("bar")
+        f.create_dataset("shared/x", data=1)
+        MEMBER_LIST_LOST[what](f)
+
+    report = _edit(archive, change)
+    reasons = [b["reason"] for b in report["bad"]]
+    assert "attribute @members: damaged" in reasons, reasons
+    assert [(b["where"], b["shot"]) for b in report["bad"] if b["reason"].startswith("added: ")] == \
+        [("/bar", None), ("/shared/x", None)], reasons
+    assert report["shots"] == 3 and report["ok"] == 3  # the shots themselves are intact

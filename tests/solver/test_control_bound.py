@@ -1,5 +1,6 @@
 """The accuracy control's bound: a run whose error does not fall with the step ends within
 the work its estimate announced, and says which accuracy it could not reach."""
+import json
 import time
 
 import pytest
@@ -32,7 +33,8 @@ def test_the_hard_override_ends_within_its_estimate_and_names_the_accuracy():
     assert estimate.seconds < estimate.bound_seconds == pytest.approx(estimate.seconds * WORK_BUDGET / CONTROL_WORK)
     Rig.from_scene("ptfe52_magnetic").solution()  # the kernels compiled or loaded, outside the timing
     t0 = time.process_time()
-    with pytest.raises(AccuracyNotReached, match=r"accuracy = 0\.0001: not reached; the error estimate stayed at 0\.\d+ .*"
+    with pytest.raises(AccuracyNotReached, match=r"accuracy = 0\.0001: not reached; over solver\.duration = 0\.003 s the error "
+                       r"estimate stayed at 0\.\d+ .*"
                        r"a step 16 times finer, which lowered it by less than 2 times"):
         rig.solution()
     assert time.process_time() - t0 < SLOWER * estimate.bound_seconds < 60.0
@@ -71,7 +73,36 @@ def test_the_control_spends_at_most_its_work_budget(monkeypatch):
     assert max(steps) > 16 * first  # it went as fine as the budget let it
 
 
-def test_the_command_line_refuses_it_in_one_line(capsys):
+def test_the_command_line_refuses_it_in_one_line_naming_the_duration_that_reaches_it(capsys):
+    # the steel chain's error stays within 1e-4 for its first millisecond and grows with
+    # time after (0.57 at 3 ms, at every step): the refusal names the duration that passes
     assert main(["shot", *HARD[0:1], "--set", HARD[1][0], "--json"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "accuracy = 0.0001: not reached" in err and "Traceback" not in err
+    assert "over solver.duration = 0.003 s" in err and "check the scene's values" not in err, err
+    duration = float(err.split("a solver.duration of at most ")[1].split(" s")[0])
+    assert 0.3e-3 < duration < 3e-3, err
+    tenfold = float(err.split("tenfold every ")[1].split(" s")[0])  # exponential growth, as the record goes on
+    assert 0.02e-3 < tenfold < duration, err
+    # the remedy holds: that duration (a scope record that fits in it) reaches the accuracy
+    record = int(0.8 * duration / 0.2e-6)
+    assert main(["shot", *HARD[0:1], "--set", HARD[1][0], "--set", f"solver.duration={duration}",
+                 "--set", f"scope.record_length={record}", "--json"]) == 0, capsys.readouterr().err
+    out = json.loads(capsys.readouterr().out)
+    assert out["solver"]["error_estimate"] <= 1e-4
+
+
+def test_the_error_over_time_ends_at_the_whole_records_error_and_cuts_where_it_should():
+    # two channels: a pulse at 1 ms, a second one at 2 ms where the solution drifts off
+    from rig.solver.control import error_over_time
+    from rig.solver.solution import relative_error
+    import numpy as np
+
+    t = np.arange(3000) * 1e-6
+    pulse = lambda t0: np.exp(-(((t - t0) / 5e-5) ** 2))  # noqa: E731
+    reference = {"a": 2.0 + pulse(1e-3), "b": 1.0 + 3 * pulse(2e-3)}
+    forces = {"a": reference["a"] + 1e-7 * pulse(1e-3), "b": reference["b"] + 1e-2 * (t > 2e-3)}
+    err = error_over_time(forces, reference)
+    assert err[-1] == pytest.approx(relative_error(forces, reference), rel=1e-12)
+    assert err[1500] == pytest.approx(1e-7, rel=1e-3)  # before the drift: channel a's error only
+    assert err[2500] == pytest.approx(1e-2 / 3, rel=1e-3)  # after it: channel b's against its peak

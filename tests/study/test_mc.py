@@ -365,6 +365,11 @@ def test_a_second_run_into_a_held_folder_is_refused_and_a_killed_holder_blocks_n
                                                        f"on {socket.gethostname()} since "), err
         assert err.rstrip().endswith("wait for it to end, or give another --out")
         assert not (out / "batches").exists() or not list((out / "batches").iterdir())  # it fired nothing
+        # a study large enough to announce its cost, on a Sobol design: the hold is taken
+        # before anything is printed, so the refusal is the only line
+        assert main([*argv, "--shots", "100000", "--sobol", "--allow-large"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith(f"rig mc: error: {out}: in use by another run"), err
     finally:
         os.kill(holder.pid, signal.SIGKILL)  # a killed run: its lock file stays, naming a dead pid
         holder.wait()
