@@ -33,7 +33,7 @@ from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_ent
 from .archive_reader import read_entry
 from .archive_verify import addresses, check, root_seal, sealed_members, shot_names
 from .errors import InstrumentError
-from .files import cause, first_missing, hdf5_image, remove_empty
+from .files import cause, first_missing, hdf5_image, held_lock, remove_empty
 from .files import fsync as _fsync  # a name of this module's own: the crash tests stop a writer after it
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
@@ -134,18 +134,10 @@ class Archive:
         nothing behind."""
         lock = self.path.with_name(self.path.name + ".lock")
         top = first_missing(self.path.parent)
-        created = not lock.exists()
-        try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            fh = open(lock, "a")  # noqa: SIM115 - closed below
-        except OSError as exc:
-            if top is not None:
-                remove_empty(self.path.parent, top)
-            raise InstrumentError(f"{self.path}: cannot write an archive there ({exc.strerror})") from None
         failed = True
         try:
+            fh, created = self._held_lock_file(lock, top)
             with fh:
-                fcntl.flock(fh, fcntl.LOCK_EX)
                 try:
                     yield
                     failed = False
@@ -156,6 +148,19 @@ class Archive:
         finally:
             if top is not None and not self.path.exists():
                 remove_empty(self.path.parent, top)
+
+    def _held_lock_file(self, lock: Path, top) -> tuple:
+        """(the lock file, open and exclusively held (instruments.files.held_lock, which a
+        writer waiting on a lock file its failed holder removed survives); whether this run
+        created it)."""
+        created = not lock.exists()
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            return held_lock(lock), created
+        except OSError as exc:
+            if top is not None:
+                remove_empty(self.path.parent, top)
+            raise InstrumentError(f"{self.path}: cannot write an archive there ({exc.strerror})") from None
 
     def _drop_stale_temporaries(self):
         for stale in self.path.parent.glob(f".{self.path.name}.*.tmp"):

@@ -220,13 +220,11 @@ def folder_lock(folder, name: str, what: str):
     one InstrumentError naming the folder, the holder (pid, host, since) and ``what`` to do.
     A lock file that cannot be opened (no permission, a read-only disk) is an OSError."""
     lock = Path(folder) / name
-    with open(lock, "a+") as fh:  # an OSError names the lock file; closing it releases the lock
-        try:
-            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            fh.seek(0)
-            holder = " ".join(fh.read().split()) or "a process that has not written its name yet"
-            raise InstrumentError(f"{Path(folder)}: in use by another run ({holder}); {what}") from None
+    try:
+        fh = held_lock(lock, blocking=False)  # an OSError names the lock file
+    except BlockingIOError:
+        raise InstrumentError(f"{Path(folder)}: in use by another run ({_holder(lock)}); {what}") from None
+    with fh:  # closing it releases the lock
         try:
             with contextlib.suppress(OSError):  # the name is for a refusal's message; a full disk stops the run later
                 fh.seek(0)
@@ -237,3 +235,35 @@ def folder_lock(folder, name: str, what: str):
             yield lock
         finally:
             fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+
+def held_lock(lock, blocking: bool = True):
+    """The file ``lock`` open ("a+") and exclusively held (flock), waiting for it where
+    ``blocking``, else BlockingIOError while another holds it. A run that fails removes a
+    lock file it created while still holding it: one that opened that file just before then
+    holds a file no longer in the folder, so it takes the file now at the path instead (the
+    same inode under the path and in its hand): two runs never hold two different files."""
+    while True:
+        fh = open(lock, "a+")  # noqa: SIM115 - the caller closes it (closing releases the lock)
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
+        except BaseException:
+            fh.close()
+            raise
+        held = os.fstat(fh.fileno())
+        try:
+            here = os.stat(lock)
+        except FileNotFoundError:
+            here = None
+        if here is not None and (here.st_ino, here.st_dev) == (held.st_ino, held.st_dev):
+            return fh
+        fh.close()
+
+
+def _holder(lock: Path) -> str:
+    """Who holds ``lock``, as its holder wrote it ("pid 12 on host since ...")."""
+    try:
+        return " ".join(lock.read_text().split()) or "a process that has not written its name yet"
+    except OSError:
+        return "a process that has not written its name yet"

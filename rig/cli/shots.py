@@ -1,8 +1,8 @@
 """`rig shot` and `rig animate`: one virtual shot, summarised, exported or rendered."""
 from __future__ import annotations
 
-from rig.cli.common import (check_archive_out, check_export_folder, check_size, flag_lines, missing_lines, progress_bar,
-                            scene_overrides, writing_to)
+from rig.cli.common import (check_archive_out, check_export_folder, check_size, flag_lines, missing_lines,
+                            progress_bar, scene_overrides, writing_to)
 from rig.errors import RigError, invalid
 
 

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rig.cli.common import (check_archive_out, check_size, flag_lines, folder_shown, missing_lines, progress_bar, scene_overrides,
-                            writing_to)
+from rig.cli.common import (check_archive_out, check_size, flag_lines, folder_shown, missing_lines, progress_bar,
+                            scene_overrides, writing_to)
 from rig.cli.shots import shot_summary
 from rig.errors import Interrupted, RigError
 

@@ -3,12 +3,14 @@
 Synthetic scope records (the emulated oscilloscope on a Gaussian pulse) keep these tests
 on the measurement side: no rig import.
 """
+import contextlib
 import json
 import os
 import signal
 import subprocess
 import sys
 import threading
+import time
 
 import h5py
 import numpy as np
@@ -232,3 +234,49 @@ def _all_datasets(group):
     out = []
     group.visititems(lambda n, o: out.append((n, o)) if isinstance(o, h5py.Dataset) else None)
     return out
+
+
+def test_a_writer_waiting_on_a_lock_file_its_holder_removes_takes_the_one_at_the_path(tmp_path):
+    """A failed first write removes the lock file it created while still holding it; a
+    writer that was waiting on that file must not go on holding a file no longer in the
+    folder, or a third writer would take a new one and two would write at once."""
+    import fcntl
+    import threading
+
+    archive = Archive(tmp_path / "shots.h5")
+    lock = tmp_path / "shots.h5.lock"
+    a_holds, a_may_fail, b_holds, b_may_go = (threading.Event() for _ in range(4))
+    seen = {}
+
+    def first():
+        with contextlib.suppress(RuntimeError), archive._lock():
+            a_holds.set()
+            a_may_fail.wait(10)
+            raise RuntimeError("the first write fails")
+
+    def second():
+        a_holds.wait(10)
+        with archive._lock():
+            b_holds.set()
+            b_may_go.wait(10)
+
+    threads = [threading.Thread(target=first), threading.Thread(target=second)]
+    for t in threads:
+        t.start()
+    a_holds.wait(10)
+    time.sleep(0.2)  # the second writer is now waiting on the first's lock file
+    a_may_fail.set()
+    assert b_holds.wait(10)
+    try:
+        with open(lock, "a") as third:  # what a third writer opens: the file at the path
+            try:
+                fcntl.flock(third, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                seen["third got it"] = True
+                fcntl.flock(third, fcntl.LOCK_UN)
+            except BlockingIOError:
+                seen["third got it"] = False
+    finally:
+        b_may_go.set()
+        for t in threads:
+            t.join(10)
+    assert seen == {"third got it": False}
