@@ -19,7 +19,7 @@ from ._kernels import acquisition, batch_analysis, pulses
 from .frontend import highpass_coefficients
 from .oscilloscope import CODE_MAX, CODE_MIN, Oscilloscope
 from .pipeline import Setup, report_of
-from .rails import clipping, rail_of_codes
+from .rails import Rail, clipping, code_rails, rail_of_codes
 from .records import ScopeRecord
 from .report import Report
 
@@ -155,6 +155,9 @@ def analysed(records: Records, setup: Setup) -> list:
                                  sigma, finite)
     limits = {ch: scope.channels[ch].bandwidth for ch in (setup.upper.channel, setup.lower.channel)}
     ticks = dx * np.arange(records.codes.shape[2])  # each record's sample times from its first
+    read = records.codes[:, roles]
+    lo, hi = code_rails(read)
+    touches = np.any((read <= lo) | (read >= hi), axis=2)  # (shots, 2): which channels reach a rail at all
     out = []
     for s in range(S):
         rep = Report(beta=setup.beta, static_force_N=setup.static_force_N)
@@ -167,7 +170,8 @@ def analysed(records: Records, setup: Setup) -> list:
             t = records.times[s, 1] + ticks
             noise = {r: None if math.isnan(sigma[s, k]) else float(sigma[s, k])
                      for k, r in enumerate(("upper", "lower"))}
-            clipped = tuple(filter(None, (clipping(channels[c], rail_of_codes(records.codes[s, c]), dx,
-                                                   bool(records.over[s, c])) for c in roles)))
+            clipped = tuple(filter(None, (clipping(channels[c], rail_of_codes(records.codes[s, c]) if touches[s, k]
+                                                   else Rail(), dx, bool(records.over[s, c]))
+                                          for k, c in enumerate(roles))))
             out.append(report_of(answer[s], t, {}, setup, False, noise, clipped, limits))
     return out
