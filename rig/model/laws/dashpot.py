@@ -11,6 +11,7 @@ from rig.model.laws.law import KUWABARA_KONO, ContactLaw, LawParameter, ViscousT
 CONTACT_DAMPING = LawParameter("contact_damping", "kg/s", 0.0, float("inf"), 0.0,
                                "dashpot coefficient mu (kg/s) of each contact", switch=True)
 
+
 def viscous_terms(values: dict) -> ViscousTerms:
     """A linear dashpot of mu kg/s (the chain's values, {key: SI value})."""
     return ViscousTerms(dashpot=values["contact_damping"])

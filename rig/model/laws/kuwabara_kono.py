@@ -10,6 +10,7 @@ from rig.model.laws.law import KUWABARA_KONO, ContactLaw, LawParameter, ViscousT
 DAMPING_TIME = LawParameter("damping_time", "s", 0.0, float("inf"), 0.0,
                             "Kuwabara-Kono damping time tau_d (s) of the contacts' material", switch=True)
 
+
 def viscous_terms(values: dict) -> ViscousTerms:
     """The damping time tau_d (s) of the chain's values ({key: SI value})."""
     return ViscousTerms(damping_time=values["damping_time"])

@@ -14,6 +14,7 @@ GAMMA = LawParameter("dashpot_gamma", "1", 0.0, float("inf"), 0.0,
 ALPHA = LawParameter("dashpot_exponent", "1", 0.1, 3.0, 1.0,
                      "power-law dashpot exponent alpha (dimensionless; 1: a linear dashpot)")
 
+
 def viscous_terms(values: dict) -> ViscousTerms:
     """A dashpot gamma |d'|^alpha sgn d' (the chain's values, {key: SI value})."""
     return ViscousTerms(dashpot=values["dashpot_gamma"], dashpot_exponent=values["dashpot_exponent"])
