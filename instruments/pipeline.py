@@ -24,11 +24,12 @@ import numpy as np
 from ._kernels import pulses
 from ._kernels.pulses import AMPLITUDE, BASE_WIDTH, FOUND, FWHM, LAG, PEAK, RISE, ROLE, STATUS, TIME
 from .analysis import MIN_BASELINE, PeakRules, Pulse, find_pulses, leading, noise_level
+from .distortion import record_ends_in_pulse, too_slow, with_clipping
 from .errors import InstrumentError, check
 from .plausibility import Limits, record_doubt, speed_doubt
 from .rails import clipping, rail
 from .records import ScopeRecord, time_base_mismatch
-from .report import FIGURES, SPEED_FIGURES, Report
+from .report import SPEED_FIGURES, Report
 
 
 @dataclass(frozen=True)
@@ -148,44 +149,6 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
     return with_clipping(_report(answer, t, forces, setup, train, noise, bandwidth), clipped)
 
 
-CLIPPED_FIGURES = ("averaged_amplitude_N", "amplitude_N", "total_force_N", "duration_s", "base_duration_s",
-                   "width_diameters")
-# The most a flat top may move the speed: each peak time is uncertain by half its channel's
-# flat top (the parabola through a plateau finds its middle, which is the peak's time only for
-# a symmetric pulse), and the sum over the time of flight must stay below this.
-CLIPPED_SPEED = 0.01
-
-
-def with_clipping(rep: Report, clipped: tuple) -> Report:
-    """``rep`` with what clipped channels (rails.Clip) allow: no amplitude or width (the
-    pulses' tops are cut), and the speed figures only where the flat tops leave the peak
-    times certain to CLIPPED_SPEED of the flight time; each reason names the samples at
-    the rail, and where no figure is left, all share one reason."""
-    if not clipped:
-        return rep
-    cut = (f"{'; '.join(c.reason for c in clipped)}: the signal ran off the scope's range, which cuts the pulses' "
-           f"tops (a larger volts_per_div keeps them on screen)")
-    if rep.speed_m_per_s is None:  # refused already: the clipping first
-        for name in FIGURES:
-            setattr(rep, name, None)
-            rep.reasons[name] = f"{cut}; {rep.reasons[name]}" if name in rep.reasons else cut
-        return rep
-    flight = rep.leading["lower"]["time"] - rep.leading["upper"]["time"]
-    doubt = 0.5 * sum(c.flat_top_s for c in clipped)
-    if doubt <= CLIPPED_SPEED * flight:
-        for name in CLIPPED_FIGURES:
-            setattr(rep, name, None)
-            rep.reasons[name] = cut
-        return rep
-    said = (f"the flat tops leave the peak times uncertain by up to {doubt:.3g} s, {100 * doubt / flight:.2g}% of the "
-            f"{flight:.3g} s between the gauges" if math.isfinite(doubt)  # nan: a flag without the samples
-            else "a flat top leaves the peak time uncertain")
-    for name in FIGURES:
-        setattr(rep, name, None)
-        rep.reasons[name] = f"{cut}, and {said}"
-    return rep
-
-
 def _report(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, train: bool,
             noise: dict | None, bandwidth: dict | None) -> Report:
     """report_of without the clipping rule."""
@@ -257,44 +220,6 @@ def _report(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, train
     else:
         rep.refuse("the train was not counted (leading pulse only)", ("pulses",))
     return rep
-
-
-RISE_PER_BANDWIDTH = 0.35  # a one-pole filter's 10-90% rise time x its -3 dB bandwidth
-# The most rise time per pulse FWHM: a Gaussian pulse through a one-pole filter whose rise
-# time is 1/3 of its FWHM comes out 5% lower and 5% wider, its peak 0.14 FWHM late; at 1/2
-# 10% and 10%, at 1 23% and 25% (numerical convolution). 5% is the amplitude's own error
-# budget; beyond it the filter, not the chain, sets the pulse.
-SLOW_FRACTION = 1 / 3
-
-
-def too_slow(channel: str, bandwidth_Hz: float | None, fwhm: float) -> str:
-    """Why a channel's bandwidth limit distorts its pulse of FWHM ``fwhm`` (s): its rise
-    time RISE_PER_BANDWIDTH / bandwidth beyond SLOW_FRACTION of the FWHM; '' otherwise
-    (no limit known, or no FWHM measured)."""
-    if not bandwidth_Hz or not math.isfinite(fwhm):
-        return ""
-    rise = RISE_PER_BANDWIDTH / bandwidth_Hz
-    if rise <= SLOW_FRACTION * fwhm:
-        return ""
-    return (f"{channel}: its bandwidth limit of {bandwidth_Hz:.6g} Hz rises in 0.35/B = {rise:.3g} s, more than "
-            f"1/3 of the measured pulse's FWHM ({fwhm:.3g} s): the filter lowers, widens and delays the pulse "
-            f"(5% at 1/3); a wider bandwidth (scope.channels.{channel}.bandwidth) or none")
-
-
-END_SAMPLES = 3  # the last samples that show a pulse still rising at the record's end
-
-
-def record_ends_in_pulse(f: np.ndarray | None, sigma: float | None, rules: PeakRules) -> bool:
-    """Whether a conditioned record ``f`` (baseline 0) ends inside its largest pulse: its
-    maximum among its last END_SAMPLES samples (still rising), or its last sample above
-    half its maximum (the pulse's fall cut), the maximum standing ``rules.snr`` noise
-    levels above the baseline where the noise ``sigma`` is known. False without a record."""
-    if f is None or f.size <= END_SAMPLES:
-        return False
-    peak = float(np.max(f))
-    if not peak > 0 or (sigma is not None and peak < rules.snr * sigma):
-        return False
-    return int(np.argmax(f)) >= f.size - END_SAMPLES or float(f[-1]) >= 0.5 * peak
 
 
 def _snr_floor(rules: PeakRules, peak: float, sigma: float | None) -> float | None:

@@ -119,8 +119,12 @@ def _label(data: bytes) -> str:
 def _horizontal_unit(data: bytes) -> str:
     """The implicit dimension's units through the documented layout (RigolWFM's Kaitai
     description of WFM#001/#002/#003); 's' where the file is a legacy LLWFM file."""
-    from RigolWFM import (tektronix_wfm_001_be_wfm, tektronix_wfm_001_le_wfm, tektronix_wfm_002_be_wfm,
-                          tektronix_wfm_002_le_wfm)
+    from RigolWFM import (
+        tektronix_wfm_001_be_wfm,
+        tektronix_wfm_001_le_wfm,
+        tektronix_wfm_002_be_wfm,
+        tektronix_wfm_002_le_wfm,
+    )
 
     if data[:2] not in (b"\x0f\x0f", b"\xf0\xf0"):
         return "s"

@@ -9,7 +9,8 @@ import pytest
 
 from instruments.formats import read_waveforms
 from instruments.formats.isf import isf_bytes
-from instruments.pipeline import GaugeSetup, Setup, analyze_record, too_slow
+from instruments.distortion import too_slow
+from instruments.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.records import Preamble, ScopeRecord, Waveform
 
 DT = 2e-7
