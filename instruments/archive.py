@@ -21,7 +21,6 @@ the archive is left as it was.
 from __future__ import annotations
 
 import contextlib
-import fcntl
 import os
 import shutil
 import tempfile
@@ -33,7 +32,7 @@ from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_ent
 from .archive_reader import read_entry
 from .archive_verify import addresses, check, root_seal, sealed_members, shot_names
 from .errors import InstrumentError
-from .files import cause, first_missing, hdf5_image, held_lock, remove_empty
+from .files import cause, folder_lock, hdf5_image
 from .files import fsync as _fsync  # a name of this module's own: the crash tests stop a writer after it
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
@@ -128,39 +127,17 @@ class Archive:
 
     @contextlib.contextmanager
     def _lock(self):
-        """Hold ``ARCHIVE.h5.lock`` while the block runs. Where the block fails, or the
-        archive does not exist after it, the lock file this run created is removed (and the
-        folders it created for an archive that does not exist): a failed write leaves
-        nothing behind."""
-        lock = self.path.with_name(self.path.name + ".lock")
-        top = first_missing(self.path.parent)
-        failed = True
-        try:
-            fh, created = self._held_lock_file(lock, top)
-            with fh:
-                try:
-                    yield
-                    failed = False
-                finally:
-                    if created and (failed or not self.path.exists()):  # removed while still held
-                        lock.unlink(missing_ok=True)
-                    fcntl.flock(fh, fcntl.LOCK_UN)
-        finally:
-            if top is not None and not self.path.exists():
-                remove_empty(self.path.parent, top)
-
-    def _held_lock_file(self, lock: Path, top) -> tuple:
-        """(the lock file, open and exclusively held (instruments.files.held_lock, which a
-        writer waiting on a lock file its failed holder removed survives); whether this run
-        created it)."""
-        created = not lock.exists()
-        try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            return held_lock(lock), created
-        except OSError as exc:
-            if top is not None:
-                remove_empty(self.path.parent, top)
-            raise InstrumentError(f"{self.path}: cannot write an archive there ({exc.strerror})") from None
+        """Hold ``ARCHIVE.h5.lock`` while the block runs (instruments.files.folder_lock,
+        waiting for another writer). Where the block fails, or the archive does not exist
+        after it, the lock file and the folders this run created are removed: a failed write
+        leaves nothing behind."""
+        with contextlib.ExitStack() as held:
+            try:
+                held.enter_context(folder_lock(self.path.parent, self.path.name + ".lock", blocking=True,
+                                               keep=self.path.exists))
+            except OSError as exc:
+                raise InstrumentError(f"{self.path}: cannot write an archive there ({exc.strerror})") from None
+            yield
 
     def _drop_stale_temporaries(self):
         for stale in self.path.parent.glob(f".{self.path.name}.*.tmp"):

@@ -215,27 +215,43 @@ def fsync(path):
 
 
 @contextlib.contextmanager
-def folder_lock(folder, name: str, what: str):
-    """Hold ``folder/name`` exclusively while the block runs. Held by another live process:
-    one InstrumentError naming the folder, the holder (pid, host, since) and ``what`` to do.
-    A lock file that cannot be opened (no permission, a read-only disk) is an OSError."""
-    lock = Path(folder) / name
+def folder_lock(folder, name: str, what: str = "", *, blocking: bool = False, keep=lambda: True):
+    """Hold ``folder/name`` exclusively while the block runs, the folder made where it is
+    missing; the holder writes its name (pid, host, since) into it. Not ``blocking``: held
+    by another live process, one InstrumentError naming the folder, the holder and ``what``
+    to do; ``blocking``: wait for it. Where the block fails, or ``keep()`` is false after
+    it, a lock file this run created is removed while still held (held_lock: a run that
+    waited on it takes the file then at the path), and the folders this run made are
+    removed where empty: a failed run leaves nothing behind. A folder or lock file that
+    cannot be made or opened (no permission, a read-only disk) is an OSError."""
+    folder = Path(folder)
+    lock = folder / name
+    top = first_missing(folder)
     try:
-        fh = held_lock(lock, blocking=False)  # an OSError names the lock file
-    except BlockingIOError:
-        raise InstrumentError(f"{Path(folder)}: in use by another run ({_holder(lock)}); {what}") from None
-    with fh:  # closing it releases the lock
+        folder.mkdir(parents=True, exist_ok=True)
+        created = not lock.exists()
         try:
-            with contextlib.suppress(OSError):  # the name is for a refusal's message; a full disk stops the run later
-                fh.seek(0)
-                fh.truncate()
-                fh.write(f"pid {os.getpid()} on {socket.gethostname()} since "
-                         f"{time.strftime('%Y-%m-%dT%H:%M:%S%z')}\n")
-                fh.flush()
-            yield lock
-        finally:
-            fcntl.flock(fh, fcntl.LOCK_UN)
-
+            fh = held_lock(lock, blocking)
+        except BlockingIOError:
+            raise InstrumentError(f"{folder}: in use by another run ({_holder(lock)}); {what}") from None
+        with fh:  # closing it releases the lock
+            kept = False
+            try:
+                with contextlib.suppress(OSError):  # the name is for a refusal's message; a full disk stops it later
+                    fh.seek(0)
+                    fh.truncate()
+                    fh.write(f"pid {os.getpid()} on {socket.gethostname()} since "
+                             f"{time.strftime('%Y-%m-%dT%H:%M:%S%z')}\n")
+                    fh.flush()
+                yield lock
+                kept = keep()
+            finally:
+                if created and not kept:
+                    lock.unlink(missing_ok=True)
+                fcntl.flock(fh, fcntl.LOCK_UN)
+    finally:
+        if top is not None:
+            remove_empty(folder, top)
 
 
 def held_lock(lock, blocking: bool = True):

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from instruments.files import first_missing, folder_lock, left_as_found, remove_empty, write_hdf5, write_text
+from instruments.files import folder_lock, left_as_found, write_hdf5, write_text
 from rig.errors import RigError
 from rig.study.batch import BatchResult
 from rig.study.mc_spec import OUTPUTS, Study
@@ -56,23 +56,9 @@ class Store:
         """The folder, held by this run for as long as the block runs: another run into it
         (same folder, any study) is refused in one line naming the holder. The OS releases
         the hold when this process ends, killed or not."""
-        top = first_missing(self.folder)
-        self.folder.mkdir(parents=True, exist_ok=True)
-        lock = self.folder / "study.lock"
-        created = not lock.exists()
-        try:
-            with folder_lock(self.folder, lock.name, "wait for it to end, or give another --out"):
-                try:
-                    with left_as_found(self.folder, Exception, keep=lambda exc: bool(self.done())):  # inside the hold
-                        yield self
-                except Exception:
-                    if created:  # removed while held: a run that opened it meanwhile is refused, not let in
-                        lock.unlink(missing_ok=True)
-                    raise
-        except Exception:
-            if top is not None:
-                remove_empty(self.folder, top)
-            raise
+        with folder_lock(self.folder, "study.lock", "wait for it to end, or give another --out"):
+            with left_as_found(self.folder, Exception, keep=lambda exc: bool(self.done())):  # inside the hold
+                yield self
 
     def open(self) -> "Store":
         """Create the folder, or check that it holds this very study (to resume it)."""
