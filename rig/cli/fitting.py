@@ -46,12 +46,12 @@ def cmd_fit(args) -> dict:
     fitted = {t.split("=", 1)[0].strip(): f"--param {t}" for t in args.param}
     overrides = list(scene_overrides(args, fitted))
     for p in params:  # a fitted damping switches its contact law on, after --set
-        law = POSITIVE_LAW_KEYS.get(p.key)
+        laws = POSITIVE_LAW_KEYS.get(p.key, ())
         for item in overrides:
             key, _, value = item.partition("=")
-            if law and key.strip() == "chain.contact_law" and value.strip().lower() != law:
-                raise invalid("--set", item, f"--param {p.key} fits the {law} law's damping and switches "
-                                             f"chain.contact_law to {law}; leave the --set out")
+            if laws and key.strip() == "chain.contact_law" and value.strip().lower() not in laws:
+                raise invalid("--set", item, f"--param {p.key} belongs to the {' or '.join(laws)} law and "
+                                             f"switches chain.contact_law to {laws[0]}; leave the --set out")
     scene_io.load(args.scene, overrides)  # the scene and its overrides, checked before any work
     points = None
     if args.points:

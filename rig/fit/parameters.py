@@ -8,10 +8,11 @@ from rig.experiment.scene import key_spec
 from rig.model.laws import OWNER, PARAMETERS
 from rig.units import check_digits, is_number, number, quantity
 
-LAW_KEYS = {PARAMETERS[key].field: law.name for key, law in OWNER.items()}
-"""The keys that belong to one contact law (rig.model.laws): fitting one selects that law."""
-POSITIVE_LAW_KEYS = {PARAMETERS[key].field: law.name for key, law in OWNER.items() if PARAMETERS[key].switch}
-"""Keys that switch their contact law on (the law needs them > 0)."""
+LAW_KEYS = {PARAMETERS[key].field: tuple(law.name for law in laws) for key, laws in OWNER.items()}
+"""The keys that belong to some contact laws (rig.model.laws), with those laws' names: fitting
+one selects the first of them (or the scene's law where it is one of them)."""
+POSITIVE_LAW_KEYS = {field: laws for field, laws in LAW_KEYS.items() if PARAMETERS[field[len("chain."):]].switch}
+"""Keys that switch a contact law on (their laws need them > 0)."""
 
 
 @dataclass(frozen=True)
@@ -64,7 +65,7 @@ def parse_parameter(text: str) -> FitParameter:
     if not lo < hi:
         raise invalid(f"--param {key}", bounds, "needs LO < HI, the lower bound first")
     if key in POSITIVE_LAW_KEYS and lo <= 0:
-        raise invalid(f"--param {key} LO", lo_text, f"> 0 (the {POSITIVE_LAW_KEYS[key]} law needs it; "
+        raise invalid(f"--param {key} LO", lo_text, f"> 0 (the {' and '.join(POSITIVE_LAW_KEYS[key])} law needs it; "
                                                    "leave the key out to fit without it)")
     law_parameter = PARAMETERS.get(key.split(".", 1)[1]) if key.startswith("chain.") else None
     if law_parameter is not None:  # both bounds inside what the contact law allows
@@ -84,9 +85,20 @@ def parse_parameters(texts) -> tuple:
     return params
 
 
-def law_overrides(params) -> list:
-    """The contact-law switch a fitted key needs (chain.contact_law=...)."""
-    laws = {LAW_KEYS[p.key] for p in params if p.key in LAW_KEYS}
-    if len(laws) > 1:
-        raise invalid("--param", sorted(laws), f"one contact law at a time (of {', '.join(sorted(LAW_KEYS))})")
-    return [f"chain.contact_law={laws.pop()}"] if laws else []
+def law_overrides(params, overrides=()) -> list:
+    """The contact-law switch the fitted keys need (chain.contact_law=...): none where they
+    belong to no law or ``overrides`` (--set texts) already name a law they all belong to;
+    else the first law (rig.model.laws.LAWS' order) they all belong to."""
+    owners = [LAW_KEYS[p.key] for p in params if p.key in LAW_KEYS]
+    if not owners:
+        return []
+    common = [name for name in owners[0] if all(name in o for o in owners)]
+    if not common:
+        keys = ", ".join(p.key for p in params if p.key in LAW_KEYS)
+        raise invalid("--param", keys, "keys of different contact laws; one law at a time: "
+                                       + "; ".join(f"{k}: {' or '.join(v)}" for k, v in LAW_KEYS.items()))
+    named = [item.partition("=")[2].strip().lower() for item in overrides
+             if item.partition("=")[0].strip() == "chain.contact_law"]
+    if named and named[-1] in common:
+        return []
+    return [f"chain.contact_law={common[0]}"]

@@ -55,7 +55,7 @@ class PointObjective:
 
     def __init__(self, scene: str, params: tuple, points: Points, overrides=()):
         self.scene, self.params, self.points = scene, tuple(params), points
-        self.overrides = list(overrides) + law_overrides(params)
+        self.overrides = list(overrides) + law_overrides(params, overrides)
         self.configs = points.configurations()
         self.config_of = np.array([self.configs.index(c) for c in points.configs])
         v0 = scene_io.load(scene, self.overrides).values["striker"]["velocity"]

@@ -123,7 +123,7 @@ class TraceObjective:
 
     def __init__(self, scene: str, params: tuple, records: list, overrides=()):
         self.scene, self.params = scene, tuple(params)
-        self.overrides = list(overrides) + law_overrides(params)
+        self.overrides = list(overrides) + law_overrides(params, overrides)
         self._start = start_values(scene, self.overrides, params)
         check_bounds(scene, self.overrides, self.params, self._start)
         rig = self.rig_of(self._start)

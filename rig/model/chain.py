@@ -105,6 +105,9 @@ class Chain:
         self.contact_parameters = law_values(self.law, contact)
         for key, value in self.contact_parameters.items():  # chain.damping_time, chain.contact_exponent, ...
             setattr(self, key, value)
+        if self.contact_parameters.get("static_hold", 0.0) > 0 and not self.has_top_force:
+            raise invalid("chain.static_hold", self.contact_parameters["static_hold"],
+                          "a static hold needs the magnet's load: give the scene a [magnet], or leave it 0 s")
         self.drag = quantity(drag, "kg/s", "holder.drag", bare_ok=True)
         self.friction = quantity(friction, "N", "holder.friction", bare_ok=True)
         self.slip_speed = quantity(slip_speed, "m/s", "holder.slip_speed", bare_ok=True)
@@ -182,9 +185,34 @@ class Chain:
 
     def static_overlaps(self) -> np.ndarray:
         """Static overlaps (m), d0 = (F/A)^(1/n) ((F/A)^(2/3): Hertz); 0 where a contact
-        carries nothing."""
-        return self._cached("d0", lambda: static_overlaps_of(self.contact_constants(), self.static_forces(),
-                                                             self.contact_exponents()))
+        carries nothing; a contact flattened by a static hold rests deeper (contact_memory)."""
+        return self._cached("d0", lambda: self.contact_memory(self.contact_constants(), self.static_forces())[1])
+
+    def contact_memory(self, A, F) -> tuple:
+        """(state, d0, hold_work) of contacts of constants A (N/m^n) carrying static forces F
+        (N) (arrays (..., contacts)): the kernels' memory of each contact
+        (rig.model.laws.thornton.STATE_ROWS, first axis), the static overlaps (m) and the
+        plastic work (J) a static hold took. Contacts that do not follow a yielding law are
+        elastic and as new."""
+        from rig.model.laws.thornton import NO_YIELD, STATE_ROWS, initial_state
+
+        n = self.contact_exponents()
+        d_el = static_overlaps_of(A, F, n)
+        terms = self.law.yielding(self.contact_parameters) if self.law.yielding else NO_YIELD
+        live = follows_law(self) & np.isfinite(A)
+        state, d0, work = initial_state(np.where(live, A, 0.0), n, np.where(live, F, 0.0), d_el, terms)
+        ap = STATE_ROWS.index("unloading_constant")
+        state[ap] = np.where(live, state[ap], np.where(np.isfinite(A), A, 0.0))  # as new: A_p = A
+        return state, np.where(live, d0, d_el), work
+
+    def contact_yield_rates(self) -> tuple:
+        """(m, r_ref): each contact's yield rate exponent and reference closing rate (m/s)
+        (rig.model.laws.thornton); (0, 1) where it does not follow a yielding law."""
+        from rig.model.laws.thornton import NO_YIELD
+
+        terms = self.law.yielding(self.contact_parameters) if self.law.yielding else NO_YIELD
+        law = follows_law(self)
+        return np.where(law, terms.rate_exponent, 0.0), np.where(law, terms.reference_rate, 1.0)
 
     def equilibrium_positions(self) -> np.ndarray:
         """Bead centres at equilibrium (m, down from bead 0's centre)."""

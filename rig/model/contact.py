@@ -100,5 +100,6 @@ def power_law_constant(A_hertz, n, reference_force):
 
 # The laws themselves (names, equations, parameters, kernel codes) live one module each in
 # rig.model.laws; their registry is re-exported here, where the rig has always read it.
-CONTACT_LAWS, HERTZ, KUWABARA_KONO, POWER = laws.CONTACT_LAWS, laws.HERTZ, laws.KUWABARA_KONO, laws.POWER
+CONTACT_LAWS, HERTZ, KUWABARA_KONO, POWER, PLASTIC = (laws.CONTACT_LAWS, laws.HERTZ, laws.KUWABARA_KONO, laws.POWER,
+                                                 laws.PLASTIC)
 ContactLaw, contact_law = laws.ContactLaw, laws.contact_law

@@ -10,19 +10,26 @@ from dataclasses import dataclass
 import numpy as np
 
 from rig.model.chain import Chain, ForceSchedule
-from rig.model.contact import HERTZ, KUWABARA_KONO, POWER
-from rig.model.statics import static_forces_of, static_overlaps_of
+from rig.model.contact import HERTZ, KUWABARA_KONO, PLASTIC, POWER
+from rig.model.laws.thornton import STATE_ROWS
+from rig.model.statics import static_forces_of
 
-PER_BODY = ("mass", "invm", "bias", "A", "expo", "d0", "f0", "damping", "dashpot", "dashpot_exponent", "d_limit",
-            "drag", "friction", "u0", "v0")
-CONTACT_ROWS = ("expo", "damping", "dashpot", "dashpot_exponent")
+CONTACT_ROWS = ("expo", "damping", "dashpot", "dashpot_exponent", "yield_rate_exponent", "yield_reference_rate")
 """The rows of the kernels' ``con`` array, each slot's law: exponent n, Kuwabara-Kono damping
-time tau (s), dashpot coefficient gamma (N (s/m)^alpha) and dashpot exponent alpha."""
+time tau (s), dashpot coefficient gamma (N (s/m)^alpha), dashpot exponent alpha, and the
+yield's rate exponent m and reference rate r_ref (m/s) (rig.model.laws.thornton)."""
+PER_BODY = ("mass", "invm", "bias", "A", "d0", "f0", "d_limit", "drag", "friction", "u0", "v0") + CONTACT_ROWS \
+    + STATE_ROWS
+"""A ChainProblem's arrays of one value per body (or per contact slot): STATE_ROWS are each
+slot's memory before the shot (rig.model.laws.thornton), which the kernels copy and renew."""
 
 
-def kernel_law(expo, damping, dashpot) -> int:
-    """The kernels' code for contacts of exponents ``expo``, damping times and dashpots
-    (arrays of the live slots): HERTZ, KUWABARA_KONO (Hertz with viscous terms) or POWER."""
+def kernel_law(expo, damping, dashpot, yield_overlap=None) -> int:
+    """The kernels' code for contacts of exponents ``expo``, damping times, dashpots and
+    reference yield overlaps (arrays of the live slots): PLASTIC where any contact yields,
+    else HERTZ, KUWABARA_KONO (Hertz with viscous terms) or POWER."""
+    if yield_overlap is not None and np.any(yield_overlap > 0):
+        return PLASTIC
     if np.all(expo == 1.5):
         return HERTZ if not (np.any(damping) or np.any(dashpot)) else KUWABARA_KONO
     return POWER
@@ -35,7 +42,8 @@ class _ContactCodes:
     def law(self) -> int:
         """The kernels' contact code of the live slots (of every shot together; kernel_law)."""
         live = self.A > 0
-        return kernel_law(self.expo[live], self.damping[live], self.dashpot[live])
+        return kernel_law(self.expo[live], self.damping[live], self.dashpot[live],
+                          self.reference_yield_overlap[live])
 
     @property
     def onsite(self) -> bool:
@@ -62,6 +70,14 @@ class ProblemArrays(_ContactCodes):
     damping: np.ndarray
     dashpot: np.ndarray
     dashpot_exponent: np.ndarray
+    yield_rate_exponent: np.ndarray
+    yield_reference_rate: np.ndarray
+    permanent_overlap: np.ndarray
+    unloading_constant: np.ndarray
+    largest_rate: np.ndarray
+    yield_overlap: np.ndarray
+    plastic_work: np.ndarray
+    reference_yield_overlap: np.ndarray
     d_limit: np.ndarray
     drag: np.ndarray
     friction: np.ndarray
@@ -114,7 +130,8 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
 
     expo_c = chain.contact_exponents()
     F_c = static_forces_of(bodies, chain.gravity, top)
-    d_c = static_overlaps_of(A_c, F_c, expo_c)
+    state_c, d_c, _ = chain.contact_memory(A_c, F_c)
+    state = np.zeros((len(STATE_ROWS), S, nb))
     A, d0, f0 = np.zeros((S, nb)), np.zeros((S, nb)), np.zeros((S, nb))
     expo, damping, dashpot = np.full((S, nb), 1.5), np.zeros((S, nb)), np.zeros((S, nb))
     dashpot_exponent = np.ones((S, nb))
@@ -129,6 +146,10 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     tau_c, gamma_c, alpha_c = chain.contact_dissipation()
     damping[:, slot[live]], dashpot[:, slot[live]] = tau_c[live], gamma_c[live]
     dashpot_exponent[:, slot[live]] = alpha_c[live]
+    state[:, :, slot[live]] = state_c[:, :, live]
+    m_c, r_c = chain.contact_yield_rates()
+    yield_rate_exponent, yield_reference_rate = np.zeros((S, nb)), np.ones((S, nb))
+    yield_rate_exponent[:, slot[live]], yield_reference_rate[:, slot[live]] = m_c[live], r_c[live]
     d_limit[:, slot[live]] = 0.5 * near[live]
     if off:
         d0[:, 1] = -chain.striker.gap
@@ -146,8 +167,9 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
         e_scale = np.where(e_scale == 0.0, 1.0, e_scale)
         p_scale = np.sqrt(2.0 * mass.sum(axis=1) * e_scale)
     return dict(mass=mass, invm=invm, bias=bias, load=load, A=A, expo=expo, d0=d0, f0=f0, damping=damping,
-                dashpot=dashpot, dashpot_exponent=dashpot_exponent, d_limit=d_limit, drag=drag, friction=friction,
-                u0=u0, v0=v0, energy_scale=e_scale, momentum_scale=p_scale)
+                dashpot=dashpot, dashpot_exponent=dashpot_exponent, yield_rate_exponent=yield_rate_exponent,
+                yield_reference_rate=yield_reference_rate, **dict(zip(STATE_ROWS, state)), d_limit=d_limit,
+                drag=drag, friction=friction, u0=u0, v0=v0, energy_scale=e_scale, momentum_scale=p_scale)
 
 
 REST_TOLERANCE = 1e-12  # a body's net force at rest below this x its loads is rounding, not physics
@@ -184,8 +206,11 @@ class ChainProblem(_ContactCodes):
     (m/s^2): the holder's drag and Coulomb friction over the body's mass; and per contact
     slot (slot i joins bodies i-1 and i): A (N/m^n), expo (n), d0 (m), f0 (N), damping (s,
     Kuwabara-Kono), dashpot (gamma, N (s/m)^alpha: kg/s for a linear one), dashpot_exponent
-    (alpha, 1: linear), d_limit (m, an overlap beyond which the integration is
-    declared unstable). u0, v0 the initial state (m, m/s). With a compliant wall the plate
+    (alpha, 1: linear), yield_rate_exponent and yield_reference_rate (m/s) of a yielding
+    contact, its memory before the shot (STATE_ROWS: permanent_overlap (m),
+    unloading_constant (N/m^n, A where as new), largest_rate (m/s), yield_overlap (m),
+    plastic_work (J), reference_yield_overlap (m; 0: it never yields); rig.model.laws.thornton),
+    d_limit (m, an overlap beyond which the integration is declared unstable). u0, v0 the initial state (m, m/s). With a compliant wall the plate
     is a body and the rod the slot below it, to the wall's immovable body.
     """
 
@@ -202,6 +227,14 @@ class ChainProblem(_ContactCodes):
     damping: np.ndarray
     dashpot: np.ndarray
     dashpot_exponent: np.ndarray
+    yield_rate_exponent: np.ndarray
+    yield_reference_rate: np.ndarray
+    permanent_overlap: np.ndarray
+    unloading_constant: np.ndarray
+    largest_rate: np.ndarray
+    yield_overlap: np.ndarray
+    plastic_work: np.ndarray
+    reference_yield_overlap: np.ndarray
     d_limit: np.ndarray
     drag: np.ndarray
     friction: np.ndarray

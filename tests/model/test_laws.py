@@ -32,7 +32,8 @@ def test_scene_schema_and_fit_keys_derive_from_the_registry():
     for key, p in PARAMETERS.items():
         assert SCHEMA["chain"][key] == p.scene_spec == key_spec(f"chain.{key}")
     assert SCHEMA["chain"]["damping_time"] == "s" and SCHEMA["chain"]["contact_exponent"] is float
-    for key, law in OWNER.items():  # fitting a law's key selects that law
+    for key, laws in OWNER.items():  # fitting a law's key selects its first law
+        law = laws[0]
         p = PARAMETERS[key]
         lo, hi = (p.lo or 1e-3), min(p.hi, (p.lo or 1e-3) * 3)
         unit = "" if p.unit == "1" else f" {p.unit}"

@@ -36,7 +36,7 @@ class ObservationObjective:
 
     def __init__(self, scene: str, params: tuple, observations: tuple, overrides=(), source: str = ""):
         self.scene, self.params, self.observations, self.source = scene, tuple(params), tuple(observations), source
-        self.overrides = list(overrides) + law_overrides(params)
+        self.overrides = list(overrides) + law_overrides(params, overrides)
         keys = {p.key for p in self.params}
         for obs in self.observations:
             for shot in obs.shots():

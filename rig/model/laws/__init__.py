@@ -9,10 +9,10 @@ their parameters from here.
 from __future__ import annotations
 
 from rig.errors import invalid, lookup
-from rig.model.laws import dashpot, hertz, kuwabara_kono, powerlaw_dashpot
-from rig.model.laws.law import HERTZ, KUWABARA_KONO, POWER, ContactLaw, LawParameter, ViscousTerms
+from rig.model.laws import dashpot, hertz, kuwabara_kono, powerlaw_dashpot, thornton
+from rig.model.laws.law import HERTZ, KUWABARA_KONO, PLASTIC, POWER, ContactLaw, LawParameter, ViscousTerms
 
-LAWS = (hertz.LAW, kuwabara_kono.LAW, dashpot.LAW, powerlaw_dashpot.LAW)
+LAWS = (hertz.LAW, kuwabara_kono.LAW, dashpot.LAW, powerlaw_dashpot.LAW, thornton.LAW)
 
 CONTACT_LAWS: dict[str, ContactLaw] = {law.name: law for law in LAWS}
 
@@ -20,11 +20,13 @@ PARAMETERS: dict[str, LawParameter] = {p.key: p for p in tuple(
     q for law in LAWS for q in law.parameters) + hertz.ELASTIC_PARAMETERS}
 """Every law's parameters by scene key (chain.<key>): each law's own, then the elastic ones."""
 
-OWNER: dict[str, ContactLaw] = {p.key: law for law in LAWS for p in law.parameters}
-"""The law each law-specific parameter belongs to."""
+OWNER: dict[str, tuple] = {p.key: tuple(law for law in LAWS if p in law.parameters)
+                           for p in (q for law in LAWS for q in law.parameters)}
+"""The laws each law-specific parameter belongs to (a dashpot's coefficient: the dashpot's and
+the elastic-plastic law's)."""
 
 __all__ = ["CONTACT_LAWS", "ContactLaw", "HERTZ", "KUWABARA_KONO", "LAWS", "LawParameter", "OWNER", "PARAMETERS",
-           "POWER", "ViscousTerms", "contact_law", "law_values"]
+           "PLASTIC", "POWER", "ViscousTerms", "contact_law", "law_values"]
 
 
 def contact_law(name) -> ContactLaw:
@@ -40,11 +42,12 @@ def law_values(law: ContactLaw, given: dict) -> dict:
         if key not in PARAMETERS:
             raise invalid("chain", key, f"not a contact parameter; known: {', '.join(PARAMETERS)}")
     values = {key: (p.read(given[key]) if key in given else p.default) for key, p in PARAMETERS.items()}
-    for key, other in OWNER.items():
+    for key, owners in OWNER.items():
         p = PARAMETERS[key]
-        if other is not law and values[key] != p.default:
-            raise invalid(p.field, values[key], f"belongs to contact law {other.name!r}, not {law.name!r}; "
+        if law not in owners and values[key] != p.default:
+            names = " or ".join(repr(o.name) for o in owners)
+            raise invalid(p.field, values[key], f"belongs to contact law {names}, not {law.name!r}; "
                                                 f"leave it {p.default:g}")
-        if other is law and p.switch and values[key] == 0:
+        if p.switch and values[key] == 0 and p.key == law.parameter:
             raise invalid(p.field, values[key], f"contact law {law.name!r} needs it > 0")
     return values

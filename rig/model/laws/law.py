@@ -19,10 +19,12 @@ from rig.units import number, quantity
 # The kernels' code of a chain's contact forces (rig/solver/kernels/forces.py), chosen from
 # its contacts (rig/solver/problem.py), not named by users: HERTZ, every contact elastic
 # Hertz; KUWABARA_KONO, every contact Hertz with viscous terms (Kuwabara-Kono's and/or a
-# dashpot), vectorised; POWER, any exponent per contact (scalar: a pow per contact).
+# dashpot), vectorised; POWER, any exponent per contact (scalar: a pow per contact);
+# PLASTIC, contacts that yield and remember it (rig.model.laws.thornton; scalar, stateful).
 HERTZ = 0
 KUWABARA_KONO = 1
 POWER = 2
+PLASTIC = 3
 
 
 @dataclass(frozen=True)
@@ -93,13 +95,16 @@ class ContactLaw:
     """A contact law between neighbours: what ``chain.contact_law`` names. ``parameters``:
     its own (the elastic part's, every law's, are rig.model.laws.hertz.ELASTIC_PARAMETERS);
     ``viscous``: its ViscousTerms from the chain's parameter values ({key: SI value});
-    ``code``: the kernels' code of its path with Hertz's exponent."""
+    ``code``: the kernels' code of its path with Hertz's exponent; ``yielding``: its
+    rig.model.laws.thornton.YieldTerms from the values (None: a law whose contacts never
+    yield)."""
 
     name: str
     description: str
     parameters: tuple
     viscous: Callable[[dict], ViscousTerms]
     code: int
+    yielding: Callable | None = None
 
     @property
     def dissipative(self) -> bool:

@@ -8,4 +8,4 @@ so that every body sees ``f[i] - f[i+1]`` with no special case at the ends.
 """
 from instruments.jit import drop_stale_cache
 
-drop_stale_cache(__name__, constants=("rig.model.contact",))
+drop_stale_cache(__name__, constants=("rig.model.contact", "rig.model.laws.law", "rig.model.laws.thornton"))
