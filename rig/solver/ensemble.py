@@ -17,7 +17,7 @@ from rig.errors import RigError, invalid
 from rig.solver.kernels.ensemble import integrate_ensemble
 from rig.solver.methods import DEFAULT_METHOD
 from rig.solver.methods import method as get_method
-from rig.solver.problem import CONTACT_ROWS, ProblemArrays
+from rig.solver.problem import CONTACT_ROWS, STATE_ROWS, ProblemArrays
 from rig.solver.run import check_interval, check_record, time_grid
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import DIAGNOSTICS, KernelReport, SolverStats, Status
@@ -121,10 +121,11 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
     diag = np.zeros((n_chunks, DIAGNOSTICS, width))
     u, v = stack("u0"), stack("v0")
     con = np.ascontiguousarray(np.stack([stack(k) for k in CONTACT_ROWS], axis=1))
+    state = np.ascontiguousarray(np.stack([stack(k) for k in STATE_ROWS], axis=1))  # the contacts' memory
     onsite = np.ascontiguousarray(np.stack([stack(k) for k in ("drag", "friction")], axis=1))
     t0 = time.perf_counter()
     integrate_ensemble(u, v, stack("mass"), stack("invm"), stack("bias"), stack("load"), stack("A"),
-                       stack("d0"), problems.law, con, onsite, p0.slip_speed, viscous_rate(problems),
+                       stack("d0"), problems.law, con, state, onsite, p0.slip_speed, viscous_rate(problems),
                        np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head, sub,
                        ch_slot, ch_weight, save.sample_interval, out,
                        check_interval(n_steps), stack("d_limit"), p0.wall_slot,

@@ -78,6 +78,8 @@ class ProblemArrays(_ContactCodes):
     yield_overlap: np.ndarray
     plastic_work: np.ndarray
     reference_yield_overlap: np.ndarray
+    elastic_limit: np.ndarray
+    last_overlap: np.ndarray
     d_limit: np.ndarray
     drag: np.ndarray
     friction: np.ndarray
@@ -132,6 +134,7 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     F_c = static_forces_of(bodies, chain.gravity, top)
     state_c, d_c, _ = chain.contact_memory(A_c, F_c)
     state = np.zeros((len(STATE_ROWS), S, nb))
+    state[STATE_ROWS.index("elastic_limit")] = np.inf  # a slot of no contact never yields
     A, d0, f0 = np.zeros((S, nb)), np.zeros((S, nb)), np.zeros((S, nb))
     expo, damping, dashpot = np.full((S, nb), 1.5), np.zeros((S, nb)), np.zeros((S, nb))
     dashpot_exponent = np.ones((S, nb))
@@ -209,7 +212,8 @@ class ChainProblem(_ContactCodes):
     (alpha, 1: linear), yield_rate_exponent and yield_reference_rate (m/s) of a yielding
     contact, its memory before the shot (STATE_ROWS: permanent_overlap (m),
     unloading_constant (N/m^n, A where as new), largest_rate (m/s), yield_overlap (m),
-    plastic_work (J), reference_yield_overlap (m; 0: it never yields); rig.model.laws.thornton),
+    plastic_work (J), reference_yield_overlap (m; 0: it never yields), elastic_limit (m; inf: it
+    never yields), last_overlap (m); rig.model.laws.thornton),
     d_limit (m, an overlap beyond which the integration is declared unstable). u0, v0 the initial state (m, m/s). With a compliant wall the plate
     is a body and the rod the slot below it, to the wall's immovable body.
     """
@@ -235,6 +239,8 @@ class ChainProblem(_ContactCodes):
     yield_overlap: np.ndarray
     plastic_work: np.ndarray
     reference_yield_overlap: np.ndarray
+    elastic_limit: np.ndarray
+    last_overlap: np.ndarray
     d_limit: np.ndarray
     drag: np.ndarray
     friction: np.ndarray
@@ -265,6 +271,11 @@ class ChainProblem(_ContactCodes):
     @property
     def n_bodies(self) -> int:
         return self.mass.shape[0]
+
+    def memory(self) -> np.ndarray:
+        """A fresh copy of the contacts' memory before the shot (STATE_ROWS, bodies): the
+        kernels' ``state``, which they renew in place."""
+        return np.stack([getattr(self, k) for k in STATE_ROWS])
 
     @property
     def slip_speed(self) -> float:

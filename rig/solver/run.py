@@ -92,17 +92,18 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     diag = np.zeros(DIAGNOSTICS)
     check_every = check_interval(n_steps)
 
-    args = (f, problem.mass, invm, problem.bias, load, A, d0, problem.law,
-            np.stack([getattr(problem, k) for k in CONTACT_ROWS]), np.stack((problem.drag, problem.friction)),
+    head = (f, problem.mass, invm, problem.bias, load, A, d0, problem.law,
+            np.stack([getattr(problem, k) for k in CONTACT_ROWS]))
+    args = (np.stack((problem.drag, problem.friction)),
             problem.slip_speed, viscous_rate(problem), np.array(m.drifts), np.array(m.kicks), step)
     mid = (stepping.head, sub)
     tail = (problem.sched_body, problem.sched_t, problem.sched_f,
             ch_slot, ch_weight, save.sample_interval, out, frame_dt, frames,
             check_every, problem.d_limit, problem.wall_slot,
             problem.energy_scale, problem.momentum_scale, diag, front)
-    integrate(u.copy(), v.copy(), *args, 0, *mid, *tail)  # load the compiled kernel before timing
+    integrate(u.copy(), v.copy(), *head, problem.memory(), *args, 0, *mid, *tail)  # load the compiled kernel
     t0 = time.perf_counter()
-    integrate(u, v, *args, n_steps, *mid, *tail)
+    integrate(u, v, *head, problem.memory(), *args, n_steps, *mid, *tail)
     wall = time.perf_counter() - t0
     report = KernelReport.of(diag)
     if report.status is not Status.SUCCESS:

@@ -119,7 +119,7 @@ def head_contacts(p) -> int:
     contacts that close and open at speed, and the head flow resolves those instants."""
     tau = contact_time_scales(p)[1:]
     finite = tau[np.isfinite(tau)]
-    elastic = (p.expo == 1.5) & (p.damping == 0.0) & (p.dashpot == 0.0)  # the head flow's law: Hertz
+    elastic = (p.expo == 1.5) & (p.damping == 0.0) & (p.dashpot == 0.0) & (p.reference_yield_overlap == 0.0)  # Hertz
     if not p.offset or finite.size < 2 * MAX_HEAD or not elastic[1]:
         return 0
     slow = HEAD_RATIO * float(np.median(finite))

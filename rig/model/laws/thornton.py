@@ -15,25 +15,33 @@ are elastic with the enlarged radius and the permanent overlap,
 
 (k_u: Thornton's unloading stiffness 2 E* a_p, the contact radius a_p^2 = a_y^2 (2F* + F_y) /
 (3 F_y); for n = 3/2 this is Thornton's R_p and delta_p exactly). The contact yields again
-where, closing, its elastic curve passes the envelope.
+where its elastic curve meets the envelope (its elastic limit).
 
 The yield rises with the loading rate (polymers: Rae & Dattelbaum, Polymer 45, 7615 (2004);
 a rate-dependent yield in granular chains: Burgoyne & Daraio, Phys. Rev. E 89, 032203
-(2014)): the yield pressure goes as r^m, r the largest closing rate (m/s) the contact has
-seen, so that (p ~ delta^(1/2) at Hertz's yield, F_y = A delta_y^n)
+(2014)): above the reference closing rate r_ref the yield pressure goes as (r / r_ref)^m, r
+the largest closing rate (m/s) the contact has seen, so that (p ~ delta^(1/2) at Hertz's
+yield, F_y = A delta_y^n)
 
-    F_y(r) = F_y (r / r_ref)^(2 n m),   delta_y(r) = delta_y (r / r_ref)^(2 m).
+    F_y(r) = F_y (r / r_ref)^(2 n m),   delta_y(r) = delta_y (r / r_ref)^(2 m)    (r > r_ref);
 
 m = 0: a rate-independent yield. A **static hold** (chain.static_hold seconds of the magnet's
-load before the shot) flattens each contact at its static force with the static yield
-pressure, static_yield_ratio x the yield pressure at the hold's own loading rate r_hold =
-delta_H / t_hold (delta_H the Hertz overlap of the static force): contacts pre-flattened so are
-stiffer, and yield later, under the pulse, which is how precompression changes the
-dissipation.
+load before the shot; the model does not follow creep during it, any hold > 0 counts the same)
+flattens each contact at its static force with the static yield pressure, static_yield_ratio x
+the dynamic one: contacts pre-flattened so are stiffer, and yield later under the pulse, which
+is how precompression changes the dissipation. Without a hold a static force beyond the
+dynamic yield flattens its contact too (the load was put on once).
 
-Energy: between yields the contact is elastic with U = A_p (delta - delta_p)^(n+1) / (n+1); a
-yield at overlap delta moves U_old(delta) - U_new(delta) into plastic work, so that kinetic +
-elastic + plastic work stays the striker's energy to the integrator's error.
+Memory in a step. A contact's memory changes only at step ends (``commit``): inside a step its
+force is a fixed function of the overlap (the elastic curve up to its elastic limit, the
+envelope beyond), so that every stage of the composition sees one conservative force and the
+method keeps its order; a yield (passing the elastic limit) and the closing rate, (overlap -
+last overlap) / step, are taken at the step's end.
+
+Energy: inside a step the contact has the potential plastic_energy; at a commit the potential
+it loses (the envelope's work less the energy left on the new elastic curve) becomes plastic
+work, so that kinetic + elastic + plastic work stays the striker's energy to the integrator's
+error.
 
 The compiled functions below are the kernels' (rig/solver/kernels): a contact's state is its
 column of ``state`` (STATE_ROWS), the same in the single-shot and batched kernels.
@@ -53,26 +61,26 @@ YIELD_FORCE = LawParameter("yield_force", "N", 0.0, float("inf"), 0.0,
                            "force F_y (N) at which a virgin contact yields, closing at the reference rate",
                            switch=True)
 RATE_EXPONENT = LawParameter("yield_rate_exponent", "1", 0.0, 0.5, 0.0,
-                             "exponent m of the yield pressure's rise with the closing rate, p_y ~ r^m "
-                             "(0: a rate-independent yield)")
+                             "exponent m of the yield pressure's rise with the closing rate above the "
+                             "reference rate, p_y ~ (r / r_ref)^m (0: a rate-independent yield)")
 REFERENCE_RATE = LawParameter("yield_reference_rate", "m/s", 0.0, float("inf"), 1.0,
                               "closing rate r_ref (m/s) at which a contact yields at chain.yield_force",
                               lo_open=True)
 STATIC_RATIO = LawParameter("static_yield_ratio", "1", 0.05, 1.0, 1.0,
-                            "static yield pressure over the rate law's at the hold's loading rate "
-                            "(1: the rate law alone)")
+                            "yield pressure of a static hold over the dynamic one (chain.yield_force's)")
 STATIC_HOLD = LawParameter("static_hold", "s", 0.0, float("inf"), 0.0,
                            "seconds the magnet's load is held before the shot, flattening the contacts "
                            "(0: contacts as new)")
 
 STATE_ROWS = ("permanent_overlap", "unloading_constant", "largest_rate", "yield_overlap", "plastic_work",
-              "reference_yield_overlap")
-"""A contact's memory, the rows of the kernels' ``state`` (6, slots): delta_p (m), A_p (N/m^n),
-the largest closing rate seen r (m/s), delta_y(r) (m), the plastic work it has taken in the
-shot (J) and delta_y at r_ref (m; 0: the contact never yields)."""
-DP, AP, RMAX, DY, WORK, DYREF = range(6)
-RATE_FLOOR = 1e-9  # a rate (x r_ref) below which the rate law is held: a yield that stays > 0
-
+              "reference_yield_overlap", "elastic_limit", "last_overlap")
+"""A contact's memory, the rows of the kernels' ``state`` (8, slots): its elastic curve's
+delta_p (m) and A_p (N/m^n), the largest closing rate seen (m/s), delta_y at that rate (m),
+the plastic work it has taken in the shot (J), delta_y at r_ref (m; 0: it never yields), the
+overlap up to which the elastic curve holds (m; inf: it never yields) and the overlap at
+the last step's end (m)."""
+DP, AP, RMAX, DY, WORK, DYREF, DC, DLAST = range(8)
+BISECTIONS = 60  # halvings of the bracket of an elastic limit (2^-60: below a float's spacing)
 
 @dataclass(frozen=True)
 class YieldTerms:
@@ -119,42 +127,99 @@ def unloading(d, F, Fy, dy, n):
 
 
 @jit(inline="always")
-def plastic_force(d, rate, A, n, m, r_ref, state, i, s):
-    """Force (N) of contact i of shot s at overlap d (m) closing at ``rate`` (m/s), its
-    memory in state[:, i, s] (STATE_ROWS) renewed: the largest rate, and where the contact
-    yields (closing, its elastic curve above the envelope) its new elastic curve and the
-    plastic work it took. Elastic A_p (d - d_p)^n otherwise, 0 where d <= d_p."""
-    dp = state[DP, i, s]
-    ap = state[AP, i, s]
-    de = d - dp
-    F = ap * elastic_power(de, n) if de > 0.0 else 0.0
-    dy = state[DY, i, s]
-    if dy > 0.0 and rate > 0.0 and de > 0.0:
-        if rate > state[RMAX, i, s]:
-            state[RMAX, i, s] = rate
-            if m != 0.0:
-                dy = state[DYREF, i, s] * max(rate / r_ref, RATE_FLOOR) ** (2.0 * m)
-                state[DY, i, s] = dy
-        if d > dy:
-            Fy = A * elastic_power(dy, n)
-            env = Fy + n * Fy / dy * (d - dy)
-            if F > env:
-                u_old = F * de / (n + 1.0)
-                dp, ap = unloading(d, env, Fy, dy, n)
-                state[DP, i, s] = dp
-                state[AP, i, s] = ap
-                state[WORK, i, s] += u_old - env * (d - dp) / (n + 1.0)
-                F = env
-    return F
+def envelope(d, A, n, dy):
+    """Force (N) on the loading envelope at overlap d (m): A d^n up to dy, then the tangent line."""
+    if d <= dy:
+        return A * elastic_power(d, n)
+    Fy = A * elastic_power(dy, n)
+    return Fy + n * Fy / dy * (d - dy)
 
 
 @jit(inline="always")
-def plastic_energy(d, n, state, i, s):
-    """Elastic energy (J) A_p (d - d_p)^(n+1) / (n+1) of contact i of shot s at overlap d
-    (m) on its present elastic curve, plus the plastic work it has taken."""
-    de = d - state[DP, i, s]
+def envelope_work(a, b, A, n, dy):
+    """The envelope's work (J) from overlap a to b >= a (m): A x^(n+1) / (n+1) below dy, a
+    trapezoid on the line beyond."""
+    w = 0.0
+    if a < dy:
+        hi = min(b, dy)
+        w += A * (hi * elastic_power(hi, n) - a * elastic_power(a, n)) / (n + 1.0)
+    if b > dy:
+        lo = max(a, dy)
+        w += 0.5 * (envelope(lo, A, n, dy) + envelope(b, A, n, dy)) * (b - lo)
+    return w
+
+
+@jit(inline="always")
+def plastic_force(d, A, n, state, i, s):
+    """Force (N) of contact i of shot s at overlap d (m) by its memory state[:, i, s], which a
+    step holds fixed: its elastic curve A_p (d - d_p)^n up to its elastic limit, the
+    envelope beyond (0 where d <= d_p)."""
+    if d <= state[DC, i, s]:
+        de = d - state[DP, i, s]
+        return state[AP, i, s] * elastic_power(de, n) if de > 0.0 else 0.0
+    return envelope(d, A, n, state[DY, i, s])
+
+
+@jit(inline="always")
+def plastic_energy(d, A, n, state, i, s):
+    """The potential (J) of plastic_force at overlap d (m) for the memory state[:, i, s]:
+    A_p (x - d_p)^(n+1) / (n+1) at x = min(d, elastic limit), plus the envelope's work
+    beyond, plus the plastic work the contact has taken."""
+    dc = state[DC, i, s]
+    de = min(d, dc) - state[DP, i, s]
     u = state[AP, i, s] * de * elastic_power(de, n) / (n + 1.0) if de > 0.0 else 0.0
+    if d > dc:
+        u += envelope_work(dc, d, A, n, state[DY, i, s])
     return u + state[WORK, i, s]
+
+
+@jit(inline="always")
+def elastic_limit(A, n, dp, ap, dy, start):
+    """The overlap (m) from ``start`` on where the elastic curve A_p (x - d_p)^n meets the
+    envelope of yield overlap dy (A, n the contact's elastic law; bisection: the curve
+    is below the envelope at start and, steeper, above it far enough on)."""
+    lo = max(start, dp)
+    step = max(lo - dp, dy)
+    hi = lo + step
+    for _ in range(BISECTIONS):
+        if ap * elastic_power(hi - dp, n) > envelope(hi, A, n, dy):
+            break
+        step *= 2.0
+        hi = lo + step
+    for _ in range(BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        if ap * elastic_power(mid - dp, n) > envelope(mid, A, n, dy):
+            hi = mid
+        else:
+            lo = mid
+    return lo
+
+
+@jit(inline="always")
+def commit(d, dt, A, n, m, r_ref, state, i, s):
+    """Renew the memory of contact i of shot s at a step's end, at overlap d (m), dt (s)
+    after the last: where d passed the elastic limit the contact yielded, its new elastic
+    curve through (d, envelope(d)) and the potential it lost counted as plastic work; where
+    the closing rate (d - last overlap) / dt passes the largest seen and r_ref (m > 0), the
+    yield overlap rises as (rate / r_ref)^(2 m) and the elastic limit with it."""
+    rate = (d - state[DLAST, i, s]) / dt
+    state[DLAST, i, s] = d
+    dy = state[DY, i, s]
+    if d > state[DC, i, s] and d > state[DP, i, s]:
+        lost = plastic_energy(d, A, n, state, i, s) - state[WORK, i, s]
+        F = envelope(d, A, n, dy)
+        dp, ap = unloading(d, F, A * elastic_power(dy, n), dy, n)
+        state[DP, i, s] = dp
+        state[AP, i, s] = ap
+        state[DC, i, s] = d
+        state[WORK, i, s] += lost - F * (d - dp) / (n + 1.0)
+    if m != 0.0 and rate > state[RMAX, i, s]:
+        state[RMAX, i, s] = rate
+        if rate > r_ref:
+            dy_new = state[DYREF, i, s] * (rate / r_ref) ** (2.0 * m)
+            if dy_new > dy:
+                state[DY, i, s] = dy_new
+                state[DC, i, s] = elastic_limit(A, n, state[DP, i, s], state[AP, i, s], dy_new, d)
 
 
 def yield_overlap(A, Fy, n):
@@ -168,32 +233,38 @@ def yield_overlap(A, Fy, n):
 
 
 def initial_state(A, n, F_static, d_static, terms: YieldTerms) -> tuple:
-    """(state, d0, hold_work): the kernels' state (STATE_ROWS, contacts) before the shot, the
-    static overlaps d0 (m) and the plastic work the hold took (J, per contact; before the
-    shot, so not in the shot's energy), for contacts of constants A (N/m^n), exponents n,
-    static forces F_static (N) and elastic static overlaps d_static (m). Without a hold the
-    contacts are as new (A_p = A, delta_p = 0) at d_static; with one, each contact loaded
-    past its static yield (static_ratio x the rate law's pressure at the hold's rate
-    r_hold = d_static / hold) rests flattened on its elastic curve through (delta*, F_static),
-    at delta* > d_static."""
+    """(state, d0, hold_work): the kernels' memory (STATE_ROWS, contacts) before the shot,
+    the static overlaps d0 (m) and the plastic work (J, per contact) the static load took
+    (before the shot: not in its energy), for contacts of constants A (N/m^n), exponents n,
+    static forces F_static (N) and elastic static overlaps d_static (m).
+
+    A contact whose static force passes its yield force was flattened as the load went on:
+    it rests on its elastic curve through (delta*, F_static) on the envelope, at delta* >
+    d_static. The yield is chain.yield_force's; after a static hold (terms.hold > 0 s) the
+    static one, static_ratio x its pressure (the yield overlap x ratio^2, the force x
+    ratio^(2n)). The others are as new (A_p = A, delta_p = 0) at d_static. Each yields
+    again where its curve meets the envelope of chain.yield_force (elastic_limit)."""
     A, n, F, d0 = (np.array(x, float) for x in np.broadcast_arrays(A, n, F_static, d_static))
     state = np.zeros((len(STATE_ROWS),) + A.shape)
     dy = yield_overlap(A, terms.yield_force, n)
     state[AP], state[DY], state[DYREF] = A, dy, dy
+    state[DC] = np.where(dy > 0, dy, np.inf)
     work = np.zeros(A.shape)
-    if terms.hold > 0 and terms.yield_force > 0:
-        rate = np.maximum(d0 / terms.hold / terms.reference_rate, RATE_FLOOR)
-        dys = dy * terms.static_ratio**2 * rate ** (2.0 * terms.rate_exponent)
-        flat = (dys > 0) & (F > A * np.where(dys > 0, dys, 0.0) ** n)
-        if np.any(flat):
-            a, m, f, y = A[flat], n[flat], F[flat], dys[flat]
-            fy = a * y**m
-            ky = m * fy / y
-            d_star = y + (f - fy) / ky
-            de = m * f / (ky * np.sqrt((2.0 * f + fy) / (3.0 * fy)))
-            state[DP][flat], state[AP][flat] = d_star - de, f / de**m
-            work[flat] = a * y**(m + 1.0) / (m + 1.0) + 0.5 * (fy + f) * (d_star - y) - f * de / (m + 1.0)
-            d0[flat] = d_star
+    dys = dy * (terms.static_ratio**2 if terms.hold > 0 else 1.0)
+    flat = (dys > 0) & (F > A * dys**n)
+    if np.any(flat):
+        a, m, f, y, yd = A[flat], n[flat], F[flat], dys[flat], dy[flat]
+        fy = a * y**m
+        ky = m * fy / y
+        d_star = y + (f - fy) / ky
+        de = m * f / (ky * np.sqrt((2.0 * f + fy) / (3.0 * fy)))
+        dp, ap = d_star - de, f / de**m
+        state[DP][flat], state[AP][flat] = dp, ap
+        state[DC][flat] = [elastic_limit(float(x), float(k), float(p), float(q), float(z), float(w))
+                           for x, k, p, q, z, w in zip(a, m, dp, ap, yd, d_star)]
+        work[flat] = a * y**(m + 1.0) / (m + 1.0) + 0.5 * (fy + f) * (d_star - y) - f * de / (m + 1.0)
+        d0[flat] = d_star
+    state[DLAST] = d0
     return state, d0, work
 
 

@@ -10,7 +10,9 @@ end) and E the flow of dv/dt = what dissipates, at fixed positions:
 
 - each closed contact's viscous force g = c d' (c = mu + A tau d^(n-1),
   forces.viscous_coefficient), never more pulling than the elastic force pushes
-  (g >= -A d^n, so the whole contact force never attracts), taken by explicit midpoint
+  (g >= -A d^n, so the whole contact force never attracts; a contact with memory, PLASTIC,
+  is closed while d > d_p and pushes rig.model.laws.thornton.plastic_force), taken by explicit
+  midpoint
   (second-order Runge-Kutta) substeps short enough to be stable (``substeps``);
 - with a power-law dashpot (exponent alpha != 1), g = A tau d^(n-1) d' + mu |d'|^alpha
   sgn d', whose coefficient c = A tau d^(n-1) + mu |d'|^(alpha-1) depends on the rate and,
@@ -38,6 +40,8 @@ import math
 import numpy as np
 
 from instruments.jit import jit
+from rig.model.contact import PLASTIC
+from rig.model.laws.thornton import DP, plastic_force
 from rig.solver.kernels.forces import power, viscous_coefficient
 
 
@@ -118,7 +122,7 @@ def _viscous_power(v, c, dash, alpha, im, h, el, g, w, m):
 
 
 @jit
-def _contacts(u, v, invm, A, d0, con, t, n, wall_slot, work, j_wall):
+def _contacts(u, v, invm, A, d0, con, law, state, t, n, wall_slot, work, j_wall):
     """V(t): n explicit midpoint substeps of the contacts' viscous flow; j_wall[s] += the
     viscous impulse on the wall (N s). work: (5, bodies + 1, shots). The (bodies, shots)
     arrays are C-contiguous and taken flat, row after row, so that the loops vectorise."""
@@ -146,6 +150,13 @@ def _contacts(u, v, invm, A, d0, con, t, n, wall_slot, work, j_wall):
             d = d0f[k] + uf[k - w] - uf[k]
             c[k] = viscous_coefficient(d, Af[k], ex[k], tau[k], mu[k])
             el[k] = Af[k] * power(d, ex[k]) if d > 0.0 else 0.0
+    if law == PLASTIC:  # closed while d > d_p, pushing thornton.plastic_force (a dashpot alone: tau = 0)
+        for i in range(1, nb):
+            for s in range(W):
+                d = d0[i, s] + u[i - 1, s] - u[i, s]
+                k = i * W + s
+                c[k] = mu[k] if d > state[DP, i, s] else 0.0
+                el[k] = plastic_force(d, A[i, s], con[0, i, s], state, i, s)
     if nonlinear:  # c: Kuwabara-Kono's part alone, the dashpots apart
         for k in range(w, np.uint64(m)):
             d = d0f[k] + uf[k - w] - uf[k]
@@ -193,13 +204,14 @@ def _book(v, mass, sign, lost, j_holder):
 
 
 @jit
-def dissipate(u, v, mass, invm, A, d0, con, hold, slip, viscous, holder, rate, t, wall_slot, work, lost, j_wall,
-              j_holder):
+def dissipate(u, v, mass, invm, A, d0, con, law, state, hold, slip, viscous, holder, rate, t, wall_slot, work, lost,
+              j_wall, j_holder):
     """E(t) (module doc) on every shot: lost[s] += the kinetic energy it takes (J),
     j_wall[s] += its impulse on the wall, j_holder[s] += the holder's impulse (N s).
     viscous: whether any contact has viscous terms; holder: whether any body has drag or
     friction; rate: the bound of ``substeps``; hold: holder_factors(onsite, t, viscous)
-    (H(t/2) V(t) H(t/2) with viscous contacts, else E(t) = H(t), one pass)."""
+    (H(t/2) V(t) H(t/2) with viscous contacts, else E(t) = H(t), one pass); law, state: the
+    contacts' code and memory (PLASTIC: closed while d > d_p)."""
     if not viscous:
         _holder(v, mass, hold, slip, t, lost, j_holder)
         return
@@ -208,7 +220,7 @@ def dissipate(u, v, mass, invm, A, d0, con, hold, slip, viscous, holder, rate, t
     _book(v, mass, 1.0, lost, j_holder)
     for s in range(v.shape[1]):  # the contacts' flow conserves momentum but for the wall's share
         j_holder[s] -= j_wall[s]
-    _contacts(u, v, invm, A, d0, con, t, substeps(t, rate), wall_slot, work, j_wall)
+    _contacts(u, v, invm, A, d0, con, law, state, t, substeps(t, rate), wall_slot, work, j_wall)
     for s in range(v.shape[1]):
         j_holder[s] += j_wall[s]
     _book(v, mass, -1.0, lost, j_holder)

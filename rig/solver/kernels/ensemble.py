@@ -18,9 +18,10 @@ import numpy as np
 from numba import prange
 
 from instruments.jit import jit
-from rig.model.contact import HERTZ, POWER
+from rig.model.contact import HERTZ, PLASTIC, POWER
+from rig.model.laws.thornton import WORK, plastic_force
 from rig.solver.kernels.dissipation import dissipate, holder_factors
-from rig.solver.kernels.forces import contact_force, power, state_sums
+from rig.solver.kernels.forces import contact_force, plastic_commit, plastic_contact, power, state_sums
 from rig.solver.kernels.integrators import rest_from, still_from
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
@@ -48,22 +49,28 @@ def _power_row(u, A, d0, load, f, i, expo):
 
 
 @jit
-def _other_laws(u, A, d0, load, f, expo, law, lo, hi):
-    """POWER: slots lo.. whose exponent is not 3/2 renewed by their own law, after a pass
-    renewed every slot as Hertz's from the same positions (no pass reads a slot's force
-    after renewing it, so this is the same as renewing them in the pass). Apart from the
-    pass: inlined in its loop, this branch kept numba's atomic reference counts there (6%
-    of the pass)."""
+def _other_laws(u, A, d0, load, f, con, state, law, lo, hi):
+    """POWER: slots lo.. whose exponent is not 3/2 renewed by their own law; PLASTIC: every
+    slot lo.. by the elastic-plastic law of its memory ``state`` (forces.plastic_pass's
+    operations); after a pass renewed every slot as Hertz's from the same positions (no pass
+    reads a slot's force after renewing it, so this is the same as renewing them in the
+    pass). Apart from the pass: inlined in its loop, this branch kept numba's atomic
+    reference counts there (6% of the pass)."""
     if law == POWER:
         for i in range(max(lo, 1), hi):
-            _power_row(u, A, d0, load, f, i, expo)
+            _power_row(u, A, d0, load, f, i, con[0])
+    elif law == PLASTIC:
+        for i in range(max(lo, 1), hi):
+            for s in range(u.shape[1]):
+                f[i, s] = plastic_force(d0[i, s] + u[i - 1, s] - u[i, s], A[i, s], con[0, i, s], state, i, s) \
+                    - load[i, s]
 
 
 @jit
-def _forces(u, A, d0, load, f, law, expo):
+def _forces(u, A, d0, load, f, law, con, state):
     for i in range(1, u.shape[0]):
         _contact_row(u, A, d0, load, f, i)
-    _other_laws(u, A, d0, load, f, expo, law, 1, u.shape[0])
+    _other_laws(u, A, d0, load, f, con, state, law, 1, u.shape[0])
 
 
 @jit
@@ -93,8 +100,8 @@ def _kick_drift(u, v, invm, f, hb, ha, head, reach):
 
 
 @jit
-def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_work, h_busy, law, expo,
-                       reach):
+def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_work, h_busy, law, con,
+                       state, reach):
     """_kick_drift (and the head's flow) then _forces in one pass over rows 0..reach-1 (the
     others at rest bit for bit, integrators.integrate's front): row i is kicked and drifted
     (reading f[i], f[i+1], not yet renewed), then contact i is renewed from rows i-1 and i
@@ -108,17 +115,17 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
         _kick_drift_row(u, v, invm, f, hb, ha, i)
         if i >= 1:
             _contact_row(u, A, d0, load, f, i)
-    _other_laws(u, A, d0, load, f, expo, law, start, reach)
+    _other_laws(u, A, d0, load, f, con, state, law, start, reach)
 
 
 @jit
-def _record(out, lo, j0, nj, w, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new):
+def _record(out, lo, j0, nj, w, x, ch_slot, ch_weight, A, law, con, state, d_old, r_old, d_new, r_new):
     """out[lo + s, c, j0 + m] for m < nj: channel c's force (N) of every shot s of the chunk
     (its last ones may be fill, not in out) at the step's m-th sample, at fraction x[m] of
     the step, whose Hermite weights are column m of w: record.recorded_force's operations,
     in its order (0 + the first term is that term: no force is -0). The samples of a step
     are innermost: the Hertz loop vectorises over them, and each shot's channel is written
-    as one contiguous run of its record."""
+    as one contiguous run of its record. ``state``: the contacts' memory (PLASTIC)."""
     n_ch = ch_slot.shape[0]
     for s in range(min(d_old.shape[2], out.shape[0] - lo)):
         for c in range(n_ch):
@@ -135,6 +142,10 @@ def _record(out, lo, j0, nj, w, x, ch_slot, ch_weight, A, law, con, d_old, r_old
                         if law == HERTZ:
                             d = d if d > 0.0 else 0.0
                             fk = wk * (a * d * math.sqrt(d))
+                        elif law == PLASTIC:
+                            rate = (1.0 - x[m]) * r0 + x[m] * r1
+                            fc, _ = plastic_contact(d, rate, a, con[0, i, s], con[2, i, s], state, i, s)
+                            fk = wk * fc
                         else:
                             rate = (1.0 - x[m]) * r0 + x[m] * r1
                             fc, _ = contact_force(d, rate, a, con[0, i, s], con[1, i, s], con[2, i, s],
@@ -148,7 +159,7 @@ def _record(out, lo, j0, nj, w, x, ch_slot, ch_weight, A, law, con, d_old, r_old
 
 
 @jit
-def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_rate, a_coef, b_coef, dt, n_steps,
+def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, viscous_rate, a_coef, b_coef, dt, n_steps,
            head, sub, ch_slot, ch_weight, sample_dt, out, lo, check_every, d_limit, wall_slot,
            e_ref, p_ref, diag, f, d_old, r_old, d_new, r_new):
     nb = u.shape[0]
@@ -170,7 +181,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
     for s in range(u.shape[1]):
         f[0, s] = 0.0
         f[nb, s] = -load[nb, s]
-    _forces(u, A, d0, load, f, law, con[0])
+    _forces(u, A, d0, load, f, law, con, state)
     e0 = np.empty(W)
     p0 = np.empty(W)
     e = np.empty(W)
@@ -181,7 +192,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
     w = np.empty((4, int(dt / sample_dt) + 2))  # Hermite weights of the samples of one step
     x = np.empty(w.shape[1])  # their fractions of the step
     h_work, h_busy = np.empty((2, 3, head + 1, W)), np.empty((5 + head, W))  # the head flow's work arrays
-    state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, e0, p0, worst)
+    state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, state, e0, p0, worst)
     for s in range(u.shape[1]):
         net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
     probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, 0.0, head, -1, 0.0, d_old, r_old)
@@ -194,7 +205,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
     if n_out > 0:
         hermite_weights(0.0, dt, w, 0)
         x[0] = 0.0
-        _record(out, lo, 0, 1, w, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_old, r_old)
+        _record(out, lo, 0, 1, w, x, ch_slot, ch_weight, A, law, con, state, d_old, r_old, d_old, r_old)
     j_out = 1
     pending = 0.0
     stepped = 0
@@ -203,7 +214,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
         reach = min(nb, still + n_drift + 2)
         stepped += reach
         if dissipative:  # E(dt/2) S(dt) E(dt/2) (integrators.integrate)
-            dissipate(u, v, mass, invm, A, d0, con, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
+            dissipate(u, v, mass, invm, A, d0, con, law, state, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
                       work, lost, j_visc, j_holder)
         for st in range(n_drift):
             hb = b_coef[st] * dt
@@ -214,7 +225,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
                     j_wall[s] += hb * f[wall_slot, s]
             h = a_coef[st] * dt
             _kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_work, h_busy,
-                               law, con[0], reach)
+                               law, con, state, reach)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1
@@ -227,7 +238,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
         if still < nb:
             still = still_from(u, v, u_rest, still, reach)
         if dissipative:
-            dissipate(u, v, mass, invm, A, d0, con, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
+            dissipate(u, v, mass, invm, A, d0, con, law, state, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
                       work, lost, j_visc, j_holder)
         probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, pending, head, -1, 0.0, d_new, r_new)
         j_end = j_out
@@ -236,12 +247,15 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
         for j in range(j_out, j_end):  # the weights are the same for every shot and channel
             x[j - j_out] = (j * sample_dt - t) / dt
             hermite_weights(x[j - j_out], dt, w, j - j_out)
-        _record(out, lo, j_out, j_end - j_out, w, x, ch_slot, ch_weight, A, law, con, d_old, r_old, d_new, r_new)
+        _record(out, lo, j_out, j_end - j_out, w, x, ch_slot, ch_weight, A, law, con, state, d_old, r_old, d_new,
+                r_new)
+        if law == PLASTIC:  # the contacts' memory renewed at the step's end, after its records
+            plastic_commit(u, A, d0, con, state, dt, reach)
         j_out = j_end
         d_old[:, :, :] = d_new
         r_old[:, :, :] = r_new
         if check:
-            state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, e, pn, worst)
+            state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, state, e, pn, worst)
             for s in range(u.shape[1]):
                 err = abs(e[s] + lost[s] - e0[s]) / e_ref[s]
                 pe = abs(pn[s] - p0[s] - (t_new * net[s] - (j_wall[s] + j_visc[s]) + j_holder[s])) / p_ref[s]
@@ -254,16 +268,19 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_
         diag[4, s] = n_steps
         diag[5, s] = n_steps * dt
         diag[6, s] = lost[s]
+        if law == PLASTIC:  # the contacts' plastic work (integrators.integrate)
+            for i in range(nb):
+                diag[6, s] += state[WORK, i, s]
         diag[7, s] = stepped
 
 
 @jit(parallel=True)
-def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_rate, a_coef, b_coef,
+def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, viscous_rate, a_coef, b_coef,
                        dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
                        e_ref, p_ref, diag):
     """Integrate every shot of the (chunks, bodies, width) arrays in place; con
-    (chunks, 3, bodies, width) and onsite (chunks, 2, bodies, width) as in the single-shot
-    kernel; out is (shots, channels, samples), each shot's record contiguous, chunk k
+    (chunks, 6, bodies, width), state (chunks, 6, bodies, width: the contacts' memory,
+    renewed) and onsite (chunks, 2, bodies, width) as in the single-shot kernel; out is (shots, channels, samples), each shot's record contiguous, chunk k
     holding shots k width .. (k + 1) width - 1 (fill past the last shot); diag is
     (chunks, DIAGNOSTICS, width) as in the single-shot kernel."""
     n_chunks, nb, W = u.shape
@@ -274,6 +291,6 @@ def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, law, con, onsite, sl
         r_old = np.zeros((n_ch, ch_slot.shape[1], W))
         d_new = np.zeros((n_ch, ch_slot.shape[1], W))
         r_new = np.zeros((n_ch, ch_slot.shape[1], W))
-        _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], law, con[k], onsite[k], slip,
+        _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], law, con[k], state[k], onsite[k], slip,
                viscous_rate, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, k * W,
                check_every, d_limit[k], wall_slot, e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)

@@ -6,11 +6,14 @@ A contact at overlap d (m) closing at rate r = d' (m/s) pushes its two bodies ap
     HERTZ          F = A d^(3/2)
     KUWABARA_KONO  F = max(A d^(1/2) (d + tau r) + mu |r|^alpha sgn r, 0)   (Hertz with viscous terms)
     POWER          F = max(A d^(n-1) (d + tau r) + mu |r|^alpha sgn r, 0)   (any exponent n per contact)
+    PLASTIC        F = max(F_p(d, r; memory) + mu r, 0)    (rig.model.laws.thornton, a linear dashpot beside)
 
 for d > 0, and 0 otherwise (rig.model.laws: tau the Kuwabara-Kono damping time, mu a
 dashpot's coefficient, alpha its exponent, 1 for a linear one). Its elastic part is A d^n,
 its energy A d^(n+1) / (n+1); the rest, A tau d^(n-1) r + mu |r|^alpha sgn r, is viscous
-(dissipation.py integrates it). The law code is the problem's
+(dissipation.py integrates it). A PLASTIC contact's elastic part is its present elastic
+curve A_p (d - d_p)^n, which a yield renews (its memory, ``state``: rows
+rig.model.laws.thornton.STATE_ROWS, (rows, slots, shots)). The law code is the problem's
 (rig.solver.problem.kernel_law): the kernels' force passes carry the elastic part, by the
 Hertz loops wherever every exponent is 3/2.
 """
@@ -19,7 +22,8 @@ import math
 import numpy as np
 
 from instruments.jit import jit
-from rig.model.contact import HERTZ, KUWABARA_KONO, POWER
+from rig.model.contact import HERTZ, KUWABARA_KONO, PLASTIC, POWER
+from rig.model.laws.thornton import DP, commit, plastic_energy, plastic_force
 
 
 @jit(inline="always")
@@ -72,6 +76,36 @@ def contact_force(d, rate, A, n, tau, mu, alpha, law):
     return (fi if fi > 0.0 else 0.0), el
 
 
+@jit
+def plastic_pass(u, A, d0, load, f, expo, state, lo, hi):
+    """Renew slots lo..hi-1 (lo >= 1) of one shot by the elastic-plastic law, f[i] =
+    F_p(d) - load[i] (thornton.plastic_force: the memory state (rows, bodies, 1) held
+    through the step), after a Hertz pass renewed every slot from the same positions, as
+    other_law."""
+    for i in range(lo, hi):
+        f[i] = plastic_force(d0[i] + u[i - 1] - u[i], A[i], expo[i], state, i, 0) - load[i]
+
+
+@jit
+def plastic_commit(u, A, d0, con, state, dt, hi):
+    """Renew the memory of slots 1..hi-1 of every shot at a step's end, dt (s) after the
+    last (thornton.commit; arrays (bodies, shots), con (rows, bodies, shots))."""
+    for i in range(1, hi):
+        for s in range(u.shape[1]):
+            commit(d0[i, s] + u[i - 1, s] - u[i, s], dt, A[i, s], con[0, i, s], con[4, i, s], con[5, i, s],
+                   state, i, s)
+
+
+@jit(inline="always")
+def plastic_contact(d, rate, A, n, mu, state, i, s):
+    """(F, its elastic-plastic part) (N) of a PLASTIC contact (module doc): the part by
+    thornton.plastic_force, a dashpot mu r beside it while closed (d > d_p), never
+    attractive."""
+    el = plastic_force(d, A, n, state, i, s)
+    fi = el + (mu * rate if d > state[DP, i, s] else 0.0)
+    return (fi if fi > 0.0 else 0.0), el
+
+
 @jit(inline="always")
 def elastic_energy(d, A, n):
     """A d^(n+1) / (n+1) (J) for d > 0, else 0: (2/5) A d^(5/2) for Hertz."""
@@ -103,27 +137,32 @@ def viscous_coefficient(d, A, n, tau, mu):
 
 
 @jit
-def elastic_forces(u, A, d0, load, f, law, expo):
+def elastic_forces(u, A, d0, load, f, law, con, state):
     """Fill f[1:nb] with the dynamic elastic contact forces (N): A d^n minus ``load``.
 
     load[i] is the constant external force carried from above through slot i (the weight
     and magnet force of bodies 0..i-1), so that body i is pushed by f[i] - f[i+1] alone
     (its own constant load is load[i+1] - load[i]) and a chain at rest has f = 0.
     Hertz: A d^(3/2), d = max(d0[i] + u[i-1] - u[i], 0), branch-free so that LLVM
-    vectorises the square roots; POWER: that pass, then other_law's.
+    vectorises the square roots; POWER: that pass, then other_law's; PLASTIC: that pass, then
+    plastic_pass's (con: the slots' CONTACT_ROWS, state their memory, (rows, bodies, 1)).
     """
     hertz_forces(u, A, d0, load, f)
     if law == POWER:
-        other_law(u, A, d0, load, f, expo, 1, u.shape[0])
+        other_law(u, A, d0, load, f, con[0], 1, u.shape[0])
+    elif law == PLASTIC:
+        plastic_pass(u, A, d0, load, f, con[0], state, 1, u.shape[0])
 
 
 @jit(error_model="numpy")  # a division by zero gives inf (no check per element, which stops vectorising)
-def state_sums(u, v, mass, bias, A, expo, d0, d_limit, law, e, p, w):
+def state_sums(u, v, mass, bias, A, expo, d0, d_limit, law, state, e, p, w):
     """Each shot's energy e (J), momentum p (kg m/s) and largest d / d_limit w (> 1: an
     overlap no real contact reaches; inf for nan), arrays (bodies, shots), in two passes:
 
         E = sum m v^2 / 2 + sum A d^(n+1) / (n+1) - sum m b u,   P = sum m v,
 
+    (PLASTIC: each contact's potential plus the plastic work it took, thornton.plastic_energy
+    of its memory ``state``)
     m b each body's constant external force (gravity, the magnet's force at t = 0); the
     wall (mass 0 here) counts for neither. An open contact adds +0, which leaves a sum
     unchanged. Where every exponent is 3/2 (law not POWER) the loop over the shots
@@ -138,7 +177,10 @@ def state_sums(u, v, mass, bias, A, expo, d0, d_limit, law, e, p, w):
             e[s] += 0.5 * mass[i, s] * v[i, s] * v[i, s] - mass[i, s] * bias[i, s] * u[i, s]
             p[s] += mass[i, s] * v[i, s]
     for i in range(1, nb):
-        if law != POWER:  # the exponent a literal: no branch on the data, the loop vectorises
+        if law == PLASTIC:
+            for s in range(u.shape[1]):
+                e[s] += plastic_energy(d0[i, s] + u[i - 1, s] - u[i, s], A[i, s], expo[i, s], state, i, s)
+        elif law != POWER:  # the exponent a literal: no branch on the data, the loop vectorises
             for s in range(u.shape[1]):
                 e[s] += elastic_energy(d0[i, s] + u[i - 1, s] - u[i, s], A[i, s], 1.5)
         else:

@@ -37,8 +37,10 @@ balance E(t) + dissipated = E(0) closes to the method's own error.
 import numpy as np
 
 from instruments.jit import jit
+from rig.model.contact import PLASTIC
+from rig.model.laws.thornton import WORK
 from rig.solver.kernels.dissipation import dissipate, holder_factors
-from rig.solver.kernels.forces import elastic_forces, state_sums
+from rig.solver.kernels.forces import elastic_forces, plastic_commit, state_sums
 from rig.solver.kernels.record import hermite, hermite_weights, probe_overlaps, recorded_force
 from rig.solver.kernels.step import closing_kick, external_kick, schedule_force, step
 
@@ -72,7 +74,7 @@ def still_from(u, v, u_rest, lo, hi):
 
 
 @jit
-def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, viscous_rate,
+def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, viscous_rate,
               a_coef, b_coef, dt, n_steps, head, sub,
               sched_body, sched_t, sched_f,
               ch_slot, ch_weight, sample_dt, out,
@@ -82,8 +84,10 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, vi
 
     f (size nb + 1): the contact forces' work array (layout.working_arrays places it with
     u, v and the parameters the passes read).
-    law: the contact code (forces.py) with con (4, nb): each slot's exponent, damping
-    time (s), dashpot coefficient and dashpot exponent (rig.solver.problem.CONTACT_ROWS);
+    law: the contact code (forces.py) with con (6, nb): each slot's exponent, damping
+    time (s), dashpot coefficient and exponent, yield rate exponent and reference rate (m/s)
+    (rig.solver.problem.CONTACT_ROWS); state (8, nb): each slot's memory
+    (rig.model.laws.thornton.STATE_ROWS), renewed in place (PLASTIC only);
     onsite (2, nb): each body's drag rate (1/s) and friction
     deceleration (m/s^2), smoothed over slip (m/s); viscous_rate (1/s): a bound on the
     contacts' viscous decay rates (dissipation.substeps).
@@ -112,7 +116,8 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, vi
         holder = holder or onsite[0, i] != 0.0 or onsite[1, i] != 0.0
     dissipative = viscous or holder
 
-    elastic_forces(u, A, d0, load, f, law, con[0])
+    state3 = state.reshape((state.shape[0], nb, 1))
+    elastic_forces(u, A, d0, load, f, law, con, state3)
     # (bodies, 1) views for the multirate head, the records and the dissipation (shared with the batched kernel)
     heads = (u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1)),
              A.reshape((nb, 1)), d0.reshape((nb, 1)), load.reshape((nb + 1, 1)))
@@ -128,7 +133,8 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, vi
     net_const = load[nb] - wall_load
     sums = np.empty(3)  # energy (J), momentum (kg m/s), largest d / d_limit of one state
     m2, b2, dl2 = mass.reshape((nb, 1)), bias.reshape((nb, 1)), d_limit.reshape((nb, 1))
-    state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, law, sums[0:1], sums[1:2], sums[2:3])
+    state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, law, state3, sums[0:1], sums[1:2],
+               sums[2:3])
     e0, p0 = sums[0], sums[1]
     impulses = np.zeros(2)  # the wall's dynamic impulse, the schedule's (N s)
     w_sched = 0.0
@@ -146,7 +152,8 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, vi
     if n_out > 0:
         hermite_weights(0.0, dt, w, 0)
         for c in range(n_ch):
-            out[c, 0] = recorded_force(w, 0, 0.0, c, 0, ch_slot, ch_weight, A2, con3, law, d_old, r_old, d_old, r_old)
+            out[c, 0] = recorded_force(w, 0, 0.0, c, 0, ch_slot, ch_weight, A2, con3, law, state3, d_old, r_old,
+                                       d_old, r_old)
     j_out = 1
     u_old = np.empty(nb if n_frames > 0 else 0)
     v_old = np.empty(nb if n_frames > 0 else 0)
@@ -171,11 +178,11 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, vi
             us_old = u[sched_body]
             fe_old = schedule_force(t, sched_t, sched_f)
         if dissipative:  # E(dt/2) S(dt) E(dt/2): each step ends synchronised
-            dissipate(u2, v2, m2, im2, A2, d02, con3, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
-                      work, lost, j_visc, j_holder)
+            dissipate(u2, v2, m2, im2, A2, d02, con3, law, state3, hold, slip, viscous, holder, viscous_rate, 0.5 * dt,
+                      wall_slot, work, lost, j_visc, j_holder)
         reach = min(nb, still + n_drift + 2)
         stepped += reach
-        step(u, v, invm, f, A, d0, load, law, con[0], a_coef, b_coef, dt, t, pending, head, sub,
+        step(u, v, invm, f, A, d0, load, law, con, state3, a_coef, b_coef, dt, t, pending, head, sub,
               sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
@@ -189,8 +196,8 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, vi
         if still < nb:
             still = still_from(u2, v2, u_rest, still, reach)
         if dissipative:
-            dissipate(u2, v2, m2, im2, A2, d02, con3, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
-                      work, lost, j_visc, j_holder)
+            dissipate(u2, v2, m2, im2, A2, d02, con3, law, state3, hold, slip, viscous, holder, viscous_rate, 0.5 * dt,
+                      wall_slot, work, lost, j_visc, j_holder)
         if has_sched:
             fe_new = schedule_force(t_new, sched_t, sched_f)
             w_sched += 0.5 * (fe_old + fe_new) * (u[sched_body] - us_old)
@@ -203,9 +210,11 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, vi
             x = (j_out * sample_dt - t) / dt
             hermite_weights(x, dt, w, 0)
             for c in range(n_ch):
-                out[c, j_out] = recorded_force(w, 0, x, c, 0, ch_slot, ch_weight, A2, con3, law,
+                out[c, j_out] = recorded_force(w, 0, x, c, 0, ch_slot, ch_weight, A2, con3, law, state3,
                                                d_old, r_old, d_new, r_new)
             j_out += 1
+        if law == PLASTIC:  # the contacts' memory renewed at the step's end, after its records
+            plastic_commit(u2, A2, d02, con3, state3, dt, reach)
         d_old, d_new = d_new, d_old  # this step's end is the next one's start
         r_old, r_new = r_new, r_old
         while j_frame < n_frames and j_frame * frame_dt <= t_new * (1.0 + 1e-12):
@@ -215,8 +224,8 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, vi
             j_frame += 1
 
         if check:
-            state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, law, sums[0:1], sums[1:2],
-                       sums[2:3])
+            state_sums(heads[0], heads[1], m2, b2, heads[4], con3[0], heads[5], dl2, law, state3, sums[0:1],
+                       sums[1:2], sums[2:3])
             e = sums[0] - w_sched + lost[0]
             err = abs(e - e0) / e_ref
             j_wall = impulses[0] + j_visc[0]
@@ -234,4 +243,7 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, onsite, slip, vi
     diag[4] = steps_done
     diag[5] = steps_done * dt
     diag[6] = lost[0]
+    if law == PLASTIC:  # the contacts' plastic work, which the energy carries, is dissipated too
+        for i in range(nb):
+            diag[6] += state3[WORK, i, 0]
     diag[7] = stepped

@@ -8,11 +8,14 @@ the step each overlap is interpolated by the cubic Hermite polynomial through th
 ends, and the contact law is applied to it. The overlap is smooth in time even where a
 contact closes or opens, so the recorded force keeps the integrator's accuracy there;
 interpolating the force itself would be accurate only to O(h^1.5) in such a step (the
-force grows as (t - t0)^(3/2) from the instant t0 the contact closes).
+force grows as (t - t0)^(3/2) from the instant t0 the contact closes). A contact with
+memory (PLASTIC) is recorded by the law its memory gives through the step, before the
+step's end renews it.
 """
 
 from instruments.jit import jit
-from rig.solver.kernels.forces import contact_force
+from rig.model.contact import PLASTIC
+from rig.solver.kernels.forces import contact_force, plastic_contact
 from rig.solver.kernels.multirate import slow_net
 
 
@@ -62,12 +65,12 @@ def hermite(w, k, y0, r0, y1, r1):
 
 
 @jit
-def recorded_force(w, col, x, c, s, ch_slot, ch_weight, A, con, law, d_old, r_old, d_new, r_new):
+def recorded_force(w, col, x, c, s, ch_slot, ch_weight, A, con, law, state, d_old, r_old, d_new, r_new):
     """Channel c's force (N) in shot s at fraction x of a step, whose Hermite weights are
     column col of w: sum over its contacts of weight x the contact law (forces.contact_force;
     con: (4, bodies, shots) exponents, damping times, dashpots and their exponents) at the
     interpolated overlap d and the rate d' linear in the step (which only a law with
-    viscous terms reads)."""
+    viscous terms reads; ``state``: the contacts' memory, PLASTIC)."""
     y = 0.0
     for k in range(ch_slot.shape[1]):
         wk = ch_weight[c, k]
@@ -75,6 +78,9 @@ def recorded_force(w, col, x, c, s, ch_slot, ch_weight, A, con, law, d_old, r_ol
             i = ch_slot[c, k]
             d = hermite(w, col, d_old[c, k, s], r_old[c, k, s], d_new[c, k, s], r_new[c, k, s])
             rate = (1.0 - x) * r_old[c, k, s] + x * r_new[c, k, s]
-            fk, _ = contact_force(d, rate, A[i, s], con[0, i, s], con[1, i, s], con[2, i, s], con[3, i, s], law)
+            if law == PLASTIC:
+                fk, _ = plastic_contact(d, rate, A[i, s], con[0, i, s], con[2, i, s], state, i, s)
+            else:
+                fk, _ = contact_force(d, rate, A[i, s], con[0, i, s], con[1, i, s], con[2, i, s], con[3, i, s], law)
             y += wk * fk
     return y

@@ -13,8 +13,8 @@ import math
 import numpy as np
 
 from instruments.jit import jit
-from rig.model.contact import POWER
-from rig.solver.kernels.forces import other_law
+from rig.model.contact import PLASTIC, POWER
+from rig.solver.kernels.forces import other_law, plastic_pass
 from rig.solver.kernels.layout import LINE
 from rig.solver.kernels.multirate import head_flow
 
@@ -50,14 +50,16 @@ def external_kick(v, invm, h, t, sched_body, sched_t, sched_f):
 
 
 @jit(inline="always")
-def fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, expo):
+def fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, con, state):
     """Bodies lo..hi-1 (lo >= 1), in order: kick v += hb (f_above - f_below)/m, drift
     u += ha v, then renew contact slot i's elastic force from bodies i-1 and i (both moved;
     forces.elastic_forces' operations). Slot i + 1 is still the old force when body i is
     kicked, so one pass does what a kick-drift pass and a force pass do. ``law``: POWER
     renews the slots whose exponent ``expo`` is not 3/2 again by their own law
     (forces.other_law; no slot's force is read in the pass that renews it, so this is the
-    same as renewing them in the pass), any other code is Hertz's.
+    same as renewing them in the pass), PLASTIC renews every slot by the elastic-plastic law
+    of its memory ``state`` (forces.plastic_pass), any other code is Hertz's (``con``: the
+    slots' CONTACT_ROWS).
 
     The index is unsigned: with a signed start known only at run time numba keeps its
     negative-index wraparound in the loop and LLVM no longer vectorises it
@@ -80,7 +82,9 @@ def fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, expo):
             f[i] = A[i] * d * math.sqrt(d) - load[i]
             u_prev = ui
     if law == POWER:  # not in the loop: a pow there (even behind a branch) stops it vectorising
-        other_law(u, A, d0, load, f, expo, lo, hi)
+        other_law(u, A, d0, load, f, con[0], lo, hi)
+    elif law == PLASTIC:
+        plastic_pass(u, A, d0, load, f, con[0], state, lo, hi)
 
 
 @jit
@@ -100,7 +104,7 @@ BLOCK = 2048  # bodies per block of a step's wavefront (their arrays stay in the
 
 
 @jit(inline="always")
-def step(u, v, invm, f, A, d0, load, law, expo, a_coef, b_coef, dt, t, pending, head, sub,
+def step(u, v, invm, f, A, d0, load, law, con, state, a_coef, b_coef, dt, t, pending, head, sub,
           sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach):
     """One step of the composition (its closing kick owed), bodies 0..reach-1, every stage.
     ``reach``: the bodies beyond it are still at rest and unforced (integrators.rest_from):
@@ -143,5 +147,5 @@ def step(u, v, invm, f, A, d0, load, law, expo, a_coef, b_coef, dt, t, pending, 
                     u[0] += h * v0
                     lo = 1
             if hi > lo:
-                fused_run(u, v, invm, f, A, d0, load, hb, h, lo, hi, law, expo)
+                fused_run(u, v, invm, f, A, d0, load, hb, h, lo, hi, law, con, state)
             ts += h
