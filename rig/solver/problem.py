@@ -80,6 +80,7 @@ class ProblemArrays(_ContactCodes):
     reference_yield_overlap: np.ndarray
     elastic_limit: np.ndarray
     last_overlap: np.ndarray
+    last_rate: np.ndarray
     d_limit: np.ndarray
     drag: np.ndarray
     friction: np.ndarray
@@ -213,7 +214,7 @@ class ChainProblem(_ContactCodes):
     contact, its memory before the shot (STATE_ROWS: permanent_overlap (m),
     unloading_constant (N/m^n, A where as new), largest_rate (m/s), yield_overlap (m),
     plastic_work (J), reference_yield_overlap (m; 0: it never yields), elastic_limit (m; inf: it
-    never yields), last_overlap (m); rig.model.laws.thornton),
+    never yields), last_overlap (m), last_rate (m/s); rig.model.laws.thornton),
     d_limit (m, an overlap beyond which the integration is declared unstable). u0, v0 the initial state (m, m/s). With a compliant wall the plate
     is a body and the rod the slot below it, to the wall's immovable body.
     """
@@ -241,6 +242,7 @@ class ChainProblem(_ContactCodes):
     reference_yield_overlap: np.ndarray
     elastic_limit: np.ndarray
     last_overlap: np.ndarray
+    last_rate: np.ndarray
     d_limit: np.ndarray
     drag: np.ndarray
     friction: np.ndarray

@@ -34,9 +34,11 @@ dynamic yield flattens its contact too (the load was put on once).
 
 Memory in a step. A contact's memory changes only at step ends (``commit``): inside a step its
 force is a fixed function of the overlap (the elastic curve up to its elastic limit, the
-envelope beyond), so that every stage of the composition sees one conservative force and the
-method keeps its order; a yield (passing the elastic limit) and the closing rate, (overlap -
-last overlap) / step, are taken at the step's end.
+envelope beyond), so that every stage of the composition sees one conservative force (the
+stages of a composition move off the trajectory and back: a memory renewed at each would
+keep their overshoot); the step's largest overlap (at its end, or the peak of the overlap's
+cubic Hermite interpolant where the contact turned back in the step) and the closing rate are
+taken at the step's end.
 
 Energy: inside a step the contact has the potential plastic_energy; at a commit the potential
 it loses (the envelope's work less the energy left on the new elastic curve) becomes plastic
@@ -73,13 +75,13 @@ STATIC_HOLD = LawParameter("static_hold", "s", 0.0, float("inf"), 0.0,
                            "(0: contacts as new)")
 
 STATE_ROWS = ("permanent_overlap", "unloading_constant", "largest_rate", "yield_overlap", "plastic_work",
-              "reference_yield_overlap", "elastic_limit", "last_overlap")
-"""A contact's memory, the rows of the kernels' ``state`` (8, slots): its elastic curve's
+              "reference_yield_overlap", "elastic_limit", "last_overlap", "last_rate")
+"""A contact's memory, the rows of the kernels' ``state`` (9, slots): its elastic curve's
 delta_p (m) and A_p (N/m^n), the largest closing rate seen (m/s), delta_y at that rate (m),
 the plastic work it has taken in the shot (J), delta_y at r_ref (m; 0: it never yields), the
-overlap up to which the elastic curve holds (m; inf: it never yields) and the overlap at
-the last step's end (m)."""
-DP, AP, RMAX, DY, WORK, DYREF, DC, DLAST = range(8)
+overlap up to which the elastic curve holds (m; inf: it never yields), and the overlap (m)
+and its rate (m/s) at the last step's end."""
+DP, AP, RMAX, DY, WORK, DYREF, DC, DLAST, RLAST = range(9)
 BISECTIONS = 60  # halvings of the bracket of an elastic limit (2^-60: below a float's spacing)
 
 @dataclass(frozen=True)
@@ -156,7 +158,11 @@ def plastic_force(d, A, n, state, i, s):
     envelope beyond (0 where d <= d_p)."""
     if d <= state[DC, i, s]:
         de = d - state[DP, i, s]
-        return state[AP, i, s] * elastic_power(de, n) if de > 0.0 else 0.0
+        if not de > 0.0:
+            return 0.0
+        if n == 1.5:  # (A_p d) sqrt(d): the Hertz passes' operations, their bits as new
+            return state[AP, i, s] * de * math.sqrt(de)
+        return state[AP, i, s] * elastic_power(de, n)
     return envelope(d, A, n, state[DY, i, s])
 
 
@@ -196,30 +202,58 @@ def elastic_limit(A, n, dp, ap, dy, start):
 
 
 @jit(inline="always")
-def commit(d, dt, A, n, m, r_ref, state, i, s):
-    """Renew the memory of contact i of shot s at a step's end, at overlap d (m), dt (s)
-    after the last: where d passed the elastic limit the contact yielded, its new elastic
-    curve through (d, envelope(d)) and the potential it lost counted as plastic work; where
-    the closing rate (d - last overlap) / dt passes the largest seen and r_ref (m > 0), the
-    yield overlap rises as (rate / r_ref)^(2 m) and the elastic limit with it."""
-    rate = (d - state[DLAST, i, s]) / dt
+def hermite_peak(y0, m0, y1, m1):
+    """The largest value of the cubic Hermite polynomial through y0, y1 with slopes m0 > 0 >
+    m1 (per unit of the interval) on [0, 1]: at the one root of its derivative there
+    (bisection), written in y1 - y0 so that the small change of a large overlap keeps its
+    digits."""
+    dy = y1 - y0
+    a = -6.0 * dy + 3.0 * m0 + 3.0 * m1
+    b = 6.0 * dy - 4.0 * m0 - 2.0 * m1
+    lo, hi = 0.0, 1.0
+    for _ in range(BISECTIONS):
+        x = 0.5 * (lo + hi)
+        if (a * x + b) * x + m0 > 0.0:
+            lo = x
+        else:
+            hi = x
+    x = 0.5 * (lo + hi)
+    x2 = x * x
+    return y0 + (3.0 * x2 - 2.0 * x2 * x) * dy + (x2 * x - 2.0 * x2 + x) * m0 + (x2 * x - x2) * m1
+
+
+@jit(inline="always")
+def commit(d, rate, dt, A, n, m, r_ref, state, i, s):
+    """Renew the memory of contact i of shot s at a step's end: overlap d (m), closing rate
+    ``rate`` (m/s), dt (s) after the last. The step's largest overlap: d, or where the
+    contact turned back in the step (closing at its start, opening at its end) the peak of
+    the cubic Hermite through both ends. Where that passed the elastic limit the contact
+    yielded there: its new elastic curve runs through (peak, envelope(peak)), and the
+    potential it lost at d counts as plastic work. Where the closing rate passes the
+    largest seen and r_ref (m > 0), the yield overlap rises as (rate / r_ref)^(2 m) and the
+    elastic limit with it."""
+    d_last, r_last = state[DLAST, i, s], state[RLAST, i, s]
     state[DLAST, i, s] = d
+    state[RLAST, i, s] = rate
+    peak = d
+    if r_last > 0.0 and rate < 0.0:
+        peak = hermite_peak(d_last, r_last * dt, d, rate * dt)
     dy = state[DY, i, s]
-    if d > state[DC, i, s] and d > state[DP, i, s]:
-        lost = plastic_energy(d, A, n, state, i, s) - state[WORK, i, s]
-        F = envelope(d, A, n, dy)
-        dp, ap = unloading(d, F, A * elastic_power(dy, n), dy, n)
+    if peak > state[DC, i, s] and peak > state[DP, i, s]:
+        before = plastic_energy(d, A, n, state, i, s)
+        F = envelope(peak, A, n, dy)
+        dp, ap = unloading(peak, F, A * elastic_power(dy, n), dy, n)
         state[DP, i, s] = dp
         state[AP, i, s] = ap
-        state[DC, i, s] = d
-        state[WORK, i, s] += lost - F * (d - dp) / (n + 1.0)
+        state[DC, i, s] = peak
+        state[WORK, i, s] = before - (plastic_energy(d, A, n, state, i, s) - state[WORK, i, s])
     if m != 0.0 and rate > state[RMAX, i, s]:
         state[RMAX, i, s] = rate
         if rate > r_ref:
             dy_new = state[DYREF, i, s] * (rate / r_ref) ** (2.0 * m)
             if dy_new > dy:
                 state[DY, i, s] = dy_new
-                state[DC, i, s] = elastic_limit(A, n, state[DP, i, s], state[AP, i, s], dy_new, d)
+                state[DC, i, s] = elastic_limit(A, n, state[DP, i, s], state[AP, i, s], dy_new, max(peak, d))
 
 
 def yield_overlap(A, Fy, n):

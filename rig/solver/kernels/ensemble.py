@@ -21,8 +21,9 @@ from instruments.jit import jit
 from rig.model.contact import HERTZ, PLASTIC, POWER
 from rig.model.laws.thornton import WORK, plastic_force
 from rig.solver.kernels.dissipation import dissipate, holder_factors
-from rig.solver.kernels.forces import contact_force, plastic_commit, plastic_contact, power, state_sums
+from rig.solver.kernels.forces import contact_force, plastic_contact, power, state_sums
 from rig.solver.kernels.integrators import rest_from, still_from
+from rig.solver.kernels.memory import plastic_commit
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
 
@@ -250,7 +251,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
         _record(out, lo, j_out, j_end - j_out, w, x, ch_slot, ch_weight, A, law, con, state, d_old, r_old, d_new,
                 r_new)
         if law == PLASTIC:  # the contacts' memory renewed at the step's end, after its records
-            plastic_commit(u, A, d0, con, state, dt, reach)
+            plastic_commit(u, v, invm, f, A, d0, con, state, pending, head, -1, 0.0, dt, reach)
         j_out = j_end
         d_old[:, :, :] = d_new
         r_old[:, :, :] = r_new

@@ -23,7 +23,7 @@ import numpy as np
 
 from instruments.jit import jit
 from rig.model.contact import HERTZ, KUWABARA_KONO, PLASTIC, POWER
-from rig.model.laws.thornton import DP, commit, plastic_energy, plastic_force
+from rig.model.laws.thornton import DP, plastic_energy, plastic_force
 
 
 @jit(inline="always")
@@ -84,16 +84,6 @@ def plastic_pass(u, A, d0, load, f, expo, state, lo, hi):
     other_law."""
     for i in range(lo, hi):
         f[i] = plastic_force(d0[i] + u[i - 1] - u[i], A[i], expo[i], state, i, 0) - load[i]
-
-
-@jit
-def plastic_commit(u, A, d0, con, state, dt, hi):
-    """Renew the memory of slots 1..hi-1 of every shot at a step's end, dt (s) after the
-    last (thornton.commit; arrays (bodies, shots), con (rows, bodies, shots))."""
-    for i in range(1, hi):
-        for s in range(u.shape[1]):
-            commit(d0[i, s] + u[i - 1, s] - u[i, s], dt, A[i, s], con[0, i, s], con[4, i, s], con[5, i, s],
-                   state, i, s)
 
 
 @jit(inline="always")

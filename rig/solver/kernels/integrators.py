@@ -40,7 +40,8 @@ from instruments.jit import jit
 from rig.model.contact import PLASTIC
 from rig.model.laws.thornton import WORK
 from rig.solver.kernels.dissipation import dissipate, holder_factors
-from rig.solver.kernels.forces import elastic_forces, plastic_commit, state_sums
+from rig.solver.kernels.forces import elastic_forces, state_sums
+from rig.solver.kernels.memory import plastic_commit
 from rig.solver.kernels.record import hermite, hermite_weights, probe_overlaps, recorded_force
 from rig.solver.kernels.step import closing_kick, external_kick, schedule_force, step
 
@@ -214,7 +215,7 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, state, onsite, s
                                                d_old, r_old, d_new, r_new)
             j_out += 1
         if law == PLASTIC:  # the contacts' memory renewed at the step's end, after its records
-            plastic_commit(u2, A2, d02, con3, state3, dt, reach)
+            plastic_commit(u2, v2, im2, f2, A2, d02, con3, state3, pending, head, sched_body, fe_new, dt, reach)
         d_old, d_new = d_new, d_old  # this step's end is the next one's start
         r_old, r_new = r_new, r_old
         while j_frame < n_frames and j_frame * frame_dt <= t_new * (1.0 + 1e-12):
