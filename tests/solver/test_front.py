@@ -9,6 +9,7 @@ from rig.solver.ensemble import solve_ensemble
 from rig.solver.kernels.forces import elastic_forces
 from rig.solver.kernels.integrators import rest_from
 from rig.solver.methods import method
+from rig.solver.problem import CONTACT_ROWS
 from rig.solver.run import integrate_at
 from rig.solver.stepsize import Stepping, contact_time_scale, stepping_at
 
@@ -66,7 +67,8 @@ def test_a_chain_at_rest_is_at_rest_bit_for_bit():
         p = ChainProblem.from_chain(chain)
         f = np.zeros(p.n_bodies + 1)
         f[-1] = -p.load[-1]
-        elastic_forces(p.u0.copy(), p.A, p.d0, p.load, f, p.law, p.expo)
+        con = np.stack([getattr(p, k) for k in CONTACT_ROWS])
+        elastic_forces(p.u0.copy(), p.A, p.d0, p.load, f, p.law, con, p.memory()[:, :, None])
         rest = (f[:-1] == f[1:]) | (p.invm == 0)
         assert rest[2:].all(), np.flatnonzero(~rest)
         assert rest_from(p.v0, p.invm, f, 1) <= 2  # the striker (and the magnetic bead it strikes) only

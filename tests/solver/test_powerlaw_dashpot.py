@@ -10,8 +10,10 @@ from conftest import PTFE, record_contacts
 from test_models import _forces, _slope, ptfe_chain
 
 from rig import Bead, Chain, ChainProblem, Wall
+from rig.model.contact import KUWABARA_KONO
 from rig.solver.ensemble import solve_ensemble
 from rig.solver.kernels.dissipation import dissipate
+from rig.solver.problem import CONTACT_ROWS, STATE_ROWS
 from rig.solver.stepsize import contact_time_scale, stepping_at
 
 M, R0 = 1e-4, 0.3  # each bead's mass (kg), the pair's closing rate (m/s)
@@ -24,13 +26,13 @@ def pair_flow(alpha, gamma, t, substeps):
     u, v = np.zeros((2, 1)), np.array([[R0], [0.0]])
     mass = np.full((2, 1), M)
     A, d0 = np.array([[0.0], [1e3]]), np.array([[0.0], [1e-5]])
-    con = np.zeros((4, 2, 1))
+    con = np.zeros((len(CONTACT_ROWS), 2, 1))
     con[0], con[3] = 1.5, 1.0
     con[2, 1, 0], con[3, 1, 0] = gamma, alpha
     hold = np.zeros((2, 2, 1))
     hold[0] = 1.0
     lost, j_wall, j_holder = np.zeros(1), np.zeros(1), np.zeros(1)
-    dissipate(u, v, mass, 1.0 / mass, A, d0, con, hold, 1e-3, True, False, substeps / t, t, 0,
+    dissipate(u, v, mass, 1.0 / mass, A, d0, con, KUWABARA_KONO, np.zeros((len(STATE_ROWS), 2, 1)), hold, 1e-3, True, False, substeps / t, t, 0,
               np.zeros((5, 3, 1)), lost, j_wall, j_holder)
     return v[0, 0] - v[1, 0], lost[0], M * (v[0, 0] + v[1, 0])
 

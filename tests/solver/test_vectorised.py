@@ -9,7 +9,8 @@ import numba
 import numpy as np
 import pytest
 
-from rig.model.contact import HERTZ, KUWABARA_KONO, POWER
+from rig.model.contact import HERTZ, KUWABARA_KONO, PLASTIC, POWER
+from rig.solver.problem import CONTACT_ROWS, STATE_ROWS
 from rig.solver.kernels import dissipation, ensemble, forces, multirate, record, step
 
 
@@ -30,11 +31,15 @@ def _chain(nb=64):
     return u, np.zeros(nb), np.ones(nb), np.zeros(nb + 1), np.full(nb, 1e9), np.full(nb, 1e-7), np.zeros(nb)
 
 
-@pytest.mark.parametrize("law", [HERTZ, KUWABARA_KONO, POWER])
+@pytest.mark.parametrize("law", [HERTZ, KUWABARA_KONO, POWER, PLASTIC])
 def test_the_fused_kick_drift_force_pass_is_vectorised(law):
-    """POWER too: its pass is Hertz's, the slots of another exponent renewed after it."""
+    """POWER and PLASTIC too: their pass is Hertz's, the slots renewed by their own law after it."""
     u, v, invm, f, A, d0, _ = _chain()
-    ir = _llvm(step.fused_run, u, v, invm, f, A, d0, np.zeros(65), 1e-9, 1e-9, 3, 64, law, np.full(64, 1.5))
+    con = np.zeros((len(CONTACT_ROWS), 64))
+    con[0] = 1.5
+    state = np.zeros((len(STATE_ROWS), 64, 1))
+    state[STATE_ROWS.index("elastic_limit")] = np.inf
+    ir = _llvm(step.fused_run, u, v, invm, f, A, d0, np.zeros(65), 1e-9, 1e-9, 3, 64, law, con, state)
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the square roots of the force pass are scalar"
     assert _vector_ops(ir), "no vector arithmetic in the fused pass"
 
@@ -62,7 +67,8 @@ def test_the_batched_pass_runs_its_rows_inline():
     z = np.zeros((nb, W))
     ir = _llvm(ensemble._kick_drift_forces, z, z.copy(), np.ones((nb, W)), np.zeros((nb + 1, W)), np.ones((nb, W)),
                np.full((nb, W), 1e-7), np.zeros((nb + 1, W)), 1e-9, 1e-9, 0, np.array(m.drifts), np.array(m.kicks),
-               1, np.zeros((2, 3, 1, W)), np.zeros((5, W)), HERTZ, np.full((nb, W), 1.5), nb)
+               1, np.zeros((2, 3, 1, W)), np.zeros((5, W)), HERTZ, np.full((len(CONTACT_ROWS), nb, W), 1.5),
+               np.zeros((len(STATE_ROWS), nb, W)), nb)
     called = set(re.findall(r"call [^@]*@\"?([\w.$]+)", ir))
     assert not [name for name in called if "_row" in name], f"row helpers called, not inlined: {called}"
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the batched force rows are scalar"
@@ -102,7 +108,8 @@ def test_the_energy_check_is_vectorised_over_the_shots():
     nb, W = 16, 32
     z = np.zeros((nb, W))
     ir = _llvm(forces.state_sums, z, z.copy(), np.ones((nb, W)), z.copy(), np.ones((nb, W)), np.full((nb, W), 1.5),
-               np.full((nb, W), 1e-7), np.ones((nb, W)), HERTZ, np.zeros(W), np.zeros(W), np.zeros(W))
+               np.full((nb, W), 1e-7), np.ones((nb, W)), HERTZ, np.zeros((len(STATE_ROWS), nb, W)), np.zeros(W),
+               np.zeros(W), np.zeros(W))
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the elastic energies' square roots are scalar"
     assert re.search(r"fdiv <\d+ x double>", ir), "the overlaps' ratios to their limits are scalar"
 
@@ -113,10 +120,10 @@ def test_the_viscous_contacts_flow_is_vectorised():
     nb = 64
     u, v = np.zeros((nb, 1)), np.zeros((nb, 1))
     ones = np.ones((nb, 1))
-    con = np.zeros((3, nb, 1))
-    con[0], con[1] = 1.5, 1e-6
-    ir = _llvm(dissipation._contacts, u, v, ones, 1e9 * ones, 1e-7 * ones, con, 1e-9, 1, nb - 1,
-               np.zeros((4, nb + 1, 1)), np.zeros(1))
+    con = np.zeros((len(CONTACT_ROWS), nb, 1))
+    con[0], con[1], con[3] = 1.5, 1e-6, 1.0
+    ir = _llvm(dissipation._contacts, u, v, ones, 1e9 * ones, 1e-7 * ones, con, HERTZ,
+               np.zeros((len(STATE_ROWS), nb, 1)), 1e-9, 1, nb - 1, np.zeros((5, nb + 1, 1)), np.zeros(1))
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the viscous coefficients' square roots are scalar"
     assert _vector_ops(ir), "no vector arithmetic in the viscous substeps"
     flat = np.zeros(nb + 1)
