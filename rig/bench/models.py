@@ -40,8 +40,6 @@ ON = {  # name: scene overrides switching the model on (values of the order a fi
     "power law n=1.75": ["chain.contact_exponent=1.75"],
     "Kuwabara-Kono 2 us": ["chain.contact_law=kuwabara-kono", "chain.damping_time=2 us"],
     "dashpot 0.5 kg/s": ["chain.contact_law=dashpot", "chain.contact_damping=0.5 kg/s"],
-    "power-law dashpot 0.05, 1/2": ["chain.contact_law=powerlaw-dashpot", "chain.dashpot_gamma=0.05",
-                                    "chain.dashpot_exponent=0.5"],
     "Thornton yield 0.8 N": ["chain.contact_law=thornton", "chain.yield_force=0.8 N"],
     "Thornton 0.8 N + dashpot 0.05 kg/s": ["chain.contact_law=thornton", "chain.yield_force=0.8 N",
                                            "chain.contact_damping=0.05 kg/s"],
