@@ -116,7 +116,8 @@ class Assembly:
                            top_force=self.magnet.top_force() if self.magnet else 0.0,
                            contact_law=c.get("contact_law", "hertz"),
                            **{key: c[key] for key in LAW_PARAMETERS if key in c},
-                           drag=h.drag, friction=h.friction, slip_speed=h.slip_speed)
+                           drag=h.drag, friction=h.friction, slip_speed=h.slip_speed,
+                           hold=self.magnet.held if self.magnet else 0.0)
         if shared("wall_sensor"):
             self.wall_sensor = like.wall_sensor
         elif "wall_sensor" in v:

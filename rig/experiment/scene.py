@@ -36,7 +36,7 @@ SCHEMA = {
               "youngs_modulus": "Pa", "poisson_ratio": float,
               "magnetic_youngs_modulus": "Pa", "magnetic_poisson_ratio": float},
     "striker": {"material": str, "mass": "kg", "velocity": "m/s", "diameter": "m", "gap": "m"},
-    "magnet": {"force": "N", "position": "m", "peak_force": "N", "schedule": list},
+    "magnet": {"force": "N", "position": "m", "peak_force": "N", "schedule": list, "hold": "s"},
     "holder": {"bore": "m", "outer_diameter": "m", "length": "m", "vertical": bool,
                "drag": "kg/s", "friction": "N", "slip_speed": "m/s"},
     "wall": {"material": str, "plate_mass": "kg", "rod_stiffness": "N/m"},

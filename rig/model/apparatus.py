@@ -69,6 +69,7 @@ class Holder:
 # Published ring (Daraio et al. 2006): NdFeB, inner 11.43 mm, outer 53.34 mm, 242.2 g.
 # Its thickness is not published; 12.7 mm is assumed (a standard 1/2 inch ring).
 RING_INNER, RING_OUTER, RING_THICKNESS, RING_MASS = 11.43e-3, 53.34e-3, 12.7e-3, 0.2422
+LONG_HOLD = 600.0  # s: a ring left resting on the bead between shots (minutes; any hold > 0 s flattens the same)
 
 
 @functools.lru_cache(maxsize=8)
@@ -101,7 +102,10 @@ class RingMagnet:
     from the on-axis pull profile, so that sliding the ring changes the force. A ring left
     to hang on the bead carries its weight: 0.2422 kg x g = 2.38 N, the published
     precompression. ``schedule``: [(t (s), F (N)), ...] varies the force in time
-    (piecewise linear).
+    (piecewise linear). ``hold`` (s): how long its force rested on the chain before the
+    shot (0: put on at the shot; not given: LONG_HOLD, the ring resting on the bead between
+    shots); a contact law that yields flattens the loaded contacts at its static yield
+    (rig.model.laws.thornton), any hold > 0 s the same.
     """
 
     force: float | None = None
@@ -109,6 +113,7 @@ class RingMagnet:
     peak_force: float = 6.0
     schedule: tuple | None = None
     mass: float = RING_MASS
+    hold: float | None = None
 
     def __post_init__(self):
         given = [k for k in ("force", "position", "schedule") if getattr(self, k) is not None]
@@ -120,6 +125,19 @@ class RingMagnet:
             raise invalid("magnet.position", self.position, f"allowed 0 <= position <= {6 * RING_OUTER:.3g} m")
         if not self.peak_force > 0:
             raise invalid("magnet.peak_force", self.peak_force, "must be > 0 N")
+        if self.hold is not None and not self.hold >= 0:
+            raise invalid("magnet.hold", self.hold, "must be >= 0 s")
+        if self.hold is not None and self.hold > 0 and self.force == 0:
+            raise invalid("magnet.hold", self.hold, "a static hold needs the magnet's load (magnet.force > 0 N), "
+                                                    "or leave it 0 s")
+
+    @property
+    def held(self) -> float:
+        """Seconds its force rested on the chain before the shot: ``hold``, LONG_HOLD where
+        not given (0 where it pulls with no force)."""
+        if self.hold is not None:
+            return self.hold
+        return 0.0 if self.force == 0 else LONG_HOLD
 
     @classmethod
     def hanging(cls, added_mass: float = 0.0) -> "RingMagnet":

@@ -73,12 +73,13 @@ class Chain:
     reference_force (N). The contacts that touch a bead of the chain's material follow the
     law (follows_law).
     drag (kg/s), friction (N), slip_speed (m/s): what the holder's wall does to each bead
-    (rig.model.apparatus.Holder); 0: nothing.
+    (rig.model.apparatus.Holder); 0: nothing. hold (s): how long the top force rested on the
+    chain before the shot (a yielding law flattens the loaded contacts at its static yield).
     """
 
     def __init__(self, beads, *, striker: Striker | None = None, wall: Wall | None = None,
                  gravity: float = STANDARD_GRAVITY, top_force=0.0,
-                 contact_law: str = "hertz", drag=0.0, friction=0.0, slip_speed=1e-3, **contact):
+                 contact_law: str = "hertz", drag=0.0, friction=0.0, slip_speed=1e-3, hold=0.0, **contact):
         if isinstance(beads, (str, bytes)) or not hasattr(beads, "__iter__"):
             raise invalid("chain.beads", beads, "a list of Beads")
         beads = list(beads)
@@ -105,9 +106,12 @@ class Chain:
         self.contact_parameters = law_values(self.law, contact)
         for key, value in self.contact_parameters.items():  # chain.damping_time, chain.contact_exponent, ...
             setattr(self, key, value)
-        if self.contact_parameters.get("static_hold", 0.0) > 0 and not self.has_top_force:
-            raise invalid("chain.static_hold", self.contact_parameters["static_hold"],
-                          "a static hold needs the magnet's load: give the scene a [magnet], or leave it 0 s")
+        self.hold = quantity(hold, "s", "magnet.hold", bare_ok=True)
+        if not self.hold >= 0:
+            raise invalid("magnet.hold", hold, "must be >= 0 s")
+        if self.hold > 0 and not self.has_top_force:
+            raise invalid("magnet.hold", hold, "a static hold needs the magnet's load (magnet.force > 0 N), "
+                                               "or leave it 0 s")
         self.drag = quantity(drag, "kg/s", "holder.drag", bare_ok=True)
         self.friction = quantity(friction, "N", "holder.friction", bare_ok=True)
         self.slip_speed = quantity(slip_speed, "m/s", "holder.slip_speed", bare_ok=True)
@@ -200,7 +204,7 @@ class Chain:
         d_el = static_overlaps_of(A, F, n)
         terms = self.law.yielding(self.contact_parameters) if self.law.yielding else NO_YIELD
         live = follows_law(self) & np.isfinite(A)
-        state, d0, work = initial_state(np.where(live, A, 0.0), n, np.where(live, F, 0.0), d_el, terms)
+        state, d0, work = initial_state(np.where(live, A, 0.0), n, np.where(live, F, 0.0), d_el, terms, self.hold)
         ap = STATE_ROWS.index("unloading_constant")
         state[ap] = np.where(live, state[ap], np.where(np.isfinite(A), A, 0.0))  # as new: A_p = A
         return state, np.where(live, d0, d_el), work

@@ -101,7 +101,7 @@ def test_convergence_order():
 
 
 def test_batched_kernel_gives_the_single_shots_bits():
-    probs = [ChainProblem.from_chain(chain(top_force=2.38 + 0.05 * k, yield_force=0.8 + 0.1 * k, static_hold=60.0,
+    probs = [ChainProblem.from_chain(chain(top_force=2.38 + 0.05 * k, yield_force=0.8 + 0.1 * k, hold=60.0,
                                            static_yield_ratio=0.6)) for k in range(5)]
     dt = Stepping(2e-8, head=head_contacts(probs[0]))
     save = record_contacts(chain(yield_force=1.0), 5, 14, 21, sample_interval=1e-6)
@@ -120,7 +120,7 @@ def test_static_hold_flattens_the_loaded_contacts():
     through its static force; without the hold, a yield above every static force leaves the
     contacts as new."""
     new = chain(top_force=2.38, yield_force=2.5)
-    held = chain(top_force=2.38, yield_force=2.5, static_hold=60.0, static_yield_ratio=0.6)
+    held = chain(top_force=2.38, yield_force=2.5, hold=60.0, static_yield_ratio=0.6)
     hertz_d0 = Chain([MagneticBead()] + [Bead(**PTFE)] * 20, striker=Striker("alumina", "0.47 g", f"{V} m/s"),
                      wall=Wall(), top_force=2.38).static_overlaps()
     assert np.array_equal(new.static_overlaps(), hertz_d0)
@@ -137,7 +137,7 @@ def test_static_hold_flattens_the_loaded_contacts():
 @pytest.mark.parametrize("kw, words", [
     ({"yield_force": -1.0}, "chain.yield_force = -1.0: must be >= 0 N"),
     ({"yield_force": 0.0}, "chain.yield_force = 0.0: contact law 'thornton' needs it > 0"),
-    ({"yield_force": 1.0, "static_hold": 60.0}, "chain.static_hold = 60.0: a static hold needs the magnet's load"),
+    ({"yield_force": 1.0, "hold": 60.0}, "magnet.hold = 60.0: a static hold needs the magnet's load"),
     ({"yield_force": 1.0, "static_yield_ratio": 1.5}, "chain.static_yield_ratio = 1.5: a number in [0.05, 1]"),
     ({"yield_force": 1.0, "yield_reference_rate": 0.0}, "chain.yield_reference_rate = 0.0: must be > 0 m/s"),
 ])
@@ -145,3 +145,21 @@ def test_bad_values_are_refused_by_name(kw, words):
     with pytest.raises(RigError) as exc:
         chain(**kw)
     assert words in str(exc.value)
+
+
+def test_the_magnet_holds_its_load_unless_told():
+    """A published magnetic scene's ring rests on the bead before the shot (LONG_HOLD);
+    magnet.hold = 0 s puts it on at the shot; a hold with no load is refused by name."""
+    from rig.experiment.shot import Rig
+    from rig.model.apparatus import LONG_HOLD
+
+    sets = ["chain.contact_law=thornton", "chain.yield_force=0.8 N", "chain.static_yield_ratio=0.6"]
+    held = Rig.from_scene("ptfe52_magnetic", sets).chain
+    at_shot = Rig.from_scene("ptfe52_magnetic", sets + ["magnet.hold=0 s"]).chain
+    assert held.hold == LONG_HOLD and at_shot.hold == 0.0
+    assert np.all(held.static_overlaps()[2:] > at_shot.static_overlaps()[2:])  # the static yield is lower
+    assert Rig.from_scene("ptfe52_gravity", sets + ["magnet.force=0 N"]).chain.hold == 0.0
+    with pytest.raises(RigError, match=r"magnet.hold = 60.0: a static hold needs the magnet's load"):
+        Rig.from_scene("ptfe52_gravity", sets + ["magnet.force=0 N", "magnet.hold=60 s"])
+    with pytest.raises(RigError, match=r"magnet.hold = -1.0: must be >= 0 s"):
+        Rig.from_scene("ptfe52_magnetic", sets + ["magnet.hold=-1 s"])

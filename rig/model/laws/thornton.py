@@ -25,8 +25,8 @@ yield, F_y = A delta_y^n)
 
     F_y(r) = F_y (r / r_ref)^(2 n m),   delta_y(r) = delta_y (r / r_ref)^(2 m)    (r > r_ref);
 
-m = 0: a rate-independent yield. A **static hold** (chain.static_hold seconds of the magnet's
-load before the shot; the model does not follow creep during it, any hold > 0 counts the same)
+m = 0: a rate-independent yield. A **static hold** (magnet.hold seconds of the magnet's load
+before the shot; the model does not follow creep during it, any hold > 0 counts the same)
 flattens each contact at its static force with the static yield pressure, static_yield_ratio x
 the dynamic one: contacts pre-flattened so are stiffer, and yield later under the pulse, which
 is how precompression changes the dissipation. Without a hold a static force beyond the
@@ -70,9 +70,6 @@ REFERENCE_RATE = LawParameter("yield_reference_rate", "m/s", 0.0, float("inf"), 
                               lo_open=True)
 STATIC_RATIO = LawParameter("static_yield_ratio", "1", 0.05, 1.0, 1.0,
                             "yield pressure of a static hold over the dynamic one (chain.yield_force's)")
-STATIC_HOLD = LawParameter("static_hold", "s", 0.0, float("inf"), 0.0,
-                           "seconds the magnet's load is held before the shot, flattening the contacts "
-                           "(0: contacts as new)")
 
 STATE_ROWS = ("permanent_overlap", "unloading_constant", "largest_rate", "yield_overlap", "plastic_work",
               "reference_yield_overlap", "elastic_limit", "last_overlap", "last_rate")
@@ -87,14 +84,13 @@ BISECTIONS = 60  # halvings of the bracket of an elastic limit (2^-60: below a f
 @dataclass(frozen=True)
 class YieldTerms:
     """What the law hands the kernels for each of its contacts: yield force F_y (N) at the
-    reference closing rate r_ref (m/s), the rate exponent m, and the static hold: its
-    duration (s) and static_yield_ratio. F_y = 0: the contact never yields."""
+    reference closing rate r_ref (m/s), the rate exponent m, and static_yield_ratio, the
+    static yield pressure of a hold over the dynamic one. F_y = 0: the contact never yields."""
 
     yield_force: float = 0.0
     rate_exponent: float = 0.0
     reference_rate: float = 1.0
     static_ratio: float = 1.0
-    hold: float = 0.0
 
 
 NO_YIELD = YieldTerms()
@@ -103,7 +99,7 @@ NO_YIELD = YieldTerms()
 def yield_terms(values: dict) -> YieldTerms:
     """The chain's values ({key: SI value}) as YieldTerms."""
     return YieldTerms(values["yield_force"], values["yield_rate_exponent"], values["yield_reference_rate"],
-                      values["static_yield_ratio"], values["static_hold"])
+                      values["static_yield_ratio"])
 
 
 def viscous_terms(values: dict) -> ViscousTerms:
@@ -266,7 +262,7 @@ def yield_overlap(A, Fy, n):
     return out
 
 
-def initial_state(A, n, F_static, d_static, terms: YieldTerms) -> tuple:
+def initial_state(A, n, F_static, d_static, terms: YieldTerms, hold: float = 0.0) -> tuple:
     """(state, d0, hold_work): the kernels' memory (STATE_ROWS, contacts) before the shot,
     the static overlaps d0 (m) and the plastic work (J, per contact) the static load took
     (before the shot: not in its energy), for contacts of constants A (N/m^n), exponents n,
@@ -274,7 +270,7 @@ def initial_state(A, n, F_static, d_static, terms: YieldTerms) -> tuple:
 
     A contact whose static force passes its yield force was flattened as the load went on:
     it rests on its elastic curve through (delta*, F_static) on the envelope, at delta* >
-    d_static. The yield is chain.yield_force's; after a static hold (terms.hold > 0 s) the
+    d_static. The yield is chain.yield_force's; after a static hold (``hold`` > 0 s) the
     static one, static_ratio x its pressure (the yield overlap x ratio^2, the force x
     ratio^(2n)). The others are as new (A_p = A, delta_p = 0) at d_static. Each yields
     again where its curve meets the envelope of chain.yield_force (elastic_limit)."""
@@ -284,7 +280,7 @@ def initial_state(A, n, F_static, d_static, terms: YieldTerms) -> tuple:
     state[AP], state[DY], state[DYREF] = A, dy, dy
     state[DC] = np.where(dy > 0, dy, np.inf)
     work = np.zeros(A.shape)
-    dys = dy * (terms.static_ratio**2 if terms.hold > 0 else 1.0)
+    dys = dy * (terms.static_ratio**2 if hold > 0 else 1.0)
     flat = (dys > 0) & (F > A * dys**n)
     if np.any(flat):
         a, m, f, y, yd = A[flat], n[flat], F[flat], dys[flat], dy[flat]
@@ -307,7 +303,7 @@ LAW = ContactLaw(
     "elastic-plastic with memory (Thornton, J. Appl. Mech. 64, 383 (1997)): elastic A delta^n up to the yield "
     "force chain.yield_force, then the tangent line; unloading and reloading elastic with the enlarged radius "
     "and the permanent overlap; the yield pressure rises as (rate / chain.yield_reference_rate)^"
-    "chain.yield_rate_exponent; chain.static_hold seconds of the magnet's load flatten the contacts before the "
+    "chain.yield_rate_exponent; magnet.hold seconds of the magnet's load flatten the contacts before the "
     "shot at static_yield_ratio x that yield; an optional linear dashpot chain.contact_damping beside it",
-    (YIELD_FORCE, RATE_EXPONENT, REFERENCE_RATE, STATIC_RATIO, STATIC_HOLD, dashpot.CONTACT_DAMPING),
+    (YIELD_FORCE, RATE_EXPONENT, REFERENCE_RATE, STATIC_RATIO, dashpot.CONTACT_DAMPING),
     viscous_terms, PLASTIC, yield_terms)
