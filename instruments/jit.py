@@ -24,16 +24,38 @@ from pathlib import Path
 
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # before numba loads its OpenMP layer
 
-from numba import njit  # noqa: E402
-
 OPTIONS = {"cache": True, "fastmath": False}
 
 
 def jit(function=None, **options):
-    """numba's njit with the project's options; ``@jit`` or ``@jit(parallel=True)``."""
+    """numba's njit with the project's options; ``@jit`` or ``@jit(parallel=True)``. numba
+    is loaded here, by the first module that declares a kernel."""
+    from numba import njit
+
     if function is None:
         return lambda f: njit(**OPTIONS, **options)(f)
     return njit(**OPTIONS)(function)
+
+
+def kernel(function=None, **options):
+    """Mark a function of a module that must stay light to import (a contact law's,
+    rig.model.laws, which every scene check reads) as a kernel: plain Python until
+    ``compile_kernels`` of its module makes it a ``jit`` one with ``options``, as a kernel
+    package does before its own kernels are compiled (they then call it, or inline it)."""
+    def mark(f):
+        f.jit_options = options
+        return f
+    return mark if function is None else mark(function)
+
+
+def compile_kernels(module) -> None:
+    """Replace every function of ``module`` marked by ``kernel`` with its jit form (once:
+    a jit function is left as it is). numba reads a kernel's globals when it compiles it, so
+    the marked functions call each other's jit forms."""
+    for name, obj in list(vars(module).items()):
+        options = getattr(obj, "jit_options", None)
+        if options is not None and not hasattr(obj, "py_func"):
+            setattr(module, name, jit(**options)(obj))
 
 
 def drop_stale_cache(package: str, constants: tuple = ()) -> None:

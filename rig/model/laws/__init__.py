@@ -12,7 +12,9 @@ from rig.errors import invalid, lookup
 from rig.model.laws import dashpot, hertz, kuwabara_kono, powerlaw_dashpot, thornton
 from rig.model.laws.law import HERTZ, KUWABARA_KONO, PLASTIC, POWER, ContactLaw, LawParameter, ViscousTerms
 
-LAWS = (hertz.LAW, kuwabara_kono.LAW, dashpot.LAW, powerlaw_dashpot.LAW, thornton.LAW)
+MODULES = (hertz, kuwabara_kono, dashpot, powerlaw_dashpot, thornton)
+"""The laws' modules (their kernel functions compiled by rig.solver.kernels)."""
+LAWS = tuple(module.LAW for module in MODULES)
 
 CONTACT_LAWS: dict[str, ContactLaw] = {law.name: law for law in LAWS}
 
@@ -25,7 +27,8 @@ OWNER: dict[str, tuple] = {p.key: tuple(law for law in LAWS if p in law.paramete
 """The laws each law-specific parameter belongs to (a dashpot's coefficient: the dashpot's and
 the elastic-plastic law's)."""
 
-__all__ = ["CONTACT_LAWS", "ContactLaw", "HERTZ", "KUWABARA_KONO", "LAWS", "LawParameter", "OWNER", "PARAMETERS",
+__all__ = ["CONTACT_LAWS", "ContactLaw", "HERTZ", "KUWABARA_KONO", "LAWS", "LawParameter", "MODULES", "OWNER",
+           "PARAMETERS",
            "PLASTIC", "POWER", "ViscousTerms", "contact_law", "law_values"]
 
 

@@ -45,8 +45,9 @@ it loses (the envelope's work less the energy left on the new elastic curve) bec
 work, so that kinetic + elastic + plastic work stays the striker's energy to the integrator's
 error.
 
-The compiled functions below are the kernels' (rig/solver/kernels): a contact's state is its
-column of ``state`` (STATE_ROWS), the same in the single-shot and batched kernels.
+The functions marked ``kernel`` below are the kernels' (rig/solver/kernels compiles them, so
+that importing this module loads no numba): a contact's state is its column of ``state``
+(STATE_ROWS), the same in the single-shot and batched kernels.
 """
 from __future__ import annotations
 
@@ -55,7 +56,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from instruments.jit import jit
+from instruments.jit import kernel
 from rig.model.laws import dashpot
 from rig.model.laws.law import PLASTIC, ContactLaw, LawParameter, ViscousTerms
 
@@ -107,7 +108,7 @@ def viscous_terms(values: dict) -> ViscousTerms:
     return ViscousTerms(dashpot=values["contact_damping"])
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def elastic_power(d, n):
     """d^n for d >= 0 (d sqrt(d) for Hertz's 3/2, exactly as the kernels' Hertz passes)."""
     if n == 1.5:
@@ -115,7 +116,7 @@ def elastic_power(d, n):
     return d**n
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def unloading(d, F, Fy, dy, n):
     """(delta_p, A_p): the elastic curve through (d, F) (m, N) of a contact yielding at Fy
     (N) at overlap dy (m): Thornton's k_u = k_y sqrt((2F + Fy) / (3 Fy)), k_y = n Fy / dy."""
@@ -124,7 +125,7 @@ def unloading(d, F, Fy, dy, n):
     return d - de, F / elastic_power(de, n)
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def envelope(d, A, n, dy):
     """Force (N) on the loading envelope at overlap d (m): A d^n up to dy, then the tangent line."""
     if d <= dy:
@@ -133,7 +134,7 @@ def envelope(d, A, n, dy):
     return Fy + n * Fy / dy * (d - dy)
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def envelope_work(a, b, A, n, dy):
     """The envelope's work (J) from overlap a to b >= a (m): A x^(n+1) / (n+1) below dy, a
     trapezoid on the line beyond."""
@@ -147,7 +148,7 @@ def envelope_work(a, b, A, n, dy):
     return w
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def plastic_force(d, A, n, state, i, s):
     """Force (N) of contact i of shot s at overlap d (m) by its memory state[:, i, s], which a
     step holds fixed: its elastic curve A_p (d - d_p)^n up to its elastic limit, the
@@ -162,7 +163,7 @@ def plastic_force(d, A, n, state, i, s):
     return envelope(d, A, n, state[DY, i, s])
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def plastic_energy(d, A, n, state, i, s):
     """The potential (J) of plastic_force at overlap d (m) for the memory state[:, i, s]:
     A_p (x - d_p)^(n+1) / (n+1) at x = min(d, elastic limit), plus the envelope's work
@@ -175,7 +176,7 @@ def plastic_energy(d, A, n, state, i, s):
     return u + state[WORK, i, s]
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def elastic_limit(A, n, dp, ap, dy, start):
     """The overlap (m) from ``start`` on where the elastic curve A_p (x - d_p)^n meets the
     envelope of yield overlap dy (A, n the contact's elastic law; bisection: the curve
@@ -197,7 +198,7 @@ def elastic_limit(A, n, dp, ap, dy, start):
     return lo
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def hermite_peak(y0, m0, y1, m1):
     """The largest value of the cubic Hermite polynomial through y0, y1 with slopes m0 > 0 >
     m1 (per unit of the interval) on [0, 1]: at the one root of its derivative there
@@ -218,7 +219,7 @@ def hermite_peak(y0, m0, y1, m1):
     return y0 + (3.0 * x2 - 2.0 * x2 * x) * dy + (x2 * x - 2.0 * x2 + x) * m0 + (x2 * x - x2) * m1
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def commit(d, rate, dt, A, n, m, r_ref, state, i, s):
     """Renew the memory of contact i of shot s at a step's end: overlap d (m), closing rate
     ``rate`` (m/s), dt (s) after the last. The step's largest overlap: d, or where the

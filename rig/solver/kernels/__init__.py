@@ -5,7 +5,14 @@ beads, then the wall as a body of zero inverse mass if any). ``u`` is the displa
 from static equilibrium (m, positive down), ``v`` the velocity (m/s). Force slot ``f[i]``
 (size nb + 1) holds the contact between body i-1 and body i; ``f[0]`` and ``f[nb]`` stay 0
 so that every body sees ``f[i] - f[i+1]`` with no special case at the ends.
-"""
-from instruments.jit import drop_stale_cache
 
-drop_stale_cache(__name__, constants=("rig.model.contact", "rig.model.laws.law", "rig.model.laws.thornton"))
+The contact laws' kernel functions (rig.model.laws, marked ``instruments.jit.kernel``) are
+compiled here, before any kernel of this package imports them.
+"""
+from instruments.jit import compile_kernels, drop_stale_cache
+from rig.model import laws
+
+for _module in laws.MODULES:
+    compile_kernels(_module)
+drop_stale_cache(__name__, constants=("rig.model.contact",) + tuple(m.__name__ for m in laws.MODULES)
+                 + ("rig.model.laws.law",))
