@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from rig.model.contact import HERTZ, KUWABARA_KONO, PLASTIC, POWER
-from rig.solver.problem import CONTACT_ROWS, STATE_ROWS
 from rig.solver.kernels import dissipation, ensemble, forces, multirate, record, step
+from rig.solver.problem import CONTACT_ROWS, STATE_ROWS
 
 
 def _llvm(kernel, *args) -> str:
