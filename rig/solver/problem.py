@@ -81,6 +81,7 @@ class ProblemArrays(_ContactCodes):
     elastic_limit: np.ndarray
     last_overlap: np.ndarray
     last_rate: np.ndarray
+    shifted_rest_overlap: np.ndarray
     d_limit: np.ndarray
     drag: np.ndarray
     friction: np.ndarray
@@ -158,6 +159,7 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     if off:
         d0[:, 1] = -chain.striker.gap
     balance_at_rest(load, A, d0, expo, invm)  # before d_limit, f0, e_scale read d0
+    state[STATE_ROWS.index("shifted_rest_overlap")] = d0 - state[STATE_ROWS.index("permanent_overlap")]
     beads = np.zeros((S, nb), dtype=bool)
     beads[:, off:off + n] = True  # the holder drags and rubs the beads only
     drag = np.where(beads, chain.drag * invm, 0.0)
@@ -214,7 +216,8 @@ class ChainProblem(_ContactCodes):
     contact, its memory before the shot (STATE_ROWS: permanent_overlap (m),
     unloading_constant (N/m^n, A where as new), largest_rate (m/s), yield_overlap (m),
     plastic_work (J), reference_yield_overlap (m; 0: it never yields), elastic_limit (m; inf: it
-    never yields), last_overlap (m), last_rate (m/s); rig.model.laws.thornton),
+    never yields), last_overlap (m), last_rate (m/s), shifted_rest_overlap (m, d0 - delta_p);
+    rig.model.laws.thornton),
     d_limit (m, an overlap beyond which the integration is declared unstable). u0, v0 the initial state (m, m/s). With a compliant wall the plate
     is a body and the rod the slot below it, to the wall's immovable body.
     """
@@ -243,6 +246,7 @@ class ChainProblem(_ContactCodes):
     elastic_limit: np.ndarray
     last_overlap: np.ndarray
     last_rate: np.ndarray
+    shifted_rest_overlap: np.ndarray
     d_limit: np.ndarray
     drag: np.ndarray
     friction: np.ndarray

@@ -39,7 +39,7 @@ def test_the_fused_kick_drift_force_pass_is_vectorised(law):
     con[0] = 1.5
     state = np.zeros((len(STATE_ROWS), 64, 1))
     state[STATE_ROWS.index("elastic_limit")] = np.inf
-    ir = _llvm(step.fused_run, u, v, invm, f, A, d0, np.zeros(65), 1e-9, 1e-9, 3, 64, law, con, state)
+    ir = _llvm(step.fused_run, u, v, invm, f, A, d0, np.zeros(65), 1e-9, 1e-9, 3, 64, law, con, state, A, d0)
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the square roots of the force pass are scalar"
     assert _vector_ops(ir), "no vector arithmetic in the fused pass"
 

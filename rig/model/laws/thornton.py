@@ -73,13 +73,17 @@ STATIC_RATIO = LawParameter("static_yield_ratio", "1", 0.05, 1.0, 1.0,
                             "yield pressure of a static hold over the dynamic one (chain.yield_force's)")
 
 STATE_ROWS = ("permanent_overlap", "unloading_constant", "largest_rate", "yield_overlap", "plastic_work",
-              "reference_yield_overlap", "elastic_limit", "last_overlap", "last_rate")
-"""A contact's memory, the rows of the kernels' ``state`` (9, slots): its elastic curve's
+              "reference_yield_overlap", "elastic_limit", "last_overlap", "last_rate", "shifted_rest_overlap")
+"""A contact's memory, the rows of the kernels' ``state`` (10, slots): its elastic curve's
 delta_p (m) and A_p (N/m^n), the largest closing rate seen (m/s), delta_y at that rate (m),
 the plastic work it has taken in the shot (J), delta_y at r_ref (m; 0: it never yields), the
-overlap up to which the elastic curve holds (m; inf: it never yields), and the overlap (m)
-and its rate (m/s) at the last step's end."""
-DP, AP, RMAX, DY, WORK, DYREF, DC, DLAST, RLAST = range(9)
+overlap up to which the elastic curve holds (m; inf: it never yields), the overlap (m) and
+its rate (m/s) at the last step's end, and the rest overlap less delta_p (m): the kernels'
+Hertz passes take A_p and d0 - delta_p for A and d0, and so give the elastic curve."""
+DP, AP, RMAX, DY, WORK, DYREF, DC, DLAST, RLAST, DS = range(10)
+SPAN_FIRST, SPAN_END = DLAST, RLAST
+"""Slot 0 joins no bodies: its DLAST and RLAST hold, for each shot, the slots the kernels'
+force passes check for the envelope, SPAN_FIRST <= i < SPAN_END (rig/solver/kernels/memory.py)."""
 BISECTIONS = 60  # halvings of the bracket of an elastic limit (2^-60: below a float's spacing)
 
 @dataclass(frozen=True)
@@ -201,28 +205,25 @@ def elastic_limit(A, n, dp, ap, dy, start):
 @kernel(inline="always")
 def hermite_peak(y0, m0, y1, m1):
     """The largest value of the cubic Hermite polynomial through y0, y1 with slopes m0 > 0 >
-    m1 (per unit of the interval) on [0, 1]: at the one root of its derivative there
-    (bisection), written in y1 - y0 so that the small change of a large overlap keeps its
-    digits."""
+    m1 (per unit of the interval) on [0, 1]: at the one root there of its derivative
+    a x^2 + b x + m0 (the stable form of the quadratic's roots), written in y1 - y0 so that the
+    small change of a large overlap keeps its digits."""
     dy = y1 - y0
     a = -6.0 * dy + 3.0 * m0 + 3.0 * m1
     b = 6.0 * dy - 4.0 * m0 - 2.0 * m1
-    lo, hi = 0.0, 1.0
-    for _ in range(BISECTIONS):
-        x = 0.5 * (lo + hi)
-        if (a * x + b) * x + m0 > 0.0:
-            lo = x
-        else:
-            hi = x
-    x = 0.5 * (lo + hi)
+    q = -0.5 * (b + math.copysign(math.sqrt(max(b * b - 4.0 * a * m0, 0.0)), b))
+    x = q / a if a != 0.0 else -1.0
+    if not 0.0 <= x <= 1.0:
+        x = m0 / q if q != 0.0 else 0.5
+    x = min(max(x, 0.0), 1.0)
     x2 = x * x
     return y0 + (3.0 * x2 - 2.0 * x2 * x) * dy + (x2 * x - 2.0 * x2 + x) * m0 + (x2 * x - x2) * m1
 
 
 @kernel(inline="always")
-def commit(d, rate, dt, A, n, m, r_ref, state, i, s):
+def commit(d, rate, dt, A, d0, n, m, r_ref, state, i, s):
     """Renew the memory of contact i of shot s at a step's end: overlap d (m), closing rate
-    ``rate`` (m/s), dt (s) after the last. The step's largest overlap: d, or where the
+    ``rate`` (m/s), dt (s) after the last (d0: its rest overlap, m). The step's largest overlap: d, or where the
     contact turned back in the step (closing at its start, opening at its end) the peak of
     the cubic Hermite through both ends. Where that passed the elastic limit the contact
     yielded there: its new elastic curve runs through (peak, envelope(peak)), and the
@@ -242,6 +243,7 @@ def commit(d, rate, dt, A, n, m, r_ref, state, i, s):
         dp, ap = unloading(peak, F, A * elastic_power(dy, n), dy, n)
         state[DP, i, s] = dp
         state[AP, i, s] = ap
+        state[DS, i, s] = d0 - dp
         state[DC, i, s] = peak
         state[WORK, i, s] = before - (plastic_energy(d, A, n, state, i, s) - state[WORK, i, s])
     if m != 0.0 and rate > state[RMAX, i, s]:

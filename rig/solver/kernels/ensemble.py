@@ -19,9 +19,9 @@ from numba import prange
 
 from instruments.jit import jit
 from rig.model.contact import HERTZ, PLASTIC, POWER
-from rig.model.laws.thornton import WORK, plastic_force
+from rig.model.laws.thornton import AP, DC, DS, SPAN_END, SPAN_FIRST, WORK, plastic_force
 from rig.solver.kernels.dissipation import dissipate, holder_factors
-from rig.solver.kernels.forces import contact_force, plastic_contact, power, state_sums
+from rig.solver.kernels.forces import contact_force, open_span, plastic_contact, power, state_sums
 from rig.solver.kernels.integrators import rest_from, still_from
 from rig.solver.kernels.memory import plastic_commit
 from rig.solver.kernels.multirate import head_flow
@@ -60,17 +60,26 @@ def _other_laws(u, A, d0, load, f, con, state, law, lo, hi):
     if law == POWER:
         for i in range(max(lo, 1), hi):
             _power_row(u, A, d0, load, f, i, con[0])
-    elif law == PLASTIC:
-        for i in range(max(lo, 1), hi):
+    elif law == PLASTIC:  # after a pass over the elastic curves: the slots it does not give, in each span
+        first, end = hi, 0
+        for s in range(u.shape[1]):
+            first = min(first, int(state[SPAN_FIRST, 0, s]))
+            end = max(end, int(state[SPAN_END, 0, s]))
+        for i in range(max(lo, 1, first), min(hi, end)):
             for s in range(u.shape[1]):
-                f[i, s] = plastic_force(d0[i, s] + u[i - 1, s] - u[i, s], A[i, s], con[0, i, s], state, i, s) \
-                    - load[i, s]
+                d = d0[i, s] + u[i - 1, s] - u[i, s]
+                inside = state[SPAN_FIRST, 0, s] <= i < state[SPAN_END, 0, s]
+                if inside and (d > state[DC, i, s] or con[0, i, s] != 1.5):
+                    f[i, s] = plastic_force(d, A[i, s], con[0, i, s], state, i, s) - load[i, s]
 
 
 @jit
 def _forces(u, A, d0, load, f, law, con, state):
+    A_el, d0_el = (state[AP], state[DS]) if law == PLASTIC else (A, d0)
+    if law == PLASTIC:
+        open_span(state)  # every slot looked at until a step's end finds the near ones
     for i in range(1, u.shape[0]):
-        _contact_row(u, A, d0, load, f, i)
+        _contact_row(u, A_el, d0_el, load, f, i)
     _other_laws(u, A, d0, load, f, con, state, law, 1, u.shape[0])
 
 
@@ -112,10 +121,11 @@ def _kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef,
         _head_kick(v, invm, f, hb, head)
         head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub, h_work, h_busy)
         start = head + 1
+    A_el, d0_el = (state[AP], state[DS]) if law == PLASTIC else (A, d0)  # PLASTIC: each slot's elastic curve
     for i in range(start, reach):
         _kick_drift_row(u, v, invm, f, hb, ha, i)
         if i >= 1:
-            _contact_row(u, A, d0, load, f, i)
+            _contact_row(u, A_el, d0_el, load, f, i)
     _other_laws(u, A, d0, load, f, con, state, law, start, reach)
 
 
@@ -174,6 +184,10 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
             viscous = viscous or con[1, i, s] != 0.0 or con[2, i, s] != 0.0
             holder = holder or onsite[0, i, s] != 0.0 or onsite[1, i, s] != 0.0
     dissipative = viscous or holder
+    every = False  # PLASTIC: a contact of another exponent than 3/2 (memory.plastic_commit)
+    for i in range(nb):
+        for s in range(W):
+            every = every or (A[i, s] > 0.0 and con[0, i, s] != 1.5)
     work = np.zeros((5, nb + 1, W))  # the dissipation's work arrays
     hold = holder_factors(onsite, 0.5 * dt, viscous)  # E(dt/2)'s holder flows
     lost = np.zeros(W)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
@@ -251,7 +265,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
         _record(out, lo, j_out, j_end - j_out, w, x, ch_slot, ch_weight, A, law, con, state, d_old, r_old, d_new,
                 r_new)
         if law == PLASTIC:  # the contacts' memory renewed at the step's end, after its records
-            plastic_commit(u, v, invm, f, A, d0, con, state, pending, head, -1, 0.0, dt, reach)
+            plastic_commit(u, v, invm, f, A, d0, con, state, pending, head, -1, 0.0, dt, reach, every)
         j_out = j_end
         d_old[:, :, :] = d_new
         r_old[:, :, :] = r_new

@@ -23,7 +23,7 @@ import numpy as np
 
 from instruments.jit import jit
 from rig.model.contact import HERTZ, KUWABARA_KONO, PLASTIC, POWER
-from rig.model.laws.thornton import DP, plastic_energy, plastic_force
+from rig.model.laws.thornton import AP, DC, DP, DS, SPAN_END, SPAN_FIRST, plastic_energy, plastic_force
 
 
 @jit(inline="always")
@@ -77,13 +77,27 @@ def contact_force(d, rate, A, n, tau, mu, alpha, law):
 
 
 @jit
-def plastic_pass(u, A, d0, load, f, expo, state, lo, hi):
-    """Renew slots lo..hi-1 (lo >= 1) of one shot by the elastic-plastic law, f[i] =
-    F_p(d) - load[i] (thornton.plastic_force: the memory state (rows, bodies, 1) held
-    through the step), after a Hertz pass renewed every slot from the same positions, as
-    other_law."""
-    for i in range(lo, hi):
-        f[i] = plastic_force(d0[i] + u[i - 1] - u[i], A[i], expo[i], state, i, 0) - load[i]
+def open_span(state):
+    """Every slot in every shot's span (rig/solver/kernels/memory.py), before a step's end
+    has found the near ones."""
+    for s in range(state.shape[2]):
+        state[SPAN_FIRST, 0, s] = 1.0
+        state[SPAN_END, 0, s] = state.shape[1]
+
+
+@jit
+def plastic_fixup(u, A, d0, load, f, expo, state, lo, hi):
+    """After a Hertz pass that took each slot's elastic curve (A_p and d0 - delta_p for A and
+    d0: thornton's DS row), renew the slots of lo..hi-1 (lo >= 1) of one shot that it does
+    not give: those past their elastic limit (on the envelope) and those of another exponent,
+    f[i] = F_p(d) - load[i] (thornton.plastic_force; state (rows, bodies, 1), held through the
+    step). Only the slots of the shot's span are looked at (rig/solver/kernels/memory.py)."""
+    first = max(lo, int(state[SPAN_FIRST, 0, 0]))
+    end = min(hi, int(state[SPAN_END, 0, 0]))
+    for i in range(first, end):
+        d = d0[i] + u[i - 1] - u[i]
+        if d > state[DC, i, 0] or expo[i] != 1.5:
+            f[i] = plastic_force(d, A[i], expo[i], state, i, 0) - load[i]
 
 
 @jit(inline="always")
@@ -134,14 +148,18 @@ def elastic_forces(u, A, d0, load, f, law, con, state):
     and magnet force of bodies 0..i-1), so that body i is pushed by f[i] - f[i+1] alone
     (its own constant load is load[i+1] - load[i]) and a chain at rest has f = 0.
     Hertz: A d^(3/2), d = max(d0[i] + u[i-1] - u[i], 0), branch-free so that LLVM
-    vectorises the square roots; POWER: that pass, then other_law's; PLASTIC: that pass, then
-    plastic_pass's (con: the slots' CONTACT_ROWS, state their memory, (rows, bodies, 1)).
+    vectorises the square roots; POWER: that pass, then other_law's; PLASTIC: that pass over
+    each slot's elastic curve, then plastic_fixup's (con: the slots' CONTACT_ROWS, state their
+    memory, (rows, bodies, 1)).
     """
+    if law == PLASTIC:  # the elastic curves by the Hertz pass, then what it does not give, every slot
+        hertz_forces(u, state[AP, :, 0].copy(), state[DS, :, 0].copy(), load, f)
+        open_span(state)
+        plastic_fixup(u, A, d0, load, f, con[0], state, 1, u.shape[0])
+        return
     hertz_forces(u, A, d0, load, f)
     if law == POWER:
         other_law(u, A, d0, load, f, con[0], 1, u.shape[0])
-    elif law == PLASTIC:
-        plastic_pass(u, A, d0, load, f, con[0], state, 1, u.shape[0])
 
 
 @jit(error_model="numpy")  # a division by zero gives inf (no check per element, which stops vectorising)

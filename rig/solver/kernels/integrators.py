@@ -118,6 +118,9 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, state, onsite, s
     dissipative = viscous or holder
 
     state3 = state.reshape((state.shape[0], nb, 1))
+    every = False  # PLASTIC: a contact of another exponent than 3/2, renewed by the law at every stage
+    for i in range(nb):
+        every = every or (A[i] > 0.0 and con[0, i] != 1.5)
     elastic_forces(u, A, d0, load, f, law, con, state3)
     # (bodies, 1) views for the multirate head, the records and the dissipation (shared with the batched kernel)
     heads = (u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1)),
@@ -183,7 +186,7 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, state, onsite, s
                       wall_slot, work, lost, j_visc, j_holder)
         reach = min(nb, still + n_drift + 2)
         stepped += reach
-        step(u, v, invm, f, A, d0, load, law, con, state3, a_coef, b_coef, dt, t, pending, head, sub,
+        step(u, v, invm, f, A, d0, load, law, con, state, a_coef, b_coef, dt, t, pending, head, sub,
               sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
@@ -215,7 +218,8 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, state, onsite, s
                                                d_old, r_old, d_new, r_new)
             j_out += 1
         if law == PLASTIC:  # the contacts' memory renewed at the step's end, after its records
-            plastic_commit(u2, v2, im2, f2, A2, d02, con3, state3, pending, head, sched_body, fe_new, dt, reach)
+            plastic_commit(u2, v2, im2, f2, A2, d02, con3, state3, pending, head, sched_body, fe_new, dt, reach,
+                           every)
         d_old, d_new = d_new, d_old  # this step's end is the next one's start
         r_old, r_new = r_new, r_old
         while j_frame < n_frames and j_frame * frame_dt <= t_new * (1.0 + 1e-12):
