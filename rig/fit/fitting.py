@@ -61,6 +61,8 @@ class FitResult:
     model: object = None
     replayed: int = 0  # candidates read back from the cache of an earlier run (evaluations: solved in this one)
     bounds: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (lo, hi) of each parameter, SI
+    jacobian: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  # of the residuals at the estimate,
+    # per parameter's bound span and per nuisance parameter (rig.fit.crossval)
 
     @property
     def chi2_reduced(self) -> float:
@@ -229,7 +231,7 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
     converged = bool(res.success and res.status > 0 and np.all(np.isfinite(std)))
     return FitResult(tuple(p.key for p in params), tuple(p.unit for p in params), est, std, ci, corr, r, chi2, dof,
                      converged, str(res.message), cache.solved, at_bound, objective.nuisance_report(res.x[P:]),
-                     res.x[P:].copy(), model, cache.replayed, np.column_stack((lo, lo + span)))
+                     res.x[P:].copy(), model, cache.replayed, np.column_stack((lo, lo + span)), J)
 
 
 def _savez(path, arrays: dict):
