@@ -9,15 +9,19 @@ records) and in their pilot's step, which the batched kernel would split again.
 """
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 
 from rig.errors import invalid
 
 
 class JointObjective:
-    """The objectives ``parts`` (each with the same fitted parameters) as one (module doc)."""
+    """The objectives ``parts`` (each with the same fitted parameters) as one (module doc);
+    ``start``: where the fit starts (SI, in the parameters' order; None: the first part's
+    start, the scene's values)."""
 
-    def __init__(self, parts):
+    def __init__(self, parts, start=None):
         self.parts = tuple(parts)
         if not self.parts:
             raise invalid("joint fit", "no objective", "at least one objective to fit")
@@ -26,17 +30,20 @@ class JointObjective:
             if p.params != self.params:
                 raise invalid("joint fit", [q.key for q in p.params],
                               f"the same fitted parameters in every part ({[q.key for q in self.params]})")
+        self._start = None if start is None else np.asarray(start, dtype=float)
+        if self._start is not None and self._start.shape != (len(self.params),):
+            raise invalid("joint fit start", self._start.tolist(), f"{len(self.params)} values, one per parameter")
         self.central_differences = any(p.central_differences for p in self.parts)
         sizes = [p.n_data for p in self.parts]
         ends = np.cumsum([0] + sizes)
-        self.slices = tuple(slice(int(a), int(b)) for a, b in zip(ends[:-1], ends[1:]))
+        self.slices = tuple(slice(int(a), int(b)) for a, b in pairwise(ends))
         """The rows of each part in the joint residuals."""
         eta_sizes = [p.nuisance_start()[0].size for p in self.parts]
         eta_ends = np.cumsum([0] + eta_sizes)
-        self.eta_slices = tuple(slice(int(a), int(b)) for a, b in zip(eta_ends[:-1], eta_ends[1:]))
+        self.eta_slices = tuple(slice(int(a), int(b)) for a, b in pairwise(eta_ends))
 
     def spec(self) -> dict:
-        return {"kind": "joint", "parts": [p.spec() for p in self.parts]}
+        return {"kind": "joint", "parts": [p.spec() for p in self.parts], "start": self.start().tolist()}
 
     def numerics(self, theta) -> dict:
         """Each part's numerics (rig.fit.evaluate.numerics); within_accuracy: all of them."""
@@ -44,7 +51,7 @@ class JointObjective:
         return {"parts": parts, "within_accuracy": all(n["within_accuracy"] for n in parts)}
 
     def start(self) -> np.ndarray:
-        return self.parts[0].start()
+        return self.parts[0].start() if self._start is None else self._start
 
     @property
     def n_data(self) -> int:

@@ -23,8 +23,20 @@ from rig.errors import RigError
 from rig.fit.checks import unusable
 from rig.fit.crossval import leverages
 from rig.fit.fitting import FitResult, fit
-from rig.study.fitted_families import (Family, fitted_overrides, magnetic_observation, magnetic_points,
-                                       objective, unavailable)
+from rig.study.fitted_families import (
+    Family,
+    fitted_overrides,
+    magnetic_observation,
+    magnetic_points,
+    objective,
+    unavailable,
+)
+
+FTOL, XTOL = 1e-3, 1e-3
+"""Where a family's fits stop: a step that changes chi2 by less than 0.1% (far below the
+change of 1 that moves an interval) or the parameters by less than 1e-3 of their bounds'
+span (a tenth of the Jacobian's step): tighter, they spend solves on the solver's
+noise (rig.fit.fitting's defaults are 1e-8 and 1e-6)."""
 
 
 @dataclass(frozen=True)
@@ -77,13 +89,19 @@ def table1_figures(obj, result: FitResult) -> dict:
             "loo_relative_residuals": loo_rel.tolist()}
 
 
-def magnetic_from_gravity(family: Family, points, observations) -> dict:
-    """The family fitted to the gravity-only data, predicting the magnetic data (module doc)."""
+def estimates(result: FitResult) -> dict:
+    """{key: estimate (SI)} of a fit."""
+    return {k: float(e) for k, e in zip(result.keys, result.estimate)}
+
+
+def magnetic_from_gravity(family: Family, points, observations, joint: FitResult) -> dict:
+    """The family fitted to the gravity-only data (starting at its ``joint`` fit's values),
+    predicting the magnetic data (module doc)."""
     mag_p = magnetic_points(points)
     mag_o = [magnetic_observation(o) for o in observations]
     g_obj = objective(family, points.subset(np.flatnonzero(~mag_p)),
-                      tuple(o for o, m in zip(observations, mag_o) if not m))
-    g = fit(g_obj)
+                      tuple(o for o, m in zip(observations, mag_o) if not m), estimates(joint))
+    g = fit(g_obj, ftol=FTOL, xtol=XTOL)
     m_obj = objective(family, points.subset(np.flatnonzero(mag_p)), tuple(o for o, m in zip(observations, mag_o) if m))
     (model,) = m_obj.evaluate([g.estimate])
     r = m_obj.residuals(model, np.zeros(0))
@@ -91,8 +109,9 @@ def magnetic_from_gravity(family: Family, points, observations) -> dict:
             "chi2_per_point": float(r @ r) / r.size, "rms_relative": m_obj.relative_rms(model, np.zeros(0))}
 
 
-def assess(family: Family, points, observations, tell) -> Assessment:
-    """The family's joint fit and held-out prediction (module doc); a family this version
+def assess(family: Family, points, observations, tell, done=()) -> Assessment:
+    """The family's joint fit and held-out prediction (module doc), its fit starting where
+    the Assessment in ``done`` of the family it starts from ended; a family this version
     cannot fit is skipped, one whose fit the rig refuses is failed, each with the reason."""
     row = {"note": family.note, "fitted_keys": list(family.params), "fixed": list(family.fixed),
            "magnetic_only": list(family.magnetic), "skipped": unavailable(family) or None, "failed": None}
@@ -100,8 +119,9 @@ def assess(family: Family, points, observations, tell) -> Assessment:
         tell(f"{family.name}: skipped")
         return Assessment(family, row)
     try:
-        obj = objective(family, points, observations)
-        r = fit(obj)
+        parent = next((a.result for a in done if a.family.name == family.starts_from and a.result), None)
+        obj = objective(family, points, observations, None if parent is None else estimates(parent))
+        r = fit(obj, ftol=FTOL, xtol=XTOL)
     except RigError as exc:
         row["failed"] = f"joint fit: {exc}"
         tell(f"{family.name}: failed")
@@ -111,7 +131,7 @@ def assess(family: Family, points, observations, tell) -> Assessment:
                 "fig3_chi2": float(np.sum(r.residuals[obj.slices[1]] ** 2)), **table1_figures(obj, r)})
     tell(f"{family.name}: joint fit")
     try:
-        row["magnetic_from_gravity"] = magnetic_from_gravity(family, points, observations)
+        row["magnetic_from_gravity"] = magnetic_from_gravity(family, points, observations, r)
         row["held_out_chi2"] = row["loo_chi2"] + row["magnetic_from_gravity"]["chi2"]
     except RigError as exc:
         row["magnetic_from_gravity"] = {"failed": str(exc)}

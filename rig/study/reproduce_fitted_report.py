@@ -30,6 +30,19 @@ STEEL = (("gravity_speed_m_per_s", "steel speed, gravity only (m/s)", 580.0),
          ("magnetic_speed_m_per_s", "steel speed with 2.38 N (m/s)", 688.0))
 
 
+INTRO = ("Each family fitted jointly to Table 1 (10 points, errors in both coordinates) and Fig. 3's observations "
+         "(speeds, duration, gauge ratio, tail). Held-out prediction: Table 1's leave-one-out is LINEARISED (PRESS, "
+         "r_i / (1 - h_ii) at the joint optimum, exact for a linear model; no refits), and the magnetic data (points "
+         "and observations) are predicted by the family fitted to the gravity-only data.")
+FAMILY_HEADER = ("| family | parameters (SI) | joint chi2 / dof | BIC | Table 1 chi2/dof | Table 1 RMS | worst (sd) "
+                 "| leave-one-out chi2, RMS | magnetic from gravity chi2 / n, RMS |")
+RATIOS = ("The gauge ratio compares the gauges' READINGS (the peaks of the upper gauge's trace, as Fig. 3 does); "
+          "the JSON's amplitude_ratio_magnetic_to_gravity is the ratio of the leading pulses' F_d (the truth "
+          "analysis):")
+SCAN_HEADER = ("| dashpot (kg/s) | Table 1 RMS | speed gravity (m/s) | FWHM / base duration (us) | speed magnet (m/s) "
+               "| F_d ratio |")
+
+
 def _inside(value, window) -> bool | None:
     if value is None or not math.isfinite(value):
         return None
@@ -79,13 +92,7 @@ def markdown(f: dict) -> str:
     targets, the dashpot scan and steel."""
     fitted = {n: b for n, b in f["models"].items() if "fig3" in b}
     lines = ["# Daraio 2006, model families fitted to the experiment", "",
-             "Each family fitted jointly to Table 1 (10 points, errors in both coordinates) and Fig. 3's "
-             "observations (speeds, duration, gauge ratio, tail). Held-out prediction: Table 1's leave-one-out is "
-             "LINEARISED (PRESS, r_i / (1 - h_ii) at the joint optimum, exact for a linear model; no refits), and "
-             "the magnetic data (points and observations) are predicted by the family fitted to the gravity-only "
-             "data.", "",
-             "| family | parameters (SI) | joint chi2 / dof | BIC | Table 1 chi2/dof | Table 1 RMS | worst (sd) "
-             "| leave-one-out chi2, RMS | magnetic from gravity chi2 / n, RMS |",
+             INTRO, "", FAMILY_HEADER,
              "|---|---|---|---|---|---|---|---|---|"]
     lines += [_family_line(n, b) for n, b in f["models"].items()]
     lines += ["", f"Kept ({f['selection']}): **{f['model'] or 'none'}**."]
@@ -94,9 +101,8 @@ def markdown(f: dict) -> str:
     for key, what, published, _ in FIG3:
         lines.append(f"| {what} | {published} | "
                      + " | ".join(_f(b["fig3"].get(key), ".3g") for b in fitted.values()) + " |")
-    lines += ["", "The gauge ratio compares the gauges' READINGS (the peaks of the upper gauge's trace, as Fig. 3 "
-              "does); the JSON's amplitude_ratio_magnetic_to_gravity is the ratio of the leading pulses' F_d "
-              f"(the truth analysis): {_f(f.get('amplitude_ratio_magnetic_to_gravity'), '.2f')} for the kept model.",
+    ratio = _f(f.get("amplitude_ratio_magnetic_to_gravity"), ".2f")
+    lines += ["", f"{RATIOS} {ratio} for the kept model.",
               "", "Targets (the kept model; not tuned to):", ""]
     lines += [f"- {t['target']}: {_shown(t['value'])}: "
               f"{'met' if t['met'] else 'NOT met' if t['met'] is False else 'no value'}" for t in f["targets"]]
@@ -104,8 +110,7 @@ def markdown(f: dict) -> str:
     lines += ["", f"Fitted scene: {scene} (`rig shot` fires it)." if scene
               else f"No fitted scene written: {f.get('no_fitted_scene')}."]
     lines += ["", "Dashpot scan on the elastic power law's fitted E and n:", "",
-              "| dashpot (kg/s) | Table 1 RMS | speed gravity (m/s) | FWHM / base duration (us) | speed magnet (m/s) "
-              "| F_d ratio |", "|---|---|---|---|---|---|"]
+              SCAN_HEADER, "|---|---|---|---|---|---|"]
     for s in f["dashpot_scan"]:
         lines.append(f"| {s['contact_damping_kg_per_s']:g} | {s['table1_rms_relative']:.1%} | "
                      f"{_f(s['gravity_speed_m_per_s'], '.0f')} | {_f(s['gravity_duration_s'] and s['gravity_duration_s'] * 1e6, '.0f')} / "
