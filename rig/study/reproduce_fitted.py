@@ -51,7 +51,8 @@ def fig3_figures(truths: dict) -> dict:
 
     peaks = of("peak", m, "upper"), of("peak", g, "upper")
     duration = of("duration", g, "upper")
-    return {"gravity_speed_m_per_s": of("speed", g), "gravity_duration_us": None if duration is None else 1e6 * duration,
+    return {"gravity_speed_m_per_s": of("speed", g),
+            "gravity_duration_us": None if duration is None else 1e6 * duration,
             "gravity_pulses_lower_gauge": of("pulses", g, "lower"), "magnetic_speed_m_per_s": of("speed", m),
             "gauge_ratio_magnetic_to_gravity": peaks[0] / peaks[1] if None not in peaks and peaks[1] else None,
             "wall_peak_gravity_N": of("wall_peak", g, WALL), "wall_peak_magnetic_N": of("wall_peak", m, WALL),

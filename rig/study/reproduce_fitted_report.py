@@ -113,15 +113,20 @@ def markdown(f: dict) -> str:
               SCAN_HEADER, "|---|---|---|---|---|---|"]
     for s in f["dashpot_scan"]:
         lines.append(f"| {s['contact_damping_kg_per_s']:g} | {s['table1_rms_relative']:.1%} | "
-                     f"{_f(s['gravity_speed_m_per_s'], '.0f')} | {_f(s['gravity_duration_s'] and s['gravity_duration_s'] * 1e6, '.0f')} / "
-                     f"{_f(s['gravity_base_duration_s'] and s['gravity_base_duration_s'] * 1e6, '.0f')} | "
+                     f"{_f(s['gravity_speed_m_per_s'], '.0f')} | {_us(s['gravity_duration_s'])} / "
+                     f"{_us(s['gravity_base_duration_s'])} | "
                      f"{_f(s['magnetic_speed_m_per_s'], '.0f')} | {_f(s['amplitude_ratio'], '.2f')} |")
     st = f["steel"]
-    lines += ["", f"Steel-21 (its own Hertz law, its modulus fitted to its two speeds): E = "
-              f"{st['youngs_modulus_Pa'] / 1e9:.0f} ± {st['youngs_modulus_std_Pa'] / 1e9:.0f} GPa (published constants: "
-              f"{st['published_modulus_Pa'] / 1e9:.0f} GPa): {st['gravity_speed_m_per_s']:.0f} and "
-              f"{st['magnetic_speed_m_per_s']:.0f} m/s against 580 and 688 m/s."]
+    steel = (f"Steel-21 (its own Hertz law, its modulus fitted to its two speeds): E = "
+             f"{st['youngs_modulus_Pa'] / 1e9:.0f} ± {st['youngs_modulus_std_Pa'] / 1e9:.0f} GPa (published "
+             f"constants: {st['published_modulus_Pa'] / 1e9:.0f} GPa): {st['gravity_speed_m_per_s']:.0f} and "
+             f"{st['magnetic_speed_m_per_s']:.0f} m/s against 580 and 688 m/s.")
+    lines += ["", steel]
     return "\n".join(lines) + "\n"
+
+
+def _us(seconds) -> str:
+    return "-" if seconds is None else _f(seconds * 1e6, ".0f")
 
 
 def _shown(v) -> str:
