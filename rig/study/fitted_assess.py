@@ -32,9 +32,9 @@ from rig.study.fitted_families import (
     unavailable,
 )
 
-FTOL, XTOL = 1e-3, 1e-3
-"""Where a family's fits stop: a step that changes chi2 by less than 0.1% (far below the
-change of 1 that moves an interval) or the parameters by less than 1e-3 of their bounds'
+FTOL, XTOL = 1e-2, 1e-3
+"""Where a family's fits stop: a step that changes chi2 by less than 1% (below the change
+of 1 that moves an interval, for any chi2 below 100) or the parameters by less than 1e-3 of their bounds'
 span (a tenth of the Jacobian's step): tighter, they spend solves on the solver's
 noise (rig.fit.fitting's defaults are 1e-8 and 1e-6)."""
 
@@ -126,7 +126,7 @@ def assess(family: Family, points, observations, tell, done=()) -> Assessment:
         row["failed"] = f"joint fit: {exc}"
         tell(f"{family.name}: failed")
         return Assessment(family, row)
-    row.update({"parameters": parameters(r), "chi2": r.chi2, "dof": r.dof, "bic": r.bic, "converged": r.converged,
+    row.update({"parameters": parameters(r), "chi2": r.chi2, "dof": r.dof, "bic": r.bic, "converged": r.converged, "candidates_solved": r.evaluations,
                 "at_bound": list(r.at_bound), "unusable": unusable(r) or None,
                 "fig3_chi2": float(np.sum(r.residuals[obj.slices[1]] ** 2)), **table1_figures(obj, r)})
     tell(f"{family.name}: joint fit")

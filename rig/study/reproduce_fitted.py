@@ -111,7 +111,7 @@ def reproduce_fitted(out, progress=None) -> dict:
     else:
         fitted.update(_kept(best, shots[best.family.name], out))
     fitted["targets"] = targets(fitted)
-    write_text(out / "fitted.json", json.dumps(fitted, indent=1, default=float))
+    write_text(out / "fitted.json", json.dumps(fitted, indent=1))
     write_text(out / "fitted.md", markdown(fitted))
     return fitted
 

@@ -46,7 +46,7 @@ SCAN_HEADER = ("| dashpot (kg/s) | Table 1 RMS | speed gravity (m/s) | FWHM / ba
 def _inside(value, window) -> bool | None:
     if value is None or not math.isfinite(value):
         return None
-    return window[0] <= value <= window[1]
+    return bool(window[0] <= value <= window[1])
 
 
 def targets(fitted: dict) -> list:
@@ -62,7 +62,7 @@ def targets(fitted: dict) -> list:
                         "value": fig3.get(key), "met": _inside(fig3.get(key), window)})
     g, m = fig3.get("wall_peak_gravity_N"), fig3.get("wall_peak_magnetic_N")
     out.append({"target": "the magnet does not reduce the wall's peak", "value": [g, m],
-                "met": None if None in (g, m) else m >= g})
+                "met": None if None in (g, m) else bool(m >= g)})
     for key, what, published in STEEL:
         v = fitted["steel"].get(key)
         out.append({"target": f"{what}: {published:g} +- 20%", "value": v,
