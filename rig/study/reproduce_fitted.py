@@ -35,6 +35,12 @@ POWER_LAW = "elastic power law"
 """The family whose fitted E and n the dashpot scan holds ("power_law_shots": its shots)."""
 DASHPOTS = (0.0, 0.1, 0.4, 1.6)  # kg/s
 FITTED_SCENE = "fitted_scene.toml"
+KEPT_KEYS = ("table1_chi2_per_dof", "table1_rms_relative", "table1_max_sigma", "table1_max_relative", "parameters",
+             "fig3", "gravity_fit_predicts_magnetic_rms_relative", "gravity_only_fit", "ptfe52_gravity_speed_m_per_s",
+             "ptfe52_magnetic_speed_m_per_s", "ptfe52_gravity_duration_s", "ptfe52_gravity_base_duration_s",
+             "amplitude_ratio_magnetic_to_gravity", "wall_peak_gravity_N", "wall_peak_magnetic_N", "pulses_gravity",
+             "pulses_magnetic", "fitted_scene")
+"""The "fitted" block's keys that describe the kept family (rig reproduce --json)."""
 
 
 def fig3_figures(truths: dict) -> dict:
@@ -105,8 +111,8 @@ def reproduce_fitted(out, progress=None) -> dict:
               "dashpot_scan": _dashpot_scan(pts, list(power.overrides), tell) if power.result else [],
               "steel": _steel(tell), "published": PUBLISHED}
     (out / FITTED_SCENE).unlink(missing_ok=True)
-    if best is None:
-        fitted["fitted_scene"] = None
+    if best is None:  # every key of the kept model's, none with a value, and why
+        fitted.update(dict.fromkeys(KEPT_KEYS))
         fitted["no_fitted_scene"] = "no family's joint fit converged with both held-out predictions"
     else:
         fitted.update(_kept(best, shots[best.family.name], out))

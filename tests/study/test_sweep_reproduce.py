@@ -153,3 +153,22 @@ def test_reproduce_fitted_compares_the_families_and_writes_a_scene_that_fires(tm
         assert shot["truth"]["speed_m_per_s"] == pytest.approx(f["fig3"]["gravity_speed_m_per_s"], rel=0.02)
     else:
         assert not (out / "fitted_scene.toml").exists() and f["no_fitted_scene"]
+
+
+def test_without_a_kept_family_every_target_says_it_has_no_value():
+    """No family fitted (every one skipped): the report says so, claims no target met and
+    writes no fitted scene."""
+    from rig.study.reproduce_fitted import KEPT_KEYS
+    from rig.study.reproduce_fitted_report import markdown, targets
+
+    steel = {"youngs_modulus_Pa": 1.73e11, "youngs_modulus_std_Pa": 4e10, "published_modulus_Pa": 1.93e11,
+             "gravity_speed_m_per_s": 602.0, "magnetic_speed_m_per_s": 659.0}
+    f = {"model": None, "selection": "lowest held-out chi2", "models": {"x": {"skipped": "no such law"}},
+         "dashpot_scan": [], "steel": steel, "no_fitted_scene": "no family's joint fit converged",
+         **dict.fromkeys(KEPT_KEYS)}
+    f["targets"] = targets(f)
+    assert [t["met"] for t in f["targets"] if "steel" not in t["target"]] == [None] * (len(f["targets"]) - 2)
+    assert [t["met"] for t in f["targets"] if "steel" in t["target"]] == [True, True]
+    md = markdown(f)
+    assert "**none**" in md and "No fitted scene written: no family's joint fit converged" in md
+    assert "skipped: no such law" in md
