@@ -105,9 +105,11 @@ def cmd_reproduce(args) -> dict:
             results = reproduce(args.study, args.out, progress)
     block = {"out": args.out, "table1": results["table1"], "summary": results["summary"]}
     if args.fitted:
-        from rig.study.reproduce_fitted import reproduce_fitted
+        from rig.study.fitted_families import FAMILIES
+        from rig.study.reproduce_fitted import DASHPOTS, reproduce_fitted
 
-        with progress_bar(args.quiet, total=14, desc="fitted model", unit="step") as bar:
+        steps = 3 * len(FAMILIES) + len(DASHPOTS) + 1  # each family's fits and shots, the scan, steel
+        with progress_bar(args.quiet, total=steps, desc="fitted models", unit="step") as bar:
             def progress(what):
                 bar.set_postfix_str(what[:40])
                 bar.update()

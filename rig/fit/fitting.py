@@ -61,6 +61,8 @@ class FitResult:
     model: object = None
     replayed: int = 0  # candidates read back from the cache of an earlier run (evaluations: solved in this one)
     bounds: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (lo, hi) of each parameter, SI
+    jacobian: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  # of the residuals at the estimate,
+    # per parameter's bound span and per nuisance parameter (rig.fit.crossval)
 
     @property
     def chi2_reduced(self) -> float:
@@ -170,8 +172,12 @@ def difference_steps(x: np.ndarray, central: bool) -> tuple:
     return up, down
 
 
-def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None) -> FitResult:
-    """Fit ``objective`` (rig.fit.points.PointObjective or rig.fit.traces.TraceObjective)."""
+def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None, ftol: float = 1e-8,
+        xtol: float = 1e-6) -> FitResult:
+    """Fit ``objective`` (rig.fit.points.PointObjective, rig.fit.traces.TraceObjective,
+    rig.fit.observations.objective.ObservationObjective, rig.fit.joint.JointObjective); it
+    stops where a step changes chi2 by less than the fraction ``ftol`` or the normalised
+    parameters by less than about ``xtol`` (scipy.optimize.least_squares)."""
     params = objective.params
     P = len(params)
     lo = np.array([p.lo for p in params])
@@ -211,7 +217,7 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
         return J
 
     res = optimize.least_squares(fun, x0, jac=jac, bounds=bounds, method="trf", x_scale="jac",
-                                 max_nfev=max_evaluations, xtol=1e-6, ftol=1e-8, gtol=1e-8)
+                                 max_nfev=max_evaluations, xtol=xtol, ftol=ftol, gtol=1e-8)
     (model,) = cache.get([theta(res.x)])
     r = objective.residuals(model, res.x[P:])
     J = jac(res.x)
@@ -229,7 +235,7 @@ def fit(objective, cache_folder=None, max_evaluations: int = 400, progress=None)
     converged = bool(res.success and res.status > 0 and np.all(np.isfinite(std)))
     return FitResult(tuple(p.key for p in params), tuple(p.unit for p in params), est, std, ci, corr, r, chi2, dof,
                      converged, str(res.message), cache.solved, at_bound, objective.nuisance_report(res.x[P:]),
-                     res.x[P:].copy(), model, cache.replayed, np.column_stack((lo, lo + span)))
+                     res.x[P:].copy(), model, cache.replayed, np.column_stack((lo, lo + span)), J)
 
 
 def _savez(path, arrays: dict):

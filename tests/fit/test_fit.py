@@ -166,16 +166,23 @@ def test_trace_fit_of_a_csv_export_is_the_fit_of_its_record(tmp_path):
 def test_leave_one_out_predicts_each_point_from_the_others(tmp_path):
     """Points on the model's own curve are predicted from the others to the curve's
     interpolation (< 1%); a point moved 20% up is predicted where the others put it, about
-    20% / 1.2 = 17% below its value, further than the full fit's residual there."""
-    from rig.study.reproduce_fitted import leave_one_out
+    20% / 1.2 = 17% below its value, further than the full fit's residual there. The
+    leave-one-out is the linearised one `rig reproduce --fitted` reports
+    (rig.study.fitted_assess.table1_figures)."""
+    from rig.fit.joint import JointObjective
+    from rig.study.fitted_assess import table1_figures
+
+    def leave_one_out(points):
+        obj = JointObjective([PointObjective(SCENE, parse_parameters(bounds), points)])
+        return table1_figures(obj, fit(obj))
 
     pts = read_points(_virtual_points(tmp_path))
     bounds = ["chain.youngs_modulus=0.5 GPa:3 GPa"]
-    exact = leave_one_out(SCENE, pts, bounds, lambda *a: None)
+    exact = leave_one_out(pts)
     assert max(abs(r) for r in exact["loo_relative_residuals"]) < 0.01
     moved = pts.subset(range(pts.n))
     moved.speed[1] *= 1.2
-    cv = leave_one_out(SCENE, moved, bounds, lambda *a: None)
+    cv = leave_one_out(moved)
     full = PointObjective(SCENE, parse_parameters(bounds), moved)
     r = fit(full)
     assert cv["loo_relative_residuals"][1] == pytest.approx(-0.2 / 1.2, abs=0.01)

@@ -72,6 +72,103 @@ def test_the_fitted_models_shots_keep_their_whole_records_to_the_accuracy():
     from rig.study.reproduce_fitted import fitted_shots
 
     shots = fitted_shots(["chain.youngs_modulus=1.05e9", "chain.contact_exponent=1.74"])
-    for name, s in shots.items():
+    for name in ("ptfe52_gravity", "ptfe52_magnetic"):
+        s = shots[name]
         assert 0 < s["error_estimate"] <= 1e-4, name
         assert s["speed_m_per_s"] > 0 and s["wall_peak_N"] > 0
+    # Fig. 3's figures, measured as the observation kinds measure them, agree with the truth
+    # analysis where both measure the same thing, and the magnet does what a precompression does
+    f = shots["fig3"]
+    assert f["gravity_speed_m_per_s"] == pytest.approx(shots["ptfe52_gravity"]["speed_m_per_s"], rel=0.02)
+    assert f["magnetic_speed_m_per_s"] == pytest.approx(shots["ptfe52_magnetic"]["speed_m_per_s"], rel=0.02)
+    assert f["magnetic_speed_m_per_s"] > 1.2 * f["gravity_speed_m_per_s"]
+    assert f["wall_peak_gravity_N"] == pytest.approx(shots["ptfe52_gravity"]["wall_peak_N"], rel=0.05)
+    assert 30.0 < f["gravity_duration_us"] < 400.0  # a few bead diameters at ~150 m/s
+    assert f["gravity_pulses_lower_gauge"] >= 1 and f["magnetic_tail_relative"] >= 0
+    assert f["gauge_ratio_magnetic_to_gravity"] > 0
+
+
+def test_the_families_are_data_and_one_this_version_lacks_is_skipped_with_the_reason():
+    """A family whose law the scene schema does not know is reported as skipped, naming the
+    key; its magnetic-only overrides go to the magnetic shots and to no other."""
+    from rig.study.fitted_families import (
+        FAMILIES,
+        fig3_observations,
+        magnetic_points,
+        table1_points,
+        unavailable,
+        with_magnetic,
+    )
+
+    names = [f.name for f in FAMILIES]
+    assert len(set(names)) == len(names)
+    by_name = {f.name: f for f in FAMILIES}
+    for name in ("hertz", "elastic power law", "dashpot", "power-law dashpot", "holder friction"):
+        assert unavailable(by_name[name]) == "", name
+    plastic = by_name["elastic-plastic"]
+    why = unavailable(plastic)
+    if why:  # a version without the elastic-plastic law
+        assert "chain.yield_force" in why and "unknown key" in why
+    pts, obs = with_magnetic(plastic, table1_points(), fig3_observations())
+    mag = magnetic_points(pts)
+    assert all(("chain.static_hold=60 s" in c) == m for c, m in zip(pts.configs, mag))
+    for o in obs:
+        for s in o.shots():
+            assert ("chain.static_hold=60 s" in s.overrides) == (s.scene == "ptfe52_magnetic")
+
+
+@pytest.mark.slow
+def test_reproduce_fitted_compares_the_families_and_writes_a_scene_that_fires(tmp_path, capsys):
+    """The whole `rig reproduce daraio2006 --fitted`: its JSON keys, physics sanity (not the
+    targets) and a fitted scene that `rig shot` fires."""
+    out = tmp_path / "r"
+    assert main(["reproduce", "daraio2006", "--fitted", "--out", str(out), "--quiet", "--json"]) == 0
+    f = json.loads(capsys.readouterr().out)["fitted"]
+    for key in ("model", "table1_rms_relative", "table1_max_relative", "gravity_fit_predicts_magnetic_rms_relative",
+                "ptfe52_gravity_speed_m_per_s", "ptfe52_magnetic_speed_m_per_s", "ptfe52_gravity_duration_s",
+                "amplitude_ratio_magnetic_to_gravity", "wall_peak_gravity_N", "wall_peak_magnetic_N",
+                "pulses_gravity", "pulses_magnetic", "parameters", "models", "gravity_only_fit", "power_law_shots",
+                "dashpot_scan", "steel", "published", "table1_chi2_per_dof", "table1_max_sigma", "fig3",
+                "targets", "fitted_scene"):
+        assert key in f, key
+    assert set(f["fig3"]) == {"gravity_speed_m_per_s", "gravity_duration_us", "gravity_pulses_lower_gauge",
+                              "magnetic_speed_m_per_s", "gauge_ratio_magnetic_to_gravity", "wall_peak_gravity_N",
+                              "wall_peak_magnetic_N", "magnetic_tail_relative"}
+    assert {"gravity_speed_m_per_s", "magnetic_speed_m_per_s"} <= set(f["steel"])
+    assert all({"estimate", "std", "ci95", "unit"} <= set(p) for p in f["parameters"].values())
+    fitted_rows = [r for r in f["models"].values() if r.get("fig3")]
+    assert f["model"] in f["models"] and len(fitted_rows) >= 4
+    for r in fitted_rows:  # held-out data are predicted no better than fitted ones
+        assert r["loo_chi2"] >= r["table1_chi2"] and r["magnetic_from_gravity"]["chi2"] > 0
+        assert r["fig3"]["magnetic_speed_m_per_s"] > r["fig3"]["gravity_speed_m_per_s"]
+    kept = f["models"][f["model"]]
+    assert kept["held_out_chi2"] == min(r["held_out_chi2"] for r in fitted_rows if r.get("converged"))
+    assert 80.0 < f["fig3"]["gravity_speed_m_per_s"] < 250.0 and 0.3e9 < f["parameters"]["chain.youngs_modulus"][
+        "estimate"] < 3e9
+    md = (out / "fitted.md").read_text()
+    assert "LINEARISED" in md and "F_d" in md and "READINGS" in md
+    if f["fitted_scene"]:
+        assert main(["shot", f["fitted_scene"], "--json", "--seed", "1"]) == 0
+        shot = json.loads(capsys.readouterr().out)
+        assert shot["truth"]["speed_m_per_s"] == pytest.approx(f["fig3"]["gravity_speed_m_per_s"], rel=0.02)
+    else:
+        assert not (out / "fitted_scene.toml").exists() and f["no_fitted_scene"]
+
+
+def test_without_a_kept_family_every_target_says_it_has_no_value():
+    """No family fitted (every one skipped): the report says so, claims no target met and
+    writes no fitted scene."""
+    from rig.study.reproduce_fitted import KEPT_KEYS
+    from rig.study.reproduce_fitted_report import markdown, targets
+
+    steel = {"youngs_modulus_Pa": 1.73e11, "youngs_modulus_std_Pa": 4e10, "published_modulus_Pa": 1.93e11,
+             "gravity_speed_m_per_s": 602.0, "magnetic_speed_m_per_s": 659.0}
+    f = {"model": None, "selection": "lowest held-out chi2", "models": {"x": {"skipped": "no such law"}},
+         "dashpot_scan": [], "steel": steel, "no_fitted_scene": "no family's joint fit converged",
+         **dict.fromkeys(KEPT_KEYS)}
+    f["targets"] = targets(f)
+    assert [t["met"] for t in f["targets"] if "steel" not in t["target"]] == [None] * (len(f["targets"]) - 2)
+    assert [t["met"] for t in f["targets"] if "steel" in t["target"]] == [True, True]
+    md = markdown(f)
+    assert "**none**" in md and "No fitted scene written: no family's joint fit converged" in md
+    assert "skipped: no such law" in md

@@ -121,10 +121,15 @@ class ObservationObjective:
         r = (model - self.value) / self.sd
         return np.where(np.isfinite(r), r, NO_FIGURE)
 
-    def relative_rms(self, model, eta) -> float:
-        """RMS of model / observed - 1 (observations without a figure, or observed 0, left out)."""
+    def relative_residuals(self, model) -> np.ndarray:
+        """model / observed - 1 of each observation (nan without a figure or where observed is 0)."""
         with np.errstate(divide="ignore", invalid="ignore"):
             rel = model / self.value - 1.0
+        return np.where(np.isfinite(rel), rel, np.nan)
+
+    def relative_rms(self, model, eta) -> float:
+        """RMS of model / observed - 1 (observations without a figure, or observed 0, left out)."""
+        rel = self.relative_residuals(model)
         rel = rel[np.isfinite(rel)]
         return float(np.sqrt(np.mean(rel ** 2))) if rel.size else math.nan
 

@@ -1,0 +1,154 @@
+"""The model families `rig reproduce daraio2006 --fitted` compares, as data: each a name,
+scene overrides it fixes (on every shot, and on the magnetic shots only), and the scene keys
+it fits with their bounds (``KEY=LO:HI``, rig.fit.parameters). A family whose keys or law
+the scene schema does not know (a contact law this version does not have) is skipped, and
+the reason is reported; adding a family is adding an entry to FAMILIES.
+
+Also here: the published data the families are fitted to (Table 1's points, Fig. 3's
+observations), split into the gravity-only and the magnetic shots, and the joint objective
+of a family on any part of them.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from importlib import resources
+
+import numpy as np
+
+from rig.errors import RigError
+from rig.experiment import scene as scene_io
+from rig.fit.data import Points, read_points
+from rig.fit.joint import JointObjective
+from rig.fit.observations.objective import ObservationObjective
+from rig.fit.observations.reading import read_observations
+from rig.fit.parameters import law_overrides, parse_parameters
+from rig.fit.points import PointObjective
+
+SCENE = "ptfe52_gravity"
+MAGNETIC_SCENE = "ptfe52_magnetic"
+E_BOUNDS = "chain.youngs_modulus=0.2 GPa:4 GPa"
+N_BOUNDS = "chain.contact_exponent=1.05:2.6"
+MU_BOUNDS = "chain.contact_damping=0.001 kg/s:3 kg/s"
+
+
+@dataclass(frozen=True)
+class Family:
+    """A model family: ``params`` the fitted keys with bounds (KEY=LO:HI), ``fixed`` the
+    overrides of every shot, ``magnetic`` the overrides of the shots with the magnet only
+    (after ``fixed``), ``note`` what it stands for."""
+
+    name: str
+    params: tuple
+    fixed: tuple = ()
+    magnetic: tuple = ()
+    note: str = ""
+    starts_from: str = ""
+    """The family (nested in this one) whose fitted values this one's fit starts from, for
+    the keys both fit: a richer model starts where the simpler one ended, not in a far
+    local minimum."""
+
+
+FAMILIES = (
+    Family("hertz", (E_BOUNDS,), note="the published law: Hertz (n = 3/2), the modulus fitted"),
+    Family("elastic power law", (E_BOUNDS, N_BOUNDS), note="F = A delta^n, modulus and exponent fitted",
+           starts_from="hertz"),
+    Family("dashpot", (E_BOUNDS, N_BOUNDS, MU_BOUNDS), note="the power law with a linear dashpot in the contacts",
+           starts_from="elastic power law"),
+    Family("power-law dashpot", (E_BOUNDS, N_BOUNDS, "chain.dashpot_gamma=0.001:3", "chain.dashpot_exponent=0.5:2"),
+           note="the power law with a dashpot gamma v^alpha in the contacts", starts_from="elastic power law"),
+    Family("holder friction", (E_BOUNDS, N_BOUNDS, "holder.friction=0 N:0.1 N"),
+           note="the power law with Coulomb friction of every bead on the holder's wall",
+           starts_from="elastic power law"),
+    # The elastic-plastic contact law with memory (chain.contact_law = thornton): the beads'
+    # contacts yield above chain.yield_force, and a contact held under load (the magnet's
+    # precompression, for chain.static_hold before the shot) yields later by
+    # chain.static_yield_ratio. The hold is not published: the 60 s here is an assumption.
+    # Skipped, with the reason, where the scene schema does not know these keys.
+    Family("elastic-plastic", (E_BOUNDS, "chain.yield_force=0.2 N:20 N", "chain.static_yield_ratio=1:4"),
+           magnetic=("chain.static_hold=60 s",), note="elastic-plastic contacts with memory (Thornton)",
+           starts_from="hertz"),
+    Family("elastic-plastic + dashpot", (E_BOUNDS, "chain.yield_force=0.2 N:20 N", "chain.static_yield_ratio=1:4",
+                                         MU_BOUNDS),
+           fixed=("chain.contact_law=thornton",), magnetic=("chain.static_hold=60 s",),
+           note="elastic-plastic contacts with memory and a linear dashpot", starts_from="elastic-plastic"),
+)
+"""The families, in the order they are reported."""
+
+
+def unavailable(family: Family) -> str:
+    """Why ``family`` cannot be fitted with this version's scene schema and laws ('' where it
+    can): its bounds, its law and its fixed overrides are read as a fit would read them."""
+    try:
+        params = parse_parameters(family.params)
+        overrides = list(family.fixed) + law_overrides(params)
+        for scene, extra in ((SCENE, ()), (MAGNETIC_SCENE, family.magnetic)):
+            scene_io.load(scene, overrides + list(extra))
+    except RigError as exc:
+        return str(exc)
+    return ""
+
+
+def table1_points() -> Points:
+    """Table 1's ten experimental (F_d, V_s) points, with and without the magnet."""
+    path = resources.files("rig") / "scenes" / "daraio2006" / "table1_experiment.csv"
+    with resources.as_file(path) as p:
+        return read_points(p)
+
+
+def fig3_observations() -> tuple:
+    """Fig. 3's observed figures (rig/scenes/daraio2006/fig3_observations.toml)."""
+    path = resources.files("rig") / "scenes" / "daraio2006" / "fig3_observations.toml"
+    with resources.as_file(path) as p:
+        return read_observations(p, SCENE)
+
+
+def magnetic_points(points: Points) -> np.ndarray:
+    """Whether each point was taken with the magnet (a magnet.force above 0 in its configuration)."""
+    return np.array([any(o.startswith("magnet.force=") and float(o.split("=", 1)[1]) > 0 for o in c)
+                     for c in points.configs])
+
+
+def magnetic_observation(obs) -> bool:
+    """Whether an observation needs a shot with the magnet."""
+    return any(s.scene == MAGNETIC_SCENE for s in obs.shots())
+
+
+def with_magnetic(family: Family, points: Points, observations: tuple) -> tuple:
+    """(points, observations) with the family's magnetic-only overrides on the magnetic shots."""
+    if not family.magnetic:
+        return points, observations
+    mag = magnetic_points(points)
+    configs = tuple(c + family.magnetic if m else c for c, m in zip(points.configs, mag))
+
+    def shot(s):
+        return dataclasses.replace(s, overrides=s.overrides + family.magnetic) if s.scene == MAGNETIC_SCENE else s
+
+    obs = tuple(dataclasses.replace(o, shot=shot(o.shot), over=None if o.over is None else shot(o.over))
+                for o in observations)
+    return dataclasses.replace(points, configs=configs), obs
+
+
+def objective(family: Family, points: Points, observations: tuple, start: dict | None = None) -> JointObjective:
+    """The family's joint objective on these points and observations (either may be empty),
+    its fit starting at ``start`` ({key: SI value}) for the keys it gives, at the scene's
+    values for the others."""
+    params = parse_parameters(family.params)
+    points, observations = with_magnetic(family, points, observations)
+    parts = []
+    if points.n:
+        parts.append(PointObjective(SCENE, params, points, family.fixed))
+    if observations:
+        parts.append(ObservationObjective(SCENE, params, observations, family.fixed, "Fig. 3"))
+    theta0 = parts[0].start().copy()
+    for k, p in enumerate(params):
+        if start and p.key in start:
+            theta0[k] = min(max(start[p.key], p.lo), p.hi)
+    return JointObjective(parts, theta0)
+
+
+def fitted_overrides(family: Family, result) -> list:
+    """The overrides of every shot of the family at a fit's estimate (its law switched on)."""
+    params = parse_parameters(family.params)
+    return (list(family.fixed) + law_overrides(params)
+            + [p.override(v) for p, v in zip(params, result.estimate)])
