@@ -172,6 +172,15 @@ class Curve:
     force: np.ndarray
     speed: np.ndarray
 
+    def reach(self) -> tuple:
+        """(F_d, V_s) of the curve's largest leading pulse (nan, nan where it has none): no
+        striker velocity of the curve gives a larger amplitude."""
+        ok = np.isfinite(self.force) & np.isfinite(self.speed) & (self.force > 0)
+        if not np.any(ok):
+            return math.nan, math.nan
+        k = int(np.argmax(np.where(ok, self.force, -np.inf)))
+        return float(self.force[k]), float(self.speed[k])
+
     def speed_at(self, F: np.ndarray) -> tuple:
         """(V_s, dlnV/dlnF) at forces F (N): linear in log-log between the curve's points,
         the end slopes beyond them. Raises RigError when fewer than two points are usable."""

@@ -8,6 +8,11 @@ at its force, in units of the effective standard deviation (errors in variables,
 effective-variance method: Orear, Am. J. Phys. 50, 912 (1982)):
 
     r_i = (V(F_i) - V_i) / sqrt(sd_V,i^2 + (dV/dF)^2 sd_F,i^2)
+
+A point of an amplitude larger than any the curve reaches over its striker velocities (a
+model whose pulses stop growing: contacts that yield) is unreachable: its residual is its
+distance to the curve's end (F_e, V_e), sqrt(((V_e - V_i) / sd_eff)^2 + ((F_i - F_e) / sd_F)^2)
+with the sign of V_e - V_i, which meets the residual above where F_i = F_e.
 """
 from __future__ import annotations
 
@@ -140,16 +145,31 @@ class PointObjective:
                 continue
         return V, s
 
+    def reach(self, model) -> tuple:
+        """(F_e, V_e) of each point's curve's largest pulse (module doc)."""
+        ends = np.array([c.reach() for c in model])
+        return ends[self.config_of, 0], ends[self.config_of, 1]
+
+    def reachable(self, model) -> np.ndarray:
+        """Whether a striker velocity of its curve gives each point's amplitude."""
+        return self.points.force <= self.reach(model)[0]
+
     def residuals(self, model, eta) -> np.ndarray:
         p = self.points
         V, s = self.model_speeds(model)
-        sd = np.sqrt(p.speed_sd ** 2 + (s * V / p.force * p.force_sd) ** 2)
+        F_e, V_e = self.reach(model)
+        beyond = ~self.reachable(model)
+        V = np.where(beyond, V_e, V)
+        sd = np.sqrt(p.speed_sd ** 2 + (s * V / np.where(beyond, F_e, p.force) * p.force_sd) ** 2)
         r = (V - p.speed) / sd
+        gap = np.where(beyond, (p.force - F_e) / p.force_sd, 0.0)
+        r = np.where(beyond, np.where(r >= 0, 1.0, -1.0) * np.hypot(r, gap), r)
         return np.where(np.isfinite(r), r, NO_CURVE)
 
     def relative_residuals(self, model) -> np.ndarray:
-        """V_model(F_i) / V_i - 1 at each point."""
-        return self.model_speeds(model)[0] / self.points.speed - 1.0
+        """V_model(F_i) / V_i - 1 at each point (an unreachable one: the curve's end speed's)."""
+        V = np.where(self.reachable(model), self.model_speeds(model)[0], self.reach(model)[1])
+        return V / self.points.speed - 1.0
 
     def relative_rms(self, model, eta) -> float:
         """RMS of the relative speed residuals (points without a model curve left out)."""

@@ -71,8 +71,9 @@ def _rms(x) -> float:
 
 def table1_figures(obj, result: FitResult) -> dict:
     """Table 1's share of a joint fit (its first part): chi2 per (points - fitted parameters),
-    relative RMS and worst point, the largest |residual| in sd, and the linearised
-    leave-one-out (rig.fit.crossval)."""
+    relative RMS and worst point, the largest |residual| in sd, the points no striker velocity
+    of the model's curve reaches (rig.fit.points), and the linearised leave-one-out
+    (rig.fit.crossval)."""
     rows = obj.slices[0]
     r = result.residuals[rows]
     rel = obj.parts[0].relative_residuals(result.model[0])
@@ -80,7 +81,9 @@ def table1_figures(obj, result: FitResult) -> dict:
     keep = 1.0 - h
     loo_r, loo_rel = r / keep, rel / keep
     dof = r.size - len(result.keys)
-    return {"table1_chi2": float(r @ r), "table1_chi2_per_dof": float(r @ r) / dof if dof > 0 else math.nan,
+    reach = obj.parts[0].reachable(result.model[0])
+    return {"table1_unreachable": int(np.count_nonzero(~reach)), "table1_reachable": reach.tolist(),
+            "table1_chi2": float(r @ r), "table1_chi2_per_dof": float(r @ r) / dof if dof > 0 else math.nan,
             "table1_rms_relative": _rms(rel), "table1_max_sigma": float(np.max(np.abs(r))),
             "rms_relative": _rms(rel), "max_relative": float(np.nanmax(np.abs(rel))),
             "relative_residuals": rel.tolist(), "normalised_residuals": r.tolist(),
@@ -120,7 +123,8 @@ def assess(family: Family, points, observations, tell, done=()) -> Assessment:
         return Assessment(family, row)
     try:
         parent = next((a.result for a in done if a.family.name == family.starts_from and a.result), None)
-        obj = objective(family, points, observations, None if parent is None else estimates(parent))
+        start = dict(family.start) | ({} if parent is None else estimates(parent))
+        obj = objective(family, points, observations, start)
         r = fit(obj, ftol=FTOL, xtol=XTOL)
     except RigError as exc:
         row["failed"] = f"joint fit: {exc}"

@@ -32,10 +32,13 @@ from rig.study.fitted_families import FAMILIES, MAGNETIC_SCENE, SCENE, fig3_obse
 from rig.study.reproduce_fitted_report import PUBLISHED, markdown, targets
 
 POWER_LAW = "elastic power law"
+LEGACY_NAMES = {"power law": POWER_LAW, "power law + dashpot": "dashpot"}
+"""Rows of "models" under the names earlier versions gave them (the same rows)."""
 """The family whose fitted E and n the dashpot scan holds ("power_law_shots": its shots)."""
 DASHPOTS = (0.0, 0.1, 0.4, 1.6)  # kg/s
 FITTED_SCENE = "fitted_scene.toml"
-KEPT_KEYS = ("table1_chi2_per_dof", "table1_rms_relative", "table1_max_sigma", "table1_max_relative", "parameters",
+KEPT_KEYS = ("table1_chi2_per_dof", "table1_rms_relative", "table1_max_sigma", "table1_max_relative",
+             "table1_unreachable", "parameters",
              "fig3", "gravity_fit_predicts_magnetic_rms_relative", "gravity_only_fit", "ptfe52_gravity_speed_m_per_s",
              "ptfe52_magnetic_speed_m_per_s", "ptfe52_gravity_duration_s", "ptfe52_gravity_base_duration_s",
              "amplitude_ratio_magnetic_to_gravity", "wall_peak_gravity_N", "wall_peak_magnetic_N", "pulses_gravity",
@@ -109,7 +112,11 @@ def reproduce_fitted(out, progress=None) -> dict:
                            "predicted by the fit to the gravity-only data, among the converged joint fits",
               "models": {a.family.name: a.row for a in judged}, "power_law_shots": shots.get(POWER_LAW),
               "dashpot_scan": _dashpot_scan(pts, list(power.overrides), tell) if power.result else [],
-              "steel": _steel(tell), "published": PUBLISHED}
+              "published": PUBLISHED}
+    fitted["steel"] = _steel(tell, best is not None and "chain.contact_law=thornton" in best.overrides)
+    for old, name in LEGACY_NAMES.items():  # the rows' names of earlier versions, kept
+        if name in fitted["models"]:
+            fitted["models"][old] = fitted["models"][name]
     (out / FITTED_SCENE).unlink(missing_ok=True)
     if best is None:  # every key of the kept model's, none with a value, and why
         fitted.update(dict.fromkeys(KEPT_KEYS))
@@ -127,7 +134,8 @@ def _kept(best, shots: dict, out: Path) -> dict:
     its fit is usable)."""
     row, r = best.row, best.result
     g, m = shots[SCENE], shots[MAGNETIC_SCENE]
-    block = {k: row[k] for k in ("table1_chi2_per_dof", "table1_rms_relative", "table1_max_sigma")}
+    block = {k: row[k] for k in ("table1_chi2_per_dof", "table1_rms_relative", "table1_max_sigma",
+                                 "table1_unreachable")}
     block.update({
         "table1_max_relative": row["max_relative"], "parameters": row["parameters"], "fig3": shots["fig3"],
         "gravity_fit_predicts_magnetic_rms_relative": row["magnetic_from_gravity"]["rms_relative"],
@@ -173,21 +181,34 @@ def _ratio(shots: dict) -> float:
     return float(a / b) if a and b else math.nan
 
 
-def _steel(tell) -> dict:
-    """Steel-21's modulus from its two published speeds at 0.44 m/s (10% each): a 1-D
-    weighted least squares over a grid of moduli, refined by parabola. Steel keeps its own
-    contact law (Hertz): the PTFE families' exponents and dissipation are PTFE's."""
-    grid = np.linspace(120e9, 260e9, 15)
+def _steel(tell, plastic: bool) -> dict:
+    """Steel-21 fitted to its two published speeds at 0.44 m/s (10% each), with the kept
+    family's contact law and steel's own parameters: for an elastic family its modulus, for
+    an elastic-plastic one its yield force at the published modulus (steel's contacts, not
+    PTFE's, so none of PTFE's values; no rate law, hold or dashpot). A 1-D weighted least
+    squares over a grid (log-spaced for the yield force), refined by parabola."""
     scenes = ("steel21_gravity", "steel21_magnetic")
     target = np.array([PUBLISHED["steel_gravity_speed"], PUBLISHED["steel_magnetic_speed"]])
-    moduli = [[f"chain.youngs_modulus={float(E)!r}"] for E in grid]
-    speeds = np.array([[c.speed[0] for c in curves(s, moduli, [0.44])] for s in scenes]).T
+    if plastic:
+        key, grid, law = "chain.yield_force", np.geomspace(0.5, 200.0, 15), ["chain.contact_law=thornton"]
+    else:
+        key, grid, law = "chain.youngs_modulus", np.linspace(120e9, 260e9, 15), []
+    sets = [law + [f"{key}={float(x)!r}"] for x in grid]
+    speeds = np.array([[c.speed[0] for c in curves(s, sets, [0.44])] for s in scenes]).T
     chi2 = np.sum(((speeds - target) / (0.1 * target)) ** 2, axis=1)
     k = int(np.clip(np.nanargmin(chi2), 1, grid.size - 2))
-    a, b, _ = np.polyfit(grid[k - 1:k + 2], chi2[k - 1:k + 2], 2)
-    E = float(-b / (2 * a)) if a > 0 else float(grid[k])
-    fitted = [c.speed[0] for s in scenes for c in curves(s, [[f"chain.youngs_modulus={E!r}"]], [0.44])]
+    x = np.log(grid) if plastic else grid
+    a, b, _ = np.polyfit(x[k - 1:k + 2], chi2[k - 1:k + 2], 2)
+    best = float(-b / (2 * a)) if a > 0 else float(x[k])
+    value = float(np.exp(best)) if plastic else best
+    std = float(math.sqrt(2 / a)) * (value if plastic else 1.0) if a > 0 else math.nan
+    fitted = [c.speed[0] for s in scenes for c in curves(s, [law + [f"{key}={value!r}"]], [0.44])]
     tell("steel")
-    return {"youngs_modulus_Pa": E, "youngs_modulus_std_Pa": float(math.sqrt(2 / a)) if a > 0 else math.nan,
-            "gravity_speed_m_per_s": fitted[0], "magnetic_speed_m_per_s": fitted[1],
-            "published_modulus_Pa": Rig.from_scene("steel21_gravity").chain.beads[-1].material.E}
+    published = Rig.from_scene("steel21_gravity").chain.beads[-1].material.E
+    out = {"law": "thornton" if plastic else "hertz", "fitted_key": key,
+           "youngs_modulus_Pa": published if plastic else value,
+           "youngs_modulus_std_Pa": math.nan if plastic else std,
+           "gravity_speed_m_per_s": fitted[0], "magnetic_speed_m_per_s": fitted[1], "published_modulus_Pa": published}
+    if plastic:
+        out.update({"yield_force_N": value, "yield_force_std_N": std})
+    return out

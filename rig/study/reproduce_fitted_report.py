@@ -1,10 +1,14 @@
 """What `rig reproduce daraio2006 --fitted` states: the published numbers, the targets a
 fitted model is held to (each met or not, never tuned to), and fitted.md.
 
-The targets: Table 1 fitted to a relative RMS of at most 7%, chi2/dof at most 1 and no point
-beyond 2 sd; each Fig. 3 figure inside 2 sd of its published value (the sds of
-rig/scenes/daraio2006/fig3_observations.toml, steel's the paper's 10%); a train at the lower
-gauge without the magnet; the wall's peak not reduced by the magnet.
+The targets: Table 1 fitted to a relative RMS of at most 7%, chi2/dof at most 1, no point
+beyond 2 sd and every point reachable (a striker velocity of the model's curve gives its
+amplitude); Fig. 3's figures in the windows of the project's issue on it: gravity speed
+116-142 m/s (129 +- 10%), the leading pulse's full duration at the upper gauge 120-204 us, a
+train (at least 2 pulses above 10% of the leading one at the lower gauge), magnetic speed
+200-244 m/s, gauge-reading ratio magnet / gravity 1.5-2.5, the wall's peak not reduced by the
+magnet, the magnetic tail at the lower gauge at most 10% of the leading pulse; steel's two
+speeds within the paper's 10%.
 """
 from __future__ import annotations
 
@@ -14,10 +18,10 @@ PUBLISHED = {"gravity_speed": 129.0, "gravity_duration_s": 170e-6, "magnetic_spe
              "steel_gravity_speed": 580.0, "steel_magnetic_speed": 688.0}
 
 FIG3 = (  # key, what, published, window (lo, hi)
-    ("gravity_speed_m_per_s", "speed, gravity only (m/s)", "129", (129.0 - 26.0, 129.0 + 26.0)),
-    ("gravity_duration_us", "full duration, gravity only, upper gauge (us)", "170", (170.0 - 50.0, 170.0 + 50.0)),
+    ("gravity_speed_m_per_s", "speed, gravity only (m/s)", "129", (116.0, 142.0)),
+    ("gravity_duration_us", "full duration, gravity only, upper gauge (us)", "170", (120.0, 204.0)),
     ("gravity_pulses_lower_gauge", "pulses at the lower gauge, gravity only", "a train", (2.0, math.inf)),
-    ("magnetic_speed_m_per_s", "speed with 2.38 N (m/s)", "222", (222.0 - 44.0, 222.0 + 44.0)),
+    ("magnetic_speed_m_per_s", "speed with 2.38 N (m/s)", "222", (200.0, 244.0)),
     ("gauge_ratio_magnetic_to_gravity", "gauge readings' peak ratio magnet / gravity", "about 2", (1.5, 2.5)),
     ("wall_peak_gravity_N", "wall peak, gravity only (N)", "-", None),
     ("wall_peak_magnetic_N", "wall peak with the magnet (N)", "not reduced", None),
@@ -25,7 +29,8 @@ FIG3 = (  # key, what, published, window (lo, hi)
 )
 TABLE1 = (("table1_rms_relative", "Table 1 relative RMS <= 7%", 0.07),
           ("table1_chi2_per_dof", "Table 1 chi2/dof <= 1", 1.0),
-          ("table1_max_sigma", "no Table 1 point beyond 2 sd", 2.0))
+          ("table1_max_sigma", "no Table 1 point beyond 2 sd", 2.0),
+          ("table1_unreachable", "every Table 1 point reachable (points no striker velocity reaches)", 0))
 STEEL = (("gravity_speed_m_per_s", "steel speed, gravity only (m/s)", 580.0),
          ("magnetic_speed_m_per_s", "steel speed with 2.38 N (m/s)", 688.0))
 
@@ -87,14 +92,19 @@ def _family_line(name: str, b: dict) -> str:
             f"{b['loo_chi2']:.2f}, {b['loo_rms_relative']:.1%} | {held} |")
 
 
+LEGACY = ("power law", "power law + dashpot")
+"""Rows that repeat a family's under an earlier version's name (not shown twice)."""
+
+
 def markdown(f: dict) -> str:
     """fitted.md: the families, their Fig. 3 figures against the published ones, the
     targets, the dashpot scan and steel."""
-    fitted = {n: b for n, b in f["models"].items() if "fig3" in b}
+    models = {n: b for n, b in f["models"].items() if n not in LEGACY}
+    fitted = {n: b for n, b in models.items() if "fig3" in b}
     lines = ["# Daraio 2006, model families fitted to the experiment", "",
              INTRO, "", FAMILY_HEADER,
              "|---|---|---|---|---|---|---|---|---|"]
-    lines += [_family_line(n, b) for n, b in f["models"].items()]
+    lines += [_family_line(n, b) for n, b in models.items()]
     lines += ["", f"Kept ({f['selection']}): **{f['model'] or 'none'}**."]
     lines += ["", "| Fig. 3 figure | published | " + " | ".join(fitted) + " |",
               "|---|---|" + "---|" * len(fitted)]
@@ -117,10 +127,17 @@ def markdown(f: dict) -> str:
                      f"{_us(s['gravity_base_duration_s'])} | "
                      f"{_f(s['magnetic_speed_m_per_s'], '.0f')} | {_f(s['amplitude_ratio'], '.2f')} |")
     st = f["steel"]
-    steel = (f"Steel-21 (its own Hertz law, its modulus fitted to its two speeds): E = "
-             f"{st['youngs_modulus_Pa'] / 1e9:.0f} ± {st['youngs_modulus_std_Pa'] / 1e9:.0f} GPa (published "
-             f"constants: {st['published_modulus_Pa'] / 1e9:.0f} GPa): {st['gravity_speed_m_per_s']:.0f} and "
-             f"{st['magnetic_speed_m_per_s']:.0f} m/s against 580 and 688 m/s.")
+    if st.get("law") == "thornton":
+        steel = (f"Steel-21 (the kept family's elastic-plastic law with steel's own parameters: the published "
+                 f"E = {st['published_modulus_Pa'] / 1e9:.0f} GPa, its yield force fitted to its two speeds): "
+                 f"F_y = {st['yield_force_N']:.3g} ± {st['yield_force_std_N']:.2g} N: "
+                 f"{st['gravity_speed_m_per_s']:.0f} and {st['magnetic_speed_m_per_s']:.0f} m/s against 580 and "
+                 "688 m/s.")
+    else:
+        steel = (f"Steel-21 (its own Hertz law, its modulus fitted to its two speeds): E = "
+                 f"{st['youngs_modulus_Pa'] / 1e9:.0f} ± {st['youngs_modulus_std_Pa'] / 1e9:.0f} GPa (published "
+                 f"constants: {st['published_modulus_Pa'] / 1e9:.0f} GPa): {st['gravity_speed_m_per_s']:.0f} and "
+                 f"{st['magnetic_speed_m_per_s']:.0f} m/s against 580 and 688 m/s.")
     lines += ["", steel]
     return "\n".join(lines) + "\n"
 

@@ -66,9 +66,9 @@ YIELD_FORCE = LawParameter("yield_force", "N", 0.0, float("inf"), 0.0,
 RATE_EXPONENT = LawParameter("yield_rate_exponent", "1", 0.0, 0.5, 0.0,
                              "exponent m of the yield pressure's rise with the closing rate above the "
                              "reference rate, p_y ~ (r / r_ref)^m (0: a rate-independent yield)")
-REFERENCE_RATE = LawParameter("yield_reference_rate", "m/s", 0.0, float("inf"), 1.0,
-                              "closing rate r_ref (m/s) at which a contact yields at chain.yield_force",
-                              lo_open=True)
+REFERENCE_RATE = LawParameter("yield_reference_rate", "m/s", 0.0, float("inf"), 0.01,
+                              "closing rate r_ref (m/s) at and below which a contact yields at "
+                              "chain.yield_force (a pulse's contacts close at 0.01-1 m/s)", lo_open=True)
 STATIC_RATIO = LawParameter("static_yield_ratio", "1", 0.05, 1.0, 1.0,
                             "yield pressure of a static hold over the dynamic one (chain.yield_force's)")
 
