@@ -15,9 +15,9 @@ import numpy as np
 
 from rig.errors import RigError, invalid
 from rig.solver.kernels.ensemble import integrate_ensemble
+from rig.solver.kernels.report import DIAGNOSTICS, ENERGY_ERROR, STATUS
 from rig.solver.methods import DEFAULT_METHOD
 from rig.solver.methods import method as get_method
-from rig.solver.kernels.report import DIAGNOSTICS, ENERGY_ERROR, STATUS
 from rig.solver.problem import ProblemArrays
 from rig.solver.run import check_record, kernel_inputs, time_grid
 from rig.solver.saveat import SaveAt

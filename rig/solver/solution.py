@@ -7,8 +7,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from rig.model.contact import hertz_energy
-from rig.solver.kernels.report import (BODIES_STEPPED, DISSIPATED, END_TIME, ENERGY_ERROR, MOMENTUM_ERROR, STATUS,
-                                       STEPS, WALL_IMPULSE)
+from rig.solver.kernels.report import (
+    BODIES_STEPPED,
+    DISSIPATED,
+    END_TIME,
+    ENERGY_ERROR,
+    MOMENTUM_ERROR,
+    STATUS,
+    STEPS,
+    WALL_IMPULSE,
+)
 
 
 class Status(enum.IntEnum):

@@ -26,8 +26,16 @@ from rig.solver.kernels.integrators import rest_from, still_from
 from rig.solver.kernels.memory import plastic_commit
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
-from rig.solver.kernels.report import (BODIES_STEPPED, DISSIPATED, END_TIME, ENERGY_ERROR, MOMENTUM_ERROR, STATUS,
-                                       STEPS, WALL_IMPULSE)
+from rig.solver.kernels.report import (
+    BODIES_STEPPED,
+    DISSIPATED,
+    END_TIME,
+    ENERGY_ERROR,
+    MOMENTUM_ERROR,
+    STATUS,
+    STEPS,
+    WALL_IMPULSE,
+)
 
 
 @jit(inline="always")

@@ -43,8 +43,16 @@ from rig.solver.kernels.dissipation import dissipate, holder_factors
 from rig.solver.kernels.forces import elastic_forces, state_sums
 from rig.solver.kernels.memory import plastic_commit
 from rig.solver.kernels.record import hermite, hermite_weights, probe_overlaps, recorded_force
-from rig.solver.kernels.report import (BODIES_STEPPED, DISSIPATED, END_TIME, ENERGY_ERROR, MOMENTUM_ERROR, STATUS,
-                                       STEPS, WALL_IMPULSE)
+from rig.solver.kernels.report import (
+    BODIES_STEPPED,
+    DISSIPATED,
+    END_TIME,
+    ENERGY_ERROR,
+    MOMENTUM_ERROR,
+    STATUS,
+    STEPS,
+    WALL_IMPULSE,
+)
 from rig.solver.kernels.step import closing_kick, external_kick, schedule_force, step
 
 
