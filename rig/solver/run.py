@@ -67,8 +67,10 @@ def check_record(problem: ChainProblem, save: SaveAt, n_out: int, n_frames: int)
 
 
 class KernelInputs(NamedTuple):
-    """What an entry kernel takes besides its state (u, v) and its report (diag): the
-    bundles of rig/solver/kernels/bundles.py, by name."""
+    """What an entry kernel takes besides the state it renews (u, v; the single-shot
+    kernel's f and front too) and its report (diag): the bundles of
+    rig/solver/kernels/bundles.py, by name, in the order integrators.integrate takes them
+    (the batched kernel takes every one but the schedule)."""
 
     chain: bundles.ChainArrays
     contacts: bundles.Contacts
