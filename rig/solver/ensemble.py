@@ -15,13 +15,14 @@ import numpy as np
 
 from rig.errors import RigError, invalid
 from rig.solver.kernels.ensemble import integrate_ensemble
+from rig.solver.kernels.report import DIAGNOSTICS, ENERGY_ERROR, STATUS
 from rig.solver.methods import DEFAULT_METHOD
 from rig.solver.methods import method as get_method
-from rig.solver.problem import CONTACT_ROWS, STATE_ROWS, ProblemArrays
-from rig.solver.run import check_interval, check_record, time_grid
+from rig.solver.problem import ProblemArrays
+from rig.solver.run import check_record, kernel_inputs, time_grid
 from rig.solver.saveat import SaveAt
-from rig.solver.solution import DIAGNOSTICS, KernelReport, SolverStats, Status
-from rig.solver.stepsize import Stepping, viscous_rate
+from rig.solver.solution import KernelReport, SolverStats, Status
+from rig.solver.stepsize import Stepping
 
 
 @dataclass(frozen=True, eq=False)
@@ -57,12 +58,12 @@ class EnsembleSolution:
     @functools.cached_property
     def succeeded(self) -> np.ndarray:
         """(shots,) bool: the shots whose status is Status.SUCCESS."""
-        return self.diagnostics[KernelReport.STATUS] == Status.SUCCESS
+        return self.diagnostics[STATUS] == Status.SUCCESS
 
     @property
     def energy_errors(self) -> np.ndarray:
         """(shots,): each shot's KernelReport.energy_error."""
-        return self.diagnostics[KernelReport.ENERGY_ERROR]
+        return self.diagnostics[ENERGY_ERROR]
 
     def stats(self, j: int, accuracy: float | None = None, estimate: float | None = None,
               basis: str = "study pilot") -> SolverStats:
@@ -101,10 +102,8 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
     stepping = dt if isinstance(dt, Stepping) else Stepping(dt)
     if not (t_end > 0 and stepping.dt > 0):
         raise invalid("t_end/dt", (t_end, stepping.dt), "both > 0 s")
-    ch_slot, ch_weight = save.channels(p0.offset)
     n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), save.sample_interval)
     check_record(p0, save, n_out * problems.shots, 0)
-    sub = stepping.substeps(step, m.drifts)
     n = problems.shots
     if width is None:
         import numba
@@ -120,16 +119,9 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
     out = np.empty((n, len(save.names), n_out))  # the kernel writes every sample of every shot
     diag = np.zeros((n_chunks, DIAGNOSTICS, width))
     u, v = stack("u0"), stack("v0")
-    con = np.ascontiguousarray(np.stack([stack(k) for k in CONTACT_ROWS], axis=1))
-    state = np.ascontiguousarray(np.stack([stack(k) for k in STATE_ROWS], axis=1))  # the contacts' memory
-    onsite = np.ascontiguousarray(np.stack([stack(k) for k in ("drag", "friction")], axis=1))
+    k = kernel_inputs(problems, stack, 1, m, stepping, step, n_steps, save, out, np.zeros((0, p0.n_bodies)), 1.0)
     t0 = time.perf_counter()
-    integrate_ensemble(u, v, stack("mass"), stack("invm"), stack("bias"), stack("load"), stack("A"),
-                       stack("d0"), problems.law, con, state, onsite, p0.slip_speed, viscous_rate(problems),
-                       np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head, sub,
-                       ch_slot, ch_weight, save.sample_interval, out,
-                       check_interval(n_steps), stack("d_limit"), p0.wall_slot,
-                       stack("energy_scale"), stack("momentum_scale"), diag)
+    integrate_ensemble(u, v, k.chain, k.contacts, k.holder, k.method, k.record, k.checks, diag)
     wall = time.perf_counter() - t0
     diag = np.ascontiguousarray(np.moveaxis(diag, 0, -2).reshape(DIAGNOSTICS, n_chunks * width)[:, :n])
     return EnsembleSolution(out, save.sample_interval, step, n_steps, wall, m.name, diag, save.names)

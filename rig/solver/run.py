@@ -6,16 +6,21 @@ from __future__ import annotations
 import math
 import os
 import time
+from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 
 from rig.errors import RigError, invalid
+from rig.model.laws.thornton import STATE_ROWS
+from rig.solver.kernels import bundles
 from rig.solver.kernels.integrators import integrate
 from rig.solver.kernels.layout import working_arrays
+from rig.solver.kernels.report import DIAGNOSTICS
 from rig.solver.methods import Method
-from rig.solver.problem import CONTACT_ROWS, ChainProblem
+from rig.solver.problem import CONTACT_ROWS, ChainProblem, ProblemArrays
 from rig.solver.saveat import SaveAt
-from rig.solver.solution import DIAGNOSTICS, KernelReport, Solution, SolverStats, Status
+from rig.solver.solution import KernelReport, Solution, SolverStats, Status
 from rig.solver.stepsize import Stepping, viscous_rate
 
 MAX_CHECKS = 50  # energy / momentum / blow-up checks per solve (each one O(N))
@@ -61,6 +66,47 @@ def check_record(problem: ChainProblem, save: SaveAt, n_out: int, n_frames: int)
                        f"sample_interval or frame_interval, or a shorter t_end")
 
 
+class KernelInputs(NamedTuple):
+    """What an entry kernel takes besides the state it renews (u, v; the single-shot
+    kernel's f and front too) and its report (diag): the bundles of
+    rig/solver/kernels/bundles.py, by name, in the order integrators.integrate takes them
+    (the batched kernel takes every one but the schedule)."""
+
+    chain: bundles.ChainArrays
+    contacts: bundles.Contacts
+    holder: bundles.Holder
+    method: bundles.Method
+    schedule: bundles.Schedule
+    record: bundles.Record
+    checks: bundles.Checks
+
+
+def kernel_inputs(problems: ChainProblem | ProblemArrays, take: Callable[[str], np.ndarray], rows_axis: int,
+                  m: Method, stepping: Stepping, step: float, n_steps: int, save: SaveAt, out: np.ndarray,
+                  frames: np.ndarray, frame_dt: float) -> KernelInputs:
+    """The bundles of one kernel call, for one shot (``integrate_at``) or a batch
+    (rig.solver.ensemble): ``take(name)`` gives the kernel's array of the ChainProblem
+    field ``name`` (a shot's as placed by layout.working_arrays; a batch's (chunks, ...,
+    width)), whose per-body rows (con, state, onsite) are stacked on ``rows_axis``; n_steps
+    steps of ``step`` (s) of method ``m`` with ``stepping``'s head; ``out`` and ``frames``
+    (every frame_dt s) receive the record of ``save``."""
+    layout = problems.layout if isinstance(problems, ProblemArrays) else problems
+
+    def rows(names):
+        return np.ascontiguousarray(np.stack([take(k) for k in names], axis=rows_axis))
+
+    ch_slot, ch_weight = save.channels(layout.offset)
+    return KernelInputs(
+        bundles.ChainArrays(*(take(k) for k in bundles.ChainArrays._fields)),
+        bundles.Contacts(problems.law, rows(CONTACT_ROWS), rows(STATE_ROWS)),
+        bundles.Holder(rows(("drag", "friction")), layout.slip_speed, viscous_rate(problems)),
+        bundles.Method(np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head,
+                       stepping.substeps(step, m.drifts)),
+        bundles.Schedule(layout.sched_body, layout.sched_t, layout.sched_f),
+        bundles.Record(ch_slot, ch_weight, save.sample_interval, out, frame_dt, frames),
+        bundles.Checks(check_interval(n_steps), take("energy_scale"), take("momentum_scale"), layout.wall_slot))
+
+
 class Unstable(RigError):
     """An integration that blew up (an overlap beyond half a bead radius): the step is too
     large. Carries the stepping that failed."""
@@ -76,9 +122,7 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     ending at t_end), recording what ``save`` names. Raises Unstable if it blows up.
     ``front``: integrate only the bodies the pulse has reached, those still at rest bit for
     bit being left as they are (False: every body every step; the same bits, for tests)."""
-    ch_slot, ch_weight = save.channels(problem.offset)
     n_steps, step, n_out = time_grid(t_end, min(stepping.dt, t_end), save.sample_interval)
-    sub = stepping.substeps(step, m.drifts)
     if save.frame_interval is not None:
         n_frames = int(math.floor(t_end / save.frame_interval * (1 + 1e-12))) + 1
         frame_dt = save.frame_interval
@@ -90,20 +134,16 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     invm, A, d0, load, u, v, f = working_arrays(problem.invm, problem.A, problem.d0, problem.load, problem.u0,
                                                 problem.v0, np.zeros(problem.n_bodies + 1))
     diag = np.zeros(DIAGNOSTICS)
-    check_every = check_interval(n_steps)
+    placed = {"invm": invm, "A": A, "d0": d0, "load": load}
 
-    head = (f, problem.mass, invm, problem.bias, load, A, d0, problem.law,
-            np.stack([getattr(problem, k) for k in CONTACT_ROWS]))
-    args = (np.stack((problem.drag, problem.friction)),
-            problem.slip_speed, viscous_rate(problem), np.array(m.drifts), np.array(m.kicks), step)
-    mid = (stepping.head, sub)
-    tail = (problem.sched_body, problem.sched_t, problem.sched_f,
-            ch_slot, ch_weight, save.sample_interval, out, frame_dt, frames,
-            check_every, problem.d_limit, problem.wall_slot,
-            problem.energy_scale, problem.momentum_scale, diag, front)
-    integrate(u.copy(), v.copy(), *head, problem.memory(), *args, 0, *mid, *tail)  # load the compiled kernel
+    def take(name):
+        return placed[name] if name in placed else getattr(problem, name)
+
+    k = kernel_inputs(problem, take, 0, m, stepping, step, n_steps, save, out, frames, frame_dt)
+    warm = k._replace(contacts=k.contacts._replace(state=problem.memory()), method=k.method._replace(n_steps=0))
+    integrate(u.copy(), v.copy(), f, *warm, diag, front)  # load the compiled kernel
     t0 = time.perf_counter()
-    integrate(u, v, *head, problem.memory(), *args, n_steps, *mid, *tail)
+    integrate(u, v, f, *k, diag, front)
     wall = time.perf_counter() - t0
     report = KernelReport.of(diag)
     if report.status is not Status.SUCCESS:

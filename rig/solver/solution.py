@@ -7,6 +7,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from rig.model.contact import hertz_energy
+from rig.solver.kernels.report import (
+    BODIES_STEPPED,
+    DISSIPATED,
+    END_TIME,
+    ENERGY_ERROR,
+    MOMENTUM_ERROR,
+    STATUS,
+    STEPS,
+    WALL_IMPULSE,
+)
 
 
 class Status(enum.IntEnum):
@@ -22,13 +32,10 @@ class Status(enum.IntEnum):
                                  "bead radius); use a smaller dt or a tighter accuracy"}[self]
 
 
-DIAGNOSTICS = 8  # the floats of a kernel's diagnostics array
-
-
 @dataclass(frozen=True)
 class KernelReport:
     """What an integration kernel reports in its float64[DIAGNOSTICS] diagnostics array,
-    by name."""
+    by name (the slots of rig/solver/kernels/report.py)."""
 
     energy_error: float
     momentum_error: float
@@ -39,12 +46,13 @@ class KernelReport:
     dissipated_energy_J: float
     bodies_stepped: float  # the bodies a step integrated, on average (the front; all of them at most)
 
-    ENERGY_ERROR, STATUS = 0, 3  # where a diagnostics array holds them (the fields' order)
-
     @classmethod
     def of(cls, diag) -> "KernelReport":
-        return cls(float(diag[cls.ENERGY_ERROR]), float(diag[1]), float(diag[2]), Status(int(diag[cls.STATUS])),
-                   int(diag[4]), float(diag[5]), float(diag[6]), float(diag[7]) / max(int(diag[4]), 1))
+        """The report in a diagnostics array (a shot's column of a batch's)."""
+        steps = int(diag[STEPS])
+        return cls(float(diag[ENERGY_ERROR]), float(diag[MOMENTUM_ERROR]), float(diag[WALL_IMPULSE]),
+                   Status(int(diag[STATUS])), steps, float(diag[END_TIME]), float(diag[DISSIPATED]),
+                   float(diag[BODIES_STEPPED]) / max(steps, 1))
 
 
 @dataclass(frozen=True)

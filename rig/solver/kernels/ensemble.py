@@ -26,6 +26,16 @@ from rig.solver.kernels.integrators import rest_from, still_from
 from rig.solver.kernels.memory import plastic_commit
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
+from rig.solver.kernels.report import (
+    BODIES_STEPPED,
+    DISSIPATED,
+    END_TIME,
+    ENERGY_ERROR,
+    MOMENTUM_ERROR,
+    STATUS,
+    STEPS,
+    WALL_IMPULSE,
+)
 
 
 @jit(inline="always")
@@ -275,29 +285,39 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
                 err = abs(e[s] + lost[s] - e0[s]) / e_ref[s]
                 pe = abs(pn[s] - p0[s] - (t_new * net[s] - (j_wall[s] + j_visc[s]) + j_holder[s])) / p_ref[s]
                 if not (err < 1e300) or not (worst[s] <= 1.0):
-                    diag[3, s] = 1.0
-                diag[0, s] = max(diag[0, s], err)
-                diag[1, s] = max(diag[1, s], pe)
+                    diag[STATUS, s] = 1.0
+                diag[ENERGY_ERROR, s] = max(diag[ENERGY_ERROR, s], err)
+                diag[MOMENTUM_ERROR, s] = max(diag[MOMENTUM_ERROR, s], pe)
     for s in range(u.shape[1]):
-        diag[2, s] = j_wall[s] + j_visc[s] + (load[wall_slot, s] if wall_slot > 0 else 0.0) * n_steps * dt
-        diag[4, s] = n_steps
-        diag[5, s] = n_steps * dt
-        diag[6, s] = lost[s]
+        diag[WALL_IMPULSE, s] = j_wall[s] + j_visc[s] + (load[wall_slot, s] if wall_slot > 0 else 0.0) * n_steps * dt
+        diag[STEPS, s] = n_steps
+        diag[END_TIME, s] = n_steps * dt
+        diag[DISSIPATED, s] = lost[s]
         if law == PLASTIC:  # the contacts' plastic work (integrators.integrate)
             for i in range(nb):
-                diag[6, s] += state[WORK, i, s]
-        diag[7, s] = stepped
+                diag[DISSIPATED, s] += state[WORK, i, s]
+        diag[BODIES_STEPPED, s] = stepped
 
 
 @jit(parallel=True)
-def integrate_ensemble(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, viscous_rate, a_coef, b_coef,
-                       dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, check_every, d_limit, wall_slot,
-                       e_ref, p_ref, diag):
-    """Integrate every shot of the (chunks, bodies, width) arrays in place; con
-    (chunks, 6, bodies, width), state (chunks, 6, bodies, width: the contacts' memory,
-    renewed) and onsite (chunks, 2, bodies, width) as in the single-shot kernel; out is (shots, channels, samples), each shot's record contiguous, chunk k
-    holding shots k width .. (k + 1) width - 1 (fill past the last shot); diag is
-    (chunks, DIAGNOSTICS, width) as in the single-shot kernel."""
+def integrate_ensemble(u, v, chain, contacts, holder, method, record, checks, diag):
+    """Integrate every shot of the (chunks, bodies, width) arrays u (m) and v (m/s) in
+    place; the bundles are bundles.py's, their arrays with the chunk axis first and the
+    shots innermost: chain's (chunks, bodies, width), contacts.con (chunks, 6, bodies,
+    width), contacts.state (chunks, STATE_ROWS, bodies, width: the contacts' memory, renewed),
+    holder.onsite (chunks, 2, bodies, width), checks.e_ref and p_ref (chunks, width);
+    record.out is (shots, channels, samples), each shot's record contiguous, chunk k
+    holding shots k width .. (k + 1) width - 1 (fill past the last shot); record.frames is
+    not read. diag is (chunks, report.DIAGNOSTICS, width), each shot's column as the
+    single-shot kernel's diag."""
+    mass, invm, bias, load, A, d0, d_limit = (chain.mass, chain.invm, chain.bias, chain.load, chain.A, chain.d0,
+                                              chain.d_limit)
+    law, con, state = contacts.law, contacts.con, contacts.state
+    onsite, slip, viscous_rate = holder.onsite, holder.slip, holder.viscous_rate
+    a_coef, b_coef, dt, n_steps, head, sub = (method.a_coef, method.b_coef, method.dt, method.n_steps, method.head,
+                                              method.sub)
+    ch_slot, ch_weight, sample_dt, out = record.ch_slot, record.ch_weight, record.sample_dt, record.out
+    check_every, e_ref, p_ref, wall_slot = checks.check_every, checks.e_ref, checks.p_ref, checks.wall_slot
     n_chunks, nb, W = u.shape
     n_ch = ch_slot.shape[0]
     for k in prange(n_chunks):

@@ -43,6 +43,16 @@ from rig.solver.kernels.dissipation import dissipate, holder_factors
 from rig.solver.kernels.forces import elastic_forces, state_sums
 from rig.solver.kernels.memory import plastic_commit
 from rig.solver.kernels.record import hermite, hermite_weights, probe_overlaps, recorded_force
+from rig.solver.kernels.report import (
+    BODIES_STEPPED,
+    DISSIPATED,
+    END_TIME,
+    ENERGY_ERROR,
+    MOMENTUM_ERROR,
+    STATUS,
+    STEPS,
+    WALL_IMPULSE,
+)
 from rig.solver.kernels.step import closing_kick, external_kick, schedule_force, step
 
 
@@ -75,33 +85,35 @@ def still_from(u, v, u_rest, lo, hi):
 
 
 @jit
-def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, viscous_rate,
-              a_coef, b_coef, dt, n_steps, head, sub,
-              sched_body, sched_t, sched_f,
-              ch_slot, ch_weight, sample_dt, out,
-              frame_dt, frames,
-              check_every, d_limit, wall_slot, e_ref, p_ref, diag, front):
-    """Integrate n_steps of size dt in place; fill out (n_ch, n_out) and frames (n_fr, nb).
+def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks, diag, front):
+    """Integrate method.n_steps of size method.dt in place; fill record.out (n_ch, n_out)
+    and record.frames (n_fr, nb); the bundles are bundles.py's (their fields, units).
 
-    f (size nb + 1): the contact forces' work array (layout.working_arrays places it with
-    u, v and the parameters the passes read).
-    law: the contact code (forces.py) with con (6, nb): each slot's exponent, damping
-    time (s), dashpot coefficient and exponent, yield rate exponent and reference rate (m/s)
-    (rig.solver.problem.CONTACT_ROWS); state (8, nb): each slot's memory
-    (rig.model.laws.thornton.STATE_ROWS), renewed in place (PLASTIC only);
-    onsite (2, nb): each body's drag rate (1/s) and friction
-    deceleration (m/s^2), smoothed over slip (m/s); viscous_rate (1/s): a bound on the
-    contacts' viscous decay rates (dissipation.substeps).
-    diag (float64[8]) receives: max relative energy error, max relative momentum balance
-    error, total wall impulse (N s), status (0 ok, 1 unstable), steps done, final time,
-    dissipated energy (J), bodies integrated summed over the steps.
+    u, v (size nb): displacements (m) and velocities (m/s), renewed in place; f (size
+    nb + 1): the contact forces' work array (layout.working_arrays places it with u, v and
+    the chain's invm, A, d0 and load, which the passes read). contacts.state is renewed in
+    place (PLASTIC only).
+    diag (float64[report.DIAGNOSTICS]) receives, at report.py's slots: max relative energy
+    error, max relative momentum balance error, total wall impulse (N s), status (0 ok,
+    1 unstable), steps done, final time, dissipated energy (J), bodies integrated summed
+    over the steps.
     Energy: E = kinetic + elastic - work of constant loads - work of the scheduled force,
     and E + dissipated stays E(0).
     Momentum balance: P(t) - P(0) - [t * sum(constant loads) + J_schedule - J_wall + J_holder].
-    load[i] (size nb + 1): constant force carried from above through slot i (N).
+    chain.load[i] (size nb + 1): constant force carried from above through slot i (N).
     front: integrate only the bodies the pulse has reached (module doc); False: every body
     every step (the same bits).
     """
+    mass, invm, bias, load, A, d0, d_limit = (chain.mass, chain.invm, chain.bias, chain.load, chain.A, chain.d0,
+                                              chain.d_limit)
+    law, con, state = contacts.law, contacts.con, contacts.state
+    onsite, slip, viscous_rate = holder.onsite, holder.slip, holder.viscous_rate
+    a_coef, b_coef, dt, n_steps, head, sub = (method.a_coef, method.b_coef, method.dt, method.n_steps, method.head,
+                                              method.sub)
+    sched_body, sched_t, sched_f = schedule.body, schedule.t, schedule.f
+    ch_slot, ch_weight, sample_dt, out = record.ch_slot, record.ch_weight, record.sample_dt, record.out
+    frame_dt, frames = record.frame_dt, record.frames
+    check_every, e_ref, p_ref, wall_slot = checks.check_every, checks.e_ref, checks.p_ref, checks.wall_slot
     nb = u.shape[0]
     f[:] = 0.0
     f[nb] = -load[nb]
@@ -241,14 +253,14 @@ def integrate(u, v, f, mass, invm, bias, load, A, d0, law, con, state, onsite, s
             e_err = max(e_err, err)
             p_err = max(p_err, pe)
 
-    diag[0] = e_err
-    diag[1] = p_err
-    diag[2] = impulses[0] + j_visc[0] + wall_load * steps_done * dt
-    diag[3] = status
-    diag[4] = steps_done
-    diag[5] = steps_done * dt
-    diag[6] = lost[0]
+    diag[ENERGY_ERROR] = e_err
+    diag[MOMENTUM_ERROR] = p_err
+    diag[WALL_IMPULSE] = impulses[0] + j_visc[0] + wall_load * steps_done * dt
+    diag[STATUS] = status
+    diag[STEPS] = steps_done
+    diag[END_TIME] = steps_done * dt
+    diag[DISSIPATED] = lost[0]
     if law == PLASTIC:  # the contacts' plastic work, which the energy carries, is dissipated too
         for i in range(nb):
-            diag[6] += state3[WORK, i, 0]
-    diag[7] = stepped
+            diag[DISSIPATED] += state3[WORK, i, 0]
+    diag[BODIES_STEPPED] = stepped
