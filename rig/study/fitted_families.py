@@ -111,8 +111,8 @@ def table1_points() -> Points:
 
 
 def fig3_observations() -> tuple:
-    """Fig. 3's observed figures (rig/scenes/daraio2006/fig3_observations.toml)."""
-    path = resources.files("rig") / "scenes" / "daraio2006" / "fig3_observations.toml"
+    """Fig. 3's observed figures (rig/data/daraio2006/fig3_observations.toml)."""
+    path = resources.files("rig") / "data" / "daraio2006" / "fig3_observations.toml"
     with resources.as_file(path) as p:
         return read_observations(p, SCENE)
 
