@@ -209,7 +209,7 @@ def table(result: dict) -> str:
     for t in result["targets"]:
         rng = ("-inf" if t["lo"] is None else f"{t['lo']:.4g}") + " .. " + ("inf" if t["hi"] is None else f"{t['hi']:.4g}")
         v = result["figures"][t["name"]]
-        lines.append(f"| {t['name']} | {rng} {t['unit']} | {'n/a' if v is None else f'{v:.4g}'} "
+        lines.append(f"| {t['name']} | {rng}{'' if t['unit'] == '1' else ' ' + t['unit']} | {'n/a' if v is None else f'{v:.4g}'} "
                      f"| {'yes' if result['holds'][t['name']] else 'NO'} |")
     lines += ["", f"d ln(figure) / d ln(p), central differences at p e^(+-{result['step_ln']}) "
                   "(a count of pulses: a step function, 0 unless a jump is crossed):", "",
