@@ -107,7 +107,8 @@ def build_parser() -> argparse.ArgumentParser:
                     help="with --identifiability: a key to find again (with --truth), instead of the five new ones")
     rp.add_argument("--truth", action="append", metavar="VALUE",
                     help="with --param: its truth, a quantity in the key's unit (one per --param, in order)")
-    rp.add_argument("--draws", type=count_arg, default=20, help="with --identifiability: data sets per key (default 20)")
+    rp.add_argument("--draws", type=count_arg, default=20,
+                    help="with --identifiability: data sets per key (default 20)")
     rp.add_argument("--seed", type=seed_arg, default=0, help="with --identifiability: the noise's seed (default 0)")
     rp.add_argument("--quiet", action="store_true", help="no progress bar")
 

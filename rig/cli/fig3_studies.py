@@ -26,8 +26,8 @@ def parameter_set(args) -> tuple:
 def questions(args, overrides: tuple) -> tuple:
     """The identifiability questions: the five new keys' (rig.study.identifiability.QUESTIONS,
     each with the --set items over its own fixed keys) or the --param/--truth pairs'."""
-    from rig.study.identifiability import QUESTIONS, Question, truth_value
     from rig.fit.parameters import parse_parameter
+    from rig.study.identifiability import QUESTIONS, Question, truth_value
 
     params, truths = args.param or [], args.truth or []
     if len(params) != len(truths):

@@ -124,7 +124,8 @@ def coverage(param: FitParameter, truth: float, overrides=(), observations=None,
     """The identifiability of ``param`` at ``truth`` (SI) over ``n`` virtual data sets of
     ``observations`` (Observations; default the Fig. 3 set), the other keys ``overrides``."""
     if not param.lo < truth < param.hi:
-        raise invalid(f"{param.key} truth", truth, f"inside its bounds {param.shown(param.lo)}..{param.shown(param.hi)}")
+        raise invalid(f"{param.key} truth", truth,
+                      f"inside its bounds, {param.shown(param.lo)} < truth < {param.shown(param.hi)}")
     if n < 1:
         raise invalid("draws", n, "a whole number >= 1")
     observations = tuple(observations or fig3.observations())
@@ -177,10 +178,10 @@ def study(questions=QUESTIONS, n: int = DRAWS, seed: int = 0, progress=None) -> 
 
 def table(result: dict) -> str:
     """identifiability.md: one row per parameter."""
-    lines = [f"# Identifiability on virtual shots (Fig. 3 observations, {result['draws']} data sets each, "
-             f"seed {result['seed']})", "",
-             "| parameter | truth | bounds | 95% intervals holding the truth | converged | mean estimate "
-             "| spread of estimates | median sd | wall |",
+    lines = [(f"# Identifiability on virtual shots (Fig. 3 observations, {result['draws']} data sets each, "
+              f"seed {result['seed']})"), "",
+             ("| parameter | truth | bounds | 95% intervals holding the truth | converged | mean estimate "
+              "| spread of estimates | median sd | wall |"),
              "|---|---|---|---|---|---|---|---|---|"]
     for r in result["parameters"]:
         u = "" if r["unit"] == "1" else " " + r["unit"]

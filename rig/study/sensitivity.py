@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rig.errors import RigError, invalid
+from rig.errors import invalid
 from rig.experiment import scene as scene_io
 from rig.experiment.scene import key_spec
 from rig.fit.observations.objective import ObservationObjective
@@ -142,7 +142,8 @@ def failing(figures) -> tuple:
 
 def sensitivities(fig: Figures) -> dict:
     """{"figures": {target: value at the set}, "holds": {target: bool}, "d_ln_figure_d_ln_p":
-    {target: {key: value or None}}, "steps": {key: [down, up] values used}}."""
+    {target: {key: value or None}}, "counts": {count target: {key: [at down, at the set, at
+    up]}} (a count's jumps), "steps": {key: [down, up] values used}}."""
     base = fig.at([fig.centre])[0]
     thetas, steps = [], {}
     for k, (p, v) in enumerate(fig.params):
@@ -154,15 +155,22 @@ def sensitivities(fig: Figures) -> dict:
             thetas.append(t)
     models = fig.at(thetas)
     sens = {t.name: {} for t in fig3.TARGETS}
+    counts = {t.name: {} for t in fig3.TARGETS if t.figure.kind == "pulses"}
     for k, (p, v) in enumerate(fig.params):
         down, up = steps[p.key]
         f_down, f_up = models[2 * k], models[2 * k + 1]
         for i, t in enumerate(fig3.TARGETS):
+            if t.name in counts:
+                counts[t.name][p.key] = [_count(f_down[i]), _count(base[i]), _count(f_up[i])]
             ok = f_down[i] > 0 and f_up[i] > 0 and math.isfinite(f_down[i]) and math.isfinite(f_up[i])
             sens[t.name][p.key] = float(math.log(f_up[i] / f_down[i]) / math.log(up / down)) if ok else None
     return {"figures": {t.name: (float(f) if math.isfinite(f) else None) for t, f in zip(fig3.TARGETS, base)},
             "holds": {t.name: t.holds(f) for t, f in zip(fig3.TARGETS, base)},
-            "d_ln_figure_d_ln_p": sens, "steps": steps}
+            "d_ln_figure_d_ln_p": sens, "counts": counts, "steps": steps}
+
+
+def _count(value: float):
+    return int(value) if math.isfinite(value) else None
 
 
 def windows(fig: Figures, progress=None) -> dict:
@@ -207,17 +215,23 @@ def table(result: dict) -> str:
     lines = ["# Fig. 3 figures' sensitivity at " + ", ".join(result["parameter_set"]), "",
              "| target | range | at the set | holds |", "|---|---|---|---|"]
     for t in result["targets"]:
-        rng = ("-inf" if t["lo"] is None else f"{t['lo']:.4g}") + " .. " + ("inf" if t["hi"] is None else f"{t['hi']:.4g}")
+        lo, hi = ("-inf" if t["lo"] is None else f"{t['lo']:.4g}"), ("inf" if t["hi"] is None else f"{t['hi']:.4g}")
+        rng = f"{lo} .. {hi}"
         v = result["figures"][t["name"]]
-        lines.append(f"| {t['name']} | {rng}{'' if t['unit'] == '1' else ' ' + t['unit']} | {'n/a' if v is None else f'{v:.4g}'} "
+        unit = "" if t["unit"] == "1" else " " + t["unit"]
+        lines.append(f"| {t['name']} | {rng}{unit} | {'n/a' if v is None else f'{v:.4g}'} "
                      f"| {'yes' if result['holds'][t['name']] else 'NO'} |")
-    lines += ["", f"d ln(figure) / d ln(p), central differences at p e^(+-{result['step_ln']}) "
-                  "(a count of pulses: a step function, 0 unless a jump is crossed):", "",
+    lines += ["", (f"d ln(figure) / d ln(p), central differences at p e^(+-{result['step_ln']}) "
+                   "(a count of pulses is a step function: where a step crosses a jump, "
+                   "its counts at p e^-step / p / p e^+step):"), "",
               "| target | " + " | ".join(keys) + " |", "|---" * (len(keys) + 1) + "|"]
     for name, row in result["d_ln_figure_d_ln_p"].items():
-        lines.append(f"| {name} | " + " | ".join("n/a" if row[k] is None else f"{row[k]:+.3g}" for k in keys) + " |")
-    lines += ["", f"Windows (others fixed; scan of {result['scan_points']} values over p/{result['scan_factor']:g} .. "
-                  f"p x {result['scan_factor']:g}, edges bisected to {result['resolution_ln']:.0%} in ln p):", "",
+        jumps = result["counts"].get(name)
+        cells = [f"count {'/'.join(map(str, jumps[k]))}" if jumps and jumps[k][0] != jumps[k][2]
+                 else "n/a" if row[k] is None else f"{row[k]:+.3g}" for k in keys]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    lines += ["", (f"Windows (others fixed; scan of {result['scan_points']} values over p/{result['scan_factor']:g}"
+                   f" .. p x {result['scan_factor']:g}, edges bisected to {result['resolution_ln']:.0%} in ln p):"), "",
               "| key | value | window | fails below | fails above |", "|---|---|---|---|---|"]
     for key, w in result["windows"].items():
         u = "" if w["unit"] == "1" else " " + w["unit"]
