@@ -45,6 +45,9 @@ def questions(args, overrides: tuple) -> tuple:
 
 
 def run_fig3_studies(args) -> dict:
+    if not (args.identifiability or args.sensitivity):
+        flag = "--set" if args.set else "--param" if args.param else "--truth"
+        raise invalid(flag, args.set or args.param or args.truth, "only with --identifiability or --sensitivity")
     if args.fitted:
         raise invalid("--fitted", True, "not with --identifiability or --sensitivity (they run instead of the study)")
     if not args.identifiability and (args.param or args.truth):

@@ -93,7 +93,7 @@ def print_sweep(key: str, points: list):
 
 
 def cmd_reproduce(args) -> dict:
-    if args.identifiability or args.sensitivity:
+    if args.identifiability or args.sensitivity or args.set or args.param or args.truth:
         from rig.cli.fig3_studies import run_fig3_studies
 
         return run_fig3_studies(args)

@@ -154,6 +154,7 @@ CASES = [
       "--truth", "1 N"], "chain.nosuch"),
     (["reproduce", "daraio2006", "--identifiability", "--out", "{d}/r", "--param", "chain.yield_force=0.3 N:2 N"],
      "--truth"),
+    (["reproduce", "daraio2006", "--out", "{d}/r", *_set("chain.yield_force=1 N")], "--identifiability"),
     # theory
     (["theory", "--material", "wood", "--f0", "1"], "wood"),
     (["theory", "--f0", "-1"], "--f0"),
