@@ -72,7 +72,9 @@ class Coverage:
     """A parameter's identifiability (module doc): ``truth``, bounds ``lo``..``hi`` (SI,
     ``unit``), the fixed ``overrides``, the ``seed``, and per data set the fit's ``estimates``,
     ``stds``, whether it ``converged`` and whether its 95% interval ``holds`` the truth;
-    ``wall_s``: seconds it took."""
+    ``wall_s``: seconds it took. ``refused``: why no data set could be fitted (the fit's own
+    refusal, e.g. a parameter the observations do not see: rig.fit.checks.unseen), with no
+    estimates; "" where they were."""
 
     key: str
     unit: str
@@ -86,6 +88,7 @@ class Coverage:
     converged: tuple
     holds: tuple
     wall_s: float
+    refused: str = ""
 
     @property
     def n(self) -> int:
@@ -102,10 +105,10 @@ class Coverage:
                 "overrides": list(self.overrides), "seed": self.seed, "n": self.n, "holding": self.count,
                 "converged": sum(self.converged), "estimates": list(self.estimates),
                 "stds": [s if math.isfinite(s) else None for s in self.stds],
-                "mean_estimate": float(np.mean(self.estimates)),
+                "mean_estimate": float(np.mean(self.estimates)) if self.n else None,
                 "median_std": float(np.median(finite)) if finite else None,
                 "estimate_spread": float(np.std(self.estimates, ddof=1)) if self.n > 1 else None,
-                "holds": list(self.holds), "wall_s": self.wall_s}
+                "holds": list(self.holds), "wall_s": self.wall_s, "refused": self.refused or None}
 
 
 def truth_value(param: FitParameter, text: str) -> float:
@@ -147,14 +150,19 @@ def coverage(param: FitParameter, truth: float, overrides=(), observations=None,
         drawn = tuple(replace(o, value=float(y)) for o, y in zip(observations, data))
         objective = ObservationObjective(scene, (param,), drawn, overrides)
         objective.pilot = at_truth.pilot  # the same shots' numerics: calibrated once
-        result = fit(objective)
+        try:
+            result = fit(objective)
+        except RigError as exc:  # the fit refuses the question itself (a parameter the data do not see)
+            tell(f"{param.key}: not fitted: {exc}")
+            return Coverage(param.key, param.unit, truth, param.lo, param.hi, overrides[:-1], seed, (), (), (), (),
+                            time.perf_counter() - start, str(exc))
         est, std = float(result.estimate[0]), float(result.std[0])
         lo, hi = (float(x) for x in result.ci95[0])
         ok = bool(result.converged and math.isfinite(std))
         rows.append((est, std, ok, ok and lo <= truth <= hi))
         tell(f"{param.key}: fit {i + 1}/{n}: {param.shown(est)} +- {param.shown(std)} "
              f"({sum(r[3] for r in rows)}/{i + 1} intervals hold the truth)")
-    est, std, ok, holds = zip(*rows)
+    est, std, ok, holds = (tuple(col) for col in zip(*rows))
     return Coverage(param.key, param.unit, truth, param.lo, param.hi, overrides[:-1], seed, est, std, ok, holds,
                     time.perf_counter() - start)
 
@@ -185,6 +193,10 @@ def table(result: dict) -> str:
              "|---|---|---|---|---|---|---|---|---|"]
     for r in result["parameters"]:
         u = "" if r["unit"] == "1" else " " + r["unit"]
+        if r["refused"]:
+            lines.append(f"| {r['key']} | {r['truth']:.4g}{u} | {r['bounds'][0]:.4g}..{r['bounds'][1]:.4g}{u} "
+                         f"| not fitted: {r['refused']} | | | | | {r['wall_s']:.0f} s |")
+            continue
         sd = "n/a" if r["median_std"] is None else f"{r['median_std']:.3g}"
         spread = "n/a" if r["estimate_spread"] is None else f"{r['estimate_spread']:.3g}"
         lines.append(f"| {r['key']} | {r['truth']:.4g}{u} | {r['bounds'][0]:.4g}..{r['bounds'][1]:.4g}{u} "

@@ -97,3 +97,11 @@ def test_sensitivity_is_the_hand_computed_central_difference():
     assert 0.25 < by_hand < 0.45
     # the static hold's yield acts only under the magnet: the gravity shot does not see it
     assert result["d_ln_figure_d_ln_p"]["gravity_speed"]["chain.static_yield_ratio"] == 0.0
+
+
+def test_a_parameter_the_observations_do_not_see_is_reported_not_fitted():
+    """The static hold's yield acts under the magnet only: the gravity shot's figures do not move with it."""
+    c = coverage(parse_parameter("chain.static_yield_ratio=0.2:1"), 0.6, fig3.PARAMETER_SET,
+                 GRAVITY_SPEED_AND_DURATION, n=2, seed=0)
+    assert "do not see it" in c.refused and c.n == 0 and c.count == 0
+    assert c.as_dict()["refused"] == c.refused and c.as_dict()["mean_estimate"] is None
