@@ -101,12 +101,15 @@ class Coverage:
 
     def as_dict(self) -> dict:
         finite = [s for s in self.stds if math.isfinite(s)]
+        span = self.hi - self.lo
+        widths = np.minimum(2 * 1.96 * np.array(self.stds), span) / span  # an infinite sd: the whole span
         return {"key": self.key, "unit": self.unit, "truth": self.truth, "bounds": [self.lo, self.hi],
                 "overrides": list(self.overrides), "seed": self.seed, "n": self.n, "holding": self.count,
                 "converged": sum(self.converged), "estimates": list(self.estimates),
                 "stds": [s if math.isfinite(s) else None for s in self.stds],
                 "mean_estimate": float(np.mean(self.estimates)) if self.n else None,
                 "median_std": float(np.median(finite)) if finite else None,
+                "median_width_over_span": float(np.median(widths)) if self.n else None,
                 "estimate_spread": float(np.std(self.estimates, ddof=1)) if self.n > 1 else None,
                 "holds": list(self.holds), "wall_s": self.wall_s, "refused": self.refused or None}
 
@@ -189,19 +192,19 @@ def table(result: dict) -> str:
     lines = [(f"# Identifiability on virtual shots (Fig. 3 observations, {result['draws']} data sets each, "
               f"seed {result['seed']})"), "",
              ("| parameter | truth | bounds | 95% intervals holding the truth | converged | mean estimate "
-              "| spread of estimates | median sd | wall |"),
-             "|---|---|---|---|---|---|---|---|---|"]
+              "| spread of estimates | median sd | median 95% width / bounds' span | wall |"),
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for r in result["parameters"]:
         u = "" if r["unit"] == "1" else " " + r["unit"]
         if r["refused"]:
             lines.append(f"| {r['key']} | {r['truth']:.4g}{u} | {r['bounds'][0]:.4g}..{r['bounds'][1]:.4g}{u} "
-                         f"| not fitted: {r['refused']} | | | | | {r['wall_s']:.0f} s |")
+                         f"| not fitted: {r['refused']} | | | | | | {r['wall_s']:.0f} s |")
             continue
         sd = "n/a" if r["median_std"] is None else f"{r['median_std']:.3g}"
         spread = "n/a" if r["estimate_spread"] is None else f"{r['estimate_spread']:.3g}"
         lines.append(f"| {r['key']} | {r['truth']:.4g}{u} | {r['bounds'][0]:.4g}..{r['bounds'][1]:.4g}{u} "
                      f"| {r['holding']}/{r['n']} | {r['converged']}/{r['n']} | {r['mean_estimate']:.4g} "
-                     f"| {spread} | {sd} | {r['wall_s']:.0f} s |")
+                     f"| {spread} | {sd} | {r['median_width_over_span']:.2f} | {r['wall_s']:.0f} s |")
     lines += ["", "Truths and fixed keys:", ""]
     lines += [f"- {r['key']}: {r['why']}; fixed: {', '.join(r['overrides'])}" for r in result["parameters"]]
     lines += ["", f"Total wall time {result['wall_s']:.0f} s."]
