@@ -71,7 +71,8 @@ QUESTIONS = (
 class Coverage:
     """A parameter's identifiability (module doc): ``truth``, bounds ``lo``..``hi`` (SI,
     ``unit``), the fixed ``overrides``, the ``seed``, and per data set the fit's ``estimates``,
-    ``stds``, whether it ``converged`` and whether its 95% interval ``holds`` the truth;
+    ``stds``, whether it ``converged``, its 95% interval (``intervals``: (lo, hi), cut at the
+    bounds, rig.fit.fitting) and whether that ``holds`` the truth;
     ``wall_s``: seconds it took. ``refused``: why no data set could be fitted (the fit's own
     refusal, e.g. a parameter the observations do not see: rig.fit.checks.unseen), with no
     estimates; "" where they were."""
@@ -87,6 +88,7 @@ class Coverage:
     stds: tuple
     converged: tuple
     holds: tuple
+    intervals: tuple
     wall_s: float
     refused: str = ""
 
@@ -101,8 +103,7 @@ class Coverage:
 
     def as_dict(self) -> dict:
         finite = [s for s in self.stds if math.isfinite(s)]
-        span = self.hi - self.lo
-        widths = np.minimum(2 * 1.96 * np.array(self.stds), span) / span  # an infinite sd: the whole span
+        widths = [(hi - lo) / (self.hi - self.lo) for lo, hi in self.intervals]
         return {"key": self.key, "unit": self.unit, "truth": self.truth, "bounds": [self.lo, self.hi],
                 "overrides": list(self.overrides), "seed": self.seed, "n": self.n, "holding": self.count,
                 "converged": sum(self.converged), "estimates": list(self.estimates),
@@ -111,7 +112,8 @@ class Coverage:
                 "median_std": float(np.median(finite)) if finite else None,
                 "median_width_over_span": float(np.median(widths)) if self.n else None,
                 "estimate_spread": float(np.std(self.estimates, ddof=1)) if self.n > 1 else None,
-                "holds": list(self.holds), "wall_s": self.wall_s, "refused": self.refused or None}
+                "holds": list(self.holds), "intervals": [list(i) for i in self.intervals], "wall_s": self.wall_s,
+                "refused": self.refused or None}
 
 
 def truth_value(param: FitParameter, text: str) -> float:
@@ -157,17 +159,17 @@ def coverage(param: FitParameter, truth: float, overrides=(), observations=None,
             result = fit(objective)
         except RigError as exc:  # the fit refuses the question itself (a parameter the data do not see)
             tell(f"{param.key}: not fitted: {exc}")
-            return Coverage(param.key, param.unit, truth, param.lo, param.hi, overrides[:-1], seed, (), (), (), (),
+            return Coverage(param.key, param.unit, truth, param.lo, param.hi, overrides[:-1], seed, (), (), (), (), (),
                             time.perf_counter() - start, str(exc))
         est, std = float(result.estimate[0]), float(result.std[0])
         lo, hi = (float(x) for x in result.ci95[0])
         ok = bool(result.converged and math.isfinite(std))
-        rows.append((est, std, ok, ok and lo <= truth <= hi))
+        rows.append((est, std, ok, ok and lo <= truth <= hi, (lo, hi)))
         tell(f"{param.key}: fit {i + 1}/{n}: {param.shown(est)} +- {param.shown(std)} "
              f"({sum(r[3] for r in rows)}/{i + 1} intervals hold the truth)")
-    est, std, ok, holds = (tuple(col) for col in zip(*rows))
+    est, std, ok, holds, intervals = (tuple(col) for col in zip(*rows))
     return Coverage(param.key, param.unit, truth, param.lo, param.hi, overrides[:-1], seed, est, std, ok, holds,
-                    time.perf_counter() - start)
+                    intervals, time.perf_counter() - start)
 
 
 def question_coverage(question: Question, n: int = DRAWS, seed: int = 0, progress=None) -> Coverage:

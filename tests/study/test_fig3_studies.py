@@ -75,7 +75,10 @@ def test_coverage_counts_the_intervals_and_the_seed_repeats_the_data():
     assert np.all(np.abs(est - 0.84e9) < 4 * sd) and np.all(sd < 0.5e9)
     d = a.as_dict()
     assert d["holding"] == a.count and d["n"] == 3 and d["seed"] == 7
-    assert d["median_width_over_span"] == pytest.approx(np.median(3.92 * sd) / 1.6e9) and d["median_width_over_span"] < 1
+    for (lo, hi), e, s in zip(a.intervals, est, sd):  # +- 1.96 sd, cut at the bounds
+        assert (lo, hi) == pytest.approx((max(e - 1.96 * s, 0.4e9), min(e + 1.96 * s, 2e9)))
+    widths = [(hi - lo) / 1.6e9 for lo, hi in a.intervals]
+    assert d["median_width_over_span"] == pytest.approx(np.median(widths)) and d["median_width_over_span"] < 1
 
 
 def test_a_truth_outside_its_bounds_is_refused():
