@@ -95,6 +95,21 @@ def build_parser() -> argparse.ArgumentParser:
     rp.add_argument("--out", required=True, metavar="DIR", help="folder for tables and figures")
     rp.add_argument("--fitted", action="store_true",
                     help="also fit the PTFE model to the published experiment (Table 1) and compare its shots")
+    rp.add_argument("--identifiability", action="store_true",
+                    help="instead: fit each new contact parameter to noisy virtual Fig. 3 observations (20 data "
+                         "sets each) and count the 95%% intervals that hold the truth (identifiability.json, .md)")
+    rp.add_argument("--sensitivity", action="store_true",
+                    help="instead: each Fig. 3 figure's d ln(figure)/d ln(p) and each key's window meeting every "
+                         "Fig. 3 target, at the Fig. 3 parameter set or --set (sensitivity.json, .md)")
+    rp.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="with --identifiability or --sensitivity: overrides of the Fig. 3 parameter set")
+    rp.add_argument("--param", action="append", metavar="KEY=LO:HI",
+                    help="with --identifiability: a key to find again (with --truth), instead of the five new ones")
+    rp.add_argument("--truth", action="append", metavar="VALUE",
+                    help="with --param: its truth, a quantity in the key's unit (one per --param, in order)")
+    rp.add_argument("--draws", type=count_arg, default=20,
+                    help="with --identifiability: data sets per key (default 20)")
+    rp.add_argument("--seed", type=seed_arg, default=0, help="with --identifiability: the noise's seed (default 0)")
     rp.add_argument("--quiet", action="store_true", help="no progress bar")
 
     fi = _command(sub, "fit", "fit scene keys to measured points, scope records or observations", fitting.cmd_fit)

@@ -93,6 +93,10 @@ def print_sweep(key: str, points: list):
 
 
 def cmd_reproduce(args) -> dict:
+    if args.identifiability or args.sensitivity or args.set or args.param or args.truth:
+        from rig.cli.fig3_studies import run_fig3_studies
+
+        return run_fig3_studies(args)
     from rig.study.reproduce import CONFIGS, MASS_RATIOS, OTHER_SCENES, VELOCITY_FACTORS, reproduce
 
     total = len(CONFIGS) + len(OTHER_SCENES) + len(CONFIGS) * len(VELOCITY_FACTORS) + len(MASS_RATIOS) + 1

@@ -145,6 +145,16 @@ CASES = [
     # reproduce
     (["reproduce", "nosuch", "--out", "{d}/r"], "nosuch"),
     (["reproduce", "daraio2006", "--out", "{d}/existing.txt"], "existing.txt"),
+    (["reproduce", "daraio2006", "--sensitivity", "--out", "{d}/r", *_set("chain.nosuch=3")], "chain.nosuch"),
+    (["reproduce", "daraio2006", "--identifiability", "--out", "{d}/r", "--param", "chain.yield_force=2 N:0.3 N",
+      "--truth", "0.8 N"], "LO < HI"),
+    (["reproduce", "daraio2006", "--identifiability", "--out", "{d}/r", "--param", "chain.yield_force=0.3 N:2 N",
+      "--truth", "3 N"], "chain.yield_force truth"),
+    (["reproduce", "daraio2006", "--identifiability", "--out", "{d}/r", "--param", "chain.nosuch=0.3 N:2 N",
+      "--truth", "1 N"], "chain.nosuch"),
+    (["reproduce", "daraio2006", "--identifiability", "--out", "{d}/r", "--param", "chain.yield_force=0.3 N:2 N"],
+     "--truth"),
+    (["reproduce", "daraio2006", "--out", "{d}/r", *_set("chain.yield_force=1 N")], "--identifiability"),
     # theory
     (["theory", "--material", "wood", "--f0", "1"], "wood"),
     (["theory", "--f0", "-1"], "--f0"),
