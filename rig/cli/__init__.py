@@ -95,6 +95,8 @@ def build_parser() -> argparse.ArgumentParser:
     rp.add_argument("--out", required=True, metavar="DIR", help="folder for tables and figures")
     rp.add_argument("--fitted", action="store_true",
                     help="also fit the PTFE model to the published experiment (Table 1) and compare its shots")
+    rp.add_argument("--family", action="append", metavar="NAME",
+                    help="with --fitted: fit only this model family (repeat for more; default: every one)")
     rp.add_argument("--identifiability", action="store_true",
                     help="instead: fit each new contact parameter to noisy virtual Fig. 3 observations (20 data "
                          "sets each) and count the 95%% intervals that hold the truth (identifiability.json, .md)")

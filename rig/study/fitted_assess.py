@@ -99,16 +99,20 @@ def estimates(result: FitResult) -> dict:
 
 def magnetic_from_gravity(family: Family, points, observations, joint: FitResult) -> dict:
     """The family fitted to the gravity-only data (starting at its ``joint`` fit's values),
-    predicting the magnetic data (module doc)."""
+    predicting the magnetic data (module doc); its magnetic-only keys at the law's defaults
+    ("at_defaults")."""
     mag_p = magnetic_points(points)
     mag_o = [magnetic_observation(o) for o in observations]
-    g_obj = objective(family, points.subset(np.flatnonzero(~mag_p)),
+    gravity = family.without(family.magnetic_only)  # keys only the magnet's shots see: at the law's defaults
+    g_obj = objective(gravity, points.subset(np.flatnonzero(~mag_p)),
                       tuple(o for o, m in zip(observations, mag_o) if not m), estimates(joint))
     g = fit(g_obj, ftol=FTOL, xtol=XTOL)
-    m_obj = objective(family, points.subset(np.flatnonzero(mag_p)), tuple(o for o, m in zip(observations, mag_o) if m))
+    m_obj = objective(gravity, points.subset(np.flatnonzero(mag_p)),
+                      tuple(o for o, m in zip(observations, mag_o) if m))
     (model,) = m_obj.evaluate([g.estimate])
     r = m_obj.residuals(model, np.zeros(0))
-    return {"parameters": parameters(g), "converged": g.converged, "chi2": float(r @ r), "n": int(r.size),
+    return {"parameters": parameters(g), "at_defaults": list(family.magnetic_only), "converged": g.converged,
+            "chi2": float(r @ r), "n": int(r.size),
             "chi2_per_point": float(r @ r) / r.size, "rms_relative": m_obj.relative_rms(model, np.zeros(0))}
 
 
