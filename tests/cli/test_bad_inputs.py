@@ -41,6 +41,13 @@ def _set(*items):
 
 
 CASES = [
+    # the elastic-plastic law and the magnet's hold
+    (["shot", S, *_set("chain.contact_law=thornton", "chain.yield_force=-1 N")], "chain.yield_force"),
+    (["shot", "ptfe52_gravity", *_set("chain.contact_law=thornton", "chain.yield_force=1 N", "magnet.force=0 N",
+                                      "magnet.hold=60 s")], "magnet.hold"),
+    (["shot", S, *_set("chain.yield_force=1 N")], "chain.yield_force"),  # another law's key
+    (["reproduce", "daraio2006", "--fitted", "--family", "no such family", "--out", "{d}/r"], "--family"),
+    (["reproduce", "daraio2006", "--family", "hertz", "--out", "{d}/r"], "--family"),
     # shot: scenes and files
     (["shot", "no_such_scene"], "no_such_scene"),
     (["shot", "{d}/missing.toml"], "missing.toml"),
