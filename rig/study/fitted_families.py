@@ -34,8 +34,8 @@ YIELD_BOUNDS = "chain.yield_force=0.05 N:10 N"
 RATE_BOUNDS = "chain.yield_rate_exponent=0:0.15"
 RATIO_BOUNDS = "chain.static_yield_ratio=0.2:1"
 WEAK_MU_BOUNDS = "chain.contact_damping=0.001 kg/s:0.1 kg/s"
-EP_START = (("chain.youngs_modulus", 0.9e9), ("chain.yield_force", 0.5), ("chain.yield_rate_exponent", 0.05),
-            ("chain.static_yield_ratio", 0.586), ("chain.contact_damping", 0.0706))
+EP_START = (("chain.youngs_modulus", 1.0225e9), ("chain.yield_force", 0.627), ("chain.yield_rate_exponent", 0.110),
+            ("chain.static_yield_ratio", 0.708), ("chain.contact_damping", 0.0999))
 """Where the elastic-plastic families' fits start: a joint fit of the rate-dependent one to
 Table 1 and Fig. 3 (rig reproduce daraio2006 --fitted, this version)."""
 
