@@ -35,30 +35,12 @@ def kernel_law(expo, damping, dashpot, yield_overlap=None) -> int:
     return POWER
 
 
-class _ContactCodes:
-    """What the kernels read off the arrays of a ChainProblem or of ProblemArrays alike."""
+@dataclass(frozen=True, eq=False, kw_only=True)
+class _BodyArrays:
+    """The arrays a ChainProblem (one per body, or per contact slot) and ProblemArrays (the
+    same with a leading shot axis) share, named as in PER_BODY (and ``load``, one longer),
+    and what the kernels read off them (ChainProblem's doc says each array's unit)."""
 
-    @property
-    def law(self) -> int:
-        """The kernels' contact code of the live slots (of every shot together; kernel_law)."""
-        live = self.A > 0
-        return kernel_law(self.expo[live], self.damping[live], self.dashpot[live],
-                          self.reference_yield_overlap[live])
-
-    @property
-    def onsite(self) -> bool:
-        """Whether the holder drags or rubs any bead."""
-        return bool(np.any(self.drag) or np.any(self.friction))
-
-
-@dataclass(frozen=True, eq=False)
-class ProblemArrays(_ContactCodes):
-    """Many shots of one chain layout: the ChainProblem arrays with a leading shot axis
-    (``load`` (shots, bodies + 1), the others (shots, bodies)), energy_scale and
-    momentum_scale (shots,); ``layout``: a ChainProblem of the layout (its offset, wall
-    slot, law and schedule, which every shot shares)."""
-
-    layout: "ChainProblem"
     mass: np.ndarray
     invm: np.ndarray
     bias: np.ndarray
@@ -87,6 +69,28 @@ class ProblemArrays(_ContactCodes):
     friction: np.ndarray
     u0: np.ndarray
     v0: np.ndarray
+
+    @property
+    def law(self) -> int:
+        """The kernels' contact code of the live slots (of every shot together; kernel_law)."""
+        live = self.A > 0
+        return kernel_law(self.expo[live], self.damping[live], self.dashpot[live],
+                          self.reference_yield_overlap[live])
+
+    @property
+    def onsite(self) -> bool:
+        """Whether the holder drags or rubs any bead."""
+        return bool(np.any(self.drag) or np.any(self.friction))
+
+
+@dataclass(frozen=True, eq=False)
+class ProblemArrays(_BodyArrays):
+    """Many shots of one chain layout: the ChainProblem arrays with a leading shot axis
+    (``load`` (shots, bodies + 1), the others (shots, bodies)), energy_scale and
+    momentum_scale (shots,); ``layout``: a ChainProblem of the layout (its offset, wall
+    slot, law and schedule, which every shot shares)."""
+
+    layout: "ChainProblem"
     energy_scale: np.ndarray
     momentum_scale: np.ndarray
 
@@ -203,7 +207,7 @@ def balance_at_rest(load, A, d0, expo, invm):
 
 
 @dataclass(frozen=True, eq=False)
-class ChainProblem(_ContactCodes):
+class ChainProblem(_BodyArrays):
     """Bodies from the top: [striker] + beads + [wall as a body of zero inverse mass].
 
     Arrays are per body (size nb) in SI: mass (kg; 0 for the wall), invm (1/kg), bias
@@ -218,40 +222,13 @@ class ChainProblem(_ContactCodes):
     plastic_work (J), reference_yield_overlap (m; 0: it never yields), elastic_limit (m; inf: it
     never yields), last_overlap (m), last_rate (m/s), shifted_rest_overlap (m, d0 - delta_p);
     rig.model.laws.thornton),
-    d_limit (m, an overlap beyond which the integration is declared unstable). u0, v0 the initial state (m, m/s). With a compliant wall the plate
+    d_limit (m, an overlap beyond which the integration is declared unstable). u0, v0 the
+    initial state (m, m/s). With a compliant wall the plate
     is a body and the rod the slot below it, to the wall's immovable body.
     """
 
     chain: Chain
     offset: int
-    mass: np.ndarray
-    invm: np.ndarray
-    bias: np.ndarray
-    load: np.ndarray
-    A: np.ndarray
-    expo: np.ndarray
-    d0: np.ndarray
-    f0: np.ndarray
-    damping: np.ndarray
-    dashpot: np.ndarray
-    dashpot_exponent: np.ndarray
-    yield_rate_exponent: np.ndarray
-    yield_reference_rate: np.ndarray
-    permanent_overlap: np.ndarray
-    unloading_constant: np.ndarray
-    largest_rate: np.ndarray
-    yield_overlap: np.ndarray
-    plastic_work: np.ndarray
-    reference_yield_overlap: np.ndarray
-    elastic_limit: np.ndarray
-    last_overlap: np.ndarray
-    last_rate: np.ndarray
-    shifted_rest_overlap: np.ndarray
-    d_limit: np.ndarray
-    drag: np.ndarray
-    friction: np.ndarray
-    u0: np.ndarray
-    v0: np.ndarray
     sched_body: int
     sched_t: np.ndarray
     sched_f: np.ndarray

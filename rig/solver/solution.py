@@ -7,16 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rig.model.contact import hertz_energy
-from rig.solver.kernels.report import (
-    BODIES_STEPPED,
-    DISSIPATED,
-    END_TIME,
-    ENERGY_ERROR,
-    MOMENTUM_ERROR,
-    STATUS,
-    STEPS,
-    WALL_IMPULSE,
-)
+from rig.solver.kernels import report as slot
 
 
 class Status(enum.IntEnum):
@@ -49,10 +40,10 @@ class KernelReport:
     @classmethod
     def of(cls, diag) -> "KernelReport":
         """The report in a diagnostics array (a shot's column of a batch's)."""
-        steps = int(diag[STEPS])
-        return cls(float(diag[ENERGY_ERROR]), float(diag[MOMENTUM_ERROR]), float(diag[WALL_IMPULSE]),
-                   Status(int(diag[STATUS])), steps, float(diag[END_TIME]), float(diag[DISSIPATED]),
-                   float(diag[BODIES_STEPPED]) / max(steps, 1))
+        steps = int(diag[slot.STEPS])
+        return cls(float(diag[slot.ENERGY_ERROR]), float(diag[slot.MOMENTUM_ERROR]), float(diag[slot.WALL_IMPULSE]),
+                   Status(int(diag[slot.STATUS])), steps, float(diag[slot.END_TIME]), float(diag[slot.DISSIPATED]),
+                   float(diag[slot.BODIES_STEPPED]) / max(steps, 1))
 
 
 @dataclass(frozen=True)

@@ -20,22 +20,13 @@ from numba import prange
 from instruments.jit import jit
 from rig.model.contact import HERTZ, PLASTIC, POWER
 from rig.model.laws.thornton import AP, DC, DS, SPAN_END, SPAN_FIRST, WORK, plastic_force
+from rig.solver.kernels import report as slot
 from rig.solver.kernels.dissipation import dissipate, holder_factors
 from rig.solver.kernels.forces import contact_force, open_span, plastic_contact, power, state_sums
 from rig.solver.kernels.integrators import rest_from, still_from
 from rig.solver.kernels.memory import plastic_commit
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
-from rig.solver.kernels.report import (
-    BODIES_STEPPED,
-    DISSIPATED,
-    END_TIME,
-    ENERGY_ERROR,
-    MOMENTUM_ERROR,
-    STATUS,
-    STEPS,
-    WALL_IMPULSE,
-)
 
 
 @jit(inline="always")
@@ -61,9 +52,11 @@ def _power_row(u, A, d0, load, f, i, expo):
 
 @jit
 def _other_laws(u, A, d0, load, f, con, state, law, lo, hi):
-    """POWER: slots lo.. whose exponent is not 3/2 renewed by their own law; PLASTIC: every
-    slot lo.. by the elastic-plastic law of its memory ``state`` (forces.plastic_pass's
-    operations); after a pass renewed every slot as Hertz's from the same positions (no pass
+    """POWER: slots lo.. whose exponent is not 3/2 renewed by their own law; PLASTIC: the
+    slots of each shot's span past their elastic limit or of another exponent, by the
+    elastic-plastic law of their memory ``state`` (forces.plastic_fixup's operations); after
+    a pass renewed every slot as Hertz's (PLASTIC: each slot's elastic curve) from the same
+    positions (no pass
     reads a slot's force after renewing it, so this is the same as renewing them in the
     pass). Apart from the pass: inlined in its loop, this branch kept numba's atomic
     reference counts there (6% of the pass)."""
@@ -180,7 +173,8 @@ def _record(out, lo, j0, nj, w, x, ch_slot, ch_weight, A, law, con, state, d_old
 
 
 @jit
-def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, viscous_rate, a_coef, b_coef, dt, n_steps,
+def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, viscous_rate, a_coef, b_coef, dt,
+           n_steps,
            head, sub, ch_slot, ch_weight, sample_dt, out, lo, check_every, d_limit, wall_slot,
            e_ref, p_ref, diag, f, d_old, r_old, d_new, r_new):
     nb = u.shape[0]
@@ -239,7 +233,8 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
         reach = min(nb, still + n_drift + 2)
         stepped += reach
         if dissipative:  # E(dt/2) S(dt) E(dt/2) (integrators.integrate)
-            dissipate(u, v, mass, invm, A, d0, con, law, state, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
+            dissipate(u, v, mass, invm, A, d0, con, law, state, hold, slip, viscous, holder, viscous_rate, 0.5 * dt,
+                      wall_slot,
                       work, lost, j_visc, j_holder)
         for st in range(n_drift):
             hb = b_coef[st] * dt
@@ -263,7 +258,8 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
         if still < nb:
             still = still_from(u, v, u_rest, still, reach)
         if dissipative:
-            dissipate(u, v, mass, invm, A, d0, con, law, state, hold, slip, viscous, holder, viscous_rate, 0.5 * dt, wall_slot,
+            dissipate(u, v, mass, invm, A, d0, con, law, state, hold, slip, viscous, holder, viscous_rate, 0.5 * dt,
+                      wall_slot,
                       work, lost, j_visc, j_holder)
         probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, pending, head, -1, 0.0, d_new, r_new)
         j_end = j_out
@@ -285,18 +281,19 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
                 err = abs(e[s] + lost[s] - e0[s]) / e_ref[s]
                 pe = abs(pn[s] - p0[s] - (t_new * net[s] - (j_wall[s] + j_visc[s]) + j_holder[s])) / p_ref[s]
                 if not (err < 1e300) or not (worst[s] <= 1.0):
-                    diag[STATUS, s] = 1.0
-                diag[ENERGY_ERROR, s] = max(diag[ENERGY_ERROR, s], err)
-                diag[MOMENTUM_ERROR, s] = max(diag[MOMENTUM_ERROR, s], pe)
+                    diag[slot.STATUS, s] = 1.0
+                diag[slot.ENERGY_ERROR, s] = max(diag[slot.ENERGY_ERROR, s], err)
+                diag[slot.MOMENTUM_ERROR, s] = max(diag[slot.MOMENTUM_ERROR, s], pe)
     for s in range(u.shape[1]):
-        diag[WALL_IMPULSE, s] = j_wall[s] + j_visc[s] + (load[wall_slot, s] if wall_slot > 0 else 0.0) * n_steps * dt
-        diag[STEPS, s] = n_steps
-        diag[END_TIME, s] = n_steps * dt
-        diag[DISSIPATED, s] = lost[s]
+        wall_load = load[wall_slot, s] if wall_slot > 0 else 0.0
+        diag[slot.WALL_IMPULSE, s] = j_wall[s] + j_visc[s] + wall_load * n_steps * dt
+        diag[slot.STEPS, s] = n_steps
+        diag[slot.END_TIME, s] = n_steps * dt
+        diag[slot.DISSIPATED, s] = lost[s]
         if law == PLASTIC:  # the contacts' plastic work (integrators.integrate)
             for i in range(nb):
-                diag[DISSIPATED, s] += state[WORK, i, s]
-        diag[BODIES_STEPPED, s] = stepped
+                diag[slot.DISSIPATED, s] += state[WORK, i, s]
+        diag[slot.BODIES_STEPPED, s] = stepped
 
 
 @jit(parallel=True)
@@ -310,12 +307,10 @@ def integrate_ensemble(u, v, chain, contacts, holder, method, record, checks, di
     holding shots k width .. (k + 1) width - 1 (fill past the last shot); record.frames is
     not read. diag is (chunks, report.DIAGNOSTICS, width), each shot's column as the
     single-shot kernel's diag."""
-    mass, invm, bias, load, A, d0, d_limit = (chain.mass, chain.invm, chain.bias, chain.load, chain.A, chain.d0,
-                                              chain.d_limit)
-    law, con, state = contacts.law, contacts.con, contacts.state
-    onsite, slip, viscous_rate = holder.onsite, holder.slip, holder.viscous_rate
-    a_coef, b_coef, dt, n_steps, head, sub = (method.a_coef, method.b_coef, method.dt, method.n_steps, method.head,
-                                              method.sub)
+    mass, invm, bias, load, A, d0, d_limit = chain  # each bundle's fields, in their order (bundles.py)
+    law, con, state = contacts
+    onsite, slip, viscous_rate = holder
+    a_coef, b_coef, dt, n_steps, head, sub = method
     ch_slot, ch_weight, sample_dt, out = record.ch_slot, record.ch_weight, record.sample_dt, record.out
     check_every, e_ref, p_ref, wall_slot = checks.check_every, checks.e_ref, checks.p_ref, checks.wall_slot
     n_chunks, nb, W = u.shape

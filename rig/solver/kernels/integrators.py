@@ -104,12 +104,10 @@ def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks
     front: integrate only the bodies the pulse has reached (module doc); False: every body
     every step (the same bits).
     """
-    mass, invm, bias, load, A, d0, d_limit = (chain.mass, chain.invm, chain.bias, chain.load, chain.A, chain.d0,
-                                              chain.d_limit)
-    law, con, state = contacts.law, contacts.con, contacts.state
-    onsite, slip, viscous_rate = holder.onsite, holder.slip, holder.viscous_rate
-    a_coef, b_coef, dt, n_steps, head, sub = (method.a_coef, method.b_coef, method.dt, method.n_steps, method.head,
-                                              method.sub)
+    mass, invm, bias, load, A, d0, d_limit = chain  # each bundle's fields, in their order (bundles.py)
+    law, con, state = contacts
+    onsite, slip, viscous_rate = holder
+    a_coef, b_coef, dt, n_steps, head, sub = method
     sched_body, sched_t, sched_f = schedule.body, schedule.t, schedule.f
     ch_slot, ch_weight, sample_dt, out = record.ch_slot, record.ch_weight, record.sample_dt, record.out
     frame_dt, frames = record.frame_dt, record.frames
