@@ -99,19 +99,29 @@ def estimates(result: FitResult) -> dict:
 
 def magnetic_from_gravity(family: Family, points, observations, joint: FitResult) -> dict:
     """The family fitted to the gravity-only data (starting at its ``joint`` fit's values),
-    predicting the magnetic data (module doc); its magnetic-only keys at the law's defaults
-    ("at_defaults")."""
+    predicting the magnetic data (module doc); its magnetic-only keys, and any the
+    gravity-only data do not see, at the law's defaults ("at_defaults")."""
     mag_p = magnetic_points(points)
     mag_o = [magnetic_observation(o) for o in observations]
     gravity = family.without(family.magnetic_only)  # keys only the magnet's shots see: at the law's defaults
-    g_obj = objective(gravity, points.subset(np.flatnonzero(~mag_p)),
-                      tuple(o for o, m in zip(observations, mag_o) if not m), estimates(joint))
-    g = fit(g_obj, ftol=FTOL, xtol=XTOL)
+    unseen = []
+    while True:  # and the keys the gravity-only data do not see (rig.fit.checks.unseen) too
+        g_obj = objective(gravity, points.subset(np.flatnonzero(~mag_p)),
+                          tuple(o for o, m in zip(observations, mag_o) if not m), estimates(joint))
+        try:
+            g = fit(g_obj, ftol=FTOL, xtol=XTOL)
+            break
+        except RigError as exc:
+            key = next((p.split("=")[0] for p in gravity.params if f"'{p.split('=')[0]}'" in str(exc)), None)
+            if "do not see it" not in str(exc) or key is None or len(gravity.params) == 1:
+                raise
+            unseen.append(key)
+            gravity = gravity.without((key,))
     m_obj = objective(gravity, points.subset(np.flatnonzero(mag_p)),
                       tuple(o for o, m in zip(observations, mag_o) if m))
     (model,) = m_obj.evaluate([g.estimate])
     r = m_obj.residuals(model, np.zeros(0))
-    return {"parameters": parameters(g), "at_defaults": list(family.magnetic_only), "converged": g.converged,
+    return {"parameters": parameters(g), "at_defaults": list(family.magnetic_only) + unseen, "converged": g.converged,
             "chi2": float(r @ r), "n": int(r.size),
             "chi2_per_point": float(r @ r) / r.size, "rms_relative": m_obj.relative_rms(model, np.zeros(0))}
 
@@ -134,7 +144,8 @@ def assess(family: Family, points, observations, tell, done=()) -> Assessment:
         row["failed"] = f"joint fit: {exc}"
         tell(f"{family.name}: failed")
         return Assessment(family, row)
-    row.update({"parameters": parameters(r), "chi2": r.chi2, "dof": r.dof, "bic": r.bic, "converged": r.converged, "candidates_solved": r.evaluations,
+    row.update({"parameters": parameters(r), "chi2": r.chi2, "dof": r.dof, "bic": r.bic, "converged": r.converged,
+                "candidates_solved": r.evaluations,
                 "at_bound": list(r.at_bound), "unusable": unusable(r) or None,
                 "fig3_chi2": float(np.sum(r.residuals[obj.slices[1]] ** 2)), **table1_figures(obj, r)})
     tell(f"{family.name}: joint fit")

@@ -70,8 +70,8 @@ def targets(fitted: dict) -> list:
                 "met": None if None in (g, m) else bool(m >= g)})
     for key, what, published in STEEL:
         v = fitted["steel"].get(key)
-        out.append({"target": f"{what}: {published:g} +- 20%", "value": v,
-                    "met": _inside(v, (0.8 * published, 1.2 * published))})
+        out.append({"target": f"{what}: {published:g} +- 10%", "value": v,
+                    "met": _inside(v, (0.9 * published, 1.1 * published))})
     return out
 
 
