@@ -112,7 +112,7 @@ def viscous_terms(values: dict) -> ViscousTerms:
     return ViscousTerms(dashpot=values["contact_damping"])
 
 
-@kernel(inline="always")
+@kernel
 def elastic_power(d, n):
     """d^n for d >= 0 (d sqrt(d) for Hertz's 3/2, exactly as the kernels' Hertz passes)."""
     if n == 1.5:
@@ -120,7 +120,7 @@ def elastic_power(d, n):
     return d**n
 
 
-@kernel(inline="always")
+@kernel
 def unloading(d, F, Fy, dy, n):
     """(delta_p, A_p): the elastic curve through (d, F) (m, N) of a contact yielding at Fy
     (N) at overlap dy (m): Thornton's k_u = k_y sqrt((2F + Fy) / (3 Fy)), k_y = n Fy / dy."""
@@ -129,7 +129,7 @@ def unloading(d, F, Fy, dy, n):
     return d - de, F / elastic_power(de, n)
 
 
-@kernel(inline="always")
+@kernel
 def envelope(d, A, n, dy):
     """Force (N) on the loading envelope at overlap d (m): A d^n up to dy, then the tangent line."""
     if d <= dy:
@@ -138,7 +138,7 @@ def envelope(d, A, n, dy):
     return Fy + n * Fy / dy * (d - dy)
 
 
-@kernel(inline="always")
+@kernel
 def envelope_work(a, b, A, n, dy):
     """The envelope's work (J) from overlap a to b >= a (m): A x^(n+1) / (n+1) below dy, a
     trapezoid on the line beyond."""
@@ -152,7 +152,7 @@ def envelope_work(a, b, A, n, dy):
     return w
 
 
-@kernel(inline="always")
+@kernel
 def plastic_force(d, A, n, state, i, s):
     """Force (N) of contact i of shot s at overlap d (m) by its memory state[:, i, s], which a
     step holds fixed: its elastic curve A_p (d - d_p)^n up to its elastic limit, the
@@ -167,7 +167,7 @@ def plastic_force(d, A, n, state, i, s):
     return envelope(d, A, n, state[DY, i, s])
 
 
-@kernel(inline="always")
+@kernel
 def plastic_energy(d, A, n, state, i, s):
     """The potential (J) of plastic_force at overlap d (m) for the memory state[:, i, s]:
     A_p (x - d_p)^(n+1) / (n+1) at x = min(d, elastic limit), plus the envelope's work
@@ -180,7 +180,7 @@ def plastic_energy(d, A, n, state, i, s):
     return u + state[WORK, i, s]
 
 
-@kernel(inline="always")
+@kernel
 def elastic_limit(A, n, dp, ap, dy, start):
     """The overlap (m) from ``start`` on where the elastic curve A_p (x - d_p)^n meets the
     envelope of yield overlap dy (A, n the contact's elastic law; bisection: the curve
@@ -202,7 +202,7 @@ def elastic_limit(A, n, dp, ap, dy, start):
     return lo
 
 
-@kernel(inline="always")
+@kernel
 def hermite_peak(y0, m0, y1, m1):
     """The largest value of the cubic Hermite polynomial through y0, y1 with slopes m0 > 0 >
     m1 (per unit of the interval) on [0, 1]: at the one root there of its derivative
@@ -220,7 +220,7 @@ def hermite_peak(y0, m0, y1, m1):
     return y0 + (3.0 * x2 - 2.0 * x2 * x) * dy + (x2 * x - 2.0 * x2 + x) * m0 + (x2 * x - x2) * m1
 
 
-@kernel(inline="always")
+@kernel
 def commit(d, rate, dt, A, d0, n, m, r_ref, state, i, s):
     """Renew the memory of contact i of shot s at a step's end: overlap d (m), closing rate
     ``rate`` (m/s), dt (s) after the last (d0: its rest overlap, m). The step's largest overlap: d, or where the

@@ -100,7 +100,7 @@ def plastic_fixup(u, A, d0, load, f, expo, state, lo, hi):
             f[i] = plastic_force(d, A[i], expo[i], state, i, 0) - load[i]
 
 
-@jit(inline="always")
+@jit
 def plastic_contact(d, rate, A, n, mu, state, i, s):
     """(F, its elastic-plastic part) (N) of a PLASTIC contact (module doc): the part by
     thornton.plastic_force, a dashpot mu r beside it while closed (d > d_p), never
