@@ -45,8 +45,6 @@ ON = {  # name: scene overrides switching the model on (values of the order a fi
     "dashpot 0.5 kg/s": ["chain.contact_law=dashpot", "chain.contact_damping=0.5 kg/s"],
     "Thornton yield 5 N": ["chain.contact_law=thornton", "chain.yield_force=5 N"],
     "Thornton yield 0.8 N": ["chain.contact_law=thornton", "chain.yield_force=0.8 N"],
-    "Thornton 0.8 N + dashpot 0.05 kg/s": ["chain.contact_law=thornton", "chain.yield_force=0.8 N",
-                                           "chain.contact_damping=0.05 kg/s"],
     "holder drag": ["holder.drag=0.05 kg/s"],
     "holder friction": ["holder.friction=2 mN"],
     "compliant wall": ["wall.plate_mass=2 g", "wall.rod_stiffness=1e8 N/m"],
