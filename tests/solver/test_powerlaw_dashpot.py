@@ -32,7 +32,8 @@ def pair_flow(alpha, gamma, t, substeps):
     hold = np.zeros((2, 2, 1))
     hold[0] = 1.0
     lost, j_wall, j_holder = np.zeros(1), np.zeros(1), np.zeros(1)
-    dissipate(u, v, mass, 1.0 / mass, A, d0, con, KUWABARA_KONO, np.zeros((len(STATE_ROWS), 2, 1)), hold, 1e-3, True, False, substeps / t, t, 0,
+    dissipate(u, v, mass, 1.0 / mass, A, d0, con, KUWABARA_KONO, np.zeros((len(STATE_ROWS), 2, 1)), hold,
+              1e-3, True, False, substeps / t, t, 0,
               np.zeros((5, 3, 1)), lost, j_wall, j_holder)
     return v[0, 0] - v[1, 0], lost[0], M * (v[0, 0] + v[1, 0])
 

@@ -38,7 +38,7 @@ import numpy as np
 
 from instruments.jit import jit
 from rig.model.contact import PLASTIC
-from rig.model.laws.thornton import WORK
+from rig.model.laws.thornton import AP, DS, WORK
 from rig.solver.kernels.dissipation import dissipate, holder_factors
 from rig.solver.kernels.forces import elastic_forces, state_sums
 from rig.solver.kernels.memory import plastic_commit
@@ -128,6 +128,8 @@ def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks
     dissipative = viscous or holder
 
     state3 = state.reshape((state.shape[0], nb, 1))
+    expo = con[0]
+    A_el, d0_el = (state[AP], state[DS]) if law == PLASTIC else (A, d0)  # the force passes' elastic curves
     every = False  # PLASTIC: a contact of another exponent than 3/2, renewed by the law at every stage
     for i in range(nb):
         every = every or (A[i] > 0.0 and con[0, i] != 1.5)
@@ -196,7 +198,7 @@ def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks
                       wall_slot, work, lost, j_visc, j_holder)
         reach = min(nb, still + n_drift + 2)
         stepped += reach
-        step(u, v, invm, f, A, d0, load, law, con, state, a_coef, b_coef, dt, t, pending, head, sub,
+        step(u, v, invm, f, A, d0, load, law, expo, state3, A_el, d0_el, a_coef, b_coef, dt, t, pending, head, sub,
               sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt

@@ -14,7 +14,6 @@ import numpy as np
 
 from instruments.jit import jit
 from rig.model.contact import PLASTIC, POWER
-from rig.model.laws.thornton import AP, DS
 from rig.solver.kernels.forces import other_law, plastic_fixup
 from rig.solver.kernels.layout import LINE
 from rig.solver.kernels.multirate import head_flow
@@ -51,17 +50,16 @@ def external_kick(v, invm, h, t, sched_body, sched_t, sched_f):
 
 
 @jit(inline="always")
-def fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, con, state, A_el, d0_el):
+def fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, expo):
     """Bodies lo..hi-1 (lo >= 1), in order: kick v += hb (f_above - f_below)/m, drift
     u += ha v, then renew contact slot i's elastic force from bodies i-1 and i (both moved;
     forces.elastic_forces' operations). Slot i + 1 is still the old force when body i is
     kicked, so one pass does what a kick-drift pass and a force pass do. ``law``: POWER
     renews the slots whose exponent ``expo`` is not 3/2 again by their own law
     (forces.other_law; no slot's force is read in the pass that renews it, so this is the
-    same as renewing them in the pass), PLASTIC's pass takes each slot's elastic curve (A_el,
-    d0_el: its memory's A_p and d0 - delta_p) and renews again the slots it does not give
-    (forces.plastic_fixup, by ``state``), any other code is Hertz's (A_el, d0_el = A, d0;
-    ``con``: the slots' CONTACT_ROWS).
+    same as renewing them in the pass), any other code is Hertz's. PLASTIC's caller passes
+    each slot's elastic curve (its memory's A_p and d0 - delta_p) for A and d0, and renews
+    after it the slots the curve does not give (step, forces.plastic_fixup).
 
     The index is unsigned: with a signed start known only at run time numba keeps its
     negative-index wraparound in the loop and LLVM no longer vectorises it
@@ -79,14 +77,12 @@ def fused_run(u, v, invm, f, A, d0, load, hb, ha, lo, hi, law, con, state, A_el,
             v[i] = vi
             ui = u[i] + ha * vi
             u[i] = ui
-            d = d0_el[i] + u_prev - ui
+            d = d0[i] + u_prev - ui
             d = d if d > 0.0 else 0.0
-            f[i] = A_el[i] * d * math.sqrt(d) - load[i]
+            f[i] = A[i] * d * math.sqrt(d) - load[i]
             u_prev = ui
     if law == POWER:  # not in the loop: a pow there (even behind a branch) stops it vectorising
-        other_law(u, A, d0, load, f, con[0], lo, hi)
-    elif law == PLASTIC:
-        plastic_fixup(u, A, d0, load, f, con[0], state, lo, hi)
+        other_law(u, A, d0, load, f, expo, lo, hi)
 
 
 @jit
@@ -106,7 +102,7 @@ BLOCK = 2048  # bodies per block of a step's wavefront (their arrays stay in the
 
 
 @jit(inline="always")
-def step(u, v, invm, f, A, d0, load, law, con, state, a_coef, b_coef, dt, t, pending, head, sub,
+def step(u, v, invm, f, A, d0, load, law, expo, state, A_el, d0_el, a_coef, b_coef, dt, t, pending, head, sub,
           sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach):
     """One step of the composition (its closing kick owed), bodies 0..reach-1, every stage.
     ``reach``: the bodies beyond it are still at rest and unforced (integrators.rest_from):
@@ -124,8 +120,6 @@ def step(u, v, invm, f, A, d0, load, law, con, state, a_coef, b_coef, dt, t, pen
     """
     nb = reach
     u2, v2, im2, f2, A2, d02, load2 = heads
-    A_el, d0_el = (state[AP], state[DS]) if law == PLASTIC else (A, d0)  # the force passes' elastic curves
-    st3 = state.reshape((state.shape[0], state.shape[1], 1))
     n_blocks = max(1, (nb + BLOCK - 1) // BLOCK)
     for k in range(n_blocks):
         ts = t
@@ -151,5 +145,7 @@ def step(u, v, invm, f, A, d0, load, law, con, state, a_coef, b_coef, dt, t, pen
                     u[0] += h * v0
                     lo = 1
             if hi > lo:
-                fused_run(u, v, invm, f, A, d0, load, hb, h, lo, hi, law, con, st3, A_el, d0_el)
+                fused_run(u, v, invm, f, A_el, d0_el, load, hb, h, lo, hi, law, expo)
+                if law == PLASTIC:  # the slots past their elastic limit, apart: no call in the pass
+                    plastic_fixup(u, A, d0, load, f, expo, state, lo, hi)
             ts += h
