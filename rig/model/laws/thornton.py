@@ -285,18 +285,15 @@ def initial_state(A, n, F_static, d_static, terms: YieldTerms, hold: float = 0.0
     work = np.zeros(A.shape)
     dys = dy * (terms.static_ratio**2 if hold > 0 else 1.0)
     flat = (dys > 0) & (F > A * dys**n)
-    if np.any(flat):
-        a, m, f, y, yd = A[flat], n[flat], F[flat], dys[flat], dy[flat]
-        fy = a * y**m
-        ky = m * fy / y
-        d_star = y + (f - fy) / ky
-        de = m * f / (ky * np.sqrt((2.0 * f + fy) / (3.0 * fy)))
-        dp, ap = d_star - de, f / de**m
-        state[DP][flat], state[AP][flat] = dp, ap
-        state[DC][flat] = [elastic_limit(float(x), float(k), float(p), float(q), float(z), float(w))
-                           for x, k, p, q, z, w in zip(a, m, dp, ap, yd, d_star)]
-        work[flat] = a * y**(m + 1.0) / (m + 1.0) + 0.5 * (fy + f) * (d_star - y) - f * de / (m + 1.0)
-        d0[flat] = d_star
+    for k in zip(*np.nonzero(flat)):  # the contacts loaded past their yield, by the kernels' own functions
+        a, m, f, y = A[k], n[k], F[k], dys[k]
+        fy = a * elastic_power(y, m)
+        d_star = y + (f - fy) / (m * fy / y)  # on the envelope's line
+        dp, ap = unloading(d_star, f, fy, y, m)
+        state[DP][k], state[AP][k] = dp, ap
+        state[DC][k] = elastic_limit(a, m, dp, ap, dy[k], d_star)
+        work[k] = envelope_work(0.0, d_star, a, m, y) - f * (d_star - dp) / (m + 1.0)
+        d0[k] = d_star
     state[DLAST] = d0
     return state, d0, work
 
