@@ -19,12 +19,12 @@ from numba import prange
 
 from instruments.jit import jit
 from rig.model.contact import HERTZ, PLASTIC, POWER
-from rig.model.laws.thornton import AP, DC, DS, SPAN_END, SPAN_FIRST, WORK, plastic_force
+from rig.model.laws.thornton import AP, DC, DS, SPAN_END, SPAN_FIRST, plastic_force
 from rig.solver.kernels import report as slot
 from rig.solver.kernels.dissipation import dissipate, holder_factors
 from rig.solver.kernels.forces import contact_force, open_span, plastic_contact, power, state_sums
 from rig.solver.kernels.integrators import rest_from, still_from
-from rig.solver.kernels.memory import plastic_commit
+from rig.solver.kernels.memory import other_exponent, plastic_commit, plastic_work
 from rig.solver.kernels.multirate import head_flow
 from rig.solver.kernels.record import hermite_weights, probe_overlaps
 
@@ -188,10 +188,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
             viscous = viscous or con[1, i, s] != 0.0 or con[2, i, s] != 0.0
             holder = holder or onsite[0, i, s] != 0.0 or onsite[1, i, s] != 0.0
     dissipative = viscous or holder
-    every = False  # PLASTIC: a contact of another exponent than 3/2 (memory.plastic_commit)
-    for i in range(nb):
-        for s in range(W):
-            every = every or (A[i, s] > 0.0 and con[0, i, s] != 1.5)
+    every = other_exponent(A, con)  # PLASTIC: every slot renewed at every stage (memory.plastic_commit)
     work = np.zeros((5, nb + 1, W))  # the dissipation's work arrays
     hold = holder_factors(onsite, 0.5 * dt, viscous)  # E(dt/2)'s holder flows
     lost = np.zeros(W)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
@@ -290,9 +287,8 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
         diag[slot.STEPS, s] = n_steps
         diag[slot.END_TIME, s] = n_steps * dt
         diag[slot.DISSIPATED, s] = lost[s]
-        if law == PLASTIC:  # the contacts' plastic work (integrators.integrate)
-            for i in range(nb):
-                diag[slot.DISSIPATED, s] += state[WORK, i, s]
+        if law == PLASTIC:
+            diag[slot.DISSIPATED, s] += plastic_work(state, s)
         diag[slot.BODIES_STEPPED, s] = stepped
 
 

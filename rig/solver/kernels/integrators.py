@@ -38,10 +38,10 @@ import numpy as np
 
 from instruments.jit import jit
 from rig.model.contact import PLASTIC
-from rig.model.laws.thornton import AP, DS, WORK
+from rig.model.laws.thornton import AP, DS
 from rig.solver.kernels.dissipation import dissipate, holder_factors
 from rig.solver.kernels.forces import elastic_forces, state_sums
-from rig.solver.kernels.memory import plastic_commit
+from rig.solver.kernels.memory import other_exponent, plastic_commit, plastic_work
 from rig.solver.kernels.record import hermite, hermite_weights, probe_overlaps, recorded_force
 from rig.solver.kernels.report import (
     BODIES_STEPPED,
@@ -130,9 +130,7 @@ def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks
     state3 = state.reshape((state.shape[0], nb, 1))
     expo = con[0]
     A_el, d0_el = (state[AP], state[DS]) if law == PLASTIC else (A, d0)  # the force passes' elastic curves
-    every = False  # PLASTIC: a contact of another exponent than 3/2, renewed by the law at every stage
-    for i in range(nb):
-        every = every or (A[i] > 0.0 and con[0, i] != 1.5)
+    every = other_exponent(A.reshape((nb, 1)), con.reshape((con.shape[0], nb, 1)))  # PLASTIC: every slot renewed
     elastic_forces(u, A, d0, load, f, law, con, state3)
     # (bodies, 1) views for the multirate head, the records and the dissipation (shared with the batched kernel)
     heads = (u.reshape((nb, 1)), v.reshape((nb, 1)), invm.reshape((nb, 1)), f.reshape((nb + 1, 1)),
@@ -260,7 +258,6 @@ def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks
     diag[STEPS] = steps_done
     diag[END_TIME] = steps_done * dt
     diag[DISSIPATED] = lost[0]
-    if law == PLASTIC:  # the contacts' plastic work, which the energy carries, is dissipated too
-        for i in range(nb):
-            diag[DISSIPATED] += state3[WORK, i, 0]
+    if law == PLASTIC:
+        diag[DISSIPATED] += plastic_work(state3, 0)
     diag[BODIES_STEPPED] = stepped

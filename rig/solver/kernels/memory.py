@@ -14,7 +14,7 @@ SPAN_END; slot 0 joins no bodies) and the force passes check only those slots fo
 envelope (forces.plastic_fixup), instead of every slot at every stage. Where any exponent
 is not 3/2 every slot is renewed by the law at every stage (``every``)."""
 from instruments.jit import jit
-from rig.model.laws.thornton import DC, DLAST, RLAST, RMAX, SPAN_END, SPAN_FIRST, commit
+from rig.model.laws.thornton import DC, DLAST, RLAST, RMAX, SPAN_END, SPAN_FIRST, WORK, commit
 from rig.solver.kernels.record import synced_velocity
 
 NEAR = 3.0  # a contact is near its elastic limit within this many of its last step's changes of overlap
@@ -50,3 +50,23 @@ def plastic_commit(u, v, invm, f, A, d0, con, state, pending, head, sched_body, 
         for s in range(W):
             state[SPAN_FIRST, 0, s] = 1.0
             state[SPAN_END, 0, s] = state.shape[1]
+
+
+@jit
+def other_exponent(A, con) -> bool:
+    """Whether a contact of any shot has an exponent other than 3/2 (A (bodies, shots), con
+    (rows, bodies, shots)): plastic_commit's ``every``."""
+    for i in range(A.shape[0]):
+        for s in range(A.shape[1]):
+            if A[i, s] > 0.0 and con[0, i, s] != 1.5:
+                return True
+    return False
+
+
+@jit
+def plastic_work(state, s) -> float:
+    """The plastic work (J) the contacts of shot s took, which the energy carries: dissipated."""
+    w = 0.0
+    for i in range(state.shape[1]):
+        w += state[WORK, i, s]
+    return w
