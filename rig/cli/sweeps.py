@@ -95,10 +95,10 @@ def print_sweep(key: str, points: list):
 def cmd_reproduce(args) -> dict:
     if args.family and not args.fitted:
         raise invalid("--family", args.family[0], "chooses the families of --fitted; give --fitted too")
-    if args.family:
+    if args.fitted:
         from rig.study.fitted_families import chosen_families
 
-        chosen_families(args.family)  # a name this version lacks: refused before any work
+        families = chosen_families(args.family)  # a name this version lacks: refused before any work
     if args.identifiability or args.sensitivity or args.set or args.param or args.truth:
         from rig.cli.fig3_studies import run_fig3_studies
 
@@ -115,10 +115,8 @@ def cmd_reproduce(args) -> dict:
             results = reproduce(args.study, args.out, progress)
     block = {"out": args.out, "table1": results["table1"], "summary": results["summary"]}
     if args.fitted:
-        from rig.study.fitted_families import chosen_families
         from rig.study.reproduce_fitted import DASHPOTS, reproduce_fitted
 
-        families = chosen_families(args.family)
         steps = 3 * len(families) + len(DASHPOTS) + 1  # each family's fits and shots, the scan, steel
         with progress_bar(args.quiet, total=steps, desc="fitted models", unit="step") as bar:
             def progress(what):
