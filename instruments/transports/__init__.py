@@ -1,0 +1,3 @@
+"""How a message-based instrument is reached over the network, as VISA reaches a real one:
+the raw socket (``socket.py``), HiSLIP (``hislip.py``, IVI-6.1) and VXI-11 (``vxi11.py``, ONC
+RPC). Each transport serves any ``MessageInstrument`` (``device.py``); none knows SCPI."""

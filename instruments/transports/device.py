@@ -1,0 +1,102 @@
+"""What every transport serves: an IEEE 488.2 message-based instrument.
+
+A transport takes complete program messages off the wire (the terminator or END already
+removed) and hands each to its connection's ``Session``; what the session answers is the
+response message the client reads next (ending in ``\\n``, as a Tektronix scope's replies do).
+The instrument is one, shared by every connection and transport; a ``Session`` is one
+client's view of it (its output queue). ``InstrumentLock`` is the lock VISA clients take
+(HiSLIP's exclusive and shared locks, VXI-11's ``device_lock``), one per instrument, so a lock
+taken over one transport holds on all."""
+from __future__ import annotations
+
+import threading
+import time
+from typing import Protocol
+
+
+class Session(Protocol):
+    """One client's connection to the instrument."""
+
+    def handle(self, message: bytes) -> bytes:
+        """Execute one complete program message; return the response (b"" when it held no
+        query). May block while a query waits for the instrument (``*OPC?``)."""
+
+    def device_clear(self) -> None:
+        """IEEE 488.2 device clear: drop this session's pending input and output."""
+
+    def trigger(self) -> None:
+        """The group execute trigger (``*TRG``) sent out of band (VXI-11 ``device_trigger``)."""
+
+    def status_byte(self) -> int:
+        """The status byte (``*STB?``), read out of band (serial poll)."""
+
+    def close(self) -> None:
+        """The client is gone; forget what was queued for it."""
+
+
+class MessageInstrument(Protocol):
+    """An instrument a transport can serve."""
+
+    max_message_bytes: int
+    """The largest program message taken; a longer one is refused, not buffered."""
+
+    lock: "InstrumentLock"
+
+    def open_session(self, peer: str) -> Session:
+        """A new client (``peer``: its address, for the log)."""
+
+
+class InstrumentLock:
+    """The instrument's lock: one exclusive holder, or shared holders that named the same
+    lock string (HiSLIP, IVI-6.1 6.5), never both. Owners are opaque hashable keys (one per
+    connection or link). ``acquire`` waits at most ``timeout_s``."""
+
+    def __init__(self) -> None:
+        self._cond = threading.Condition()
+        self._exclusive: object | None = None
+        self._shared: dict[object, str] = {}
+
+    def acquire(self, owner: object, *, exclusive: bool = True, shared_name: str = "",
+                timeout_s: float = 0.0) -> bool:
+        """Take the lock for ``owner``; True when taken (or already held by it)."""
+        deadline = time.monotonic() + max(timeout_s, 0.0)
+        with self._cond:
+            while True:
+                if self._grantable(owner, exclusive, shared_name):
+                    if exclusive:
+                        self._exclusive = owner
+                    else:
+                        self._shared[owner] = shared_name
+                    return True
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return False
+                self._cond.wait(left)
+
+    def _grantable(self, owner: object, exclusive: bool, shared_name: str) -> bool:
+        if self._exclusive not in (None, owner):
+            return False
+        if exclusive:
+            return all(o == owner for o in self._shared)
+        names = {n for o, n in self._shared.items() if o != owner}
+        return not names or names == {shared_name}
+
+    def release(self, owner: object) -> bool:
+        """Drop what ``owner`` holds; True when it held something."""
+        with self._cond:
+            held = self._exclusive == owner or owner in self._shared
+            if self._exclusive == owner:
+                self._exclusive = None
+            self._shared.pop(owner, None)
+            self._cond.notify_all()
+            return held
+
+    def blocks(self, owner: object) -> bool:
+        """True when another owner holds the lock exclusively (``owner`` may not write)."""
+        with self._cond:
+            return self._exclusive not in (None, owner)
+
+    def holds(self, owner: object) -> bool:
+        """True when ``owner`` holds the lock, exclusively or shared."""
+        with self._cond:
+            return self._exclusive == owner or owner in self._shared
