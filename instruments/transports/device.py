@@ -30,6 +30,10 @@ class Session(Protocol):
     def status_byte(self) -> int:
         """The status byte (``*STB?``), read out of band (serial poll)."""
 
+    def overflow(self, size: int) -> None:
+        """A program message of ``size`` bytes, over ``max_message_bytes``, was discarded by
+        the transport unread; the instrument records the error in its queue."""
+
     def close(self) -> None:
         """The client is gone; forget what was queued for it."""
 
