@@ -8,11 +8,11 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-# a module may import its own layer or a lower one; model and theory share a rank but stay apart
+# a module may import its own layer or a lower one; model and theory, study and lab share a rank but stay apart
 RANKS = {"instruments": 0, "rig.errors": 1, "rig.units": 2, "rig.memo": 2, "rig.model": 3, "rig.theory": 3,
-         "rig.solver": 4, "rig.experiment": 5, "rig.viz": 6, "rig.fit": 7, "rig.study": 8, "rig.bench": 9,
+         "rig.solver": 4, "rig.experiment": 5, "rig.viz": 6, "rig.fit": 7, "rig.study": 8, "rig.lab": 8, "rig.bench": 9,
          "rig.cli": 10}
-APART = {frozenset({"rig.model", "rig.theory"})}
+APART = {frozenset({"rig.model", "rig.theory"}), frozenset({"rig.study", "rig.lab"})}
 HEAVY = {"numba", "scipy", "pint", "pyvista", "vtk", "vtkmodules", "matplotlib", "dask", "h5py"}
 
 

@@ -1,0 +1,140 @@
+"""A scene as the shot source of a virtual scope.
+
+``SceneShots("ptfe52_magnetic", ["striker.velocity=0.9 m/s"])`` is the callable a virtual
+scope is given (``instruments`` never imports the rig): called with ``(overrides, seed)``,
+where ``overrides`` maps a dotted scene key to its value text with its unit (e.g.
+``{"scope.channels.CH1.volts_per_div": "0.05 V"}``), it returns the ``ScopeRecord`` of
+``Rig(scene with the base and these overrides).fire(seed)``: the very bits of
+``rig shot SCENE --set KEY=VALUE ... --seed SEED``, because it reads the scene the way that
+command does (``rig.experiment.scene.load`` of the "key=value" items).
+
+The rigs built are kept per distinct set of overrides (a small LRU), so repeated shots cost
+one fire each; a rig whose settings differ from a kept one only in ``scope.*`` keys takes
+that rig's solved chain (the scope does not change what the chain does). A refusal of the
+rig (``RigError``) is raised as ``instruments.errors.InstrumentError`` with the same one
+line, the form the instrument side puts in its error queue.
+"""
+from __future__ import annotations
+
+import threading
+from collections import OrderedDict
+from collections.abc import Callable, Iterable, Mapping
+
+from instruments.errors import InstrumentError
+from instruments.records import ScopeRecord
+from rig.errors import RigError, invalid
+from rig.experiment.scene import load
+from rig.experiment.shot import Rig, ShotRecord
+
+RIG_KEYS = ("striker.velocity", "magnet.force", "magnet.position")
+"""The settings of the rig itself (not of the scope) that a lab client may change."""
+
+SCOPE_PREFIX = "scope."  # settings of the scope only: the chain's solve does not depend on them
+
+
+def key_of(item: str) -> str:
+    """The key of a "key=value" item, as ``rig shot --set`` reads it."""
+    return item.split("=", 1)[0].strip()
+
+
+class SceneShots:
+    """The shot source of one scene: ``(overrides, seed) -> ScopeRecord``.
+
+    scene: a published scene's name or a scene file's path. base_overrides: the "key=value"
+    items the scene is served with (``rig serve scope --set``), or a {key: value text}
+    mapping; a key the call's overrides give again takes the call's value. on_shot: called
+    with each shot's ``ShotRecord`` (what ``--out`` archives); ``last`` keeps the latest.
+    cache: how many rigs (distinct override sets) are kept. allow_large: fire shots beyond
+    the solver's size limits (rig/solver/estimate.py), as ``rig shot --allow-large``.
+    A bad scene or base override raises RigError here, before any shot.
+    """
+
+    def __init__(self, scene, base_overrides: Iterable[str] | Mapping[str, str] = (), *,
+                 on_shot: Callable[[ShotRecord], None] | None = None, cache: int = 8, allow_large: bool = False):
+        if isinstance(base_overrides, Mapping):
+            base_overrides = [f"{k}={v}" for k, v in base_overrides.items()]
+        if isinstance(base_overrides, (str, bytes)):
+            raise invalid("base_overrides", base_overrides, 'a list of "key=value" texts or a {key: value} mapping')
+        if isinstance(cache, bool) or not isinstance(cache, int) or cache < 1:
+            raise invalid("cache", cache, "a whole number of rigs >= 1")
+        self.scene = scene
+        self.base = tuple(base_overrides)
+        self.loaded = load(scene, self.base)  # refused here, not at the first shot
+        self.on_shot = on_shot
+        self.allow_large = allow_large
+        self.last: ShotRecord | None = None
+        self._size = cache
+        self._rigs: OrderedDict[tuple, Rig] = OrderedDict()
+        self._lock = threading.RLock()
+
+    def items(self, overrides: Mapping[str, str]) -> tuple:
+        """The "key=value" items a shot with ``overrides`` is fired with: the base items whose
+        key the overrides do not give, then the overrides in key order."""
+        if not isinstance(overrides, Mapping):
+            raise InstrumentError(f"overrides = {overrides!r}: a mapping of scene keys to value texts")
+        given = {str(k).strip(): str(v) for k, v in overrides.items()}
+        kept = tuple(item for item in self.base if key_of(item) not in given)
+        return kept + tuple(f"{k}={given[k]}" for k in sorted(given))
+
+    def rig(self, overrides: Mapping[str, str] | None = None) -> Rig:
+        """The rig of the scene with ``overrides`` (built once per distinct set; RigError)."""
+        items = self.items(overrides or {})
+        key = tuple(sorted(items))
+        with self._lock:
+            if key in self._rigs:
+                self._rigs.move_to_end(key)
+                return self._rigs[key]
+            rig = Rig(load(self.scene, items))
+            rig.check_record()
+            rig.estimate().refuse_unless(self.allow_large, "this shot")
+            twin = next((other for k, other in reversed(self._rigs.items()) if same_chain(key, k)), None)
+            if twin is not None:
+                rig.use_solution(twin.solution())
+            self._rigs[key] = rig
+            if len(self._rigs) > self._size:
+                self._rigs.popitem(last=False)
+            return rig
+
+    def shot(self, overrides: Mapping[str, str], seed: int) -> ShotRecord:
+        """The whole shot (scope record, settings, truth) with ``overrides`` and ``seed``;
+        a refusal of the rig is an InstrumentError of one line."""
+        with self._lock:
+            try:
+                shot = self.rig(overrides).fire(seed=seed)
+            except RigError as exc:
+                raise InstrumentError(str(exc)) from None
+            self.last = shot
+            if self.on_shot is not None:
+                self.on_shot(shot)
+            return shot
+
+    def __call__(self, overrides: Mapping[str, str], seed: int) -> ScopeRecord:
+        """The ShotSource: the scope record of ``shot(overrides, seed)``."""
+        return self.shot(overrides, seed).scope
+
+    def validate(self, key: str, text: str) -> str | None:
+        """None when ``key`` (one of RIG_KEYS) may be set to ``text`` (a quantity with its
+        unit as in scene files, e.g. "0.9 m/s", "2.38 N"; a plain number is in SI), else the
+        one-line refusal: the scene read with it and its parts built, as a shot would."""
+        if key not in RIG_KEYS:
+            return str(invalid("rig key", key, f"one of {', '.join(RIG_KEYS)}"))
+        try:
+            self.rig({key: text})
+        except (RigError, InstrumentError) as exc:
+            return str(exc)
+        return None
+
+
+def same_chain(a: tuple, b: tuple) -> bool:
+    """Whether two sorted item sets differ only in the scope's settings (the same solve)."""
+    return {i for i in a if not key_of(i).startswith(SCOPE_PREFIX)} == {
+        i for i in b if not key_of(i).startswith(SCOPE_PREFIX)}
+
+
+def append_shot(archive, shot: ShotRecord) -> int:
+    """Append a served shot to the archive at ``archive`` (a path) as ``rig shot --out``
+    does; returns its shot number. An I/O failure is an OSError naming the path."""
+    from instruments.archive import Archive
+    from rig.experiment.entry import shot_entry
+
+    return Archive(archive).append([shot_entry(shot)])[0]
