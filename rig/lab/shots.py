@@ -84,9 +84,7 @@ class SceneShots:
             if key in self._rigs:
                 self._rigs.move_to_end(key)
                 return self._rigs[key]
-            rig = Rig(load(self.scene, items))
-            rig.check_record()
-            rig.estimate().refuse_unless(self.allow_large, "this shot")
+            rig = self._built(items)
             twin = next((other for k, other in reversed(self._rigs.items()) if same_chain(key, k)), None)
             if twin is not None:
                 rig.use_solution(twin.solution())
@@ -94,6 +92,14 @@ class SceneShots:
             if len(self._rigs) > self._size:
                 self._rigs.popitem(last=False)
             return rig
+
+    def _built(self, items: tuple) -> Rig:
+        """A new rig of the scene with the "key=value" ``items``, refused (RigError) where it
+        could give no record or passes the size limits, before anything is solved."""
+        rig = Rig(load(self.scene, items))
+        rig.check_record()
+        rig.estimate().refuse_unless(self.allow_large, "this shot")
+        return rig
 
     def shot(self, overrides: Mapping[str, str], seed: int) -> ShotRecord:
         """The whole shot (scope record, settings, truth) with ``overrides`` and ``seed``;
@@ -115,11 +121,12 @@ class SceneShots:
     def validate(self, key: str, text: str) -> str | None:
         """None when ``key`` (one of RIG_KEYS) may be set to ``text`` (a quantity with its
         unit as in scene files, e.g. "0.9 m/s", "2.38 N"; a plain number is in SI), else the
-        one-line refusal: the scene read with it and its parts built, as a shot would."""
+        one-line refusal: the scene read with it and its parts built, as a shot would (the
+        rig built is not kept: checking a value costs no shot's place in the cache)."""
         if key not in RIG_KEYS:
             return str(invalid("rig key", key, f"one of {', '.join(RIG_KEYS)}"))
         try:
-            self.rig({key: text})
+            self._built(self.items({key: text}))
         except (RigError, InstrumentError) as exc:
             return str(exc)
         return None

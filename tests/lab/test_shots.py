@@ -119,3 +119,18 @@ def test_a_bad_scene_or_base_setting_is_refused_before_any_shot():
         SceneShots("no_such_scene")
     with pytest.raises(RigError, match="striker.speed"):
         SceneShots(SCENE, ["striker.speed=1 m/s"])
+
+
+def test_shots_asked_from_many_threads_at_once_are_the_shots_asked_one_by_one(shots):
+    """The servers call the source from a thread per client: the rigs built meanwhile are
+    shared, never half-built, and each shot keeps its own bits."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    asks = [({"magnet.force": f"{2 + k % 3 * 0.25} N", "scope.channels.CH2.volts_per_div": "0.1 V"}, 20 + k)
+            for k in range(9)]
+    with ThreadPoolExecutor(6) as pool:
+        together = list(pool.map(lambda ask: shots(*ask), asks))
+    alone = SceneShots(SCENE, QUICK)
+    for (overrides, seed), record in zip(asks, together):
+        one = alone(overrides, seed)
+        assert all(np.array_equal(one[ch].codes, record[ch].codes) for ch in one.waveforms), seed
