@@ -73,6 +73,10 @@ class VirtualScope(StandardReadable):
         record = fired.record
         if not record.triggered:
             raise InstrumentError(f"the scope did not trigger (seed {fired.seed}): {record.reason}")
+        missing = [ch for ch in self.backend.channels if ch not in record.waveforms]
+        if missing:  # an event must not carry an earlier shot's waveform
+            raise InstrumentError(f"channels = {', '.join(missing)}: not in the record of seed {fired.seed} "
+                                  f"(it holds {', '.join(record.waveforms)})")
         for ch, waveform in record.waveforms.items():
             self.channel(ch).show(waveform)
         self._show_seed(fired.seed)
