@@ -15,6 +15,7 @@ from bluesky import RunEngine
 from bluesky.utils import FailedStatus
 from ophyd_async.plan_stubs import ensure_connected
 
+from instruments.errors import InstrumentError
 from rig.errors import RigError
 from rig.experiment.scene import load
 from rig.experiment.shot import Rig
@@ -124,3 +125,17 @@ def test_without_tiled_the_tiled_example_refuses_in_one_line():
     with pytest.raises(RigError, match="needs the tiled client") as err:
         tiled_writer("http://127.0.0.1:8000")
     assert "\n" not in str(err.value)
+
+
+def test_a_shot_that_does_not_trigger_fails_the_trigger_with_the_scopes_reason():
+    bench = InProcessBench(SCENE, QUICK, seed=1)
+    scope = VirtualScope(bench, name="scope")
+    bench.set("scope.trigger.level", "0.35 V")  # on screen (8 div x 50 mV), above every pulse of CH1
+
+    async def run():
+        await scope.connect()
+        await scope.trigger()
+
+    with pytest.raises(InstrumentError, match="did not trigger \\(seed 1\\)") as err:
+        asyncio.run(run())
+    assert "\n" not in str(err.value) and scope.last is None
