@@ -239,10 +239,10 @@ def serve_connection(conn: socket.socket, programs: Mapping[int, Program], max_r
     while True:
         try:
             record = read_record(conn, max_record)
-        except ConnectionError as e:
-            if isinstance(e, RecordTooLarge):
-                raise
-            return
+        except RecordTooLarge:
+            raise
+        except ConnectionError:
+            return  # the peer closed, between calls or within one
         reply = answer(record, programs)
         if reply is not None:
             write_record(conn, reply)

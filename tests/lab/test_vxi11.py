@@ -11,6 +11,8 @@ import time
 
 import pytest
 import pyvisa
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 import vxi11 as python_vxi11
 from pyvisa_py.protocols import vxi11 as v
 from pyvisa_py.tcpip import Vxi11CoreClient
@@ -349,3 +351,30 @@ def test_close_stops_both_channels_ends_links_and_unregisters():
     finally:
         server.close()
         mapper.close()
+
+
+@pytest.fixture(scope="module")
+def fuzzed():
+    """A server of its own (no link of the other tests to stumble on) and one connection."""
+    server = Vxi11Server(EchoInstrument()).start()
+    sock = socket.create_connection((HOST, server.port), timeout=5.0)
+    yield server, sock
+    sock.close()
+    server.close()
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(proc=st.sampled_from([10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26, 99]),
+       args=st.binary(max_size=80))
+def test_random_arguments_get_an_rpc_answer_and_leave_the_server_serving(fuzzed, proc, args):
+    server, sock = fuzzed
+    _raw_call(sock, proc, args)
+    reply = oncrpc.XdrReader(oncrpc.read_record(sock, 1 << 16))
+    xid, kind, accepted, _, _ = reply.uint(), reply.uint(), reply.uint(), reply.uint(), reply.opaque()
+    assert (xid, kind, accepted) == (7, 1, 0)
+    status = reply.uint()
+    assert status in (oncrpc.SUCCESS, oncrpc.GARBAGE_ARGS, oncrpc.PROC_UNAVAIL)
+    assert (status == oncrpc.PROC_UNAVAIL) == (proc in (21, 24, 99))
+    if status == oncrpc.SUCCESS:  # well-formed by chance: an error code of VXI-11's, or a link
+        assert reply.int() in (0, 3, 4, 5, 6, 8, 9, 11, 12, 15, 17, 23)
+    assert server.links == 0 or proc == 10
