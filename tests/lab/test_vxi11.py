@@ -246,6 +246,30 @@ def test_write_data_over_max_recv_size_is_refused_and_an_oversize_record_closes_
     fresh.close()
 
 
+def test_a_slow_message_runs_while_the_link_still_answers_out_of_band_and_the_next_waits(core):
+    client, link = core
+    t0 = time.monotonic()
+    assert client.device_write(link, 1000, 0, v.OP_FLAG_END, b"SLEEP 0.6") == (0, 9)
+    assert client.device_read_stb(link, 0, 0, 1000) == (0, 0)  # answered during the slow command
+    assert time.monotonic() - t0 < 0.3
+    # one message at a time: the next one is not taken before the slow one ends
+    assert client.device_write(link, 100, 0, v.OP_FLAG_END, b"ECHO? next") == (v.ErrorCodes.io_timeout, 0)
+    assert client.device_write(link, 3000, 0, v.OP_FLAG_END, b"ECHO? next") == (0, 10)
+    assert time.monotonic() - t0 > 0.55
+    assert client.device_read(link, 100, 1000, 0, 0, 0) == (0, v.RX_END, b"next\n")
+
+
+def test_links_are_bounded_the_one_over_gets_out_of_resources():
+    server = Vxi11Server(EchoInstrument(), max_links=2).start()
+    client = Vxi11CoreClient(HOST, server.port)
+    try:
+        assert [client.create_link(k, 0, 0, "inst0")[0] for k in range(3)] == [0, 0, v.ErrorCodes.out_of_resources]
+        assert server.links == 2
+    finally:
+        client.close()
+        server.close()
+
+
 def test_link_errors_name_what_is_wrong(served, core):
     client, link = core
     assert client.device_write(9999, 1000, 0, v.OP_FLAG_END, b"*IDN?") == (4, 0)
