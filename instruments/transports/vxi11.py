@@ -27,9 +27,10 @@ import threading
 import time
 from collections.abc import Callable
 
+from instruments.errors import InstrumentError
 from instruments.transports import oncrpc
 from instruments.transports.device import MessageInstrument, Session
-from instruments.transports.portmap import Announcement, announce
+from instruments.transports.portmap import PMAP_PORT, Announcement, announce
 from instruments.transports.tcp import TcpService
 
 DEVICE_CORE_PROG, DEVICE_ASYNC_PROG, VERSION = 0x0607AF, 0x0607B0, 1
@@ -116,7 +117,11 @@ class Vxi11Server:
         self._links: dict[int, _Link] = {}
         self._guard = threading.Lock()
         self._ids = itertools.count(1)
-        self._core = TcpService(self._serve_core, host, port, max_clients=max_clients, name="vxi11-core")
+        try:
+            self._core = TcpService(self._serve_core, host, port, max_clients=max_clients, name="vxi11-core")
+        except OSError as e:
+            raise InstrumentError(f"VXI-11 port = {port}: cannot listen on {host} ({e.strerror}); "
+                                  f"allowed: a free port, or 0 for any") from None
         self._abort = TcpService(self._serve_abort, host, 0, max_clients=max_clients, name="vxi11-abort")
         self.host, self.port, self.abort_port = self._core.host, self._core.port, self._abort.port
         self._abort_programs = {DEVICE_ASYNC_PROG: oncrpc.Program(
@@ -131,7 +136,7 @@ class Vxi11Server:
     @property
     def resource(self) -> str:
         """The VISA resource string: through the portmapper when announced, else with the port."""
-        return (f"TCPIP::{self.host}::INSTR" if self.announcement and self.announcement.port == 111
+        return (f"TCPIP::{self.host}::INSTR" if self.announcement and self.announcement.port == PMAP_PORT
                 else f"TCPIP::{self.host},{self.port}::INSTR")
 
     @property
@@ -140,7 +145,7 @@ class Vxi11Server:
         with self._guard:
             return len(self._links)
 
-    def announce(self, *, start_portmapper: bool = True, portmapper_port: int = 111) -> str:
+    def announce(self, *, start_portmapper: bool = True, portmapper_port: int = PMAP_PORT) -> str:
         """Register the core and abort channels with the portmapper (starting one where none
         answers and ``start_portmapper``); returns how, in words. ``InstrumentError`` when
         neither can be done."""

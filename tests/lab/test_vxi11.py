@@ -270,6 +270,12 @@ def test_links_are_bounded_the_one_over_gets_out_of_resources():
         server.close()
 
 
+def test_a_port_in_use_is_refused_in_one_line(served):
+    with pytest.raises(InstrumentError, match=f"^VXI-11 port = {served.server.port}: cannot listen on "
+                                              f"127.0.0.1 .*allowed: a free port, or 0 for any$"):
+        Vxi11Server(EchoInstrument(), port=served.server.port)
+
+
 def test_link_errors_name_what_is_wrong(served, core):
     client, link = core
     assert client.device_write(9999, 1000, 0, v.OP_FLAG_END, b"*IDN?") == (4, 0)
