@@ -24,7 +24,7 @@ MAX_RECORD = 4096
 
 
 @dataclass(frozen=True)
-class Mapping:
+class PortMapping:
     """One registration: program, version, protocol (6 TCP, 17 UDP) and port."""
 
     prog: int
@@ -36,7 +36,7 @@ class Mapping:
         return bytes(oncrpc.XdrWriter().uint(self.prog).uint(self.vers).uint(self.prot).uint(self.port))
 
     @classmethod
-    def unpacked(cls, r: oncrpc.XdrReader) -> "Mapping":
+    def unpacked(cls, r: oncrpc.XdrReader) -> "PortMapping":
         m = cls(r.uint(), r.uint(), r.uint(), r.uint())
         r.done()
         return m
@@ -69,12 +69,12 @@ class PortMapper:
         self._udp_thread.start()
         return self
 
-    def mappings(self) -> list[Mapping]:
+    def mappings(self) -> list[PortMapping]:
         """What is registered now."""
         with self._guard:
-            return [Mapping(p, v, t, port) for (p, v, t), port in self._table.items()]
+            return [PortMapping(p, v, t, port) for (p, v, t), port in self._table.items()]
 
-    def register(self, m: Mapping) -> bool:
+    def register(self, m: PortMapping) -> bool:
         """Map (prog, vers, prot) to its port; False when already mapped (RFC 1833: SET
         refuses a triple that is mapped, UNSET it first)."""
         with self._guard:
@@ -84,10 +84,10 @@ class PortMapper:
             return not taken
 
     def _set(self, r: oncrpc.XdrReader) -> bytes:
-        return bytes(oncrpc.XdrWriter().bool(self.register(Mapping.unpacked(r))))
+        return bytes(oncrpc.XdrWriter().bool(self.register(PortMapping.unpacked(r))))
 
     def _unset(self, r: oncrpc.XdrReader) -> bytes:
-        m = Mapping.unpacked(r)  # UNSET ignores prot and port: every protocol of (prog, vers)
+        m = PortMapping.unpacked(r)  # UNSET ignores prot and port: every protocol of (prog, vers)
         with self._guard:
             keys = [k for k in self._table if k[:2] == (m.prog, m.vers)]
             for k in keys:
@@ -95,7 +95,7 @@ class PortMapper:
         return bytes(oncrpc.XdrWriter().bool(bool(keys)))
 
     def _getport(self, r: oncrpc.XdrReader) -> bytes:
-        m = Mapping.unpacked(r)
+        m = PortMapping.unpacked(r)
         with self._guard:
             port = self._table.get((m.prog, m.vers, m.prot), 0)
         return bytes(oncrpc.XdrWriter().uint(port))
@@ -136,7 +136,7 @@ class Announcement:
     """A program made findable through the portmapper on ``port``; ``close()`` unregisters it
     (and stops the portmapper when this announcement started it)."""
 
-    def __init__(self, mappings: list[Mapping], host: str, port: int, started: PortMapper | None) -> None:
+    def __init__(self, mappings: list[PortMapping], host: str, port: int, started: PortMapper | None) -> None:
         self.mappings, self._host, self.port, self._started = mappings, host, port, started
         self.how = (f"started a portmapper on port {port}" if started else
                     f"registered with the portmapper already answering on port {port}")
@@ -152,7 +152,7 @@ class Announcement:
             pass  # that portmapper is gone, and the registration with it
 
 
-def _call_each(host: str, port: int, proc: int, mappings: list[Mapping]) -> list[bool]:
+def _call_each(host: str, port: int, proc: int, mappings: list[PortMapping]) -> list[bool]:
     client = oncrpc.RpcClient(host, port, PMAP_PROG, PMAP_VERS, timeout_s=2.0)
     try:
         return [client.call(proc, m.packed()).bool() for m in mappings]
@@ -164,7 +164,7 @@ def getport(host: str, prog: int, vers: int, *, port: int = PMAP_PORT) -> int:
     """The TCP port the portmapper at (host, port) gives (prog, vers); 0 when unregistered."""
     client = oncrpc.RpcClient(host, port, PMAP_PROG, PMAP_VERS, timeout_s=2.0)
     try:
-        return client.call(PMAPPROC_GETPORT, Mapping(prog, vers, IPPROTO_TCP, 0).packed()).uint()
+        return client.call(PMAPPROC_GETPORT, PortMapping(prog, vers, IPPROTO_TCP, 0).packed()).uint()
     finally:
         client.close()
 
@@ -174,7 +174,7 @@ def announce(programs: list[tuple[int, int, int]], host: str = "127.0.0.1", *,
     """Register each (prog, vers, tcp port) with the portmapper answering on (host, port); when
     none answers and ``start`` is set, start one there first. Raises ``InstrumentError`` (one
     line) when neither is possible."""
-    mappings = [Mapping(p, v, IPPROTO_TCP, tcp_port) for p, v, tcp_port in programs]
+    mappings = [PortMapping(p, v, IPPROTO_TCP, tcp_port) for p, v, tcp_port in programs]
     try:
         accepted = _call_each(host, port, PMAPPROC_SET, mappings)
     except (OSError, oncrpc.XdrError) as e:

@@ -22,6 +22,7 @@ supported; device_docmd too."""
 from __future__ import annotations
 
 import itertools
+import select
 import socket
 import threading
 import time
@@ -85,10 +86,10 @@ class _Link:
 
 
 def _peer_gone(conn: socket.socket) -> bool:
+    """True when the client closed its connection (readable, and nothing to read)."""
     try:
-        return conn.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b""
-    except BlockingIOError:
-        return False
+        readable, _, _ = select.select([conn], [], [], 0)
+        return bool(readable) and conn.recv(1, socket.MSG_PEEK) == b""
     except OSError:
         return True
 
