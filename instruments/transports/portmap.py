@@ -133,8 +133,9 @@ class PortMapper:
 
 
 class Announcement:
-    """A program made findable through the portmapper on ``port``; ``close()`` unregisters it
-    (and stops the portmapper when this announcement started it)."""
+    """A program made findable through the portmapper on ``port``; ``close()`` unregisters it,
+    or, when this announcement started that portmapper, stops it (and with it whatever other
+    processes registered there meanwhile: the port is this process's until it ends)."""
 
     def __init__(self, mappings: list[PortMapping], host: str, port: int, started: PortMapper | None) -> None:
         self.mappings, self._host, self.port, self._started = mappings, host, port, started
