@@ -49,18 +49,18 @@ class XdrWriter:
     def __init__(self) -> None:
         self._parts: list[bytes] = []
 
-    def uint(self, value: int) -> "XdrWriter":
+    def uint(self, value: int) -> XdrWriter:
         self._parts.append(struct.pack(">I", value & 0xFFFF_FFFF))
         return self
 
-    def int(self, value: int) -> "XdrWriter":
+    def int(self, value: int) -> XdrWriter:
         self._parts.append(struct.pack(">i", value))
         return self
 
-    def bool(self, value: bool) -> "XdrWriter":
+    def bool(self, value: bool) -> XdrWriter:
         return self.uint(1 if value else 0)
 
-    def opaque(self, data: bytes) -> "XdrWriter":
+    def opaque(self, data: bytes) -> XdrWriter:
         """Variable-length opaque data (and ``string``): its length, the bytes, zero padding."""
         self.uint(len(data))
         self._parts.append(bytes(data))
@@ -69,7 +69,7 @@ class XdrWriter:
 
     string = opaque
 
-    def raw(self, data: bytes) -> "XdrWriter":
+    def raw(self, data: bytes) -> XdrWriter:
         """Bytes already in XDR (a nested item packed elsewhere)."""
         self._parts.append(bytes(data))
         return self

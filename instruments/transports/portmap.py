@@ -36,7 +36,7 @@ class PortMapping:
         return bytes(oncrpc.XdrWriter().uint(self.prog).uint(self.vers).uint(self.prot).uint(self.port))
 
     @classmethod
-    def unpacked(cls, r: oncrpc.XdrReader) -> "PortMapping":
+    def unpacked(cls, r: oncrpc.XdrReader) -> PortMapping:
         m = cls(r.uint(), r.uint(), r.uint(), r.uint())
         r.done()
         return m
@@ -64,7 +64,7 @@ class PortMapper:
         self._stop = threading.Event()
         self._udp_thread = threading.Thread(target=self._serve_udp, name="portmap-udp", daemon=True)
 
-    def start(self) -> "PortMapper":
+    def start(self) -> PortMapper:
         self._tcp.start()
         self._udp_thread.start()
         return self

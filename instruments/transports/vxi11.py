@@ -129,7 +129,7 @@ class Vxi11Server:
             DEVICE_ASYNC_PROG, VERSION, VERSION, {DEVICE_ABORT: self._device_abort})}
         self.announcement: Announcement | None = None
 
-    def start(self) -> "Vxi11Server":
+    def start(self) -> Vxi11Server:
         self._core.start()
         self._abort.start()
         return self

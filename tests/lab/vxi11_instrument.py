@@ -41,7 +41,7 @@ class EchoInstrument:
         self.sessions_open = 0
         self.messages: list[bytes] = []
 
-    def open_session(self, peer: str) -> "EchoSession":
+    def open_session(self, peer: str) -> EchoSession:
         with self._guard:
             self.sessions_open += 1
         return EchoSession(self)
