@@ -1,0 +1,83 @@
+"""The portmapper (instruments/transports/portmap.py), asked by pyvisa-py's own portmapper
+clients over TCP and UDP, on a free port (port 111 is the VXI-11 tests' alone)."""
+import socket
+
+import pytest
+from pyvisa_py.protocols import rpc
+
+from instruments.errors import InstrumentError
+from instruments.transports import portmap
+
+CORE = 0x0607AF
+
+
+class TcpAsker(rpc.PartialPortMapperClient, rpc.RawTCPClient):
+    """pyvisa-py's portmapper client, on another port than 111."""
+
+    def __init__(self, port):
+        rpc.RawTCPClient.__init__(self, "127.0.0.1", rpc.PMAP_PROG, rpc.PMAP_VERS, port)
+        rpc.PartialPortMapperClient.__init__(self)
+
+
+class UdpAsker(rpc.PartialPortMapperClient, rpc.RawUDPClient):
+    def __init__(self, port):
+        rpc.RawUDPClient.__init__(self, "127.0.0.1", rpc.PMAP_PROG, rpc.PMAP_VERS, port)
+        rpc.PartialPortMapperClient.__init__(self)
+
+
+@pytest.fixture
+def mapper():
+    m = portmap.PortMapper(port=0).start()
+    yield m
+    m.close()
+
+
+@pytest.mark.parametrize("asker", [TcpAsker, UdpAsker])
+def test_set_getport_dump_unset_as_a_client_sees_them(mapper, asker):
+    c = asker(mapper.port)
+    try:
+        assert c.get_port((CORE, 1, rpc.IPPROTO_TCP, 0)) == 0
+        assert c.set((CORE, 1, rpc.IPPROTO_TCP, 4321)) == 1
+        assert c.set((CORE, 1, rpc.IPPROTO_TCP, 9999)) == 0  # mapped already: refused
+        assert c.set((CORE, 1, rpc.IPPROTO_UDP, 4322)) == 1
+        assert c.get_port((CORE, 1, rpc.IPPROTO_TCP, 0)) == 4321
+        assert c.get_port((CORE, 2, rpc.IPPROTO_TCP, 0)) == 0
+        assert sorted(c.dump()) == [(CORE, 1, rpc.IPPROTO_TCP, 4321), (CORE, 1, rpc.IPPROTO_UDP, 4322)]
+        assert c.unset((CORE, 1, 0, 0)) == 1  # every protocol of (prog, vers)
+        assert c.dump() == [] and c.unset((CORE, 1, 0, 0)) == 0
+    finally:
+        c.close()
+
+
+def test_a_garbage_datagram_is_ignored_and_the_mapper_keeps_answering(mapper):
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.sendto(b"\x00\x01", ("127.0.0.1", mapper.port))
+    s.close()
+    c = UdpAsker(mapper.port)
+    assert c.get_port((CORE, 1, rpc.IPPROTO_TCP, 0)) == 0
+    c.close()
+
+
+def test_announce_registers_with_a_running_mapper_and_close_unregisters(mapper):
+    a = portmap.announce([(CORE, 1, 5555)], port=mapper.port, start=False)
+    assert a.how == f"registered with the portmapper already answering on port {mapper.port}"
+    assert portmap.getport("127.0.0.1", CORE, 1, port=mapper.port) == 5555
+    b = portmap.announce([(CORE, 1, 6666)], port=mapper.port)  # the newer server wins
+    assert portmap.getport("127.0.0.1", CORE, 1, port=mapper.port) == 6666
+    b.close()
+    a.close()
+    assert mapper.mappings() == []
+
+
+def test_announce_starts_a_mapper_where_none_answers_and_close_stops_it():
+    probe = socket.create_server(("127.0.0.1", 0))
+    free = probe.getsockname()[1]
+    probe.close()
+    with pytest.raises(InstrumentError, match=f"portmapper on 127.0.0.1:{free}:.*allowed"):
+        portmap.announce([(CORE, 1, 5555)], port=free, start=False)
+    a = portmap.announce([(CORE, 1, 5555)], port=free)
+    assert a.how == f"started a portmapper on port {free}"
+    assert portmap.getport("127.0.0.1", CORE, 1, port=free) == 5555
+    a.close()
+    with pytest.raises(ConnectionRefusedError):
+        socket.create_connection(("127.0.0.1", free), timeout=2.0)
