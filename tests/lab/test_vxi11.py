@@ -22,6 +22,9 @@ from instruments.errors import InstrumentError
 from instruments.transports import oncrpc, portmap
 from instruments.transports.vxi11 import DEVICE_CORE_PROG, Vxi11Server
 
+# port 111 is one per machine: its tests run in one pytest-xdist worker (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("port111")
+
 MAX_MESSAGE = 4096
 HOST = "127.0.0.1"
 
