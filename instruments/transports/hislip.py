@@ -131,9 +131,11 @@ class HislipServer:
 
     def close(self) -> None:
         """Stop listening and end every session (their locks are released)."""
-        self._service.close()
         with self._guard:
             links = list(self._links.values())
+        for link in links:  # first none may be granted a lock another's end releases
+            link.closed.set()
+        self._service.close()
         for link in links:
             link.close()
 

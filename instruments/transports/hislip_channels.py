@@ -60,6 +60,9 @@ class Link:
         """What this session holds of the lock: True exclusive, False shared, None nothing."""
         self.clearing = threading.Event()
         self.closed = threading.Event()
+        """Set when the session is ending: it is granted nothing more."""
+        self._ended = False
+        self._ending = threading.Lock()
         self._sync_out = threading.Lock()
         self._async_out = threading.Lock()
 
@@ -101,8 +104,10 @@ class Link:
 
     def close(self) -> None:
         """End the session: its lock released, both connections shut (once)."""
-        if self.closed.is_set():
-            return
+        with self._ending:
+            if self._ended:
+                return
+            self._ended = True
         self.closed.set()
         self.lock.release(self)
         self.session.close()
@@ -263,6 +268,9 @@ def _lock(link: Link, header: Header) -> int:
     while True:
         step = min(left_s, WAIT_SLICE_S)
         if link.lock.acquire(link, exclusive=exclusive, shared_name=name, timeout_s=step):
+            if link.closed.is_set():  # the server is closing: another's lock went with it
+                link.lock.release(link)
+                return LockReply.FAILURE
             link.held = bool(link.held) or exclusive
             return LockReply.SUCCESS
         left_s -= step
