@@ -267,3 +267,49 @@ def test_close_stops_everything_promptly(rm, instrument, eventually):
     assert eventually(lambda: not any(t.name.startswith("hislip-") for t in threading.enumerate()))
     waiting.join(2)
     assert not waiting.is_alive() and outcome and outcome[0] != "success"  # dropped, not granted
+
+
+def initialize(conn, version=(1, 0), sub_address=b"hislip0"):
+    """Send an Initialize as IVI-6.1 lays it out: version bytes and vendor id in the parameter."""
+    conn.sendall(struct.pack("!2sBBBB2sQ", b"HS", 0, 0, *version, b"zz", len(sub_address)) + sub_address)
+
+
+@pytest.mark.parametrize("asked, granted", [((1, 0), 0x0100), ((1, 1), 0x0101), ((2, 0), 0x0200), ((3, 0), 0x0200)])
+def test_version_is_the_lower_of_the_clients_and_2_0(server, asked, granted):
+    hislip = hislip_module()
+    with socket.create_connection(("127.0.0.1", server.port), timeout=3) as s:
+        initialize(s, asked)
+        reply = hislip.InitializeResponse(s)
+        assert (reply.version, reply.overlap) == (granted, False)  # synchronized mode
+        assert reply.session_id >= 1
+
+
+def test_async_channel_pairs_by_session_id_only(server):
+    hislip = hislip_module()
+    with socket.create_connection(("127.0.0.1", server.port), timeout=3) as sync:
+        initialize(sync)
+        session_id = hislip.InitializeResponse(sync).session_id
+        sync.sendall(struct.pack("!2sBBIQ", b"HS", 7, 0, 0, 6) + b"*IDN?\n")  # Data before the async channel
+        assert hislip.FatalError(sync).error_code == "Attempt to use connection without both channels established"
+    for wrong in (session_id + 1000, 0):
+        with socket.create_connection(("127.0.0.1", server.port), timeout=3) as s:
+            hislip.send_msg(s, "AsyncInitialize", 0, wrong)
+            assert hislip.FatalError(s).error_code == "Invalid Initialization sequence"
+
+
+def test_async_initialize_response_names_the_vendor(rm, server):
+    inst = open_hislip(rm, server.port)
+    assert protocol(inst)._async_init.vendor_id == (b"\x00\x00TK",)
+
+
+def test_remote_local_control_and_bad_control_codes(rm, server):
+    inst = open_hislip(rm, server.port)
+    client, hislip = protocol(inst), hislip_module()
+    for request in ("enableRemote", "disableAndGTL", "justGTL"):
+        client.async_remote_local_control(request)  # answered with AsyncRemoteLocalResponse
+    hislip.send_msg(client._async, "AsyncRemoteLocalControl", 9, 0)
+    assert hislip.Error(client._async).error_code == "Unrecognized control code"
+    hislip.send_msg(client._async, "AsyncLock", 7, 0)
+    assert hislip.Error(client._async).error_code == "Unrecognized control code"
+    assert client.async_lock_request(timeout=0.1, lock_string="k" * 300) == "error"  # over 256 bytes
+    assert inst.query("ECHO? fine") == "fine"
