@@ -3,7 +3,7 @@
 A client opens two TCP connections to one port: the synchronous channel (Initialize, then its
 program messages as Data/DataEnd, Trigger, DeviceClearComplete) and the asynchronous channel
 (AsyncInitialize with the session id the first got, then locks, status queries, device clear,
-the maximum message size, remote/local control). Each pair is one ``Link``; the channel
+the maximum message size, remote/local control). Each pair is one ``Link`` (``hislip_link.py``); the channel
 loops are in ``hislip_channels.py``.
 
 Bounded: the largest HiSLIP message taken is the instrument's ``max_message_bytes`` (the
@@ -18,7 +18,7 @@ import socket
 import threading
 
 from instruments.transports.device import MessageInstrument, Session
-from instruments.transports.hislip_channels import Link, serve_async, serve_sync
+from instruments.transports.hislip_channels import serve_async, serve_sync
 from instruments.transports.hislip_codec import (
     VERSION_2_0,
     Fatal,
@@ -28,6 +28,7 @@ from instruments.transports.hislip_codec import (
     message,
     read_header,
 )
+from instruments.transports.hislip_link import Link
 from instruments.transports.tcp import TcpService, recv_exact
 
 VENDOR_ID = int.from_bytes(b"TK", "big")
