@@ -313,3 +313,27 @@ def test_remote_local_control_and_bad_control_codes(rm, server):
     assert hislip.Error(client._async).error_code == "Unrecognized control code"
     assert client.async_lock_request(timeout=0.1, lock_string="k" * 300) == "error"  # over 256 bytes
     assert inst.query("ECHO? fine") == "fine"
+
+
+def test_random_bytes_never_take_the_server_down(rm, instrument):
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    server = HislipServer(instrument).start()
+    try:
+        inst = open_hislip(rm, server.port)
+        hislip = hislip_module()
+
+        @settings(max_examples=60, deadline=None, suppress_health_check=list(HealthCheck))
+        @given(st.binary(max_size=64), st.booleans(), st.integers(0, 255))
+        def survives(garbage, headed, kind):
+            with socket.create_connection(("127.0.0.1", server.port), timeout=3) as s:
+                if headed:  # a well-formed header of any type, then garbage
+                    s.sendall(struct.pack("!2sBBIQ", b"HS", kind, 0, 0, len(garbage)))
+                s.sendall(garbage)
+            assert inst.query("ECHO? alive") == "alive"
+
+        survives()
+        assert hislip.Instrument("127.0.0.1", port=server.port).async_status_query() == 0
+    finally:
+        server.close()

@@ -154,3 +154,24 @@ def test_close_stops_everything_promptly(rm, instrument, eventually):
     assert eventually(lambda: not any(t.name.startswith("socket-") for t in threading.enumerate()))
     with pytest.raises(VisaIOError):
         clients[1].query("*IDN?")  # the server, not the client, ended the connection
+
+
+def test_framer_is_the_same_for_any_cut_of_the_stream_and_keeps_at_most_its_limit():
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    alphabet = st.sampled_from([b"\n", b"\r", b'"', b"'", b"#", b"0", b"1", b"2", b"9", b"A", b";", b" "])
+
+    @settings(max_examples=300, deadline=None)
+    @given(st.lists(alphabet, max_size=120).map(b"".join), st.lists(st.integers(1, 20), min_size=1))
+    def same_messages(stream, cuts):
+        whole = MessageFramer(limit=16).feed(stream)
+        framer, pieces, i, k = MessageFramer(limit=16), [], 0, 0
+        while i < len(stream):
+            step = cuts[k % len(cuts)]
+            pieces += framer.feed(stream[i:i + step])
+            i, k = i + step, k + 1
+        assert pieces == whole
+        assert all(len(m) <= 16 if isinstance(m, bytes) else m > 16 for m in whole)
+
+    same_messages()
