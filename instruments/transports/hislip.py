@@ -64,6 +64,11 @@ class HislipServer:
         with self._guard:
             return len(self._links)
 
+    @property
+    def resource(self) -> str:
+        """The VISA resource string a client opens."""
+        return f"TCPIP::{self.host}::{self.sub_address},{self.port}::INSTR"
+
     def _serve(self, conn: socket.socket, peer: str) -> None:
         try:
             header = read_header(conn)

@@ -132,7 +132,13 @@ class SocketServer:
 
     @property
     def clients(self) -> int:
+        """Connections open now."""
         return self._service.clients
+
+    @property
+    def resource(self) -> str:
+        """The VISA resource string a client opens."""
+        return f"TCPIP::{self.host}::{self.port}::SOCKET"
 
     def _serve(self, conn: socket.socket, peer: str) -> None:
         session = self.instrument.open_session(peer)

@@ -337,3 +337,23 @@ def test_random_bytes_never_take_the_server_down(rm, instrument):
         assert hislip.Instrument("127.0.0.1", port=server.port).async_status_query() == 0
     finally:
         server.close()
+
+
+def test_sessions_over_the_maximum_are_refused_with_a_reason(rm, instrument, eventually):
+    server = HislipServer(instrument, max_sessions=2).start()
+    try:
+        assert server.resource == f"TCPIP::127.0.0.1::hislip0,{server.port}::INSTR"
+        first, second = open_hislip(rm, server.port), open_hislip(rm, server.port)
+        with socket.create_connection(("127.0.0.1", server.port), timeout=3) as s:
+            initialize(s)
+            fatal = hislip_module().FatalError(s)
+            assert fatal.error_code == "Server refused connection due to maximum number of clients exceeded"
+            assert b"2" in fatal.error_message
+        with pytest.raises(VisaIOError):
+            rm.open_resource(server.resource)
+        first.close()
+        assert eventually(lambda: server.sessions == 1)
+        third = open_hislip(rm, server.port)
+        assert third.query("*IDN?") == second.query("*IDN?") == instrument.IDN.decode()
+    finally:
+        server.close()

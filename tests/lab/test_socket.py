@@ -175,3 +175,20 @@ def test_framer_is_the_same_for_any_cut_of_the_stream_and_keeps_at_most_its_limi
         assert all(len(m) <= 16 if isinstance(m, bytes) else m > 16 for m in whole)
 
     same_messages()
+
+
+def test_clients_over_the_maximum_are_closed_at_once(rm, instrument):
+    server = SocketServer(instrument, max_clients=2).start()
+    try:
+        assert server.resource == f"TCPIP::127.0.0.1::{server.port}::SOCKET"
+        kept = [open_socket(rm, server.port) for _ in range(2)]
+        with socket.create_connection(("127.0.0.1", server.port), timeout=3) as s:
+            s.sendall(b"*IDN?\n")
+            try:
+                got = s.recv(100)
+            except ConnectionResetError:  # closed before it read what was sent
+                got = b""
+            assert got == b""  # closed, not left hanging
+        assert [k.query("ECHO? in") for k in kept] == ["in", "in"]
+    finally:
+        server.close()
