@@ -23,7 +23,9 @@ class Session(Protocol):
         query). May block while a query waits for the instrument (``*OPC?``)."""
 
     def device_clear(self) -> None:
-        """IEEE 488.2 device clear: drop this session's pending input and output."""
+        """IEEE 488.2 device clear: drop this session's pending input and output. It may come
+        while ``handle`` runs in another thread (HiSLIP's clear arrives on its own channel):
+        a query waiting there (``*OPC?``) should then end."""
 
     def trigger(self) -> None:
         """The group execute trigger (``*TRG``) sent out of band (VXI-11 ``device_trigger``)."""

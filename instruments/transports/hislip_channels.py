@@ -4,8 +4,9 @@ Synchronous channel: Data parts are gathered into one program message up to Data
 ``max_message`` bytes kept); the instrument's reply goes back as Data parts and a DataEnd no
 larger than the client's maximum message size, carrying the id of the message it answers.
 A client that starts a new message without having taken the last reply (RMT-delivered clear)
-interrupts it: Interrupted and AsyncInterrupted are sent. From AsyncDeviceClear to
-DeviceClearComplete whatever arrives on the synchronous channel is discarded.
+interrupts it: Interrupted and AsyncInterrupted are sent. AsyncDeviceClear clears the
+instrument session at once; from then to DeviceClearComplete whatever arrives on the
+synchronous channel, and the reply of a message the clear caught in the instrument, is dropped.
 
 Asynchronous channel: one reply to each request (AsyncLock, AsyncLockInfo, AsyncStatusQuery,
 AsyncDeviceClear, AsyncMaximumMessageSize, AsyncRemoteLocalControl). A lock request waits at
@@ -83,7 +84,6 @@ def _sync_loop(link: Link) -> None:
         elif header.kind == Kind.DEVICE_CLEAR_COMPLETE:
             discard(link.sync, header.length)
             pending.reset()
-            link.session.device_clear()
             link.undelivered = False
             link.clearing.clear()
             link.send_sync(Kind.DEVICE_CLEAR_ACKNOWLEDGE, 0)  # feature: synchronized mode
@@ -156,6 +156,7 @@ def _async_loop(link: Link) -> None:
         elif kind == Kind.ASYNC_DEVICE_CLEAR:
             discard(conn, header.length)
             link.clearing.set()
+            link.session.device_clear()  # now, so that a query waiting in the instrument ends
             link.send_async(Kind.ASYNC_DEVICE_CLEAR_ACKNOWLEDGE, 0)  # feature: synchronized mode
         elif kind == Kind.ASYNC_REMOTE_LOCAL_CONTROL and header.control <= 6:
             discard(conn, header.length)  # no front panel to lock out: every request is granted

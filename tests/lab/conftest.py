@@ -3,7 +3,7 @@ pyvisa with the pyvisa-py backend as the client, as a lab script uses it.
 
 The instrument answers ``*IDN?``; ``ECHO? <bytes>`` with the bytes; ``DATA? <n>`` with an
 IEEE 488.2 definite-length block of n bytes (byte k is k mod 251); ``WAIT? <s>`` after s
-seconds with ``DONE``; ``SYST:ERR?`` with the oldest error (``-363`` input buffer overrun for a
+seconds, or at once when a device clear comes, with ``DONE``; ``SYST:ERR?`` with the oldest error (``-363`` input buffer overrun for a
 message dropped for its size, ``-113`` undefined header); ``COUNT? TRG|CLEAR`` with how many
 triggers and device clears it took. Its status byte has bit 2 (error queue not empty). One
 message is handled at a time, as on a real instrument."""
@@ -55,6 +55,7 @@ class EchoSession:
     def __init__(self, instrument: EchoInstrument) -> None:
         self.instrument = instrument
         self.errors: list[bytes] = []
+        self.cleared = threading.Event()
 
     def handle(self, message: bytes) -> bytes:
         with self.instrument.busy:
@@ -69,8 +70,9 @@ class EchoSession:
             return argument + b"\n"
         if header == b"DATA?":
             return block(pattern(int(argument))) + b"\n"
-        if header == b"WAIT?":
-            time.sleep(float(argument))
+        if header == b"WAIT?":  # a wait a device clear ends, as *OPC? on a scope
+            self.cleared.clear()
+            self.cleared.wait(float(argument))
             return b"DONE\n"
         if header == b"SYST:ERR?":
             return (self.errors.pop(0) if self.errors else b'0,"No error"') + b"\n"
@@ -82,6 +84,7 @@ class EchoSession:
 
     def device_clear(self) -> None:
         self.instrument.clears += 1
+        self.cleared.set()
 
     def trigger(self) -> None:
         self.instrument.triggers += 1

@@ -122,11 +122,13 @@ def test_lock_of_a_client_that_goes_is_released(rm, server, instrument, eventual
     assert protocol(b).async_lock_request(timeout=0.5) == "success"
 
 
-def test_device_clear_drops_a_reply_in_progress(rm, server, instrument):
+def test_device_clear_ends_a_wait_and_drops_its_reply(rm, server, instrument):
     inst = open_hislip(rm, server.port, timeout_ms=5000)
-    inst.write("WAIT? 0.6")  # the instrument is still working when the clear comes
+    inst.write("WAIT? 30")  # the instrument waits (as in *OPC?) when the clear comes
     time.sleep(0.1)
+    started = time.monotonic()
     inst.clear()
+    assert time.monotonic() - started < 1.0  # pyvisa-py itself pauses 0.1 s in a clear
     assert instrument.clears == 1
     assert inst.query("*IDN?") == instrument.IDN.decode()  # no DONE before it
     assert inst.query("COUNT? CLEAR") == "1"
