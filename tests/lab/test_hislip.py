@@ -128,7 +128,7 @@ def test_device_clear_ends_a_wait_and_drops_its_reply(rm, server, instrument):
     time.sleep(0.1)
     started = time.monotonic()
     inst.clear()
-    assert time.monotonic() - started < 1.0  # pyvisa-py itself pauses 0.1 s in a clear
+    assert time.monotonic() - started < 5.0  # not the 30 s wait (pyvisa-py itself pauses 0.1 s)
     assert instrument.clears == 1
     assert inst.query("*IDN?") == instrument.IDN.decode()  # no DONE before it
     assert inst.query("COUNT? CLEAR") == "1"
