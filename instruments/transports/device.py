@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import threading
 import time
+from dataclasses import dataclass
 from typing import Protocol
 
 
@@ -22,7 +23,9 @@ class Session(Protocol):
         query). May block while a query waits for the instrument (``*OPC?``)."""
 
     def device_clear(self) -> None:
-        """IEEE 488.2 device clear: drop this session's pending input and output."""
+        """IEEE 488.2 device clear: drop this session's pending input and output. It may come
+        while ``handle`` runs in another thread (HiSLIP's clear arrives on its own channel):
+        a query waiting there (``*OPC?``) should then end."""
 
     def trigger(self) -> None:
         """The group execute trigger (``*TRG``) sent out of band (VXI-11 ``device_trigger``)."""
@@ -48,6 +51,16 @@ class MessageInstrument(Protocol):
 
     def open_session(self, peer: str) -> Session:
         """A new client (``peer``: its address, for the log)."""
+
+
+@dataclass(frozen=True)
+class LockState:
+    """Who holds the instrument's lock now (HiSLIP's AsyncLockInfo)."""
+
+    exclusive: bool
+    """True when one owner holds it exclusively."""
+    holders: int
+    """How many owners hold it, exclusively or shared."""
 
 
 class InstrumentLock:
@@ -94,6 +107,18 @@ class InstrumentLock:
             self._shared.pop(owner, None)
             self._cond.notify_all()
             return held
+
+    def wait_unblocked(self, owner: object, timeout_s: float) -> bool:
+        """Wait at most ``timeout_s`` until no other owner holds the lock exclusively; True
+        when ``owner`` may go on (a transport holds a client's message while it is locked out)."""
+        with self._cond:
+            return self._cond.wait_for(lambda: self._exclusive in (None, owner), max(timeout_s, 0.0))
+
+    def state(self) -> LockState:
+        """Whether the lock is held exclusively, and by how many owners."""
+        with self._cond:
+            owners = set(self._shared) | ({self._exclusive} if self._exclusive is not None else set())
+            return LockState(exclusive=self._exclusive is not None, holders=len(owners))
 
     def blocks(self, owner: object) -> bool:
         """True when another owner holds the lock exclusively (``owner`` may not write)."""
