@@ -1,0 +1,115 @@
+"""Waveform transfer and immediate measurements (programmer manuals, "Waveform Transfer"
+and "Measurement" command groups): ``DATa:SOUrce[:AVAILable?]/STARt/STOP/ENCdg/WIDth``,
+the personality's preamble (``WFMPre?`` or ``WFMOutpre?``, whole and per field), ``CURVe?``,
+``WAVFrm?`` (preamble;curve) and ``MEASUrement:IMMed:TYPe/SOUrce/VALue?/UNIts?`` on the
+last record. A channel that is off is refused with 2244 "Source waveform is not active";
+a measurement without a record answers 9.91E37 with 2225, as the scopes do."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..records import Preamble
+from ..scpi.engine import Call, Fields, Word
+from ..scpi.status import ScpiError
+from .commands import CHANNEL_WORDS
+from .transfer import ENCODINGS, curve_bytes, preamble_fields, waveform_id
+
+NO_VALUE = 9.91e37  # what a Tek scope answers for a measurement it cannot make
+MEASUREMENTS = {"AMPlitude": lambda v: v.max() - v.min(), "MAXimum": np.max, "MINimum": np.min,
+                "PK2pk": lambda v: v.max() - v.min(), "MEAN": np.mean,
+                "RMS": lambda v: float(np.sqrt(np.mean(v * v))), "HIGH": np.max, "LOW": np.min}
+
+
+def source_waveform(scope, ch: str, header: str):
+    """(codes or None, Preamble, WFID) of channel ``ch``: the last record's, or where there
+    is none yet the preamble its settings give (codes None)."""
+    if ch not in scope.shown:
+        raise ScpiError(2244, f"{ch} is off; {header}")
+    shot = scope.acq.last
+    if shot is not None and ch in shot.record.waveforms:
+        w = shot.record[ch]
+        mode = "Sample" if w.preamble.waveform_id.endswith("Sample mode") else "Average"
+        ex = w.preamble.extra
+        return w.codes, w.preamble, waveform_id(ch, w.preamble, ex.get("coupling", "DC"),
+                                                ex.get("volts_per_div", w.preamble.y_multiplier * 25), mode,
+                                                scope.personality)
+    s = scope.settings
+    n, dt = s["scope.record_length"], s["scope.sample_interval"]
+    vdiv = s[f"scope.channels.{ch}.volts_per_div"]
+    pre = Preamble(points=n, x_increment=dt, x_zero=-s["scope.trigger.pre_trigger"] * n * dt,
+                   trigger_index=int(round(s["scope.trigger.pre_trigger"] * n)), y_multiplier=vdiv / 25,
+                   y_offset=s[f"scope.channels.{ch}.position"] * 25, y_zero=s[f"scope.channels.{ch}.offset"])
+    mode = "Sample" if s["scope.mode"] == "sample" else "Average"
+    return None, pre, waveform_id(ch, pre, s[f"scope.channels.{ch}.coupling"], vdiv, mode, scope.personality)
+
+
+def register(tree, scope) -> None:
+    """Add the waveform and measurement commands of ``scope`` (a VirtualScope)."""
+    p = scope.personality
+
+    def data(**changes):
+        scope.data = replace(scope.data, **changes)
+
+    def point(c: Call) -> int:
+        n = c.number()
+        if not 1 <= n <= scope.max_record_length:
+            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed 1 to {scope.max_record_length}")
+        return int(round(n))
+
+    def width(c: Call):
+        w = c.number()
+        if w not in (1, 2):
+            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed 1 or 2 bytes per point")
+        data(width=int(w))
+
+    def preamble(c: Call) -> Fields:
+        _, pre, wfid = source_waveform(scope, scope.data.source, c.header)
+        return preamble_fields(pre, scope.data, wfid, p)
+
+    def curve(c: Call) -> bytes:
+        codes, _, _ = source_waveform(scope, scope.data.source, c.header)
+        if codes is None:
+            raise ScpiError(-200, f"{scope.data.source} has no record yet; fire a shot (ACQuire:STATE ON, "
+                                  f"TRIGger FORCe or RIG:FIRE); {c.header}")
+        return curve_bytes(codes, scope.data)
+
+    def wavfrm(c: Call) -> bytes:
+        pre = preamble(c)
+        body = curve(c)
+        return b";".join(scope.engine.text(v) for _, v in pre.pairs) + b";" + body
+
+    def measure(c: Call) -> str:
+        ch = scope.measurement["source"]
+        codes, pre, _ = source_waveform(scope, ch, c.header)
+        if codes is None:
+            scope.status.post(2225, c.header)
+            return p.number(NO_VALUE)
+        v = pre.y_zero + pre.y_multiplier * (codes.astype(np.float64) - pre.y_offset)
+        return p.number(float(MEASUREMENTS[scope.measurement["type"]](v)))
+
+    tree.add("DATa:SOUrce", write=lambda c: data(source=c.word(CHANNEL_WORDS)),
+             read=lambda c: Word(scope.data.source))
+    tree.add("DATa:SOUrce:AVAILable", read=lambda c: ",".join(ch for ch in CHANNEL_WORDS if ch in scope.shown))
+    tree.add("DATa:STARt", write=lambda c: data(start=point(c)), read=lambda c: str(scope.data.start))
+    tree.add("DATa:STOP", write=lambda c: data(stop=point(c)), read=lambda c: str(scope.data.stop))
+    tree.add("DATa:ENCdg", write=lambda c: data(encoding=c.word(ENCODINGS)), read=lambda c: Word(scope.data.encoding))
+    tree.add("DATa:WIDth", write=width, read=lambda c: str(scope.data.width))
+    tree.add(p.preamble, read=preamble)
+    for name in p.preamble_fields:
+        tree.add(f"{p.preamble}:{name}", read=lambda c, n=name: dict(preamble(c).pairs)[n],
+                 write=width if name == "BYT_Nr" else None)
+    tree.add("CURVe", read=curve)
+    tree.add("WAVFrm", read=wavfrm)
+
+    def set_type(c: Call):
+        scope.measurement["type"] = c.word(tuple(MEASUREMENTS))
+
+    def set_source(c: Call):
+        scope.measurement["source"] = c.word(CHANNEL_WORDS)
+
+    tree.add("MEASUrement:IMMed:TYPe", write=set_type, read=lambda c: Word(scope.measurement["type"]))
+    tree.add("MEASUrement:IMMed:SOUrce<n>", write=set_source, read=lambda c: Word(scope.measurement["source"]))
+    tree.add("MEASUrement:IMMed:VALue", read=measure)
+    tree.add("MEASUrement:IMMed:UNIts", read=lambda c: '"V"')
