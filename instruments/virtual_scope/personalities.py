@@ -5,6 +5,8 @@
   ``WFMPre?`` (BYT_NR, BIT_NR, ENCDG, BN_FMT, BYT_OR, NR_PT, WFID, PT_FMT, XINCR, PT_OFF,
   XZERO, XUNIT, YMULT, YZERO, YOFF, YUNIT), ``YUNit?`` "Volts", time bases in a 1-2.5-5
   sequence, numbers such as ``2.0E-6``.
+- time bases of the mdo3000 in a 1-2-4 sequence (its WFID reads "400.0us/div"), of the mso4
+  in 1-2-5.
 - ``mdo3000`` (MDO3000 Series Programmer Manual, 077-0968) and ``mso4`` (4 Series MSO
   Programmer Manual, 077-1497): the 22-field ``WFMOutpre?`` (... PT_ORDER, ..., DOMAIN,
   WFMTYPE, CENTERFREQUENCY, SPAN, REFLEVEL), record lengths from the model's list, 16-bit
@@ -75,7 +77,7 @@ PERSONALITIES = {
                            (1.0, 2.5, 5.0), "WFMPre", WFMPRE_16, "Volts", False, 3),
     "mdo3000": Personality("mdo3000", "TEKTRONIX,MDO3024,C010001,CF:91.1CT FV:v1.30", (1000, 10000, 100000, 1000000,
                                                                                       5000000, 10000000),
-                           (1.0, 2.0, 5.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4),
+                           (1.0, 2.0, 4.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4),
     "mso4": Personality("mso4", "TEKTRONIX,MSO44,C010001,CF:91.1CT FV:2.0.3.950",
                         (1000, 2000, 5000, 10000, 20000, 50000, 100000, 200000, 500000, 1000000, 2000000, 5000000,
                          10000000, 20000000, 31250000),
