@@ -12,6 +12,7 @@ TDS2000-family scripts and qcodes' TPS2012 driver read without asking) and VERBo
 ``*RST`` leaves both as they are."""
 from __future__ import annotations
 
+import math
 import threading
 from collections.abc import Callable
 
@@ -23,7 +24,7 @@ from ..scpi.tree import CommandTree
 from ..transports.device import InstrumentLock
 from . import commands, common, rig_commands, waveform_commands
 from .acquisition import Acquisition, ShotSource
-from .personalities import personality, snap_record_length, snap_to_steps
+from .personalities import personality, snap_to_steps
 from .settings import acquired, overrides, scene_settings, scope_of
 from .transfer import DataSelection
 
@@ -67,11 +68,13 @@ class VirtualScope:
         self.rig_engine = Engine(rig_tree, self.status, self.form)
 
     def _personality_settings(self, s: dict) -> dict:
-        n = snap_record_length(s["scope.record_length"], self.personality.record_lengths)
-        if n is None or n > self.max_record_length:
-            raise InstrumentError(f"scope.record_length = {s['scope.record_length']}: the {self.personality.name} "
-                                  f"takes {', '.join(map(str, self.personality.record_lengths))} points "
-                                  f"(here at most {self.max_record_length})")
+        """The scene's settings on this model: its record length nearest the scene's (within
+        max_record_length), the s/div snapped to its steps, the sample interval they give."""
+        lengths = [n for n in self.personality.record_lengths if n <= self.max_record_length]
+        if not lengths:
+            raise InstrumentError(f"max_record_length = {self.max_record_length}: the {self.personality.name} "
+                                  f"takes at least {self.personality.record_lengths[0]} points")
+        n = min(lengths, key=lambda x: abs(math.log(x / s["scope.record_length"])))
         s_div = snap_to_steps(s["scope.sample_interval"] * s["scope.record_length"] / 10,
                               self.personality.time_steps)
         return {**s, "scope.record_length": n, "scope.sample_interval": s_div * 10 / n}
