@@ -36,7 +36,7 @@ def parsed(text: str, like):
 
 class PulseSource:
     """ShotSource: the scene's scope with the overrides, acquiring pulse() on CH1 and a
-    smaller one on CH2 (scaled by striker.velocity / 0.9 m/s); ``gate``, where set, holds
+    larger one on CH2 (both scaled by striker.velocity / 0.9 m/s; magnet keys taken, no effect); ``gate``, where set, holds
     each shot until it is set; ``calls`` lists (overrides, seed)."""
 
     def __init__(self, scene):
@@ -53,6 +53,8 @@ class PulseSource:
         for key, text in overrides.items():
             if key == "striker.velocity":
                 scale = float(text.split()[0]) / VELOCITY
+                continue
+            if key.startswith("magnet."):  # the synthetic pulse does not depend on the magnet
                 continue
             if key not in settings:
                 raise InstrumentError(f"{key} = {text!r}: not a scope key")
