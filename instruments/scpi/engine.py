@@ -9,7 +9,8 @@ Reply forms as the Tektronix programmer manuals give them (HEADer, VERBose): wit
 a reply starts with the query's path, ``:DATA:ENCDG RIBINARY``, in long forms with VERBose
 ON and short ones (``:DAT:ENC RIB``) with it OFF; an enumerated value (``Word``) is given in
 its long form with VERBose ON, its short form otherwise. A query that fails answers nothing
-(IEEE 488.2 6.4.5) and leaves its event in the queue."""
+(IEEE 488.2 6.4.5) and leaves its event in the queue. A handler that fails other than with
+an event (a bug) leaves -200 "internal fault" and the message goes on."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -18,6 +19,8 @@ from .numbers import number
 from .parser import Argument, parse_unit, split_units
 from .status import ScpiError, StatusModel
 from .tree import CommandTree, Mnemonic
+
+INTERNAL = "internal fault"  # the words of the event a handler's own fault (a bug) leaves
 
 
 class Word(str):
@@ -133,6 +136,9 @@ class Engine:
                 value = handler(Call(unit.args, found.suffixes, unit.header, context))
             except ScpiError as e:
                 self.status.post(e.code, f"{e.detail}" if e.detail else unit.header[:60])
+                continue
+            except Exception as e:  # noqa: BLE001 - a handler's fault must not drop the client
+                self.status.post(-200, f"{INTERNAL} in {unit.header[:60]}: {type(e).__name__}: {e}")
                 continue
             if unit.query:
                 replies.append(self.reply(value, found))

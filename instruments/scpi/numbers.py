@@ -54,4 +54,7 @@ def scale_of(suffix: str, unit: str) -> float:
 def number(text: str, unit: str = "") -> float:
     """A numeric argument in SI units."""
     value, suffix = split_number(text)
-    return value * scale_of(suffix, unit)
+    scaled = value * scale_of(suffix, unit)
+    if not math.isfinite(scaled):
+        raise ScpiError(-120, f"{text!r} is not a finite number")
+    return scaled

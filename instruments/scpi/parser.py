@@ -74,7 +74,7 @@ def split_units(message: bytes) -> list:
 def parse_unit(text: str) -> Unit:
     """One unit's header and arguments; ScpiError for a malformed one."""
     body = text.strip(" \t\r\n")
-    head, rest = re.match(r"(\S*)\s*(.*)", body, re.S).groups()
+    head, rest = re.match(r"(\S*)\s*(.*)", body, re.DOTALL).groups()
     if not head.isascii() or not head.isprintable():
         raise ScpiError(-101, f"in header {head[:40]!r}")
     query = head.endswith("?")

@@ -22,7 +22,7 @@ def register(tree, scope) -> None:
             value = call.number()
             if not 0 <= value <= 255:
                 raise ScpiError(-222, f"{call.header} {value:g}: allowed 0 to 255")
-            setattr(status, name, int(round(value)))
+            setattr(status, name, round(value))
         return write
 
     def form_flag(name: str):

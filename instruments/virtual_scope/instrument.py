@@ -132,10 +132,10 @@ class VirtualScope:
             raise ScpiError(-200, f"no record after {self.opc_timeout_s:g} s")
 
     # --- MessageInstrument -------------------------------------------------------------
-    def open_session(self, peer: str) -> "ScopeSession":
+    def open_session(self, peer: str) -> ScopeSession:
         return ScopeSession(self, self.engine, peer)
 
-    def rig_port(self) -> "RigPort":
+    def rig_port(self) -> RigPort:
         """The RIG: commands (and the common ones) on the same state, for another port."""
         return RigPort(self)
 
@@ -149,7 +149,7 @@ class RigPort:
     def __init__(self, scope: VirtualScope) -> None:
         self.scope, self.lock, self.max_message_bytes = scope, scope.lock, scope.max_message_bytes
 
-    def open_session(self, peer: str) -> "ScopeSession":
+    def open_session(self, peer: str) -> ScopeSession:
         return ScopeSession(self.scope, self.scope.rig_engine, peer)
 
 

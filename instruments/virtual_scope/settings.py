@@ -12,7 +12,6 @@ from __future__ import annotations
 
 from dataclasses import fields
 
-from ..errors import InstrumentError
 from ..oscilloscope import CHANNELS, ChannelSettings, Oscilloscope, Timebase, Trigger
 
 UNITS = {"sample_interval": "s", "level": "V", "volts_per_div": "V", "offset": "V", "bandwidth": "Hz"}

@@ -39,7 +39,7 @@ def source_waveform(scope, ch: str, header: str):
     n, dt = s["scope.record_length"], s["scope.sample_interval"]
     vdiv = s[f"scope.channels.{ch}.volts_per_div"]
     pre = Preamble(points=n, x_increment=dt, x_zero=-s["scope.trigger.pre_trigger"] * n * dt,
-                   trigger_index=int(round(s["scope.trigger.pre_trigger"] * n)), y_multiplier=vdiv / 25,
+                   trigger_index=round(s["scope.trigger.pre_trigger"] * n), y_multiplier=vdiv / 25,
                    y_offset=s[f"scope.channels.{ch}.position"] * 25, y_zero=s[f"scope.channels.{ch}.offset"])
     mode = "Sample" if s["scope.mode"] == "sample" else "Average"
     return None, pre, waveform_id(ch, pre, s[f"scope.channels.{ch}.coupling"], vdiv, mode, scope.personality)
@@ -56,7 +56,7 @@ def register(tree, scope) -> None:
         n = c.number()
         if not 1 <= n <= scope.max_record_length:
             raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed 1 to {scope.max_record_length}")
-        return int(round(n))
+        return round(n)
 
     def width(c: Call):
         w = c.number()

@@ -3,7 +3,7 @@ fault queues, and the IEEE 488.2 status registers."""
 import pytest
 
 from instruments.scpi.engine import Engine, Fields, Word
-from instruments.scpi.status import CME, DDE, ESB, EXE, MSS, PON, QYE, QUEUE_SIZE, ScpiError, StatusModel
+from instruments.scpi.status import CME, DDE, ESB, EXE, MSS, PON, QUEUE_SIZE, QYE, ScpiError, StatusModel
 from instruments.scpi.tree import CommandTree
 
 

@@ -11,7 +11,7 @@ from instruments.virtual_scope.instrument import VirtualScope
 @pytest.mark.parametrize("personality, model, fields, yunit", [
     ("tds2000", "TDS 2024C", 16, '"Volts"'), ("mdo3000", "MDO3024", 22, '"V"'), ("mso4", "MSO44", 22, '"V"')])
 def test_personalities_identify_and_answer_their_preamble(make_scope, personality, model, fields, yunit):
-    scope, s, _ = make_scope(personality)
+    _scope, s, _ = make_scope(personality)
     idn = ask(s, "*IDN?").split(",")
     assert idn[0] == "TEKTRONIX" and idn[1] == model and len(idn) == 4
     name = "WFMPre" if personality == "tds2000" else "WFMOutpre"
@@ -26,14 +26,14 @@ def test_personalities_identify_and_answer_their_preamble(make_scope, personalit
 
 
 def test_tds_wfid_and_numbers_are_in_the_tek_form(make_scope):
-    scope, s, _ = make_scope("tds2000")
+    _scope, s, _ = make_scope("tds2000")
     fire(s)
     assert ask(s, "WFMPRE:WFID?") == '"Ch1, DC coupling, 50.0mV/div, 50.0us/div, 2500 points, Sample mode"'
     assert ask(s, "WFMPRE:XINCR?;YMULT?;YZERO?") == "2.0E-7;2.0E-3;0.0E0"
 
 
 def test_idn_text_overrides_and_is_checked(make_scope):
-    scope, s, _ = make_scope("mso4", idn="TEKTRONIX,MSO46,X1,FV:1.0")
+    _scope, s, _ = make_scope("mso4", idn="TEKTRONIX,MSO46,X1,FV:1.0")
     assert ask(s, "*IDN?") == "TEKTRONIX,MSO46,X1,FV:1.0"
     with pytest.raises(InstrumentError, match="idn"):
         make_scope("mso4", idn="just a model")
@@ -77,7 +77,7 @@ def test_rst_restores_the_scene_as_loaded(make_scope):
 
 
 def test_a_channel_switched_on_is_recorded_with_all_its_settings_and_one_off_is_refused(make_scope):
-    scope, s, source = make_scope("tds2000")
+    scope, s, _source = make_scope("tds2000")
     s.handle(b"SELECT:CH3 ON;:CH3:SCALE 0.5")
     assert {k: v for k, v in scope.overrides().items() if ".CH3." in k} == {
         "scope.channels.CH3.volts_per_div": "0.5 V", "scope.channels.CH3.position": "0.0",

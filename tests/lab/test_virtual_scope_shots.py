@@ -20,7 +20,7 @@ def wait_for(predicate, timeout=30.0):
 
 def test_kth_shot_uses_seed_n_plus_k_minus_1_and_equals_an_acquisition_with_the_same_settings(make_scope):
     shots = []
-    scope, s, source = make_scope("tds2000", seed=40, on_shot=shots.append)
+    _scope, s, source = make_scope("tds2000", seed=40, on_shot=shots.append)
     s.handle(b"CH1:SCALE 20mV;:HOR:SCALE 1E-4;:TRIG:A:LEVEL 0.03")
     for _ in range(3):
         fire(s)
@@ -74,7 +74,7 @@ def test_run_mode_fires_back_to_back_until_stopped(make_scope):
 
 @pytest.mark.parametrize("command", ["TRIGGER FORCE", "RIG:FIRE", "*TRG"])
 def test_forced_shots_fire_once(make_scope, command):
-    scope, s, source = make_scope("tds2000", seed=9)
+    _scope, s, source = make_scope("tds2000", seed=9)
     s.handle(command.encode())
     assert ask(s, "*OPC?") == "1" and ask(s, "ACQ:NUMACQ?") == "1" and source.calls[0][1] == 9
 
@@ -90,7 +90,7 @@ def test_opc_command_sets_the_esr_bit_when_the_record_is_in(make_scope):
 
 
 def test_device_clear_interrupts_a_waiting_query(make_scope):
-    scope, s, source = make_scope("tds2000")
+    _scope, s, source = make_scope("tds2000")
     source.gate = threading.Event()
     s.handle(b"ACQ:STOPA SEQ;STATE 1")
     answer = []
@@ -104,7 +104,7 @@ def test_device_clear_interrupts_a_waiting_query(make_scope):
 
 
 def test_the_rigs_refusal_is_an_event_and_takes_no_seed(make_scope):
-    scope, s, source = make_scope("mso4", seed=3)
+    scope, s, _source = make_scope("mso4", seed=3)
     s.handle(b"HOR:SCALE 1E-3")  # the model takes 10 ms; the synthetic input stops at 8 ms
     s.handle(b"RIG:FIRE;*OPC?")
     assert ask(s, "EVENT?") == "-200" and scope.acq.last is None
@@ -139,7 +139,7 @@ def test_the_rig_port_shares_the_instruments_state(make_scope):
 
 
 def test_limits_of_messages_and_replies(make_scope):
-    scope, s, _ = make_scope("tds2000", max_message_bytes=100, max_reply_bytes=1000)
+    _scope, s, _ = make_scope("tds2000", max_message_bytes=100, max_reply_bytes=1000)
     assert s.handle(b"*IDN?;" * 30) == b"" and ask(s, "EVENT?") == "-363"
     s.overflow(10_000)
     assert ask(s, "EVENT?") == "-363"

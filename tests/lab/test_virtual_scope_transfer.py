@@ -61,7 +61,7 @@ def test_bytes_and_preamble_give_the_records_volts(make_scope, personality, name
 
 
 def test_wavfrm_is_the_preamble_then_the_curve(make_scope):
-    scope, s, _ = make_scope("tds2000", seed=1)
+    _scope, s, _ = make_scope("tds2000", seed=1)
     fire(s)
     s.handle(b"DATA:ENCDG RPBINARY;WIDTH 2")
     reply = s.handle(b"WAVFRM?")
@@ -80,7 +80,7 @@ def test_stop_past_the_record_is_clipped_and_start_past_it_sends_the_last_point(
 
 
 def test_preamble_before_any_shot_follows_the_settings(make_scope):
-    scope, s, _ = make_scope("mdo3000")
+    _scope, s, _ = make_scope("mdo3000")
     assert ask(s, "*ESR?") == "128"  # power on
     s.handle(b"CH1:SCALE 0.2;:HORIZONTAL:SCALE 400E-6")
     pre = preamble(s, "WFMOutpre")
