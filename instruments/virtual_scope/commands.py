@@ -5,7 +5,9 @@ the model's 1-2-5 (TDS s/div: 1-2.5-5) steps, the record length to the model's l
 length it cannot take is an execution error), and a value the oscilloscope refuses is
 -222 (data out of range) or -221 (settings conflict) with its reason. Not emulated, and
 refused with -221: GND coupling, trigger couplings other than DC, acquisition modes other
-than sample and average. ``AUTOSet`` is a documented no-op: the scene sets the scope."""
+than sample and average, roll mode. ``AUTOSet`` is a documented no-op (the scene sets the
+scope), and so is ``HORizontal:MODE`` (kept and answered: scale and record length are always
+both set here, as in MANual)."""
 from __future__ import annotations
 
 import math
@@ -65,6 +67,13 @@ def register(tree, scope) -> None:
                 "bandwidth": read_bandwidth}.get(field, lambda c, f=field: p.number(scope.settings[channel(c, f)]))
         tree.add(f"CH<n>:{name}", write=set_channel(field, convert), read=read)
 
+    def refuse_but(allowed: str):
+        """A setting that takes one value only (what is emulated); others are -221."""
+        def write(c: Call):
+            if c.arg().text.upper() not in (Word(allowed).form(True), Word(allowed).form(False)):
+                raise ScpiError(-221, f"{c.header} {c.arg().text}: only {allowed} is emulated")
+        return write
+
     # --- horizontal -------------------------------------------------------------------
     def s_div() -> float:
         return scope.settings["scope.sample_interval"] * scope.settings["scope.record_length"] / 10
@@ -94,22 +103,24 @@ def register(tree, scope) -> None:
         pre = scope.settings["scope.trigger.pre_trigger"]
         return p.number((0.5 - pre) * record_span() if p.name == "tds2000" else pre * 100)
 
-    for head in ("HORizontal", "HORizontal:MAIn"):
+    def set_mode(c: Call):
+        scope.horizontal_mode = c.word(("AUTO", "CONStant", "MANual"))
+
+    for head in ("HORizontal", "HORizontal:MAIn", "HORizontal:MODE"):
         tree.add(f"{head}:SCAle", write=set_scale, read=lambda c: p.number(s_div()))
+    for head in ("HORizontal", "HORizontal:MAIn"):
         tree.add(f"{head}:POSition", write=set_position, read=read_position)
-    tree.add("HORizontal:RECOrdlength", write=set_length, read=lambda c: str(scope.settings["scope.record_length"]))
-    tree.add("HORizontal:SAMPLERate", read=lambda c: p.number(1.0 / scope.settings["scope.sample_interval"]))
+    for head in ("HORizontal", "HORizontal:MODE"):
+        tree.add(f"{head}:RECOrdlength", write=set_length, read=lambda c: str(scope.settings["scope.record_length"]))
+        tree.add(f"{head}:SAMPLERate", read=lambda c: p.number(1.0 / scope.settings["scope.sample_interval"]))
+    tree.add("HORizontal:MODE", write=set_mode, read=lambda c: Word(scope.horizontal_mode))
+    tree.add("HORizontal:MAIn:UNIts", read=lambda c: '"s"')
+    tree.add("HORizontal:ROLL", write=refuse_but("OFF"), read=lambda c: Word("OFF"))
 
     # --- trigger ----------------------------------------------------------------------
     def force(c: Call):
         c.word(("FORCe",))
         scope.acq.force()
-
-    def refuse_but(allowed: str):
-        def write(c: Call):
-            if c.arg().text.upper() not in (Word(allowed).form(True), Word(allowed).form(False)):
-                raise ScpiError(-221, f"{c.header} {c.arg().text}: only {allowed} is emulated")
-        return write
 
     tree.add("TRIGger", write=force)
     tree.add("TRIGger:STATE", read=lambda c: Word("READy" if scope.acq.acquiring else "SAVe"))
@@ -122,6 +133,7 @@ def register(tree, scope) -> None:
                      c.word(("RISe", "FALL"))]}))
         tree.add(f"{head}:EDGE:COUPling", write=refuse_but("DC"), read=lambda c: Word("DC"))
         tree.add(f"{head}:TYPe", write=refuse_but("EDGe"), read=lambda c: Word("EDGe"))
+        tree.add(f"{head}:READy", read=lambda c: "1" if scope.acq.acquiring else "0")
         tree.add(f"{head}:LEVel", write=lambda c: scope.change({"scope.trigger.level": c.number("V")}, code=-222),
                  read=num("scope.trigger.level"))
 

@@ -22,8 +22,9 @@ from ..scpi.engine import Engine, ReplyForm
 from ..scpi.status import OPC, ScpiError, StatusModel
 from ..scpi.tree import CommandTree
 from ..transports.device import InstrumentLock
-from . import commands, common, rig_commands, waveform_commands
+from . import commands, common, measurements, rig_commands, waveform_commands
 from .acquisition import Acquisition, ShotSource
+from .measurements import default_slots
 from .personalities import personality, snap_to_steps
 from .settings import acquired, overrides, scene_settings, scope_of
 from .transfer import DataSelection
@@ -64,6 +65,7 @@ class VirtualScope:
             rig_commands.register(t, self)
         commands.register(tree, self)
         waveform_commands.register(tree, self)
+        measurements.register(tree, self)
         self.engine = Engine(tree, self.status, self.form)
         self.rig_engine = Engine(rig_tree, self.status, self.form)
 
@@ -87,7 +89,8 @@ class VirtualScope:
         self.shown = set(self.scene.channels)
         self.rig: dict = {}
         self.data = DataSelection(stop=self.initial["scope.record_length"])
-        self.measurement = {"type": "AMPlitude", "source": next(iter(self.scene.channels))}
+        self.horizontal_mode = "MANual"
+        self.measurements = default_slots(next(iter(self.scene.channels)))
         self.numavg = self.scene.averages if self.scene.mode == "average" else 16
         self.acq.stop_after, self.acq.pending = "RUNSTop", 0
         self.acq.run(False)

@@ -100,8 +100,9 @@ def personality(name: str, idn: str | None = None) -> Personality:
 
 
 def snap_to_steps(x: float, mantissas) -> float:
-    """The value of a 1-2-5 (or 1-2.5-5) sequence nearest x on a log scale."""
-    decade = math.floor(math.log10(x))
+    """The value of a 1-2-5 (or 1-2.5-5) sequence nearest x (> 0) on a log scale; x beyond
+    1e-15 .. 1e15 is taken at that bound (no scope setting is near it; the bounds refuse it)."""
+    decade = math.floor(math.log10(min(max(x, 1e-15), 1e15)))
     candidates = [m * 10.0 ** e for e in (decade - 1, decade, decade + 1) for m in mantissas]
     best = min(candidates, key=lambda c: abs(math.log(c / x)))
     return float(f"{best:.12g}")

@@ -1,25 +1,17 @@
-"""Waveform transfer and immediate measurements (programmer manuals, "Waveform Transfer"
-and "Measurement" command groups): ``DATa:SOUrce[:AVAILable?]/STARt/STOP/ENCdg/WIDth``,
+"""Waveform transfer (programmer manuals, "Waveform Transfer"
+command group): ``DATa:SOUrce[:AVAILable?]/STARt/STOP/ENCdg/WIDth``,
 the personality's preamble (``WFMPre?`` or ``WFMOutpre?``, whole and per field), ``CURVe?``,
-``WAVFrm?`` (preamble;curve) and ``MEASUrement:IMMed:TYPe/SOUrce/VALue?/UNIts?`` on the
-last record. A channel that is off is refused with 2244 "Source waveform is not active";
-a measurement without a record answers 9.91E37 with 2225, as the scopes do."""
+and ``WAVFrm?`` (preamble;curve). A channel that is off is refused with 2244 "Source
+waveform is not active"; ``CURVe?`` before the first record is an execution error."""
 from __future__ import annotations
 
 from dataclasses import replace
-
-import numpy as np
 
 from ..records import Preamble
 from ..scpi.engine import Call, Fields, Word
 from ..scpi.status import ScpiError
 from .commands import CHANNEL_WORDS
 from .transfer import ENCODINGS, curve_bytes, preamble_fields, waveform_id
-
-NO_VALUE = 9.91e37  # what a Tek scope answers for a measurement it cannot make
-MEASUREMENTS = {"AMPlitude": lambda v: v.max() - v.min(), "MAXimum": np.max, "MINimum": np.min,
-                "PK2pk": lambda v: v.max() - v.min(), "MEAN": np.mean,
-                "RMS": lambda v: float(np.sqrt(np.mean(v * v))), "HIGH": np.max, "LOW": np.min}
 
 
 def source_waveform(scope, ch: str, header: str):
@@ -46,17 +38,16 @@ def source_waveform(scope, ch: str, header: str):
 
 
 def register(tree, scope) -> None:
-    """Add the waveform and measurement commands of ``scope`` (a VirtualScope)."""
+    """Add the waveform commands of ``scope`` (a VirtualScope)."""
     p = scope.personality
 
     def data(**changes):
         scope.data = replace(scope.data, **changes)
 
     def point(c: Call) -> int:
-        n = c.number()
-        if not 1 <= n <= scope.max_record_length:
-            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed 1 to {scope.max_record_length}")
-        return round(n)
+        """A point number, clamped to 1 .. max_record_length as the scopes clamp it (scripts
+        send ``DATa:STOP 1e10`` for "to the end")."""
+        return min(max(round(c.number()), 1), scope.max_record_length)
 
     def width(c: Call):
         w = c.number()
@@ -80,15 +71,6 @@ def register(tree, scope) -> None:
         body = curve(c)
         return b";".join(scope.engine.text(v) for _, v in pre.pairs) + b";" + body
 
-    def measure(c: Call) -> str:
-        ch = scope.measurement["source"]
-        codes, pre, _ = source_waveform(scope, ch, c.header)
-        if codes is None:
-            scope.status.post(2225, c.header)
-            return p.number(NO_VALUE)
-        v = pre.y_zero + pre.y_multiplier * (codes.astype(np.float64) - pre.y_offset)
-        return p.number(float(MEASUREMENTS[scope.measurement["type"]](v)))
-
     tree.add("DATa:SOUrce", write=lambda c: data(source=c.word(CHANNEL_WORDS)),
              read=lambda c: Word(scope.data.source))
     tree.add("DATa:SOUrce:AVAILable", read=lambda c: ",".join(ch for ch in CHANNEL_WORDS if ch in scope.shown))
@@ -102,14 +84,3 @@ def register(tree, scope) -> None:
                  write=width if name == "BYT_Nr" else None)
     tree.add("CURVe", read=curve)
     tree.add("WAVFrm", read=wavfrm)
-
-    def set_type(c: Call):
-        scope.measurement["type"] = c.word(tuple(MEASUREMENTS))
-
-    def set_source(c: Call):
-        scope.measurement["source"] = c.word(CHANNEL_WORDS)
-
-    tree.add("MEASUrement:IMMed:TYPe", write=set_type, read=lambda c: Word(scope.measurement["type"]))
-    tree.add("MEASUrement:IMMed:SOUrce<n>", write=set_source, read=lambda c: Word(scope.measurement["source"]))
-    tree.add("MEASUrement:IMMed:VALue", read=measure)
-    tree.add("MEASUrement:IMMed:UNIts", read=lambda c: '"V"')

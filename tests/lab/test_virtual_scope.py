@@ -1,6 +1,7 @@
 """The emulated scope's front panel: personalities' identities and preambles, settings
 snapped to the model's steps and handed to the rig as scene overrides, *RST, channels on
 and off, the events of refused settings, no file commands."""
+import numpy as np
 import pytest
 from lab_scope import ask, fire, scene_scope
 
@@ -98,7 +99,7 @@ def test_a_channel_switched_on_is_recorded_with_all_its_settings_and_one_off_is_
 @pytest.mark.parametrize("command, code", [
     ("CH1:SCALE 20", -222), ("CH1:SCALE -1", -222), ("CH1:COUPLING GND", -221), ("CH1:POSITION 7", -222),
     ("TRIG:A:EDGE:SOURCE CH4", -221), ("TRIG:A:EDGE:COUPLING HFREJ", -221), ("ACQ:MODE PEAK", -221),
-    ("ACQ:NUMAVG 1024", -222), ("DATA:WIDTH 4", -222), ("DATA:ENC FASTEST", -224), ("DATA:START 0", -222),
+    ("ACQ:NUMAVG 1024", -222), ("DATA:WIDTH 4", -222), ("DATA:ENC FASTEST", -224), 
     ("CH5:SCALE 1", -113), ("FILESYSTEM:READFILE \"/etc/passwd\"", -113), ("SAVE:WAVEFORM CH1,\"a.isf\"", -113),
     ("SAVE:SETUP 1", -113), ("RIG:STR:VEL 5 furlongs", -224), ("RIG:SEED -1", -222)])
 def test_refused_settings_queue_their_event_and_change_nothing(make_scope, command, code):
@@ -118,15 +119,31 @@ def test_trigger_and_acquisition_settings(make_scope):
                                  "scope.trigger.pre_trigger": "0.5"}
 
 
-def test_measurements_on_the_last_record(make_scope):
+def test_data_start_and_stop_are_clamped_as_the_scopes_clamp_them(make_scope):
+    _scope, s, _ = make_scope("mdo3000", max_record_length=100_000)
+    s.handle(b"DAT:START 0;STOP 1e10")
+    assert ask(s, "DAT:START?;STOP?;:WFMO:NR_P?") == "1;100000;10000"
+
+
+def test_horizontal_mode_forms_are_the_same_settings(make_scope):
+    _scope, s, _ = make_scope("mso4")
+    s.handle(b"HOR:MODE MAN;:HOR:MODE:SCALE 1E-4;RECORDLENGTH 20000")
+    assert ask(s, "HOR:SCALE?;RECO?;:HOR:MODE:SAMPLERATE?;:HOR:MODE?") == "100.0000E-6;20000;20.0000E+6;MANUAL"
+
+
+@pytest.mark.parametrize("slot", ["IMM", "MEAS3"])
+def test_measurements_on_the_last_record(make_scope, slot):
     scope, s, _ = make_scope("mdo3000")
-    s.handle(b"MEASU:IMM:SOU1 CH1;TYP MAX")
-    assert ask(s, "MEASU:IMM:VAL?") == "99.1000E+36" and ask(s, "EVENT?") == "2225"
+    s.handle(f"MEASU:{slot}:SOU1 CH1;TYP MAX".encode())
+    assert ask(s, f"MEASU:{slot}:VAL?") == "99.1000E+36" and ask(s, "EVENT?") == "2225"
     fire(s)
     v = scope.acq.last.record["CH1"].volts()
-    for kind, value in (("MAX", v.max()), ("MIN", v.min()), ("AMP", v.max() - v.min()), ("MEAN", v.mean())):
-        s.handle(f"MEASU:IMM:TYP {kind}".encode())
-        assert float(ask(s, "MEASU:IMM:VAL?")) == pytest.approx(value, rel=1e-12)
+    for kind, value in (("MAX", v.max()), ("MIN", v.min()), ("AMP", v.max() - v.min()), ("MEAN", v.mean()),
+                        ("RMS", np.sqrt(np.mean(v * v)))):
+        s.handle(f"MEASU:{slot}:TYP {kind}".encode())
+        assert float(ask(s, f"MEASU:{slot}:VAL?")) == pytest.approx(value, rel=1e-12)
+    s.handle(f"MEASU:{slot}:SOURCE CH2;:SEL:CH2 OFF".encode())
+    assert s.handle(f"MEASU:{slot}:VAL?".encode()) == b"" and ask(s, "EVENT?") == "2244"
     assert v.max() == pytest.approx(0.2, abs=0.005)  # the pulse's peak, within 2 codes and the noise
 
 
