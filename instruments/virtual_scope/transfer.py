@@ -10,7 +10,7 @@ bytes ``CURVe?`` sends with the current DATa settings: NR_PT the points from STA
 PT_OFF 0, so volts = YZERO + YMULT (code - YOFF) and t = XZERO + XINCR n."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -20,18 +20,33 @@ from ..scpi.engine import Fields, Word
 from .personalities import Personality
 
 ENCODINGS = ("ASCIi", "RIBinary", "RPBinary", "SRIbinary", "SRPbinary")
+BINARY = {(True, True): "RIBinary", (False, True): "RPBinary", (True, False): "SRIbinary", (False, False): "SRPbinary"}
+"""(signed, MSB first) -> the binary encoding."""
 
 
 @dataclass(frozen=True)
 class DataSelection:
     """The DATa settings: source channel, first and last point (1-based, inclusive),
-    encoding (one of ENCODINGS), bytes per point (1 or 2)."""
+    encoding (one of ENCODINGS), bytes per point (1 or 2); binary: the binary encoding
+    the preamble names (BN_FMT, BYT_OR) and ``ENCdg BINary`` returns to, kept under ASCIi."""
 
     source: str = "CH1"
     start: int = 1
     stop: int = 10_000
     encoding: str = "RIBinary"
     width: int = 1
+    binary: str = "RIBinary"
+
+    def encoded(self, encoding: str) -> DataSelection:
+        """These settings with ``DATa:ENCdg encoding``."""
+        return replace(self, encoding=encoding, binary=self.binary if encoding == "ASCIi" else encoding)
+
+    def formatted(self, *, signed: bool | None = None, msb_first: bool | None = None) -> DataSelection:
+        """These settings with the preamble's BN_Fmt (signed) or BYT_Or (msb_first) set, as
+        ``WFMPre:BN_Fmt``/``WFMOutpre:BYT_Or`` set them (the encoding stays ASCIi if it is)."""
+        was_signed, was_msb = next(k for k, v in BINARY.items() if v == self.binary)
+        binary = BINARY[(was_signed if signed is None else signed, was_msb if msb_first is None else msb_first)]
+        return replace(self, binary=binary, encoding="ASCIi" if self.encoding == "ASCIi" else binary)
 
     @property
     def unsigned(self) -> bool:
@@ -83,8 +98,8 @@ def preamble_fields(pre: Preamble, sel: DataSelection, wfid: str, p: Personality
     values = {
         "BYT_Nr": str(sel.width), "BIT_Nr": str(8 * sel.width),
         "ENCdg": Word("BINary" if binary else "ASCIi"),
-        "BN_Fmt": Word("RP" if sel.unsigned else "RI"),
-        "BYT_Or": Word("LSB" if sel.encoding.startswith("S") else "MSB"),
+        "BN_Fmt": Word("RP" if sel.binary in ("RPBinary", "SRPbinary") else "RI"),
+        "BYT_Or": Word("LSB" if sel.binary.startswith("S") else "MSB"),
         "NR_Pt": str(end - first), "WFId": f'"{wfid}"', "PT_Fmt": Word("Y"),
         "XINcr": p.number(pre.x_increment), "PT_Off": "0",
         "XZEro": p.number(pre.x_zero + first * pre.x_increment), "XUNit": '"s"',

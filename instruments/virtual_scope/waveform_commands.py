@@ -1,8 +1,10 @@
 """Waveform transfer (programmer manuals, "Waveform Transfer"
 command group): ``DATa:SOUrce[:AVAILable?]/STARt/STOP/ENCdg/WIDth``,
 the personality's preamble (``WFMPre?`` or ``WFMOutpre?``, whole and per field), ``CURVe?``,
-and ``WAVFrm?`` (preamble;curve). A channel that is off is refused with 2244 "Source
-waveform is not active"; ``CURVe?`` before the first record is an execution error."""
+and ``WAVFrm?`` (preamble;curve). The preamble's BYT_Nr, ENCdg, BN_Fmt and BYT_Or are
+settable too, as the manuals give them: they set DATa:WIDth and DATa:ENCdg. A channel that is off is refused with 2244 "Source
+waveform is not active" by CURVe? (the preamble: see ``preamble`` below); ``CURVe?``
+before the first record is an execution error."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -14,13 +16,15 @@ from .commands import CHANNEL_WORDS
 from .transfer import ENCODINGS, curve_bytes, preamble_fields, waveform_id
 
 
-def source_waveform(scope, ch: str, header: str):
+def source_waveform(scope, ch: str, header: str, *, off_too: bool = False):
     """(codes or None, Preamble, WFID) of channel ``ch``: the last record's, or where there
-    is none yet the preamble its settings give (codes None)."""
-    if ch not in scope.shown:
+    is none yet (or the channel is off and ``off_too``) the preamble its settings give
+    (codes None); a channel that is off is 2244 unless ``off_too``."""
+    shown = ch in scope.shown
+    if not shown and not off_too:
         raise ScpiError(2244, f"{ch} is off; {header}")
     shot = scope.acq.last
-    if shot is not None and ch in shot.record.waveforms:
+    if shown and shot is not None and ch in shot.record.waveforms:
         w = shot.record[ch]
         mode = "Sample" if w.preamble.waveform_id.endswith("Sample mode") else "Average"
         ex = w.preamble.extra
@@ -56,8 +60,21 @@ def register(tree, scope) -> None:
         data(width=int(w))
 
     def preamble(c: Call) -> Fields:
-        _, pre, wfid = source_waveform(scope, scope.data.source, c.header)
-        return preamble_fields(pre, scope.data, wfid, p)
+        """The whole preamble; of a channel that is off, a TDS answers its format fields
+        only (BYT_NR to BYT_OR, TDS2000 manual, WFMPre?), an MDO or MSO every field from
+        the channel's settings (qcodes' DPO7200xx driver reads XUNit of every channel)."""
+        off = scope.data.source not in scope.shown
+        _, pre, wfid = source_waveform(scope, scope.data.source, c.header, off_too=True)
+        fields = preamble_fields(pre, scope.data, wfid, p)
+        return Fields(fields.pairs[:5]) if off and p.name == "tds2000" else fields
+
+    def preamble_field(name: str):
+        def read(c: Call):
+            pairs = dict(preamble(c).pairs)
+            if name not in pairs:
+                raise ScpiError(2244, f"{scope.data.source} is off; {c.header}")
+            return pairs[name]
+        return read
 
     def curve(c: Call) -> bytes:
         codes, _, _ = source_waveform(scope, scope.data.source, c.header)
@@ -76,11 +93,22 @@ def register(tree, scope) -> None:
     tree.add("DATa:SOUrce:AVAILable", read=lambda c: ",".join(ch for ch in CHANNEL_WORDS if ch in scope.shown))
     tree.add("DATa:STARt", write=lambda c: data(start=point(c)), read=lambda c: str(scope.data.start))
     tree.add("DATa:STOP", write=lambda c: data(stop=point(c)), read=lambda c: str(scope.data.stop))
-    tree.add("DATa:ENCdg", write=lambda c: data(encoding=c.word(ENCODINGS)), read=lambda c: Word(scope.data.encoding))
+    tree.add("DATa:ENCdg", write=lambda c: setattr(scope, "data", scope.data.encoded(c.word(ENCODINGS))),
+             read=lambda c: Word(scope.data.encoding))
     tree.add("DATa:WIDth", write=width, read=lambda c: str(scope.data.width))
     tree.add(p.preamble, read=preamble)
+    def set_format(c: Call):
+        fmt = c.word(("RI", "RP", "FP"))
+        if fmt == "FP":
+            raise ScpiError(-221, f"{c.header} FP: the scope sends integer codes (RI or RP)")
+        scope.data = scope.data.formatted(signed=fmt == "RI")
+
+    def set_encoding(c: Call):
+        scope.data = scope.data.encoded("ASCIi" if c.word(("ASCIi", "BINary")) == "ASCIi" else scope.data.binary)
+
+    setters = {"BYT_Nr": width, "ENCdg": set_encoding, "BN_Fmt": set_format,
+               "BYT_Or": lambda c: setattr(scope, "data", scope.data.formatted(msb_first=c.word(("MSB", "LSB")) == "MSB"))}
     for name in p.preamble_fields:
-        tree.add(f"{p.preamble}:{name}", read=lambda c, n=name: dict(preamble(c).pairs)[n],
-                 write=width if name == "BYT_Nr" else None)
+        tree.add(f"{p.preamble}:{name}", read=preamble_field(name), write=setters.get(name))
     tree.add("CURVe", read=curve)
     tree.add("WAVFrm", read=wavfrm)

@@ -88,10 +88,11 @@ def test_a_channel_switched_on_is_recorded_with_all_its_settings_and_one_off_is_
     fire(s)
     assert set(scope.acq.last.record.waveforms) == {"CH1", "CH2", "CH3"}  # the rig still records CH2
     assert ask(s, "*ESR?") == "128"
-    assert s.handle(b"DATA:SOURCE CH2;:CURVE?") == b"" and s.handle(b"WFMPRE?") == b""
+    assert s.handle(b"DATA:SOURCE CH2;:CURVE?") == b"" and ask(s, "WFMPRE?") == "1;8;BINARY;RI;MSB"
+    assert s.handle(b"WFMPRE:NR_PT?") == b""
     assert ask(s, "*ESR?") == "16"
     assert ask(s, "ALLEV?") == ('2244,"Source waveform is not active; CH2 is off; :CURVE?",'
-                                '2244,"Source waveform is not active; CH2 is off; WFMPRE?"')
+                                '2244,"Source waveform is not active; CH2 is off; WFMPRE:NR_PT?"')
     s.handle(b"SELECT:CH1 OFF;CH3 OFF")
     assert ask(s, "SEL?") == "0;0;1;0" and ask(s, "EVENT?") == "-221"  # one channel stays on
 
@@ -117,6 +118,14 @@ def test_trigger_and_acquisition_settings(make_scope):
     assert scope.overrides() == {"scope.trigger.slope": "falling", "scope.trigger.source": "CH2",
                                  "scope.trigger.level": "-0.02 V", "scope.mode": "average", "scope.averages": "64",
                                  "scope.trigger.pre_trigger": "0.5"}
+
+
+def test_an_mdo_answers_the_preamble_of_a_channel_that_is_off_from_its_settings(make_scope):
+    _scope, s, _ = make_scope("mdo3000")
+    fire(s)
+    s.handle(b"DATA:SOURCE CH4;:CH4:SCALE 0.5")
+    assert ask(s, "WFMO:XUNIT?;YMULT?;NR_PT?") == '"s";20.0000E-3;10000'
+    assert s.handle(b"CURVE?") == b"" and ask(s, "EVENT?") == "2244"
 
 
 def test_data_start_and_stop_are_clamped_as_the_scopes_clamp_them(make_scope):
