@@ -3,13 +3,18 @@
 Shots run in one worker thread, outside the instrument's message lock, so every session
 keeps being answered while the rig computes a shot. ``ACQuire:STOPAfter SEQuence`` with
 ``ACQuire:STATE ON`` fires one shot and stops; ``RUNSTop`` fires shots back to back until
-``ACQuire:STATE OFF``; ``TRIGger FORCe``, ``*TRG`` and ``RIG:FIRE`` fire one now. A shot
+``ACQuire:STATE OFF``; ``TRIGger FORCe``, ``*TRG`` and ``RIG:FIRE`` fire one now. How an
+armed scope gets its shots is the rig's (``rig serve scope --fire``): at once (on-arm), at
+the ticks of a period (every=SECONDS, as a rig that drops its striker periodically), or
+only from those fire commands (on-command: the armed scope waits for the impact). A shot
 takes the settings as they are when it starts (a change during a shot applies to the
 next) and the next seed: the k-th shot fired uses seed N + k - 1 (a refused shot uses
 none). ``*OPC?``/``*WAI`` wait while a single sequence or a forced shot is pending."""
 from __future__ import annotations
 
+import math
 import threading
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
@@ -37,9 +42,13 @@ class Acquisition:
     is called after each finished shot, outside the lock."""
 
     def __init__(self, cond: threading.Condition, source: ShotSource, snapshot, post, done_opc,
-                 seed: int = 0, on_shot=None) -> None:
+                 seed: int = 0, on_shot=None, *, period_s: float | None = None, on_command: bool = False) -> None:
+        if period_s is not None and not 0 < period_s < math.inf:
+            raise InstrumentError(f"fire_period_s = {period_s!r}: a period > 0 s, or None")
         self.cond, self.source, self.snapshot, self.post = cond, source, snapshot, post
         self.done_opc, self.on_shot = done_opc, on_shot
+        self.period_s, self.on_command = period_s, on_command
+        self.epoch = self.next_tick = time.monotonic()  # the ticks: epoch + k period
         self.next_seed = int(seed)
         self.stop_after = "RUNSTop"
         self.running = False
@@ -64,6 +73,10 @@ class Acquisition:
         return bool(self.running or self.busy or self.pending)
 
     def run(self, on: bool) -> None:
+        """ACQuire:STATE: armed or stopped; once armed, the first tick is the next one."""
+        if on and not self.running and self.period_s is not None:
+            now = time.monotonic()
+            self.next_tick = self.epoch + self.period_s * (math.floor((now - self.epoch) / self.period_s) + 1)
         self.running = on
         self.cond.notify_all()
 
@@ -84,13 +97,29 @@ class Acquisition:
             self.running, self.pending = False, 0
             self.cond.notify_all()
 
+    def _wait_for_a_shot(self) -> bool:
+        """Wait (holding ``cond``) until a shot is due; False once closed. Due: a forced shot,
+        or while armed (ACQuire:STATE ON) at once, or at the next tick of the period, or
+        never (on_command: only forced shots fire, an armed scope waits for them)."""
+        while not self.closed:
+            if self.pending:
+                self.pending -= 1
+                return True
+            armed = self.running and not self.on_command
+            if armed and self.period_s is None:
+                return True
+            now = time.monotonic()
+            if armed and now >= self.next_tick:
+                self.next_tick += self.period_s * (1 + math.floor((now - self.next_tick) / self.period_s))
+                return True
+            self.cond.wait(self.next_tick - now if armed else None)
+        return False
+
     def _work(self) -> None:
         while True:
             with self.cond:
-                self.cond.wait_for(lambda: self.closed or self.pending or self.running)
-                if self.closed:
+                if not self._wait_for_a_shot():
                     return
-                self.pending = max(self.pending - 1, 0)
                 overrides, seed = dict(self.snapshot()), self.next_seed
                 self.next_seed += 1
                 self.busy = True

@@ -38,12 +38,15 @@ class VirtualScope:
     personality: tds2000 | mdo3000 | mso4 (``idn`` overrides its *IDN?); seed: the first
     shot's; validate: checks RIG: values; on_shot(Shot): called after each shot; bounds:
     max_message_bytes (program message), max_reply_bytes (one message's replies),
-    max_record_length (points); opc_timeout_s: the longest *OPC? wait."""
+    max_record_length (points); opc_timeout_s: the longest *OPC? wait; fire_period_s /
+    on_command: how an armed scope gets shots (acquisition.py): every so many seconds, or
+    only from TRIGger FORCe, *TRG and RIG:FIRE; neither: at once."""
 
     def __init__(self, scope: Oscilloscope, shot_source: ShotSource, *, personality_name: str = "tds2000",
                  idn: str | None = None, seed: int = 0, validate: Validate | None = None, on_shot=None,
                  scene_name: str = "", max_message_bytes: int = 1 << 20, max_reply_bytes: int = 64 << 20,
-                 max_record_length: int = 1_000_000, opc_timeout_s: float = 600.0) -> None:
+                 max_record_length: int = 1_000_000, opc_timeout_s: float = 600.0,
+                 fire_period_s: float | None = None, on_command: bool = False) -> None:
         self.scene, self.scene_name = scope, scene_name
         self.personality = personality(personality_name, idn)
         self.validate = validate or (lambda key, text: None)
@@ -56,7 +59,7 @@ class VirtualScope:
         self.initial = self._personality_settings(scene_settings(scope))
         scope_of(self.initial, acquired(scope, set()), scope)  # InstrumentError: the scene suits no such model
         self.acq = Acquisition(self.cond, shot_source, self.overrides_locked, self.status.post, self._set_opc,
-                               seed, on_shot)
+                               seed, on_shot, period_s=fire_period_s, on_command=on_command)
         with self.cond:
             self.reset()
         tree, rig_tree = CommandTree(), CommandTree()

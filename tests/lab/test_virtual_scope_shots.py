@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from lab_scope import H, ask, fire, pulse
 
+from instruments.errors import InstrumentError
 from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 
 
@@ -147,3 +148,33 @@ def test_limits_of_messages_and_replies(make_scope):
     assert s.handle(b"DATA:ENC ASCII;:CURVE?") == b"" and ask(s, "EVENT?") == "-350"
     s.handle(b"DATA:ENC RIB;START 1;STOP 500")
     assert len(s.handle(b"CURVE?")) == 506
+
+
+def test_on_command_an_armed_scope_waits_for_a_fire_command(make_scope):
+    scope, s, source = make_scope("tds2000", on_command=True)
+    s.handle(b"ACQ:STOPA SEQ;STATE ON")
+    time.sleep(0.2)
+    assert source.calls == [] and ask(s, "BUSY?;:ACQ:STATE?") == "1;1"
+    rig = scope.rig_port().open_session("rig")
+    rig.handle(b"RIG:FIRE")
+    assert ask(s, "*OPC?") == "1" and ask(s, "BUSY?;:ACQ:STATE?;NUMACQ?") == "0;0;1"
+
+
+def test_every_period_an_armed_scope_fires_at_the_ticks(make_scope):
+    _scope, s, source = make_scope("tds2000", fire_period_s=0.3)
+    time.sleep(0.35)
+    assert source.calls == []  # not armed: the ticks pass by
+    start = time.monotonic()
+    s.handle(b"ACQ:STOPA SEQ;STATE ON")
+    assert ask(s, "*OPC?") == "1"
+    waited = time.monotonic() - start
+    assert 0.1 < waited < 0.6 and len(source.calls) == 1  # the next tick, 0.6 s after the start
+    s.handle(b"ACQ:STOPA RUNSTOP;STATE ON")
+    time.sleep(1.0)
+    s.handle(b"ACQ:STATE OFF")
+    assert 2 <= len(source.calls) - 1 <= 4  # about one shot per 0.3 s
+
+
+def test_a_period_must_be_positive(make_scope):
+    with pytest.raises(InstrumentError, match="fire_period_s"):
+        make_scope("tds2000", fire_period_s=0.0)
