@@ -4,3 +4,8 @@ source (instruments never import the rig). ``personalities.py`` the models it ca
 ``settings.py`` its settings as scene keys, ``acquisition.py`` shots and seeds,
 ``transfer.py`` CURVe? and the preamble, the command tables ``common.py``, ``commands.py``,
 ``waveform_commands.py`` and ``rig_commands.py`` (the RIG: subsystem)."""
+
+from .acquisition import Shot, ShotSource
+from .instrument import VirtualScope
+
+__all__ = ["Shot", "ShotSource", "VirtualScope"]
