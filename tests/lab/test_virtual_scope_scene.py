@@ -22,8 +22,8 @@ def never(overrides, seed):
 
 @pytest.mark.parametrize("personality, commands", [
     ("tds2000", ""),
-    ("mdo3000", "CH1:SCA 0.1;POS 2;OFFS 0.01;COUP AC;BAN FULL;PRO 10;:SEL:CH4 ON;:CH4:SCA 0.2;:HOR:SCA 4E-4;"
-                "RECO 100000;:TRIG:A:LEV 0.04;EDGE:SLO FALL;SOU CH2;:ACQ:MOD AVE;NUMAV 16;:HOR:POS 30"),
+    ("mdo3000", ("CH1:SCA 0.1;POS 2;OFFS 0.01;COUP AC;BAN FULL;PRO 10;:SEL:CH4 ON;:CH4:SCA 0.2;:HOR:SCA 4E-4;"
+                 "RECO 100000;:TRIG:A:LEV 0.04;EDGE:SLO FALL;SOU CH2;:ACQ:MOD AVE;NUMAV 16;:HOR:POS 30")),
     ("tds2000", "CH2:BAN OFF;:CH3:BAN ON;:HOR:MAIN:POS 1E-4;:ACQ:MODE SAMPLE;:SEL:CH2 OFF"),
     ("mso4", "HOR:RECO 20000;:CH1:BANDWIDTH 2.5E7;:RIG:STR:VEL 1.1 m/s;:RIG:MAG:FORC 2.0 N"),
 ])
