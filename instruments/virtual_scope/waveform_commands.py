@@ -1,5 +1,5 @@
 """Waveform transfer (programmer manuals, "Waveform Transfer"
-command group): ``DATa:SOUrce[:AVAILable?]/STARt/STOP/ENCdg/WIDth``,
+command group): ``DATa:SOUrce[:AVAILable?]/STARt/STOP/ENCdg/WIDth``, ``DATa INIT``, ``DATa?``,
 the personality's preamble (``WFMPre?`` or ``WFMOutpre?``, whole and per field), ``CURVe?``,
 and ``WAVFrm?`` (preamble;curve). The preamble's BYT_Nr, ENCdg, BN_Fmt and BYT_Or are
 settable too, as the manuals give them: they set DATa:WIDth and DATa:ENCdg. A channel that is off is refused with 2244 "Source
@@ -13,7 +13,7 @@ from ..records import Preamble
 from ..scpi.engine import Call, Fields, Word
 from ..scpi.status import ScpiError
 from .commands import CHANNEL_WORDS
-from .transfer import ENCODINGS, curve_bytes, preamble_fields, waveform_id
+from .transfer import ENCODINGS, DataSelection, curve_bytes, preamble_fields, waveform_id
 
 
 def source_waveform(scope, ch: str, header: str, *, off_too: bool = False):
@@ -88,6 +88,14 @@ def register(tree, scope) -> None:
         body = curve(c)
         return b";".join(scope.engine.text(v) for _, v in pre.pairs) + b";" + body
 
+    def data_init(c: Call):
+        c.word(("INIT",))
+        scope.data = DataSelection(stop=scope.initial["scope.record_length"])
+
+    destination = Word("REFA" if p.name == "tds2000" else "REF1")  # where DATa:DESTination would write (no refs)
+    tree.add("DATa", write=data_init, read=lambda c: Fields((
+        ("DESTination", destination), ("ENCdg", Word(scope.data.encoding)), ("SOUrce", Word(scope.data.source)),
+        ("STARt", str(scope.data.start)), ("STOP", str(scope.data.stop)), ("WIDth", str(scope.data.width)))))
     tree.add("DATa:SOUrce", write=lambda c: data(source=c.word(CHANNEL_WORDS)),
              read=lambda c: Word(scope.data.source))
     tree.add("DATa:SOUrce:AVAILable", read=lambda c: ",".join(ch for ch in CHANNEL_WORDS if ch in scope.shown))

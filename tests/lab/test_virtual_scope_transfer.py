@@ -100,3 +100,11 @@ def test_the_preambles_format_fields_set_the_data_encoding(make_scope, fields, e
     assert bn_fmt == ("RP" if "BN_FMT RP" in fields else "RI")
     assert byt_or == ("LSB" if "LSB" in fields else "MSB")
     assert s.handle(b"WFMO:BN_FMT FP") == b"" and ask(s, "EVENT?") == "-221"
+
+
+def test_data_query_and_init(make_scope):
+    _scope, s, _ = make_scope("tds2000")
+    s.handle(b"DATA:ENC ASCII;SOURCE CH2;START 5;STOP 50;WIDTH 2")
+    assert ask(s, "DATA?") == "REFA;ASCII;CH2;5;50;2"
+    s.handle(b"DATA INIT")
+    assert ask(s, "DATA?") == "REFA;RIBINARY;CH1;1;2500;1"
