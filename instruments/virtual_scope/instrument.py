@@ -47,6 +47,8 @@ class VirtualScope:
                  scene_name: str = "", max_message_bytes: int = 1 << 20, max_reply_bytes: int = 64 << 20,
                  max_record_length: int = 1_000_000, opc_timeout_s: float = 600.0,
                  fire_period_s: float | None = None, on_command: bool = False) -> None:
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 63:
+            raise InstrumentError(f"seed = {seed!r}: a whole number from 0 to 2^63 - 1")
         self.scene, self.scene_name = scope, scene_name
         self.personality = personality(personality_name, idn)
         self.validate = validate or (lambda key, text: None)
@@ -90,7 +92,7 @@ class VirtualScope:
         default DATa and acquisition (stopped); the seed sequence goes on."""
         self.settings = dict(self.initial)
         self.shown = set(self.scene.channels)
-        self.rig: dict = {}
+        self.rig_values: dict = {}  # RIG: settings, scene key -> value text
         self.data = DataSelection(stop=self.initial["scope.record_length"])
         self.horizontal_mode = "MANual"
         self.measurements = default_slots(next(iter(self.scene.channels)))
@@ -115,7 +117,7 @@ class VirtualScope:
         self.settings, self.shown = settings, set(shown)
 
     def overrides_locked(self) -> dict:
-        return {**overrides(self.scene, self.settings, self.channels()), **self.rig}
+        return {**overrides(self.scene, self.settings, self.channels()), **self.rig_values}
 
     def overrides(self) -> dict:
         """The settings that differ from the scene as loaded, {scene key: value text}: what

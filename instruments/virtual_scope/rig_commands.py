@@ -1,7 +1,8 @@
 """The rest of the rig over SCPI, the ``RIG:`` subsystem: ``RIG:FIRE`` (a shot now),
 ``RIG:STRiker:VELocity``, ``RIG:MAGnet:FORCe``, ``RIG:MAGnet:POSition`` (scene keys
 striker.velocity, magnet.force, magnet.position; values as in scene files, a number and
-its unit: ``RIG:STR:VEL 0.9 m/s``, or a quoted string), ``RIG:SEED`` (the next shot's seed),
+its unit: ``RIG:STR:VEL 0.9 m/s``, or a quoted string; the query answers the text set, or
+"scene" while the scene's own value holds), ``RIG:SEED`` (the next shot's seed),
 ``RIG:SCENe?`` (the scene's name) and ``RIG:OVERrides?`` (what the next shot is fired with,
 ``"key=value,..."``). A value goes to the injected ``validate(key, text)``; its refusal
 is a -224 event with the rig's own words. Its own table, so a server can put it on the
@@ -25,11 +26,11 @@ def register(tree, scope) -> None:
             refusal = scope.validate(key, text)
             if refusal is not None:
                 raise ScpiError(-224, refusal)
-            scope.rig[key] = text
+            scope.rig_values[key] = text
         return write
 
     def reader(key: str):
-        return lambda c: _quoted(scope.rig.get(key, "scene"))
+        return lambda c: _quoted(scope.rig_values.get(key, "scene"))
 
     def set_seed(c: Call):
         seed = c.number()

@@ -159,3 +159,9 @@ def test_measurements_on_the_last_record(make_scope, slot):
 def test_a_scene_scope_no_model_can_take_is_refused():
     with pytest.raises(InstrumentError, match="personality"):
         VirtualScope(scene_scope(), lambda o, s: None, personality_name="tds9999")
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, True, 2 ** 63])
+def test_a_first_seed_that_is_no_seed_is_refused(seed):
+    with pytest.raises(InstrumentError, match="seed"):
+        VirtualScope(scene_scope(), lambda o, s: None, seed=seed)

@@ -178,3 +178,33 @@ def test_every_period_an_armed_scope_fires_at_the_ticks(make_scope):
 def test_a_period_must_be_positive(make_scope):
     with pytest.raises(InstrumentError, match="fire_period_s"):
         make_scope("tds2000", fire_period_s=0.0)
+
+
+def test_sixteen_clients_at_once_during_shots(make_scope):
+    scope, s, source = make_scope("mdo3000", seed=0)
+    s.handle(b"ACQ:STOPAFTER RUNSTOP;STATE RUN")  # shots back to back meanwhile
+    failures = []
+
+    def client(k):
+        session = scope.open_session(f"client {k}")
+        try:
+            for i in range(40):
+                session.handle(f"CH{k % 4 + 1}:POSITION {i % 5 - 2}".encode())
+                reply = session.handle(b"*IDN?;:DATA:WIDTH?;:BUSY?;:HOR:RECO?")
+                idn, width, busy, length = reply.decode().rstrip("\n").split(";")
+                if not (idn.startswith("TEKTRONIX,MDO3024") and width == "1" and busy in "01" and length == "10000"):
+                    failures.append(reply)
+        except Exception as e:  # noqa: BLE001 - collected and asserted below
+            failures.append(repr(e))
+        finally:
+            session.close()
+
+    threads = [threading.Thread(target=client, args=(k,)) for k in range(16)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(60)
+    s.handle(b"ACQ:STATE STOP")
+    assert failures == [] and scope.acq.count >= 1
+    assert [seed for _, seed in source.calls] == list(range(len(source.calls)))
+    assert ask(s, "ALLEV?") == '0,"No events to report - queue empty"'
