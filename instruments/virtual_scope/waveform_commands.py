@@ -84,9 +84,11 @@ def register(tree, scope) -> None:
         return curve_bytes(codes, scope.data)
 
     def wavfrm(c: Call) -> bytes:
-        pre = preamble(c)
-        body = curve(c)
-        return b";".join(scope.engine.text(v) for _, v in pre.pairs) + b";" + body
+        """``WFMPre?;CURVe?`` in one reply, each part in the current reply form (with
+        HEADer ON: ``:WFMPRE:BYT_NR 1;...;:CURVE #...``)."""
+        engine, tree = scope.engine, scope.engine.tree
+        return (engine.reply(preamble(c), tree.find((p.preamble.upper(),))) + b";"
+                + engine.reply(curve(c), tree.find(("CURVE",))))
 
     def data_init(c: Call):
         c.word(("INIT",))
@@ -119,4 +121,4 @@ def register(tree, scope) -> None:
     for name in p.preamble_fields:
         tree.add(f"{p.preamble}:{name}", read=preamble_field(name), write=setters.get(name))
     tree.add("CURVe", read=curve)
-    tree.add("WAVFrm", read=wavfrm)
+    tree.add("WAVFrm", read=wavfrm, bare=True)  # its parts carry their own headers

@@ -68,6 +68,9 @@ def test_wavfrm_is_the_preamble_then_the_curve(make_scope):
     fields = reply.split(b";", 16)
     assert b";".join(fields[:16]).decode() == ask(s, "WFMPRE?")
     assert fields[16] == s.handle(b"CURVE?")
+    s.handle(b"HEADER ON")
+    assert s.handle(b"WAVFRM?") == s.handle(b"WFMPRE?;CURVE?")
+    assert s.handle(b"WAVFRM?").startswith(b":WFMPRE:BYT_NR 2;")
 
 
 def test_stop_past_the_record_is_clipped_and_start_past_it_sends_the_last_point(make_scope):
