@@ -66,6 +66,8 @@ def register(tree, scope) -> None:
         read = {"coupling": lambda c: Word(scope.settings[channel(c, "coupling")]),
                 "bandwidth": read_bandwidth}.get(field, lambda c, f=field: p.number(scope.settings[channel(c, f)]))
         tree.add(f"CH<n>:{name}", write=set_channel(field, convert), read=read)
+    tree.add("CH<n>:PRObe:GAIN", write=set_channel("probe", lambda c: 1.0 / _positive(c, c.number())),
+             read=lambda c: p.number(1.0 / scope.settings[channel(c, "probe")]))  # MDO form: gain = 1 / attenuation
 
     def refuse_but(allowed: str):
         """A setting that takes one value only (what is emulated); others are -221."""
@@ -180,6 +182,7 @@ def register(tree, scope) -> None:
     tree.add("SELect:CH<n>", write=show, read=shown)
     tree.add("SELect", read=lambda c: Fields(tuple((ch, "1" if ch in scope.shown else "0") for ch in CHANNEL_WORDS)))
     tree.add("DISplay:GLObal:CH<n>:STATE", write=show, read=shown)
+    tree.add("DISplay:WAVEView<n>:CH<n>:STATE", write=show, read=shown)  # 4/5/6 Series MSO form
     tree.add("CONFIGuration:ANALOg:NUMCHANnels", read=lambda c: str(len(CHANNEL_WORDS)))
     tree.add("AUTOSet", write=lambda c: c.word(("EXECute", "UNDo")) and None)
 

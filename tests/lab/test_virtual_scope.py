@@ -110,6 +110,13 @@ def test_refused_settings_queue_their_event_and_change_nothing(make_scope, comma
     assert ask(s, "EVENT?") == str(code) and scope.overrides() == before
 
 
+def test_probe_gain_and_waveview_forms(make_scope):
+    scope, s, _ = make_scope("mso4")
+    s.handle(b"CH1:PROBE:GAIN 0.1;:DISPLAY:WAVEVIEW1:CH3:STATE ON")
+    assert ask(s, "CH1:PROBE?;PROBE:GAIN?;:SEL:CH3?") == "10.0000;100.0000E-3;1"
+    assert scope.overrides()["scope.channels.CH1.probe"] == "10.0"
+
+
 def test_trigger_and_acquisition_settings(make_scope):
     scope, s, _ = make_scope("tds2000")
     s.handle(b"TRIG:MAIN:EDGE:SLOPE FALL;SOURCE CH2;:TRIG:MAIN:LEVEL -20mV;:ACQ:MODE AVE;NUMAVG 60;"
