@@ -1,7 +1,7 @@
 """IEEE 488.2 common commands and the status, event and reply-form commands of a Tek scope
 (TDS2000 and MDO3000 programmer manuals, "Status and Events", "Miscellaneous"):
 ``*IDN? *RST *CLS *OPC[?] *WAI *ESR? *ESE *SRE *STB? *TRG *TST?``, ``ALLEv? EVENT? EVMsg?
-SYSTem:ERRor? BUSY? HEADer VERBose``. Every queue read takes the event off the queue;
+EVQty? SYSTem:ERRor? BUSY? HEADer VERBose``. Every queue read takes the event off the queue;
 ``ALLEv?`` takes them all (``0,"No events to report - queue empty"`` when none)."""
 from __future__ import annotations
 
@@ -44,6 +44,7 @@ def register(tree, scope) -> None:
     tree.add("*TST", read=lambda c: "0", bare=True)
     tree.add("ALLEv", read=lambda c: ",".join(_drain(status)))
     tree.add("EVENT", read=lambda c: str(status.next_event().code))
+    tree.add("EVQty", read=lambda c: str(len(status.events)))
     tree.add("EVMsg", read=lambda c: status.next_event().text())
     tree.add("SYSTem:ERRor", read=lambda c: _scpi_error(status.next_event()))
     tree.add("BUSY", read=lambda c: "1" if acq.awaiting else "0")

@@ -55,7 +55,7 @@ def test_tds_takes_2500_points_only_and_its_scene_snapping_is_an_override(make_s
     scope, s, _ = make_scope("tds2000", scene=scene_scope(20_000, 1e-7))
     assert scope.overrides() == {"scope.record_length": "2500", "scope.sample_interval": "1e-06 s"}
     s.handle(b"HOR:RECO 5000;:HOR:RECO 2500")
-    assert ask(s, "HOR:RECO?;*ESR?") == "2500;144"
+    assert ask(s, "HOR:RECO?;*ESR?;:EVQTY?") == "2500;144;1"
     assert ask(s, "ALLEV?") == '-200,"Execution error; HOR:RECO 5000: the tds2000 takes 2500"'
 
 
