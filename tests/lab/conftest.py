@@ -14,8 +14,10 @@ import time
 import warnings
 
 import pytest
+from lab_scope import PulseSource, scene_scope, velocity_only
 
 from instruments.transports.device import InstrumentLock
+from instruments.virtual_scope.instrument import VirtualScope
 
 IDN = b"RIG,TRANSPORT-TEST,0,1.0"
 EAV = 0x04
@@ -131,3 +133,22 @@ def eventually():
     """``eventually(condition, timeout_s=3)``: True as soon as ``condition()`` is, False after
     the timeout (for what a server does in its own threads)."""
     return _eventually
+
+
+@pytest.fixture
+def make_scope():
+    """make_scope(personality="tds2000", **kw) -> (VirtualScope, session, PulseSource): an
+    emulated scope on a synthetic shot source (lab_scope.py)."""
+    made = []
+
+    def make(personality="tds2000", scene=None, **kw):
+        scene = scene or scene_scope(10_000 if personality != "tds2000" else 2500)
+        source = PulseSource(scene)
+        scope = VirtualScope(scene, source, personality_name=personality, validate=velocity_only,
+                             scene_name="synthetic", **kw)
+        made.append(scope)
+        return scope, scope.open_session("test"), source
+
+    yield make
+    for scope in made:
+        scope.close()

@@ -1,0 +1,161 @@
+"""The emulated scope's acquisition system: run/stop, single sequence, forced shots, seeds.
+
+Shots run in one worker thread, outside the instrument's message lock, so every session
+keeps being answered while the rig computes a shot. ``ACQuire:STOPAfter SEQuence`` with
+``ACQuire:STATE ON`` fires one shot and stops; ``RUNSTop`` fires shots back to back until
+``ACQuire:STATE OFF``; ``TRIGger FORCe``, ``*TRG`` and ``RIG:FIRE`` fire one now. How an
+armed scope gets its shots is the rig's (``rig serve scope --fire``): at once (on-arm), at
+the ticks of a period (every=SECONDS, as a rig that drops its striker periodically), or
+only from those fire commands (on-command: the armed scope waits for the impact). A shot
+takes the settings as they are when it starts (a change during a shot applies to the
+next) and the next seed: the k-th shot fired uses seed N + k - 1 (a refused shot uses
+none). ``*OPC?``/``*WAI`` wait while a single sequence or a forced shot is pending."""
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+from ..errors import InstrumentError
+from ..records import ScopeRecord
+
+ShotSource = Callable[[Mapping[str, str], int], ScopeRecord]
+"""(overrides: scene key -> value text with its unit, seed) -> the shot's ScopeRecord."""
+
+
+@dataclass(frozen=True)
+class Shot:
+    """A finished shot: the overrides and seed it was fired with, and its record."""
+
+    overrides: Mapping[str, str]
+    seed: int
+    record: ScopeRecord
+
+
+class Acquisition:
+    """The acquisition state (guarded by ``cond``, the instrument's condition) and its worker.
+
+    snapshot() -> the overrides of the next shot (called holding ``cond``); post(code,
+    detail) queues an event (holding ``cond``); done_opc() sets ESR's OPC bit; on_shot(Shot)
+    is called after each finished shot, outside the lock."""
+
+    def __init__(self, cond: threading.Condition, source: ShotSource, snapshot, post, done_opc,
+                 seed: int = 0, on_shot=None, *, period_s: float | None = None, on_command: bool = False) -> None:
+        if period_s is not None and not 0 < period_s < math.inf:
+            raise InstrumentError(f"fire_period_s = {period_s!r}: a period > 0 s, or None")
+        self.cond, self.source, self.snapshot, self.post = cond, source, snapshot, post
+        self.done_opc, self.on_shot = done_opc, on_shot
+        self.period_s, self.on_command = period_s, on_command
+        self.epoch = self.next_tick = time.monotonic()  # the ticks: epoch + k period
+        self.next_seed = int(seed)
+        self.stop_after = "RUNSTop"
+        self.running = False
+        self.pending = 0
+        self.busy = False
+        self.opc_armed = False
+        self.count = 0
+        self.last: Shot | None = None
+        self.closed = False
+        self.thread = threading.Thread(target=self._work, name="scope-shots", daemon=True)
+        self.thread.start()
+
+    @property
+    def awaiting(self) -> bool:
+        """A shot that *OPC? waits for is pending or running (BUSY? 1)."""
+        return bool(self.pending or (self.running and self.stop_after == "SEQuence")
+                    or (self.busy and not self.running))
+
+    @property
+    def acquiring(self) -> bool:
+        """ACQuire:STATE? 1: running, or a shot on its way."""
+        return bool(self.running or self.busy or self.pending)
+
+    def run(self, on: bool) -> None:
+        """ACQuire:STATE: armed or stopped; once armed, the first tick is the next one."""
+        if on and not self.running and self.period_s is not None:
+            now = time.monotonic()
+            self.next_tick = self.epoch + self.period_s * (math.floor((now - self.epoch) / self.period_s) + 1)
+        self.running = on
+        self.cond.notify_all()
+
+    def force(self) -> None:
+        self.pending += 1
+        self.cond.notify_all()
+
+    def opc(self) -> None:
+        """*OPC: OPC set now, or when the pending shot is in."""
+        if self.awaiting:
+            self.opc_armed = True
+        else:
+            self.done_opc()
+
+    def close(self) -> None:
+        with self.cond:
+            self.closed = True
+            self.running, self.pending = False, 0
+            self.cond.notify_all()
+
+    def _wait_for_a_shot(self) -> bool:
+        """Wait (holding ``cond``) until a shot is due; False once closed. Due: a forced shot,
+        or while armed (ACQuire:STATE ON) at once, or at the next tick of the period, or
+        never (on_command: only forced shots fire, an armed scope waits for them)."""
+        while not self.closed:
+            if self.pending:
+                self.pending -= 1
+                return True
+            armed = self.running and not self.on_command
+            if armed and self.period_s is None:
+                return True
+            now = time.monotonic()
+            if armed and now >= self.next_tick:
+                self.next_tick += self.period_s * (1 + math.floor((now - self.next_tick) / self.period_s))
+                return True
+            self.cond.wait(self.next_tick - now if armed else None)
+        return False
+
+    def _work(self) -> None:
+        while True:
+            with self.cond:
+                if not self._wait_for_a_shot():
+                    return
+                overrides, seed = dict(self.snapshot()), self.next_seed
+                self.next_seed += 1
+                self.busy = True
+            record, error = self._fire(overrides, seed)
+            shot = None if record is None else Shot(overrides, seed, record)
+            with self.cond:
+                self._finish(shot, seed, error)
+            if shot is not None and self.on_shot is not None:
+                try:
+                    self.on_shot(shot)
+                except Exception as e:  # noqa: BLE001 - the instrument keeps serving; the client is told
+                    with self.cond:
+                        self.post(-200, f"the shot of seed {seed} was not kept: {type(e).__name__}: {e}")
+
+    def _fire(self, overrides: dict, seed: int):
+        try:
+            return self.source(overrides, seed), None
+        except InstrumentError as e:
+            return None, str(e)
+        except Exception as e:  # noqa: BLE001 - a failing shot must not stop the instrument
+            return None, f"the shot failed: {type(e).__name__}: {e}"
+
+    def _finish(self, shot: Shot | None, seed: int, error: str | None) -> None:
+        self.busy = False
+        if shot is None:
+            self.post(-200, error)
+            if self.next_seed == seed + 1:
+                self.next_seed = seed  # a refused shot takes no seed
+            self.running = False
+        else:
+            self.last, self.count = shot, self.count + 1
+            if not shot.record.triggered:
+                self.post(-200, f"the shot of seed {seed} did not trigger: {shot.record.reason}")
+        if self.stop_after == "SEQuence":
+            self.running = False
+        if self.opc_armed and not self.awaiting:
+            self.opc_armed = False
+            self.done_opc()
+        self.cond.notify_all()

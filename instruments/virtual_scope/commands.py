@@ -1,0 +1,193 @@
+"""The emulated scope's front panel over SCPI: vertical, horizontal, trigger, acquisition
+and which channels are on (TDS2000 and MDO3000 programmer manuals, command groups of the
+same names). Each setting is the scene key it overrides; V/div and s/div are snapped to
+the model's 1-2-5 (TDS s/div: 1-2.5-5) steps, the record length to the model's list (a
+length it cannot take is an execution error), and a value the oscilloscope refuses is
+-222 (data out of range) or -221 (settings conflict) with its reason. Not emulated, and
+refused with -221: GND coupling, trigger couplings other than DC, acquisition modes other
+than sample and average, roll mode. ``AUTOSet`` is a documented no-op (the scene sets the
+scope), and so is ``HORizontal:MODE`` (kept and answered: scale and record length are always
+both set here, as in MANual)."""
+from __future__ import annotations
+
+import math
+
+from ..scpi.engine import Call, Fields, Word
+from ..scpi.status import ScpiError
+from .personalities import snap_record_length, snap_to_steps
+from .settings import channel_key
+
+CHANNEL_WORDS = ("CH1", "CH2", "CH3", "CH4")
+TWENTY_MHZ = 20e6
+
+
+def register(tree, scope) -> None:
+    """Add the front-panel commands of ``scope`` (a VirtualScope) to a command tree."""
+    p = scope.personality
+
+    def num(key):
+        return lambda c: p.number(scope.settings[key])
+
+    def channel(c: Call, field: str) -> str:
+        if not 1 <= c.suffix <= 4:
+            raise ScpiError(-113, f"{c.header}: channels CH1 to CH4")
+        return channel_key(f"CH{c.suffix}", field)
+
+    def set_channel(field, convert):
+        return lambda c: scope.change({channel(c, field): convert(c)}, code=-222)
+
+    def volts_per_div(c: Call) -> float:
+        return snap_to_steps(_positive(c, c.number("V")), p.volt_steps)
+
+    def coupling(c: Call) -> str:
+        word = c.word(("DC", "AC", "GND"))
+        if word == "GND":
+            raise ScpiError(-221, f"{c.header} GND: not emulated (DC or AC)")
+        return word
+
+    def bandwidth(c: Call):
+        a = c.arg()
+        if a.kind == "number":
+            return _positive(c, c.number("HZ"))
+        return {"ON": TWENTY_MHZ, "TWEnty": TWENTY_MHZ, "OFF": None, "FULl": None}[
+            c.word(("ON", "OFF", "TWEnty", "FULl"))]
+
+    def read_bandwidth(c: Call):
+        bw = scope.settings[channel(c, "bandwidth")]
+        if p.name == "tds2000":
+            return Word("ON" if bw is not None and bw <= TWENTY_MHZ else "OFF")
+        return Word("FULl") if bw is None else p.number(bw)
+
+    for field, convert in (("volts_per_div", volts_per_div), ("position", lambda c: c.number()),
+                           ("offset", lambda c: c.number("V")), ("coupling", coupling),
+                           ("bandwidth", bandwidth), ("probe", lambda c: c.number())):
+        name = {"volts_per_div": "SCAle", "position": "POSition", "offset": "OFFSet", "coupling": "COUPling",
+                "bandwidth": "BANdwidth", "probe": "PRObe"}[field]
+        read = {"coupling": lambda c: Word(scope.settings[channel(c, "coupling")]),
+                "bandwidth": read_bandwidth}.get(field, lambda c, f=field: p.number(scope.settings[channel(c, f)]))
+        tree.add(f"CH<n>:{name}", write=set_channel(field, convert), read=read)
+    tree.add("CH<n>:PRObe:GAIN", write=set_channel("probe", lambda c: 1.0 / _positive(c, c.number())),
+             read=lambda c: p.number(1.0 / scope.settings[channel(c, "probe")]))  # MDO form: gain = 1 / attenuation
+
+    def refuse_but(allowed: str):
+        """A setting that takes one value only (what is emulated); others are -221."""
+        def write(c: Call):
+            if c.arg().text.upper() not in (Word(allowed).form(True), Word(allowed).form(False)):
+                raise ScpiError(-221, f"{c.header} {c.arg().text}: only {allowed} is emulated")
+        return write
+
+    # --- horizontal -------------------------------------------------------------------
+    def s_div() -> float:
+        return scope.settings["scope.sample_interval"] * scope.settings["scope.record_length"] / 10
+
+    def set_scale(c: Call):
+        snapped = snap_to_steps(_positive(c, c.number("S")), p.time_steps)
+        scope.change({"scope.sample_interval": snapped * 10 / scope.settings["scope.record_length"]}, code=-222)
+
+    def set_length(c: Call):
+        n = snap_record_length(_positive(c, c.number()), p.record_lengths)
+        if n is None or n > scope.max_record_length:
+            raise ScpiError(-200, f"{c.header} {c.arg().text}: the {p.name} takes "
+                                  f"{', '.join(str(x) for x in p.record_lengths if x <= scope.max_record_length)}")
+        scope.change({"scope.record_length": n, "scope.sample_interval": s_div() * 10 / n}, code=-222)
+
+    def record_span() -> float:
+        return scope.settings["scope.sample_interval"] * scope.settings["scope.record_length"]
+
+    def set_position(c: Call):
+        if p.name == "tds2000":  # seconds from the trigger to the screen's centre
+            pre = 0.5 - c.number("S") / record_span()
+        else:  # percent of the record before the trigger
+            pre = c.number() / 100
+        scope.change({"scope.trigger.pre_trigger": pre}, code=-222)
+
+    def read_position(c: Call) -> str:
+        pre = scope.settings["scope.trigger.pre_trigger"]
+        return p.number((0.5 - pre) * record_span() if p.name == "tds2000" else pre * 100)
+
+    def set_mode(c: Call):
+        scope.horizontal_mode = c.word(("AUTO", "CONStant", "MANual"))
+
+    for head in ("HORizontal", "HORizontal:MAIn", "HORizontal:MODE"):
+        tree.add(f"{head}:SCAle", write=set_scale, read=lambda c: p.number(s_div()))
+    for head in ("HORizontal", "HORizontal:MAIn"):
+        tree.add(f"{head}:POSition", write=set_position, read=read_position)
+    for head in ("HORizontal", "HORizontal:MODE"):
+        tree.add(f"{head}:RECOrdlength", write=set_length, read=lambda c: str(scope.settings["scope.record_length"]))
+        tree.add(f"{head}:SAMPLERate", read=lambda c: p.number(1.0 / scope.settings["scope.sample_interval"]))
+    tree.add("HORizontal:MODE", write=set_mode, read=lambda c: Word(scope.horizontal_mode))
+    tree.add("HORizontal:MAIn:UNIts", read=lambda c: '"s"')
+    tree.add("HORizontal:ROLL", write=refuse_but("OFF"), read=lambda c: Word("OFF"))
+
+    # --- trigger ----------------------------------------------------------------------
+    def force(c: Call):
+        c.word(("FORCe",))
+        scope.acq.force()
+
+    tree.add("TRIGger", write=force)
+    tree.add("TRIGger:STATE", read=lambda c: Word("READy" if scope.acq.acquiring else "SAVe"))
+    for head in ("TRIGger:A", "TRIGger:MAIn"):
+        tree.add(f"{head}:EDGE:SOUrce", write=lambda c: scope.change({"scope.trigger.source": c.word(CHANNEL_WORDS)}),
+                 read=lambda c: Word(scope.settings["scope.trigger.source"]))
+        tree.add(f"{head}:EDGE:SLOpe", read=lambda c: Word("RISe" if scope.settings["scope.trigger.slope"] == "rising"
+                                                           else "FALL"),
+                 write=lambda c: scope.change({"scope.trigger.slope": {"RISe": "rising", "FALL": "falling"}[
+                     c.word(("RISe", "FALL"))]}))
+        tree.add(f"{head}:EDGE:COUPling", write=refuse_but("DC"), read=lambda c: Word("DC"))
+        tree.add(f"{head}:TYPe", write=refuse_but("EDGe"), read=lambda c: Word("EDGe"))
+        tree.add(f"{head}:READy", read=lambda c: "1" if scope.acq.acquiring else "0")
+        tree.add(f"{head}:LEVel", write=lambda c: scope.change({"scope.trigger.level": c.number("V")}, code=-222),
+                 read=num("scope.trigger.level"))
+
+    # --- acquisition -----------------------------------------------------------------
+    def set_state(c: Call):
+        a = c.arg()
+        on = c.boolean() if a.kind == "number" else c.word(("ON", "OFF", "RUN", "STOP")) in ("ON", "RUN")
+        scope.acq.run(on)
+
+    def set_mode(c: Call):
+        mode = c.word(("SAMple", "AVErage", "PEAKdetect", "HIRes", "ENVelope"))
+        if mode not in ("SAMple", "AVErage"):
+            raise ScpiError(-221, f"{c.header} {c.arg().text}: only SAMple and AVErage are emulated")
+        scope.change({"scope.mode": "sample" if mode == "SAMple" else "average",
+                      "scope.averages": 1 if mode == "SAMple" else scope.numavg})
+
+    def set_numavg(c: Call):
+        n = c.number()
+        if not 2 <= n <= 512:
+            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed 2 to 512")
+        scope.numavg = 2 ** round(math.log2(n))
+        if scope.settings["scope.mode"] == "average":
+            scope.change({"scope.averages": scope.numavg})
+
+    tree.add("ACQuire:STATE", write=set_state, read=lambda c: "1" if scope.acq.acquiring else "0")
+    tree.add("ACQuire:STOPAfter", write=lambda c: setattr(scope.acq, "stop_after", c.word(("RUNSTop", "SEQuence"))),
+             read=lambda c: Word(scope.acq.stop_after))
+    tree.add("ACQuire:MODe", write=set_mode,
+             read=lambda c: Word("SAMple" if scope.settings["scope.mode"] == "sample" else "AVErage"))
+    tree.add("ACQuire:NUMAVg", write=set_numavg, read=lambda c: str(scope.numavg))
+    tree.add("ACQuire:NUMACq", read=lambda c: str(scope.acq.count))
+
+    # --- channels on and off ----------------------------------------------------------
+    def show(c: Call):
+        ch = f"CH{c.suffix}"
+        if ch not in CHANNEL_WORDS:
+            raise ScpiError(-113, f"{c.header}: channels CH1 to CH4")
+        on = c.boolean()
+        scope.change({}, shown=(scope.shown | {ch}) if on else (scope.shown - {ch}))
+
+    def shown(c: Call) -> str:
+        return "1" if f"CH{c.suffix}" in scope.shown else "0"
+
+    tree.add("SELect:CH<n>", write=show, read=shown)
+    tree.add("SELect", read=lambda c: Fields(tuple((ch, "1" if ch in scope.shown else "0") for ch in CHANNEL_WORDS)))
+    tree.add("DISplay:GLObal:CH<n>:STATE", write=show, read=shown)
+    tree.add("DISplay:WAVEView<n>:CH<n>:STATE", write=show, read=shown)  # 4/5/6 Series MSO form
+    tree.add("CONFIGuration:ANALOg:NUMCHANnels", read=lambda c: str(len(CHANNEL_WORDS)))
+    tree.add("AUTOSet", write=lambda c: c.word(("EXECute", "UNDo")) and None)
+
+
+def _positive(c: Call, x: float) -> float:
+    if not x > 0:
+        raise ScpiError(-222, f"{c.header} {c.arg().text}: a value > 0")
+    return x

@@ -1,0 +1,203 @@
+"""The emulated Tektronix scope as a message-based instrument (transports/device.py).
+
+One instrument state (settings, acquisition, status, reply forms) is shared by every
+session and transport; one program message is executed at a time under the instrument's
+condition, which a query waiting for a shot (``*OPC?``, ``*WAI``) releases while it waits,
+so other sessions are answered during a shot. The scope starts from the scene's scope
+(``instruments.oscilloscope.Oscilloscope``), its record length and s/div snapped to the
+personality's (those count as overrides); ``*RST`` returns there. ``rig_port()`` serves the
+RIG: commands alone, on the same state, for a separate port. No command reads or writes a
+file (FILESystem and SAVe are undefined headers). Replies start with HEADer OFF (what
+TDS2000-family scripts and qcodes' TPS2012 driver read without asking) and VERBose ON;
+``*RST`` leaves both as they are."""
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Callable
+
+from ..errors import InstrumentError
+from ..oscilloscope import Oscilloscope
+from ..scpi.engine import Engine, ReplyForm
+from ..scpi.status import OPC, ScpiError, StatusModel
+from ..scpi.tree import CommandTree
+from ..transports.device import InstrumentLock
+from . import commands, common, measurements, rig_commands, waveform_commands
+from .acquisition import Acquisition, ShotSource
+from .measurements import default_slots
+from .personalities import personality, snap_to_steps
+from .settings import acquired, overrides, scene_settings, scope_of
+from .transfer import DataSelection
+
+Validate = Callable[[str, str], "str | None"]
+"""(scene key, value text) -> None when the rig takes it, else its one-line refusal."""
+
+
+class VirtualScope:
+    """The emulated scope. scope: the scene's; shot_source: (overrides, seed) -> ScopeRecord;
+    personality: tds2000 | mdo3000 | mso4 (``idn`` overrides its *IDN?); seed: the first
+    shot's; validate: checks RIG: values; on_shot(Shot): called after each shot; bounds:
+    max_message_bytes (program message), max_reply_bytes (one message's replies),
+    max_record_length (points); opc_timeout_s: the longest *OPC? wait; fire_period_s /
+    on_command: how an armed scope gets shots (acquisition.py): every so many seconds, or
+    only from TRIGger FORCe, *TRG and RIG:FIRE; neither: at once."""
+
+    def __init__(self, scope: Oscilloscope, shot_source: ShotSource, *, personality_name: str = "tds2000",
+                 idn: str | None = None, seed: int = 0, validate: Validate | None = None, on_shot=None,
+                 scene_name: str = "", max_message_bytes: int = 1 << 20, max_reply_bytes: int = 64 << 20,
+                 max_record_length: int = 1_000_000, opc_timeout_s: float = 600.0,
+                 fire_period_s: float | None = None, on_command: bool = False) -> None:
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 63:
+            raise InstrumentError(f"seed = {seed!r}: a whole number from 0 to 2^63 - 1")
+        self.scene, self.scene_name = scope, scene_name
+        self.personality = personality(personality_name, idn)
+        self.validate = validate or (lambda key, text: None)
+        self.max_message_bytes, self.max_reply_bytes = max_message_bytes, max_reply_bytes
+        self.max_record_length, self.opc_timeout_s = max_record_length, opc_timeout_s
+        self.lock = InstrumentLock()
+        self.cond = threading.Condition()
+        self.status = StatusModel()
+        self.form = ReplyForm(header=False)
+        self.initial = self._personality_settings(scene_settings(scope))
+        scope_of(self.initial, acquired(scope, set()), scope)  # InstrumentError: the scene suits no such model
+        self.acq = Acquisition(self.cond, shot_source, self.overrides_locked, self.status.post, self._set_opc,
+                               seed, on_shot, period_s=fire_period_s, on_command=on_command)
+        with self.cond:
+            self.reset()
+        tree, rig_tree = CommandTree(), CommandTree()
+        for t in (tree, rig_tree):
+            common.register(t, self)
+            rig_commands.register(t, self)
+        commands.register(tree, self)
+        waveform_commands.register(tree, self)
+        measurements.register(tree, self)
+        self.engine = Engine(tree, self.status, self.form)
+        self.rig_engine = Engine(rig_tree, self.status, self.form)
+
+    def _personality_settings(self, s: dict) -> dict:
+        """The scene's settings on this model: its record length nearest the scene's (within
+        max_record_length), the s/div snapped to its steps, the sample interval they give."""
+        lengths = [n for n in self.personality.record_lengths if n <= self.max_record_length]
+        if not lengths:
+            raise InstrumentError(f"max_record_length = {self.max_record_length}: the {self.personality.name} "
+                                  f"takes at least {self.personality.record_lengths[0]} points")
+        n = min(lengths, key=lambda x: abs(math.log(x / s["scope.record_length"])))
+        s_div = snap_to_steps(s["scope.sample_interval"] * s["scope.record_length"] / 10,
+                              self.personality.time_steps)
+        return {**s, "scope.record_length": n, "scope.sample_interval": s_div * 10 / n}
+
+    # --- state, all under self.cond ------------------------------------------------
+    def reset(self) -> None:
+        """*RST: the scene's settings as loaded (the personality's snapping kept), the
+        default DATa and acquisition (stopped); the seed sequence goes on."""
+        self.settings = dict(self.initial)
+        self.shown = set(self.scene.channels)
+        self.rig_values: dict = {}  # RIG: settings, scene key -> value text
+        self.data = DataSelection(stop=self.initial["scope.record_length"])
+        self.horizontal_mode = "MANual"
+        self.measurements = default_slots(next(iter(self.scene.channels)))
+        self.numavg = self.scene.averages if self.scene.mode == "average" else 16
+        self.acq.stop_after, self.acq.pending = "RUNSTop", 0
+        self.acq.run(False)
+
+    def channels(self) -> tuple:
+        return acquired(self.scene, self.shown)
+
+    def change(self, updates: dict, shown: set | None = None, code: int = -221) -> None:
+        """Apply settings (scene key -> SI value) and the channels shown, or raise ``code``
+        (-221 settings conflict, -222 data out of range) with the oscilloscope's refusal and
+        change nothing."""
+        settings, shown = {**self.settings, **updates}, self.shown if shown is None else shown
+        try:
+            if not shown:
+                raise InstrumentError("display at least one channel")
+            scope_of(settings, acquired(self.scene, shown), self.scene)
+        except InstrumentError as e:
+            raise ScpiError(code, str(e)) from None
+        self.settings, self.shown = settings, set(shown)
+
+    def overrides_locked(self) -> dict:
+        return {**overrides(self.scene, self.settings, self.channels()), **self.rig_values}
+
+    def overrides(self) -> dict:
+        """The settings that differ from the scene as loaded, {scene key: value text}: what
+        the next shot is fired with."""
+        with self.cond:
+            return self.overrides_locked()
+
+    def _set_opc(self) -> None:
+        self.status.esr |= OPC
+
+    def wait_idle(self, session) -> None:
+        """Wait (the lock released) until no shot is pending; -410 when the session was
+        cleared meanwhile, -200 on timeout."""
+        mark = session.clears
+        ok = self.cond.wait_for(lambda: not self.acq.awaiting or session.clears != mark or self.acq.closed,
+                                timeout=self.opc_timeout_s)
+        if session.clears != mark:
+            raise ScpiError(-410, "device clear during *OPC?/*WAI")
+        if not ok:
+            raise ScpiError(-200, f"no record after {self.opc_timeout_s:g} s")
+
+    # --- MessageInstrument -------------------------------------------------------------
+    def open_session(self, peer: str) -> ScopeSession:
+        return ScopeSession(self, self.engine, peer)
+
+    def rig_port(self) -> RigPort:
+        """The RIG: commands (and the common ones) on the same state, for another port."""
+        return RigPort(self)
+
+    def close(self) -> None:
+        self.acq.close()
+
+
+class RigPort:
+    """A MessageInstrument serving the rig's commands of a VirtualScope."""
+
+    def __init__(self, scope: VirtualScope) -> None:
+        self.scope, self.lock, self.max_message_bytes = scope, scope.lock, scope.max_message_bytes
+
+    def open_session(self, peer: str) -> ScopeSession:
+        return ScopeSession(self.scope, self.scope.rig_engine, peer)
+
+
+class ScopeSession:
+    """One client: runs its messages on the shared engine, one at a time."""
+
+    def __init__(self, scope: VirtualScope, engine: Engine, peer: str) -> None:
+        self.scope, self.engine, self.peer = scope, engine, peer
+        self.clears = 0
+
+    def handle(self, message: bytes) -> bytes:
+        scope = self.scope
+        with scope.cond:
+            if len(message) > scope.max_message_bytes:
+                scope.status.post(-363, f"a message of {len(message)} bytes (at most {scope.max_message_bytes})")
+                return b""
+            reply = self.engine.execute(message, self)
+            if len(reply) > scope.max_reply_bytes:
+                scope.status.post(-350, f"a reply of {len(reply)} bytes exceeds the output queue's "
+                                        f"{scope.max_reply_bytes}; nothing sent")
+                return b""
+            return reply
+
+    def device_clear(self) -> None:
+        with self.scope.cond:
+            self.clears += 1
+            self.scope.cond.notify_all()
+
+    def trigger(self) -> None:
+        with self.scope.cond:
+            self.scope.acq.force()
+
+    def status_byte(self) -> int:
+        """The status byte without MAV: the transport holds the reply and adds MAV."""
+        with self.scope.cond:
+            return self.scope.status.status_byte(False)
+
+    def overflow(self, size: int) -> None:
+        with self.scope.cond:
+            self.scope.status.post(-363, f"a message of {size} bytes (at most {self.scope.max_message_bytes})")
+
+    def close(self) -> None:
+        self.device_clear()

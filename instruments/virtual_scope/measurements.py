@@ -1,0 +1,64 @@
+"""Measurements on the last record (programmer manuals, "Measurement" command group):
+the immediate one, ``MEASUrement:IMMed:TYPe/SOUrce/VALue?/UNIts?``, and the numbered slots
+``MEASUrement:MEAS<n>:TYPe/SOUrce/STATE/VALue?/UNIts?`` (n = 1..8). Period-free types
+only: AMPlitude and PK2pk (max - min: the min-max method of HIGH and LOW), MAXimum,
+MINimum, HIGH, LOW, MEAN, RMS, in volts. Without a record the value is 9.91E37 with event
+2225, as the scopes answer; a source that is off is 2244."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..scpi.engine import Call, Word
+from ..scpi.status import ScpiError
+from .commands import CHANNEL_WORDS
+from .waveform_commands import source_waveform
+
+NO_VALUE = 9.91e37  # what a Tek scope answers for a measurement it cannot make
+SLOTS = 8
+MEASUREMENTS = {"AMPlitude": lambda v: v.max() - v.min(), "PK2pk": lambda v: v.max() - v.min(),
+                "MAXimum": np.max, "MINimum": np.min, "HIGH": np.max, "LOW": np.min, "MEAN": np.mean,
+                "RMS": lambda v: np.sqrt(np.mean(v * v))}
+
+
+def default_slots(channel: str) -> dict:
+    """{slot: {"type", "source", "state"}}: "IMMed" and 1..8, AMPlitude of ``channel``."""
+    return {slot: {"type": "AMPlitude", "source": channel, "state": slot == "IMMed"}
+            for slot in ("IMMed", *range(1, SLOTS + 1))}
+
+
+def register(tree, scope) -> None:
+    """Add the measurement commands of ``scope`` (a VirtualScope) to a command tree."""
+    p = scope.personality
+
+    def slot(c: Call) -> dict:
+        if not c.suffixes or c.suffixes[1] is None:
+            return scope.measurements["IMMed"]
+        if not 1 <= c.suffixes[1] <= SLOTS:
+            raise ScpiError(-113, f"{c.header}: MEAS1 to MEAS{SLOTS}")
+        return scope.measurements[c.suffixes[1]]
+
+    def setter(field: str, choices):
+        def write(c: Call):
+            slot(c)[field] = c.word(choices)
+        return write
+
+    def value(c: Call) -> str:
+        m = slot(c)
+        codes, pre, _ = source_waveform(scope, m["source"], c.header)
+        if codes is None:
+            scope.status.post(2225, c.header)
+            return p.number(NO_VALUE)
+        v = pre.y_zero + pre.y_multiplier * (codes.astype(np.float64) - pre.y_offset)
+        return p.number(float(MEASUREMENTS[m["type"]](v)))
+
+    def set_state(c: Call):
+        slot(c)["state"] = c.boolean()
+
+    for node in ("IMMed", "MEAS<n>"):
+        tree.add(f"MEASUrement:{node}:TYPe", write=setter("type", tuple(MEASUREMENTS)),
+                 read=lambda c: Word(slot(c)["type"]))
+        tree.add(f"MEASUrement:{node}:SOUrce<n>", write=setter("source", CHANNEL_WORDS),
+                 read=lambda c: Word(slot(c)["source"]))
+        tree.add(f"MEASUrement:{node}:VALue", read=value)
+        tree.add(f"MEASUrement:{node}:UNIts", read=lambda c: '"V"')
+    tree.add("MEASUrement:MEAS<n>:STATE", write=set_state, read=lambda c: "1" if slot(c)["state"] else "0")

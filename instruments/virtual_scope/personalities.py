@@ -1,0 +1,115 @@
+"""The Tektronix models the emulated scope can claim: what they answer and what they take.
+
+- ``tds2000``: a TDS2024C (TDS200/TDS1000/TDS2000 Series Programmer Manual, 071-1075):
+  2,500-point records only, 8-bit data (``DATa:WIDth 2`` pads the low byte), the 16-field
+  ``WFMPre?`` (BYT_NR, BIT_NR, ENCDG, BN_FMT, BYT_OR, NR_PT, WFID, PT_FMT, XINCR, PT_OFF,
+  XZERO, XUNIT, YMULT, YZERO, YOFF, YUNIT), ``YUNit?`` "Volts", time bases in a 1-2.5-5
+  sequence, numbers such as ``2.0E-6``.
+- time bases of the mdo3000 in a 1-2-4 sequence (its WFID reads "400.0us/div"), of the mso4
+  in 1-2-5.
+- ``mdo3000`` (MDO3000 Series Programmer Manual, 077-0968) and ``mso4`` (4 Series MSO
+  Programmer Manual, 077-1497): the 22-field ``WFMOutpre?`` (... PT_ORDER, ..., DOMAIN,
+  WFMTYPE, CENTERFREQUENCY, SPAN, REFLEVEL), record lengths from the model's list, 16-bit
+  data with ``DATa:WIDth 2``, numbers in engineering notation such as ``400.0000E-9``,
+  ``1.0000``, ``0.0E+0``.
+Every model: V/div in a 1-2-5 sequence, 25 codes per division of the 8-bit converter."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from decimal import Decimal
+
+from ..errors import InstrumentError
+
+WFMPRE_16 = ("BYT_Nr", "BIT_Nr", "ENCdg", "BN_Fmt", "BYT_Or", "NR_Pt", "WFId", "PT_Fmt", "XINcr", "PT_Off",
+             "XZEro", "XUNit", "YMUlt", "YZEro", "YOFf", "YUNit")
+WFMOUTPRE_22 = ("BYT_Nr", "BIT_Nr", "ENCdg", "BN_Fmt", "BYT_Or", "WFId", "NR_Pt", "PT_Fmt", "PT_ORder", "XUNit",
+                "XINcr", "XZEro", "PT_Off", "YUNit", "YMUlt", "YOFf", "YZEro", "DOMain", "WFMTYpe",
+                "CENTERFREQuency", "SPAN", "REFLevel")
+
+
+@dataclass(frozen=True)
+class Personality:
+    """A model's identity and reply forms.
+
+    idn: the ``*IDN?`` reply; record_lengths (points, ascending); time_steps: the mantissas
+    of s/div in a decade; preamble: "WFMPre" (16 fields) or "WFMOutpre" (22); preamble_fields
+    in reply order; y_unit: YUNit's text; engineering: numbers with an exponent that is a
+    multiple of 3 and at least 4 decimals (MDO, MSO) or plain NR3 (TDS); wfid_digits: the
+    significant digits of V/div and s/div in WFID."""
+
+    name: str
+    idn: str
+    record_lengths: tuple
+    time_steps: tuple
+    preamble: str
+    preamble_fields: tuple
+    y_unit: str
+    engineering: bool
+    wfid_digits: int
+    volt_steps: tuple = (1.0, 2.0, 5.0)
+
+    def number(self, x: float) -> str:
+        """x in the model's notation, with every digit needed to read it back exactly."""
+        d = Decimal(repr(float(x)))
+        if d == 0:
+            return "0.0E+0" if self.engineering else "0.0E0"
+        exp = d.adjusted()
+        if self.engineering:
+            exp = 3 * math.floor(exp / 3)
+        mant = d.scaleb(-exp).normalize()
+        decimals = max(4 if self.engineering else 1, -mant.as_tuple().exponent)
+        text = f"{mant:.{decimals}f}"
+        if self.engineering:
+            return text if exp == 0 else f"{text}E{exp:+d}"
+        return f"{text}E{exp}"
+
+    def per_div(self, x: float, unit: str) -> str:
+        """A V/div or s/div figure as WFID prints it: ``50.0mV``, ``10.0us``, ``1.000V``."""
+        prefixes = {-12: "p", -9: "n", -6: "u", -3: "m", 0: "", 3: "k"}
+        exp = min(max(3 * math.floor(math.log10(abs(x)) / 3), -12), 3) if x else 0
+        text = f"{x / 10 ** exp:#.{self.wfid_digits}g}".rstrip(".")
+        return f"{text}{prefixes[exp]}{unit}"
+
+
+PERSONALITIES = {
+    "tds2000": Personality("tds2000", "TEKTRONIX,TDS 2024C,C010001,CF:91.1CT FV:v24.26", (2500,),
+                           (1.0, 2.5, 5.0), "WFMPre", WFMPRE_16, "Volts", False, 3),
+    "mdo3000": Personality("mdo3000", "TEKTRONIX,MDO3024,C010001,CF:91.1CT FV:v1.30", (1000, 10000, 100000, 1000000,
+                                                                                      5000000, 10000000),
+                           (1.0, 2.0, 4.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4),
+    "mso4": Personality("mso4", "TEKTRONIX,MSO44,C010001,CF:91.1CT FV:2.0.3.950",
+                        (1000, 2000, 5000, 10000, 20000, 50000, 100000, 200000, 500000, 1000000, 2000000, 5000000,
+                         10000000, 20000000, 31250000),
+                        (1.0, 2.0, 5.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4),
+}
+
+
+def personality(name: str, idn: str | None = None) -> Personality:
+    """A personality by name, its ``*IDN?`` replaced by ``idn`` where given."""
+    if name not in PERSONALITIES:
+        raise InstrumentError(f"personality = {name!r}: allowed {', '.join(PERSONALITIES)}")
+    p = PERSONALITIES[name]
+    if idn is not None:
+        fields = idn.split(",")
+        if len(fields) != 4 or not all(f.strip() for f in fields) or not idn.isprintable():
+            raise InstrumentError(f"idn = {idn!r}: allowed four comma-separated fields, "
+                                  f"MAKER,MODEL,SERIAL,FIRMWARE (e.g. TEKTRONIX,MSO44,C000001,FV:1.0)")
+        p = Personality(**{**p.__dict__, "idn": idn})
+    return p
+
+
+def snap_to_steps(x: float, mantissas) -> float:
+    """The value of a 1-2-5 (or 1-2.5-5) sequence nearest x (> 0) on a log scale; x beyond
+    1e-15 .. 1e15 is taken at that bound (no scope setting is near it; the bounds refuse it)."""
+    decade = math.floor(math.log10(min(max(x, 1e-15), 1e15)))
+    candidates = [m * 10.0 ** e for e in (decade - 1, decade, decade + 1) for m in mantissas]
+    best = min(candidates, key=lambda c: abs(math.log(c / x)))
+    return float(f"{best:.12g}")
+
+
+def snap_record_length(n: float, lengths) -> int | None:
+    """The model's record length nearest n on a log scale, or None outside its range."""
+    if not lengths[0] * 0.999 <= n <= lengths[-1] * 1.001:
+        return None
+    return min(lengths, key=lambda c: abs(math.log(c / n)))

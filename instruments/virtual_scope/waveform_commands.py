@@ -1,0 +1,124 @@
+"""Waveform transfer (programmer manuals, "Waveform Transfer"
+command group): ``DATa:SOUrce[:AVAILable?]/STARt/STOP/ENCdg/WIDth``, ``DATa INIT``, ``DATa?``,
+the personality's preamble (``WFMPre?`` or ``WFMOutpre?``, whole and per field), ``CURVe?``,
+and ``WAVFrm?`` (preamble;curve). The preamble's BYT_Nr, ENCdg, BN_Fmt and BYT_Or are
+settable too, as the manuals give them: they set DATa:WIDth and DATa:ENCdg. A channel that is off is refused with 2244 "Source
+waveform is not active" by CURVe? (the preamble: see ``preamble`` below); ``CURVe?``
+before the first record is an execution error."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+from ..records import Preamble
+from ..scpi.engine import Call, Fields, Word
+from ..scpi.status import ScpiError
+from .commands import CHANNEL_WORDS
+from .transfer import ENCODINGS, DataSelection, curve_bytes, preamble_fields, waveform_id
+
+
+def source_waveform(scope, ch: str, header: str, *, off_too: bool = False):
+    """(codes or None, Preamble, WFID) of channel ``ch``: the last record's, or where there
+    is none yet (or the channel is off and ``off_too``) the preamble its settings give
+    (codes None); a channel that is off is 2244 unless ``off_too``."""
+    shown = ch in scope.shown
+    if not shown and not off_too:
+        raise ScpiError(2244, f"{ch} is off; {header}")
+    shot = scope.acq.last
+    if shown and shot is not None and ch in shot.record.waveforms:
+        w = shot.record[ch]
+        mode = "Sample" if w.preamble.waveform_id.endswith("Sample mode") else "Average"
+        ex = w.preamble.extra
+        return w.codes, w.preamble, waveform_id(ch, w.preamble, ex.get("coupling", "DC"),
+                                                ex.get("volts_per_div", w.preamble.y_multiplier * 25), mode,
+                                                scope.personality)
+    s = scope.settings
+    n, dt = s["scope.record_length"], s["scope.sample_interval"]
+    vdiv = s[f"scope.channels.{ch}.volts_per_div"]
+    pre = Preamble(points=n, x_increment=dt, x_zero=-s["scope.trigger.pre_trigger"] * n * dt,
+                   trigger_index=round(s["scope.trigger.pre_trigger"] * n), y_multiplier=vdiv / 25,
+                   y_offset=s[f"scope.channels.{ch}.position"] * 25, y_zero=s[f"scope.channels.{ch}.offset"])
+    mode = "Sample" if s["scope.mode"] == "sample" else "Average"
+    return None, pre, waveform_id(ch, pre, s[f"scope.channels.{ch}.coupling"], vdiv, mode, scope.personality)
+
+
+def register(tree, scope) -> None:
+    """Add the waveform commands of ``scope`` (a VirtualScope)."""
+    p = scope.personality
+
+    def data(**changes):
+        scope.data = replace(scope.data, **changes)
+
+    def point(c: Call) -> int:
+        """A point number, clamped to 1 .. max_record_length as the scopes clamp it (scripts
+        send ``DATa:STOP 1e10`` for "to the end")."""
+        return min(max(round(c.number()), 1), scope.max_record_length)
+
+    def width(c: Call):
+        w = c.number()
+        if w not in (1, 2):
+            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed 1 or 2 bytes per point")
+        data(width=int(w))
+
+    def preamble(c: Call) -> Fields:
+        """The whole preamble; of a channel that is off, a TDS answers its format fields
+        only (BYT_NR to BYT_OR, TDS2000 manual, WFMPre?), an MDO or MSO every field from
+        the channel's settings (qcodes' DPO7200xx driver reads XUNit of every channel)."""
+        off = scope.data.source not in scope.shown
+        _, pre, wfid = source_waveform(scope, scope.data.source, c.header, off_too=True)
+        fields = preamble_fields(pre, scope.data, wfid, p)
+        return Fields(fields.pairs[:5]) if off and p.name == "tds2000" else fields
+
+    def preamble_field(name: str):
+        def read(c: Call):
+            pairs = dict(preamble(c).pairs)
+            if name not in pairs:
+                raise ScpiError(2244, f"{scope.data.source} is off; {c.header}")
+            return pairs[name]
+        return read
+
+    def curve(c: Call) -> bytes:
+        codes, _, _ = source_waveform(scope, scope.data.source, c.header)
+        if codes is None:
+            raise ScpiError(-200, f"{scope.data.source} has no record yet; fire a shot (ACQuire:STATE ON, "
+                                  f"TRIGger FORCe or RIG:FIRE); {c.header}")
+        return curve_bytes(codes, scope.data)
+
+    def wavfrm(c: Call) -> bytes:
+        """``WFMPre?;CURVe?`` in one reply, each part in the current reply form (with
+        HEADer ON: ``:WFMPRE:BYT_NR 1;...;:CURVE #...``)."""
+        engine, tree = scope.engine, scope.engine.tree
+        return (engine.reply(preamble(c), tree.find((p.preamble.upper(),))) + b";"
+                + engine.reply(curve(c), tree.find(("CURVE",))))
+
+    def data_init(c: Call):
+        c.word(("INIT",))
+        scope.data = DataSelection(stop=scope.initial["scope.record_length"])
+
+    destination = Word("REFA" if p.name == "tds2000" else "REF1")  # where DATa:DESTination would write (no refs)
+    tree.add("DATa", write=data_init, read=lambda c: Fields((
+        ("DESTination", destination), ("ENCdg", Word(scope.data.encoding)), ("SOUrce", Word(scope.data.source)),
+        ("STARt", str(scope.data.start)), ("STOP", str(scope.data.stop)), ("WIDth", str(scope.data.width)))))
+    tree.add("DATa:SOUrce", write=lambda c: data(source=c.word(CHANNEL_WORDS)),
+             read=lambda c: Word(scope.data.source))
+    tree.add("DATa:SOUrce:AVAILable", read=lambda c: ",".join(ch for ch in CHANNEL_WORDS if ch in scope.shown))
+    tree.add("DATa:STARt", write=lambda c: data(start=point(c)), read=lambda c: str(scope.data.start))
+    tree.add("DATa:STOP", write=lambda c: data(stop=point(c)), read=lambda c: str(scope.data.stop))
+    tree.add("DATa:ENCdg", write=lambda c: setattr(scope, "data", scope.data.encoded(c.word(ENCODINGS))),
+             read=lambda c: Word(scope.data.encoding))
+    tree.add("DATa:WIDth", write=width, read=lambda c: str(scope.data.width))
+    tree.add(p.preamble, read=preamble)
+    def set_format(c: Call):
+        fmt = c.word(("RI", "RP", "FP"))
+        if fmt == "FP":
+            raise ScpiError(-221, f"{c.header} FP: the scope sends integer codes (RI or RP)")
+        scope.data = scope.data.formatted(signed=fmt == "RI")
+
+    def set_encoding(c: Call):
+        scope.data = scope.data.encoded("ASCIi" if c.word(("ASCIi", "BINary")) == "ASCIi" else scope.data.binary)
+
+    setters = {"BYT_Nr": width, "ENCdg": set_encoding, "BN_Fmt": set_format,
+               "BYT_Or": lambda c: setattr(scope, "data", scope.data.formatted(msb_first=c.word(("MSB", "LSB")) == "MSB"))}
+    for name in p.preamble_fields:
+        tree.add(f"{p.preamble}:{name}", read=preamble_field(name), write=setters.get(name))
+    tree.add("CURVe", read=curve)
+    tree.add("WAVFrm", read=wavfrm, bare=True)  # its parts carry their own headers

@@ -1,0 +1,174 @@
+"""The emulated scope's front panel: personalities' identities and preambles, settings
+snapped to the model's steps and handed to the rig as scene overrides, *RST, channels on
+and off, the events of refused settings, no file commands."""
+import numpy as np
+import pytest
+from lab_scope import ask, fire, scene_scope
+
+from instruments.errors import InstrumentError
+from instruments.virtual_scope.instrument import VirtualScope
+
+
+@pytest.mark.parametrize("personality, model, fields, yunit", [
+    ("tds2000", "TDS 2024C", 16, '"Volts"'), ("mdo3000", "MDO3024", 22, '"V"'), ("mso4", "MSO44", 22, '"V"')])
+def test_personalities_identify_and_answer_their_preamble(make_scope, personality, model, fields, yunit):
+    _scope, s, _ = make_scope(personality)
+    idn = ask(s, "*IDN?").split(",")
+    assert idn[0] == "TEKTRONIX" and idn[1] == model and len(idn) == 4
+    name = "WFMPre" if personality == "tds2000" else "WFMOutpre"
+    assert len(ask(s, f"{name}?").split(";")) == fields
+    assert ask(s, f"{name}:YUNIT?") == yunit
+    s.handle(b"HEADER ON")
+    reply = ask(s, f"{name}?")
+    assert reply.startswith(f":{name.upper()}:BYT_NR 1;BIT_NR 8;ENCDG BINARY;BN_FMT RI;BYT_OR MSB;")
+    s.handle(b"VERBOSE OFF")
+    assert ask(s, f"{name}:NR_PT?") == f":{'WFMP' if name == 'WFMPre' else 'WFMO'}:NR_P " + \
+        ("2500" if personality == "tds2000" else "10000")
+
+
+def test_tds_wfid_and_numbers_are_in_the_tek_form(make_scope):
+    _scope, s, _ = make_scope("tds2000")
+    fire(s)
+    assert ask(s, "WFMPRE:WFID?") == '"Ch1, DC coupling, 50.0mV/div, 50.0us/div, 2500 points, Sample mode"'
+    assert ask(s, "WFMPRE:XINCR?;YMULT?;YZERO?") == "2.0E-7;2.0E-3;0.0E0"
+
+
+def test_idn_text_overrides_and_is_checked(make_scope):
+    _scope, s, _ = make_scope("mso4", idn="TEKTRONIX,MSO46,X1,FV:1.0")
+    assert ask(s, "*IDN?") == "TEKTRONIX,MSO46,X1,FV:1.0"
+    with pytest.raises(InstrumentError, match="idn"):
+        make_scope("mso4", idn="just a model")
+
+
+def test_settings_snap_to_the_models_steps_and_become_overrides(make_scope):
+    scope, s, _ = make_scope("mdo3000")
+    assert scope.overrides() == {}
+    s.handle(b"CH1:SCALE 30mV;:HOR:SCALE 3E-4;:HOR:RECORDLENGTH 120000;:TRIG:A:LEVEL 80mV;:CH2:BANDWIDTH FULL")
+    assert ask(s, "CH1:SCALE?;:HOR:SCALE?;:HOR:RECO?;:HOR:SAMPLERATE?") == "20.0000E-3;400.0000E-6;100000;25.0000E+6"
+    assert scope.overrides() == {"scope.channels.CH1.volts_per_div": "0.02 V", "scope.sample_interval": "4e-08 s",
+                                 "scope.record_length": "100000", "scope.trigger.level": "0.08 V",
+                                 "scope.channels.CH2.bandwidth": "full"}
+    assert ask(s, "ALLEV?") == '0,"No events to report - queue empty"'
+
+
+def test_tds_takes_2500_points_only_and_its_scene_snapping_is_an_override(make_scope):
+    scope, s, _ = make_scope("tds2000", scene=scene_scope(20_000, 1e-7))
+    assert scope.overrides() == {"scope.record_length": "2500", "scope.sample_interval": "1e-06 s"}
+    s.handle(b"HOR:RECO 5000;:HOR:RECO 2500")
+    assert ask(s, "HOR:RECO?;*ESR?;:EVQTY?") == "2500;144;1"
+    assert ask(s, "ALLEV?") == '-200,"Execution error; HOR:RECO 5000: the tds2000 takes 2500"'
+
+
+def test_record_length_is_bounded(make_scope):
+    scope, s, _ = make_scope("mso4", max_record_length=100_000)
+    s.handle(b"HOR:RECO 1E6")
+    assert ask(s, "HOR:RECO?") == "10000" and ask(s, "EVENT?") == "-200"
+    scope, s, _ = make_scope("mso4", scene=scene_scope(500_000), max_record_length=100_000)
+    assert scope.overrides()["scope.record_length"] == "100000"
+    with pytest.raises(InstrumentError, match="max_record_length"):
+        make_scope("mso4", max_record_length=500)
+
+
+def test_rst_restores_the_scene_as_loaded(make_scope):
+    scope, s, _ = make_scope("mdo3000")
+    s.handle(b"CH1:SCA 1;POS 2;:SEL:CH3 ON;:DATA:ENC ASCII;:RIG:STR:VEL 1.2 m/s;:ACQ:MODE AVERAGE")
+    assert len(scope.overrides()) > 5 and ask(s, "DATA:ENC?") == "ASCII"
+    s.handle(b"*RST")
+    assert scope.overrides() == {} and ask(s, "DATA:ENC?;:SEL?;:ACQ:MODE?") == "RIBINARY;1;1;0;0;SAMPLE"
+
+
+def test_a_channel_switched_on_is_recorded_with_all_its_settings_and_one_off_is_refused(make_scope):
+    scope, s, _source = make_scope("tds2000")
+    s.handle(b"SELECT:CH3 ON;:CH3:SCALE 0.5")
+    assert {k: v for k, v in scope.overrides().items() if ".CH3." in k} == {
+        "scope.channels.CH3.volts_per_div": "0.5 V", "scope.channels.CH3.position": "0.0",
+        "scope.channels.CH3.offset": "0.0 V", "scope.channels.CH3.coupling": "DC",
+        "scope.channels.CH3.bandwidth": "20000000.0 Hz", "scope.channels.CH3.probe": "1.0"}
+    s.handle(b"SELECT:CH2 OFF")
+    fire(s)
+    assert set(scope.acq.last.record.waveforms) == {"CH1", "CH2", "CH3"}  # the rig still records CH2
+    assert ask(s, "*ESR?") == "128"
+    assert s.handle(b"DATA:SOURCE CH2;:CURVE?") == b"" and ask(s, "WFMPRE?") == "1;8;BINARY;RI;MSB"
+    assert s.handle(b"WFMPRE:NR_PT?") == b""
+    assert ask(s, "*ESR?") == "16"
+    assert ask(s, "ALLEV?") == ('2244,"Source waveform is not active; CH2 is off; :CURVE?",'
+                                '2244,"Source waveform is not active; CH2 is off; WFMPRE:NR_PT?"')
+    s.handle(b"SELECT:CH1 OFF;CH3 OFF")
+    assert ask(s, "SEL?") == "0;0;1;0" and ask(s, "EVENT?") == "-221"  # one channel stays on
+
+
+@pytest.mark.parametrize("command, code", [
+    ("CH1:SCALE 20", -222), ("CH1:SCALE -1", -222), ("CH1:COUPLING GND", -221), ("CH1:POSITION 7", -222),
+    ("TRIG:A:EDGE:SOURCE CH4", -221), ("TRIG:A:EDGE:COUPLING HFREJ", -221), ("ACQ:MODE PEAK", -221),
+    ("ACQ:NUMAVG 1024", -222), ("DATA:WIDTH 4", -222), ("DATA:ENC FASTEST", -224), 
+    ("CH5:SCALE 1", -113), ("FILESYSTEM:READFILE \"/etc/passwd\"", -113), ("SAVE:WAVEFORM CH1,\"a.isf\"", -113),
+    ("SAVE:SETUP 1", -113), ("RIG:STR:VEL 5 furlongs", -224), ("RIG:SEED -1", -222)])
+def test_refused_settings_queue_their_event_and_change_nothing(make_scope, command, code):
+    scope, s, _ = make_scope("mdo3000")
+    before = scope.overrides()
+    assert s.handle(command.encode()) == b""
+    assert ask(s, "EVENT?") == str(code) and scope.overrides() == before
+
+
+def test_probe_gain_and_waveview_forms(make_scope):
+    scope, s, _ = make_scope("mso4")
+    s.handle(b"CH1:PROBE:GAIN 0.1;:DISPLAY:WAVEVIEW1:CH3:STATE ON")
+    assert ask(s, "CH1:PROBE?;PROBE:GAIN?;:SEL:CH3?") == "10.0000;100.0000E-3;1"
+    assert scope.overrides()["scope.channels.CH1.probe"] == "10.0"
+
+
+def test_trigger_and_acquisition_settings(make_scope):
+    scope, s, _ = make_scope("tds2000")
+    s.handle(b"TRIG:MAIN:EDGE:SLOPE FALL;SOURCE CH2;:TRIG:MAIN:LEVEL -20mV;:ACQ:MODE AVE;NUMAVG 60;"
+             b":HOR:MAIN:POSITION 0")
+    assert ask(s, "TRIG:A:EDGE:SLOPE?;SOURCE?;:TRIG:A:LEVEL?;:ACQ:NUMAVG?;MODE?") == "FALL;CH2;-2.0E-2;64;AVERAGE"
+    assert scope.overrides() == {"scope.trigger.slope": "falling", "scope.trigger.source": "CH2",
+                                 "scope.trigger.level": "-0.02 V", "scope.mode": "average", "scope.averages": "64",
+                                 "scope.trigger.pre_trigger": "0.5"}
+
+
+def test_an_mdo_answers_the_preamble_of_a_channel_that_is_off_from_its_settings(make_scope):
+    _scope, s, _ = make_scope("mdo3000")
+    fire(s)
+    s.handle(b"DATA:SOURCE CH4;:CH4:SCALE 0.5")
+    assert ask(s, "WFMO:XUNIT?;YMULT?;NR_PT?") == '"s";20.0000E-3;10000'
+    assert s.handle(b"CURVE?") == b"" and ask(s, "EVENT?") == "2244"
+
+
+def test_data_start_and_stop_are_clamped_as_the_scopes_clamp_them(make_scope):
+    _scope, s, _ = make_scope("mdo3000", max_record_length=100_000)
+    s.handle(b"DAT:START 0;STOP 1e10")
+    assert ask(s, "DAT:START?;STOP?;:WFMO:NR_P?") == "1;100000;10000"
+
+
+def test_horizontal_mode_forms_are_the_same_settings(make_scope):
+    _scope, s, _ = make_scope("mso4")
+    s.handle(b"HOR:MODE MAN;:HOR:MODE:SCALE 1E-4;RECORDLENGTH 20000")
+    assert ask(s, "HOR:SCALE?;RECO?;:HOR:MODE:SAMPLERATE?;:HOR:MODE?") == "100.0000E-6;20000;20.0000E+6;MANUAL"
+
+
+@pytest.mark.parametrize("slot", ["IMM", "MEAS3"])
+def test_measurements_on_the_last_record(make_scope, slot):
+    scope, s, _ = make_scope("mdo3000")
+    s.handle(f"MEASU:{slot}:SOU1 CH1;TYP MAX".encode())
+    assert ask(s, f"MEASU:{slot}:VAL?") == "99.1000E+36" and ask(s, "EVENT?") == "2225"
+    fire(s)
+    v = scope.acq.last.record["CH1"].volts()
+    for kind, value in (("MAX", v.max()), ("MIN", v.min()), ("AMP", v.max() - v.min()), ("MEAN", v.mean()),
+                        ("RMS", np.sqrt(np.mean(v * v)))):
+        s.handle(f"MEASU:{slot}:TYP {kind}".encode())
+        assert float(ask(s, f"MEASU:{slot}:VAL?")) == pytest.approx(value, rel=1e-12)
+    s.handle(f"MEASU:{slot}:SOURCE CH2;:SEL:CH2 OFF".encode())
+    assert s.handle(f"MEASU:{slot}:VAL?".encode()) == b"" and ask(s, "EVENT?") == "2244"
+    assert v.max() == pytest.approx(0.2, abs=0.005)  # the pulse's peak, within 2 codes and the noise
+
+
+def test_a_scene_scope_no_model_can_take_is_refused():
+    with pytest.raises(InstrumentError, match="personality"):
+        VirtualScope(scene_scope(), lambda o, s: None, personality_name="tds9999")
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, True, 2 ** 63])
+def test_a_first_seed_that_is_no_seed_is_refused(seed):
+    with pytest.raises(InstrumentError, match="seed"):
+        VirtualScope(scene_scope(), lambda o, s: None, seed=seed)
