@@ -11,7 +11,7 @@ import sys
 
 from instruments.errors import InstrumentError
 from rig import __version__
-from rig.cli import data, fitting, shots, study, sweeps, tools
+from rig.cli import data, fitting, lab, shots, study, sweeps, tools
 from rig.cli.common import (
     OneLineParser,
     allow_large,
@@ -192,9 +192,11 @@ def build_parser() -> argparse.ArgumentParser:
     ls = _command(sub, "ls", "list the shots of an archive", data.cmd_ls)
     ls.add_argument("archive")
 
+    lab.add_parsers(sub, _command)
+
     be = _command(sub, "bench", "benchmarks", tools.cmd_bench)
     be.add_argument("what", choices=["solver", "accuracy", "models", "fit", "shot", "archive", "pipeline", "mc",
-                                     "animate", "startup"],
+                                     "animate", "startup", "serve"],
                     help="what to benchmark")
     be.add_argument("--quick", action="store_true", help="solver, accuracy, models, fit: fewer settings, one repeat")
     be.add_argument("--peers", action="store_true",

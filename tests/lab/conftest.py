@@ -1,17 +1,21 @@
-"""What the transport tests serve: a small message-based instrument (``EchoInstrument``) and
-pyvisa with the pyvisa-py backend as the client, as a lab script uses it.
+"""What the lab tests serve: a small message-based instrument (``EchoInstrument``) for the
+transports, the emulated scope on a synthetic shot source (``make_scope``), and the lock of
+port 111 (``port111``); pyvisa with the pyvisa-py backend is the client, as in a lab script.
 
 The instrument answers ``*IDN?``; ``ECHO? <bytes>`` with the bytes; ``DATA? <n>`` with an
 IEEE 488.2 definite-length block of n bytes (byte k is k mod 251); ``WAIT? <s>`` after s
-seconds, or at once when a device clear comes, with ``DONE``; ``SYST:ERR?`` with the oldest error (``-363`` input buffer overrun for a
-message dropped for its size, ``-113`` undefined header); ``COUNT? TRG|CLEAR`` with how many
-triggers and device clears it took. Its status byte has bit 2 (error queue not empty). One
+seconds, or at once when a device clear comes, with ``DONE``; ``SYST:ERR?`` with the oldest
+error (``-363`` input buffer overrun for a message dropped for its size, ``-113`` undefined
+header); ``COUNT? TRG|CLEAR`` with how many triggers and device clears it took. Its status byte has bit 2 (error queue not empty). One
 message is handled at a time, as on a real instrument."""
 from __future__ import annotations
 
+import fcntl
+import tempfile
 import threading
 import time
 import warnings
+from pathlib import Path
 
 import pytest
 from lab_scope import PulseSource, scene_scope, velocity_only
@@ -152,3 +156,16 @@ def make_scope():
     yield make
     for scope in made:
         scope.close()
+
+
+@pytest.fixture(scope="module")
+def port111():
+    """Port 111 (the portmapper VXI-11 clients ask) is one per machine: a module that serves
+    on it holds this lock, so that two test processes (pytest -n, --dist loadfile) never serve
+    there at once."""
+    with open(Path(tempfile.gettempdir()) / "sonic-rig-tests-port111.lock", "w") as f:
+        fcntl.flock(f, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f, fcntl.LOCK_UN)

@@ -100,7 +100,7 @@ def test_a_channel_switched_on_is_recorded_with_all_its_settings_and_one_off_is_
 @pytest.mark.parametrize("command, code", [
     ("CH1:SCALE 20", -222), ("CH1:SCALE -1", -222), ("CH1:COUPLING GND", -221), ("CH1:POSITION 7", -222),
     ("TRIG:A:EDGE:SOURCE CH4", -221), ("TRIG:A:EDGE:COUPLING HFREJ", -221), ("ACQ:MODE PEAK", -221),
-    ("ACQ:NUMAVG 1024", -222), ("DATA:WIDTH 4", -222), ("DATA:ENC FASTEST", -224), 
+    ("ACQ:NUMAVG 1024", -222), ("DATA:WIDTH 4", -222), ("DATA:ENC FASTEST", -224),
     ("CH5:SCALE 1", -113), ("FILESYSTEM:READFILE \"/etc/passwd\"", -113), ("SAVE:WAVEFORM CH1,\"a.isf\"", -113),
     ("SAVE:SETUP 1", -113), ("RIG:STR:VEL 5 furlongs", -224), ("RIG:SEED -1", -222)])
 def test_refused_settings_queue_their_event_and_change_nothing(make_scope, command, code):

@@ -22,9 +22,6 @@ from instruments.errors import InstrumentError
 from instruments.transports import oncrpc, portmap
 from instruments.transports.vxi11 import DEVICE_CORE_PROG, Vxi11Server
 
-# port 111 is one per machine: its tests run in one pytest-xdist worker (--dist loadgroup)
-pytestmark = pytest.mark.xdist_group("port111")
-
 MAX_MESSAGE = 4096
 HOST = "127.0.0.1"
 
@@ -39,14 +36,14 @@ class Served:
             self.how, self.why_not = None, str(e)
 
 
-@pytest.fixture(scope="session")
-def served():
+@pytest.fixture(scope="module")
+def served(port111):
     s = Served()
     yield s
     s.server.close()
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def rm():
     manager = pyvisa.ResourceManager("@py")
     yield manager

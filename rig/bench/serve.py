@@ -1,0 +1,114 @@
+"""Served-scope benchmark (``rig bench serve``): what a lab script pays for the network.
+
+A served scope (rig/lab/serve.py, raw socket and HiSLIP, in this process) and pyvisa with
+pyvisa-py as the client, against ``Rig.fire`` of the same shot in process, in interleaved
+rounds; CPU time of this process (server threads and client together), medians:
+
+- arm to record ready: ``ACQuire:STATE ON`` then ``*OPC?`` answered, against one
+  ``Rig.fire``: at the scene's settings (the solve reused, as a repeated shot reuses it) and
+  with a new striker velocity per shot (each one solved);
+- ``CURVe?`` of 10,000 points, 16-bit binary (an mso4's record);
+- 100 acquire cycles (arm, wait, fetch CH1) against 100 shots in process.
+"""
+from __future__ import annotations
+
+import statistics
+import time
+
+SCENE = "ptfe52_magnetic"
+ROUNDS = 5
+CYCLES = 100
+CURVE_POINTS = 10_000
+
+
+def _client(rm, resource: str):
+    inst = rm.open_resource(resource, timeout=120_000)
+    if resource.endswith("SOCKET"):
+        inst.read_termination = inst.write_termination = "\n"
+    inst.write("*CLS;:HEADER OFF;:ACQUIRE:STOPAFTER SEQUENCE")
+    return inst
+
+
+def _arm(inst) -> None:
+    inst.write("ACQUIRE:STATE ON")
+    inst.query("*OPC?")
+
+
+def _cpu(f) -> float:
+    t0 = time.process_time()
+    f()
+    return time.process_time() - t0
+
+
+def run(scene: str = SCENE, rounds: int = ROUNDS, cycles: int = CYCLES) -> dict:
+    import numpy as np
+    import pyvisa
+
+    from rig.experiment.shot import Rig
+    from rig.lab.serve import ScopeServer, ServeSettings
+
+    server = ScopeServer(ServeSettings(scene=scene, port=0, hislip=0, personality="mso4", seed=1),
+                         say=lambda line: None)
+    rm = pyvisa.ResourceManager("@py")
+    try:
+        clients = {kind: _client(rm, next(r for r in server.resources if kind in r)) for kind in ("SOCKET", "hislip")}
+        sock = clients["SOCKET"]
+        sock.write(f"HORIZONTAL:RECORDLENGTH {CURVE_POINTS}")
+        overrides = [o for o in sock.query("RIG:OVERRIDES?").strip().strip('"').split(",") if o]
+        rig = Rig.from_scene(scene, overrides)
+        rig.fire(seed=0)
+        velocities = [f"{0.85 + 0.001 * k:.3f} m/s" for k in range(rounds)]
+        rows = {f"arm to record ready ({kind})": [] for kind in clients} | {"new striker velocity": [],
+                                                                             "CURVe? 10,000 points 16-bit": [],
+                                                                             f"{cycles} acquire cycles": []}
+        base = {"fire": [], "fire, new velocity": [], f"{cycles} fires": []}
+        for k in range(rounds):
+            for kind, inst in clients.items():
+                rows[f"arm to record ready ({kind})"].append(_cpu(lambda: _arm(inst)))
+            base["fire"].append(_cpu(lambda: rig.fire(seed=k)))
+            sock.write(f"RIG:STRIKER:VELOCITY {velocities[k]}")
+            rows["new striker velocity"].append(_cpu(lambda: _arm(sock)))
+            fresh = [*overrides, f"striker.velocity={velocities[k]}"]
+            base["fire, new velocity"].append(_cpu(lambda: Rig.from_scene(scene, fresh).fire(seed=k)))
+            sock.write("DATA:SOURCE CH1;:DATA:ENCDG SRIBINARY;:DATA:WIDTH 2;:DATA:START 1;"
+                       f":DATA:STOP {CURVE_POINTS}")
+            curve = []
+            rows["CURVe? 10,000 points 16-bit"].append(_cpu(lambda: curve.append(
+                sock.query_binary_values("CURVE?", datatype="h", container=np.array))))
+            if curve[0].size != CURVE_POINTS:
+                raise RuntimeError(f"CURVe? gave {curve[0].size} points, not {CURVE_POINTS}")
+
+            def cycle():
+                for _ in range(cycles):
+                    _arm(sock)
+                    sock.query_binary_values("CURVE?", datatype="h", container=np.array)
+            rows[f"{cycles} acquire cycles"].append(_cpu(cycle))
+            base[f"{cycles} fires"].append(_cpu(lambda: [rig.fire(seed=j) for j in range(cycles)]))
+        for inst in clients.values():
+            inst.close()
+    finally:
+        rm.close()
+        server.close()
+    pairs = {f"arm to record ready ({kind})": "fire" for kind in clients} | {
+        "new striker velocity": "fire, new velocity", "CURVe? 10,000 points 16-bit": None,
+        f"{cycles} acquire cycles": f"{cycles} fires"}
+    out = []
+    for name, against in pairs.items():
+        ms = statistics.median(rows[name]) * 1e3
+        ref = statistics.median(base[against]) * 1e3 if against else None
+        ratio = statistics.median(a / b for a, b in zip(rows[name], base[against])) if against else None
+        out.append(dict(figure=name, served_ms=ms, in_process=against, in_process_ms=ref, ratio=ratio))
+    return dict(scene=scene, rounds=rounds, personality="mso4", record_points=CURVE_POINTS, rows=out,
+                targets={"arm to record ready": "<= 1.5x Rig.fire", "CURVe? 10,000 points 16-bit": "<= 20 ms",
+                         f"{cycles} acquire cycles": "<= 2x"})
+
+
+def table(r: dict) -> str:
+    lines = [f"served scope ({r['personality']}, {r['record_points']} points) of {r['scene']} through pyvisa-py, "
+             f"CPU medians of {r['rounds']} interleaved rounds",
+             f"  {'figure':34s} {'served ms':>10s}  {'in process':22s} {'ms':>9s} {'ratio':>6s}"]
+    for row in r["rows"]:
+        ref = f"{row['in_process_ms']:9.2f} {row['ratio']:6.2f}" if row["in_process"] else f"{'':9s} {'':6s}"
+        lines.append(f"  {row['figure']:34s} {row['served_ms']:10.2f}  {row['in_process'] or '':22s} {ref}")
+    lines.append("  targets: " + "; ".join(f"{k} {v}" for k, v in r["targets"].items()))
+    return "\n".join(lines)

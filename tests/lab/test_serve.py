@@ -1,0 +1,164 @@
+"""``rig serve scope`` end to end: the command a lab runs, real VISA clients (pyvisa with
+pyvisa-py) on each transport, the records compared bit for bit with ``rig shot`` at the
+same settings and seed, SIGTERM ending it cleanly, bad input refused in one line."""
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pyvisa = pytest.importorskip("pyvisa")
+
+from instruments.formats import read_waveforms  # noqa: E402
+
+SCENE = "ptfe52_magnetic"
+FIRST_SEED = 11
+RIG = [sys.executable, "-m", "rig.cli"]
+READY_S = 300  # the warm-up shot compiles the kernels on a cold cache
+
+
+class Served:
+    """A ``rig serve scope`` process: its resources (from the "listening" line) and output."""
+
+    def __init__(self, *args: str):
+        self.proc = subprocess.Popen([*RIG, "serve", "scope", *args], stdout=subprocess.PIPE,
+                                     stderr=subprocess.STDOUT, text=True, env=os.environ | {"PYTHONUNBUFFERED": "1"})
+        self.lines = []
+        for line in self.proc.stdout:
+            self.lines.append(line.rstrip("\n"))
+            if line.startswith("listening"):
+                break
+        else:
+            raise AssertionError("rig serve ended before listening:\n" + "\n".join(self.lines))
+        self.resources = self.lines[-1].split(": ", 1)[1].split("  ")
+
+    def resource(self, kind: str) -> str:
+        return next(r for r in self.resources if kind in r)
+
+    def stop(self) -> tuple:
+        self.proc.send_signal(signal.SIGTERM)
+        rest, _ = self.proc.communicate(timeout=30)
+        return self.proc.returncode, rest
+
+
+@pytest.fixture(scope="module")
+def served(port111):
+    s = Served(SCENE, "--port", "0", "--hislip", "0", "--vxi11", "--seed", str(FIRST_SEED))
+    yield s
+    if s.proc.poll() is None:
+        s.stop()
+
+
+@pytest.fixture(scope="module")
+def rm():
+    manager = pyvisa.ResourceManager("@py")
+    yield manager
+    manager.close()
+
+
+def open_scope(rm, resource: str):
+    inst = rm.open_resource(resource, timeout=60_000)
+    if resource.endswith("SOCKET"):
+        inst.read_termination = inst.write_termination = "\n"
+    return inst
+
+
+def shot_codes(rm, resource: str, channel: str = "CH1") -> tuple:
+    """One single-sequence shot through ``resource``: (codes of ``channel``, the overrides it
+    was fired with, its seed)."""
+    scope = open_scope(rm, resource)
+    try:
+        scope.write("*CLS;:HEADER OFF;:ACQUIRE:STOPAFTER SEQUENCE")
+        overrides = scope.query("RIG:OVERRIDES?").strip().strip('"')
+        seed = int(scope.query("RIG:SEED?"))
+        scope.write("ACQUIRE:STATE ON")
+        assert scope.query("*OPC?").strip() == "1"
+        assert scope.query("ACQUIRE:STATE?").strip() == "0"
+        scope.write(f"DATA:SOURCE {channel};:DATA:ENCDG RIBINARY;:DATA:WIDTH 1;:DATA:START 1;:DATA:STOP 1000000")
+        codes = scope.query_binary_values("CURVE?", datatype="b", container=np.array, is_big_endian=True)
+        assert scope.query("*ESR?").strip() in ("0", "1")  # no error bit: only OPC may be set
+        return codes, [o for o in overrides.split(",") if o], seed
+    finally:
+        scope.close()
+
+
+def rig_shot_codes(tmp_path: Path, overrides: list, seed: int, channel: str = "CH1") -> np.ndarray:
+    out = tmp_path / f"shot{seed}"
+    sets = [a for o in overrides for a in ("--set", o)]
+    subprocess.run([*RIG, "shot", SCENE, "--seed", str(seed), *sets, "--export", str(out)], check=True,
+                   capture_output=True, text=True)
+    (w,) = [w for f in sorted(out.iterdir()) for w in read_waveforms(f) if w.channel == channel]
+    return w.codes
+
+
+def test_it_says_where_it_listens_on_loopback(served):
+    assert any(line.startswith("warm-up shot") for line in served.lines)
+    assert served.resources[0].startswith("TCPIP::127.0.0.1::") and served.resources[0].endswith("::SOCKET")
+    assert any("::hislip0," in r for r in served.resources)
+    assert "TCPIP::127.0.0.1::INSTR" in served.resources  # VXI-11, found through port 111
+
+
+@pytest.mark.parametrize("kind", ["SOCKET", "hislip0", "127.0.0.1::INSTR"])
+def test_a_shot_over_each_transport_is_the_rig_shot_of_its_settings_and_seed(served, rm, kind, tmp_path):
+    codes, overrides, seed = shot_codes(rm, served.resource(kind))
+    assert seed >= FIRST_SEED
+    assert "scope.record_length=2500" in overrides  # a TDS2024C's record
+    assert codes.size == 2500
+    assert np.array_equal(codes, rig_shot_codes(tmp_path, overrides, seed))
+
+
+def test_the_kth_shot_uses_seed_n_plus_k_minus_1_and_settings_apply_to_the_next(served, rm, tmp_path):
+    resource = served.resource("SOCKET")
+    scope = open_scope(rm, resource)
+    try:
+        before = int(scope.query("RIG:SEED?"))
+        scope.write("CH1:SCALE 0.1;:RIG:STRIKER:VELOCITY 0.95 m/s")
+        assert scope.query("*OPC?").strip() == "1"  # taken before this client goes
+    finally:
+        scope.close()
+    codes, overrides, seed = shot_codes(rm, resource)
+    assert seed == before
+    assert "striker.velocity=0.95 m/s" in overrides
+    assert any(o.startswith("scope.channels.CH1.volts_per_div=") for o in overrides)
+    assert np.array_equal(codes, rig_shot_codes(tmp_path, overrides, seed))
+    _, _, next_seed = shot_codes(rm, resource)
+    assert next_seed == seed + 1
+
+
+def test_a_bad_command_is_an_error_in_the_queue_and_the_server_answers_on(served, rm):
+    scope = open_scope(rm, served.resource("SOCKET"))
+    try:
+        scope.write("*CLS")
+        scope.write("NOSUCH:COMMAND 5")
+        scope.write("RIG:MAGNET:FORCE -3 N")
+        events = scope.query("ALLEV?")
+        assert "-113" in events and "-224" in events
+        assert "TDS 2024C" in scope.query("*IDN?")
+    finally:
+        scope.close()
+
+
+def test_sigterm_stops_it_cleanly():
+    s = Served(SCENE, "--port", "0", "--seed", "3", "--set", "striker.velocity=0.9 m/s")
+    code, rest = s.stop()
+    assert code == 0, rest
+    assert rest.strip().endswith("stopped")
+
+
+@pytest.mark.parametrize("args, field", [
+    (["nosuchscene"], "scene"),
+    ([SCENE, "--fire", "every=-1"], "--fire"),
+    ([SCENE, "--port", "70000"], "--port"),
+    ([SCENE, "--personality", "tds9"], "--personality"),
+    ([SCENE, "--set", "striker.velocity=fast"], "striker.velocity"),
+])
+def test_bad_input_is_one_line_and_exit_2(args, field):
+    r = subprocess.run([*RIG, "serve", "scope", *args, "--port", "0"] if "--port" not in args else
+                       [*RIG, "serve", "scope", *args], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 2, r.stdout + r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and field in lines[0], r.stderr
+    assert "Traceback" not in r.stderr
