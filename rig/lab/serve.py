@@ -102,25 +102,27 @@ class ScopeServer:
         self.stopped = threading.Event()
 
     def _open(self, s: ServeSettings) -> None:
-        sock = self._start(SocketServer(self.scope, s.host, s.port))
+        sock = self._start(SocketServer(self.scope, s.host, s.port), "raw socket")
         self.resources.append(f"TCPIP::{s.host}::{sock.port}::SOCKET")
         if s.hislip is not None:
-            hs = self._start(HislipServer(self.scope, s.host, s.hislip))
+            hs = self._start(HislipServer(self.scope, s.host, s.hislip), "HiSLIP")
             self.resources.append(f"TCPIP::{s.host}::hislip0,{hs.port}::INSTR")
         if s.vxi11:
-            vx = self._start(Vxi11Server(self.scope, s.host, 0))
+            vx = self._start(Vxi11Server(self.scope, s.host, 0), "VXI-11 core channel")
+            self.say(f"VXI-11 abort channel on {vx.host} port {vx.abort_port}")
             try:
                 self.say(f"VXI-11: {vx.announce()}")
             except InstrumentError as e:  # no portmapper: clients name the core port
                 self.say(f"VXI-11: {e}")
             self.resources.append(vx.resource)
         if s.rig_port is not None:
-            rp = self._start(SocketServer(self.scope.rig_port(), s.host, s.rig_port))
+            rp = self._start(SocketServer(self.scope.rig_port(), s.host, s.rig_port), "RIG: commands, raw socket")
             self.resources.append(f"TCPIP::{s.host}::{rp.port}::SOCKET (RIG: commands)")
 
-    def _start(self, server):
+    def _start(self, server, what: str):
         self.servers.append(server.start())
-        self.log.info("listening: %s on %s:%d", type(server).__name__, server.host, server.port)
+        self.say(f"{what} on {server.host} port {server.port}")
+        self.log.info("%s on %s port %d", what, server.host, server.port)
         return server
 
     def _record(self, shot: ShotRecord) -> None:
