@@ -6,8 +6,9 @@ The instrument answers ``*IDN?``; ``ECHO? <bytes>`` with the bytes; ``DATA? <n>`
 IEEE 488.2 definite-length block of n bytes (byte k is k mod 251); ``WAIT? <s>`` after s
 seconds, or at once when a device clear comes, with ``DONE``; ``SYST:ERR?`` with the oldest
 error (``-363`` input buffer overrun for a message dropped for its size, ``-113`` undefined
-header); ``COUNT? TRG|CLEAR`` with how many triggers and device clears it took. Its status byte has bit 2 (error queue not empty). One
-message is handled at a time, as on a real instrument."""
+header); ``COUNT? TRG|CLEAR`` with how many triggers and device clears it took. Its status
+byte has bit 2 (error queue not empty). One message is handled at a time, as on a real
+instrument."""
 from __future__ import annotations
 
 import fcntl

@@ -5,6 +5,7 @@ import threading
 import time
 
 import pytest
+from many_clients import talk_at_once
 from pyvisa.errors import VisaIOError
 
 from instruments.transports.hislip import HislipServer
@@ -108,17 +109,7 @@ def test_client_gone_mid_transfer_harms_nobody(rm, server, instrument, eventuall
 
 def test_sixteen_clients_at_once(rm, server):
     sessions = [open_socket(rm, server.port, timeout_ms=10000) for _ in range(16)]
-    results, start = {}, threading.Barrier(16)
-
-    def client(k):
-        start.wait()
-        results[k] = [sessions[k].query(f"ECHO? {k}-{i}") for i in range(25)]
-
-    threads = [threading.Thread(target=client, args=(k,)) for k in range(16)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join(30)
+    results = talk_at_once(sessions)
     assert server.clients == 16
     assert results == {k: [f"{k}-{i}" for i in range(25)] for k in range(16)}
 
