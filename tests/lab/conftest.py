@@ -19,10 +19,10 @@ import warnings
 from pathlib import Path
 
 import pytest
-from lab_scope import PulseSource, scene_scope, velocity_only
 
 from instruments.transports.device import InstrumentLock
 from instruments.virtual_scope.instrument import VirtualScope
+from lab.lab_scope import PulseSource, scene_scope, velocity_only
 
 IDN = b"RIG,TRANSPORT-TEST,0,1.0"
 EAV = 0x04

@@ -4,10 +4,10 @@ random arguments) never raise, never leave an internal fault, and *IDN? answers 
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from lab_scope import PulseSource, scene_scope, velocity_only
 
 from instruments.scpi.engine import INTERNAL
 from instruments.virtual_scope.instrument import VirtualScope
+from lab.lab_scope import PulseSource, scene_scope, velocity_only
 
 
 def patterns(node, prefix=()):

@@ -5,11 +5,11 @@ import threading
 import time
 
 import pytest
-from many_clients import talk_at_once
 from pyvisa.errors import VisaIOError
 
 from instruments.transports.hislip import HislipServer
 from instruments.transports.socket import MessageFramer, SocketServer
+from lab.many_clients import talk_at_once
 
 
 @pytest.fixture

@@ -3,10 +3,10 @@ snapped to the model's steps and handed to the rig as scene overrides, *RST, cha
 and off, the events of refused settings, no file commands."""
 import numpy as np
 import pytest
-from lab_scope import ask, fire, scene_scope
 
 from instruments.errors import InstrumentError
 from instruments.virtual_scope.instrument import VirtualScope
+from lab.lab_scope import ask, fire, scene_scope
 
 
 @pytest.mark.parametrize("personality, model, fields, yunit", [

@@ -6,10 +6,10 @@ import time
 
 import numpy as np
 import pytest
-from lab_scope import H, ask, fire, pulse
 
 from instruments.errors import InstrumentError
 from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
+from lab.lab_scope import H, ask, fire, pulse
 
 
 def wait_for(predicate, timeout=30.0):

@@ -3,10 +3,10 @@ record's codes and the preamble turns them into the record's volts and times, re
 a plain decoder here and by the rig's ISF reader from the scope's own header-on replies."""
 import numpy as np
 import pytest
-from lab_scope import ask, fire
 
 from instruments.formats.isf import read_isf
 from instruments.scpi.blocks import block_payload
+from lab.lab_scope import ask, fire
 
 ENCODINGS = ("ASCIi", "RIBinary", "RPBinary", "SRIbinary", "SRPbinary")
 

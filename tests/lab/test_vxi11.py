@@ -16,11 +16,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pyvisa_py.protocols import vxi11 as v
 from pyvisa_py.tcpip import Vxi11CoreClient
-from vxi11_instrument import IDN, EchoInstrument, block
 
 from instruments.errors import InstrumentError
 from instruments.transports import oncrpc, portmap
 from instruments.transports.vxi11 import DEVICE_CORE_PROG, Vxi11Server
+from lab.vxi11_instrument import IDN, EchoInstrument, block
 
 MAX_MESSAGE = 4096
 HOST = "127.0.0.1"
