@@ -1,0 +1,57 @@
+"""``rig serve scope`` with --fire on-command, the RIG: commands on a port of their own,
+--out and --log: an armed scope waits for RIG:FIRE, a setting made on the rig port is the
+next shot's, and every served shot is archived with its seed and settings and logged."""
+import json
+import subprocess
+import time
+
+import pytest
+
+from lab.test_serve import RIG, SCENE, Served, open_scope
+
+pyvisa = pytest.importorskip("pyvisa")
+
+SEED = 40
+
+
+@pytest.fixture(scope="module")
+def rm():
+    manager = pyvisa.ResourceManager("@py")
+    yield manager
+    manager.close()
+
+
+def test_on_command_the_rig_port_fires_and_every_shot_is_archived_and_logged(rm, tmp_path):
+    archive, log = tmp_path / "served.h5", tmp_path / "served.log"
+    s = Served(SCENE, "--port", "0", "--rig-port", "0", "--fire", "on-command", "--seed", str(SEED),
+               "--out", str(archive), "--log", str(log))
+    try:
+        scope_port, rig_port = s.resources[0], s.resource("RIG: commands").split(" ")[0]
+        scope, bench = open_scope(rm, scope_port), open_scope(rm, rig_port)
+        try:
+            bench.write("RIG:STRIKER:VELOCITY 0.92 m/s")
+            assert bench.query("RIG:STRIKER:VELOCITY?").strip() == '"0.92 m/s"'
+            bench.timeout = 2000
+            with pytest.raises(pyvisa.errors.VisaIOError):  # the rig's port answers no scope command
+                bench.query("CURVE?")
+            assert "-113" in bench.query("ALLEV?")
+            scope.write("ACQUIRE:STOPAFTER SEQUENCE;:ACQUIRE:STATE ON")
+            time.sleep(1.0)
+            assert scope.query("ACQUIRE:STATE?").strip() == "1"  # armed, waiting for the command
+            assert scope.query("ACQUIRE:NUMACQ?").strip() == "0"
+            bench.write("RIG:FIRE")
+            assert scope.query("*OPC?").strip() == "1"
+            assert scope.query("ACQUIRE:NUMACQ?").strip() == "1"
+        finally:
+            scope.close()
+            bench.close()
+    finally:
+        code, rest = s.stop()
+    assert code == 0, rest
+    rows = json.loads(subprocess.run([*RIG, "ls", str(archive), "--json"], capture_output=True, text=True,
+                                     check=True).stdout)
+    assert [r["seed"] for r in rows] == [SEED]
+    assert rows[0]["simulated"] and rows[0]["scene"] == SCENE
+    assert rows[0]["settings"]["velocity"] == pytest.approx(0.92)
+    text = log.read_text()
+    assert "raw socket on 127.0.0.1" in text and f"shot: seed {SEED}" in text and "striker.velocity=0.92 m/s" in text
