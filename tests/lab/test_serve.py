@@ -126,11 +126,18 @@ def test_a_bad_command_is_an_error_in_the_queue_and_the_server_answers_on(served
         scope.close()
 
 
-def test_sigterm_stops_it_cleanly():
-    s = Served(SCENE, "--port", "0", "--seed", "3", "--set", "striker.velocity=0.9 m/s")
+def test_sigterm_stops_it_cleanly_and_out_has_archived_the_warm_up_shot(tmp_path):
+    from instruments.archive import Archive
+
+    archive = tmp_path / "served.h5"
+    s = Served(SCENE, "--port", "0", "--seed", "3", "--set", "striker.velocity=0.9 m/s", "--out", str(archive))
     code, rest = s.stop()
     assert code == 0, rest
     assert rest.strip().endswith("stopped")
+    (number,) = Archive(archive).ids()  # the first shot, fired before the ports opened
+    entry = Archive(archive).read(number)
+    assert entry.seed == 3 and entry.record["CH1"].codes.size == 2500
+    assert "striker.velocity=0.9 m/s" in entry.settings["overrides"]
 
 
 @pytest.mark.parametrize("args, field", [
