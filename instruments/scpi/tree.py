@@ -4,7 +4,9 @@ A pattern is mnemonics joined by ``:``, each written as the programmer manuals p
 the short form in upper case, the rest of the long form in lower case (``DATa:ENCdg``
 matches DAT:ENC, DATA:ENCDG, data:encdg). A mnemonic ending in ``<n>`` takes a numeric
 suffix (``CH<n>``: CH1 .. CH4; a missing suffix is 1, SCPI 1999 6.2.5). Common commands
-are registered as ``*IDN`` and so on."""
+are registered as ``*IDN`` and so on. A tree made with ``truncation=True`` also takes any
+spelling between the two forms (DATA:SOUR for DATa:SOUrce), as Tektronix scopes do and
+their own example scripts rely on; an exact form is preferred where both could match."""
 from __future__ import annotations
 
 import re
@@ -32,15 +34,20 @@ class Mnemonic:
     def short(self) -> str:
         return "".join(c for c in self.spec.removesuffix("<n>") if not c.islower())
 
-    def match(self, token: str):
+    def match(self, token: str, truncated: bool = False):
         """The suffix (int, or None for an unnumbered node) when token names this node,
-        else False."""
+        else False; ``truncated``: a spelling between the short and the long form names it."""
         if not self.numbered:
-            return None if token in (self.long, self.short) else False
+            return None if self.spelled(token, truncated) else False
         m = SUFFIX.match(token)
-        if not m or m.group(1) not in (self.long, self.short):
+        if not m or not self.spelled(m.group(1), truncated):
             return False
         return int(m.group(2)) if m.group(2) else 1
+
+    def spelled(self, word: str, truncated: bool) -> bool:
+        """Whether ``word`` is the short or the long form (or, truncated, one between)."""
+        return word in (self.long, self.short) or (
+            truncated and word.startswith(self.short) and self.long.startswith(word))
 
     def form(self, verbose: bool, suffix) -> str:
         """The node in a reply header: long or short, with its suffix."""
@@ -80,8 +87,9 @@ class Found:
 class CommandTree:
     """The command tree of an instrument."""
 
-    def __init__(self) -> None:
+    def __init__(self, *, truncation: bool = False) -> None:
         self.root = Node(Mnemonic(""))
+        self.truncation = truncation
 
     def add(self, pattern: str, *, write=None, read=None, bare=False) -> None:
         """Register a pattern's handlers (ValueError for a pattern given twice)."""
@@ -100,13 +108,19 @@ class CommandTree:
         """The command a header's mnemonics (upper case) name, or None."""
         node, nodes, suffixes = self.root, [], []
         for token in tokens:
-            for child in node.children:
-                suffix = child.mnemonic.match(token)
-                if suffix is not False:
-                    node = child
-                    nodes.append(child.mnemonic)
-                    suffixes.append(suffix)
-                    break
-            else:
+            node, suffix = self._child(node, token)
+            if node is None:
                 return None
+            nodes.append(node.mnemonic)
+            suffixes.append(suffix)
         return Found(node.command, tuple(nodes), tuple(suffixes)) if node.command else None
+
+    def _child(self, node: Node, token: str) -> tuple:
+        """(the child of ``node`` that ``token`` names, its suffix), or (None, False);
+        an exact form first, then (``truncation``) a spelling between the forms."""
+        for truncated in (False, True) if self.truncation else (False,):
+            for child in node.children:
+                suffix = child.mnemonic.match(token, truncated)
+                if suffix is not False:
+                    return child, suffix
+        return None, False

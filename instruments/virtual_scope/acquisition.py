@@ -115,24 +115,47 @@ class Acquisition:
             self.cond.wait(self.next_tick - now if armed else None)
         return False
 
+    def first_acquisition(self) -> Shot:
+        """Fire one shot now in the caller's thread, before any client is served: the record
+        a scope holds from power-on, so that ``CURVe?`` answers before a client fires. It is
+        the first shot (seed N, counted, ``on_shot`` called); InstrumentError with the
+        rig's reason when it fails (one that does not trigger is kept, as later ones)."""
+        with self.cond:
+            overrides, seed = self._take_seed()
+        shot, error = self._shoot(overrides, seed)
+        if shot is None:
+            raise InstrumentError(f"the first shot, at seed {seed}: {error}")
+        return shot
+
+    def _take_seed(self) -> tuple:
+        """(overrides, seed) of the shot that starts now (holding ``cond``)."""
+        overrides, seed = dict(self.snapshot()), self.next_seed
+        self.next_seed += 1
+        self.busy = True
+        return overrides, seed
+
     def _work(self) -> None:
         while True:
             with self.cond:
                 if not self._wait_for_a_shot():
                     return
-                overrides, seed = dict(self.snapshot()), self.next_seed
-                self.next_seed += 1
-                self.busy = True
-            record, error = self._fire(overrides, seed)
-            shot = None if record is None else Shot(overrides, seed, record)
-            with self.cond:
-                self._finish(shot, seed, error)
-            if shot is not None and self.on_shot is not None:
-                try:
-                    self.on_shot(shot)
-                except Exception as e:  # noqa: BLE001 - the instrument keeps serving; the client is told
-                    with self.cond:
-                        self.post(-200, f"the shot of seed {seed} was not kept: {type(e).__name__}: {e}")
+                overrides, seed = self._take_seed()
+            self._shoot(overrides, seed)
+
+    def _shoot(self, overrides: dict, seed: int) -> tuple:
+        """Fire the shot, keep it as the last record, tell ``on_shot``: (Shot, None), or
+        (None, the reason) when it failed."""
+        record, error = self._fire(overrides, seed)
+        shot = None if record is None else Shot(overrides, seed, record)
+        with self.cond:
+            self._finish(shot, seed, error)
+        if shot is not None and self.on_shot is not None:
+            try:
+                self.on_shot(shot)
+            except Exception as e:  # noqa: BLE001 - the instrument keeps serving; the client is told
+                with self.cond:
+                    self.post(-200, f"the shot of seed {seed} was not kept: {type(e).__name__}: {e}")
+        return shot, error
 
     def _fire(self, overrides: dict, seed: int):
         try:

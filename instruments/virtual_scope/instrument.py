@@ -64,7 +64,7 @@ class VirtualScope:
                                seed, on_shot, period_s=fire_period_s, on_command=on_command)
         with self.cond:
             self.reset()
-        tree, rig_tree = CommandTree(), CommandTree()
+        tree, rig_tree = CommandTree(truncation=True), CommandTree(truncation=True)  # DATA:SOUR as on a Tek
         for t in (tree, rig_tree):
             common.register(t, self)
             rig_commands.register(t, self)

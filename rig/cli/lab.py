@@ -32,7 +32,8 @@ def add_parsers(sub, command) -> None:
     sc.add_argument("--fire", default="on-arm", metavar="on-arm|on-command|every=SECONDS",
                     help="when a shot is fired: on-arm (ACQuire:STATE ON; default), on-command (armed, the shot "
                          "waits for TRIGger FORCe, *TRG or RIG:FIRE), every=SECONDS (armed, a shot every SECONDS)")
-    sc.add_argument("--seed", type=seed_arg, help="the first shot's seed; the k-th shot uses SEED+k-1 "
+    sc.add_argument("--seed", type=seed_arg, help="the first shot's seed (the warm-up shot, which the scope "
+                                                  "holds as its first record); the k-th shot uses SEED+k-1 "
                                                   "(default: a fresh one, printed)")
     sc.add_argument("--rig-port", type=port_arg, metavar="PORT",
                     help="serve the RIG: commands (striker, magnet, seed, fire) alone on PORT too (0: a free one)")

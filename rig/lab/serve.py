@@ -3,9 +3,12 @@
 The scope (``instruments.virtual_scope.VirtualScope``) is served on a raw socket (always),
 on HiSLIP and VXI-11 when asked, and its RIG: commands alone on a port of their own when
 asked; every transport serves the one instrument. Before any port opens, one warm-up shot
-is fired (kept nowhere), so that no client waits for numba to compile. Shots are the
-scene's (``rig.lab.shots.SceneShots``): the k-th one is fired at seed N + k - 1 and its
-record has the bits of ``rig shot SCENE --set ... --seed N+k-1``; ``--out`` archives each.
+is fired, so that no client waits for numba to compile: it is the scope's first
+acquisition (seed N, with the settings the scope starts with), the record that ``CURVe?``
+answers with before a client fires, as a real scope holds one from power-on. Shots are the
+scene's (``rig.lab.shots.SceneShots``): the k-th one, the warm-up shot the first, is fired
+at seed N + k - 1 and its record has the bits of ``rig shot SCENE --set ... --seed N+k-1``;
+``--out`` archives each.
 """
 from __future__ import annotations
 
@@ -81,10 +84,7 @@ class ScopeServer:
         self.settings, self.say = s, say
         self.seed = fresh_seed() if s.seed is None else s.seed
         self.log = _logger(s.log)
-        self.shots = SceneShots(s.scene, s.overrides)
-        say(f"warm-up shot of {s.scene} (compiles what the shots need)")
-        self.shots({}, self.seed)  # kept nowhere: the served shots start at seed N
-        self.shots.on_shot = self._record
+        self.shots = SceneShots(s.scene, s.overrides, on_shot=self._record)
         try:
             self.scope = VirtualScope(self.shots.rig().scope, self.shots, personality_name=s.personality,
                                       idn=s.idn, seed=self.seed, validate=self.shots.validate,
@@ -92,9 +92,12 @@ class ScopeServer:
                                       on_command=s.fire == "on-command")
         except InstrumentError as e:
             raise invalid("--personality", s.personality, str(e)) from None
+        say(f"warm-up shot of {s.scene} at seed {self.seed}, the scope's first acquisition "
+            "(compiles what the shots need)")
         self.servers: list = []
         self.resources: list[str] = []
         try:
+            self.scope.acq.first_acquisition()  # InstrumentError: the rig refuses the scope's settings
             self._open(s)
         except BaseException:
             self.close()
@@ -144,10 +147,12 @@ class ScopeServer:
         self.stopped.set()
 
     def close(self) -> None:
-        """Close every transport (their clients see the connection end) and the log."""
+        """Close every transport (their clients see the connection end), the scope's
+        acquisition and the log."""
         for server in reversed(self.servers):
             server.close()
         self.servers.clear()
+        self.scope.close()
         for handler in list(self.log.handlers):
             handler.close()
             self.log.removeHandler(handler)

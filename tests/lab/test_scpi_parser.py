@@ -92,3 +92,18 @@ def test_mnemonics_match_their_short_and_long_forms_only():
     assert found.header(True) == ":MEASUREMENT:MEAS2:VALUE" and found.header(False) == ":MEASU:MEAS2:VAL"
     with pytest.raises(ValueError):
         tree.add("measurement:meas<n>:value", read=lambda c: None)
+
+
+def test_a_truncating_tree_takes_every_spelling_between_the_forms_and_prefers_an_exact_one():
+    strict, tek = CommandTree(), CommandTree(truncation=True)
+    for tree in (strict, tek):
+        tree.add("DATa:SOUrce", read=lambda c: "source")
+        tree.add("DATa:SOUrcex", read=lambda c: "other")  # a sibling the truncation of the first could name
+        tree.add("CH<n>:SCAle", read=lambda c: None)
+    assert strict.find(("DATA", "SOUR")) is None
+    for spelling in ("SOU", "SOUR", "SOURC", "SOURCE"):
+        assert tek.find(("DATA", spelling)).header(True) == ":DATA:SOURCE"
+    assert tek.find(("DATA", "SOURCEX")).header(True) == ":DATA:SOURCEX"
+    assert tek.find(("DA", "SOURCE")) is None and tek.find(("DATA", "SOURCEXY")) is None
+    assert tek.find(("DATA", "SO")) is None and tek.find(("DATA", "SOUX")) is None
+    assert tek.find(("CH2", "SCAL")).suffixes == (2, None)

@@ -1,10 +1,7 @@
 """``rig serve scope`` end to end: the command a lab runs, real VISA clients (pyvisa with
 pyvisa-py) on each transport, the records compared bit for bit with ``rig shot`` at the
 same settings and seed, SIGTERM ending it cleanly, bad input refused in one line."""
-import os
-import signal
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -12,36 +9,12 @@ import pytest
 
 pyvisa = pytest.importorskip("pyvisa")
 
-from instruments.formats import read_waveforms  # noqa: E402
+from served import RIG, Served, open_scope
+
+from instruments.formats import read_waveforms
 
 SCENE = "ptfe52_magnetic"
 FIRST_SEED = 11
-RIG = [sys.executable, "-m", "rig.cli"]
-READY_S = 300  # the warm-up shot compiles the kernels on a cold cache
-
-
-class Served:
-    """A ``rig serve scope`` process: its resources (from the "listening" line) and output."""
-
-    def __init__(self, *args: str):
-        self.proc = subprocess.Popen([*RIG, "serve", "scope", *args], stdout=subprocess.PIPE,
-                                     stderr=subprocess.STDOUT, text=True, env=os.environ | {"PYTHONUNBUFFERED": "1"})
-        self.lines = []
-        for line in self.proc.stdout:
-            self.lines.append(line.rstrip("\n"))
-            if line.startswith("listening"):
-                break
-        else:
-            raise AssertionError("rig serve ended before listening:\n" + "\n".join(self.lines))
-        self.resources = self.lines[-1].split(": ", 1)[1].split("  ")
-
-    def resource(self, kind: str) -> str:
-        return next(r for r in self.resources if kind in r)
-
-    def stop(self) -> tuple:
-        self.proc.send_signal(signal.SIGTERM)
-        rest, _ = self.proc.communicate(timeout=30)
-        return self.proc.returncode, rest
 
 
 @pytest.fixture(scope="module")
@@ -57,13 +30,6 @@ def rm():
     manager = pyvisa.ResourceManager("@py")
     yield manager
     manager.close()
-
-
-def open_scope(rm, resource: str):
-    inst = rm.open_resource(resource, timeout=60_000)
-    if resource.endswith("SOCKET"):
-        inst.read_termination = inst.write_termination = "\n"
-    return inst
 
 
 def shot_codes(rm, resource: str, channel: str = "CH1") -> tuple:
@@ -99,6 +65,25 @@ def test_it_says_where_it_listens_on_loopback(served):
     assert served.resources[0].startswith("TCPIP::127.0.0.1::") and served.resources[0].endswith("::SOCKET")
     assert any("::hislip0," in r for r in served.resources)
     assert "TCPIP::127.0.0.1::INSTR" in served.resources  # VXI-11, found through port 111
+
+
+def test_before_any_client_fires_the_scope_holds_the_warm_up_shot_at_the_first_seed(served, rm, tmp_path):
+    """A script that only fetches (CURVe? with no acquisition of its own, as real scopes
+    allow) gets the warm-up shot: the first shot, seed N, the rig shot of the settings the
+    scope started with; the next shot takes seed N + 1."""
+    scope = open_scope(rm, served.resource("SOCKET"))
+    try:
+        scope.write("*CLS;:HEADER OFF")
+        assert scope.query("ACQUIRE:NUMACQ?").strip() == "1"
+        assert int(scope.query("RIG:SEED?")) == FIRST_SEED + 1
+        overrides = [o for o in scope.query("RIG:OVERRIDES?").strip().strip('"').split(",") if o]
+        scope.write("DATA:SOURCE CH1;:DATA:ENCDG RIBINARY;:DATA:WIDTH 1;:DATA:START 1;:DATA:STOP 2500")
+        codes = scope.query_binary_values("CURVE?", datatype="b", container=np.array, is_big_endian=True)
+        assert scope.query("ALLEV?").strip().startswith("0,")  # nothing refused, no shot failed
+    finally:
+        scope.close()
+    assert codes.size == 2500
+    assert np.array_equal(codes, rig_shot_codes(tmp_path, overrides, FIRST_SEED))
 
 
 @pytest.mark.parametrize("kind", ["SOCKET", "hislip0", "127.0.0.1::INSTR"])
@@ -141,11 +126,18 @@ def test_a_bad_command_is_an_error_in_the_queue_and_the_server_answers_on(served
         scope.close()
 
 
-def test_sigterm_stops_it_cleanly():
-    s = Served(SCENE, "--port", "0", "--seed", "3", "--set", "striker.velocity=0.9 m/s")
+def test_sigterm_stops_it_cleanly_and_out_has_archived_the_warm_up_shot(tmp_path):
+    from instruments.archive import Archive
+
+    archive = tmp_path / "served.h5"
+    s = Served(SCENE, "--port", "0", "--seed", "3", "--set", "striker.velocity=0.9 m/s", "--out", str(archive))
     code, rest = s.stop()
     assert code == 0, rest
     assert rest.strip().endswith("stopped")
+    (number,) = Archive(archive).ids()  # the first shot, fired before the ports opened
+    entry = Archive(archive).read(number)
+    assert entry.seed == 3 and entry.record["CH1"].codes.size == 2500
+    assert "striker.velocity=0.9 m/s" in entry.settings["overrides"]
 
 
 @pytest.mark.parametrize("args, field", [
@@ -157,7 +149,7 @@ def test_sigterm_stops_it_cleanly():
 ])
 def test_bad_input_is_one_line_and_exit_2(args, field):
     r = subprocess.run([*RIG, "serve", "scope", *args, "--port", "0"] if "--port" not in args else
-                       [*RIG, "serve", "scope", *args], capture_output=True, text=True, timeout=300)
+                       [*RIG, "serve", "scope", *args], check=False, capture_output=True, text=True, timeout=300)
     assert r.returncode == 2, r.stdout + r.stderr
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and field in lines[0], r.stderr

@@ -33,6 +33,17 @@ def test_tds_wfid_and_numbers_are_in_the_tek_form(make_scope):
     assert ask(s, "WFMPRE:XINCR?;YMULT?;YZERO?") == "2.0E-7;2.0E-3;0.0E0"
 
 
+def test_headers_spelled_between_short_and_long_as_tek_scripts_send_them(make_scope):
+    """Tektronix's 5K/7K/70K fetch example sends DATA:SOUR and WFMO:NR_P?; a spelling
+    past the long form or off it stays an undefined header."""
+    _scope, s, _ = make_scope("mso4")
+    s.handle(b"DATA:SOUR CH2;:HORIZ:RECORDL 1000")
+    assert ask(s, "DATA:SOURC?;:WFMO:NR_P?;:HORIZONTAL:RECO?") == "CH2;1000;1000"
+    s.handle(b"DATA:SOURCES CH1;:DATA:SOR CH1")
+    assert ask(s, "DATA:SOURCE?") == "CH2"
+    assert ask(s, "ALLEV?").count("-113") == 2
+
+
 def test_idn_text_overrides_and_is_checked(make_scope):
     _scope, s, _ = make_scope("mso4", idn="TEKTRONIX,MSO46,X1,FV:1.0")
     assert ask(s, "*IDN?") == "TEKTRONIX,MSO46,X1,FV:1.0"

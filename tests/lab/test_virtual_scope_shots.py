@@ -208,3 +208,37 @@ def test_sixteen_clients_at_once_during_shots(make_scope):
     assert failures == [] and scope.acq.count >= 1
     assert [seed for _, seed in source.calls] == list(range(len(source.calls)))
     assert ask(s, "ALLEV?") == '0,"No events to report - queue empty"'
+
+
+def test_the_first_acquisition_is_the_first_shot_and_what_curve_answers_before_any_client_fires(make_scope):
+    scope, s, source = make_scope("mso4", seed=7)
+    kept = []
+    scope.acq.on_shot = kept.append
+    assert s.handle(b"CURVE?") == b""  # before it: an execution error, no record yet
+    assert ask(s, "EVENT?") == "-200"
+    shot = scope.acq.first_acquisition()
+    assert (shot.seed, scope.acq.count, kept) == (7, 1, [shot])
+    assert source.calls == [(scope.overrides(), 7)]  # the settings the scope starts with
+    assert ask(s, "RIG:SEED?;:ACQUIRE:NUMACQ?;:ACQUIRE:STATE?;:BUSY?") == "8;1;0;0"
+    s.handle(b"DATA:SOURCE CH1;:DATA:ENCDG ASCII;:DATA:START 1;:DATA:STOP 100000")
+    codes = np.array(ask(s, "CURVE?").split(","), dtype=int)
+    assert np.array_equal(codes, shot.record["CH1"].codes) and ask(s, "EVENT?") == "0"
+    fire(s)
+    assert scope.acq.last.seed == 8
+
+
+def test_a_first_acquisition_the_rig_refuses_is_one_line_and_takes_no_seed():
+    from lab_scope import scene_scope
+
+    from instruments.virtual_scope.instrument import VirtualScope
+
+    def refusing(overrides, seed):
+        raise InstrumentError("striker.velocity = '9 m/s': at most 5 m/s")
+
+    scope = VirtualScope(scene_scope(), refusing, personality_name="mso4", seed=4)
+    try:
+        with pytest.raises(InstrumentError, match=r"^the first shot, at seed 4: striker.velocity = '9 m/s'"):
+            scope.acq.first_acquisition()
+        assert scope.acq.next_seed == 4 and scope.acq.last is None and scope.acq.count == 0
+    finally:
+        scope.close()
