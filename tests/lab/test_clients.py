@@ -18,8 +18,7 @@ import pytest
 
 pyvisa = pytest.importorskip("pyvisa")
 
-from served import Served, Tap, open_scope
-
+from lab.served import Served, Tap, open_scope
 from rig.lab.shots import SceneShots
 
 SCENE = "ptfe52_magnetic"

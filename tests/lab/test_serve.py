@@ -9,9 +9,8 @@ import pytest
 
 pyvisa = pytest.importorskip("pyvisa")
 
-from served import RIG, Served, open_scope
-
 from instruments.formats import read_waveforms
+from lab.served import RIG, Served, open_scope
 
 SCENE = "ptfe52_magnetic"
 FIRST_SEED = 11

@@ -1,13 +1,14 @@
 """``rig serve scope`` with --fire on-command, the RIG: commands on a port of their own,
 --out and --log: an armed scope waits for RIG:FIRE, a setting made on the rig port is the
-next shot's, and every served shot is archived with its seed and settings and logged."""
+next shot's, and every served shot (the warm-up shot first) is archived with its seed and settings and logged."""
 import json
 import subprocess
 import time
 
 import pytest
 
-from lab.test_serve import RIG, SCENE, Served, open_scope
+from lab.served import RIG, Served, open_scope
+from lab.test_serve import SCENE
 
 pyvisa = pytest.importorskip("pyvisa")
 
@@ -38,10 +39,10 @@ def test_on_command_the_rig_port_fires_and_every_shot_is_archived_and_logged(rm,
             scope.write("ACQUIRE:STOPAFTER SEQUENCE;:ACQUIRE:STATE ON")
             time.sleep(1.0)
             assert scope.query("ACQUIRE:STATE?").strip() == "1"  # armed, waiting for the command
-            assert scope.query("ACQUIRE:NUMACQ?").strip() == "0"
+            assert scope.query("ACQUIRE:NUMACQ?").strip() == "1"  # the warm-up shot only
             bench.write("RIG:FIRE")
             assert scope.query("*OPC?").strip() == "1"
-            assert scope.query("ACQUIRE:NUMACQ?").strip() == "1"
+            assert scope.query("ACQUIRE:NUMACQ?").strip() == "2"
         finally:
             scope.close()
             bench.close()
@@ -50,8 +51,10 @@ def test_on_command_the_rig_port_fires_and_every_shot_is_archived_and_logged(rm,
     assert code == 0, rest
     rows = json.loads(subprocess.run([*RIG, "ls", str(archive), "--json"], capture_output=True, text=True,
                                      check=True).stdout)
-    assert [r["seed"] for r in rows] == [SEED]
-    assert rows[0]["simulated"] and rows[0]["scene"] == SCENE
-    assert rows[0]["settings"]["velocity"] == pytest.approx(0.92)
+    assert [r["seed"] for r in rows] == [SEED, SEED + 1]  # the warm-up shot, at the scene's settings, then ours
+    assert all(r["simulated"] and r["scene"] == SCENE for r in rows)
+    assert rows[0]["settings"]["velocity"] == pytest.approx(0.89)
+    assert rows[1]["settings"]["velocity"] == pytest.approx(0.92)
     text = log.read_text()
-    assert "raw socket on 127.0.0.1" in text and f"shot: seed {SEED}" in text and "striker.velocity=0.92 m/s" in text
+    assert "raw socket on 127.0.0.1" in text and f"shot: seed {SEED + 1}" in text
+    assert "striker.velocity=0.92 m/s" in text

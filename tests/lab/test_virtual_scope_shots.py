@@ -228,7 +228,7 @@ def test_the_first_acquisition_is_the_first_shot_and_what_curve_answers_before_a
 
 
 def test_a_first_acquisition_the_rig_refuses_is_one_line_and_takes_no_seed():
-    from lab_scope import scene_scope
+    from lab.lab_scope import scene_scope
 
     from instruments.virtual_scope.instrument import VirtualScope
 
