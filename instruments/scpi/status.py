@@ -28,6 +28,7 @@ MESSAGES = {
     2244: "Source waveform is not active",
 }
 QUEUE_SIZE = 32  # events kept; a Tek scope keeps 20 to 32
+DETAIL_CHARS = 1000  # an event's detail is kept whole to this length (the rig's refusals run to ~300 characters)
 
 
 class ScpiError(Exception):
@@ -85,7 +86,7 @@ class StatusModel:
         elif len(self.events) == self.capacity - 1:
             self.events.append(Event(-350))
         else:
-            self.events.append(Event(code, detail[:200]))
+            self.events.append(Event(code, detail[:DETAIL_CHARS]))
 
     def next_event(self) -> Event:
         """The oldest event, removed (``Event(0)`` when none)."""

@@ -57,6 +57,7 @@ class Acquisition:
         self.opc_armed = False
         self.count = 0
         self.last: Shot | None = None
+        self.failure: str | None = None  # why the last shot failed (its record is gone), None after a good one
         self.closed = False
         self.thread = threading.Thread(target=self._work, name="scope-shots", daemon=True)
         self.thread.start()
@@ -167,13 +168,14 @@ class Acquisition:
 
     def _finish(self, shot: Shot | None, seed: int, error: str | None) -> None:
         self.busy = False
-        if shot is None:
+        if shot is None:  # no stale record may pass for this shot's: the last one is dropped
             self.post(-200, error)
+            self.last, self.failure = None, error
             if self.next_seed == seed + 1:
                 self.next_seed = seed  # a refused shot takes no seed
             self.running = False
         else:
-            self.last, self.count = shot, self.count + 1
+            self.last, self.failure, self.count = shot, None, self.count + 1
             if not shot.record.triggered:
                 self.post(-200, f"the shot of seed {seed} did not trigger: {shot.record.reason}")
         if self.stop_after == "SEQuence":

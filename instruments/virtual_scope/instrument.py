@@ -40,18 +40,22 @@ class VirtualScope:
     max_message_bytes (program message), max_reply_bytes (one message's replies),
     max_record_length (points); opc_timeout_s: the longest *OPC? wait; fire_period_s /
     on_command: how an armed scope gets shots (acquisition.py): every so many seconds, or
-    only from TRIGger FORCe, *TRG and RIG:FIRE; neither: at once."""
+    only from TRIGger FORCe, *TRG and RIG:FIRE; neither: at once. rig_scene: the scene's
+    values of the RIG: settings as text ({"striker.velocity": "0.89 m/s", ...}), what their
+    queries answer until a client sets them."""
 
     def __init__(self, scope: Oscilloscope, shot_source: ShotSource, *, personality_name: str = "tds2000",
                  idn: str | None = None, seed: int = 0, validate: Validate | None = None, on_shot=None,
                  scene_name: str = "", max_message_bytes: int = 1 << 20, max_reply_bytes: int = 64 << 20,
                  max_record_length: int = 1_000_000, opc_timeout_s: float = 600.0,
-                 fire_period_s: float | None = None, on_command: bool = False) -> None:
+                 fire_period_s: float | None = None, on_command: bool = False,
+                 rig_scene: dict | None = None) -> None:
         if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 63:
             raise InstrumentError(f"seed = {seed!r}: a whole number from 0 to 2^63 - 1")
         self.scene, self.scene_name = scope, scene_name
         self.personality = personality(personality_name, idn)
         self.validate = validate or (lambda key, text: None)
+        self.rig_scene = dict(rig_scene or {})
         self.max_message_bytes, self.max_reply_bytes = max_message_bytes, max_reply_bytes
         self.max_record_length, self.opc_timeout_s = max_record_length, opc_timeout_s
         self.lock = InstrumentLock()

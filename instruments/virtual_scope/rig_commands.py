@@ -30,7 +30,7 @@ def register(tree, scope) -> None:
         return write
 
     def reader(key: str):
-        return lambda c: _quoted(scope.rig_values.get(key, "scene"))
+        return lambda c: _quoted(scope.rig_values.get(key, scope.rig_scene.get(key, "not set in the scene")))
 
     def set_seed(c: Call):
         seed = c.number()

@@ -78,6 +78,9 @@ def register(tree, scope) -> None:
 
     def curve(c: Call) -> bytes:
         codes, _, _ = source_waveform(scope, scope.data.source, c.header)
+        if codes is None and scope.acq.failure:
+            raise ScpiError(-200, f"{scope.data.source} has no record: the last shot failed ({scope.acq.failure}); "
+                                  f"{c.header}")
         if codes is None:
             raise ScpiError(-200, f"{scope.data.source} has no record yet; fire a shot (ACQuire:STATE ON, "
                                   f"TRIGger FORCe or RIG:FIRE); {c.header}")

@@ -230,23 +230,24 @@ def main(argv=None) -> int:
 
 def _run(argv) -> int:
     args, extra = build_parser().parse_known_args(argv)
+    command = f"{args.command} {args.what}" if args.command == "serve" else args.command  # as argparse names it
     if extra:  # named by the command's parser, not the top one's ("rig: error:")
-        return _fail(args.command, f"unrecognized arguments: {' '.join(extra)} (see rig {args.command} --help)")
+        return _fail(command, f"unrecognized arguments: {' '.join(extra)} (see rig {command} --help)")
     try:
         out = args.func(args)
     except BrokenPipeError:
         raise
     except Interrupted as exc:  # Ctrl-C, with what the run kept
-        _fail(args.command, str(exc))
+        _fail(command, str(exc))
         return 130
     except (RigError, InstrumentError) as exc:
-        return _fail(args.command, str(exc))
+        return _fail(command, str(exc))
     except OSError as exc:
-        return _fail(args.command, os_error_line(exc))
+        return _fail(command, os_error_line(exc))
     except MemoryError:
-        return _fail(args.command, "out of memory: choose a shorter duration, fewer beads or fewer points")
+        return _fail(command, "out of memory: choose a shorter duration, fewer beads or fewer points")
     except KeyboardInterrupt:
-        _fail(args.command, "interrupted")
+        _fail(command, "interrupted")
         return 130
     if args.json:
         print(json.dumps(out, indent=2))

@@ -12,7 +12,9 @@ at seed N + k - 1 and its record has the bits of ``rig shot SCENE --set ... --se
 """
 from __future__ import annotations
 
+import errno
 import logging
+import os
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -66,6 +68,18 @@ def fire_period(text: str) -> float | None:
     return period
 
 
+def rig_scene(shots: SceneShots) -> dict:
+    """The scene's values of the settings the RIG: commands change, as text with units."""
+    values = shots.loaded.values
+    out = {}
+    for key, unit in (("striker.velocity", "m/s"), ("magnet.force", "N"), ("magnet.position", "m")):
+        table, name = key.split(".")
+        value = values.get(table, {}).get(name)
+        if value is not None:
+            out[key] = f"{value:g} {unit}"
+    return out
+
+
 def _port(name: str, port: int | None) -> None:
     if port is not None and not 0 <= port <= 65535:
         raise invalid(name, port, "a TCP port 0..65535 (0: a free one)")
@@ -89,9 +103,9 @@ class ScopeServer:
             self.scope = VirtualScope(self.shots.rig().scope, self.shots, personality_name=s.personality,
                                       idn=s.idn, seed=self.seed, validate=self.shots.validate,
                                       scene_name=str(s.scene), fire_period_s=period,
-                                      on_command=s.fire == "on-command")
-        except InstrumentError as e:
-            raise invalid("--personality", s.personality, str(e)) from None
+                                      on_command=s.fire == "on-command", rig_scene=rig_scene(self.shots))
+        except InstrumentError as e:  # it names the setting (the personality's or --idn's)
+            raise invalid("rig serve scope", s.scene, str(e)) from None
         say(f"warm-up shot of {s.scene} at seed {self.seed}, the scope's first acquisition "
             "(compiles what the shots need)")
         self.servers: list = []
@@ -105,24 +119,37 @@ class ScopeServer:
         self.stopped = threading.Event()
 
     def _open(self, s: ServeSettings) -> None:
-        sock = self._start(SocketServer(self.scope, s.host, s.port), "raw socket")
+        sock = self._start(lambda: SocketServer(self.scope, s.host, s.port), "raw socket", "--port", s.port)
         self.resources.append(f"TCPIP::{s.host}::{sock.port}::SOCKET")
         if s.hislip is not None:
-            hs = self._start(HislipServer(self.scope, s.host, s.hislip), "HiSLIP")
+            hs = self._start(lambda: HislipServer(self.scope, s.host, s.hislip), "HiSLIP", "--hislip", s.hislip)
             self.resources.append(f"TCPIP::{s.host}::hislip0,{hs.port}::INSTR")
         if s.vxi11:
-            vx = self._start(Vxi11Server(self.scope, s.host, 0), "VXI-11 core channel")
+            vx = self._start(lambda: Vxi11Server(self.scope, s.host, 0), "VXI-11 core channel", "--host", s.host)
             self.say(f"VXI-11 abort channel on {vx.host} port {vx.abort_port}")
             try:
                 self.say(f"VXI-11: {vx.announce()}")
             except InstrumentError as e:  # no portmapper: clients name the core port
                 self.say(f"VXI-11: {e}")
             self.resources.append(vx.resource)
+            if vx.resource != f"TCPIP::{s.host},{vx.port}::INSTR":  # the core port named: no portmapper asked
+                self.resources.append(f"TCPIP::{s.host},{vx.port}::INSTR")
         if s.rig_port is not None:
-            rp = self._start(SocketServer(self.scope.rig_port(), s.host, s.rig_port), "RIG: commands, raw socket")
+            rp = self._start(lambda: SocketServer(self.scope.rig_port(), s.host, s.rig_port),
+                             "RIG: commands, raw socket", "--rig-port", s.rig_port)
             self.resources.append(f"TCPIP::{s.host}::{rp.port}::SOCKET (RIG: commands)")
 
-    def _start(self, server, what: str):
+    def _start(self, make, what: str, option: str, port: int):
+        """Start the server ``make()`` builds; a port it cannot take is one line naming the
+        option."""
+        try:
+            server = make()
+        except OSError as e:
+            why = os.strerror(e.errno) if e.errno else str(e)
+            if e.errno == errno.EADDRNOTAVAIL:  # no interface of this machine has that address
+                raise invalid("--host", self.settings.host, f"an address of this machine ({why}); "
+                              "127.0.0.1 (loopback) unless clients elsewhere must reach it") from None
+            raise invalid(option, port, f"a port free on {self.settings.host} ({why}), or 0 for any") from None
         self.servers.append(server.start())
         self.say(f"{what} on {server.host} port {server.port}")
         self.log.info("%s on %s port %d", what, server.host, server.port)

