@@ -102,13 +102,13 @@ def thread_rate(study: Study, threads: int) -> float:
     return study.batch / statistics.median(wall)
 
 
-def run(vary: tuple, batch: int, cores: int | None = None) -> dict:
-    """The scaling table's figures: {mode: {N: {"shots_per_s", "efficiency", ...}}}, the
-    counts, the batch size and one batch result's pickled bytes per shot."""
+def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
+    """The scaling table's figures at the worker counts ``ns`` (default: 1, 2, 4, ... up to
+    the machine's cores): {mode: {N: {"shots_per_s", "efficiency_vs_2", ...}}}, the counts,
+    the batch size and one batch result's pickled bytes per shot."""
     import numba
 
-    cores = cores or os.cpu_count() or 1
-    ns = counts(cores)
+    ns = sorted(ns or counts(os.cpu_count() or 1))
     try:
         import dask.distributed  # noqa: F401
         modes = list(MODES)
