@@ -139,8 +139,8 @@ def _efficiency(by_n: dict, n: int, base: int):
 
 def table(r: dict) -> str:
     ns = r["counts"]
-    lines = [f"  scaling, batches of {r['batch']}, {PER_WORKER} per worker; shots/s (efficiency vs 2: "
-             f"rate_N / (N/2 x rate_2); one run each)",
+    lines = [(f"  scaling, batches of {r['batch']}, {PER_WORKER} per worker; shots/s (efficiency vs 2: "
+              f"rate_N / (N/2 x rate_2); one run each)"),
              f"  {'':58s}" + "".join(f" {'N = ' + str(n):>14s}" for n in ns)]
     for mode, by_n in r["modes"].items():
         cells = []

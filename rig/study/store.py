@@ -234,7 +234,7 @@ class BatchWriter:
                     self.store.write_all(results)
                 for result in results:
                     self.stored(result)
-            except BaseException as exc:  # raised where the batches are handed over
+            except BaseException as exc:  # noqa: BLE001 (KeyboardInterrupt too): raised where batches are handed over
                 self.failure = exc
                 return
             if len(results) < len(group):

@@ -58,11 +58,11 @@ def test_batches_that_come_faster_than_the_disk_are_stored_as_one_group(tmp_path
 def test_a_failed_run_keeps_every_batch_it_handed_over(tmp_path):
     store = Store(tmp_path / "s", _study()).open()
     told = []
-    with pytest.raises(RuntimeError, match="a worker failed"):
-        with store.writer(lambda result: told.append(result.batch)) as writer:
-            for b in (2, 0, 5):
-                writer.put(_result(b))
-            raise RuntimeError("a worker failed")
+    with pytest.raises(RuntimeError, match="a worker failed"), \
+            store.writer(lambda result: told.append(result.batch)) as writer:
+        for b in (2, 0, 5):
+            writer.put(_result(b))
+        raise RuntimeError("a worker failed")
     assert store.done() == {0, 2, 5} and sorted(told) == [0, 2, 5]
 
 
@@ -78,13 +78,12 @@ def test_a_full_disk_stops_the_writer_and_is_raised_where_batches_are_handed_ove
 
     monkeypatch.setattr(Path, "write_bytes", full_after_one)
     stored = threading.Event()
-    with pytest.raises(OSError) as failure:
-        with store.writer(lambda result: stored.set()) as writer:
-            writer.put(_result(0))
-            assert stored.wait(10)
-            writer.put(_result(1))  # the disk is full now: the writer stops
-            writer.thread.join(10)
-            writer.put(_result(2))  # raised here, not stored
+    with pytest.raises(OSError) as failure, store.writer(lambda result: stored.set()) as writer:
+        writer.put(_result(0))
+        assert stored.wait(10)
+        writer.put(_result(1))  # the disk is full now: the writer stops
+        writer.thread.join(10)
+        writer.put(_result(2))  # raised here, not stored
     assert failure.value.errno == errno.ENOSPC and "batch_000001.h5" in str(failure.value)
     assert store.done() == {0}
     assert sorted(p.name for p in store.batches.iterdir()) == ["batch_000000.h5"]  # no temporary left
