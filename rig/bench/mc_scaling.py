@@ -19,6 +19,7 @@ too), the workers' CPU (reaped children, so start-up included; none for one work
 runs in this process), and the bytes of one batch's result as it is pickled back."""
 from __future__ import annotations
 
+import dataclasses
 import os
 import pickle
 import resource
@@ -37,6 +38,7 @@ MODES = {"workers": "rig mc --workers N (processes, 1 numba thread each), steady
          "threads": "one process, N numba threads (batch path)"}
 PER_WORKER = 8  # batches per worker in each study
 THREAD_BATCHES = 4  # timed batches per thread count (after WARM_UP)
+STORE_GROUP = 8  # batches stored at once in the store's timing
 WARM_UP = 2
 
 
@@ -125,9 +127,26 @@ def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
         for n, row in by_n.items():
             row["efficiency_vs_2"] = _efficiency(by_n, n, 2)
             row["efficiency_vs_1"] = _efficiency(by_n, n, 1)
-    result = run_batch(_study(vary, 1, batch, seed=1), 0)
+    study = _study(vary, 1, batch, seed=1)
+    result = run_batch(study, 0)
     return {"counts": ns, "batch": batch, "modes": rows,
-            "result_bytes_per_shot": len(pickle.dumps(result, pickle.HIGHEST_PROTOCOL)) / batch}
+            "result_bytes_per_shot": len(pickle.dumps(result, pickle.HIGHEST_PROTOCOL)) / batch,
+            "store_ms_per_batch": store_time(study, result)}
+
+
+def store_time(study: Study, result, group: int = STORE_GROUP, groups: int = 3) -> dict:
+    """Wall time (ms) the store takes per batch, one batch at a time and in groups of
+    ``group`` (as its writer stores batches that come while it is busy), in a temporary
+    folder as the scaling studies' stores are: 1000 / ms is the batches/s one writer sustains."""
+    out = {}
+    with tempfile.TemporaryDirectory() as folder:
+        store = Store(folder, study).open()
+        for size in (1, group):
+            t0 = time.perf_counter()
+            for _ in range(groups):
+                store.write_all([dataclasses.replace(result, batch=b) for b in range(size)])
+            out[size] = (time.perf_counter() - t0) / (groups * size) * 1e3
+    return out
 
 
 def _efficiency(by_n: dict, n: int, base: int):
@@ -157,4 +176,9 @@ def table(r: dict) -> str:
                          + ", ".join(f"N = {n}: {row['parent_cpu_ms_per_batch']:.1f} / "
                                      f"{row['worker_cpu_ms_per_batch']:.0f}" for n, row in by_n.items()))
     lines.append(f"  a batch's result as pickled back to the parent: {r['result_bytes_per_shot']:.0f} bytes per shot")
+    if "store_ms_per_batch" in r:
+        alone, grouped = (r["store_ms_per_batch"][k] for k in sorted(r["store_ms_per_batch"]))
+        lines.append(f"  the store, per batch: {alone:.1f} ms one at a time, {grouped:.1f} ms in groups of {STORE_GROUP} "
+                     f"(its writer keeps up with {1000 / grouped:.0f} batches/s, {1000 / grouped * r['batch']:.0f} "
+                     f"shots/s)")
     return "\n".join(lines)

@@ -78,6 +78,7 @@ def test_the_mc_scaling_table_runs_at_one_and_two_workers(monkeypatch):
         assert two["efficiency_vs_1"] == two["shots_per_s"] / (2 * one["shots_per_s"])
     pool = r["modes"]["workers"]
     assert pool[2]["parent_cpu_ms_per_batch"] > 0 and pool[2]["worker_cpu_ms_per_batch"] > 0
+    assert set(r["store_ms_per_batch"]) == {1, mc_scaling.STORE_GROUP} and min(r["store_ms_per_batch"].values()) > 0
     text = mc_scaling.table(r)
     for mode, label in mc_scaling.MODES.items():
         if mode in r["modes"]:
