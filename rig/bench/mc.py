@@ -10,7 +10,10 @@ default accuracy, in the study's leading-pulse window, batches of rig mc's defau
   steady rate (shots finished after each worker's first batch, over the time since) and
   the rate of the whole run, worker start-up included;
 - where a shot's wall time goes in one process: each stage of a batch (rig/study/batch.py)
-  timed apart.
+  timed apart;
+- how it scales with cores (rig/bench/mc_scaling.py, once, after the rounds, this revision
+  only): worker processes, a Dask cluster and numba threads at 1, 2, 4, ... cores, with each
+  one's parallel efficiency against 2.
 
 Each figure is the median of ``repeats`` in a round (the study runs once a round). With
 ``--baseline REV`` every round runs the same measurement with revision REV in a
@@ -50,7 +53,8 @@ SNIPPET = """
 import json
 from rig.bench import mc
 mc.BATCH = %d  # a baseline whose default batch differs runs this one's
-print(json.dumps(mc.run(**({"rounds": 1} if "rounds" in mc.run.__code__.co_varnames else {}))))
+kw = {"rounds": 1, "scaling": False}  # what this revision's run takes of them
+print(json.dumps(mc.run(**{k: v for k, v in kw.items() if k in mc.run.__code__.co_varnames})))
 """ % BATCH
 
 
@@ -193,7 +197,10 @@ def measure(shots: int = 512, study_shots: int = 8192) -> dict:
     return out
 
 
-def run(rounds: int = 3, baseline: str | None = None) -> dict:
+def run(rounds: int = 3, baseline: str | None = None, scaling: bool = True) -> dict:
+    """The figures over ``rounds`` rounds (with ``baseline``'s in turns), then the scaling
+    table where ``scaling``."""
+    from rig.bench import mc_scaling
     from rig.bench.baseline import ROOT, checkout, machine
     from rig.bench.baseline import measure as measure_in
 
@@ -210,6 +217,8 @@ def run(rounds: int = 3, baseline: str | None = None) -> dict:
         out["baseline"] = {key: statistics.median(r[key] for r in runs["baseline"]) for key in FIGURES}
         out["ratio"] = {key: statistics.median(c[key] / b[key] for c, b in zip(runs["current"], runs["baseline"]))
                         for key in FIGURES}
+    if scaling:
+        out["scaling"] = mc_scaling.run(VARY, BATCH)
     return out
 
 
@@ -239,4 +248,8 @@ def table(r: dict) -> str:
         for key, what in STAGES.items():
             us = r[f"stage_{key}_us_per_shot"]
             lines.append(f"    {key:12s} {us:7.1f}  {100 * us / total:4.0f}%  {what}")
+    if "scaling" in r:
+        from rig.bench import mc_scaling
+
+        lines.append(mc_scaling.table(r["scaling"]))
     return "\n".join(lines)

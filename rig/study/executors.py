@@ -1,12 +1,14 @@
 """Where a study's batches run: in this process, in a pool of local processes, or on a Dask
 cluster (optional extra: pip install ".[dask]"). Batches are the same whatever runs them,
-so the results are identical; each finished batch is stored at once."""
+so the results are identical; each finished batch goes at once to the store's writer
+(a thread of its own), so the loop that feeds the workers never waits on the disk."""
 from __future__ import annotations
 
-import asyncio
 import concurrent.futures as cf
+import contextlib
 import multiprocessing
 import os
+import queue
 
 from rig.errors import RigError
 from rig.study.batch import run_batch
@@ -53,10 +55,14 @@ class WorkerWatch:
         self.clock = clock or time.monotonic
         self.since = None
 
+    def seen(self):
+        """A worker just delivered a batch: it is alive."""
+        self.since = None
+
     def check(self, workers: int, kept: int):
         """RigError when no worker has been alive for the timeout (``kept``: batches stored)."""
         if workers:
-            self.since = None
+            self.seen()
             return
         now = self.clock()
         self.since = now if self.since is None else self.since
@@ -67,35 +73,50 @@ class WorkerWatch:
 
 def run_study(study: Study, store: Store, workers: int = 1, scheduler: str | None = None,
               progress=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> int:
-    """Run the batches not yet stored; returns how many batches ran. On Dask, a study
-    with no live worker for ``worker_timeout`` seconds stops (RigError)."""
+    """Run the batches not yet stored; returns how many batches ran. ``progress(n)`` is told
+    the shots of each batch once it is stored. The batches are stored on a thread of their
+    own (``Store.writer``), so that neither the workers nor this loop wait on the disk. On
+    Dask, a study with no live worker for ``worker_timeout`` seconds stops (RigError)."""
     todo = [b for b in range(study.n_batches) if b not in store.done()]
     tick = progress or (lambda n: None)
-    if scheduler:
-        return _dask(study, store, todo, scheduler, workers, tick, WorkerWatch(worker_timeout))
-    if workers <= 1:
-        for b in todo:
-            store.write(run_batch(study, b))
-            tick(len(study.shots_of(b)))
-        return len(todo)
+    with store.writer(lambda result: tick(len(result.index))) as writer:
+        if scheduler:
+            _dask(study, store, todo, scheduler, workers, writer, WorkerWatch(worker_timeout))
+        elif workers <= 1:
+            for b in todo:
+                writer.put(run_batch(study, b))
+        else:
+            _local_pool(study, todo, workers, writer)
+    return len(todo)
+
+
+def _local_pool(study: Study, todo: list, workers: int, writer):
     ctx = multiprocessing.get_context("spawn")  # numba's threads and fork do not mix
     with cf.ProcessPoolExecutor(workers, mp_context=ctx, initializer=_worker_start,
                                 initargs=(os.getpid(),)) as pool:
-        futures = {pool.submit(run_batch, study, b): b for b in todo}
+        futures = [pool.submit(run_batch, study, b) for b in todo]
         try:
             for fut in cf.as_completed(futures):
-                store.write(fut.result())
-                tick(len(study.shots_of(futures[fut])))
+                writer.put(fut.result())
         except BaseException:
             for fut in futures:
                 fut.cancel()
             raise
-    return len(todo)
 
 
-def _dask(study, store, todo, scheduler, workers, tick, watch: WorkerWatch):
+def run_batch_alone(study: Study, b: int):
+    """Batch b on one numba thread: what a Dask task runs. Dask runs one task per worker
+    thread; numba's own threads (one per core by default) in every worker would put
+    workers x cores threads on the cores."""
+    import numba
+
+    numba.set_num_threads(1)  # this thread's (numba's thread count is per calling thread)
+    return run_batch(study, b)
+
+
+def _dask(study, store, todo, scheduler, workers, writer, watch: WorkerWatch):
     try:
-        from dask.distributed import Client, LocalCluster, wait
+        from dask.distributed import Client, LocalCluster
     except ImportError:
         raise RigError('--scheduler needs Dask: pip install ".[dask]"') from None
     if scheduler == "local":
@@ -112,21 +133,25 @@ def _dask(study, store, todo, scheduler, workers, tick, watch: WorkerWatch):
             raise RigError(f"--scheduler = {scheduler!r}: allowed 'local' or a scheduler's address such as "
                            f"tcp://HOST:PORT ({exc})") from None
     try:
-        pending = {client.submit(run_batch, study, b, pure=False) for b in todo}
-        while pending:
+        finished = queue.SimpleQueue()  # each future once it is done (Dask calls back on a thread of its own)
+        futures = [client.submit(run_batch_alone, study, b, pure=False) for b in todo]
+        for fut in futures:
+            fut.add_done_callback(finished.put)
+        left = len(futures)
+        while left:
             try:
-                done = wait(pending, timeout=POLL_S, return_when="FIRST_COMPLETED").done
-            except (TimeoutError, asyncio.TimeoutError):  # nothing finished in this poll
-                done = set()
-            pending -= done
-            for fut in done:
-                result = fut.result()
-                store.write(result)
-                tick(len(result.index))
-            if pending:
+                done = [finished.get(timeout=POLL_S)]
+            except queue.Empty:  # nothing finished in this poll: is any worker alive?
                 watch.check(len(client.scheduler_info()["workers"]), len(store.done()))
+                continue
+            with contextlib.suppress(queue.Empty):
+                while True:
+                    done.append(finished.get_nowait())
+            for result in client.gather(done):  # one round trip for every batch finished meanwhile
+                writer.put(result)
+            left -= len(done)
+            watch.seen()
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
-    return len(todo)

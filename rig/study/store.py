@@ -2,7 +2,10 @@
 batch_NNNNNN.h5 (one per finished batch), for a study with traces DIR/traces/
 batch_NNNNNN.h5 (a shot archive per batch, written before the batch counts as finished),
 and at the end DIR/study.h5. Every file appears whole or not at all (instruments.files), so
-a killed or failed run can always be resumed by running it again. DIR/study.lock is held by
+a killed or failed run can always be resumed by running it again. Finished batches are
+written on a thread of their own (``Store.writer``), in groups when they come faster than
+the disk takes them: the run's loop hands a batch over and goes back to its workers, and a
+group of k batches costs k file syncs and one sync of the folder, not 2k. DIR/study.lock is held by
 the run that writes the folder (``Store.held``): a second run into it is refused. A run
 that fails before its first batch is stored leaves the folder as it found it (no
 study.json, no folder it created); one that stored batches keeps them, and the same
@@ -11,12 +14,14 @@ from __future__ import annotations
 
 import contextlib
 import json
+import queue
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from instruments.files import folder_lock, left_as_found, write_hdf5, write_text
+from instruments.files import atomic_writes, folder_lock, hdf5_image, left_as_found, write_hdf5, write_text
 from rig.errors import RigError
 from rig.study.batch import BatchResult
 from rig.study.mc_spec import OUTPUTS, Study
@@ -101,22 +106,35 @@ class Store:
         return {int(p.stem.split("_")[1]) for p in self.batches.glob("batch_*.h5")}
 
     def write(self, result: BatchResult):
-        if result.traces:
-            from instruments.archive import Archive
+        """Store one finished batch (its file appears whole or not at all)."""
+        self.write_all([result])
 
-            self.traces.mkdir(exist_ok=True)
-            archive = self.traces / f"batch_{result.batch:06d}.h5"
-            archive.unlink(missing_ok=True)  # left by an interrupted run: that batch did not finish
-            Archive(archive).append(list(result.traces))
+    def write_all(self, results: list):
+        """Store finished batches: each one's trace archive first (where the study keeps
+        traces), then every batch file, all written and synced before any is renamed into
+        DIR/batches/ and the folder synced once."""
+        for result in results:
+            if result.traces:
+                from instruments.archive import Archive
 
-        def write(f):
-            f["index"] = result.index
-            f["inputs"] = result.inputs
-            f["seeds"] = result.seeds
-            for k, v in result.outputs.items():
-                f[f"outputs/{k}"] = v
+                self.traces.mkdir(exist_ok=True)
+                archive = self.traces / f"batch_{result.batch:06d}.h5"
+                archive.unlink(missing_ok=True)  # left by an interrupted run: that batch did not finish
+                Archive(archive).append(list(result.traces))
+        atomic_writes({self.batches / f"batch_{r.batch:06d}.h5": _batch_file(r) for r in results})
 
-        write_hdf5(self.batches / f"batch_{result.batch:06d}.h5", write)
+    @contextlib.contextmanager
+    def writer(self, stored=None, backlog: int = 64):
+        """A ``BatchWriter`` storing the batches handed to it on a thread of its own;
+        ``stored(result)`` is told each batch once it is on disk (on that thread). On
+        leaving the block every batch handed over is stored; where the block fails, the
+        batches already handed over are stored too (finished work kept), then the failure
+        goes on."""
+        batch_writer = BatchWriter(self, stored or (lambda result: None), backlog)
+        try:
+            yield batch_writer
+        finally:
+            batch_writer.close()
 
     def collect(self) -> StudyResults:
         """Every finished shot, in shot order."""
@@ -150,6 +168,77 @@ class Store:
                 f[f"outputs/{k}"] = v
 
         return write_hdf5(self.folder / "study.h5", write)
+
+
+def _batch_file(result: BatchResult):
+    """What writes batch ``result``'s file (DIR/batches/batch_NNNNNN.h5) to a path."""
+    def fill(f):
+        f["index"] = result.index
+        f["inputs"] = result.inputs
+        f["seeds"] = result.seeds
+        for k, v in result.outputs.items():
+            f[f"outputs/{k}"] = v
+
+    return lambda path: Path(path).write_bytes(hdf5_image(fill)[0])
+
+
+class BatchWriter:
+    """Stores finished batches on a thread of its own (``Store.writer``), in the order they
+    are handed over, each time every batch waiting (a group: one folder sync for all). At
+    most ``backlog`` batches wait; ``put`` waits beyond that. A failure to store (a full
+    disk) or in ``stored`` stops the writer: the batches still waiting are not stored, and
+    the failure is raised in the thread that hands batches over, at its next ``put`` or at
+    ``close``."""
+
+    STOP = None
+
+    def __init__(self, store: Store, stored, backlog: int):
+        self.store, self.stored = store, stored
+        self.waiting = queue.Queue(backlog)
+        self.failure = None
+        self.thread = threading.Thread(target=self._run, name="rig-study-store", daemon=True)
+        self.thread.start()
+
+    def put(self, result: BatchResult):
+        """Hand batch ``result`` over to be stored."""
+        self._raise_failure()
+        while self.thread.is_alive():
+            try:
+                self.waiting.put(result, timeout=0.1)
+                return
+            except queue.Full:
+                continue
+        self._raise_failure()
+
+    def close(self):
+        """Store every batch handed over, stop the thread; raise a failure it met."""
+        if self.thread.is_alive():
+            self.waiting.put(self.STOP)
+            self.thread.join()
+        self._raise_failure()
+
+    def _raise_failure(self):
+        if self.failure is not None:
+            failure, self.failure = self.failure, None
+            raise failure
+
+    def _run(self):
+        while True:
+            group = [self.waiting.get()]
+            with contextlib.suppress(queue.Empty):
+                while group[-1] is not self.STOP:
+                    group.append(self.waiting.get_nowait())
+            results = [r for r in group if r is not self.STOP]
+            try:
+                if results:
+                    self.store.write_all(results)
+                for result in results:
+                    self.stored(result)
+            except BaseException as exc:  # noqa: BLE001 (KeyboardInterrupt too): raised where batches are handed over
+                self.failure = exc
+                return
+            if len(results) < len(group):
+                return
 
 
 def _output(part: dict, key: str) -> np.ndarray:

@@ -58,3 +58,28 @@ def test_rounds_reach_the_benchmark(monkeypatch, what, argv, expected):
         assert seen[key] == value, key
     if what == "mc" and "--rounds" not in argv:
         assert "rounds" not in seen  # mc.run's own default
+
+
+def test_the_mc_scaling_table_runs_at_one_and_two_workers(monkeypatch):
+    # rig bench mc's scaling table on a small study (batches of 8, 2 per worker): a positive
+    # steady rate for every way of running at each N, the efficiencies computed from them,
+    # and the table shows each mode's rates
+    from rig.bench import mc, mc_scaling
+
+    monkeypatch.setattr(mc_scaling, "PER_WORKER", 3)
+    monkeypatch.setattr(mc_scaling, "WARM_UP", 1)
+    monkeypatch.setattr(mc_scaling, "THREAD_BATCHES", 1)
+    r = mc_scaling.run(mc.VARY, 8, [2, 1])
+    assert r["counts"] == [1, 2] and r["batch"] == 8 and 60 < r["result_bytes_per_shot"] < 200
+    for mode, by_n in r["modes"].items():
+        one, two = by_n[1], by_n[2]
+        assert one["shots_per_s"] > 0 and two["shots_per_s"] > 0, mode
+        assert two["efficiency_vs_2"] == 1 and one["efficiency_vs_2"] is None
+        assert two["efficiency_vs_1"] == two["shots_per_s"] / (2 * one["shots_per_s"])
+    pool = r["modes"]["workers"]
+    assert pool[2]["parent_cpu_ms_per_batch"] > 0 and pool[2]["worker_cpu_ms_per_batch"] > 0
+    assert set(r["store_ms_per_batch"]) == {1, mc_scaling.STORE_GROUP} and min(r["store_ms_per_batch"].values()) > 0
+    text = mc_scaling.table(r)
+    for mode, label in mc_scaling.MODES.items():
+        if mode in r["modes"]:
+            assert label in text and f"{r['modes'][mode][2]['shots_per_s']:7.0f} (100%)" in text

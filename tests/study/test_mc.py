@@ -127,7 +127,7 @@ def test_a_resumed_study_keeps_its_batch_size(tmp_path, capsys):
 
 
 def test_interrupted_study_keeps_finished_shots_and_resumes(tmp_path):
-    study = _study()
+    study = _study(shots=96)  # 6 batches
     store = Store(tmp_path / "s", study).open()
     seen = []
 
@@ -138,8 +138,11 @@ def test_interrupted_study_keeps_finished_shots_and_resumes(tmp_path):
 
     with pytest.raises(KeyboardInterrupt):
         run_study(study, store, progress=interrupt)
-    assert store.done() == {0, 1}  # the two finished batches are on disk
-    assert run_study(study, store) == 1  # the re-run does only what is missing
+    # the two batches progress was told of are on disk; the writer stores batches that came
+    # while it was busy as one group, so the interrupt may find one or two more stored with them
+    kept = store.done()
+    assert {0, 1} <= kept and kept == set(range(len(kept))), kept
+    assert run_study(study, store) == 6 - len(kept)  # the re-run does only what is missing
     whole = Store(tmp_path / "w", study).open()
     run_study(study, whole)
     for k, v in whole.collect().outputs.items():
