@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from instruments.archive import Archive, Entry
+from instruments.archive.facts import GaugeFact, ShotFacts
 from instruments.errors import InstrumentError
-from instruments.facts import GaugeFact, ShotFacts
 from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 
 SCOPE = Oscilloscope(channels={c: ChannelSettings(volts_per_div=0.05) for c in ("CH1", "CH2", "CH3")},

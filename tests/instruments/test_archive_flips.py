@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from instruments.archive import Archive, Entry
+from instruments.archive.facts import GaugeFact, ShotFacts
 from instruments.errors import InstrumentError
-from instruments.facts import GaugeFact, ShotFacts
 from instruments.records import Preamble, ScopeRecord, Waveform
 
 FLIPS = 240

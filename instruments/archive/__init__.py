@@ -1,9 +1,9 @@
 """HDF5 shot archive (NeXus-style) that never loses a committed shot.
 
-The layout of one shot: instruments/archive_layout.py (version 2, NeXus); its checksums:
-instruments/archive_digest.py and archive_verify.py; archives of layout 1 (no version
+The layout of one shot: instruments/archive/layout.py (version 2, NeXus); its checksums:
+instruments/archive/digest.py and verify.py; archives of layout 1 (no version
 attribute) are refused with a line that says to run ``rig upgrade``, which rewrites them
-(``Archive.upgrade``, through instruments/archive_legacy.py).
+(``Archive.upgrade``, through instruments/archive/legacy.py).
 
 Appends are transactions. Under an exclusive lock (``ARCHIVE.h5.lock``) the archive is
 copied to a temporary file beside it, the new shots are written into that copy's image in
@@ -27,13 +27,13 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .archive_digest import damage, linked_groups
-from .archive_layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_entry
-from .archive_reader import read_entry
-from .archive_verify import addresses, check, root_seal, sealed_members, shot_names
-from .errors import InstrumentError
-from .files import cause, folder_lock, hdf5_image
-from .files import fsync as _fsync  # a name of this module's own: the crash tests stop a writer after it
+from ..errors import InstrumentError
+from ..files import cause, folder_lock, hdf5_image
+from ..files import fsync as _fsync  # a name of this module's own: the crash tests stop a writer after it
+from .digest import damage, linked_groups
+from .layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_entry
+from .reader import read_entry
+from .verify import addresses, check, root_seal, sealed_members, shot_names
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
     import h5py
@@ -58,7 +58,7 @@ class Archive:
     def upgrade(self) -> int:
         """Rewrite an archive of layout 1 in the current layout (one transaction); returns
         the number of shots. An archive of the current layout is left as it is (0)."""
-        from .archive_legacy import read_legacy_entry
+        from .legacy import read_legacy_entry
 
         with self._lock():
             with self._open(current=False) as f:
@@ -70,7 +70,7 @@ class Archive:
 
     def record_members(self) -> bool:
         """Record the root's member lists in an archive sealed before they were (root table
-        version 1, instruments/archive_verify.py), after checking it whole: True where they
+        version 1, instruments/archive/verify.py), after checking it whole: True where they
         were recorded now, False where they already were. A damaged archive is refused
         (InstrumentError): recording its members would accept what was added or deleted."""
         with self._lock():
@@ -286,7 +286,7 @@ def _fsync_dir(path):
 
 
 def _truth_item(problem: str) -> bool:
-    """Whether a line of archive_digest.damage names the truth's forces (the "forces" group,
+    """Whether a line of digest.damage names the truth's forces (the "forces" group,
     its datasets or attributes) of a shared group."""
     key = problem.removeprefix("attribute ").split(":", 1)[0]
     return key.split("@", 1)[0].split("/", 1)[0] == "forces"

@@ -5,7 +5,7 @@ The layout (version 2; ``LAYOUT`` below, also stored in the file) is NeXus: vali
 NX_class on every group, ``title`` and ``start_time`` on every entry, signal/axes/units on
 every NXdata, volts and seconds as floats in ``data/``. Every array dataset is chunked with
 the fletcher32 checksum; every group's tree (values and attributes) is in its table of
-SHA-256 checksums (instruments/archive_digest.py).
+SHA-256 checksums (instruments/archive/digest.py).
 """
 from __future__ import annotations
 
@@ -18,10 +18,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .archive_digest import address, seal
-from .errors import InstrumentError
+from ..errors import InstrumentError
+from ..records import Preamble, ScopeRecord, Waveform
+from .digest import address, seal
 from .facts import ShotFacts
-from .records import Preamble, ScopeRecord, Waveform
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened: Entry alone does not need it
     import h5py
@@ -244,7 +244,7 @@ def _facts_json(e: Entry, where: str) -> str:
     if e.facts is None:
         return "{}"
     if not isinstance(e.facts, ShotFacts):
-        raise InstrumentError(f"{where} = {type(e.facts).__name__}: expected ShotFacts (instruments.facts) or None")
+        raise InstrumentError(f"{where} = {type(e.facts).__name__}: expected ShotFacts (instruments.archive.facts) or None")
     text = json.dumps(e.facts.to_dict(), default=_jsonable)
     ShotFacts.from_dict(json.loads(text), where)
     return text

@@ -1,17 +1,17 @@
-"""Reading one NXentry of the current layout (instruments/archive_layout.py) back into
+"""Reading one NXentry of the current layout (instruments/archive/layout.py) back into
 the Entry it was written from: the same scope records (codes, preamble with its point
 format, channel names), facts and truth. The checksums are checked by the caller
-(instruments/archive.py)."""
+(instruments/archive/__init__.py)."""
 from __future__ import annotations
 
 import json
 from dataclasses import fields
 from typing import TYPE_CHECKING
 
-from .archive_layout import Entry
-from .errors import InstrumentError
+from ..errors import InstrumentError
+from ..records import Preamble, ScopeRecord, Waveform
 from .facts import ShotFacts
-from .records import Preamble, ScopeRecord, Waveform
+from .layout import Entry
 
 if TYPE_CHECKING:
     import h5py

@@ -1,5 +1,5 @@
 """Checking an open archive: the root's attributes and member lists, each shared group once,
-then each shot, against their tables of SHA-256 checksums (instruments/archive_digest.py).
+then each shot, against their tables of SHA-256 checksums (instruments/archive/digest.py).
 Every problem is a row naming the shot (or the shots of a shared group) and the dataset or
 attribute; an object added or deleted anywhere is named by its path ("added: /foo",
 "missing: /shot_000003/data/CH2"); a damaged file gives rows, never an exception.
@@ -16,14 +16,14 @@ import json
 import re
 from typing import TYPE_CHECKING
 
-from .archive_digest import TABLE, address, damage, linked_groups, sha
+from .digest import TABLE, address, damage, linked_groups, sha
 
 if TYPE_CHECKING:
     import h5py
 
 ROOT_TABLE = "checksums"  # root attribute: {attribute: SHA-256} of the root's other attributes
 MEMBERS = "members"  # root attribute (version 2): {"/": root's member names, "/shared": shared's}
-_ADDED = "not in the table of checksums"  # how archive_digest.damage words an added item
+_ADDED = "not in the table of checksums"  # how digest.damage words an added item
 
 
 def root_seal(f: h5py.File):
@@ -174,7 +174,7 @@ def check(f: h5py.File) -> dict:
 
 
 def named(problems: list, prefix: str) -> list:
-    """archive_digest.damage's lines for the group at ``prefix``, with each object added or
+    """digest.damage's lines for the group at ``prefix``, with each object added or
     deleted (a dataset, or a group: its member-list row "X/") named once by its path
     ("missing: /shot_000003/data/CH2") and the lines it alone explains left out: the member
     list of its group, its own attributes and members."""
