@@ -33,6 +33,7 @@ from ..files import fsync as _fsync  # a name of this module's own: the crash te
 from .digest import damage, linked_groups
 from .layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_entry
 from .reader import read_entry
+from .parts import LAYOUT3, PARTS_TEXT, folder, link_into, part_name, stored_shared
 from .verify import addresses, check, root_seal, sealed_members, shot_names
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
@@ -49,24 +50,36 @@ class Archive:
 
     # --- writing --------------------------------------------------------------------
     def append(self, entries) -> list:
-        """Append shots in one transaction; returns their ids. All or nothing."""
+        """Append shots in one transaction; returns their ids. All or nothing. An archive of
+        layout 2 grows in layout 2 (a copy per transaction) until ``rig upgrade``."""
         entries = list(entries)
         with self._lock():
             self._drop_stale_temporaries()
-            return self._transaction(lambda f: self._write(f, entries), self.path.exists())
+            if self.path.exists():
+                with self._open() as f:
+                    version = f.attrs.get("layout_version")
+                if version == LAYOUT_VERSION:
+                    return self._transaction(lambda f: self._write(f, entries), True)
+            return self._commit(entries)
 
     def upgrade(self) -> int:
-        """Rewrite an archive of layout 1 in the current layout (one transaction); returns
-        the number of shots. An archive of the current layout is left as it is (0)."""
+        """Rewrite an archive of layout 1 or 2 in layout 3 (one transaction); returns the
+        number of shots. An archive of layout 3 is left as it is (0); one of layout 2 that
+        does not verify is refused (InstrumentError): converting it would accept its damage."""
         from .legacy import read_legacy_entry
 
         with self._lock():
             with self._open(current=False) as f:
-                if f.attrs.get("layout_version") == LAYOUT_VERSION:
+                version = f.attrs.get("layout_version")
+                if version == LAYOUT3:
                     return 0
-                entries = [read_legacy_entry(f[n], self.path) for n in shot_names(f)]
+                if version == LAYOUT_VERSION:
+                    self._refuse_damaged(check(f)["bad"], "converted")
+                    entries = [read_entry(f[n], self.path, keyed=True) for n in shot_names(f)]
+                else:
+                    entries = [read_legacy_entry(f[n], self.path) for n in shot_names(f)]
             self._drop_stale_temporaries()
-            return len(self._transaction(lambda f: self._write(f, entries, [e.shot_id for e in entries]), False))
+            return len(self._commit(entries, [e.shot_id for e in entries], fresh=True))
 
     def record_members(self) -> bool:
         """Record the root's member lists in an archive sealed before they were (root table
@@ -78,23 +91,87 @@ class Archive:
                 if sealed_members(f):
                     return False
                 bad = check(f)["bad"]
-            if bad:
-                raise InstrumentError(f"{self.path}: {len(bad)} problem{'' if len(bad) == 1 else 's'} (first: "
-                                      f"{bad[0]['where']}: {bad[0]['reason']}); `rig verify` lists them; the "
-                                      "member lists are recorded only in an archive that verifies")
+            self._refuse_damaged(bad, "recorded")
             self._drop_stale_temporaries()
             self._transaction(lambda f: root_seal(f) or [], True)
             return True
 
-    def _transaction(self, write, copy: bool) -> list:
-        """Write into a copy of the archive (or a new file), then put it in place."""
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp", dir=self.path.parent)
+    def _refuse_damaged(self, bad: list, what: str):
+        if bad:
+            raise InstrumentError(f"{self.path}: {len(bad)} problem{'' if len(bad) == 1 else 's'} (first: "
+                                  f"{bad[0]['where']}: {bad[0]['reason']}); `rig verify` lists them; the "
+                                  f"{'member lists are' if what == 'recorded' else 'archive is'} {what} only in "
+                                  "an archive that verifies")
+
+    def _commit(self, entries, ids=None, fresh: bool = False) -> list:
+        """Layout 3 (instruments/archive/parts.py): the new shots into a part file of their
+        own, written whole beside the master, then a copy of the small master that links to
+        them put in place. A writer stopped between the two leaves a part no master names,
+        which the next transaction of the same first shot replaces."""
+        master = None if fresh or not self.path.exists() else self._open()
+        with contextlib.ExitStack() as held:
+            if master is not None:
+                held.enter_context(master)
+            names = shot_names(master) if master is not None else []
+            start = max([int(n.split("_", 1)[1]) for n in names] + [0]) + 1
+            ids = ids or [start + i for i in range(len(entries))]
+            stored = stored_shared(master) if master is not None else {}
+            part = part_name(ids[0]) if ids else part_name(start)
+            where = folder(self.path)
+            made = not where.exists()
+            checked = set()
+
+            def fill(f):
+                for shot_id, e in zip(ids, entries):
+                    write_entry(f, shot_id, e, checked, stored)
+                f.attrs.update({"NX_class": "NXroot", "creator": "sonic-rig", "layout_version": LAYOUT3,
+                                "part_of": self.path.name})
+                return sorted(f["shared"]) if "shared" in f else []
+
+            try:
+                where.mkdir(exist_ok=True)
+                new_shared = self._transaction(fill, False, where / part)
+            except BaseException:
+                if made:
+                    with contextlib.suppress(OSError):
+                        where.rmdir()
+                raise
+        try:
+            self._transaction(lambda f: self._link(f, part, ids, new_shared), not fresh and master is not None)
+        except BaseException:
+            with contextlib.suppress(OSError):
+                (where / part).unlink()
+                if made:
+                    where.rmdir()
+            raise
+        return ids
+
+    def _link(self, f, part: str, ids: list, new_shared: list) -> list:
+        """The master's links to a new part's shots and shared groups, and its root sealed."""
+        for shot_id in ids:
+            f[f"shot_{shot_id:06d}"] = link_into(self.path.name, part, f"/shot_{shot_id:06d}")
+        if new_shared:
+            shared = f.require_group("shared")
+            shared.attrs["NX_class"] = "NXcollection"
+            for key in new_shared:
+                shared[key] = link_into(self.path.name, part, f"/shared/{key}")
+        f.attrs.update({"NX_class": "NXroot", "creator": "sonic-rig", "layout_version": LAYOUT3,
+                        "layout": PARTS_TEXT + "\n\n" + LAYOUT, "file_name": self.path.name})
+        f.attrs["default"] = f"shot_{max(ids):06d}" if ids else f.attrs.get("default", "")
+        root_seal(f)
+        return ids
+
+    def _transaction(self, write, copy: bool, target=None) -> list:
+        """Write into a copy of ``target`` (the archive's file) or a new file, then put it in
+        place: whole or not at all."""
+        target = Path(target or self.path)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
         os.close(fd)
         try:
             if copy:
                 self._open().close()  # refuse to build on a broken or foreign archive
-                shutil.copyfile(self.path, tmp)
-                shutil.copymode(self.path, tmp)
+                shutil.copyfile(target, tmp)
+                shutil.copymode(target, tmp)
             else:
                 umask = os.umask(0)
                 os.umask(umask)
@@ -103,8 +180,8 @@ class Archive:
             data, ids = hdf5_image(write, image, libver=("v110", "latest"))  # HDF5 itself writes no file
             Path(tmp).write_bytes(data)  # a full disk fails here, in one OSError
             _fsync(tmp)
-            os.replace(tmp, self.path)
-            _fsync_dir(self.path.parent)
+            os.replace(tmp, target)
+            _fsync_dir(target.parent)
         except BaseException as exc:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
@@ -113,9 +190,10 @@ class Archive:
             raise InstrumentError(f"{self.path}: cannot append: {cause(exc)}") from None
         return ids
 
-    def _write(self, f, entries, ids=None) -> list:
+    def _write(self, f, entries) -> list:
+        """Layout 2: the shots written into the archive's copy."""
         start = max([int(n.split("_", 1)[1]) for n in shot_names(f)] + [0]) + 1
-        ids = ids or [start + i for i in range(len(entries))]
+        ids = [start + i for i in range(len(entries))]
         checked = set()
         for shot_id, e in zip(ids, entries):
             write_entry(f, shot_id, e, checked)
@@ -140,7 +218,8 @@ class Archive:
             yield
 
     def _drop_stale_temporaries(self):
-        for stale in self.path.parent.glob(f".{self.path.name}.*.tmp"):
+        stale_parts = folder(self.path).glob(".shots_*.h5.*.tmp")
+        for stale in [*self.path.parent.glob(f".{self.path.name}.*.tmp"), *stale_parts]:
             with contextlib.suppress(OSError):
                 stale.unlink()  # we hold the lock: no live writer owns it
 
@@ -168,10 +247,10 @@ class Archive:
                 raise InstrumentError(f"{path}: a Monte Carlo study's results (rig mc), not a shot archive: its "
                                       f"shots' scope records are archived under traces/ when it runs with --traces")
             raise InstrumentError(f"{path}: not a rig archive (an HDF5 file that this project did not write)")
-        if current and version != LAYOUT_VERSION:
+        if current and version not in (LAYOUT_VERSION, LAYOUT3):
             f.close()
-            raise InstrumentError(f"{path}: archive layout {version or 1}, this version reads layout "
-                                  f"{LAYOUT_VERSION}: run `rig upgrade {path}` to convert it")
+            raise InstrumentError(f"{path}: archive layout {version or 1}, this version reads layouts "
+                                  f"{LAYOUT_VERSION} and {LAYOUT3}: run `rig upgrade {path}` to convert it")
         return f
 
     def ids(self) -> list:

@@ -4,7 +4,9 @@ A group's table (``checksums``, a JSON text dataset in the group) has one row pe
 its tree, in sorted order: ``path`` -> the SHA-256 of a dataset's dtype, shape and values,
 ``path@name`` -> the SHA-256 of an attribute's value, ``path/`` -> that of a group's member
 names. A hard link to an object that another table covers (the truth shared by the shots
-of one scene) is a row ``link:<path>`` instead. Object references (the dimension scales of
+of one scene) is a row ``link:<path>`` instead; an HDF5 external link (layout 3: a shot
+whose scene was stored by an earlier transaction, in another part file) is the row
+``link:<path> in <file>``, read from the link itself, never followed. Object references (the dimension scales of
 xarray and netCDF) are hashed as the paths they point to. The group's attribute ``sha256``
 is the SHA-256 of the table's text, so a damaged table is found too.
 
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,11 +35,21 @@ def sha(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def address(obj) -> int:
-    """The object's address in the file: equal for every hard link to it."""
+def address(obj) -> tuple:
+    """The object's file and address in it: equal for every hard link to it, and for the
+    paths that reach it through external links (layout 3's part files)."""
     import h5py
 
-    return h5py.h5o.get_info(obj.id).addr
+    return os.path.normpath(h5py.h5f.get_name(obj.id).decode()), h5py.h5o.get_info(obj.id).addr
+
+
+def external(g, name: str) -> str | None:
+    """The row of ``g[name]`` where it is an HDF5 external link ("link:/shared/k/x in
+    part.h5"), else None; the link is not followed."""
+    import h5py
+
+    link = g.get(name, getlink=True)
+    return f"link:{link.path} in {link.filename}" if isinstance(link, h5py.ExternalLink) else None
 
 
 def paths(group: h5py.Group, linked: dict) -> dict:
@@ -48,6 +61,8 @@ def paths(group: h5py.Group, linked: dict) -> dict:
 
     def walk(g, prefix):
         for name in sorted(g):
+            if external(g, name):
+                continue
             try:
                 obj = g[name]
                 a = address(obj)
@@ -84,6 +99,10 @@ def table(group: h5py.Group, linked: dict) -> dict:
         attrs(g, prefix.rstrip("/"))
         for name in members:
             path = prefix + name
+            link = external(g, name)
+            if link:
+                rows[path] = link
+                continue
             try:
                 obj = g[name]
                 a = address(obj)
