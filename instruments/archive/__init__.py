@@ -73,35 +73,23 @@ class Archive:
                 version = f.attrs.get("layout_version")
                 if version == LAYOUT3:
                     return 0
+                bad = check(f)["bad"] if version == LAYOUT_VERSION else []
+                if bad:
+                    raise InstrumentError(f"{self.path}: {len(bad)} problem{'' if len(bad) == 1 else 's'} (first: "
+                                          f"{bad[0]['where']}: {bad[0]['reason']}); `rig verify` lists them; an "
+                                          "archive is converted only when it verifies")
                 if version == LAYOUT_VERSION:
-                    self._refuse_damaged(check(f)["bad"], "converted")
                     entries = [read_entry(f[n], self.path, keyed=True) for n in shot_names(f)]
                 else:
                     entries = [read_legacy_entry(f[n], self.path) for n in shot_names(f)]
             self._drop_stale_temporaries()
             return len(self._commit(entries, [e.shot_id for e in entries], fresh=True))
 
-    def record_members(self) -> bool:
-        """Record the root's member lists in an archive sealed before they were (root table
-        version 1, instruments/archive/verify.py), after checking it whole: True where they
-        were recorded now, False where they already were. A damaged archive is refused
-        (InstrumentError): recording its members would accept what was added or deleted."""
-        with self._lock():
-            with self._open() as f:
-                if sealed_members(f):
-                    return False
-                bad = check(f)["bad"]
-            self._refuse_damaged(bad, "recorded")
-            self._drop_stale_temporaries()
-            self._transaction(lambda f: root_seal(f) or [], True)
-            return True
-
-    def _refuse_damaged(self, bad: list, what: str):
-        if bad:
-            raise InstrumentError(f"{self.path}: {len(bad)} problem{'' if len(bad) == 1 else 's'} (first: "
-                                  f"{bad[0]['where']}: {bad[0]['reason']}); `rig verify` lists them; the "
-                                  f"{'member lists are' if what == 'recorded' else 'archive is'} {what} only in "
-                                  "an archive that verifies")
+    def lists_members(self) -> bool:
+        """Whether the root records its member lists (instruments/archive/verify.py): False
+        for layout 1 and for a layout-2 archive sealed before they were."""
+        with self._open(current=False) as f:
+            return sealed_members(f)
 
     def _commit(self, entries, ids=None, fresh: bool = False) -> list:
         """Layout 3 (instruments/archive/parts.py): the new shots into a part file of their
@@ -112,10 +100,13 @@ class Archive:
         with contextlib.ExitStack() as held:
             if master is not None:
                 held.enter_context(master)
-            names = shot_names(master) if master is not None else []
+            try:
+                names = shot_names(master) if master is not None else []
+                stored = stored_shared(master) if master is not None else {}
+            except Exception as exc:  # noqa: BLE001 - a damaged master: one line, nothing written
+                raise InstrumentError(f"{self.path}: cannot append: {cause(exc)}") from None
             start = max([int(n.split("_", 1)[1]) for n in names] + [0]) + 1
             ids = ids or [start + i for i in range(len(entries))]
-            stored = stored_shared(master) if master is not None else {}
             part = part_name(ids[0]) if ids else part_name(start)
             where = folder(self.path)
             made = not where.exists()
@@ -124,8 +115,7 @@ class Archive:
             def fill(f):
                 for shot_id, e in zip(ids, entries):
                     write_entry(f, shot_id, e, checked, stored)
-                f.attrs.update({"NX_class": "NXroot", "creator": "sonic-rig", "layout_version": LAYOUT3,
-                                "part_of": self.path.name})
+                f.attrs.update({"NX_class": "NXroot", "layout_version": LAYOUT3, "part_of": self.path.name})
                 return sorted(f["shared"]) if "shared" in f else []
 
             try:

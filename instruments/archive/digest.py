@@ -75,6 +75,7 @@ def paths(group: h5py.Group, linked: dict) -> dict:
                 walk(obj, prefix + name + "/")
 
     walk(group, "")
+    del walk  # the recursive closure's cycle would keep the groups, and their part files, open
     return out
 
 
@@ -120,6 +121,7 @@ def table(group: h5py.Group, linked: dict) -> dict:
                 attrs(obj, path)
 
     walk(group, "")
+    del walk  # as in paths()
     return rows
 
 
