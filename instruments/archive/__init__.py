@@ -33,7 +33,7 @@ from ..files import fsync as _fsync  # a name of this module's own: the crash te
 from .digest import damage, linked_groups
 from .layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_entry
 from .reader import read_entry
-from .parts import LAYOUT3, PARTS_TEXT, folder, link_into, part_name, stored_shared
+from .parts import LAYOUT3, PARTS_TEXT, folder, link_into, part_name, recorded_members, stored_shared, with_new
 from .verify import addresses, check, root_seal, sealed_members, shot_names
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
@@ -101,7 +101,8 @@ class Archive:
             if master is not None:
                 held.enter_context(master)
             try:
-                names = shot_names(master) if master is not None else []
+                members = recorded_members(master) if master is not None else {"/": [], "/shared": []}
+                names = [n for n in members["/"] if n.startswith("shot_")]
                 stored = stored_shared(master) if master is not None else {}
             except Exception as exc:  # noqa: BLE001 - a damaged master: one line, nothing written
                 raise InstrumentError(f"{self.path}: cannot append: {cause(exc)}") from None
@@ -127,7 +128,7 @@ class Archive:
                         where.rmdir()
                 raise
         try:
-            self._transaction(lambda f: self._link(f, part, ids, new_shared), not fresh and master is not None)
+            self._transaction(lambda f: self._link(f, part, ids, new_shared, members), not fresh and master is not None)
         except BaseException:
             with contextlib.suppress(OSError):
                 (where / part).unlink()
@@ -136,10 +137,12 @@ class Archive:
             raise
         return ids
 
-    def _link(self, f, part: str, ids: list, new_shared: list) -> list:
-        """The master's links to a new part's shots and shared groups, and its root sealed."""
-        for shot_id in ids:
-            f[f"shot_{shot_id:06d}"] = link_into(self.path.name, part, f"/shot_{shot_id:06d}")
+    def _link(self, f, part: str, ids: list, new_shared: list, members: dict) -> list:
+        """The master's links to a new part's shots and shared groups, and its root sealed
+        (``members``: its member lists before, to which the new names are added)."""
+        names = [f"shot_{shot_id:06d}" for shot_id in ids]
+        for name in names:
+            f[name] = link_into(self.path.name, part, f"/{name}")
         if new_shared:
             shared = f.require_group("shared")
             shared.attrs["NX_class"] = "NXcollection"
@@ -148,7 +151,7 @@ class Archive:
         f.attrs.update({"NX_class": "NXroot", "creator": "sonic-rig", "layout_version": LAYOUT3,
                         "layout": PARTS_TEXT + "\n\n" + LAYOUT, "file_name": self.path.name})
         f.attrs["default"] = f"shot_{max(ids):06d}" if ids else f.attrs.get("default", "")
-        root_seal(f)
+        root_seal(f, with_new(members, names, new_shared))
         return ids
 
     def _transaction(self, write, copy: bool, target=None) -> list:

@@ -54,11 +54,20 @@ def stored_shared(f) -> dict:
     return out
 
 
-def member_names(f) -> list:
-    """The root's shot names as the root's sealed member list records them (no walk over
-    the master's links: a large master's names are read as one attribute)."""
+def recorded_members(f) -> dict:
+    """The root's member lists as its sealed attribute records them ({"/": names, "/shared":
+    names}; the walk over the root where the attribute is missing or unreadable: a large
+    master's names are read as one attribute, not link by link)."""
     try:
-        names = json.loads(f.attrs["members"])["/"]
-    except Exception:  # noqa: BLE001 - an archive being built, or a damaged list: walk the root
-        names = list(f)
-    return sorted(n for n in names if n.startswith("shot_"))
+        members = json.loads(f.attrs["members"])
+        return {"/": list(members["/"]), "/shared": list(members.get("/shared", []))}
+    except Exception:  # noqa: BLE001 - a damaged list: the writer builds on what the root holds
+        return {"/": sorted(f), "/shared": sorted(f["shared"]) if "shared" in f else []}
+
+
+def with_new(members: dict, shots: list, shared: list) -> dict:
+    """``members`` with the names a transaction adds (``/shared`` listed once it exists)."""
+    out = {"/": sorted({*members["/"], *shots, *(["shared"] if shared or members["/shared"] else [])})}
+    if "shared" in out["/"]:
+        out["/shared"] = sorted({*members["/shared"], *shared})
+    return out

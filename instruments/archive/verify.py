@@ -26,9 +26,10 @@ MEMBERS = "members"  # root attribute (version 2): {"/": root's member names, "/
 _ADDED = "not in the table of checksums"  # how digest.damage words an added item
 
 
-def root_seal(f: h5py.File):
-    """Write the root's member lists and its table (after its other attributes)."""
-    f.attrs[MEMBERS] = json.dumps(_members(f), sort_keys=True)
+def root_seal(f: h5py.File, members: dict | None = None):
+    """Write the root's member lists (``members``, {"/": names, "/shared": names}, where the
+    writer knows them: a large root is not walked) and its table (after its other attributes)."""
+    f.attrs[MEMBERS] = json.dumps(members or _members(f), sort_keys=True)
     f.attrs[ROOT_TABLE] = json.dumps(_root_rows(f), sort_keys=True)
 
 
