@@ -1,22 +1,28 @@
-"""HDF5 shot archive (NeXus-style) that never loses a committed shot.
+"""HDF5 shot archive (NeXus) that never loses a committed shot, whose appends cost what
+they add.
 
-The layout of one shot: instruments/archive/layout.py (version 2, NeXus); its checksums:
-instruments/archive/digest.py and verify.py; archives of layout 1 (no version
-attribute) are refused with a line that says to run ``rig upgrade``, which rewrites them
-(``Archive.upgrade``, through instruments/archive/legacy.py).
+Layout 3 (instruments/archive/parts.py): a small master file (``shots.h5``) whose shots and
+shared groups are HDF5 external links into part files (``shots.h5.d/shots_NNNNNN.h5``), one
+per transaction, written once and never changed; the groups they hold are those of layout 2
+(instruments/archive/layout.py), with their checksums (digest.py, verify.py). Layout 2 (one
+file) is read and still appended to; ``rig upgrade`` (``Archive.upgrade``) converts layouts
+1 (through legacy.py) and 2 to layout 3; layout 1 is refused with a line that says so.
 
-Appends are transactions. Under an exclusive lock (``ARCHIVE.h5.lock``) the archive is
-copied to a temporary file beside it, the new shots are written into that copy's image in
-memory and the image over the copy (HDF5 writes no file itself: an HDF5 write that fails on
-a full disk leaves the library in a state that can crash the process), the copy is flushed
-to disk (fsync), and ``os.replace`` puts it in place atomically; then the directory is
-synced. A writer killed at any moment, a power loss or a full disk leaves either the old
-archive or the new one, never a mix, and a stale temporary file is removed by the next
-append. Readers open the path and see one complete version: this is what SWMR would give,
-without SWMR's ban on creating groups. The price is a file copy per transaction; append
-many shots in one call where that matters. An I/O failure (a full disk, no permission) or
-a damaged archive ends an append with one InstrumentError naming the archive and the cause;
-the archive is left as it was.
+Appends are transactions under an exclusive lock (``ARCHIVE.h5.lock``). The new shots are
+written into a new part: its image is built in memory (HDF5 writes no file itself: an HDF5
+write that fails on a full disk leaves the library in a state that can crash the process),
+written to a temporary file, flushed to disk (fsync) and renamed into place; then the master
+is copied, the links to the new part added, its root sealed, and the copy flushed and put in
+place with ``os.replace``; each rename is followed by a sync of its folder. Nothing already
+stored is copied: the master holds links only (about 160 bytes a shot). A writer killed at
+any moment, a power loss or a full disk leaves either the old master or the new one, each
+naming only whole parts; a part no master names (a writer killed between the two renames)
+is replaced by the next transaction of the same first shot, and a stale temporary file is
+removed by the next append. Readers open the master and see one complete version: this is
+what SWMR would give, without SWMR's ban on creating groups. An archive of layout 2 grows
+by copying the whole file per transaction, as it always did. An I/O failure (a full disk,
+no permission) or a damaged archive ends an append with one InstrumentError naming the
+archive and the cause; the archive is left as it was.
 """
 from __future__ import annotations
 
