@@ -38,8 +38,8 @@ from ..files import cause, folder_lock, hdf5_image
 from ..files import fsync as _fsync  # a name of this module's own: the crash tests stop a writer after it
 from .digest import damage, linked_groups
 from .layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_entry
-from .reader import read_entry
 from .parts import LAYOUT3, PARTS_TEXT, folder, link_into, part_name, recorded_members, stored_shared, with_new
+from .reader import read_entry
 from .verify import addresses, check, root_seal, sealed_members, shot_names
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened

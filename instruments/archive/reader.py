@@ -10,8 +10,8 @@ from typing import TYPE_CHECKING
 
 from ..errors import InstrumentError
 from ..records import Preamble, ScopeRecord, Waveform
-from .facts import ShotFacts
 from .digest import linked_groups
+from .facts import ShotFacts
 from .layout import Entry
 
 if TYPE_CHECKING:
