@@ -40,7 +40,7 @@ from .digest import damage, linked_groups
 from .layout import LAYOUT, LAYOUT_VERSION, Entry, raw_digest, write_entry
 from .parts import LAYOUT3, PARTS_TEXT, folder, link_into, part_name, recorded_members, stored_shared, with_new
 from .reader import read_entry
-from .verify import addresses, check, root_seal, sealed_members, shot_names
+from .verify import addresses, check, compact, root_seal, sealed_members, shot_names
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
     import h5py
@@ -157,7 +157,7 @@ class Archive:
         f.attrs.update({"NX_class": "NXroot", "creator": "sonic-rig", "layout_version": LAYOUT3,
                         "layout": PARTS_TEXT + "\n\n" + LAYOUT, "file_name": self.path.name})
         f.attrs["default"] = f"shot_{max(ids):06d}" if ids else f.attrs.get("default", "")
-        root_seal(f, with_new(members, names, new_shared))
+        root_seal(f, compact(with_new(members, names, new_shared)))
         return ids
 
     def _transaction(self, write, copy: bool, target=None) -> list:

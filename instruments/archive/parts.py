@@ -14,8 +14,9 @@ folder, side by side.
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
+
+from .verify import member_list
 
 LAYOUT3 = 3
 PARTS_TEXT = """Layout version 3: this file is the master of the archive; each shot_NNNNNN and
@@ -56,10 +57,10 @@ def stored_shared(f) -> dict:
 
 def recorded_members(f) -> dict:
     """The root's member lists as its sealed attribute records them ({"/": names, "/shared":
-    names}; the walk over the root where the attribute is missing or unreadable: a large
-    master's names are read as one attribute, not link by link)."""
+    names}; the walk over the root where the attribute is missing or unreadable): a large
+    master's names are read as one small attribute, not link by link."""
     try:
-        members = json.loads(f.attrs["members"])
+        members = member_list(f)
         return {"/": list(members["/"]), "/shared": list(members.get("/shared", []))}
     except Exception:  # noqa: BLE001 - a damaged list: the writer builds on what the root holds
         return {"/": sorted(f), "/shared": sorted(f["shared"]) if "shared" in f else []}
