@@ -14,7 +14,7 @@ write that fails on a full disk leaves the library in a state that can crash the
 written to a temporary file, flushed to disk (fsync) and renamed into place; then the master
 is copied, the links to the new part added, its root sealed, and the copy flushed and put in
 place with ``os.replace``; each rename is followed by a sync of its folder. Nothing already
-stored is copied: the master holds links only (about 160 bytes a shot). A writer killed at
+stored is copied: the master holds links only (772 kB at 10,017 shots). A writer killed at
 any moment, a power loss or a full disk leaves either the old master or the new one, each
 naming only whole parts; a part no master names (a writer killed between the two renames)
 is replaced by the next transaction of the same first shot, and a stale temporary file is
