@@ -1,7 +1,10 @@
 """Archive benchmark (``rig bench archive``): virtual shots of 3 channels x 10,000 points
 (ptfe52_magnetic with scope.record_length = 10000), appended in transactions of 100 shots
 and, for comparison, one transaction per shot (what ``rig shot --out`` does). Medians of
-3 runs into fresh files; then verify and read-back rates."""
+3 runs into fresh files; then verify and read-back rates; then, for an archive that already
+holds N shots (built by appends of 100 shots, the same shots over again), the median time of
+a one-shot append and of reading one shot back (the first and the last), which layout 3
+keeps near what the shot itself costs."""
 from __future__ import annotations
 
 import statistics
@@ -14,7 +17,7 @@ from rig.experiment.entry import shot_entry
 from rig.experiment.shot import Rig
 
 
-def run(shots: int = 400, batch: int = 100, single: int = 60) -> dict:
+def run(shots: int = 400, batch: int = 100, single: int = 60, held: tuple = (10, 1000)) -> dict:
     rig = Rig.from_scene("ptfe52_magnetic", ["scope.record_length=10000"])
     entries = [shot_entry(rig.fire(seed=s)) for s in range(shots)]
 
@@ -34,7 +37,8 @@ def run(shots: int = 400, batch: int = 100, single: int = 60) -> dict:
     with tempfile.TemporaryDirectory() as d:
         a = Archive(Path(d) / "bench.h5")
         a.append(entries)
-        size = (Path(d) / "bench.h5").stat().st_size
+        files = [Path(d) / "bench.h5", *Path(d).glob("bench.h5.d/*.h5")]  # the master and its parts
+        size = sum(p.stat().st_size for p in files)
         t0 = time.perf_counter()
         a.verify()
         verify = shots / (time.perf_counter() - t0)
@@ -45,7 +49,27 @@ def run(shots: int = 400, batch: int = 100, single: int = 60) -> dict:
     return {"points_per_channel": 10000, "channels": 3, "shots": shots,
             "batched_shots_per_s": batched, "batch": batch,
             "single_shots_per_s": one_by_one, "verify_shots_per_s": verify,
-            "read_shots_per_s": read, "bytes_per_shot": size / shots}
+            "read_shots_per_s": read, "bytes_per_shot": size / shots,
+            "held": {n: _held(entries, n, batch) for n in held}}
+
+
+def _held(entries: list, n: int, batch: int, repeats: int = 7) -> dict:
+    """Medians (ms) of a one-shot append and of one shot read back, the first and the last,
+    in an archive that holds ``n`` shots."""
+    with tempfile.TemporaryDirectory() as d:
+        a = Archive(Path(d) / "bench.h5")
+        for k in range(0, n, batch):
+            a.append([entries[(k + i) % len(entries)] for i in range(min(batch, n - k))])
+        append, read = [], []
+        for r in range(repeats):
+            t0 = time.perf_counter()
+            (new,) = a.append([entries[r % len(entries)]])
+            append.append(time.perf_counter() - t0)
+            for i in (1, new):
+                t0 = time.perf_counter()
+                a.read(i, with_truth=False)
+                read.append(time.perf_counter() - t0)
+    return {"append_ms": 1e3 * statistics.median(append), "read_ms": 1e3 * statistics.median(read)}
 
 
 def table(r: dict) -> str:
@@ -55,4 +79,6 @@ def table(r: dict) -> str:
         f"  append, one shot per transaction   {r['single_shots_per_s']:8.0f} shots/s",
         f"  verify (fletcher32 + sha256)       {r['verify_shots_per_s']:8.0f} shots/s",
         f"  read back (codes + metadata)       {r['read_shots_per_s']:8.0f} shots/s",
-        f"  file size                          {r['bytes_per_shot'] / 1e3:8.1f} kB/shot"])
+        f"  file size                          {r['bytes_per_shot'] / 1e3:8.1f} kB/shot",
+        *(f"  holding {n:>7,} shots: one-shot append {h['append_ms']:6.1f} ms, read one shot {h['read_ms']:5.1f} ms"
+          for n, h in r.get("held", {}).items())])

@@ -39,17 +39,17 @@ def cmd_verify(args) -> dict:
 
 
 def cmd_upgrade(args) -> dict:
-    """Rewrite an archive of an older layout in the current one (one transaction); in one of
-    the current layout sealed before the root's member lists were, record them."""
+    """Rewrite an archive of an older layout (1 or 2) in the current one, layout 3 (one
+    transaction); "members_recorded": the root's member lists are recorded now and were not."""
     from instruments.archive import Archive
 
     archive = Archive(args.archive)
+    listed = archive.lists_members()
     n = archive.upgrade()
-    members = n == 0 and archive.record_members()
+    members = n > 0 and not listed
     if not args.json:
         print(f"{args.archive}: {n} shots rewritten in the current layout" if n else
-              f"{args.archive}: the root's member lists recorded (its shots were in the current layout)" if members
-              else f"{args.archive}: already in the current layout")
+              f"{args.archive}: already in the current layout")
     return {"archive": args.archive, "upgraded": n, "members_recorded": members}
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 import hashlib
 
 from instruments.archive import Entry
-from instruments.facts import GaugeFact, ShotFacts
+from instruments.archive.facts import GaugeFact, ShotFacts
 from rig import __version__
 from rig.experiment.shot import ShotRecord
 

@@ -56,10 +56,10 @@ def test_verify_names_an_added_and_a_deleted_object(tmp_path, capsys):
         del f["shot_000003/data/CH2"]  # once named only through data/time@REFERENCE_LIST
     assert main(["verify", str(path)]) == 1
     out = capsys.readouterr().out.splitlines()
-    assert out[0] == f"{path}: 3 shots, 1 ok, 2 bad (4 problems)", out
-    assert out[1:4] == ["  archive: added: /foo", "  shot 2: missing: /shot_000002",
-                        "  shot 3: missing: /shot_000003/data/CH2"], out
-    assert out[4].startswith("  shot 3: /shot_000003/data/time@REFERENCE_LIST: damaged"), out
+    # layout 3 attaches no dimension scales: no reference list that the deletion changes
+    assert out[0] == f"{path}: 3 shots, 1 ok, 2 bad (3 problems)", out
+    assert out[1:] == ["  archive: added: /foo", "  shot 2: missing: /shot_000002",
+                       "  shot 3: missing: /shot_000003/data/CH2"], out
 
 def test_real_files_import_into_the_same_layout(tmp_path, capsys, realdata):
     path = str(tmp_path / "real.h5")
@@ -166,18 +166,21 @@ def test_verify_names_the_shot_and_the_dataset_of_a_flip(tmp_path, capsys):
     rig = Rig.from_scene("steel21_gravity")
     path = tmp_path / "f.h5"
     Archive(path).append([shot_entry(rig.fire(seed=s)) for s in (1, 2)])
-    pristine = path.read_bytes()
-    with h5py.File(path, "r") as f:
-        time_chunk = f["shot_000002/data/time"].id.get_chunk_info(0).byte_offset
+    with h5py.File(path, "r") as f:  # layout 3: the chunks lie in the part file the links lead to
+        time = f["shot_000002/data/time"]
+        time_chunk, part = time.id.get_chunk_info(0).byte_offset, time.file.filename
         shared = f["shot_000001/truth/forces/upper_average_force"]
         forces_chunk, forces_name = shared.id.get_chunk_info(0).byte_offset, shared.name
         key = next(k for k in f["shared"] if f["shared"][k]["forces"] == f["shot_000001/truth/forces"])
-    _flip(path, time_chunk + 40)  # the time axis: once unprotected, now fletcher32 and SHA-256
+        del time, shared  # an object of a part file keeps that file open (and its chunks cached) after the master
+    part = Path(part)  # the file flipped; verify is given the archive (its master)
+    pristine = part.read_bytes()
+    _flip(part, time_chunk + 40)  # the time axis: once unprotected, now fletcher32 and SHA-256
     assert main(["verify", str(path)]) == 1
     out = capsys.readouterr().out
     assert "2 shots, 1 ok, 1 bad" in out and "shot 2: /shot_000002/data/time:" in out
-    path.write_bytes(pristine)
-    _flip(path, forces_chunk + 40)  # the shared truth: named once, with the shots that use it
+    part.write_bytes(pristine)
+    _flip(part, forces_chunk + 40)  # the shared truth: named once, with the shots that use it
     assert main(["verify", str(path), "--json"]) == 1
     report = json.loads(capsys.readouterr().out)
     assert report["ok"] == 0 and len(report["bad"]) == 1, report

@@ -67,7 +67,7 @@ def whole(path: Path):
     assert path.stat().st_size > 0, f"{path}: empty"
     if kind == ".h5":
         with h5py.File(path, "r") as f:
-            archive = f.attrs.get("creator") == "sonic-rig" and f.attrs.get("layout_version") == 2
+            archive = f.attrs.get("creator") == "sonic-rig" and f.attrs.get("layout_version") in (2, 3)
         if archive:
             assert Archive(path).verify()["bad"] == [], path
     elif kind == ".isf":

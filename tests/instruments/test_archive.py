@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from instruments.archive import Archive, Entry
+from instruments.archive.facts import GaugeFact, ShotFacts
 from instruments.errors import InstrumentError
-from instruments.facts import GaugeFact, ShotFacts
 from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 
 SCOPE = Oscilloscope(channels={c: ChannelSettings(volts_per_div=0.05) for c in ("CH1", "CH2", "CH3")},
@@ -149,9 +149,10 @@ def test_flipped_byte_in_a_data_chunk_is_reported_with_the_shot(tmp_path):
     path = tmp_path / "c.h5"
     a = Archive(path)
     a.append([entry(s, truth=False) for s in range(3)])
-    with h5py.File(path) as f:
-        offset = f["shot_000002/instrument/oscilloscope/CH2"].id.get_chunk_info(0).byte_offset
-    with open(path, "r+b") as fh:
+    with h5py.File(path) as f:  # layout 3: the chunk lies in the part file the shot's link leads to
+        d = f["shot_000002/instrument/oscilloscope/CH2"]
+        offset, holder = d.id.get_chunk_info(0).byte_offset, d.file.filename
+    with open(holder, "r+b") as fh:
         fh.seek(offset + 100)
         b = fh.read(1)
         fh.seek(offset + 100)
@@ -212,7 +213,7 @@ def test_files_open_with_plain_h5py_and_xarray(tmp_path):
     with h5py.File(path, "r") as f:
         g = f["shot_000001"]
         assert g.attrs["NX_class"] == "NXentry" and g["data"].attrs["signal"] == "CH1"
-        assert g["seed"][()] == 5 and "volts = y_zero" in f.attrs["layout"] and f.attrs["layout_version"] == 2
+        assert g["seed"][()] == 5 and "volts = y_zero" in f.attrs["layout"] and f.attrs["layout_version"] == 3
         assert g["title"][()].decode() == "synthetic seed 5" and g["start_time"][()].decode().startswith("20")
         for name, obj in _all_datasets(g):
             assert obj.ndim == 0 or (obj.fletcher32 and obj.chunks), name  # arrays carry fletcher32

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from instruments.archive import Archive, Entry
+from instruments.archive.facts import GaugeFact, ShotFacts
 from instruments.errors import InstrumentError
-from instruments.facts import GaugeFact, ShotFacts
 from instruments.records import Preamble, ScopeRecord, Waveform
 
 FLIPS = 240
@@ -28,8 +28,8 @@ def tiny_entry(seed: int, truth: bool = True, n: int = 96) -> Entry:
 
 
 def h5py_view(path) -> dict:
-    """Everything h5py reads from the file: {path or path@attribute: value as bytes}; a
-    read that fails is a value too."""
+    """Everything h5py reads from the archive, its external links followed (layout 3's
+    part files): {path or path@attribute: value as bytes}; a read that fails is a value too."""
     import h5py
 
     view = {}
@@ -50,6 +50,19 @@ def h5py_view(path) -> dict:
             for k in f.attrs:
                 view[f"/@{k}"] = _bytes(f.attrs[k])
             f.visititems(visit)
+            for top in ("", "shared/"):  # visititems does not follow external links: each link's tree
+                try:
+                    names = list(f[top] if top else f)
+                except Exception:  # noqa: BLE001 - no /shared, or an unreadable one: the visit above tells
+                    names = []
+                for name in names:
+                    try:
+                        obj = f[top + name]
+                        visit(top + name, obj)
+                        if isinstance(obj, h5py.Group):
+                            obj.visititems(lambda n, o, p=top + name: visit(f"{p}/{n}", o))
+                    except Exception as exc:  # noqa: BLE001
+                        view[f"/{top}{name}"] = f"error {type(exc).__name__}".encode()
     except Exception as exc:  # noqa: BLE001
         view["<file>"] = f"error {type(exc).__name__}".encode()
     return view
@@ -97,18 +110,25 @@ def _named(changed: set, bad: list, path) -> bool:
     return any("truth/forces" in c and any("/shared/" in w for w in wheres) for c in changed)
 
 
+def archive_files(path) -> list:
+    """The files of an archive (layout 3: its master, then its part files), relative to its folder."""
+    return [path.name] + sorted(str(p.relative_to(path.parent)) for p in path.parent.glob(path.name + ".d/*.h5"))
+
+
 @pytest.fixture(scope="module")
 def pristine(tmp_path_factory):
-    path = tmp_path_factory.mktemp("flips") / "a.h5"
+    path = tmp_path_factory.mktemp("flips") / "f.h5"
     a = Archive(path)
     a.append([tiny_entry(1), tiny_entry(2)])
     a.append([tiny_entry(3), tiny_entry(4, truth=False)])
     assert a.verify() == {"shots": 4, "ok": 4, "bad": []}
-    return path.read_bytes(), h5py_view(path), xarray_view(path)
+    return {n: (path.parent / n).read_bytes() for n in archive_files(path)}, h5py_view(path), xarray_view(path)
 
 
 def test_random_byte_flips_are_found_and_named_and_never_crash(pristine, tmp_path):
-    data, view, xview = pristine
+    files, view, xview = pristine
+    data = b"".join(files.values())  # the archive's bytes: its master, then its parts
+    starts = np.cumsum([0] + [len(b) for b in files.values()])
     rng = np.random.default_rng(20261123)
     offsets = rng.integers(0, len(data), FLIPS)
     masks = rng.integers(1, 256, FLIPS)
@@ -118,7 +138,11 @@ def test_random_byte_flips_are_found_and_named_and_never_crash(pristine, tmp_pat
     for offset, mask in zip(offsets, masks):
         damaged = bytearray(data)
         damaged[offset] ^= int(mask)
-        path.write_bytes(bytes(damaged))
+        for p in path.parent.glob(path.name + ".d/*.h5"):
+            p.unlink()  # the part of the last append after a flip
+        for (name, _), start, end in zip(files.items(), starts, starts[1:]):
+            (tmp_path / name).parent.mkdir(exist_ok=True)
+            (tmp_path / name).write_bytes(bytes(damaged[start:end]))
         now = h5py_view(path)
         changed = {k for k in set(view) | set(now) if view.get(k) != now.get(k)}
         if not changed:  # xarray reads through h5py: asked where h5py sees no change

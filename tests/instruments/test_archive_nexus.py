@@ -61,8 +61,9 @@ def test_names_classes_and_entry_fields(archive):
 def test_the_auxiliary_signals_are_covered_by_the_digests(archive, tmp_path):
     import shutil
 
-    copy = tmp_path / "copy.h5"
+    copy = tmp_path / archive.name  # an archive is its master and its folder of parts, copied together
     shutil.copy(archive, copy)
+    shutil.copytree(archive.with_name(archive.name + ".d"), copy.with_name(copy.name + ".d"))
     assert Archive(copy).verify()["bad"] == []
     with h5py.File(copy, "r+") as f:
         f["shot_000001/data"].attrs["auxiliary_signals"] = ["CH3"]

@@ -9,8 +9,8 @@ import pytest
 from test_archive import entry
 
 from instruments.archive import Archive
+from instruments.archive.facts import FACTS_VERSION, GaugeFact, ShotFacts
 from instruments.errors import InstrumentError
-from instruments.facts import FACTS_VERSION, GaugeFact, ShotFacts
 
 FACTS = ShotFacts(1e-7, {"upper": GaugeFact(20, "CH1", 0.0901, 0.95, 0.96),
                          "lower": GaugeFact(29, "CH2", 0.1328, 0.96, 0.97)},
@@ -126,7 +126,7 @@ def _rewrite_facts(f, text: str):
 
 
 def test_facts_and_entries_need_no_h5py():
-    code = ("import sys, instruments.facts, instruments.archive; "
+    code = ("import sys, instruments.archive.facts, instruments.archive; "
             "print('h5py' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.stdout.strip() == "False", out.stderr

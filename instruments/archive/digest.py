@@ -4,7 +4,9 @@ A group's table (``checksums``, a JSON text dataset in the group) has one row pe
 its tree, in sorted order: ``path`` -> the SHA-256 of a dataset's dtype, shape and values,
 ``path@name`` -> the SHA-256 of an attribute's value, ``path/`` -> that of a group's member
 names. A hard link to an object that another table covers (the truth shared by the shots
-of one scene) is a row ``link:<path>`` instead. Object references (the dimension scales of
+of one scene) is a row ``link:<path>`` instead; an HDF5 external link (layout 3: a shot
+whose scene was stored by an earlier transaction, in another part file) is the row
+``link:<path> in <file>``, read from the link itself, never followed. Object references (the dimension scales of
 xarray and netCDF) are hashed as the paths they point to. The group's attribute ``sha256``
 is the SHA-256 of the table's text, so a damaged table is found too.
 
@@ -16,6 +18,8 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,76 +36,106 @@ def sha(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def address(obj) -> int:
-    """The object's address in the file: equal for every hard link to it."""
+def address(obj) -> tuple:
+    """The object's file and address in it: equal for every hard link to it, and for the
+    paths that reach it through external links (layout 3's part files)."""
     import h5py
 
-    return h5py.h5o.get_info(obj.id).addr
+    return os.path.normpath(h5py.h5f.get_name(obj.id).decode()), h5py.h5o.get_info(obj.id).addr
+
+
+def external(g, name: str) -> str | None:
+    """The row of ``g[name]`` where it is an HDF5 external link ("link:/shared/k/x in
+    part.h5"), else None; the link is not followed."""
+    import h5py
+
+    link = g.get(name, getlink=True)
+    return f"link:{link.path} in {link.filename}" if isinstance(link, h5py.ExternalLink) else None
 
 
 def paths(group: h5py.Group, linked: dict) -> dict:
     """{address: path inside ``group``} of every object, the first path in sorted order;
     objects in ``linked`` (address -> the covering table's path) are not entered."""
+    out = {address(group): "."}
+    _enter(group, "", out, linked)
+    return out
+
+
+def _enter(g, prefix: str, out: dict, linked: dict):
+    """paths(): the objects below ``g``, depth first in sorted order (a module function, not
+    a closure: a recursive closure's cycle would keep the groups, and their part files, open)."""
     import h5py
 
-    out = {address(group): "."}
-
-    def walk(g, prefix):
-        for name in sorted(g):
-            try:
-                obj = g[name]
-                a = address(obj)
-            except Exception:  # noqa: BLE001 - table() reports it
-                continue
-            if a in out or a in linked:
-                continue
-            out[a] = prefix + name
-            if isinstance(obj, h5py.Group):
-                walk(obj, prefix + name + "/")
-
-    walk(group, "")
-    return out
+    for name in sorted(g):
+        if external(g, name):
+            continue
+        try:
+            obj = g[name]
+            a = address(obj)
+        except Exception:  # noqa: BLE001 - table() reports it
+            continue
+        if a in out or a in linked:
+            continue
+        out[a] = prefix + name
+        if isinstance(obj, h5py.Group):
+            _enter(obj, prefix + name + "/", out, linked)
 
 
 def table(group: h5py.Group, linked: dict) -> dict:
     """The rows of ``group``'s table as the file reads now. An item that cannot be read
     gets the row ``unreadable: <cause>`` (never an exception)."""
+    where = paths(group, linked)
+    rows = {}
+    _walk(group, "", _Tree(group, where, {**where, **linked}, linked, rows))
+    return rows
+
+
+@dataclass(frozen=True)
+class _Tree:
+    """What table()'s walk reads and fills: the sealed group, {address: path} inside it and
+    with the linked objects, the linked objects, the rows."""
+
+    group: object
+    where: dict
+    names: dict
+    linked: dict
+    rows: dict
+
+
+def _attrs(obj, path: str, t: _Tree):
+    for key in sorted(obj.attrs):
+        if obj is t.group and key == DIGEST:
+            continue
+        t.rows[f"{path}@{key}"] = _guard(lambda: _attr_digest(obj, key, t.names))
+
+
+def _walk(g, prefix: str, t: _Tree):
     import h5py
 
-    where = paths(group, linked)
-    names = {**where, **linked}
-    rows = {}
-
-    def attrs(obj, path):
-        for key in sorted(obj.attrs):
-            if obj is group and key == DIGEST:
-                continue
-            rows[f"{path}@{key}"] = _guard(lambda: _attr_digest(obj, key, names))
-
-    def walk(g, prefix):
-        members = sorted(n for n in g if n != TABLE or g is not group)
-        rows[prefix or "/"] = sha(json.dumps(members).encode())
-        attrs(g, prefix.rstrip("/"))
-        for name in members:
-            path = prefix + name
-            try:
-                obj = g[name]
-                a = address(obj)
-            except Exception as exc:  # noqa: BLE001 - a damaged link or header is a finding
-                rows[path] = f"unreadable: {_first_line(exc)}"
-                continue
-            if a in linked:
-                rows[path] = "link:" + linked[a]
-            elif where.get(a) != path:
-                rows[path] = "link:./" + where.get(a, "?")
-            elif isinstance(obj, h5py.Group):
-                walk(obj, path + "/")
-            else:
-                rows[path] = _guard(lambda: _dataset_digest(obj))
-                attrs(obj, path)
-
-    walk(group, "")
-    return rows
+    members = sorted(n for n in g if n != TABLE or g is not t.group)
+    t.rows[prefix or "/"] = sha(json.dumps(members).encode())
+    _attrs(g, prefix.rstrip("/"), t)
+    for name in members:
+        path = prefix + name
+        link = external(g, name)
+        if link:
+            t.rows[path] = link
+            continue
+        try:
+            obj = g[name]
+            a = address(obj)
+        except Exception as exc:  # noqa: BLE001 - a damaged link or header is a finding
+            t.rows[path] = f"unreadable: {_first_line(exc)}"
+            continue
+        if a in t.linked:
+            t.rows[path] = "link:" + t.linked[a]
+        elif t.where.get(a) != path:
+            t.rows[path] = "link:./" + t.where.get(a, "?")
+        elif isinstance(obj, h5py.Group):
+            _walk(obj, path + "/", t)
+        else:
+            t.rows[path] = _guard(lambda: _dataset_digest(obj))
+            _attrs(obj, path, t)
 
 
 def seal(group: h5py.Group, linked: dict):

@@ -1,5 +1,5 @@
 """Checking an open archive: the root's attributes and member lists, each shared group once,
-then each shot, against their tables of SHA-256 checksums (instruments/archive_digest.py).
+then each shot, against their tables of SHA-256 checksums (instruments/archive/digest.py).
 Every problem is a row naming the shot (or the shots of a shared group) and the dataset or
 attribute; an object added or deleted anywhere is named by its path ("added: /foo",
 "missing: /shot_000003/data/CH2"); a damaged file gives rows, never an exception.
@@ -8,7 +8,8 @@ The root's table has two versions. Version 1 (archives written before the member
 recorded): the attribute ``checksums``, {attribute: SHA-256} of the root's other attributes.
 Version 2 adds the attribute ``members``, the names in the root group and in ``/shared`` (the
 two groups that no table of their own covers); its SHA-256 is a row of ``checksums`` like
-any attribute's. An archive without ``members`` is checked as version 1; its next append
+any attribute's. A layout-3 master lists its shots as ranges of ids (``"shot_ids": [[1,
+10000]]``, ``compact``), so that the attribute an append rewrites stays small. An archive without ``members`` is checked as version 1; its next append
 (or ``rig upgrade``) writes version 2."""
 from __future__ import annotations
 
@@ -16,19 +17,21 @@ import json
 import re
 from typing import TYPE_CHECKING
 
-from .archive_digest import TABLE, address, damage, linked_groups, sha
+from .digest import TABLE, address, damage, linked_groups, sha
 
 if TYPE_CHECKING:
     import h5py
 
 ROOT_TABLE = "checksums"  # root attribute: {attribute: SHA-256} of the root's other attributes
 MEMBERS = "members"  # root attribute (version 2): {"/": root's member names, "/shared": shared's}
-_ADDED = "not in the table of checksums"  # how archive_digest.damage words an added item
+_ADDED = "not in the table of checksums"  # how digest.damage words an added item
 
 
-def root_seal(f: h5py.File):
-    """Write the root's member lists and its table (after its other attributes)."""
-    f.attrs[MEMBERS] = json.dumps(_members(f), sort_keys=True)
+def root_seal(f: h5py.File, members: dict | None = None):
+    """Write the root's member lists (``members``, {"/": names, "/shared": names}, or its
+    ``compact`` form, where the writer knows them: a large root is not walked) and its table
+    (after its other attributes)."""
+    f.attrs[MEMBERS] = json.dumps(members or _members(f), sort_keys=True)
     f.attrs[ROOT_TABLE] = json.dumps(_root_rows(f), sort_keys=True)
 
 
@@ -51,7 +54,7 @@ def member_changes(f: h5py.File) -> tuple:
     not the one the root's table holds), what no checksum covers is named instead
     (``uncovered``)."""
     try:
-        stored = _member_list(f)
+        stored = member_list(f)
     except ValueError:  # its own row (root_damage) says it is missing or damaged
         return uncovered(f), []
     if stored is None:
@@ -68,7 +71,28 @@ def member_changes(f: h5py.File) -> tuple:
     return [p for p in added if not drop(p)], [p for p in missing if not drop(p)]
 
 
-def _member_list(f) -> dict | None:
+def compact(members: dict) -> dict:
+    """``members`` with the root's shot names as ranges of ids, ``"shot_ids": [[first, last],
+    ...]`` (the form a layout-3 master records)."""
+    ids = sorted(int(n[5:]) for n in members["/"] if re.fullmatch(r"shot_\d{6}", n))
+    ranges = []
+    for i in ids:
+        if ranges and ranges[-1][1] == i - 1:
+            ranges[-1][1] = i
+        else:
+            ranges.append([i, i])
+    return {**members, "/": [n for n in members["/"] if not re.fullmatch(r"shot_\d{6}", n)], "shot_ids": ranges}
+
+
+def _expanded(stored: dict) -> dict:
+    """A recorded member list with its ranges of shot ids (``compact``) as names again."""
+    if "shot_ids" not in stored:
+        return stored
+    names = [f"shot_{i:06d}" for first, last in stored["shot_ids"] for i in range(int(first), int(last) + 1)]
+    return {**{k: v for k, v in stored.items() if k != "shot_ids"}, "/": sorted([*stored.get("/", []), *names])}
+
+
+def member_list(f) -> dict | None:
     """The root's recorded member lists ({group: names}); None for a version-1 table.
     ValueError where they are missing though the root's table names them, unreadable, or
     not what the root's table holds the SHA-256 of."""
@@ -88,7 +112,10 @@ def _member_list(f) -> dict | None:
         raise ValueError(f"@{MEMBERS} unreadable ({_line(exc)})") from None
     if not isinstance(stored, dict):
         raise ValueError(f"@{MEMBERS} is not a JSON object")
-    return stored
+    try:
+        return _expanded(stored)
+    except Exception as exc:  # noqa: BLE001 - ranges that are not pairs of numbers
+        raise ValueError(f"@{MEMBERS} unreadable ({_line(exc)})") from None
 
 
 def uncovered(f: h5py.File) -> list:
@@ -174,7 +201,7 @@ def check(f: h5py.File) -> dict:
 
 
 def named(problems: list, prefix: str) -> list:
-    """archive_digest.damage's lines for the group at ``prefix``, with each object added or
+    """digest.damage's lines for the group at ``prefix``, with each object added or
     deleted (a dataset, or a group: its member-list row "X/") named once by its path
     ("missing: /shot_000003/data/CH2") and the lines it alone explains left out: the member
     list of its group, its own attributes and members."""

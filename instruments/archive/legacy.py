@@ -11,10 +11,10 @@ from __future__ import annotations
 import json
 from typing import TYPE_CHECKING
 
-from .archive_layout import Entry, raw_digest
-from .errors import InstrumentError
+from ..errors import InstrumentError
+from ..records import Preamble, ScopeRecord, Waveform
 from .facts import ShotFacts
-from .records import Preamble, ScopeRecord, Waveform
+from .layout import Entry, raw_digest
 
 if TYPE_CHECKING:
     import h5py

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
 
-from .errors import InstrumentError
+from ..errors import InstrumentError
 
 FACTS_VERSION = 1
 

@@ -5,7 +5,7 @@ The layout (version 2; ``LAYOUT`` below, also stored in the file) is NeXus: vali
 NX_class on every group, ``title`` and ``start_time`` on every entry, signal/axes/units on
 every NXdata, volts and seconds as floats in ``data/``. Every array dataset is chunked with
 the fletcher32 checksum; every group's tree (values and attributes) is in its table of
-SHA-256 checksums (instruments/archive_digest.py).
+SHA-256 checksums (instruments/archive/digest.py).
 """
 from __future__ import annotations
 
@@ -18,10 +18,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .archive_digest import address, seal
-from .errors import InstrumentError
+from ..errors import InstrumentError
+from ..records import Preamble, ScopeRecord, Waveform
+from .digest import address, seal
 from .facts import ShotFacts
-from .records import Preamble, ScopeRecord, Waveform
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened: Entry alone does not need it
     import h5py
@@ -100,12 +100,23 @@ def shared_name(e: Entry, shot_id: int) -> str:
     return "scene_" + re.sub(r"\W", "_", e.truth_key) if e.truth_key else f"of_shot_{shot_id:06d}"
 
 
-def write_entry(f: h5py.File, shot_id: int, e: Entry, checked: set):
+def write_entry(f: h5py.File, shot_id: int, e: Entry, checked: set, stored: dict | None = None):
     """Write one NXentry, then seal its table of checksums; ``checked`` holds the shared
-    groups already compared this transaction."""
+    groups already compared this transaction. ``stored`` (layout 3, a part file; {key: (part
+    file, group)}) names the shared groups an earlier transaction wrote into another part,
+    which the entry links to with HDF5 external links; in a part, the axes are dimension
+    scales attached to nothing (h5netcdf reads an attached scale's reference in the file it
+    opened, the master, where it does not lie; it gives an unattached variable the
+    dimension of its length in its group: ``time``)."""
+    attach = stored is None
     where = f"shot {shot_id}"
     facts = _facts_json(e, f"{where}: facts") if e.truth is not None else None
-    shared = _shared(f, shared_name(e, shot_id), e, where, checked)
+    key = shared_name(e, shot_id)
+    if stored and key in stored:
+        members, linked = _stored(key, e, where, checked, *stored[key])
+    else:
+        shared = _shared(f, key, e, where, checked, attach)
+        members, linked = shared, {address(o): o.name for o in _objects(shared)}
     g = f.create_group(f"shot_{shot_id:06d}")
     g.attrs.update({"NX_class": "NXentry", "default": "data"})
     start = e.start_time or datetime.now(timezone.utc).isoformat()
@@ -123,32 +134,54 @@ def write_entry(f: h5py.File, shot_id: int, e: Entry, checked: set):
         g.create_dataset("no_trigger_reason", data=e.record.reason)
     g.create_dataset("program_name", data="sonic-rig").attrs["version"] = e.project_version
     g.create_dataset("raw_sha256", data=raw_digest(e.record))
-    g["scene_text"] = shared["scene_text"]
-    g["settings"] = shared["settings"]
-    _write_record(g, e.record)
+    g["scene_text"] = members["scene_text"]
+    g["settings"] = members["settings"]
+    _write_record(g, e.record, attach)
     if e.truth is not None:
         tg = _group(g, "truth", "NXcollection")
         tg.create_dataset("facts", data=facts)
-        tg["forces"] = shared["forces"]  # one hard link to the arrays stored once per scene
-    seal(g, {address(o): o.name for o in _objects(shared)})
+        tg["forces"] = members["forces"]  # one link to the arrays stored once per scene
+    seal(g, linked)
 
 
-def _shared(f, key: str, e: Entry, where: str, checked: set):
+def _texts(e: Entry) -> dict:
+    return {"scene_text": e.scene_text, "settings": json.dumps(e.settings, default=_jsonable, sort_keys=True)}
+
+
+def _compare(s, key: str, e: Entry, where: str):
+    for name, text in _texts(e).items():
+        if s[name][()].decode() != text:
+            raise InstrumentError(f"{where}: shared/{key}/{name} differs from this shot's {name}")
+
+
+def _stored(key: str, e: Entry, where: str, checked: set, part: str, s) -> tuple:
+    """External links to shared/<key> in the part file ``part`` (``s``: that group, read),
+    and no linked objects (an external link is its own row in the table)."""
+    import h5py
+
+    if key not in checked:
+        _compare(s, key, e, where)
+        if e.truth is not None and "forces" not in s:
+            raise InstrumentError(f"{where}: shared/{key} was stored without truth forces; this shot has them "
+                                  "(give it another truth_key)")
+        checked.add(key)
+    names = ["scene_text", "settings"] + (["forces"] if e.truth is not None else [])
+    return {n: h5py.ExternalLink(part, f"/shared/{key}/{n}") for n in names}, {}
+
+
+def _shared(f, key: str, e: Entry, where: str, checked: set, attach: bool):
     """shared/<key>: scene text, settings and truth forces, stored once per scene."""
     root = _group(f, "shared", "NXcollection")
-    texts = {"scene_text": e.scene_text, "settings": json.dumps(e.settings, default=_jsonable, sort_keys=True)}
+    texts = _texts(e)
     if key in root and key not in checked:
-        s = root[key]
-        for name, text in texts.items():
-            if s[name][()].decode() != text:
-                raise InstrumentError(f"{where}: shared/{key}/{name} differs from this shot's {name}")
+        _compare(root[key], key, e, where)
     s = _group(root, key, "NXcollection")
     fresh = "checksums" not in s
     for name, text in texts.items():
         if name not in s:
             s.create_dataset(name, data=text)
     if e.truth is not None and "forces" not in s:
-        _write_forces(s, e, where)
+        _write_forces(s, e, where, attach)
         fresh = True
     if fresh:
         if "checksums" in s:
@@ -158,7 +191,7 @@ def _shared(f, key: str, e: Entry, where: str, checked: set):
     return s
 
 
-def _write_forces(s, e: Entry, where: str):
+def _write_forces(s, e: Entry, where: str, attach: bool):
     names = list(e.truth)
     bad = [n for n in names if not NAME.match(n) or n in ("time", "sample")]
     if bad:
@@ -178,10 +211,11 @@ def _write_forces(s, e: Entry, where: str):
     for name in names:
         d = forces.create_dataset(name, data=np.asarray(e.truth[name], dtype=np.float64), **_chunks(n))
         d.attrs["units"] = "N"
-        d.dims[0].attach_scale(axis)
+        if attach:
+            d.dims[0].attach_scale(axis)
 
 
-def _write_record(g, record: ScopeRecord):
+def _write_record(g, record: ScopeRecord, attach: bool):
     scope = _group(_group(g, "instrument", "NXinstrument"), "oscilloscope", "NXcollection")
     data = _group(g, "data", "NXdata")
     chans = sorted(record.waveforms)
@@ -197,10 +231,13 @@ def _write_record(g, record: ScopeRecord):
         values = raw_values(w)
         raw = scope.create_dataset(name, data=values, **_chunks(values.size))
         raw.attrs.update({"units": "counts" if w.codes is not None else p.y_unit, "preamble": _preamble_json(w)})
-        raw.dims[0].attach_scale(_axis(scope, "sample", p.points, None))
+        sample = _axis(scope, "sample", p.points, None)
         volts = data.create_dataset(name, data=np.asarray(w.volts(), dtype=np.float64), **_chunks(values.size))
         volts.attrs.update({"units": p.y_unit, "long_name": f"{ch} ({p.y_unit})"})
-        volts.dims[0].attach_scale(_axis(data, "time", p.points, p))
+        time = _axis(data, "time", p.points, p)
+        if attach:
+            raw.dims[0].attach_scale(sample)
+            volts.dims[0].attach_scale(time)
 
 
 def _axis(group, base: str, n: int, p: Preamble | None):
@@ -244,7 +281,7 @@ def _facts_json(e: Entry, where: str) -> str:
     if e.facts is None:
         return "{}"
     if not isinstance(e.facts, ShotFacts):
-        raise InstrumentError(f"{where} = {type(e.facts).__name__}: expected ShotFacts (instruments.facts) or None")
+        raise InstrumentError(f"{where} = {type(e.facts).__name__}: expected ShotFacts (instruments.archive.facts) or None")
     text = json.dumps(e.facts.to_dict(), default=_jsonable)
     ShotFacts.from_dict(json.loads(text), where)
     return text

@@ -1,24 +1,27 @@
-"""Reading one NXentry of the current layout (instruments/archive_layout.py) back into
+"""Reading one NXentry of the current layout (instruments/archive/layout.py) back into
 the Entry it was written from: the same scope records (codes, preamble with its point
 format, channel names), facts and truth. The checksums are checked by the caller
-(instruments/archive.py)."""
+(instruments/archive/__init__.py)."""
 from __future__ import annotations
 
 import json
 from dataclasses import fields
 from typing import TYPE_CHECKING
 
-from .archive_layout import Entry
-from .errors import InstrumentError
+from ..errors import InstrumentError
+from ..records import Preamble, ScopeRecord, Waveform
+from .digest import linked_groups
 from .facts import ShotFacts
-from .records import Preamble, ScopeRecord, Waveform
+from .layout import Entry
 
 if TYPE_CHECKING:
     import h5py
 
 
-def read_entry(g: h5py.Group, path, with_truth: bool = True) -> Entry:
-    """The Entry of an NXentry of layout 2 (its checksums are checked by the caller)."""
+def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False) -> Entry:
+    """The Entry of an NXentry of layout 2 (its checksums are checked by the caller); with
+    ``keyed``, its truth_key that of the scene's shared group it links to (``rig upgrade``
+    keeps the shots of one scene sharing one group)."""
     shot_id = int(g.name.rsplit("_", 1)[1])
     where = f"{path}: shot {shot_id}"
     waves = {}
@@ -44,8 +47,10 @@ def read_entry(g: h5py.Group, path, with_truth: bool = True) -> Entry:
             forces = g["truth/forces"]
             axis = forces.attrs["axes"][0]
             truth = {k: v[()] for k, v in forces.items() if k != axis}
+    keys = sorted(k for k in linked_groups(g, "/shared/") if k.startswith("scene_")) if keyed else []
     return Entry(record, bool(g["simulated"][()]), int(g["seed"][()]) if "seed" in g else None,
-                 _text(g, "scene"), _text(g, "scene_text"), json.loads(_text(g, "settings")), truth, facts, None,
+                 _text(g, "scene"), _text(g, "scene_text"), json.loads(_text(g, "settings")), truth, facts,
+                 keys[0].removeprefix("scene_") if keys else None,
                  _text(g, "start_time"), g["program_name"].attrs["version"], shot_id,
                  g["start_time"].attrs["source"], _text(g, "file_modification_time"), _text(g, "title"))
 

@@ -1,0 +1,94 @@
+"""Layout 3: a master of external links and one part file per transaction. An append writes
+its own part and a new master and copies nothing already stored; a part no master names (a
+writer killed between its two renames) is replaced; a missing part is named by verify with
+its shots; a layout-2 archive is converted by ``rig upgrade`` with every value kept."""
+import shutil
+from pathlib import Path
+
+import h5py
+import pytest
+from test_archive_flips import tiny_entry
+
+from instruments.archive import Archive
+
+OLD = Path(__file__).parent / "data" / "root_digest_v1.h5"  # layout 2, written by the code before layout 3
+
+
+def _parts(path: Path) -> dict:
+    return {p.name: p.read_bytes() for p in sorted(path.parent.glob(path.name + ".d/*.h5"))}
+
+
+def test_an_append_writes_its_own_part_and_leaves_the_others_untouched(tmp_path):
+    path = tmp_path / "a.h5"
+    a = Archive(path)
+    assert a.append([tiny_entry(1), tiny_entry(2)]) == [1, 2]
+    before = _parts(path)
+    assert a.append([tiny_entry(3)]) == [3] and a.append([tiny_entry(4, truth=False), tiny_entry(5)]) == [4, 5]
+    after = _parts(path)
+    assert list(after) == ["shots_000001.h5", "shots_000003.h5", "shots_000004.h5"]
+    assert after["shots_000001.h5"] == before["shots_000001.h5"]  # written once, never changed
+    with h5py.File(path, "r") as f:
+        assert f.attrs["layout_version"] == 3
+        link = f.get("shot_000005", getlink=True)
+        assert isinstance(link, h5py.ExternalLink) and link.filename == "a.h5.d/shots_000004.h5"
+        # shot 5's scene was stored by the first part: its truth is that part's, not a copy
+        assert f["shot_000005/truth/forces"].file.filename.endswith("shots_000001.h5")
+        assert sorted(f["shared"]) == ["of_shot_000004", "scene_tiny"]
+    assert path.stat().st_size < 20_000  # the master holds links, not shots
+    assert a.verify() == {"shots": 5, "ok": 5, "bad": []}
+    assert a.read(5).seed == 5 and a.read(5).truth["wall_force"][0] == 1.0
+
+
+def test_a_part_that_no_master_names_is_replaced_by_the_next_append(tmp_path):
+    path = tmp_path / "a.h5"
+    a = Archive(path)
+    a.append([tiny_entry(1)])
+    orphan = path.parent / "a.h5.d" / "shots_000002.h5"
+    orphan.write_bytes(b"a part renamed into place by a writer killed before its master")
+    assert a.ids() == [1] and a.verify()["bad"] == []  # no master names it: readers never see it
+    assert a.append([tiny_entry(2)]) == [2]
+    assert a.verify() == {"shots": 2, "ok": 2, "bad": []} and a.read(2).seed == 2
+
+
+def test_a_missing_part_is_named_with_its_shots_and_a_copy_with_its_folder_verifies(tmp_path):
+    path = tmp_path / "a.h5"
+    a = Archive(path)
+    a.append([tiny_entry(1)])
+    a.append([tiny_entry(2), tiny_entry(3)])
+    copy = tmp_path / "elsewhere" / "a.h5"
+    copy.parent.mkdir()
+    shutil.copy(path, copy)
+    shutil.copytree(path.parent / "a.h5.d", copy.parent / "a.h5.d")
+    assert Archive(copy).verify() == {"shots": 3, "ok": 3, "bad": []}
+    (path.parent / "a.h5.d" / "shots_000002.h5").unlink()
+    report = a.verify()
+    assert report["shots"] == 3 and report["ok"] == 1
+    assert sorted({b["shot"] for b in report["bad"]}) == [2, 3], report["bad"]
+    assert all("\n" not in b["reason"] for b in report["bad"])
+
+
+def test_upgrade_converts_layout_2_keeping_every_shot_and_its_sharing(tmp_path):
+    a = Archive(tmp_path / "old.h5")
+    shutil.copyfile(OLD, a.path)
+    with h5py.File(a.path, "r") as f:
+        assert f.attrs["layout_version"] == 2
+        shared = sorted(f["shared"])
+    before, entries = a.digests(), [a.read(i) for i in a.ids()]
+    assert a.upgrade() == len(entries) and a.upgrade() == 0
+    with h5py.File(a.path, "r") as f:
+        assert f.attrs["layout_version"] == 3 and sorted(f["shared"]) == shared
+    assert a.digests() == before and a.verify()["bad"] == []
+    for e in entries:
+        back = a.read(e.shot_id)
+        assert (back.seed, back.settings, back.scene_text, back.start_time) == \
+            (e.seed, e.settings, e.scene_text, e.start_time)
+    assert a.append([tiny_entry(7)]) == [max(before) + 1]
+
+
+@pytest.mark.parametrize("layout", [2, 3])
+def test_readers_read_layouts_2_and_3(tmp_path, layout):
+    a = Archive(tmp_path / "a.h5")
+    shutil.copyfile(OLD, a.path)
+    if layout == 3:
+        a.upgrade()
+    assert [a.read(i).shot_id for i in a.ids()] == a.ids() and len(a.summary()) == len(a.ids())
