@@ -242,3 +242,23 @@ def flag_lines(flags: dict) -> list:
     for figure, reason in flags.items():
         why.setdefault(reason, []).append(figure)
     return [f"flagged {', '.join(figures)}: {reason}" for reason, figures in why.items()]
+
+
+def compile_cold(command: str, task: str) -> None:
+    """On a cold numba cache (a new install, a changed kernel): start compiling the
+    instruments' kernels of ``task`` ("shot" or "study") in a side process while this one
+    compiles the solver's, and say so in one line on stderr. Nothing on a warm cache."""
+    from instruments.jit import has_machine_code
+    from instruments.precompile import start
+
+    if task == "shot":
+        from rig.solver.kernels.integrators import integrate as solver
+    else:
+        from rig.solver.kernels.ensemble import integrate_ensemble as solver
+    cold_solver = not has_machine_code(solver)
+    aside = start(task)
+    parts = (["the chain solver"] if cold_solver else []) + (["the instruments (in a second process)"] if aside
+                                                               else [])
+    if parts:
+        print(f"rig {command}: numba is compiling {' and '.join(parts)}, once: later runs load the machine code "
+              f"from its cache", file=sys.stderr, flush=True)
