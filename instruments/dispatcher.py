@@ -23,14 +23,15 @@ class OneTypePerArgument(CPUDispatcher):
         return super().get_call_template(tuple(unliteral(a) for a in args),
                                          {k: unliteral(v) for k, v in kws.items()})
 
-    def _compile_for_args(self, *args, **kws):
-        """A first call from Python: if a side process compiles this kernel
-        (instruments/precompile.py), wait until numba's cache holds its machine code (or that
-        process has ended); numba then loads it from there."""
+    def compile(self, sig):
+        """Compile (or load from numba's cache) the copy for ``sig``, called from Python or
+        from a kernel being compiled. If a side process compiles this kernel
+        (instruments/precompile.py), first wait until the cache holds its machine code (or
+        that process has ended)."""
         side = SIDE_COMPILES.get(f"{self.py_func.__module__}.{self.py_func.__qualname__}")
         while side is not None and side.poll() is None and not has_machine_code(self):
             time.sleep(POLL_S)
-        return super()._compile_for_args(*args, **kws)
+        return super().compile(sig)
 
 
 SIDE_COMPILES: dict = {}  # {module.kernel: the side process (subprocess.Popen) compiling it}

@@ -246,19 +246,18 @@ def flag_lines(flags: dict) -> list:
 
 def compile_cold(command: str, task: str) -> None:
     """On a cold numba cache (a new install, a changed kernel): start compiling the
-    instruments' kernels of ``task`` ("shot" or "study") in a side process while this one
-    compiles the solver's, and say so in one line on stderr. Nothing on a warm cache."""
+    instruments' kernels of ``task`` ("shot") and a part of the solver's in a side process
+    while this one compiles the rest, and say so in one line on stderr. Nothing on a warm
+    cache."""
     from instruments.jit import has_machine_code
-    from instruments.precompile import start
+    from instruments.precompile import SHOT, start
+    from rig.solver.cold import SIDE
+    from rig.solver.kernels.integrators import integrate
 
-    if task == "shot":
-        from rig.solver.kernels.integrators import integrate as solver
-    else:
-        from rig.solver.kernels.ensemble import integrate_ensemble as solver
-    cold_solver = not has_machine_code(solver)
-    aside = start(task)
-    parts = (["the chain solver"] if cold_solver else []) + (["the instruments (in a second process)"] if aside
-                                                               else [])
+    kernels = {"shot": {**SIDE, **SHOT}}[task]
+    cold_solver = not has_machine_code(integrate)
+    aside = start(kernels)
+    parts = (["the chain solver"] if cold_solver else []) + (["the instruments"] if aside else [])
     if parts:
-        print(f"rig {command}: numba is compiling {' and '.join(parts)}, once: later runs load the machine code "
-              f"from its cache", file=sys.stderr, flush=True)
+        print(f"rig {command}: numba is compiling {' and '.join(parts)}{' (in two processes)' if aside else ''}, "
+              f"once: later runs load the machine code from its cache", file=sys.stderr, flush=True)
