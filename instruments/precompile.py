@@ -31,6 +31,16 @@ SHOT = {f"{PACKAGE}.pulses.leading_pair": f"({F1}, {F1}, {F1}, float64, float64,
         f"{PACKAGE}.pulses.conditioned": f"({F1}, int64, float64, float64, float64)",
         f"{PACKAGE}.pulses.noise_level": f"({F1}, int64, float64)",
         f"{PACKAGE}.pulses.first_peak": f"({F1},)"}
+B1, I1, I8 = "boolean[::1]", "int64[::1]", "int8[:, :, ::1]"
+F3 = "float64[:, :, ::1]"
+# and those a study's batches call (its nominal shot calls SHOT's): the acquisition and the analysis of many shots
+STUDY = {f"{PACKAGE}.acquisition.shots": f"(int64, int64, {I1}, {F3}, float64, {F1}, {F3}, "
+                                         f"Tuple(({F1}, {F1}, {B1}, {F1}, {B1}, {F2}, {F1})), "
+                                         f"Tuple(({I1}, {F1}, {F2}, {F2}, int64, float64, boolean, int64, float64, "
+                                         f"{F1}, {F1}, {F1}, {F1}, float64, float64, boolean)), {B1}, int64, {I1}, "
+                                         f"{I8}, boolean[:, ::1], {I1}, {F2}, {F3})",
+         f"{PACKAGE}.batch_analysis.analyse_shots": f"({I8}, {I1}, {F2}, float64, int64, {F1}, {F1}, {F1}, {I1}, "
+                                                   f"{F1}, {F1}, UniTuple(float64, 7), {F2}, {F2}, {B1})"}
 
 
 def needs_compiling(kernels: dict) -> bool:
@@ -57,9 +67,13 @@ def start(kernels: dict) -> bool:
 
 
 def compile_now(kernels: dict) -> None:
-    """Compile ``kernels`` in this process, in their order (numba caches each, with its callees)."""
+    """Compile ``kernels`` in this process, in their order (numba caches each, with its callees),
+    each for the tuple of its argument types: numba's cache keys a copy on what ``compile``
+    was given, and the main process looks it up by that tuple."""
+    from numba.core.sigutils import normalize_signature
+
     for name, signature in kernels.items():
-        kernel(name).compile(signature)
+        kernel(name).compile(normalize_signature(signature)[0])
 
 
 def kernel(name: str):

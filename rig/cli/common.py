@@ -246,16 +246,17 @@ def flag_lines(flags: dict) -> list:
 
 def compile_cold(command: str, task: str) -> None:
     """On a cold numba cache (a new install, a changed kernel): start compiling the
-    instruments' kernels of ``task`` ("shot") and a part of the solver's in a side process
-    while this one compiles the rest, and say so in one line on stderr. Nothing on a warm
-    cache."""
+    instruments' kernels of ``task`` ("shot" or "study") and a part of the solver's in a side
+    process while this one compiles the rest, and say so in one line on stderr. Nothing on a
+    warm cache."""
     from instruments.jit import has_machine_code
-    from instruments.precompile import SHOT, start
+    from instruments.precompile import SHOT, STUDY, start
     from rig.solver.cold import SIDE
+    from rig.solver.kernels.ensemble import integrate_ensemble
     from rig.solver.kernels.integrators import integrate
 
-    kernels = {"shot": {**SIDE, **SHOT}}[task]
-    cold_solver = not has_machine_code(integrate)
+    kernels = {**SIDE, **SHOT, **(STUDY if task == "study" else {})}
+    cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_ensemble)))
     aside = start(kernels)
     parts = (["the chain solver"] if cold_solver else []) + (["the instruments"] if aside else [])
     if parts:
