@@ -58,3 +58,15 @@ def test_rounds_reach_the_benchmark(monkeypatch, what, argv, expected):
         assert seen[key] == value, key
     if what == "mc" and "--rounds" not in argv:
         assert "rounds" not in seen  # mc.run's own default
+
+
+def test_startup_cold_takes_rounds_and_a_baseline(monkeypatch):
+    """rig bench startup --cold runs the cold benchmark (rig/bench/cold_start.py) with the
+    rounds and the baseline given (the run itself replaced)."""
+    from rig.bench import cold_start
+    from rig.cli import main
+
+    seen = {}
+    monkeypatch.setattr(cold_start, "run", lambda **kw: seen.update(kw) or {})
+    assert main(["bench", "startup", "--cold", "--rounds", "2", "--baseline", "HEAD", "--json"]) == 0
+    assert seen == {"rounds": 2, "baseline": "HEAD"}
