@@ -52,9 +52,10 @@ def _declare(function, options: dict):
 
 def has_machine_code(dispatcher) -> bool:
     """Whether numba's on-disk cache holds machine code of ``dispatcher`` (a ``jit``
-    kernel) for this machine and its current source, for any signature."""
-    cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
-    return cache_file is not None and bool(cache_file._load_index())
+    kernel) for this machine and its current source, for any signature. True where numba
+    keeps no such cache (nothing to compile ahead then: a command compiles as it goes)."""
+    load_index = getattr(getattr(getattr(dispatcher, "_cache", None), "_cache_file", None), "_load_index", None)
+    return load_index is None or bool(load_index())
 
 
 def kernel(function=None, **options):

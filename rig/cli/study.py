@@ -39,7 +39,7 @@ def cmd_mc(args) -> dict:
             print(f"Sobol design over {len(dists)} inputs: {shots} shots "
                   f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
         held = min(study.batch, study.shots)  # the shots a batch holds at once
-        compile_cold("mc", "study")
+        compile_cold("mc", "study", args.quiet)
         rig = nominal(study.scene, study.overrides).rig
         rig.check_record()  # settings that can give no record (or a made-up one) are refused before any solve
         whole = rig.estimate(controlled=False).times(study.shots, held)
