@@ -23,9 +23,9 @@ def cmd_shot(args) -> dict:
     from rig.experiment.measure import shot_blocks
     from rig.experiment.shot import Rig
 
-    compile_cold("shot", "shot")
     rig = Rig(scene)
     check_size(rig.estimate(), args, "this shot")
+    compile_cold("shot", "shot")  # after the refusals that need no kernel: a refused shot leaves no side process
     shot = rig.fire(seed=args.seed)
     out = shot_summary(rig, shot)
     out.update(shot_blocks(rig, shot))
