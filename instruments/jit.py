@@ -29,12 +29,33 @@ OPTIONS = {"cache": True, "fastmath": False}
 
 def jit(function=None, **options):
     """numba's njit with the project's options; ``@jit`` or ``@jit(parallel=True)``. numba
-    is loaded here, by the first module that declares a kernel."""
-    from numba import njit
+    is loaded here, by the first module that declares a kernel.
 
+    A call from another kernel is typed by its arguments' plain types (one compiled copy
+    per array layout, not one per constant argument: instruments/dispatcher.py)."""
     if function is None:
-        return lambda f: njit(**OPTIONS, **options)(f)
-    return njit(**OPTIONS)(function)
+        return lambda f: _declare(f, options)
+    return _declare(function, {})
+
+
+def _declare(function, options: dict):
+    """``function`` as a cached ``OneTypePerArgument`` dispatcher with njit's target
+    options and ``options``."""
+    from instruments.dispatcher import OneTypePerArgument
+
+    targetoptions = {"nopython": True, "boundscheck": None, "fastmath": OPTIONS["fastmath"], **options}
+    dispatcher = OneTypePerArgument(py_func=function, locals={}, targetoptions=targetoptions)
+    if OPTIONS["cache"]:
+        dispatcher.enable_caching()
+    return dispatcher
+
+
+def has_machine_code(dispatcher) -> bool:
+    """Whether numba's on-disk cache holds machine code of ``dispatcher`` (a ``jit``
+    kernel) for this machine and its current source, for any signature. True where numba
+    keeps no such cache (nothing to compile ahead then: a command compiles as it goes)."""
+    load_index = getattr(getattr(getattr(dispatcher, "_cache", None), "_cache_file", None), "_load_index", None)
+    return load_index is None or bool(load_index())
 
 
 def kernel(function=None, **options):

@@ -46,11 +46,13 @@ def _commands(folder: Path) -> dict:
             "rig shot ptfe52_magnetic --seed 1": [sys.executable, "-c", RIG, "shot", "ptfe52_magnetic", "--seed", "1"]}
 
 
-def timed_child(cmd: list, cwd: str | None = None, check: bool = True) -> tuple:
-    """(wall s, CPU s (the child's user + system), its stdout) of one run of ``cmd``."""
+def timed_child(cmd: list, cwd: str | None = None, check: bool = True, env: dict | None = None) -> tuple:
+    """(wall s, CPU s (the child's user + system), its stdout) of one run of ``cmd`` (in
+    environment ``env``; None: this process's)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    done = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, check=check)
+    done = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, check=check,
+                          env=env)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), done.stdout

@@ -242,3 +242,24 @@ def flag_lines(flags: dict) -> list:
     for figure, reason in flags.items():
         why.setdefault(reason, []).append(figure)
     return [f"flagged {', '.join(figures)}: {reason}" for reason, figures in why.items()]
+
+
+def compile_cold(command: str, task: str, quiet: bool = False) -> None:
+    """On a cold numba cache (a new install, a changed kernel): start compiling the
+    instruments' kernels of ``task`` ("shot" or "study") and a part of the solver's in a side
+    process while this one compiles the rest, and say so in one line on stderr when it is a
+    terminal (a log or a test keeps a failure's one error line alone) and not ``quiet``.
+    Nothing on a warm cache."""
+    from instruments.jit import has_machine_code
+    from instruments.precompile import SHOT, STUDY, start
+    from rig.solver.cold import SIDE
+    from rig.solver.kernels.ensemble import integrate_ensemble
+    from rig.solver.kernels.integrators import integrate
+
+    kernels = {**SIDE, **SHOT, **(STUDY if task == "study" else {})}
+    cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_ensemble)))
+    aside = start(kernels)
+    parts = (["the chain solver"] if cold_solver else []) + (["the instruments"] if aside else [])
+    if parts and not quiet and sys.stderr.isatty():
+        print(f"rig {command}: numba is compiling {' and '.join(parts)}{' (in two processes)' if aside else ''}, "
+              f"once: later runs load the machine code from its cache", file=sys.stderr, flush=True)

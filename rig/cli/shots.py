@@ -1,8 +1,8 @@
 """`rig shot` and `rig animate`: one virtual shot, summarised, exported or rendered."""
 from __future__ import annotations
 
-from rig.cli.common import (check_archive_out, check_export_folder, check_size, flag_lines, missing_lines,
-                            progress_bar, scene_overrides, writing_to)
+from rig.cli.common import (check_archive_out, check_export_folder, check_size, compile_cold, flag_lines,
+                            missing_lines, progress_bar, scene_overrides, writing_to)
 from rig.errors import RigError, invalid
 
 
@@ -25,6 +25,7 @@ def cmd_shot(args) -> dict:
 
     rig = Rig(scene)
     check_size(rig.estimate(), args, "this shot")
+    compile_cold("shot", "shot")  # after the refusals that need no kernel: a refused shot leaves no side process
     shot = rig.fire(seed=args.seed)
     out = shot_summary(rig, shot)
     out.update(shot_blocks(rig, shot))

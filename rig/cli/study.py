@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from rig.cli.common import check_size, progress_bar, scene_overrides, writing_to
+from rig.cli.common import check_size, compile_cold, progress_bar, scene_overrides, writing_to
 from rig.errors import invalid
 
 
@@ -39,6 +39,7 @@ def cmd_mc(args) -> dict:
             print(f"Sobol design over {len(dists)} inputs: {shots} shots "
                   f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
         held = min(study.batch, study.shots)  # the shots a batch holds at once
+        compile_cold("mc", "study", args.quiet)
         rig = nominal(study.scene, study.overrides).rig
         rig.check_record()  # settings that can give no record (or a made-up one) are refused before any solve
         whole = rig.estimate(controlled=False).times(study.shots, held)

@@ -76,15 +76,21 @@ def cmd_theory(args) -> dict:
 def cmd_bench(args) -> dict:
     import importlib
 
-    module = importlib.import_module(f"rig.bench.{args.what}")
+    module = importlib.import_module("rig.bench.cold_start" if args.what == "startup" and args.cold
+                                     else f"rig.bench.{args.what}")
     if args.quick and args.what not in ("solver", "accuracy", "models", "fit"):
         raise RigError(f"--quick: only rig bench solver, accuracy, models and fit have a quick form (not {args.what})")
     if args.peers and args.what != "solver":
         raise RigError(f"--peers: only rig bench solver has peers (not {args.what})")
-    if args.baseline and args.what not in ("solver", "mc"):
-        raise RigError(f"--baseline {args.baseline}: only rig bench solver and rig bench mc measure a baseline")
-    if args.rounds is not None and args.what not in ("solver", "mc"):
-        raise invalid("--rounds", args.rounds, "only rig bench solver and rig bench mc take rounds")
+    if args.cold and args.what != "startup":
+        raise RigError(f"--cold: only rig bench startup has a cold form (not {args.what})")
+    cold = args.what == "startup" and args.cold
+    if args.baseline and args.what not in ("solver", "mc") and not cold:
+        raise RigError(f"--baseline {args.baseline}: only rig bench solver, rig bench mc and rig bench startup --cold "
+                       f"measure a baseline")
+    if args.rounds is not None and args.what not in ("solver", "mc") and not cold:
+        raise invalid("--rounds", args.rounds, "only rig bench solver, rig bench mc and rig bench startup --cold "
+                                               "take rounds")
     if args.baseline:
         from rig.bench.baseline import check_revision
 
@@ -95,9 +101,9 @@ def cmd_bench(args) -> dict:
               "progress": None if args.json else (lambda msg: print(f"  running {msg}", file=sys.stderr, flush=True))}
     if args.what == "solver":
         kw.update(peers=args.peers, baseline=args.baseline, kernel_rounds=args.rounds)
-    if args.what == "mc" and args.baseline:
+    if (args.what == "mc" or cold) and args.baseline:
         kw["baseline"] = args.baseline
-    if args.what == "mc" and args.rounds is not None:
+    if (args.what == "mc" or cold) and args.rounds is not None:
         kw["rounds"] = args.rounds
     result = module.run(**kw)
     if not args.json:

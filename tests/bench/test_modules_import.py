@@ -83,3 +83,15 @@ def test_the_mc_scaling_table_runs_at_one_and_two_workers(monkeypatch):
     for mode, label in mc_scaling.MODES.items():
         if mode in r["modes"]:
             assert label in text and f"{r['modes'][mode][2]['shots_per_s']:7.0f} (100%)" in text
+
+
+def test_startup_cold_takes_rounds_and_a_baseline(monkeypatch):
+    """rig bench startup --cold runs the cold benchmark (rig/bench/cold_start.py) with the
+    rounds and the baseline given (the run itself replaced)."""
+    from rig.bench import cold_start
+    from rig.cli import main
+
+    seen = {}
+    monkeypatch.setattr(cold_start, "run", lambda **kw: seen.update(kw) or {})
+    assert main(["bench", "startup", "--cold", "--rounds", "2", "--baseline", "HEAD", "--json"]) == 0
+    assert seen == {"rounds": 2, "baseline": "HEAD"}

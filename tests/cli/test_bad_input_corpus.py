@@ -187,6 +187,8 @@ def _flag_cases():
         (["bench", "shot", "--peers"], "--peers"),
         (["bench", "fit", "--baseline", "HEAD"], "--baseline"),
         (["bench", "models", "--rounds", "2"], "--rounds"),
+        (["bench", "shot", "--cold"], "--cold"),
+        (["bench", "startup", "--rounds", "2"], "--rounds"),
         (["analyze", "x.isf", "--shot", "1"], "--shot"),
         (["analyze", "x.isf", "--shot", "-1"], "--shot"),
         (["analyze", "x.isf", "--shot", "1,0"], "--shot"),

@@ -1,0 +1,131 @@
+"""Cold start-up benchmark (``rig bench startup --cold``): the first ``rig shot`` and the
+first ``rig mc`` of a fresh install, where numba has compiled nothing yet, beside the same
+commands once its cache is warm.
+
+Each cold run is a fresh interpreter whose NUMBA_CACHE_DIR is an empty temporary folder
+(every kernel it needs is compiled, as in a new venv or a CI run); the warm runs reuse
+the folder the cold mc filled. Times are wall seconds and the children's CPU seconds
+(user + system: on several cores the compilation spread over processes makes CPU exceed
+wall). The cold shot also reports where its compilation went: each kernel's compile time,
+exclusive of the kernels it calls (numba's ``numba:compile`` events, seconds), the largest
+first. ``--baseline REV`` measures another revision in turns (one revision after the
+other in each round), so both see the same machine load.
+"""
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from rig.bench.startup import timed_child
+from rig.errors import RigError
+
+ROUNDS = 1  # a cold round costs tens of seconds
+TARGETS = {"cold rig shot": 10.0, "cold rig mc": 20.0, "warm rig shot": 1.2}
+SCENE = "ptfe52_magnetic"
+STUDY = ["--vary", "striker.velocity=normal(0.89 m/s, 0.01 m/s)", "--shots", "64", "--batch", "64", "--quiet"]
+# the rig's command line in a child that records each kernel's exclusive compile time into the file $RIG_COMPILE_LOG
+CHILD = """import json, os, sys, time
+from numba.core import event
+stack, spent = [], {}
+class Compiles(event.Listener):
+    def on_start(self, ev):
+        f = ev.data["dispatcher"].py_func
+        stack.append([f"{f.__module__}.{f.__qualname__}", time.perf_counter(), 0.0])
+    def on_end(self, ev):
+        name, t0, inner = stack.pop()
+        dt = time.perf_counter() - t0
+        spent[name] = spent.get(name, 0.0) + dt - inner
+        if stack:
+            stack[-1][2] += dt
+event.register("numba:compile", Compiles())
+from rig.cli import main
+try:
+    code = main(sys.argv[1:])
+finally:
+    with open(os.environ["RIG_COMPILE_LOG"], "w") as fh:
+        json.dump(spent, fh)
+sys.exit(code)
+"""
+
+
+def _run(tree: Path | None, argv: list, cache: Path, log: Path) -> tuple:
+    """(wall s, CPU s, {kernel: exclusive compile s}) of one rig command with numba's cache in ``cache``."""
+    path = [str(tree)] if tree else []
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), RIG_COMPILE_LOG=str(log),
+               PYTHONPATH=os.pathsep.join(path + [os.environ.get("PYTHONPATH", "")]))
+    try:
+        wall, cpu, _ = timed_child([sys.executable, "-c", CHILD, *argv], cwd=str(tree or Path.cwd()), env=env)
+    except subprocess.CalledProcessError as exc:
+        raise RigError(f"rig bench startup --cold: `rig {' '.join(argv)}` failed (exit {exc.returncode})") from None
+    return wall, cpu, json.loads(log.read_text())
+
+
+def measure_revision(tree: Path | None, folder: Path) -> dict:
+    """One round of one revision (``tree``: its checkout; None: this code): cold shot, cold
+    mc, then the warm shot and mc. Seconds, and the cold shot's compile times by kernel."""
+    shot = ["shot", SCENE, "--seed", "1"]
+    cold_shot, cold_mc, log = folder / "cache-shot", folder / "cache-mc", folder / "compiles.json"
+    rows = {}
+    rows["cold rig shot"] = _run(tree, shot, cold_shot, log)
+    rows["cold rig mc"] = _run(tree, ["mc", SCENE, *STUDY, "--out", str(folder / "mc-cold")], cold_mc, log)
+    rows["warm rig shot"] = _run(tree, shot, cold_mc, log)
+    rows["warm rig mc"] = _run(tree, ["mc", SCENE, *STUDY, "--out", str(folder / "mc-warm")], cold_mc, log)
+    return {"wall_s": {k: v[0] for k, v in rows.items()}, "cpu_s": {k: v[1] for k, v in rows.items()},
+            "shot_compiles_s": rows["cold rig shot"][2]}
+
+
+def run(rounds: int = ROUNDS, baseline: str | None = None) -> dict:
+    from rig.bench.baseline import checkout
+
+    revisions = {"current": None}
+    with contextlib.ExitStack() as stack:
+        if baseline:
+            revisions[f"baseline {baseline}"] = stack.enter_context(checkout(baseline))
+        got = {name: [] for name in revisions}
+        for _ in range(rounds):
+            for name, tree in revisions.items():
+                with tempfile.TemporaryDirectory() as tmp:
+                    got[name].append(measure_revision(tree, Path(tmp)))
+    result = {"rounds": rounds, "cores": os.cpu_count(), "scene": SCENE, "study": " ".join(STUDY),
+              "targets_s": TARGETS, "revisions": {}}
+    for name, runs in got.items():
+        commands = runs[0]["wall_s"]
+        compiles = {k: statistics.median(r["shot_compiles_s"].get(k, 0.0) for r in runs)
+                    for k in runs[0]["shot_compiles_s"]}
+        result["revisions"][name] = {
+            "wall_s": {c: statistics.median(r["wall_s"][c] for r in runs) for c in commands},
+            "cpu_s": {c: statistics.median(r["cpu_s"][c] for r in runs) for c in commands},
+            "shot_compile_total_s": sum(compiles.values()),
+            "shot_top_compiles_s": dict(sorted(compiles.items(), key=lambda kv: -kv[1])[:12])}
+    if baseline:
+        cur, base = result["revisions"]["current"], result["revisions"][f"baseline {baseline}"]
+        result["ratio_to_baseline"] = {c: statistics.median(a["wall_s"][c] / b["wall_s"][c]
+                                                            for a, b in zip(got["current"], got[f"baseline {baseline}"]))
+                                       for c in cur["wall_s"]}
+    return result
+
+
+def table(r: dict) -> str:
+    names = list(r["revisions"])
+    lines = [f"cold start: an empty numba cache in a fresh interpreter ({SCENE}; mc: {r['study']}); "
+             f"medians of {r['rounds']} round(s), {r['cores']} cores",
+             f"  {'command':16s}" + "".join(f" {n[:22]:>22s}" for n in names)
+             + (f" {'ratio':>6s}" if "ratio_to_baseline" in r else "") + f" {'target s':>8s}"]
+    for command in r["revisions"]["current"]["wall_s"]:
+        cells = "".join(f" {r['revisions'][n]['wall_s'][command]:9.2f} s ({r['revisions'][n]['cpu_s'][command]:5.1f} CPU)"
+                        for n in names)
+        ratio = f" {r['ratio_to_baseline'][command]:6.2f}" if "ratio_to_baseline" in r else ""
+        target = TARGETS.get(command)
+        lines.append(f"  {command:16s}{cells}{ratio} {'-' if target is None else f'{target:.1f}':>8s}")
+    for n in names:
+        rev = r["revisions"][n]
+        lines.append(f"  {n}: the cold shot's compile time by kernel (exclusive s; {rev['shot_compile_total_s']:.1f} s "
+                     f"in all, in the shot's own process):")
+        lines += [f"    {k:60s} {v:6.2f}" for k, v in rev["shot_top_compiles_s"].items()]
+    return "\n".join(lines)

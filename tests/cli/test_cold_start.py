@@ -1,0 +1,73 @@
+"""A cold start: the first `rig shot` with an empty numba cache says in one line what it
+compiles, compiles the instruments' kernels and a part of the solver's in a side process
+(instruments/precompile.py) and gives the bits of a warm shot; the side process compiles
+exactly the signatures the shot calls (else the main process would compile them again, and
+the side process be waste)."""
+import json
+import os
+import subprocess
+import sys
+
+from numba.core.sigutils import normalize_signature
+
+from instruments.precompile import SHOT, compile_now, kernel
+from rig.cli import main
+
+SHOT_ARGS = ["shot", "ptfe52_magnetic", "--seed", "1", "--json"]
+
+
+# a cold shot in a fresh process, then the side kernels the main process did not load from numba's cache
+# (it compiled them itself, or compiled another copy: a signature out of step)
+COLD_SHOT = ("import json\nfrom instruments.precompile import SHOT, kernel\nfrom rig.cli import main\n"
+             "from rig.solver.cold import SIDE\ncode = main({argv!r})\n"
+             "print(json.dumps(sorted(n for n in {{**SIDE, **SHOT}} if sum(kernel(n).stats.cache_misses.values())\n"
+             "                        or len(kernel(n).signatures) != 1)))")
+
+
+def test_the_side_process_compiles_the_signatures_a_shot_calls_from_python(capsys):
+    compile_now(SHOT)
+    assert main(SHOT_ARGS) in (0, None)
+    for name, signature in SHOT.items():
+        assert kernel(name).signatures == [normalize_signature(signature)[0]], name
+
+
+def test_a_cold_shot_says_what_it_compiles_once_compiles_nothing_twice_and_has_the_warm_bits(tmp_path):
+    warm = subprocess.run([sys.executable, "-m", "rig.cli", *SHOT_ARGS], capture_output=True, text=True, check=True)
+    cold, said = _on_a_terminal([sys.executable, "-c", COLD_SHOT.format(argv=SHOT_ARGS)],
+                                dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path)))
+    lines = said.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("rig shot: numba is compiling the chain solver and the "
+                                                   "instruments (in two processes)"), said
+    *shot, compiled_twice = cold.stdout.strip().splitlines()
+    assert json.loads(compiled_twice) == []
+    assert _bits(json.loads("\n".join(shot))) == _bits(json.loads(warm.stdout))
+    again, said = _on_a_terminal([sys.executable, "-m", "rig.cli", *SHOT_ARGS],
+                                 dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path)))
+    assert said == "" and _bits(json.loads(again.stdout)) == _bits(json.loads(warm.stdout))  # warm now: nothing said
+
+
+def _on_a_terminal(cmd, env):
+    """(the finished process, its stderr) of ``cmd`` run with its stderr on a pseudo-terminal."""
+    import pty
+
+    main_end, child_end = pty.openpty()
+    done = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=child_end, text=True, env=env, check=True)
+    os.close(child_end)
+    said = b""
+    while True:
+        try:
+            chunk = os.read(main_end, 4096)
+        except OSError:  # the terminal's other end is closed: all is read
+            break
+        if not chunk:
+            break
+        said += chunk
+    os.close(main_end)
+    return done, said.decode().replace("\r\n", "\n")
+
+
+def _bits(out):
+    """A shot's JSON less its timings (wall_s)."""
+    if isinstance(out, dict):
+        return {k: _bits(v) for k, v in out.items() if k != "wall_s"}
+    return [_bits(v) for v in out] if isinstance(out, list) else out
