@@ -1,7 +1,7 @@
 """The code blocks of the documentation (README.md and docs/**/*.md), as the docs test runs them.
 
-A fenced ```bash or ```python block may be preceded by HTML comments that say how to
-check it:
+A fenced ```bash or ```python block may be preceded, on the lines right above it, by
+HTML comments that say how to check it:
 
 - ``<!-- slow: WHY -->``: too long for the suite (a full reproduction, a big study, a
   server); its ``rig`` commands are only parsed by the command line's parser, and the test
@@ -21,6 +21,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 FENCE = re.compile(r"^```(\w+)[^\n]*\n(.*?)^```[ \t]*$", re.M | re.S)
+COMMENT_LINE = re.compile(r"^\s*<!--.*-->\s*$")
 MARKER = re.compile(r"<!--\s*(slow|needs|exit|json-keys):\s*(.*?)\s*-->")
 
 
@@ -78,7 +79,11 @@ def blocks(page: str) -> list:
         language = match.group(1)
         if language not in ("bash", "python"):
             continue
-        before = text[:match.start()].rstrip("\n").rsplit("\n\n", 1)[-1]
-        markers = tuple((name, value) for name, value in MARKER.findall(before))
+        above = []  # the comment lines right above the fence
+        for line in reversed(text[:match.start()].splitlines()):
+            if not COMMENT_LINE.match(line):
+                break
+            above.insert(0, line)
+        markers = tuple((name, value) for name, value in MARKER.findall("\n".join(above)))
         found.append(Block(page, text.count("\n", 0, match.start()) + 1, language, match.group(2), markers))
     return found

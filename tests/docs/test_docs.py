@@ -3,10 +3,10 @@ code blocks of README.md and docs/**/*.md run.
 
 - ```bash blocks: each ``rig ...`` command runs as a subprocess (``python -m rig.cli``) in
   a fresh folder per page, blocks in page order, and must exit 0 (or the block's
-  ``<!-- exit: N -->``); ``python docs/...`` scripts run too; other commands (pip, pytest,
-  mkdocs) are listed as not run. A block marked ``<!-- slow: WHY -->`` or
-  ``<!-- needs: WHAT -->`` is checked by the command line's parser only (the command and
-  its flags exist), and listed with its reason.
+  ``<!-- exit: N -->``); ``python docs/...`` scripts run too. Installing, the test suite
+  and building the site (SETUP) are listed as not run; any other command fails the test.
+  A block marked ``<!-- slow: WHY -->`` or ``<!-- needs: WHAT -->`` is checked by the
+  command line's parser only (the command and its flags exist), and listed with its reason.
 - ```python blocks run in that folder, in one namespace per page (a ``needs:`` block is
   compiled only).
 """
@@ -24,6 +24,8 @@ from doc_blocks import ROOT, blocks, pages
 
 PAGES = [page for page in pages() if blocks(page)]
 TIMEOUT = 120  # s per command: the first run of a command compiles numba kernels
+SETUP = (("pip", "install"), ("python", "-m", "pytest"), ("mkdocs", "build"), ("mkdocs", "serve"))
+"""Commands a page may show without the test running them: installing, the test suite, the site."""
 
 
 def _env() -> dict:
@@ -75,7 +77,9 @@ def _bash(block, folder: Path, report: list):
         elif words[0] == "python" and len(words) > 1 and words[1].startswith("docs/"):
             _run([str(ROOT / words[1]), *words[2:]], folder, block.where, 0)
         else:
-            report.append(f"{block.where}: not run (installs or builds, not a rig command): {line[:100]}")
+            assert any(tuple(words[:len(s)]) == s for s in SETUP), (
+                f"{block.where}: {line}: neither a rig command nor python docs/...; the test cannot check it")
+            report.append(f"{block.where}: not run (installs, tests or builds the site): {line[:100]}")
     keys = block.marker("json-keys")
     if keys:
         assert last_json is not None, f"{block.where}: json-keys on a block that runs no rig command"
@@ -106,22 +110,12 @@ def test_code_blocks_run(page, tmp_path, monkeypatch, capsys):
             print(f"\n  {line}", end="")
 
 
-def test_every_page_is_checked():
-    """Each bash block runs or parses at least one rig command, or says why not: a block
-    of only other commands is the quick start's install and test lines."""
-    for page in pages():
-        for block in blocks(page):
-            if block.language == "bash":
-                commands = block.commands()
-                assert commands, f"{block.where}: an empty bash block"
-
-
 def test_site_builds_strict(tmp_path):
     """mkdocs build --strict: a broken link, a page missing from the navigation, a docstring
     mkdocstrings cannot read or a scene key without a meaning fails; the generated reference
     names every command, flag and scene key of the program."""
     site = tmp_path / "site"
-    done = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--quiet", "--config-file",
+    done = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--config-file",
                            str(ROOT / "mkdocs.yml"), "--site-dir", str(site)], cwd=ROOT, env=_env(),
                           capture_output=True, text=True, timeout=300, check=False)
     assert done.returncode == 0, f"mkdocs build --strict failed:\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}"
@@ -143,3 +137,21 @@ def test_site_builds_strict(tmp_path):
         for key in entries:
             if key != "*":
                 assert f"{table}.{key}" in keys, f"{table}.{key}"
+
+
+def test_block_reading(tmp_path, monkeypatch):
+    """A page's markers, continuation lines, comments and ``&&`` are read as the test runs
+    them; a slow block's unknown flag fails the parser check."""
+    import doc_blocks
+
+    page = tmp_path / "page.md"
+    page.write_text('Text.\n\n<!-- slow: a long one -->\n<!-- exit: 1 -->\n```bash\n'
+                    'pip install -e . && rig shot ptfe52_magnetic \\\n    --seed 1   # a comment\n```\n\n'
+                    '```python\nx = 1\n```\n')
+    monkeypatch.setattr(doc_blocks, "ROOT", tmp_path)
+    bash, python = doc_blocks.blocks("page.md")
+    assert (bash.language, python.language) == ("bash", "python")
+    assert bash.not_run == "a long one" and bash.marker("exit") == "1" and python.not_run is None
+    assert bash.commands() == [["pip", "install", "-e", "."], ["rig", "shot", "ptfe52_magnetic", "--seed", "1"]]
+    with pytest.raises(pytest.fail.Exception, match="the parser refuses it"):
+        _parse_only(["shot", "ptfe52_magnetic", "--no-such-flag"], "page.md:5")
