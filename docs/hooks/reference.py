@@ -1,8 +1,9 @@
 """mkdocs hook: the Reference pages written from the code at each build.
 
 - reference/scene-keys.md: every key of rig.experiment.scene.SCHEMA, its unit or type, the
-  contact laws' bounds, defaults and meanings (rig.model.laws LawParameter), the names a
-  key takes (materials, laws, methods), and each key's value in a published scene;
+  contact laws' bounds, defaults and meanings (rig.model.laws LawParameter), the other
+  keys' defaults (the keyword defaults of the classes the assembly builds from each table),
+  the names a key takes (materials, laws, methods), and each key's value in a published scene;
 - reference/commands.md: every command and flag of rig.cli.build_parser();
 - reference/api.md: mkdocstrings pages for the names rig/__init__.py's facade exports and
   every public module of the instruments package;
@@ -50,7 +51,7 @@ MEANINGS = {
     "magnet.force": "the ring magnet's pull on the top bead (a ring hanging on the bead: 2.38 N)",
     "magnet.position": "the ring's position, the pull then taken from the ring's field-gradient profile",
     "magnet.peak_force": "the profile's peak pull, with magnet.position",
-    "magnet.schedule": "the pull varied in time: a list of [time, force] points",
+    "magnet.schedule": "the pull varied in time: a list of [t (s), F (N)] points (one of force, position, schedule)",
     "magnet.hold": "how long the pull rested on the chain before the shot (600 s unless given; read by a yielding law)",
     "holder.bore": "the tube's inner diameter (a bead wider than it is refused)",
     "holder.outer_diameter": "the tube's outer diameter",
@@ -134,6 +135,32 @@ def _example(values: dict, key: str):
     return f"`{node:g}`" if isinstance(node, float) else f"`{node}`"
 
 
+def _constructors() -> dict:
+    """{table: the classes the assembly builds from it} (rig/experiment/assembly.py): a key's
+    default is its keyword's default there."""
+    from instruments.gauges import GaugeSettings
+    from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
+    from rig.experiment.settings import SolverSettings
+    from rig.model.apparatus import Holder, RingMagnet
+    from rig.model.parts import Striker, Wall
+
+    return {"holder": (Holder,), "striker": (Striker,), "magnet": (RingMagnet,), "wall": (Wall,),
+            "wall_sensor": (GaugeSettings,), "gauges.NAME": (GaugeSettings,), "scope": (Oscilloscope, Timebase),
+            "scope.trigger": (Trigger,), "scope.channels.CHn": (ChannelSettings,), "solver": (SolverSettings,)}
+
+
+def _default(constructors: dict, key: str) -> str:
+    """The default of a scene key, from the keyword of the class built from its table; ""
+    where there is none (the key is required, or None: computed, or absent)."""
+    table, name = key.rsplit(".", 1)
+    for cls in constructors.get(table, ()):
+        parameter = inspect.signature(cls).parameters.get(name)
+        if parameter is not None and parameter.default not in (inspect.Parameter.empty, None):
+            value = parameter.default
+            return f"`{value:g}`" if isinstance(value, float) else f"`{value}`"
+    return ""
+
+
 def scene_keys() -> str:
     from rig.experiment.scene import SCHEMA, load
     from rig.model.laws import CONTACT_LAWS, PARAMETERS
@@ -141,6 +168,7 @@ def scene_keys() -> str:
     from rig.solver.methods import METHODS
 
     example = load(EXAMPLE_SCENE).values
+    constructors = _constructors()
     allowed = {"chain.material": _names(MATERIALS), "striker.material": _names(MATERIALS),
                "wall.material": _names(MATERIALS), "chain.contact_law": _names(CONTACT_LAWS),
                "solver.method": _names(METHODS)}
@@ -153,7 +181,7 @@ def scene_keys() -> str:
             bounds = f"{lo}{law.lo:g}, {'inf' if math.isinf(law.hi) else format(law.hi, 'g')}]"
             rows.append((key, unit, bounds, f"`{law.default:g}`", law.doc))
         elif key in MEANINGS:
-            rows.append((key, _kind(spec), allowed.get(key, ""), "", MEANINGS[key]))
+            rows.append((key, _kind(spec), allowed.get(key, ""), _default(constructors, key), MEANINGS[key]))
         else:
             missing.append(key)
     if missing:
@@ -165,9 +193,12 @@ def scene_keys() -> str:
         "is built. A quantity is written with its unit (`\"0.89 m/s\"`); a plain number given to "
         "`--set` is taken in the key's SI unit. Unknown keys, a quantity without its unit and a value "
         "outside its range are refused, naming the key.", "",
-        "Bounds and defaults are the code's where it keeps them as data (the contact laws' keys); for "
-        f"the others, *in {EXAMPLE_SCENE}* shows the value of the published scene `{EXAMPLE_SCENE}`, and "
-        "the checks the assembly makes are named in the one-line refusal a bad value gets.", "",
+        "The contact laws' bounds and defaults are their LawParameters'; the other defaults are the "
+        "keyword defaults of the classes the assembly builds from each table (`Holder`, `Striker`, "
+        "`RingMagnet`, `Wall`, `GaugeSettings`, `Oscilloscope`, `Timebase`, `Trigger`, `ChannelSettings`, "
+        "`SolverSettings`), blank where a key is required or computed when left out. The other keys' "
+        "bounds are checked where the parts are built, and a bad value's one-line refusal names them. "
+        f"*in {EXAMPLE_SCENE}* is the value in the published scene `{EXAMPLE_SCENE}`.", "",
         f"| key | unit or type | bounds or names | default | in {EXAMPLE_SCENE} | meaning |",
         "|---|---|---|---|---|---|",
     ]
