@@ -32,6 +32,7 @@ def _env() -> dict:
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [env.get("PYTHONPATH")])])
     env.setdefault("MPLBACKEND", "Agg")
+    env.setdefault("NO_MKDOCS_2_WARNING", "1")  # mkdocs-material's banner about its successor
     return env
 
 
@@ -155,3 +156,17 @@ def test_block_reading(tmp_path, monkeypatch):
     assert bash.commands() == [["pip", "install", "-e", "."], ["rig", "shot", "ptfe52_magnetic", "--seed", "1"]]
     with pytest.raises(pytest.fail.Exception, match="the parser refuses it"):
         _parse_only(["shot", "ptfe52_magnetic", "--no-such-flag"], "page.md:5")
+
+
+def test_readme_links_resolve():
+    """The README is not a page of the site, so mkdocs does not check its links: every
+    relative link and picture names a file of the repository."""
+    import re
+
+    readme = (ROOT / "README.md").read_text()
+    targets = re.findall(r"\]\(([^)#\s]+)[^)]*\)", readme)
+    local = [t for t in targets if "://" not in t]
+    assert len(local) >= 10, local  # the picture and the links to the pages
+    missing = [t for t in local if not (ROOT / t).exists()]
+    assert not missing, f"README.md links to files that do not exist: {missing}"
+    assert len(readme.splitlines()) <= 200, "the README is at most 200 lines; the rest goes to docs/"
