@@ -7,7 +7,7 @@ code blocks of README.md and docs/**/*.md run.
   and building the site (SETUP) are listed as not run; any other command fails the test.
   A block marked ``<!-- slow: WHY -->`` or ``<!-- needs: WHAT -->`` is checked by the
   command line's parser only (the command and its flags exist). What is not run is listed
-  with its reason in pytest's warnings summary (NotRun).
+  with its reason in pytest's warnings summary.
 - ```python blocks run in that folder, in one namespace per page (a ``needs:`` block is
   compiled only).
 """
@@ -100,11 +100,6 @@ def _python(block, folder: Path, namespace: dict, report: list, monkeypatch):
     exec(code, namespace)  # noqa: S102 - the documentation's own example
 
 
-class NotRun(UserWarning):
-    """The commands of a page that were checked but not run, with why: pytest lists them in
-    its warnings summary (also under pytest-xdist), so none is skipped silently."""
-
-
 @pytest.mark.parametrize("page", PAGES)
 def test_code_blocks_run(page, tmp_path, monkeypatch):
     report, namespace = [], {"__name__": "__docs__"}
@@ -114,7 +109,9 @@ def test_code_blocks_run(page, tmp_path, monkeypatch):
         else:
             _python(block, tmp_path, namespace, report, monkeypatch)
     if report:
-        warnings.warn(NotRun("\n  ".join(["checked, not run:", *report])), stacklevel=1)
+        # a plain UserWarning, which pytest-xdist's controller can unpickle (a class of this
+        # module it could not import): the warnings summary lists every block not run, with why
+        warnings.warn(UserWarning("\n  ".join([f"{page}: checked, not run:", *report])), stacklevel=1)
 
 
 def test_site_builds_strict(tmp_path):
