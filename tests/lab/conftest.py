@@ -112,9 +112,9 @@ def instrument():
     return EchoInstrument()
 
 
-@pytest.fixture
+@pytest.fixture(scope="module")
 def rm():
-    """pyvisa's resource manager on the pyvisa-py backend."""
+    """pyvisa's resource manager on the pyvisa-py backend, one per test module."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # pyvisa-py warns that no GPIB library is installed
         import pyvisa

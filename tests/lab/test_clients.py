@@ -45,13 +45,6 @@ def mso():
 
 
 @pytest.fixture(scope="module")
-def rm():
-    manager = pyvisa.ResourceManager("@py")
-    yield manager
-    manager.close()
-
-
-@pytest.fixture(scope="module")
 def rig_shots():
     return SceneShots(SCENE)
 

@@ -25,13 +25,6 @@ def served(port111):
         s.stop()
 
 
-@pytest.fixture(scope="module")
-def rm():
-    manager = pyvisa.ResourceManager("@py")
-    yield manager
-    manager.close()
-
-
 def shot_codes(rm, resource: str, channel: str = "CH1") -> tuple:
     """One single-sequence shot through ``resource``: (codes of ``channel``, the overrides it
     was fired with, its seed)."""

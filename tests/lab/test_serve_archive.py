@@ -15,13 +15,6 @@ pyvisa = pytest.importorskip("pyvisa")
 SEED = 40
 
 
-@pytest.fixture(scope="module")
-def rm():
-    manager = pyvisa.ResourceManager("@py")
-    yield manager
-    manager.close()
-
-
 def test_on_command_the_rig_port_fires_and_every_shot_is_archived_and_logged(rm, tmp_path):
     archive, log = tmp_path / "served.h5", tmp_path / "served.log"
     s = Served(SCENE, "--port", "0", "--rig-port", "0", "--fire", "on-command", "--seed", str(SEED),

@@ -43,13 +43,6 @@ def served(port111):
     s.server.close()
 
 
-@pytest.fixture(scope="module")
-def rm():
-    manager = pyvisa.ResourceManager("@py")
-    yield manager
-    manager.close()
-
-
 @pytest.fixture
 def visa(served, rm):
     """A pyvisa session through the portmapper, as a lab script opens one."""
