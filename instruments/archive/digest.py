@@ -81,25 +81,29 @@ def _enter(g, prefix: str, out: dict, linked: dict):
             _enter(obj, prefix + name + "/", out, linked)
 
 
-def table(group: h5py.Group, linked: dict) -> dict:
+def table(group: h5py.Group, linked: dict, written: dict | None = None) -> dict:
     """The rows of ``group``'s table as the file reads now. An item that cannot be read
-    gets the row ``unreadable: <cause>`` (never an exception)."""
+    gets the row ``unreadable: <cause>`` (never an exception). ``written`` ({address: the
+    value_digest of the values a writer has just given a dataset}) spares reading those
+    datasets back: the writer hashes the bytes it wrote, in one pass."""
     where = paths(group, linked)
     rows = {}
-    _walk(group, "", _Tree(group, where, {**where, **linked}, linked, rows))
+    _walk(group, "", _Tree(group, where, {**where, **linked}, linked, rows, written or {}))
     return rows
 
 
 @dataclass(frozen=True)
 class _Tree:
     """What table()'s walk reads and fills: the sealed group, {address: path} inside it and
-    with the linked objects, the linked objects, the rows."""
+    with the linked objects, the linked objects, the rows, the digests of datasets just
+    written (not read back)."""
 
     group: object
     where: dict
     names: dict
     linked: dict
     rows: dict
+    written: dict
 
 
 def _attrs(obj, path: str, t: _Tree):
@@ -134,13 +138,14 @@ def _walk(g, prefix: str, t: _Tree):
         elif isinstance(obj, h5py.Group):
             _walk(obj, path + "/", t)
         else:
-            t.rows[path] = _guard(lambda: _dataset_digest(obj))
+            t.rows[path] = t.written.get(a) or _guard(lambda: _dataset_digest(obj))
             _attrs(obj, path, t)
 
 
-def seal(group: h5py.Group, linked: dict):
-    """Write ``group``'s table and its digest (after everything else in it is written)."""
-    text = json.dumps(table(group, linked), sort_keys=True, indent=0)
+def seal(group: h5py.Group, linked: dict, written: dict | None = None):
+    """Write ``group``'s table and its digest (after everything else in it is written;
+    ``written``: as for table())."""
+    text = json.dumps(table(group, linked, written), sort_keys=True, indent=0)
     group.create_dataset(TABLE, data=text)
     group.attrs[DIGEST] = sha(text.encode())
 
@@ -182,7 +187,12 @@ def linked_groups(group: h5py.Group, under: str) -> set:
 
 
 def _dataset_digest(d) -> str:
-    value = d[()]  # fletcher32 is checked chunk by chunk here
+    return value_digest(d[()])  # fletcher32 is checked chunk by chunk here
+
+
+def value_digest(value) -> str:
+    """The row of a dataset holding ``value`` (a text, or what numpy makes an array of):
+    the SHA-256 of its dtype, shape and bytes; of "s" and its UTF-8 bytes for a text."""
     if isinstance(value, (bytes, str)):
         return sha(b"s" + (value.encode() if isinstance(value, str) else value))
     value = np.asarray(value)
