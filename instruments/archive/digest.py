@@ -150,9 +150,12 @@ def seal(group: h5py.Group, linked: dict, written: dict | None = None):
     group.attrs[DIGEST] = sha(text.encode())
 
 
-def damage(group: h5py.Group, linked: dict) -> list:
+def damage(group: h5py.Group, linked: dict, read=None) -> list:
     """What differs between ``group``'s stored table and the file: a list of
-    "path: what is wrong" lines, empty when every item matches."""
+    "path: what is wrong" lines, empty when every item matches. ``read`` (a test of a row's
+    key, e.g. ``lambda key: not key.startswith("data/")``): only the rows a reader reads are
+    computed, item by item, without walking the rest; where one differs, the whole table is
+    compared and the lines about those rows given."""
     try:
         text = group[TABLE][()]
         text = text.decode() if isinstance(text, bytes) else str(text)
@@ -161,7 +164,16 @@ def damage(group: h5py.Group, linked: dict) -> list:
         stored = json.loads(text)
     except Exception as exc:  # noqa: BLE001
         return [f"{TABLE}: unreadable ({_first_line(exc)})"]
-    now = table(group, linked)
+    if read is not None:
+        keys = [k for k in stored if read(k)]
+        if rows(group, keys, linked, stored) == {k: stored[k] for k in keys}:
+            return []
+        found = _differences(stored, table(group, linked))
+        return [p for p in found if read(p.removeprefix("attribute ").split(": ", 1)[0])] or found
+    return _differences(stored, table(group, linked))
+
+
+def _differences(stored: dict, now: dict) -> list:
     out = []
     for key in sorted(set(stored) | set(now)):
         kind = "attribute " if "@" in key else ""
@@ -173,6 +185,42 @@ def damage(group: h5py.Group, linked: dict) -> list:
             cause = now[key][len("unreadable: "):] if now[key].startswith("unreadable") else "SHA-256 differs"
             out.append(f"{kind}{key}: damaged ({cause})")
     return out
+
+
+def rows(group: h5py.Group, keys: list, linked: dict, stored: dict) -> dict:
+    """The rows ``keys`` of ``group``'s table as the file reads now, each computed alone (no
+    walk over the rest of the group); ``stored``: the table as sealed, which says where a row
+    is a hard link inside the group (only then is the group walked for its paths)."""
+    names = {}
+
+    def where() -> dict:  # {address: path} inside the group and of the linked objects, once
+        if not names:
+            names.update({**paths(group, linked), **linked})
+        return names
+
+    return {key: _guard(lambda: _row(group, key, linked, stored.get(key, ""), where)) for key in keys}
+
+
+def _row(group, key: str, linked: dict, sealed: str, where) -> str:
+    """One row of table() (see _walk), computed alone."""
+    path, at, attr = key.partition("@")
+    path = path.strip("/")
+    if not at and not key.endswith("/"):  # a dataset or a link: an external link is not followed
+        parent, _, name = path.rpartition("/")
+        link = external(group[parent] if parent else group, name)
+        if link:
+            return link
+    obj = group[path] if path else group
+    if at:
+        return _attr_digest(obj, attr, where() if attr in _REFERENCE_ATTRS else {})
+    if key.endswith("/"):  # a group's member names
+        return sha(json.dumps(sorted(n for n in obj if n != TABLE or obj is not group)).encode())
+    a = address(obj)
+    if a in linked:
+        return "link:" + linked[a]
+    if sealed.startswith("link:./"):
+        return "link:./" + where().get(a, "?") if where().get(a) != path else "not a link"
+    return _dataset_digest(obj)
 
 
 def linked_groups(group: h5py.Group, under: str) -> set:
