@@ -191,27 +191,39 @@ def rows(group: h5py.Group, keys: list, linked: dict, stored: dict) -> dict:
     """The rows ``keys`` of ``group``'s table as the file reads now, each computed alone (no
     walk over the rest of the group); ``stored``: the table as sealed, which says where a row
     is a hard link inside the group (only then is the group walked for its paths)."""
-    names = {}
+    names, objects = {}, {"": group}
 
     def where() -> dict:  # {address: path} inside the group and of the linked objects, once
         if not names:
             names.update({**paths(group, linked), **linked})
         return names
 
-    return {key: _guard(lambda: _row(group, key, linked, stored.get(key, ""), where)) for key in keys}
+    def at(path: str):  # each object looked up once (a path lookup costs as much as a small read)
+        if path not in objects:
+            objects[path] = group[path]
+        return objects[path]
+
+    out = {}
+    for key in keys:
+        try:
+            out[key] = _row(at, key, linked, stored.get(key, ""), where)
+        except Exception as exc:  # noqa: BLE001 - damage is reported, never raised
+            out[key] = f"unreadable: {_first_line(exc)}"
+    return out
 
 
-def _row(group, key: str, linked: dict, sealed: str, where) -> str:
-    """One row of table() (see _walk), computed alone."""
-    path, at, attr = key.partition("@")
+def _row(at, key: str, linked: dict, sealed: str, where) -> str:
+    """One row of table() (see _walk), computed alone; ``at(path)``: the object at a path
+    inside the group ("": the group)."""
+    path, is_attr, attr = key.partition("@")
     path = path.strip("/")
-    if not at and not key.endswith("/"):  # a dataset or a link: an external link is not followed
+    if not is_attr and not key.endswith("/"):  # a dataset or a link: an external link is not followed
         parent, _, name = path.rpartition("/")
-        link = external(group[parent] if parent else group, name)
+        link = external(at(parent), name)
         if link:
             return link
-    obj = group[path] if path else group
-    if at:
+    obj, group = at(path), at("")
+    if is_attr:
         return _attr_digest(obj, attr, where() if attr in _REFERENCE_ATTRS else {})
     if key.endswith("/"):  # a group's member names
         return sha(json.dumps(sorted(n for n in obj if n != TABLE or obj is not group)).encode())

@@ -110,7 +110,7 @@ def write_entry(f: h5py.File, shot_id: int, e: Entry, checked: set, stored: dict
     dimension of its length in its group: ``time``)."""
     attach = stored is None
     written = {}  # {address: value_digest} of the datasets this call writes (digest.table)
-    put = lambda parent, name, data, **kw: _put(parent, name, data, written, **kw)  # noqa: E731
+    put = lambda parent, name, data, **kw: _put(parent, name, data, written, **kw)
     where = f"shot {shot_id}"
     facts = _facts_json(e, f"{where}: facts") if e.truth is not None else None
     key = shared_name(e, shot_id)
