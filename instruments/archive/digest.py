@@ -16,6 +16,7 @@ such error is caught and reported against the item that raised.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -86,17 +87,18 @@ def table(group: h5py.Group, linked: dict, written: dict | None = None) -> dict:
     gets the row ``unreadable: <cause>`` (never an exception). ``written`` ({address: the
     value_digest of the values a writer has just given a dataset}) spares reading those
     datasets back: the writer hashes the bytes it wrote, in one pass."""
-    where = paths(group, linked)
     rows = {}
-    _walk(group, "", _Tree(group, where, {**where, **linked}, linked, rows, written or {}))
+    _walk(group, "", _Tree(group, {address(group): "."}, {}, linked, rows, written or {}))
     return rows
 
 
 @dataclass(frozen=True)
 class _Tree:
-    """What table()'s walk reads and fills: the sealed group, {address: path} inside it and
-    with the linked objects, the linked objects, the rows, the digests of datasets just
-    written (not read back)."""
+    """What table()'s walk reads and fills: the sealed group, {address: path} inside it of
+    the objects met so far (the walk and paths() go in one order: the first path met is
+    the first in sorted order), {address: path} of every object inside it and of the linked
+    ones (filled by names(), for the dimension scales' references only), the linked
+    objects, the rows, the digests of datasets just written (not read back)."""
 
     group: object
     where: dict
@@ -110,7 +112,16 @@ def _attrs(obj, path: str, t: _Tree):
     for key in sorted(obj.attrs):
         if obj is t.group and key == DIGEST:
             continue
-        t.rows[f"{path}@{key}"] = _guard(lambda: _attr_digest(obj, key, t.names))
+        refs = names(t) if key in _REFERENCE_ATTRS else {}
+        t.rows[f"{path}@{key}"] = _guard(functools.partial(_attr_digest, obj, key, refs))
+
+
+def names(t) -> dict:
+    """``t.names`` ({address: path} of the whole group and of its linked objects), walked
+    once, where a dimension scale's references are first met."""
+    if not t.names:
+        t.names.update({**paths(t.group, t.linked), **t.linked})
+    return t.names
 
 
 def _walk(g, prefix: str, t: _Tree):
@@ -133,11 +144,13 @@ def _walk(g, prefix: str, t: _Tree):
             continue
         if a in t.linked:
             t.rows[path] = "link:" + t.linked[a]
-        elif t.where.get(a) != path:
-            t.rows[path] = "link:./" + t.where.get(a, "?")
+        elif a in t.where:
+            t.rows[path] = "link:./" + t.where[a]
         elif isinstance(obj, h5py.Group):
+            t.where[a] = path
             _walk(obj, path + "/", t)
         else:
+            t.where[a] = path
             t.rows[path] = t.written.get(a) or _guard(lambda: _dataset_digest(obj))
             _attrs(obj, path, t)
 
@@ -191,12 +204,7 @@ def rows(group: h5py.Group, keys: list, linked: dict, stored: dict) -> dict:
     """The rows ``keys`` of ``group``'s table as the file reads now, each computed alone (no
     walk over the rest of the group); ``stored``: the table as sealed, which says where a row
     is a hard link inside the group (only then is the group walked for its paths)."""
-    names, objects = {}, {"": group}
-
-    def where() -> dict:  # {address: path} inside the group and of the linked objects, once
-        if not names:
-            names.update({**paths(group, linked), **linked})
-        return names
+    t, objects = _Tree(group, {}, {}, linked, {}, {}), {"": group}
 
     def at(path: str):  # each object looked up once (a path lookup costs as much as a small read)
         if path not in objects:
@@ -206,15 +214,15 @@ def rows(group: h5py.Group, keys: list, linked: dict, stored: dict) -> dict:
     out = {}
     for key in keys:
         try:
-            out[key] = _row(at, key, linked, stored.get(key, ""), where)
+            out[key] = _row(at, key, stored.get(key, ""), t)
         except Exception as exc:  # noqa: BLE001 - damage is reported, never raised
             out[key] = f"unreadable: {_first_line(exc)}"
     return out
 
 
-def _row(at, key: str, linked: dict, sealed: str, where) -> str:
+def _row(at, key: str, sealed: str, t: _Tree) -> str:
     """One row of table() (see _walk), computed alone; ``at(path)``: the object at a path
-    inside the group ("": the group)."""
+    inside the group ("": the group); ``sealed``: the row as stored."""
     path, is_attr, attr = key.partition("@")
     path = path.strip("/")
     if not is_attr and not key.endswith("/"):  # a dataset or a link: an external link is not followed
@@ -224,14 +232,14 @@ def _row(at, key: str, linked: dict, sealed: str, where) -> str:
             return link
     obj, group = at(path), at("")
     if is_attr:
-        return _attr_digest(obj, attr, where() if attr in _REFERENCE_ATTRS else {})
+        return _attr_digest(obj, attr, names(t) if attr in _REFERENCE_ATTRS else {})
     if key.endswith("/"):  # a group's member names
         return sha(json.dumps(sorted(n for n in obj if n != TABLE or obj is not group)).encode())
     a = address(obj)
-    if a in linked:
-        return "link:" + linked[a]
+    if a in t.linked:
+        return "link:" + t.linked[a]
     if sealed.startswith("link:./"):
-        return "link:./" + where().get(a, "?") if where().get(a) != path else "not a link"
+        return "link:./" + names(t).get(a, "?") if names(t).get(a) != path else "not a link"
     return _dataset_digest(obj)
 
 
