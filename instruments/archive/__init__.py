@@ -52,7 +52,7 @@ class Archive:
 
     def __init__(self, path):
         self.path = Path(path)
-        self._checked_shared = (None, set())  # (the file's identity, shared groups found intact)
+        self._checked_shared = (None, {})  # (the file's identity, {shared group found intact: its addresses})
 
     # --- writing --------------------------------------------------------------------
     def append(self, entries) -> list:
@@ -285,16 +285,21 @@ class Archive:
         st = os.stat(self.path)
         identity = (st.st_ino, st.st_size, st.st_mtime_ns)  # a new version is a new file (os.replace)
         if self._checked_shared[0] != identity:
-            self._checked_shared = (identity, set())
+            self._checked_shared = (identity, {})
+        sound = self._checked_shared[1]
         for key in sorted(linked_groups(g, "/shared/")):
+            if key in sound:
+                linked.update(sound[key])
+                continue
             s = f["shared"][key]
-            linked.update(addresses(s))
-            problems = [] if key in self._checked_shared[1] else damage(s, {})
+            here = addresses(s)
+            linked.update(here)
+            problems = damage(s, {})
             read = problems if with_truth else [p for p in problems if not _truth_item(p)]
             if read:
                 raise InstrumentError(f"{name}: shared/{key}/{read[0]}")
             if not problems:
-                self._checked_shared[1].add(key)
+                sound[key] = here
         problems = damage(g, linked, read=_read_by_entry)
         if problems:
             raise InstrumentError(f"{name}: {problems[0]}")
