@@ -52,7 +52,7 @@ class Archive:
 
     def __init__(self, path):
         self.path = Path(path)
-        self._checked_shared = (None, {})  # (the file's identity, {shared group found intact: its addresses})
+        self._sound_shared = {}  # {(file, shared group): (the file's identity, its addresses)}, found intact
 
     # --- writing --------------------------------------------------------------------
     def append(self, entries) -> list:
@@ -278,20 +278,20 @@ class Archive:
 
     def _check_shot(self, f, g, with_truth: bool = True):
         """The shot's table, and those of the shared groups it links to (scene text and
-        settings, and the truth's forces where ``with_truth``; once per version of the
-        file): a shot read without its truth is not refused for damaged truth forces, which
-        it does not read."""
+        settings, and the truth's forces where ``with_truth``; once per version of the file
+        that holds them: a part, never changed, or a layout-2 archive, replaced whole by each
+        transaction): a shot read without its truth is not refused for damaged truth forces,
+        which it does not read."""
         linked, name = {}, f"{self.path}: shot {int(g.name.rsplit('_', 1)[1])}"
-        st = os.stat(self.path)
-        identity = (st.st_ino, st.st_size, st.st_mtime_ns)  # a new version is a new file (os.replace)
-        if self._checked_shared[0] != identity:
-            self._checked_shared = (identity, {})
-        sound = self._checked_shared[1]
         for key in sorted(linked_groups(g, "/shared/")):
-            if key in sound:
-                linked.update(sound[key])
-                continue
             s = f["shared"][key]
+            held = s.file.filename
+            st = os.stat(held)
+            identity = (st.st_ino, st.st_size, st.st_mtime_ns)
+            known = self._sound_shared.get((held, key))
+            if known and known[0] == identity:
+                linked.update(known[1])
+                continue
             here = addresses(s)
             linked.update(here)
             problems = damage(s, {})
@@ -299,7 +299,7 @@ class Archive:
             if read:
                 raise InstrumentError(f"{name}: shared/{key}/{read[0]}")
             if not problems:
-                sound[key] = here
+                self._sound_shared[(held, key)] = (identity, here)
         problems = damage(g, linked, read=_read_by_entry)
         if problems:
             raise InstrumentError(f"{name}: {problems[0]}")
