@@ -52,7 +52,7 @@ class Archive:
 
     def __init__(self, path):
         self.path = Path(path)
-        self._checked_shared = (None, set())  # (the file's identity, shared groups found intact)
+        self._sound_shared = {}  # {(file, shared group): (the file's identity, its addresses)}, found intact
 
     # --- writing --------------------------------------------------------------------
     def append(self, entries) -> list:
@@ -258,7 +258,8 @@ class Archive:
 
     def read(self, shot_id: int, verify: bool = True, with_truth: bool = True) -> Entry:
         """The stored shot as the same record objects the scope produces; with ``verify``,
-        its checksums and those of what it shares first."""
+        the checksums of what it returns first (all of the shot's table but its NXdata plot,
+        which ``rig verify`` checks) and of what it shares."""
         with self._open() as f:
             name = f"shot_{shot_id:06d}"
             if name not in f:
@@ -277,24 +278,29 @@ class Archive:
 
     def _check_shot(self, f, g, with_truth: bool = True):
         """The shot's table, and those of the shared groups it links to (scene text and
-        settings, and the truth's forces where ``with_truth``; once per version of the
-        file): a shot read without its truth is not refused for damaged truth forces, which
-        it does not read."""
+        settings, and the truth's forces where ``with_truth``; once per version of the file
+        that holds them: a part, never changed, or a layout-2 archive, replaced whole by each
+        transaction): a shot read without its truth is not refused for damaged truth forces,
+        which it does not read."""
         linked, name = {}, f"{self.path}: shot {int(g.name.rsplit('_', 1)[1])}"
-        st = os.stat(self.path)
-        identity = (st.st_ino, st.st_size, st.st_mtime_ns)  # a new version is a new file (os.replace)
-        if self._checked_shared[0] != identity:
-            self._checked_shared = (identity, set())
         for key in sorted(linked_groups(g, "/shared/")):
             s = f["shared"][key]
-            linked.update(addresses(s))
-            problems = [] if key in self._checked_shared[1] else damage(s, {})
+            held = s.file.filename
+            st = os.stat(held)
+            identity = (st.st_ino, st.st_size, st.st_mtime_ns)
+            known = self._sound_shared.get((held, key))
+            if known and known[0] == identity:
+                linked.update(known[1])
+                continue
+            here = addresses(s)
+            linked.update(here)
+            problems = damage(s, {})
             read = problems if with_truth else [p for p in problems if not _truth_item(p)]
             if read:
                 raise InstrumentError(f"{name}: shared/{key}/{read[0]}")
             if not problems:
-                self._checked_shared[1].add(key)
-        problems = damage(g, linked)
+                self._sound_shared[(held, key)] = (identity, here)
+        problems = damage(g, linked, read=_read_by_entry)
         if problems:
             raise InstrumentError(f"{name}: {problems[0]}")
 
@@ -361,6 +367,12 @@ def _id_range(f) -> str:
 def _fsync_dir(path):
     with contextlib.suppress(OSError):
         _fsync(path)
+
+
+def _read_by_entry(key: str) -> bool:
+    """Whether a row of a shot's table is of what a read returns: all but its NXdata plot
+    (``data/``: the volts and their time axis, computed from the codes and preambles)."""
+    return not key.startswith(("data/", "data@"))
 
 
 def _truth_item(problem: str) -> bool:

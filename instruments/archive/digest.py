@@ -16,6 +16,7 @@ such error is caught and reported against the item that raised.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -81,32 +82,46 @@ def _enter(g, prefix: str, out: dict, linked: dict):
             _enter(obj, prefix + name + "/", out, linked)
 
 
-def table(group: h5py.Group, linked: dict) -> dict:
+def table(group: h5py.Group, linked: dict, written: dict | None = None) -> dict:
     """The rows of ``group``'s table as the file reads now. An item that cannot be read
-    gets the row ``unreadable: <cause>`` (never an exception)."""
-    where = paths(group, linked)
+    gets the row ``unreadable: <cause>`` (never an exception). ``written`` ({address: the
+    value_digest of the values a writer has just given a dataset}) spares reading those
+    datasets back: the writer hashes the bytes it wrote, in one pass."""
     rows = {}
-    _walk(group, "", _Tree(group, where, {**where, **linked}, linked, rows))
+    _walk(group, "", _Tree(group, {address(group): "."}, {}, linked, rows, written or {}))
     return rows
 
 
 @dataclass(frozen=True)
 class _Tree:
-    """What table()'s walk reads and fills: the sealed group, {address: path} inside it and
-    with the linked objects, the linked objects, the rows."""
+    """What table()'s walk reads and fills: the sealed group, {address: path} inside it of
+    the objects met so far (the walk and paths() go in one order: the first path met is
+    the first in sorted order), {address: path} of every object inside it and of the linked
+    ones (filled by names(), for the dimension scales' references only), the linked
+    objects, the rows, the digests of datasets just written (not read back)."""
 
     group: object
     where: dict
     names: dict
     linked: dict
     rows: dict
+    written: dict
 
 
 def _attrs(obj, path: str, t: _Tree):
     for key in sorted(obj.attrs):
         if obj is t.group and key == DIGEST:
             continue
-        t.rows[f"{path}@{key}"] = _guard(lambda: _attr_digest(obj, key, t.names))
+        refs = names(t) if key in _REFERENCE_ATTRS else {}
+        t.rows[f"{path}@{key}"] = _guard(functools.partial(_attr_digest, obj, key, refs))
+
+
+def names(t) -> dict:
+    """``t.names`` ({address: path} of the whole group and of its linked objects), walked
+    once, where a dimension scale's references are first met."""
+    if not t.names:
+        t.names.update({**paths(t.group, t.linked), **t.linked})
+    return t.names
 
 
 def _walk(g, prefix: str, t: _Tree):
@@ -129,25 +144,31 @@ def _walk(g, prefix: str, t: _Tree):
             continue
         if a in t.linked:
             t.rows[path] = "link:" + t.linked[a]
-        elif t.where.get(a) != path:
-            t.rows[path] = "link:./" + t.where.get(a, "?")
+        elif a in t.where:
+            t.rows[path] = "link:./" + t.where[a]
         elif isinstance(obj, h5py.Group):
+            t.where[a] = path
             _walk(obj, path + "/", t)
         else:
-            t.rows[path] = _guard(lambda: _dataset_digest(obj))
+            t.where[a] = path
+            t.rows[path] = t.written.get(a) or _guard(lambda: _dataset_digest(obj))
             _attrs(obj, path, t)
 
 
-def seal(group: h5py.Group, linked: dict):
-    """Write ``group``'s table and its digest (after everything else in it is written)."""
-    text = json.dumps(table(group, linked), sort_keys=True, indent=0)
+def seal(group: h5py.Group, linked: dict, written: dict | None = None):
+    """Write ``group``'s table and its digest (after everything else in it is written;
+    ``written``: as for table())."""
+    text = json.dumps(table(group, linked, written), sort_keys=True, indent=0)
     group.create_dataset(TABLE, data=text)
     group.attrs[DIGEST] = sha(text.encode())
 
 
-def damage(group: h5py.Group, linked: dict) -> list:
+def damage(group: h5py.Group, linked: dict, read=None) -> list:
     """What differs between ``group``'s stored table and the file: a list of
-    "path: what is wrong" lines, empty when every item matches."""
+    "path: what is wrong" lines, empty when every item matches. ``read`` (a test of a row's
+    key, e.g. ``lambda key: not key.startswith("data/")``): only the rows a reader reads are
+    computed, item by item, without walking the rest; where one differs, the whole table is
+    compared and the lines about those rows given."""
     try:
         text = group[TABLE][()]
         text = text.decode() if isinstance(text, bytes) else str(text)
@@ -156,7 +177,16 @@ def damage(group: h5py.Group, linked: dict) -> list:
         stored = json.loads(text)
     except Exception as exc:  # noqa: BLE001
         return [f"{TABLE}: unreadable ({_first_line(exc)})"]
-    now = table(group, linked)
+    if read is not None:
+        keys = [k for k in stored if read(k)]
+        if rows(group, keys, linked, stored) == {k: stored[k] for k in keys}:
+            return []
+        found = _differences(stored, table(group, linked))
+        return [p for p in found if read(p.removeprefix("attribute ").split(": ", 1)[0])] or found
+    return _differences(stored, table(group, linked))
+
+
+def _differences(stored: dict, now: dict) -> list:
     out = []
     for key in sorted(set(stored) | set(now)):
         kind = "attribute " if "@" in key else ""
@@ -168,6 +198,49 @@ def damage(group: h5py.Group, linked: dict) -> list:
             cause = now[key][len("unreadable: "):] if now[key].startswith("unreadable") else "SHA-256 differs"
             out.append(f"{kind}{key}: damaged ({cause})")
     return out
+
+
+def rows(group: h5py.Group, keys: list, linked: dict, stored: dict) -> dict:
+    """The rows ``keys`` of ``group``'s table as the file reads now, each computed alone (no
+    walk over the rest of the group); ``stored``: the table as sealed, which says where a row
+    is a hard link inside the group (only then is the group walked for its paths)."""
+    t, objects = _Tree(group, {}, {}, linked, {}, {}), {"": group}
+
+    def at(path: str):  # each object looked up once (a path lookup costs as much as a small read)
+        if path not in objects:
+            objects[path] = group[path]
+        return objects[path]
+
+    out = {}
+    for key in keys:
+        try:
+            out[key] = _row(at, key, stored.get(key, ""), t)
+        except Exception as exc:  # noqa: BLE001 - damage is reported, never raised
+            out[key] = f"unreadable: {_first_line(exc)}"
+    return out
+
+
+def _row(at, key: str, sealed: str, t: _Tree) -> str:
+    """One row of table() (see _walk), computed alone; ``at(path)``: the object at a path
+    inside the group ("": the group); ``sealed``: the row as stored."""
+    path, is_attr, attr = key.partition("@")
+    path = path.strip("/")
+    if not is_attr and not key.endswith("/"):  # a dataset or a link: an external link is not followed
+        parent, _, name = path.rpartition("/")
+        link = external(at(parent), name)
+        if link:
+            return link
+    obj, group = at(path), at("")
+    if is_attr:
+        return _attr_digest(obj, attr, names(t) if attr in _REFERENCE_ATTRS else {})
+    if key.endswith("/"):  # a group's member names
+        return sha(json.dumps(sorted(n for n in obj if n != TABLE or obj is not group)).encode())
+    a = address(obj)
+    if a in t.linked:
+        return "link:" + t.linked[a]
+    if sealed.startswith("link:./"):
+        return "link:./" + names(t).get(a, "?") if names(t).get(a) != path else "not a link"
+    return _dataset_digest(obj)
 
 
 def linked_groups(group: h5py.Group, under: str) -> set:
@@ -182,7 +255,12 @@ def linked_groups(group: h5py.Group, under: str) -> set:
 
 
 def _dataset_digest(d) -> str:
-    value = d[()]  # fletcher32 is checked chunk by chunk here
+    return value_digest(d[()])  # fletcher32 is checked chunk by chunk here
+
+
+def value_digest(value) -> str:
+    """The row of a dataset holding ``value`` (a text, or what numpy makes an array of):
+    the SHA-256 of its dtype, shape and bytes; of "s" and its UTF-8 bytes for a text."""
     if isinstance(value, (bytes, str)):
         return sha(b"s" + (value.encode() if isinstance(value, str) else value))
     value = np.asarray(value)

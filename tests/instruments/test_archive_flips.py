@@ -192,3 +192,31 @@ def test_a_shot_read_without_its_truth_ignores_only_damaged_truth(tmp_path, item
         assert np.array_equal(e.record.waveforms["CH1"].codes, tiny_entry(1).record.waveforms["CH1"].codes)
         with pytest.raises(InstrumentError, match="forces/wall_force: damaged"):
             archive.read(1)  # the same Archive: the shared group was not remembered as sound
+
+
+@pytest.mark.parametrize("item", ["instrument/oscilloscope/CH2@preamble", "seed", "data/CH2", "data/CH2@units"])
+def test_a_read_checks_what_it_returns_and_verify_checks_the_rest(tmp_path, item):
+    # a read refuses a shot whose returned items (codes, preambles, metadata) are damaged; the
+    # volts and time of its NXdata plot, which a read does not return, are left to verify
+    import h5py
+
+    path = tmp_path / "a.h5"
+    Archive(path).append([tiny_entry(1), tiny_entry(2)])
+    with h5py.File(path, "r+") as f:  # h5py follows the master's link into the part file
+        name, _, attr = item.partition("@")
+        obj = f[f"shot_000002/{name}"]
+        if attr:
+            obj.attrs[attr] = obj.attrs[attr].replace('"y_zero": 0.0', '"y_zero": 0.5') if attr == "preamble" else "mV"
+        elif obj.dtype.kind == "f":
+            obj[5] = obj[5] + 1.0
+        else:
+            obj[()] = 7
+    bad = Archive(path).verify()["bad"]
+    assert [b["shot"] for b in bad] == [2] and bad[0]["where"] == f"/shot_000002/{item}"
+    assert Archive(path).read(1).seed == 1
+    if name.startswith("data/"):
+        back = Archive(path).read(2)
+        assert np.array_equal(back.record.waveforms["CH2"].codes, tiny_entry(2).record.waveforms["CH2"].codes)
+    else:
+        with pytest.raises(InstrumentError, match=f"shot 2: {'attribute ' if attr else ''}{item}: damaged"):
+            Archive(path).read(2)
