@@ -29,9 +29,6 @@ from rig.errors import invalid
 from rig.experiment.shot import ShotRecord, fresh_seed
 from rig.lab.shots import SceneShots, append_shot
 
-PERSONALITIES = ("tds2000", "mdo3000", "mso4")
-FIRE_MODES = ("on-arm", "on-command", "every=SECONDS")
-
 
 @dataclass(frozen=True)
 class ServeSettings:
@@ -90,8 +87,6 @@ class ScopeServer:
 
     def __init__(self, settings: ServeSettings, say: Callable[[str], None] = print) -> None:
         s = settings
-        if s.personality not in PERSONALITIES:
-            raise invalid("--personality", s.personality, ", ".join(PERSONALITIES))
         for name, port in (("--port", s.port), ("--hislip", s.hislip), ("--rig-port", s.rig_port)):
             _port(name, port)
         period = fire_period(s.fire)
@@ -104,7 +99,7 @@ class ScopeServer:
                                       idn=s.idn, seed=self.seed, validate=self.shots.validate,
                                       scene_name=str(s.scene), fire_period_s=period,
                                       on_command=s.fire == "on-command", rig_scene=rig_scene(self.shots))
-        except InstrumentError as e:  # it names the setting (the personality's or --idn's)
+        except InstrumentError as e:  # it names the setting (the personality, its record, --idn)
             raise invalid("rig serve scope", s.scene, str(e)) from None
         say(f"warm-up shot of {s.scene} at seed {self.seed}, the scope's first acquisition "
             "(compiles what the shots need)")
@@ -120,10 +115,10 @@ class ScopeServer:
 
     def _open(self, s: ServeSettings) -> None:
         sock = self._start(lambda: SocketServer(self.scope, s.host, s.port), "raw socket", "--port", s.port)
-        self.resources.append(f"TCPIP::{s.host}::{sock.port}::SOCKET")
+        self.resources.append(sock.resource)
         if s.hislip is not None:
             hs = self._start(lambda: HislipServer(self.scope, s.host, s.hislip), "HiSLIP", "--hislip", s.hislip)
-            self.resources.append(f"TCPIP::{s.host}::hislip0,{hs.port}::INSTR")
+            self.resources.append(hs.resource)
         if s.vxi11:
             vx = self._start(lambda: Vxi11Server(self.scope, s.host, 0), "VXI-11 core channel", "--host", s.host)
             self.say(f"VXI-11 abort channel on {vx.host} port {vx.abort_port}")
@@ -137,7 +132,7 @@ class ScopeServer:
         if s.rig_port is not None:
             rp = self._start(lambda: SocketServer(self.scope.rig_port(), s.host, s.rig_port),
                              "RIG: commands, raw socket", "--rig-port", s.rig_port)
-            self.resources.append(f"TCPIP::{s.host}::{rp.port}::SOCKET (RIG: commands)")
+            self.resources.append(f"{rp.resource} (RIG: commands)")
 
     def _start(self, make, what: str, option: str, port: int):
         """Start the server ``make()`` builds; a port it cannot take is one line naming the

@@ -79,7 +79,8 @@ def test_before_any_client_fires_the_scope_holds_the_warm_up_shot_at_the_first_s
     assert np.array_equal(codes, rig_shot_codes(tmp_path, overrides, FIRST_SEED))
 
 
-@pytest.mark.parametrize("kind", ["SOCKET", "hislip0", "127.0.0.1::INSTR", "127.0.0.1,"])  # the last: VXI-11 by its port
+# the last: VXI-11 by its core port, no portmapper asked
+@pytest.mark.parametrize("kind", ["SOCKET", "hislip0", "127.0.0.1::INSTR", "127.0.0.1,"])
 def test_a_shot_over_each_transport_is_the_rig_shot_of_its_settings_and_seed(served, rm, kind, tmp_path):
     codes, overrides, seed = shot_codes(rm, served.resource(kind))
     assert seed >= FIRST_SEED
@@ -162,3 +163,15 @@ def test_a_port_in_use_is_one_line_naming_the_option():
     assert r.returncode == 2, r.stdout + r.stderr
     assert r.stderr.strip() == (f"rig serve scope: error: --port = {port}: a port free on 127.0.0.1 "
                                 "(Address already in use), or 0 for any")
+
+
+def test_the_parsers_personalities_are_the_scopes():
+    """The parser names them literally (it loads nothing of the instruments, for a quick
+    --help): they must be the emulated scope's registry."""
+    from instruments.virtual_scope.personalities import PERSONALITIES
+    from rig.cli import build_parser
+
+    serve = build_parser()._subparsers._group_actions[0].choices["serve"]
+    scope = serve._subparsers._group_actions[0].choices["scope"]
+    (action,) = [a for a in scope._actions if a.dest == "personality"]
+    assert sorted(action.choices) == sorted(PERSONALITIES)
