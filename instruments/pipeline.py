@@ -28,7 +28,7 @@ from .distortion import record_ends_in_pulse, too_slow, with_clipping
 from .errors import InstrumentError, check
 from .plausibility import Limits, record_doubt, speed_doubt
 from .rails import clipping, rail
-from .records import ScopeRecord, time_base_mismatch
+from .records import ScopeRecord, Waveform, time_base_mismatch
 from .report import SPEED_FIGURES, Report
 
 
@@ -79,7 +79,8 @@ class Setup:
 def record_forces(record: ScopeRecord, setup: Setup):
     """Calibrated dynamic forces (N) from a scope record: t (s from the trigger) and
     {"upper", "lower"[, "wall"]}: baseline from the pre-trigger samples, RC inverted."""
-    out, t, first = {}, None, None
+    first: Waveform | None = None
+    out, t = {}, None
     for role in ("upper", "lower", "wall"):
         g = getattr(setup, role)
         if g is None:
@@ -214,7 +215,7 @@ def _report(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, train
                  "the cross-correlation of the leading pulses found no positive delay")
     rep.give("width_diameters", up.fwhm * rep.speed_m_per_s / setup.bead_diameter_m, rep.reasons.get("duration_s", ""))
     if train:
-        sigma = noise and noise.get("lower")
+        sigma = noise.get("lower") if noise else None
         cut = reflection_time(t, forces, setup, low, rep.speed_m_per_s, noise)
         rep.pulses = len(solitary_train(t, forces["lower"], low, cut, rules, noise=sigma))
     else:
@@ -236,7 +237,7 @@ def solitary_train(t, f, lead, cut: float, rules: PeakRules = PeakRules(), refin
     pulse, the highest (the first of equals): the flat top of a quantised pulse, whose
     flickers between two codes each reach the top code, is not a train of its own."""
     floor = 0.05 * lead.amplitude if noise is None else max(0.05 * lead.amplitude, rules.snr * noise)
-    train = []
+    train: list[Pulse] = []
     for p in find_pulses(t, f, rules, floor=floor, refine=refine):
         if not lead.time - 0.5 * lead.fwhm <= p.time < cut:
             continue

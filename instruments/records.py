@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .errors import InstrumentError
+
 
 @dataclass(frozen=True)
 class Preamble:
@@ -45,6 +47,8 @@ class Waveform:
 
     def volts(self) -> np.ndarray:
         if self.codes is None:
+            if self.samples is None:
+                raise InstrumentError(f"channel {self.channel}: the record holds neither codes nor volts")
             return self.samples
         p = self.preamble
         return p.y_zero + p.y_multiplier * (self.codes.astype(np.float64) - p.y_offset)

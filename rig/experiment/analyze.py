@@ -19,7 +19,7 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 from instruments.analysis import PeakRules
-from instruments.archive import Archive
+from instruments.archive import Archive, Entry
 from instruments.errors import InstrumentError
 from instruments.formats import read_record
 from instruments.pipeline import GaugeSetup, Setup, analyze_record
@@ -79,7 +79,8 @@ def analyze_paths(options: AnalyzeOptions) -> list:
     files = [p for p in paths if p not in archives]
     if options.shot is not None and not archives:
         raise invalid("--shot", options.shot, "picks a shot of an archive (.h5); scope files are one shot together")
-    shots, unread = [], {}
+    shots: list[tuple[str, Entry | None]] = []
+    unread = {}
     for a in archives:
         archive = Archive(a)
         ids = [options.shot] if options.shot is not None else archive.ids()

@@ -31,10 +31,13 @@ def _unit_fields(cls) -> tuple:
 class _Part:
     """Shared construction: look the material up, convert quantities, validate."""
 
+    material: Material | str
+
     def _convert(self, prefix: str):
         if not isinstance(self.material, Material):
             object.__setattr__(self, "material", material(self.material))
-        for name in _unit_fields(type(self)):
+        # a class is hashable: typeshed's Hashable check trips on a dataclass's __hash__
+        for name in _unit_fields(type(self)):  # type: ignore[arg-type]
             value = getattr(self, name)
             if value is None:
                 continue
@@ -163,7 +166,7 @@ class Striker(_Part):
     @property
     def length(self) -> float:
         """Cylinder length (m) from mass, density and diameter."""
-        return self.mass / (self.material.rho * math.pi * self.diameter**2 / 4.0)
+        return self.mass / (material(self.material).rho * math.pi * self.diameter**2 / 4.0)
 
 
 @dataclass(frozen=True)

@@ -3,11 +3,15 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rig.model.contact import hertz_energy
 from rig.solver.kernels import report as slot
+
+if TYPE_CHECKING:
+    from rig.solver.problem import ChainProblem
 
 
 class Status(enum.IntEnum):
@@ -128,7 +132,7 @@ class Solution:
     final_u: np.ndarray
     final_v: np.ndarray
     stats: SolverStats
-    problem: object
+    problem: ChainProblem
     status: Status = Status.SUCCESS
 
     @property
@@ -142,7 +146,7 @@ class Solution:
 
     @property
     def frame_times(self) -> np.ndarray | None:
-        if self.frames is None:
+        if self.frames is None or self.frame_interval is None:
             return None
         return np.arange(self.frames.shape[0]) * self.frame_interval
 
