@@ -42,7 +42,7 @@ from rig.solver.stepsize import contact_time_scale, head_contacts, stepping_at
 
 N_BEADS = 1000
 PROBE = 500
-STEEL = dict(material="steel316", diameter="4.76 mm", mass="0.4501 g")
+STEEL = Bead("steel316", 4.76e-3, 0.4501e-3)  # diameter (m), mass (kg): 4.76 mm, 0.4501 g
 SCENARIOS = {  # name: (top force N, t_end s) -- t_end lets the pulse pass contact 500
     "sonic-vacuum": (0.0, 5.0e-3),
     "precompressed": (2.38, 4.6e-3),
@@ -57,10 +57,10 @@ QUICK = dict(divisions={"srkn6b": (3, 6, 12), "verlet": (32, 128)}, settings=(1e
     "scipy-DOP853": (1e-8,), "numba-DOP853": (1e-8, 1e-10), "LAMMPS": (20,)}, scenarios=("precompressed",))
 
 def chain(top_force: float, n: int = N_BEADS) -> Chain:
-    striker = Striker("steel316", "0.4501 g", "0.44 m/s")
+    striker = Striker("steel316", 0.4501e-3, 0.44)  # mass (kg), velocity (m/s): 0.4501 g, 0.44 m/s
     if top_force:
-        return Chain([Bead(**STEEL)] * n, striker=striker, wall=Wall(), gravity=0, top_force=top_force)
-    return Chain([Bead(**STEEL)] * n, striker=striker, gravity=0)
+        return Chain([STEEL] * n, striker=striker, wall=Wall(), gravity=0, top_force=top_force)
+    return Chain([STEEL] * n, striker=striker, gravity=0)
 
 
 def _row(scenario, method, setting, cpu, error, evaluations, bodies, **extra) -> dict:
@@ -166,7 +166,7 @@ def at_equal_error(rows: list, errors=EQUAL_ERRORS) -> list:
     it), and that time over srkn6b's at fixed steps."""
     out = []
     for name in dict.fromkeys(r["scenario"] for r in rows):
-        curves = {}
+        curves: dict = {}
         for r in rows:
             if r["scenario"] == name and r["error"] > 0:
                 curves.setdefault(r["method"], []).append((r["error"], r["cpu_s"]))
@@ -204,7 +204,8 @@ def run(quick: bool = False, peers: bool = False, baseline: str | None = None, p
     names = QUICK["scenarios"] if quick else tuple(SCENARIOS)
     peer_settings = QUICK["peers"] if quick else PEERS
     rounds = 1 if quick else ROUNDS
-    per_round, notes = [[] for _ in range(rounds)], []
+    per_round: list[list] = [[] for _ in range(rounds)]
+    notes: list = []
     for name, p, save, t_end in cases(names):
         if progress:
             progress(f"{name}: reference")
