@@ -4,8 +4,8 @@ type checkers the very names it loads (its ``if TYPE_CHECKING:`` block against `
 and ``import rig`` still loads none of the layers.
 
 mypy runs here, in the suite, not as a step of its own: with its cache (.mypy_cache) empty,
-as in a fresh clone, it took 17 s of CPU (47 s of wall time on two cores shared with a load
-of 8); with the cache, a few seconds (docs/how-to/contributing.md)."""
+as in a fresh clone, it took 16 s of CPU (41 s of wall time on two cores shared with a load
+of 7); with the cache, a few seconds (docs/how-to/contributing.md)."""
 import ast
 import subprocess
 import sys

@@ -204,7 +204,7 @@ class Assembly:
             return Oscilloscope(channels=channels, timebase=timebase, trigger=trigger, **s)
 
     def _check_connections(self):
-        used = {}
+        used: dict[str, str] = {}  # {channel: the key that took it}
         wiring = [(f"gauges.{g.name}.channel", g.channel) for g in self.gauges]
         if self.wall_sensor is not None:
             wiring.append(("wall_sensor.channel", self.wall_sensor.channel))

@@ -64,7 +64,7 @@ class Bead(_Part):
         self._convert("bead")
         self._positive("bead", "diameter")
         if self.mass is None:
-            object.__setattr__(self, "mass", self.material.rho * math.pi * self.diameter**3 / 6.0)
+            object.__setattr__(self, "mass", material(self.material).rho * math.pi * self.diameter**3 / 6.0)
         self._positive("bead", "mass")
 
     @property
@@ -113,10 +113,12 @@ class GaugeBead(Bead):
         self._positive("gauge_bead", "diameter", "plate_mass")
         if self.caps_mass is None:
             plain = self.mass if self.mass is not None else (
-                self.material.rho * math.pi * self.diameter**3 / 6.0)
+                material(self.material).rho * math.pi * self.diameter**3 / 6.0)
             object.__setattr__(self, "caps_mass", self.caps_of(plain))
         self._positive("gauge_bead", "caps_mass")
-        object.__setattr__(self, "mass", self.caps_mass + self.plate_mass)
+        caps, plate = self.caps_mass, self.plate_mass
+        assert caps is not None and plate is not None, "both were just checked > 0"
+        object.__setattr__(self, "mass", caps + plate)
 
     @staticmethod
     def caps_of(plain_mass):

@@ -56,7 +56,9 @@ def fig3_figures(truths: dict) -> dict:
     g, m = truths[SCENE], truths[MAGNETIC_SCENE]
 
     def of(kind, truth, where=""):
-        return _finite(KINDS[kind].measure(truth, where))
+        measure = KINDS[kind].measure
+        assert measure is not None, f"a {kind} is measured on one truth (not a ratio)"
+        return _finite(measure(truth, where))
 
     peaks = of("peak", m, "upper"), of("peak", g, "upper")
     duration = of("duration", g, "upper")
