@@ -87,7 +87,7 @@ def table(group: h5py.Group, linked: dict, written: dict | None = None) -> dict:
     gets the row ``unreadable: <cause>`` (never an exception). ``written`` ({address: the
     value_digest of the values a writer has just given a dataset}) spares reading those
     datasets back: the writer hashes the bytes it wrote, in one pass."""
-    rows = {}
+    rows: dict[str, str] = {}
     _walk(group, "", _Tree(group, {address(group): "."}, {}, linked, rows, written or {}))
     return rows
 

@@ -60,7 +60,7 @@ def recorded_members(f) -> dict:
     names}; the walk over the root where the attribute is missing or unreadable): a large
     master's names are read as one small attribute, not link by link."""
     try:
-        members = member_list(f)
+        members = member_list(f) or {}  # None: no list recorded, the KeyError below falls back
         return {"/": list(members["/"]), "/shared": list(members.get("/shared", []))}
     except Exception:  # noqa: BLE001 - a damaged list: the writer builds on what the root holds
         return {"/": sorted(f), "/shared": sorted(f["shared"]) if "shared" in f else []}

@@ -75,7 +75,7 @@ def compact(members: dict) -> dict:
     """``members`` with the root's shot names as ranges of ids, ``"shot_ids": [[first, last],
     ...]`` (the form a layout-3 master records)."""
     ids = sorted(int(n[5:]) for n in members["/"] if re.fullmatch(r"shot_\d{6}", n))
-    ranges = []
+    ranges: list[list[int]] = []
     for i in ids:
         if ranges and ranges[-1][1] == i - 1:
             ranges[-1][1] = i
@@ -172,7 +172,7 @@ def check(f: h5py.File) -> dict:
     for path in missing:
         bad.append(_row(_shot_id(path), path, f"missing: {path}"))
     shared, problems, linked = _shared_groups(f, bad, added)
-    users = {}
+    users: dict = {}
     for name in names:
         shot_id = int(name.split("_", 1)[1])
         try:
@@ -243,7 +243,9 @@ def _shot_id(path: str):
 def _shared_groups(f, bad, added=()) -> tuple:
     """({key: group} of the readable shared groups, {key: problems} of the damaged ones,
     {address: path} of every object in them); groups in ``added`` (root paths) are left out."""
-    shared, problems, linked = {}, {}, {}
+    shared: dict = {}
+    problems: dict[str, list] = {}
+    linked: dict = {}
     try:
         keys = sorted(f["shared"]) if "shared" in f else []
     except Exception as exc:  # noqa: BLE001
@@ -272,7 +274,7 @@ def _item(problem: str) -> str:
 
 def addresses(group) -> dict:
     """{address: path} of ``group`` and every object below it."""
-    out = {}
+    out: dict = {}
 
     def visit(name, obj):
         out.setdefault(address(obj), obj.name)
