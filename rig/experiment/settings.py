@@ -57,6 +57,6 @@ class SolverSettings:
 
     @classmethod
     def from_table(cls, table: dict) -> "SolverSettings":
-        # a missing duration (None) is refused by __post_init__, naming the key
-        return cls(table.get("method", "srkn6b"), table.get("accuracy"), table.get("duration"),  # type: ignore[arg-type]
+        duration = table.get("duration")  # None (missing): refused by __post_init__, naming the key
+        return cls(table.get("method", "srkn6b"), table.get("accuracy"), duration,  # type: ignore[arg-type]
                    table.get("sample_interval", 1e-7))

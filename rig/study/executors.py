@@ -133,7 +133,8 @@ def _dask(study, store, todo, scheduler, workers, writer, watch: WorkerWatch):
             raise RigError(f"--scheduler = {scheduler!r}: allowed 'local' or a scheduler's address such as "
                            f"tcp://HOST:PORT ({exc})") from None
     try:
-        finished: queue.SimpleQueue = queue.SimpleQueue()  # each future once it is done (Dask calls back on a thread of its own)
+        # each future once it is done (Dask calls back on a thread of its own)
+        finished: queue.SimpleQueue = queue.SimpleQueue()
         futures = [client.submit(run_batch_alone, study, b, pure=False) for b in todo]
         for fut in futures:
             fut.add_done_callback(finished.put)
