@@ -6,7 +6,7 @@ that is independent, so on a cold cache a command starts a side process that com
 of the kernels it needs (the instruments' below, a part of the solver's that rig.solver
 names) into numba's on-disk cache while the main process compiles the rest. When the main
 process needs one of those kernels, called from Python or from a kernel it compiles, it
-waits until the cache holds it (instruments/dispatcher.py) and loads it from there. A
+waits until the cache holds it (numerics/dispatcher.py) and loads it from there. A
 signature that no longer matches what the command calls costs time only (the main process
 then compiles that kernel itself); tests/cli/test_cold_start.py keeps them in step.
 """
@@ -45,7 +45,7 @@ STUDY = {f"{PACKAGE}.acquisition.shots": f"(int64, int64, {I1}, {F3}, float64, {
 
 def needs_compiling(kernels: dict) -> bool:
     """Whether numba's cache lacks the machine code of any of ``kernels`` (module.kernel names)."""
-    from instruments.jit import has_machine_code
+    from numerics.dispatcher import has_machine_code
 
     return not all(has_machine_code(kernel(name)) for name in kernels)
 
@@ -53,7 +53,7 @@ def needs_compiling(kernels: dict) -> bool:
 def start(kernels: dict) -> bool:
     """Start a side process compiling ``kernels`` ({module.kernel: argument types}, in this
     order) when numba's cache lacks any; True when started (the caller may say so)."""
-    from instruments.dispatcher import SIDE_COMPILES
+    from numerics.dispatcher import SIDE_COMPILES
 
     if not needs_compiling(kernels):
         return False

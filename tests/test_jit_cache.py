@@ -44,7 +44,7 @@ def test_every_compiled_function_is_in_a_guarded_kernel_package():
 def test_the_checker_finds_a_planted_kernel(tmp_path):
     kernels = tmp_path / "instruments" / "_kernels"
     kernels.mkdir(parents=True)
-    (kernels / "__init__.py").write_text("from instruments.jit import drop_stale_cache\n\ndrop_stale_cache(__name__)\n")
+    (kernels / "__init__.py").write_text("from numerics.jit import drop_stale_cache\n\ndrop_stale_cache(__name__)\n")
     (kernels / "ok.py").write_text("@jit\ndef fine(x):\n    return x\n")
     (tmp_path / "instruments" / "__init__.py").write_text("")
     (tmp_path / "instruments" / "batch.py").write_text(

@@ -9,10 +9,11 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 # a module may import its own layer or a lower one; model and theory, study and lab share a rank but stay apart
-RANKS = {"instruments": 0, "rig.errors": 1, "rig.units": 2, "rig.memo": 2, "rig.model": 3, "rig.theory": 3,
-         "rig.solver": 4, "rig.experiment": 5, "rig.viz": 6, "rig.fit": 7, "rig.study": 8, "rig.lab": 8, "rig.bench": 9,
-         "rig.cli": 10}
+RANKS = {"numerics": -1, "instruments": 0, "rig.errors": 1, "rig.units": 2, "rig.memo": 2, "rig.model": 3,
+         "rig.theory": 3, "rig.solver": 4, "rig.experiment": 5, "rig.viz": 6, "rig.fit": 7, "rig.study": 8, "rig.lab": 8,
+         "rig.bench": 9, "rig.cli": 10}
 APART = {frozenset({"rig.model", "rig.theory"}), frozenset({"rig.study", "rig.lab"})}
+PACKAGES = ("rig", "instruments", "numerics")  # the project's top-level packages
 HEAVY = {"numba", "scipy", "pint", "pyvista", "vtk", "vtkmodules", "matplotlib", "dask", "h5py"}
 
 
@@ -23,9 +24,9 @@ def layer(module: str):
 
 
 def modules(root: Path) -> dict:
-    """{module name: path} of every .py file under root/rig and root/instruments."""
+    """{module name: path} of every .py file under each of PACKAGES in root."""
     out = {}
-    for pkg in ("rig", "instruments"):
+    for pkg in PACKAGES:
         for path in sorted((root / pkg).rglob("*.py")):
             parts = list(path.relative_to(root).with_suffix("").parts)
             out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
@@ -84,7 +85,7 @@ def check_layers(root: Path) -> list:
             problems.append(f"{rel}: {name} is in no layer (add it to RANKS and docs/architecture.md)")
         for target, item, line, top in imports(name, path):
             full = f"{target}.{item}" if item and f"{target}.{item}" in mods else target
-            if full.split(".")[0] not in ("rig", "instruments") or full == name:
+            if full.split(".")[0] not in PACKAGES or full == name:
                 continue
             there, edge = layer(full), f"{rel}:{line}: {name} imports {full}"
             if name == "rig":
@@ -92,6 +93,8 @@ def check_layers(root: Path) -> list:
                     problems.append(f"{edge}: the facade loads its layers lazily (_PUBLIC), never at import")
             elif here == "instruments" and full.split(".")[0] == "rig":
                 problems.append(f"{edge}: instruments never import rig")
+            elif here == "numerics" and there != "numerics":
+                problems.append(f"{edge}: numerics imports neither rig nor instruments")
             elif full == "rig" and item != "__version__":
                 problems.append(f"{edge}{f' {item}' if item else ''}: only __version__ comes from the rig "
                                 "facade; name the defining module")
@@ -167,6 +170,7 @@ def test_the_checker_finds_planted_violations(tmp_path):
                                "from rig import Chain\n",
         "rig/extra/z.py": "", "rig/viz/figures.py": "", "instruments/_kernels/peaks.py": "p = 1\n",
         "instruments/y.py": "import rig\nfrom instruments._kernels import peaks\n",
+        "numerics/n.py": "from instruments import y\n",
     }
     for rel, text in files.items():
         (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
@@ -182,6 +186,7 @@ def test_the_checker_finds_planted_violations(tmp_path):
         "rig/experiment/e.py:3: rig.experiment.e imports rig Chain: only __version__ comes from the rig facade",
         "rig/extra/z.py: rig.extra.z is in no layer",
         "instruments/y.py:1: instruments.y imports rig: instruments never import rig",
+        "numerics/n.py:1: numerics.n imports instruments.y: numerics imports neither rig nor instruments",
         "import cycle: rig.solver.a -> rig.solver.b -> rig.solver.a",
     ]
     found = check_layers(tmp_path)  # each expected line, and nothing else

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 from . import pcg64
 from .filters import pole_step

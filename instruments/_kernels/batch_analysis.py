@@ -8,7 +8,7 @@ import math
 import numpy as np
 from numba import prange
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 from .acquisition import OK
 from .filters import undo_highpass_into

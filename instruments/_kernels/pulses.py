@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 from .crossings import level_bracket
 from .filters import undo_highpass_into

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 from rig.model.contact import PLASTIC, POWER
 from rig.solver.kernels.forces import other_law, plastic_fixup
 from rig.solver.kernels.layout import LINE
