@@ -11,7 +11,7 @@ A kernel package calls ``drop_stale_cache(__name__)`` in its ``__init__``.
 
 OpenMP's threads sleep when a parallel loop ends (OMP_WAIT_POLICY=PASSIVE, unless the
 environment says otherwise): by default they spin on the cores for a while, and the
-Python threads that come next (a batch's random draws, instruments/batch.acquire) ran 1.8x
+Python threads that come next (a batch's random draws, instruments/devices/batch.acquire) ran 1.8x
 slower beside them.
 """
 from __future__ import annotations

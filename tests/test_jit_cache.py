@@ -1,10 +1,10 @@
 """Every compiled function of the project lives in a kernel package whose cached machine
-code is dropped when any of the package's sources changes (instruments/jit.drop_stale_cache).
+code is dropped when any of the package's sources changes (numerics/jit.drop_stale_cache).
 numba keys a cached function on its own file only: a kernel compiled elsewhere that calls
 a kernel of another file keeps the old callee's code after that file changes (a batched
-analysis in instruments/batch.py once went on running the median and cross-correlation it
-was compiled with). Read with ``ast`` from every .py file under rig/ and instruments/; the
-checker is tested on a planted tree."""
+analysis, now instruments/analysis/batch.py, once went on running the median and
+cross-correlation it was compiled with). Read with ``ast`` from every .py file under rig/,
+instruments/ and numerics/; the checker is tested on a planted tree."""
 import ast
 from pathlib import Path
 
@@ -27,7 +27,7 @@ def _compiled(tree: ast.Module) -> list:
 def unguarded(root: Path) -> list:
     """'path: function' of each compiled function outside a package that calls drop_stale_cache."""
     bad = []
-    for pkg in ("rig", "instruments"):
+    for pkg in ("rig", "instruments", "numerics"):
         for path in sorted((root / pkg).rglob("*.py")):
             names = _compiled(ast.parse(path.read_text()))
             init = path.parent / "__init__.py"

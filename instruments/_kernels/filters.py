@@ -1,4 +1,4 @@
-"""One-pole recursive filter (numba) for the analog front ends (instruments/frontend.py)."""
+"""One-pole recursive filter (numba) for the analog front ends (instruments/devices/frontend.py)."""
 import numpy as np
 
 from numerics.jit import jit

@@ -226,7 +226,7 @@ def writing_to(path):
 def missing_lines(reasons: dict) -> list:
     """One line per reason of a Report's missing figures ({figure: reason}): "no F1, F2:
     reason", or "no result: reason" where every figure is missing for it."""
-    from instruments.report import FIGURES
+    from instruments.analysis.report import FIGURES
 
     why = {}
     for figure, reason in reasons.items():

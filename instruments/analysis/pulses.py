@@ -18,9 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._kernels.filters import undo_highpass
+from ..errors import check
 from ._kernels import pulses
-from ._kernels.filters import undo_highpass
-from .errors import check
 
 MIN_BASELINE = pulses.MIN_BASELINE  # pre-trigger samples needed to measure the noise
 
