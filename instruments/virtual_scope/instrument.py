@@ -16,8 +16,8 @@ import math
 import threading
 from collections.abc import Callable
 
+from ..devices.oscilloscope import Oscilloscope
 from ..errors import InstrumentError
-from ..oscilloscope import Oscilloscope
 from ..scpi.engine import Engine, ReplyForm
 from ..scpi.status import OPC, ScpiError, StatusModel
 from ..scpi.tree import CommandTree

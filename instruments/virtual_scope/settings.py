@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import fields
 
-from ..oscilloscope import CHANNELS, ChannelSettings, Oscilloscope, Timebase, Trigger
+from ..devices.oscilloscope import CHANNELS, ChannelSettings, Oscilloscope, Timebase, Trigger
 
 UNITS = {"sample_interval": "s", "level": "V", "volts_per_div": "V", "offset": "V", "bandwidth": "Hz"}
 CHANNEL_FIELDS = tuple(f.name for f in fields(ChannelSettings))
