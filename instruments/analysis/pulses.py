@@ -25,12 +25,6 @@ from ._kernels import pulses
 MIN_BASELINE = pulses.MIN_BASELINE  # pre-trigger samples needed to measure the noise
 
 
-def remove_baseline(y: np.ndarray, n_pre: int) -> np.ndarray:
-    """y minus the mean of its first n_pre samples (at least 10, the pre-trigger part)."""
-    y = np.ascontiguousarray(y, dtype=float)
-    return y - pulses.baseline_mean(y, int(n_pre))
-
-
 def noise_level(y: np.ndarray, n_pre: int, step: float = 0.0) -> float | None:
     """The noise of a conditioned signal (its unit) from its first n_pre samples, the
     pre-trigger baseline: 1.4826 x their median absolute deviation (the standard deviation
