@@ -20,7 +20,8 @@ PACKAGES = ("rig", "instruments", "numerics")  # the project's top-level package
 # devices never import the analysis, the analysis reads the devices' records; the kernels shared by both
 # wings, the records, rails and errors are beneath them
 ROOMS = {
-    "instruments": set(), "instruments.errors": set(), "instruments.records": set(), "instruments.rails": set(),
+    "instruments": {"instruments.analysis", "instruments.devices", "instruments.facade"},
+    "instruments.errors": set(), "instruments.records": set(), "instruments.rails": set(),
     "instruments.facade": set(), "instruments.files": {"instruments.errors"},
     "instruments._kernels": {"numerics"}, "instruments.precompile": {"numerics"},
     "instruments.streams": {"instruments._kernels", "instruments.errors"},

@@ -17,7 +17,7 @@ on first use, so ``instruments.analysis.report`` stays light.
 """
 from ..facade import lazy_names
 
-__getattr__, __all__ = lazy_names(__name__, {
+PUBLIC = {  # {module: its public names}
     "pulses": ("MIN_BASELINE", "PeakRules", "Pulse", "find_pulses", "first_peak_time", "invert_rc", "leading",
                "noise_level", "refined", "xcorr_delay"),
     "pipeline": ("GaugeSetup", "Setup", "analyze_forces", "analyze_record", "record_forces", "reflection_time",
@@ -25,4 +25,5 @@ __getattr__, __all__ = lazy_names(__name__, {
     "plausibility": ("Limits",),
     "report": ("FIGURES", "SPEED_FIGURES", "Report"),
     "batch": ("analysed",),
-})
+}
+__getattr__, __all__ = lazy_names(__name__, PUBLIC)

@@ -7,9 +7,10 @@ import the analysis. The names below load on first use.
 """
 from ..facade import lazy_names
 
-__getattr__, __all__ = lazy_names(__name__, {
+PUBLIC = {  # {module: its public names}
     "gauges": ("GaugeDraw", "GaugeSettings", "PiezoGauge"),
     "frontend": ("highpass_coefficients", "lowpass", "lowpass_coefficients", "rc_highpass"),
     "oscilloscope": ("CHANNELS", "ChannelSettings", "FrontPanel", "Oscilloscope", "Timebase", "Trigger"),
     "batch": ("NO_TRIGGER", "OK", "PAST_INPUT", "Records", "Wiring", "acquire"),
-})
+}
+__getattr__, __all__ = lazy_names(__name__, PUBLIC)
