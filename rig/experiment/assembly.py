@@ -6,9 +6,9 @@ from __future__ import annotations
 import contextlib
 import math
 
+from instruments.devices.gauges import GaugeSettings
+from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from instruments.errors import InstrumentError
-from instruments.gauges import GaugeSettings
-from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from rig.errors import RigError, invalid
 from rig.experiment.scene import Scene
 from rig.experiment.settings import GaugeWiring, SolverSettings, WallWiring

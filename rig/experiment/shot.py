@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from instruments.gauges import GaugeDraw, PiezoGauge
+from instruments.devices.gauges import GaugeDraw, PiezoGauge
 from instruments.records import ScopeRecord
 from rig.errors import RigError, invalid
 from rig.experiment import scene as scene_io
