@@ -6,7 +6,7 @@ that is independent, so on a cold cache a command starts a side process that com
 of the kernels it needs (the instruments' below, a part of the solver's that rig.solver
 names) into numba's on-disk cache while the main process compiles the rest. When the main
 process needs one of those kernels, called from Python or from a kernel it compiles, it
-waits until the cache holds it (instruments/dispatcher.py) and loads it from there. A
+waits until the cache holds it (numerics/dispatcher.py) and loads it from there. A
 signature that no longer matches what the command calls costs time only (the main process
 then compiles that kernel itself); tests/cli/test_cold_start.py keeps them in step.
 """
@@ -16,36 +16,36 @@ import importlib
 import subprocess
 import sys
 
-PACKAGE = "instruments._kernels"
+ANALYSIS, DEVICES = "instruments.analysis._kernels", "instruments.devices._kernels"  # the wings' kernel packages
 F1, F2 = "float64[::1]", "float64[:, ::1]"
 # the instruments' kernels a shot calls from Python: {module.kernel: its argument types}; the
 # analysis first (most of the compile time: numba compiles what a kernel calls with it)
-SHOT = {f"{PACKAGE}.pulses.leading_pair": f"({F1}, {F1}, {F1}, float64, float64, UniTuple(float64, 7), {F1})",
-        f"{PACKAGE}.acquisition.scope_shot": f"({F2}, float64, int64, float64, boolean, float64, int64, float64, "
+SHOT = {f"{ANALYSIS}.pulses.leading_pair": f"({F1}, {F1}, {F1}, float64, float64, UniTuple(float64, 7), {F1})",
+        f"{DEVICES}.acquisition.scope_shot": f"({F2}, float64, int64, float64, boolean, float64, int64, float64, "
                                              f"{F1}, {F1}, {F1}, {F1}, {F2}, float64, float64, int8[:, ::1], "
                                              f"boolean[::1], boolean[::1])",
-        f"{PACKAGE}.acquisition.gauge_signal": f"({F1}, float64, float64, float64, float64, float64, float64, "
+        f"{DEVICES}.acquisition.gauge_signal": f"({F1}, float64, float64, float64, float64, float64, float64, "
                                                f"float64, {F1})",
-        f"{PACKAGE}.acquisition.condition": f"({F1}, float64, {F1}, {F1})",
-        f"{PACKAGE}.acquisition.samples_before_input": "(int64, float64, float64, float64)",
-        f"{PACKAGE}.pulses.conditioned": f"({F1}, int64, float64, float64, float64)",
-        f"{PACKAGE}.pulses.noise_level": f"({F1}, int64, float64)",
-        f"{PACKAGE}.pulses.first_peak": f"({F1},)"}
+        f"{DEVICES}.acquisition.condition": f"({F1}, float64, {F1}, {F1})",
+        f"{DEVICES}.acquisition.samples_before_input": "(int64, float64, float64, float64)",
+        f"{ANALYSIS}.pulses.conditioned": f"({F1}, int64, float64, float64, float64)",
+        f"{ANALYSIS}.pulses.noise_level": f"({F1}, int64, float64)",
+        f"{ANALYSIS}.pulses.first_peak": f"({F1},)"}
 B1, I1, I8 = "boolean[::1]", "int64[::1]", "int8[:, :, ::1]"
 F3 = "float64[:, :, ::1]"
 # and those a study's batches call (its nominal shot calls SHOT's): the acquisition and the analysis of many shots
-STUDY = {f"{PACKAGE}.acquisition.shots": f"(int64, int64, {I1}, {F3}, float64, {F1}, {F3}, "
+STUDY = {f"{DEVICES}.acquisition.shots": f"(int64, int64, {I1}, {F3}, float64, {F1}, {F3}, "
                                          f"Tuple(({F1}, {F1}, {B1}, {F1}, {B1}, {F2}, {F1})), "
                                          f"Tuple(({I1}, {F1}, {F2}, {F2}, int64, float64, boolean, int64, float64, "
                                          f"{F1}, {F1}, {F1}, {F1}, float64, float64, boolean)), {B1}, int64, {I1}, "
                                          f"{I8}, boolean[:, ::1], {I1}, {F2}, {F3})",
-         f"{PACKAGE}.batch_analysis.analyse_shots": f"({I8}, {I1}, {F2}, float64, int64, {F1}, {F1}, {F1}, {I1}, "
+         f"{ANALYSIS}.batch_analysis.analyse_shots": f"({I8}, {I1}, {F2}, float64, int64, {F1}, {F1}, {F1}, {I1}, "
                                                    f"{F1}, {F1}, UniTuple(float64, 7), {F2}, {F2}, {B1})"}
 
 
 def needs_compiling(kernels: dict) -> bool:
     """Whether numba's cache lacks the machine code of any of ``kernels`` (module.kernel names)."""
-    from instruments.jit import has_machine_code
+    from numerics.dispatcher import has_machine_code
 
     return not all(has_machine_code(kernel(name)) for name in kernels)
 
@@ -53,7 +53,7 @@ def needs_compiling(kernels: dict) -> bool:
 def start(kernels: dict) -> bool:
     """Start a side process compiling ``kernels`` ({module.kernel: argument types}, in this
     order) when numba's cache lacks any; True when started (the caller may say so)."""
-    from instruments.dispatcher import SIDE_COMPILES
+    from numerics.dispatcher import SIDE_COMPILES
 
     if not needs_compiling(kernels):
         return False

@@ -13,8 +13,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import InstrumentError
-
 
 @dataclass(frozen=True)
 class Preamble:
@@ -47,8 +45,7 @@ class Waveform:
 
     def volts(self) -> np.ndarray:
         if self.codes is None:
-            if self.samples is None:
-                raise InstrumentError(f"channel {self.channel}: the record holds neither codes nor volts")
+            assert self.samples is not None, f"channel {self.channel}: every reader gives codes or volts"
             return self.samples
         p = self.preamble
         return p.y_zero + p.y_multiplier * (self.codes.astype(np.float64) - p.y_offset)

@@ -1,10 +1,10 @@
 """Every compiled function of the project lives in a kernel package whose cached machine
-code is dropped when any of the package's sources changes (instruments/jit.drop_stale_cache).
+code is dropped when any of the package's sources changes (numerics/jit.drop_stale_cache).
 numba keys a cached function on its own file only: a kernel compiled elsewhere that calls
 a kernel of another file keeps the old callee's code after that file changes (a batched
-analysis in instruments/batch.py once went on running the median and cross-correlation it
-was compiled with). Read with ``ast`` from every .py file under rig/ and instruments/; the
-checker is tested on a planted tree."""
+analysis, now instruments/analysis/batch.py, once went on running the median and
+cross-correlation it was compiled with). Read with ``ast`` from every .py file under rig/,
+instruments/ and numerics/; the checker is tested on a planted tree."""
 import ast
 from pathlib import Path
 
@@ -27,7 +27,7 @@ def _compiled(tree: ast.Module) -> list:
 def unguarded(root: Path) -> list:
     """'path: function' of each compiled function outside a package that calls drop_stale_cache."""
     bad = []
-    for pkg in ("rig", "instruments"):
+    for pkg in ("rig", "instruments", "numerics"):
         for path in sorted((root / pkg).rglob("*.py")):
             names = _compiled(ast.parse(path.read_text()))
             init = path.parent / "__init__.py"
@@ -44,7 +44,7 @@ def test_every_compiled_function_is_in_a_guarded_kernel_package():
 def test_the_checker_finds_a_planted_kernel(tmp_path):
     kernels = tmp_path / "instruments" / "_kernels"
     kernels.mkdir(parents=True)
-    (kernels / "__init__.py").write_text("from instruments.jit import drop_stale_cache\n\ndrop_stale_cache(__name__)\n")
+    (kernels / "__init__.py").write_text("from numerics.jit import drop_stale_cache\n\ndrop_stale_cache(__name__)\n")
     (kernels / "ok.py").write_text("@jit\ndef fine(x):\n    return x\n")
     (tmp_path / "instruments" / "__init__.py").write_text("")
     (tmp_path / "instruments" / "batch.py").write_text(

@@ -1,7 +1,9 @@
-"""The layers of docs/architecture.md hold, read with ``ast`` from every .py file under rig/
-and instruments/: imports point down (function-level and literal ``import_module`` ones too),
-module-level imports form no cycle, instruments never import rig, the facade is lazy and gives
-rig only ``__version__``, no private name crosses modules. The checker is tested on a planted tree."""
+"""The layers of docs/architecture.md hold, read with ``ast`` from every .py file under rig/,
+instruments/ and numerics/: imports point down (function-level and literal ``import_module`` ones
+too), imports form no cycle (module-level, function-level and TYPE_CHECKING ones alike), numerics
+imports neither rig nor instruments, instruments never import rig and its rooms import only the
+rooms ROOMS allows (the devices never the analysis), the facade is lazy and gives rig only
+``__version__``, no private name crosses modules. The checker is tested on a planted tree."""
 import ast
 import subprocess
 import sys
@@ -9,10 +11,30 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 # a module may import its own layer or a lower one; model and theory, study and lab share a rank but stay apart
-RANKS = {"instruments": 0, "rig.errors": 1, "rig.units": 2, "rig.memo": 2, "rig.model": 3, "rig.theory": 3,
-         "rig.solver": 4, "rig.experiment": 5, "rig.viz": 6, "rig.fit": 7, "rig.study": 8, "rig.lab": 8, "rig.bench": 9,
-         "rig.cli": 10}
+RANKS = {"numerics": -1, "instruments": 0, "rig.errors": 1, "rig.units": 2, "rig.memo": 2, "rig.model": 3,
+         "rig.theory": 3, "rig.solver": 4, "rig.experiment": 5, "rig.viz": 6, "rig.fit": 7, "rig.study": 8,
+         "rig.lab": 8, "rig.bench": 9, "rig.cli": 10}
 APART = {frozenset({"rig.model", "rig.theory"}), frozenset({"rig.study", "rig.lab"})}
+PACKAGES = ("rig", "instruments", "numerics")  # the project's top-level packages
+# the rooms of instruments/ (a subpackage, or a module at its top) and the rooms each may import: the
+# devices never import the analysis, the analysis reads the devices' records; the kernels shared by both
+# wings, the records, rails and errors are beneath them
+ROOMS = {
+    "instruments": {"instruments.analysis", "instruments.devices", "instruments.facade"},
+    "instruments.errors": set(), "instruments.records": set(), "instruments.rails": set(),
+    "instruments.facade": set(), "instruments.files": {"instruments.errors"},
+    "instruments._kernels": {"numerics"}, "instruments.precompile": {"numerics"},
+    "instruments.streams": {"instruments._kernels", "instruments.errors"},
+    "instruments.devices": {"instruments._kernels", "instruments.errors", "instruments.facade", "instruments.records",
+                            "numerics"},
+    "instruments.analysis": {"instruments._kernels", "instruments.devices", "instruments.errors", "instruments.facade",
+                             "instruments.rails", "instruments.records", "numerics"},
+    "instruments.formats": {"instruments.errors", "instruments.files", "instruments.rails", "instruments.records"},
+    "instruments.archive": {"instruments.errors", "instruments.files", "instruments.records"},
+    "instruments.scpi": set(), "instruments.transports": {"instruments.errors"},
+    "instruments.virtual_scope": {"instruments.devices", "instruments.errors", "instruments.records",
+                                  "instruments.scpi", "instruments.transports"},
+}
 HEAVY = {"numba", "scipy", "pint", "pyvista", "vtk", "vtkmodules", "matplotlib", "dask", "h5py"}
 
 
@@ -22,10 +44,16 @@ def layer(module: str):
     return max(hits, key=len) if hits else None
 
 
+def room(module: str):
+    """The room of an instruments module (instruments.X: its subpackage or top-level module), or None."""
+    parts = module.split(".")
+    return ".".join(parts[:2]) if parts[0] == "instruments" else None
+
+
 def modules(root: Path) -> dict:
-    """{module name: path} of every .py file under root/rig and root/instruments."""
+    """{module name: path} of every .py file under each of PACKAGES in root."""
     out = {}
-    for pkg in ("rig", "instruments"):
+    for pkg in PACKAGES:
         for path in sorted((root / pkg).rglob("*.py")):
             parts = list(path.relative_to(root).with_suffix("").parts)
             out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
@@ -77,14 +105,16 @@ def _private(part: str) -> bool:  # dunders (__version__, __main__) are public
 def check_layers(root: Path) -> list:
     """Every violation under root, one line each: 'file:line: edge: why'."""
     mods = modules(root)
-    problems, graph = [], {m: set() for m in mods}
+    problems, graph, every = [], {m: set() for m in mods}, {m: set() for m in mods}
     for name, path in mods.items():
         here, rel = layer(name), path.relative_to(root).as_posix()
         if here is None and name != "rig":
             problems.append(f"{rel}: {name} is in no layer (add it to RANKS and docs/architecture.md)")
+        if room(name) and room(name) not in ROOMS:
+            problems.append(f"{rel}: {name} is in no room of instruments (add it to ROOMS and docs/architecture.md)")
         for target, item, line, top in imports(name, path):
             full = f"{target}.{item}" if item and f"{target}.{item}" in mods else target
-            if full.split(".")[0] not in ("rig", "instruments") or full == name:
+            if full.split(".")[0] not in PACKAGES or full == name:
                 continue
             there, edge = layer(full), f"{rel}:{line}: {name} imports {full}"
             if name == "rig":
@@ -92,6 +122,10 @@ def check_layers(root: Path) -> list:
                     problems.append(f"{edge}: the facade loads its layers lazily (_PUBLIC), never at import")
             elif here == "instruments" and full.split(".")[0] == "rig":
                 problems.append(f"{edge}: instruments never import rig")
+            elif here == "numerics" and there != "numerics":
+                problems.append(f"{edge}: numerics imports neither rig nor instruments")
+            elif room(name) in ROOMS and (room(full) or there) not in ROOMS[room(name)] | {room(name)}:
+                problems.append(f"{edge}: {room(name)} may not import {room(full) or there} (ROOMS)")
             elif full == "rig" and item != "__version__":
                 problems.append(f"{edge}{f' {item}' if item else ''}: only __version__ comes from the rig "
                                 "facade; name the defining module")
@@ -105,9 +139,17 @@ def check_layers(root: Path) -> list:
                 problems.append(f"{edge}: {parts[hidden[-1]]} is private to {owner}")
             if item and _private(item) and full == target:
                 problems.append(f"{edge}: {item} is private to {full}")
-            if top and full in mods:
-                graph[name].add(full)
-    return problems + [f"import cycle: {' -> '.join(c)}" for c in cycles(graph)]
+            if full in mods:
+                every[name].add(full)
+                if top:
+                    graph[name].add(full)
+    return problems + [_cycle_line(c, graph) for c in cycles(every)]
+
+
+def _cycle_line(cycle: list, graph: dict) -> str:
+    """One import cycle, said as a path, and whether only module-level imports close it."""
+    lazy = any(b not in graph[a] for a, b in zip(cycle, cycle[1:]))
+    return f"import cycle{' (function-level or TYPE_CHECKING imports too)' if lazy else ''}: {' -> '.join(cycle)}"
 
 
 def cycles(graph: dict) -> list:
@@ -162,11 +204,14 @@ def test_the_checker_finds_planted_violations(tmp_path):
         "rig/model/lazy.py": "import importlib\ndef f():\n    importlib.import_module('rig.viz.figures')\n",
         "rig/solver/solve.py": "def solve():\n    from . import c\n",
         "rig/solver/a.py": "from rig.solver.b import y\ndef _helper(): pass\n", "rig/solver/b.py": "from . import a\n",
-        "rig/solver/c.py": "def f():\n    from rig.solver import solve\n",  # lazy: c <-> solve is no cycle
+        "rig/solver/c.py": "def f():\n    from rig.solver import solve\n",  # lazy, but c <-> solve is a cycle
         "rig/experiment/e.py": "from instruments._kernels.peaks import p\nfrom rig.solver.a import _helper\n"
                                "from rig import Chain\n",
         "rig/extra/z.py": "", "rig/viz/figures.py": "", "instruments/_kernels/peaks.py": "p = 1\n",
         "instruments/y.py": "import rig\nfrom instruments._kernels import peaks\n",
+        "numerics/n.py": "from instruments import y\n",
+        "instruments/devices/d.py": "from instruments.analysis.a import p\n",
+        "instruments/analysis/a.py": "from instruments.devices.d import q\nfrom instruments.archive import Archive\n",
     }
     for rel, text in files.items():
         (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
@@ -182,7 +227,15 @@ def test_the_checker_finds_planted_violations(tmp_path):
         "rig/experiment/e.py:3: rig.experiment.e imports rig Chain: only __version__ comes from the rig facade",
         "rig/extra/z.py: rig.extra.z is in no layer",
         "instruments/y.py:1: instruments.y imports rig: instruments never import rig",
+        "numerics/n.py:1: numerics.n imports instruments.y: numerics imports neither rig nor instruments",
+        "instruments/y.py: instruments.y is in no room of instruments",
+        "instruments/devices/d.py:1: instruments.devices.d imports instruments.analysis.a: instruments.devices may not "
+        "import instruments.analysis",
+        "instruments/analysis/a.py:2: instruments.analysis.a imports instruments.archive: instruments.analysis may not "
+        "import instruments.archive",
+        "import cycle: instruments.analysis.a -> instruments.devices.d -> instruments.analysis.a",
         "import cycle: rig.solver.a -> rig.solver.b -> rig.solver.a",
+        "import cycle (function-level or TYPE_CHECKING imports too): rig.solver.c -> rig.solver.solve -> rig.solver.c",
     ]
     found = check_layers(tmp_path)  # each expected line, and nothing else
     for line in expected:

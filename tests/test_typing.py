@@ -1,5 +1,5 @@
 """The packages are typed: mypy, with the configuration stated in pyproject.toml ([tool.mypy]),
-finds no error in rig/ and instruments/; both ship a py.typed marker; the lazy facade shows
+finds no error in rig/, instruments/ and numerics/; each ships a py.typed marker; the lazy facade shows
 type checkers the very names it loads (its ``if TYPE_CHECKING:`` block against ``_PUBLIC``),
 and ``import rig`` still loads none of the layers.
 
@@ -50,13 +50,13 @@ def test_import_rig_loads_no_layer_and_no_numba():
     assert out.stdout.strip() == "['rig']", out.stdout
 
 
-def test_both_packages_ship_a_py_typed_marker():
+def test_every_package_ships_a_py_typed_marker():
     data = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]
-    for package in ("rig", "instruments"):
+    for package in ("rig", "instruments", "numerics"):
         assert (ROOT / package / "py.typed").is_file() and "py.typed" in data[package]
 
 
-def test_mypy_finds_no_error_in_rig_and_instruments():
+def test_mypy_finds_no_error_in_rig_instruments_and_numerics():
     out = subprocess.run([sys.executable, "-m", "mypy"], check=False, capture_output=True, text=True, cwd=ROOT)
     assert out.returncode == 0, out.stdout[-4000:] + out.stderr[-2000:]
     assert "Success: no issues found" in out.stdout

@@ -138,8 +138,8 @@ def _example(values: dict, key: str):
 def _constructors() -> dict:
     """{table: the classes the assembly builds from it} (rig/experiment/assembly.py): a key's
     default is its keyword's default there."""
-    from instruments.gauges import GaugeSettings
-    from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
+    from instruments.devices.gauges import GaugeSettings
+    from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
     from rig.experiment.settings import SolverSettings
     from rig.model.apparatus import Holder, RingMagnet
     from rig.model.parts import Striker, Wall

@@ -1,7 +1,7 @@
-"""One-pole recursive filter (numba) for the analog front ends (instruments/frontend.py)."""
+"""One-pole recursive filter (numba) for the analog front ends (instruments/devices/frontend.py)."""
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 
 @jit(inline="always")

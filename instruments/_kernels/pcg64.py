@@ -20,7 +20,7 @@ from numba import types
 from numba.extending import intrinsic
 from numba.np.random._constants import fi_double, ki_double, wi_double, ziggurat_nor_inv_r, ziggurat_nor_r
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 MULTIPLIER = 0x2360ED051FC65DA44385DF649FCCF645  # PCG's default 128-bit LCG multiplier
 _I128, _I64 = ir.IntType(128), ir.IntType(64)

@@ -1,5 +1,5 @@
 """Scope file formats: Tektronix ISF (binary), Tektronix CSV and Tektronix WFM (through
-Tektronix's tm_data_types, the ``wfm`` extra). A file's format is told from its content
+RigolWFM, a core dependency). A file's format is told from its content
 (``sniff.identify``), not its name; other makers' files are refused naming their format."""
 from pathlib import Path
 

@@ -4,7 +4,7 @@ One instrument state (settings, acquisition, status, reply forms) is shared by e
 session and transport; one program message is executed at a time under the instrument's
 condition, which a query waiting for a shot (``*OPC?``, ``*WAI``) releases while it waits,
 so other sessions are answered during a shot. The scope starts from the scene's scope
-(``instruments.oscilloscope.Oscilloscope``), its record length and s/div snapped to the
+(``instruments.devices.oscilloscope.Oscilloscope``), its record length and s/div snapped to the
 personality's (those count as overrides); ``*RST`` returns there. ``rig_port()`` serves the
 RIG: commands alone, on the same state, for a separate port. No command reads or writes a
 file (FILESystem and SAVe are undefined headers). Replies start with HEADer OFF (what
@@ -16,8 +16,8 @@ import math
 import threading
 from collections.abc import Callable
 
+from ..devices.oscilloscope import Oscilloscope
 from ..errors import InstrumentError
-from ..oscilloscope import Oscilloscope
 from ..scpi.engine import Engine, ReplyForm
 from ..scpi.status import OPC, ScpiError, StatusModel
 from ..scpi.tree import CommandTree

@@ -2,7 +2,7 @@
 
 Every front-panel setting the SCPI commands change is a scene key of the scope
 (``scope.channels.CH1.volts_per_div``, ``scope.record_length``, ...; the rig's SCHEMA in its
-scene module, the fields of ``instruments.oscilloscope``), held as its SI value. The shot
+scene module, the fields of ``instruments.devices.oscilloscope``), held as its SI value. The shot
 source is handed the settings that differ from the scene as loaded, as text with the key's
 unit (``"0.05 V"``, ``"1e-06 s"``, ``"2500"``), the form ``rig shot --set KEY=VALUE`` takes.
 A channel the scene does not set up is acquired only once it is switched on, and then with
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import fields
 
-from ..oscilloscope import CHANNELS, ChannelSettings, Oscilloscope, Timebase, Trigger
+from ..devices.oscilloscope import CHANNELS, ChannelSettings, Oscilloscope, Timebase, Trigger
 
 UNITS = {"sample_interval": "s", "level": "V", "volts_per_div": "V", "offset": "V", "bandwidth": "Hz"}
 CHANNEL_FIELDS = tuple(f.name for f in fields(ChannelSettings))

@@ -12,6 +12,8 @@ from __future__ import annotations
 import time
 
 from rig.bench.baseline import machine
+from rig.bench.problems import PROBE, SCENARIOS
+from rig.bench.problems import chain as bench_chain
 from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import relative_error
@@ -30,8 +32,6 @@ def cases(names=None):
     probe at contact 500 on a 1 MS/s grid) and the published scenes (their gauges' contacts
     and the wall, on their own grid, for their whole duration)."""
     from rig.bench.kernel_cost import SAMPLE_INTERVAL
-    from rig.bench.solver import PROBE, SCENARIOS
-    from rig.bench.solver import chain as bench_chain
     from rig.experiment.shot import Rig
 
     for name, (top, t_end) in SCENARIOS.items():

@@ -104,7 +104,7 @@ def run(rounds: int = ROUNDS, baseline: str | None = None) -> dict:
             "shot_compile_total_s": sum(compiles.values()),
             "shot_top_compiles_s": dict(sorted(compiles.items(), key=lambda kv: -kv[1])[:12])}
     if baseline:
-        cur, base = result["revisions"]["current"], result["revisions"][f"baseline {baseline}"]
+        cur = result["revisions"]["current"]
         result["ratio_to_baseline"] = {c: statistics.median(a["wall_s"][c] / b["wall_s"][c]
                                                             for a, b in zip(got["current"], got[f"baseline {baseline}"]))
                                        for c in cur["wall_s"]}

@@ -30,7 +30,8 @@ import tempfile
 import time
 from dataclasses import dataclass
 
-from instruments import batch as instrument_batch
+from instruments.analysis.batch import analysed
+from instruments.devices import batch as instrument_batch
 from rig.experiment.measure import setup_for
 from rig.experiment.shot import Rig
 from rig.solver.ensemble import solve_ensemble
@@ -163,7 +164,7 @@ def _stage_times(study: Study, setting: Setting, template: Rig, wiring, setup, b
     records = instrument_batch.acquire(ens.records, ens.sample_interval, wiring, seeds, shots.fixed, speeds,
                                        read=(setup.upper.channel, setup.lower.channel))
     t.append(time.perf_counter())
-    instrument_batch.analysed(records, setup)
+    analysed(records, setup)
     t.append(time.perf_counter())
     return t
 

@@ -34,19 +34,11 @@ from rig.bench import models
 from rig.bench.accuracy import cases, reference
 from rig.bench.baseline import machine
 from rig.bench.kernel_cost import kernel_figures, median_cpu, scaling
-from rig.model.chain import Chain
-from rig.model.parts import Bead, Striker, Wall
+from rig.bench.problems import N_BEADS, PROBE, SCENARIOS, chain
 from rig.solver.solution import relative_error
 from rig.solver.solve import solve
 from rig.solver.stepsize import contact_time_scale, head_contacts, stepping_at
 
-N_BEADS = 1000
-PROBE = 500
-STEEL = Bead("steel316", 4.76e-3, 0.4501e-3)  # diameter (m), mass (kg): 4.76 mm, 0.4501 g
-SCENARIOS = {  # name: (top force N, t_end s) -- t_end lets the pulse pass contact 500
-    "sonic-vacuum": (0.0, 5.0e-3),
-    "precompressed": (2.38, 4.6e-3),
-}
 DIVISIONS = {"srkn6b": (2, 3, 4, 6, 8, 12, 16, 24, 32), "verlet": (8, 16, 32, 64, 128, 256)}
 SETTINGS = (1e-3, 1e-4, 1e-5, 1e-6)
 PEERS = {"scipy-DOP853": (1e-6, 1e-8, 1e-10), "numba-DOP853": (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12),
@@ -55,13 +47,6 @@ EQUAL_ERRORS = (1e-4, 1e-5, 1e-6)
 ROUNDS = 5  # every run of the work-precision curves, in turns with the others (interleaved)
 QUICK = dict(divisions={"srkn6b": (3, 6, 12), "verlet": (32, 128)}, settings=(1e-4,), peers={
     "scipy-DOP853": (1e-8,), "numba-DOP853": (1e-8, 1e-10), "LAMMPS": (20,)}, scenarios=("precompressed",))
-
-def chain(top_force: float, n: int = N_BEADS) -> Chain:
-    striker = Striker("steel316", 0.4501e-3, 0.44)  # mass (kg), velocity (m/s): 0.4501 g, 0.44 m/s
-    if top_force:
-        return Chain([STEEL] * n, striker=striker, wall=Wall(), gravity=0, top_force=top_force)
-    return Chain([STEEL] * n, striker=striker, gravity=0)
-
 
 def _row(scenario, method, setting, cpu, error, evaluations, bodies, **extra) -> dict:
     return dict(scenario=scenario, method=method, setting=setting, cpu_s=cpu, error=error,

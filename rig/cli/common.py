@@ -227,7 +227,7 @@ def writing_to(path):
 def missing_lines(reasons: dict) -> list:
     """One line per reason of a Report's missing figures ({figure: reason}): "no F1, F2:
     reason", or "no result: reason" where every figure is missing for it."""
-    from instruments.report import FIGURES
+    from instruments.analysis.report import FIGURES
 
     why: dict[str, list] = {}
     for figure, reason in reasons.items():
@@ -251,8 +251,8 @@ def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     process while this one compiles the rest, and say so in one line on stderr when it is a
     terminal (a log or a test keeps a failure's one error line alone) and not ``quiet``.
     Nothing on a warm cache."""
-    from instruments.jit import has_machine_code
     from instruments.precompile import SHOT, STUDY, start
+    from numerics.dispatcher import has_machine_code
     from rig.solver.cold import SIDE
     from rig.solver.kernels.ensemble import integrate_ensemble
     from rig.solver.kernels.integrators import integrate

@@ -19,13 +19,13 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 from instruments.analysis import PeakRules
+from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.analysis.plausibility import Limits
+from instruments.analysis.report import SPEED_FIGURES, Report
 from instruments.archive import Archive, Entry
 from instruments.errors import InstrumentError
 from instruments.formats import read_record
-from instruments.pipeline import GaugeSetup, Setup, analyze_record
-from instruments.plausibility import Limits
 from instruments.records import ScopeRecord
-from instruments.report import SPEED_FIGURES, Report
 from rig.errors import RigError, invalid, lookup
 from rig.model.materials import MATERIALS, Material, material
 from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed

@@ -7,9 +7,9 @@ import contextlib
 import math
 from typing import TypeGuard
 
+from instruments.devices.gauges import GaugeSettings
+from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from instruments.errors import InstrumentError
-from instruments.gauges import GaugeSettings
-from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from rig.errors import RigError, invalid
 from rig.experiment.scene import Scene
 from rig.experiment.settings import GaugeWiring, SolverSettings, WallWiring

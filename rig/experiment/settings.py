@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from instruments.gauges import GaugeSettings
+from instruments.devices.gauges import GaugeSettings
 from rig.errors import invalid
 from rig.solver.methods import method
 from rig.solver.stepsize import checked_accuracy

@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from instruments.gauges import GaugeDraw, PiezoGauge
+from instruments.analysis.report import Report
+from instruments.devices.gauges import GaugeDraw, PiezoGauge
 from instruments.records import ScopeRecord
-from instruments.report import Report
 from rig.errors import RigError, invalid
 from rig.experiment import scene as scene_io
 from rig.experiment.assembly import Assembly

@@ -2,7 +2,7 @@
 
 The model of a channel is what the scene's instruments make of a candidate's noise-free
 solution: the gauge (sensitivity, RC high-pass) and the scope's front end (probe, coupling,
-bandwidth), before noise and the 8-bit conversion (instruments.oscilloscope.analog). A
+bandwidth), before noise and the 8-bit conversion (instruments.devices.oscilloscope.analog). A
 record's channel is compared with it after its pre-trigger baseline is removed:
 
     r_c(t_k) = (g_c m_c(t_k + t_0 + d_c) - y_c(t_k)) / sd_c
@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from instruments.gauges import GaugeDraw, PiezoGauge
+from instruments.devices.gauges import GaugeDraw, PiezoGauge
 from rig.errors import RigError
 from rig.experiment.shot import Rig
 from rig.fit.checks import at_values, check_bounds, check_distinct_channels

@@ -155,11 +155,6 @@ class Chain:
             return np.append(self.masses, self.wall.plate_mass)
         return self.masses
 
-    @property
-    def conservative(self) -> bool:
-        """No dissipation anywhere: an elastic contact law and nothing from the holder."""
-        return not self.law.dissipative and self.drag == 0 and self.friction == 0
-
     def contact_exponents(self) -> np.ndarray:
         """Exponent n of each contact's elastic law A delta^n (follows_law: the chain's
         contact_exponent; 3/2 for the others, 1 for a compliant wall's rod)."""

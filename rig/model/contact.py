@@ -21,7 +21,6 @@ import numpy as np
 
 from rig.errors import invalid
 from rig.model import laws
-from rig.model.materials import Material
 
 
 def hertz_constant(E1: float, nu1: float, R1: float, E2: float, nu2: float,
@@ -32,11 +31,6 @@ def hertz_constant(E1: float, nu1: float, R1: float, E2: float, nu2: float,
     if curvature <= 0.0:
         raise invalid("contact", "flat on flat", "one of the two bodies must be a sphere")
     return 4.0 / 3.0 * e_eff * math.sqrt(1.0 / curvature)
-
-
-def contact_constant(m1: Material, R1: float, m2: Material, R2: float = math.inf) -> float:
-    """Hertz constant between two parts made of materials m1, m2 (radii in m, inf = flat)."""
-    return hertz_constant(m1.E, m1.nu, R1, m2.E, m2.nu, R2)
 
 
 def power_of(delta, n):

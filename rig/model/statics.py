@@ -9,17 +9,36 @@ d0 = (F/A)^(1/n) ((F/A)^(2/3) for Hertz), so nothing moves before impact.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 
 from rig.model.contact import hertz_constant, power_law_constant, static_overlaps
-
-if TYPE_CHECKING:
-    from rig.model.chain import Chain
+from rig.model.parts import Bead, Striker, Wall
 
 
-def follows_law(chain: "Chain") -> np.ndarray:
+class Layout(Protocol):
+    """What the statics read of a chain (rig.model.chain.Chain is one): its parts, in order
+    from the top, and its contact law's elastic exponent, matched to Hertz at
+    reference_force (N)."""
+
+    @property
+    def beads(self) -> tuple[Bead, ...]: ...
+    @property
+    def striker(self) -> Striker | None: ...
+    @property
+    def wall(self) -> Wall | None: ...
+    @property
+    def contact_exponent(self) -> float: ...
+    @property
+    def reference_force(self) -> float: ...
+    @property
+    def n_beads(self) -> int: ...
+    @property
+    def n_contacts(self) -> int: ...
+
+
+def follows_law(chain: Layout) -> np.ndarray:
     """Which contacts (0..n_beads, and the rod of a compliant wall) follow the chain's
     contact law (its exponent and dissipation): those that touch a bead of the chain's
     material (not the magnetic bead). The others (a striker on the magnetic bead, the rod)
@@ -34,7 +53,7 @@ def follows_law(chain: "Chain") -> np.ndarray:
     return out
 
 
-def contact_constants_of(chain: "Chain", E=None, nu=None) -> np.ndarray:
+def contact_constants_of(chain: Layout, E=None, nu=None) -> np.ndarray:
     """Contact constants of contacts 0..n_beads of ``chain`` (and the rod of a compliant
     wall; last axis; nan where there is no partner): Hertz constants (N/m^1.5), the
     power-law constant (N/m^n, power_law_constant) for the contacts that follow a law of

@@ -3,8 +3,8 @@
 ``order`` is the classical order on smooth forces. ``contact_order`` is what the method
 achieves on chains whose contacts open and close: the Hertz force d^(3/2) has a second
 derivative that is infinite at d = 0, which caps the order of high-order compositions
-(measured in tests/physics/test_convergence.py and in the solver benchmark).
-``error_constant`` and ``contact_order`` set the automatic step (rig/stepsize.py).
+(measured in tests/solver/test_convergence.py and in the solver benchmark).
+``error_constant`` and ``contact_order`` set the automatic step (rig/solver/stepsize.py).
 """
 from __future__ import annotations
 

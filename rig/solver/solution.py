@@ -144,12 +144,6 @@ class Solution:
         n = len(next(iter(self.forces.values()))) if self.forces else 0
         return np.arange(n) * self.sample_interval
 
-    @property
-    def frame_times(self) -> np.ndarray | None:
-        if self.frames is None or self.frame_interval is None:
-            return None
-        return np.arange(self.frames.shape[0]) * self.frame_interval
-
     def final_body_energies(self) -> np.ndarray:
         """Energy (J) of each moving body at the end: kinetic plus half of the elastic
         energy of each of its contacts (constant-load potentials excluded)."""

@@ -37,7 +37,7 @@ def solve(problem: ChainProblem | Chain, t_end: float, *, save: SaveAt | None = 
     (rig/solver/control.py), which aims at accuracy / 3. ``dt`` (s, single rate; or a
     Stepping, possibly multirate) fixes the step instead; a dt beyond the method's
     stability limit for this chain is refused. Either way the solution carries an
-    a-posteriori error estimate (``stats.error_estimate``), from a companion solve at twice
+    a-posteriori error estimate (``stats.error_estimate``), from a companion solve at half
     the step, unless ``estimate`` is False (with dt only).
     """
     m = get_method(method)

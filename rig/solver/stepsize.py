@@ -248,7 +248,8 @@ def checked_accuracy(accuracy: float | None, field: str = "accuracy") -> float:
 
 def largest_step(p, method: Method, t_end: float) -> float:
     """The largest outer step (s) a solve of t_end seconds may take: half the stability
-    limit of the contacts after the head (its companion at twice the step stays stable),
+    limit of the contacts after the head (a margin below it; the estimate's companion runs at
+    half the step, stable wherever the solve is),
     with a head at most MTS_CAP x the head's tau (multiple time stepping resonates when
     the outer step nears the period of the fast contacts), and at most t_end."""
     head = head_contacts(p)

@@ -12,9 +12,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from instruments import batch as instrument_batch
 from instruments import streams
-from instruments.pipeline import analyze_record
+from instruments.analysis.batch import analysed
+from instruments.analysis.pipeline import analyze_record
+from instruments.devices import batch as instrument_batch
 from rig.errors import RigError, invalid
 from rig.experiment.measure import setup_for
 from rig.experiment.shot import Rig
@@ -174,7 +175,7 @@ def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
     setup = setup_for(template, *nom.calibration)
     records = instrument_batch.acquire(forces, h, wiring, [drawn[j][2] for j in keep], sub.fixed, speeds,
                                        read=(setup.upper.channel, setup.lower.channel))  # what the analysis reads
-    reports = instrument_batch.analysed(records, setup)
+    reports = analysed(records, setup)
     roles = [records.wiring.channels.index(setup.upper.channel), records.wiring.channels.index(setup.lower.channel)]
     succeeded, energy_errors = ens.succeeded, ens.energy_errors
     for e, j in enumerate(keep):

@@ -1,7 +1,7 @@
 """The shots of a study batch as arrays, with no rig built per shot: from the template rig
 (rig/study/nominal.py) and each shot's drawn values, the solver's ProblemArrays
 (problem_arrays, the function a lone shot's ChainProblem comes from), the instruments'
-wiring and the forces and draws they read (instruments/batch.py). This covers studies that
+wiring and the forces and draws they read (instruments/devices/batch.py). This covers studies that
 vary only ARRAY_KEYS and the gauges' gains and position errors; any other key changes the
 rig's parts, and batch.py builds those shots' rigs.
 """
@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from instruments.batch import Wiring
+from instruments.devices.batch import Wiring
 from rig.experiment.shot import Rig
 from rig.experiment.truth import speed_between
 from rig.model.parts import GaugeBead

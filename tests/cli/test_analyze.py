@@ -5,11 +5,11 @@ import json
 import numpy as np
 import pytest
 
+from instruments.analysis.report import FIGURES
+from instruments.devices.frontend import rc_highpass
+from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from instruments.formats import read_record
 from instruments.formats.isf import write_isf
-from instruments.frontend import rc_highpass
-from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
-from instruments.report import FIGURES
 from rig.cli import main
 
 H = 1e-7

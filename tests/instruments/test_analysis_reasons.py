@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 from test_analysis_snr import SETUP, N, record, sech2
 
+from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.analysis.plausibility import Limits
+from instruments.analysis.report import FIGURES, SPEED_FIGURES
 from instruments.errors import InstrumentError
-from instruments.pipeline import GaugeSetup, Setup, analyze_record
-from instruments.plausibility import Limits
 from instruments.records import ScopeRecord
-from instruments.report import FIGURES, SPEED_FIGURES
 
 
 def clean_pair(t_up=0.5e-3, t_low=0.7e-3):
@@ -107,7 +107,7 @@ def test_limits_refuse_nonsense(limits):
 
 
 def test_json_form_has_no_infinity():
-    from instruments.report import Report
+    from instruments.analysis.report import Report
 
     d = Report(snr={"CH1": float("inf")}, noise={"CH1": 0.0}, duration_s=float("nan")).as_dict()
     assert d["snr"] == {"CH1": None} and d["noise"] == {"CH1": 0.0} and d["duration_s"] is None

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from instruments.analysis import PeakRules, noise_level
-from instruments.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.records import Preamble, ScopeRecord, Waveform
 
 H = 1e-7

@@ -18,8 +18,8 @@ import pytest
 
 from instruments.archive import Archive, Entry
 from instruments.archive.facts import GaugeFact, ShotFacts
+from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from instruments.errors import InstrumentError
-from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 
 SCOPE = Oscilloscope(channels={c: ChannelSettings(volts_per_div=0.05) for c in ("CH1", "CH2", "CH3")},
                      timebase=Timebase(2e-7, 10000), trigger=Trigger("CH1", 0.05, "rising", 0.1))

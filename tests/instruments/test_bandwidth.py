@@ -7,10 +7,10 @@ import re
 import numpy as np
 import pytest
 
+from instruments.analysis.distortion import too_slow
+from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.formats import read_waveforms
 from instruments.formats.isf import isf_bytes
-from instruments.distortion import too_slow
-from instruments.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.records import Preamble, ScopeRecord, Waveform
 
 DT = 2e-7

@@ -6,11 +6,12 @@ import re
 import numpy as np
 import pytest
 
-from instruments import batch
 from instruments.analysis import PeakRules
-from instruments.gauges import GaugeDraw, GaugeSettings, PiezoGauge
-from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
-from instruments.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.analysis.batch import analysed
+from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.devices import batch
+from instruments.devices.gauges import GaugeDraw, GaugeSettings, PiezoGauge
+from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 
 H = 2e-7
 N = 3000
@@ -68,7 +69,7 @@ def test_a_batch_of_shots_reads_as_its_shots_alone(noise, noise_floor):
             assert together.waveforms[ch].preamble == w.preamble
     setup = Setup(GaugeSetup("CH2", 0.0, 0.05, 1e-3), GaugeSetup("CH1", 0.0043, 0.05, 1e-3),
                   GaugeSetup("CH3", 0.02, 0.05, 1e-3), 4.76e-3, 1.1, 2.4, PeakRules())
-    for s, rep in enumerate(batch.analysed(records, setup)):
+    for s, rep in enumerate(analysed(records, setup)):
         ref = analyze_record(records.record(s), setup, train=False)
         assert rep.as_dict() == ref.as_dict(), s
 
@@ -96,7 +97,7 @@ def test_channels_nobody_reads_are_skipped_without_changing_the_others(read):
             assert np.array_equal(rec.waveforms[ch].codes, ref.waveforms[ch].codes), (s, ch)
     setup = Setup(GaugeSetup("CH2", 0.0, 0.05, 1e-3), GaugeSetup("CH1", 0.0043, 0.05, 1e-3))
     if {"CH1", "CH2"} <= set(kept):
-        assert [r.as_dict() for r in batch.analysed(part, setup)] == [r.as_dict() for r in batch.analysed(whole, setup)]
+        assert [r.as_dict() for r in analysed(part, setup)] == [r.as_dict() for r in analysed(whole, setup)]
 
 
 def test_before_the_impact_a_record_reads_the_gauges_at_rest():
@@ -129,7 +130,7 @@ def test_a_shot_that_does_not_trigger_or_outlasts_its_input_says_so():
     assert list(records.status) == [batch.NO_TRIGGER, batch.PAST_INPUT]
     assert not records.record(0).triggered
     setup = Setup(GaugeSetup("CH2"), GaugeSetup("CH1", 0.0043))
-    assert "did not trigger" in batch.analysed(records, setup)[0].reasons["speed_m_per_s"]
+    assert "did not trigger" in analysed(records, setup)[0].reasons["speed_m_per_s"]
 
 
 def test_a_clipped_gauge_channel_gives_no_figure_alone_or_in_a_batch():
@@ -141,7 +142,7 @@ def test_a_clipped_gauge_channel_gives_no_figure_alone_or_in_a_batch():
     records = batch.acquire(forces, H, wiring, [1, 2])
     assert records.over[0].tolist() == [False, True, False] and not records.over[1].any()
     setup = Setup(GaugeSetup("CH2", 0.0, 0.05, 1e-3), GaugeSetup("CH1", 0.0043, 0.05, 1e-3))
-    reports = batch.analysed(records, setup)
+    reports = analysed(records, setup)
     alone = analyze_record(records.record(0), setup, train=False)
     assert reports[0].as_dict() == alone.as_dict()
     assert alone.speed_m_per_s is None and alone.amplitude_N is None

@@ -8,11 +8,11 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.signal import find_peaks, lfilter, peak_prominences, peak_widths
 
 from instruments._kernels.filters import one_pole, undo_highpass
-from instruments._kernels.parabola import parabola
-from instruments._kernels.peaks import local_maxima, thin_by_distance, widths_at
-from instruments._kernels.prominence import prominence_bases, prominent
-from instruments._kernels.quantiser import quantise
-from instruments._kernels.resample import at_positions
+from instruments.analysis._kernels.parabola import parabola
+from instruments.analysis._kernels.peaks import local_maxima, thin_by_distance, widths_at
+from instruments.analysis._kernels.prominence import prominence_bases, prominent
+from instruments.devices._kernels.quantiser import quantise
+from instruments.devices._kernels.resample import at_positions
 
 
 def _same_bits(a, b):
@@ -184,7 +184,7 @@ def test_quantiser_is_the_numpy_expression(sd):
 
 @pytest.mark.parametrize("n", [1, 2, 7, 16, 1250, 1251])
 def test_median_is_numpys(n):
-    from instruments._kernels.pulses import median
+    from instruments.analysis._kernels.pulses import median
 
     rng = np.random.default_rng(n)
     for x in (rng.standard_normal(n), rng.integers(0, 4, n).astype(float)):  # ties as on 8-bit records
@@ -195,7 +195,7 @@ def test_correlation_adds_each_lag_in_order():
     # the cross-correlation's sums, four terms at a time, are the plain sums over j in
     # order (numpy adds a[j] b[j:j + K] to c one j after another), bit for bit, for
     # windows that are and are not multiples of four
-    from instruments._kernels.pulses import correlate
+    from instruments.analysis._kernels.pulses import correlate
 
     rng = np.random.default_rng(13)
     for m in (1, 3, 4, 5, 8, 611, 614):
@@ -212,7 +212,7 @@ def test_correlation_adds_each_lag_in_order():
 def test_median_of_many_records_is_numpys():
     # sorted, tied and noisy inputs of every length parity: the selection's pivots and
     # buffers give numpy's value exactly; a nan gives nan, as np.median does
-    from instruments._kernels.pulses import median
+    from instruments.analysis._kernels.pulses import median
 
     rng = np.random.default_rng(21)
     for t in range(600):
@@ -230,7 +230,7 @@ def test_front_end_is_its_filters_one_after_another(probe):
     # the scope channel's front end in one pass (both filters' recursions together, a 1x
     # probe skipped) is the input over the probe, lfilter's AC coupling, lfilter's bandwidth
     # limit about its first value, times the probe, bit for bit, each filter on or off
-    from instruments._kernels.acquisition import condition
+    from instruments.devices._kernels.acquisition import condition
 
     rng = np.random.default_rng(17)
     v = np.cumsum(rng.standard_normal(3000)) * 1e-3 + 0.2

@@ -4,8 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from instruments.frontend import lowpass, rc_highpass
-from instruments.gauges import GaugeDraw, GaugeSettings, PiezoGauge
+from instruments.devices.frontend import lowpass, rc_highpass
+from instruments.devices.gauges import GaugeDraw, GaugeSettings, PiezoGauge
 
 H = 1e-7
 

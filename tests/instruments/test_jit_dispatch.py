@@ -1,5 +1,5 @@
 """A kernel called from another kernel with constant arguments is compiled once, for the
-arguments' plain types (instruments/dispatcher.py): numba would compile one copy per
+arguments' plain types (numerics/dispatcher.py): numba would compile one copy per
 constant (each copy with everything it calls), which was most of a cold start's waste."""
 import os
 import subprocess
@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 from numba.core import types
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
+from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from instruments.errors import InstrumentError
-from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 
 H = 1e-7
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from instruments.analysis import PeakRules, find_pulses, invert_rc, leading, xcorr_delay
-from instruments.frontend import rc_highpass
-from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
-from instruments.pipeline import GaugeSetup, Setup, analyze_forces, analyze_record
+from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_forces, analyze_record
+from instruments.devices.frontend import rc_highpass
+from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 
 H = 1e-7
 T = np.arange(30000) * H
@@ -19,7 +19,7 @@ def sech2(t0, width, amp=1.0):
 
 
 def test_pipeline_modules_do_not_import_the_simulator():
-    code = ("import sys, instruments.pipeline, instruments.archive, instruments.formats; "
+    code = ("import sys, instruments.analysis.pipeline, instruments.archive, instruments.formats; "
             "print(any(m == 'rig' or m.startswith('rig.') for m in sys.modules))")
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "False"
 

@@ -7,10 +7,10 @@ import re
 import numpy as np
 import pytest
 
+from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.formats import read_record, read_waveforms
 from instruments.formats.isf import isf_bytes
 from instruments.formats.tek_csv import write_csv
-from instruments.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.rails import rail, rail_of_codes, rail_of_volts
 from instruments.records import Preamble, Waveform
 

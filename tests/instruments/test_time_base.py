@@ -8,11 +8,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.errors import InstrumentError
 from instruments.formats import check_one_time_base, read_record, read_waveforms
 from instruments.formats.isf import isf_bytes
 from instruments.formats.tek_csv import write_csv
-from instruments.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.records import Preamble, ScopeRecord, Waveform
 
 

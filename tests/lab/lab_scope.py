@@ -3,8 +3,8 @@ shot source that applies the overrides to the scene's Oscilloscope and acquires 
 pulse with the shot's seed), and a query's reply as text."""
 import numpy as np
 
+from instruments.devices.oscilloscope import CHANNELS, ChannelSettings, Oscilloscope, Timebase, Trigger
 from instruments.errors import InstrumentError
-from instruments.oscilloscope import CHANNELS, ChannelSettings, Oscilloscope, Timebase, Trigger
 from instruments.virtual_scope.settings import scene_settings, scope_of
 
 H = 1e-7  # s, the synthetic input's sampling

@@ -7,8 +7,8 @@ import time
 import numpy as np
 import pytest
 
+from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from instruments.errors import InstrumentError
-from instruments.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from lab.lab_scope import H, ask, fire, pulse
 
 

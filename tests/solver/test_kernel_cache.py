@@ -8,7 +8,7 @@ import textwrap
 def _package(root, value):
     pkg = root / "kern"
     pkg.mkdir(exist_ok=True)
-    (pkg / "__init__.py").write_text("from instruments.jit import drop_stale_cache\n\n"
+    (pkg / "__init__.py").write_text("from numerics.jit import drop_stale_cache\n\n"
                                      "drop_stale_cache(__name__)\n")
     (pkg / "callee.py").write_text(textwrap.dedent(f"""
         from numba import njit

@@ -5,7 +5,7 @@ beads, wall of zero inverse mass), displacement ``u`` from static equilibrium (m
 velocity ``v`` (m/s); a peer that integrates the first-order system holds them as one
 state ``y = [u, v]`` (size 2 nb).
 """
-from instruments.jit import drop_stale_cache
+from numerics.jit import drop_stale_cache
 
 # the kernels inline hertz_forces (rig.solver.kernels.forces)
 drop_stale_cache(__name__, constants=("rig.model.contact", "rig.solver.kernels.forces"))

@@ -6,7 +6,7 @@ import time
 
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 
 @jit

@@ -40,7 +40,7 @@ import math
 
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 from rig.bench.kernels.dop853_table import DENSE_STAGES, E3, E5, N_STAGES, N_STAGES_EXTENDED, A, B, C, D  # noqa: F401
 from rig.solver.kernels.forces import hertz_forces
 

@@ -56,7 +56,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from instruments.jit import kernel
+from numerics.jit import kernel
 from rig.model.laws import dashpot
 from rig.model.laws.law import PLASTIC, ContactLaw, LawParameter, ViscousTerms
 

@@ -6,10 +6,10 @@ from static equilibrium (m, positive down), ``v`` the velocity (m/s). Force slot
 (size nb + 1) holds the contact between body i-1 and body i; ``f[0]`` and ``f[nb]`` stay 0
 so that every body sees ``f[i] - f[i+1]`` with no special case at the ends.
 
-The contact laws' kernel functions (rig.model.laws, marked ``instruments.jit.kernel``) are
+The contact laws' kernel functions (rig.model.laws, marked ``numerics.jit.kernel``) are
 compiled here, before any kernel of this package imports them.
 """
-from instruments.jit import compile_kernels, drop_stale_cache
+from numerics.jit import compile_kernels, drop_stale_cache
 from rig.model import laws
 
 for _module in laws.MODULES:

@@ -39,7 +39,7 @@ import math
 
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 from rig.model.contact import PLASTIC
 from rig.model.laws.thornton import DP, plastic_force
 from rig.solver.kernels.forces import power, viscous_coefficient

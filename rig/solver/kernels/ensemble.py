@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numba import prange
 
-from instruments.jit import jit
+from numerics.jit import jit
 from rig.model.contact import HERTZ, PLASTIC, POWER
 from rig.model.laws.thornton import AP, DC, DS, SPAN_END, SPAN_FIRST, plastic_force
 from rig.solver.kernels import report as slot

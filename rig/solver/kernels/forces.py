@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 from rig.model.contact import HERTZ, KUWABARA_KONO, PLASTIC, POWER
 from rig.model.laws.thornton import AP, DC, DP, DS, SPAN_END, SPAN_FIRST, plastic_energy, plastic_force
 

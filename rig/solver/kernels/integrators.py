@@ -36,7 +36,7 @@ balance E(t) + dissipated = E(0) closes to the method's own error.
 
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 from rig.model.contact import PLASTIC
 from rig.model.laws.thornton import AP, DS
 from rig.solver.kernels.dissipation import dissipate, holder_factors

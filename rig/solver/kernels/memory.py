@@ -13,7 +13,7 @@ step: their span, first to last, is kept in slot 0's memory (thornton.SPAN_FIRST
 SPAN_END; slot 0 joins no bodies) and the force passes check only those slots for the
 envelope (forces.plastic_fixup), instead of every slot at every stage. Where any exponent
 is not 3/2 every slot is renewed by the law at every stage (``every``)."""
-from instruments.jit import jit
+from numerics.jit import jit
 from rig.model.laws.thornton import DC, DLAST, RLAST, RMAX, SPAN_END, SPAN_FIRST, WORK, commit
 from rig.solver.kernels.record import synced_velocity
 

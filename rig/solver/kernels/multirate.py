@@ -37,7 +37,7 @@ ptfe52_magnetic about as much as its force passes.
 """
 import math
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 REFINE = 16  # pieces of a substep across which a head contact opens or closes (two levels)
 

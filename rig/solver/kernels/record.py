@@ -13,7 +13,7 @@ memory (PLASTIC) is recorded by the law its memory gives through the step, befor
 step's end renews it.
 """
 
-from instruments.jit import jit
+from numerics.jit import jit
 from rig.model.contact import PLASTIC
 from rig.solver.kernels.forces import contact_force, plastic_contact
 from rig.solver.kernels.multirate import slow_net

@@ -3,7 +3,7 @@ its closing kick b_S owed to the next step (integrators.py).
 
 Each stage's kick, drift and renewal of the contact forces run fused in one pass over the
 bodies (``fused_run``), and the chain is swept in blocks that stay in cache (``step``).
-With a multirate head (head > 0, see rig/stepsize.py) the kicks carry every contact but
+With a multirate head (head > 0, see rig/solver/stepsize.py) the kicks carry every contact but
 the first ``head`` ones, and each drift moves bodies 0..head by multirate.head_flow
 (``sub[s]`` substeps of the same method in drift s) instead of a plain drift. The
 scheduled force of the ring magnet is a kick of its own (``external_kick``).
@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 from rig.model.contact import PLASTIC, POWER
 from rig.solver.kernels.forces import other_law, plastic_fixup
 from rig.solver.kernels.layout import LINE

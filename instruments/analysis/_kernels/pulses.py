@@ -1,17 +1,17 @@
 """The analysis of one pulse pair, compiled (numba): conditioning of a channel, its noise,
 its pulses, the leading pulse's parabola and widths, the cross-correlation delay. The
-pipeline (instruments/pipeline.py) calls these for one record, and the batched analysis
-(instruments/batch.py) for every shot of a study in one compiled loop: the same code, so
+pipeline (instruments/analysis/pipeline.py) calls these for one record, and the batched analysis
+(instruments/analysis/batch.py) for every shot of a study in one compiled loop: the same code, so
 the same bits.
 """
 import math
 
 import numpy as np
 
-from instruments.jit import jit
+from instruments._kernels.filters import undo_highpass_into
+from numerics.jit import jit
 
 from .crossings import level_bracket
-from .filters import undo_highpass_into
 from .parabola import parabola
 from .peaks import local_maxima, thin_by_distance, widths_at
 from .prominence import prominent

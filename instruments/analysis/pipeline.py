@@ -11,7 +11,7 @@ the total F_m = F_d + F_0.
 No figure without a reason: each one the analysis cannot give is None, and
 ``Report.reasons`` says why (an envelope or untriggered record, non-finite samples, no
 pulse standing ``rules.snr`` noise levels above the pre-trigger baseline, the same record
-on both gauges, the lower pulse first, a speed that fails instruments.plausibility). An
+on both gauges, the lower pulse first, a speed that fails instruments.analysis.plausibility). An
 implausible speed is not given: the speed figures are None and the reason quotes the value.
 """
 from __future__ import annotations
@@ -21,14 +21,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..errors import InstrumentError, check
+from ..rails import clipping, rail
+from ..records import ScopeRecord, Waveform, time_base_mismatch
 from ._kernels import pulses
 from ._kernels.pulses import AMPLITUDE, BASE_WIDTH, FOUND, FWHM, LAG, PEAK, RISE, ROLE, STATUS, TIME
-from .analysis import MIN_BASELINE, PeakRules, Pulse, find_pulses, leading, noise_level
 from .distortion import record_ends_in_pulse, too_slow, with_clipping
-from .errors import InstrumentError, check
 from .plausibility import Limits, record_doubt, speed_doubt
-from .rails import clipping, rail
-from .records import ScopeRecord, Waveform, time_base_mismatch
+from .pulses import MIN_BASELINE, PeakRules, Pulse, find_pulses, leading, noise_level
 from .report import SPEED_FIGURES, Report
 
 

@@ -18,17 +18,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._kernels.filters import undo_highpass
+from ..errors import check
 from ._kernels import pulses
-from ._kernels.filters import undo_highpass
-from .errors import check
 
 MIN_BASELINE = pulses.MIN_BASELINE  # pre-trigger samples needed to measure the noise
-
-
-def remove_baseline(y: np.ndarray, n_pre: int) -> np.ndarray:
-    """y minus the mean of its first n_pre samples (at least 10, the pre-trigger part)."""
-    y = np.ascontiguousarray(y, dtype=float)
-    return y - pulses.baseline_mean(y, int(n_pre))
 
 
 def noise_level(y: np.ndarray, n_pre: int, step: float = 0.0) -> float | None:

@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import check
 from ._kernels.acquisition import gauge_signal
-from .errors import check
 from .frontend import highpass_coefficients
 
 

@@ -1,27 +1,22 @@
-"""The instruments and the leading-pulse analysis of many shots at once: what a study
-fires. Every shot's draws, gauges and scope run on a few threads (``acquire``: compiled
-per-shot functions, acquisition.shot_draws and acquisition.one_shot), every shot's analysis
-in one compiled loop (``analysed``): the very functions PiezoGauge.read,
-Oscilloscope.acquire and the pipeline run for one shot, so a shot of a batch has the bits
-it has alone. Each shot's random numbers come from its own generator, seeded by its seed
-(pcg64: np.random.default_rng(seed)'s numbers, compiled), in the order a lone shot draws
-them (acquisition.shot_draws)."""
+"""The instruments of many shots at once: what a study fires. Every shot's draws, gauges
+and scope run on a few threads (``acquire``: compiled per-shot functions,
+acquisition.shot_draws and acquisition.one_shot), the very functions PiezoGauge.read and
+Oscilloscope.acquire run for one shot, so a shot of a batch has the bits it has alone
+(their analysis: instruments.analysis.batch.analysed). Each shot's random numbers come from
+its own generator, seeded by its seed (pcg64: np.random.default_rng(seed)'s numbers,
+compiled), in the order a lone shot draws them (acquisition.shot_draws)."""
 from __future__ import annotations
 
-import math
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 
-from ._kernels import acquisition, batch_analysis, pulses
+from ..records import ScopeRecord
+from ._kernels import acquisition
 from .frontend import highpass_coefficients
 from .oscilloscope import CODE_MAX, CODE_MIN, Oscilloscope
-from .pipeline import Setup, report_of
-from .rails import Rail, clipping, code_rails, rail_of_codes
-from .records import ScopeRecord
-from .report import Report
 
 OK, NO_TRIGGER, PAST_INPUT = acquisition.OK, acquisition.NO_TRIGGER, acquisition.PAST_INPUT  # a record's status
 
@@ -134,44 +129,3 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
     else:
         shots_from(0, S)
     return Records(wiring, codes, over, status, times, drawn, n_in, float(h), reads)
-
-
-def analysed(records: Records, setup: Setup) -> list:
-    """Every shot's Report of its leading pulse (the pipeline's analyze_record(record,
-    setup, train=False)), the numbers from one compiled loop over the shots."""
-    scope = records.wiring.scope
-    front = scope.front_panel(records.h)
-    channels = records.wiring.channels
-    roles = np.array([channels.index(setup.upper.channel), channels.index(setup.lower.channel)], np.int64)
-    gauges = (setup.upper, setup.lower)
-    S = records.codes.shape[0]
-    answer = np.empty((S, pulses.ANSWER))
-    sigma = np.empty((S, 2))
-    finite = np.empty(S, np.bool_)
-    dx = scope.timebase.sample_interval
-    batch_analysis.analyse_shots(records.codes, records.status, records.times, dx, front.n_pre, front.ymult,
-                                 front.yoff, front.offset, roles, np.array([g.tau_s or 0.0 for g in gauges]),
-                                 np.array([g.sensitivity_V_per_N for g in gauges]), setup.rules.as_tuple(), answer,
-                                 sigma, finite)
-    limits = {ch: scope.channels[ch].bandwidth for ch in (setup.upper.channel, setup.lower.channel)}
-    ticks = dx * np.arange(records.codes.shape[2])  # each record's sample times from its first
-    read = records.codes[:, roles]
-    lo, hi = code_rails(read)
-    touches = np.any((read <= lo) | (read >= hi), axis=2)  # (shots, 2): which channels reach a rail at all
-    out = []
-    for s in range(S):
-        rep = Report(beta=setup.beta, static_force_N=setup.static_force_N)
-        if records.status[s] != acquisition.OK:
-            out.append(rep.refuse("the scope did not trigger" if records.status[s] == acquisition.NO_TRIGGER
-                                  else "the scope's record runs past the input"))
-        elif not finite[s]:
-            out.append(rep.refuse("samples that are not finite numbers"))
-        else:
-            t = records.times[s, 1] + ticks
-            noise = {r: None if math.isnan(sigma[s, k]) else float(sigma[s, k])
-                     for k, r in enumerate(("upper", "lower"))}
-            clipped = tuple(filter(None, (clipping(channels[c], rail_of_codes(records.codes[s, c]) if touches[s, k]
-                                                   else Rail(), dx, bool(records.over[s, c]))
-                                          for k, c in enumerate(roles))))
-            out.append(report_of(answer[s], t, {}, setup, False, noise, clipped, limits))
-    return out

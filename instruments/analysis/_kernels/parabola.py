@@ -2,7 +2,7 @@
 without its set-up cost, for the many short fits of a study."""
 import math
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 
 @jit

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .errors import InstrumentError, check
+from ..errors import InstrumentError, check
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """The oscilloscope's 8-bit converter (numba): one pass from volts to codes."""
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 
 @jit(inline="always")

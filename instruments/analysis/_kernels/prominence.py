@@ -19,7 +19,7 @@ follows), which keeps the noisy baseline of a record out of the stack.
 """
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 
 @jit

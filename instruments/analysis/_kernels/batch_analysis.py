@@ -1,6 +1,6 @@
 """The leading-pulse analysis of a batch of scope records, compiled (numba): each shot's
 channels from their 8-bit codes to forces, their noise and leading_pair's answer, over
-the shots on numba's threads. instruments/batch.analysed turns the numbers into Reports.
+the shots on numba's threads. instruments/analysis/batch.analysed turns the numbers into Reports.
 The same functions as a lone record's analysis (pulses.py), so the same bits.
 """
 import math
@@ -8,10 +8,10 @@ import math
 import numpy as np
 from numba import prange
 
-from instruments.jit import jit
+from instruments._kernels.filters import undo_highpass_into
+from instruments.devices.batch import OK
+from numerics.jit import jit
 
-from .acquisition import OK
-from .filters import undo_highpass_into
 from .pulses import baseline_mean, leading_pair, noise_level
 
 

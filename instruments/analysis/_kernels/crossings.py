@@ -1,5 +1,5 @@
 """Where a pulse falls to a level on either side of its maximum (numba)."""
-from instruments.jit import jit
+from numerics.jit import jit
 
 
 @jit

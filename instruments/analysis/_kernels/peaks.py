@@ -5,7 +5,7 @@ tests/instruments/test_compiled_helpers.py compares them with scipy bit for bit.
 """
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 
 @jit

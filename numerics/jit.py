@@ -2,7 +2,7 @@
 of a kernel package consistent with its sources.
 
 Every compiled kernel (the chain integrators in rig/solver/kernels/, the instruments'
-and the analysis' loops in instruments/_kernels/) is declared with ``@jit`` (or
+and the analysis' loops in the instruments' kernel packages) is declared with ``@jit`` (or
 ``@jit(parallel=True)``): numba's ``njit`` with ``cache=True`` (compiled once per machine,
 kept on disk) and ``fastmath=False`` (IEEE arithmetic: results bit-identical to numpy's).
 A loop that divides and must vectorise takes ``error_model="numpy"`` (a division by zero
@@ -11,7 +11,7 @@ A kernel package calls ``drop_stale_cache(__name__)`` in its ``__init__``.
 
 OpenMP's threads sleep when a parallel loop ends (OMP_WAIT_POLICY=PASSIVE, unless the
 environment says otherwise): by default they spin on the cores for a while, and the
-Python threads that come next (a batch's random draws, instruments/batch.acquire) ran 1.8x
+Python threads that come next (a batch's random draws, instruments/devices/batch.acquire) ran 1.8x
 slower beside them.
 """
 from __future__ import annotations
@@ -33,7 +33,7 @@ def jit(function=None, **options):
     is loaded here, by the first module that declares a kernel.
 
     A call from another kernel is typed by its arguments' plain types (one compiled copy
-    per array layout, not one per constant argument: instruments/dispatcher.py)."""
+    per array layout, not one per constant argument: numerics/dispatcher.py)."""
     if function is None:
         return lambda f: _declare(f, options)
     return _declare(function, {})
@@ -42,21 +42,13 @@ def jit(function=None, **options):
 def _declare(function, options: dict):
     """``function`` as a cached ``OneTypePerArgument`` dispatcher with njit's target
     options and ``options``."""
-    from instruments.dispatcher import OneTypePerArgument
+    from numerics.dispatcher import OneTypePerArgument
 
     targetoptions = {"nopython": True, "boundscheck": None, "fastmath": OPTIONS["fastmath"], **options}
     dispatcher = OneTypePerArgument(py_func=function, locals={}, targetoptions=targetoptions)
     if OPTIONS["cache"]:
         dispatcher.enable_caching()
     return dispatcher
-
-
-def has_machine_code(dispatcher) -> bool:
-    """Whether numba's on-disk cache holds machine code of ``dispatcher`` (a ``jit``
-    kernel) for this machine and its current source, for any signature. True where numba
-    keeps no such cache (nothing to compile ahead then: a command compiles as it goes)."""
-    load_index = getattr(getattr(getattr(dispatcher, "_cache", None), "_cache_file", None), "_load_index", None)
-    return load_index is None or bool(load_index())
 
 
 def kernel(function=None, **options):

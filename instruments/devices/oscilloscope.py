@@ -15,10 +15,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import InstrumentError, check
+from ..records import Preamble, ScopeRecord, Waveform
 from ._kernels.acquisition import NO_TRIGGER, PAST_INPUT, at_rest_before, condition, samples_before_input, scope_shot
-from .errors import InstrumentError, check
 from .frontend import highpass_coefficients, lowpass_coefficients
-from .records import Preamble, ScopeRecord, Waveform
 
 CHANNELS = ("CH1", "CH2", "CH3", "CH4")
 CODES_PER_DIV = 25.0

@@ -1,4 +1,4 @@
-"""The dispatcher of every kernel (instruments.jit): numba's CPU dispatcher, but a call from
+"""The dispatcher of every kernel (numerics.jit): numba's CPU dispatcher, but a call from
 compiled code is typed by its arguments' plain types, never by a constant's literal type.
 
 numba compiles a callee for the types its caller hands it, and a constant argument is of
@@ -12,8 +12,6 @@ import time
 
 from numba.core.registry import CPUDispatcher
 from numba.core.types import unliteral
-
-from instruments.jit import has_machine_code
 
 
 class OneTypePerArgument(CPUDispatcher):
@@ -36,3 +34,11 @@ class OneTypePerArgument(CPUDispatcher):
 
 SIDE_COMPILES: dict = {}  # {module.kernel: the side process (subprocess.Popen) compiling it}
 POLL_S = 0.05  # how often a kernel waiting for a side process looks into numba's cache (s)
+
+
+def has_machine_code(dispatcher) -> bool:
+    """Whether numba's on-disk cache holds machine code of ``dispatcher`` (a ``jit``
+    kernel) for this machine and its current source, for any signature. True where numba
+    keeps no such cache (nothing to compile ahead then: a command compiles as it goes)."""
+    load_index = getattr(getattr(getattr(dispatcher, "_cache", None), "_cache_file", None), "_load_index", None)
+    return load_index is None or bool(load_index())

@@ -1,6 +1,6 @@
 """The instruments of one shot, compiled (numba): a gauge's signal chain and the
 oscilloscope's acquisition. PiezoGauge.read and Oscilloscope.acquire run them for one shot;
-the batched instruments (instruments/batch.py) run them (``one_shot``) for every shot of a
+the batched instruments (instruments/devices/batch.py) run them (``one_shot``) for every shot of a
 study, on a few threads: the same code, so the same bits. Random draws come in as arrays, drawn
 beforehand from each shot's generator in a fixed order (``shot_draws``, pcg64).
 """
@@ -8,10 +8,10 @@ import math
 
 import numpy as np
 
-from instruments.jit import jit
+from instruments._kernels import pcg64
+from instruments._kernels.filters import pole_step
+from numerics.jit import jit
 
-from . import pcg64
-from .filters import pole_step
 from .quantiser import quantise
 from .resample import at_positions, read_at
 
@@ -195,7 +195,7 @@ def shot_draws(st, calibration_error, misalignment_sd, noisy, draws, z_gauge, ph
 @jit(nogil=True)
 def shots(first, last, seeds, forces, h, speed, fixed, gauges, scope, reads, drawn_rows, rested, codes, over, status,
           times, drawn):
-    """Shots first..last-1 of a batch (instruments/batch.acquire), one after another
+    """Shots first..last-1 of a batch (instruments/devices/batch.acquire), one after another
     without Python's lock: each shot's draws from its seed (pcg64.seeded: numpy's
     default_rng(seed), shot_draws), its gauges' settings (shot_settings, fixed: the draws
     that replace the drawn ones), its record (one_shot) and, for a record that starts

@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from ._kernels.filters import one_pole
+from .._kernels.filters import one_pole
 
 
 def highpass_coefficients(h: float, tau: float) -> tuple:

@@ -3,7 +3,7 @@ import math
 
 import numpy as np
 
-from instruments.jit import jit
+from numerics.jit import jit
 
 
 @jit(inline="always")
