@@ -27,3 +27,29 @@ PUBLIC = {  # {module: its public names}
     "batch": ("analysed",),
 }
 __getattr__, __all__ = lazy_names(__name__, PUBLIC)
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without loading typing; mypy and pyright read the name
+if TYPE_CHECKING:  # the names above, for type checkers and editors (tests/test_typing.py holds them equal);
+    # "X as X": re-exported, as a typed package's checkers read it
+    from .batch import analysed as analysed
+    from .pipeline import GaugeSetup as GaugeSetup
+    from .pipeline import Setup as Setup
+    from .pipeline import analyze_forces as analyze_forces
+    from .pipeline import analyze_record as analyze_record
+    from .pipeline import record_forces as record_forces
+    from .pipeline import reflection_time as reflection_time
+    from .pipeline import solitary_train as solitary_train
+    from .plausibility import Limits as Limits
+    from .pulses import MIN_BASELINE as MIN_BASELINE
+    from .pulses import PeakRules as PeakRules
+    from .pulses import Pulse as Pulse
+    from .pulses import find_pulses as find_pulses
+    from .pulses import first_peak_time as first_peak_time
+    from .pulses import invert_rc as invert_rc
+    from .pulses import leading as leading
+    from .pulses import noise_level as noise_level
+    from .pulses import refined as refined
+    from .pulses import xcorr_delay as xcorr_delay
+    from .report import FIGURES as FIGURES
+    from .report import SPEED_FIGURES as SPEED_FIGURES
+    from .report import Report as Report
