@@ -54,6 +54,27 @@ def test_a_lazy_facade_shows_checkers_its_public_names(package):
         assert getattr(facade, name) is getattr(importlib.import_module(module), name), f"{package}.{name}"
 
 
+def test_the_parts_constructors_as_checkers_see_them_are_the_dataclasses():
+    """A part's ``if TYPE_CHECKING: def __init__`` (quantities with their units, as the
+    documentation writes them) has its dataclass's fields, in order, with their defaults."""
+    from dataclasses import MISSING, fields
+
+    parts = importlib.import_module("rig.model.parts")
+    seen = []
+    for node in ast.parse(Path(parts.__file__).read_text()).body:
+        init = next((f for child in getattr(node, "body", ()) if isinstance(child, ast.If)
+                     and ast.unparse(child.test) == "TYPE_CHECKING" for f in child.body
+                     if isinstance(f, ast.FunctionDef) and f.name == "__init__"), None)
+        if init is None:
+            continue
+        cls, args = getattr(parts, node.name), init.args.args[1:]
+        defaults = [None] * (len(args) - len(init.args.defaults)) + init.args.defaults
+        declared = [(a.arg, MISSING if d is None else eval(ast.unparse(d), vars(parts))) for a, d in zip(args, defaults)]
+        assert declared == [(f.name, f.default) for f in fields(cls) if f.init], node.name
+        seen.append(node.name)
+    assert {"Bead", "MagneticBead", "GaugeBead", "Striker", "Wall"} <= set(seen)
+
+
 def test_import_rig_loads_no_layer_and_no_numba():
     code = "import sys, rig; print(sorted(m for m in sys.modules if m.split('.')[0] in ('rig', 'numba', 'typing')))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)

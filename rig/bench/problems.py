@@ -10,7 +10,7 @@ from rig.model.parts import Bead, Striker, Wall
 
 N_BEADS = 1000
 PROBE = 500
-STEEL = Bead("steel316", 4.76e-3, 0.4501e-3)  # diameter (m), mass (kg): 4.76 mm, 0.4501 g
+STEEL = dict(material="steel316", diameter="4.76 mm", mass="0.4501 g")
 SCENARIOS = {  # name: (top force N, t_end s) -- t_end lets the pulse pass contact 500
     "sonic-vacuum": (0.0, 5.0e-3),
     "precompressed": (2.38, 4.6e-3),
@@ -19,7 +19,7 @@ SCENARIOS = {  # name: (top force N, t_end s) -- t_end lets the pulse pass conta
 
 def chain(top_force: float, n: int = N_BEADS) -> Chain:
     """The benchmark chain of ``n`` beads, with the top force (N) and a wall where it is not 0."""
-    striker = Striker("steel316", 0.4501e-3, 0.44)  # mass (kg), velocity (m/s): 0.4501 g, 0.44 m/s
+    striker = Striker("steel316", "0.4501 g", "0.44 m/s")
     if top_force:
-        return Chain([STEEL] * n, striker=striker, wall=Wall(), gravity=0, top_force=top_force)
-    return Chain([STEEL] * n, striker=striker, gravity=0)
+        return Chain([Bead(**STEEL)] * n, striker=striker, wall=Wall(), gravity=0, top_force=top_force)
+    return Chain([Bead(**STEEL)] * n, striker=striker, gravity=0)

@@ -9,10 +9,11 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING
 
 from rig.errors import invalid
 from rig.model.materials import Material, material
-from rig.units import is_real, quantity
+from rig.units import Quantity, is_real, quantity
 
 # Published PTFE gauge bead (Daraio et al. 2006): caps 0.093 g, plate 0.023 g, of a 0.1226 g bead.
 PTFE_GAUGE_CAPS_FRACTION = 0.093 / 0.1226
@@ -60,6 +61,9 @@ class Bead(_Part):
     diameter: float
     mass: float | None = None
 
+    if TYPE_CHECKING:  # what the constructor takes (a quantity with its unit); the fields hold SI floats
+        def __init__(self, material: Material | str, diameter: Quantity, mass: Quantity | None = None) -> None: ...
+
     def __post_init__(self):
         self._convert("bead")
         self._positive("bead", "diameter")
@@ -93,6 +97,10 @@ class MagneticBead(Bead):
     mass: float | None = 0.5e-3
     kind = "magnetic"
 
+    if TYPE_CHECKING:  # what the constructor takes (a quantity with its unit); the fields hold SI floats
+        def __init__(self, material: Material | str = "chrome_steel", diameter: Quantity = 5e-3,
+                     mass: Quantity | None = 0.5e-3) -> None: ...
+
 
 @dataclass(frozen=True)
 class GaugeBead(Bead):
@@ -107,6 +115,10 @@ class GaugeBead(Bead):
     caps_mass: float | None = None
     plate_mass: float | None = PZT_PLATE_MASS
     kind = "gauge"
+
+    if TYPE_CHECKING:  # what the constructor takes (a quantity with its unit); the fields hold SI floats
+        def __init__(self, material: Material | str, diameter: Quantity, mass: Quantity | None = None,
+                     caps_mass: Quantity | None = None, plate_mass: Quantity | None = PZT_PLATE_MASS) -> None: ...
 
     def __post_init__(self):
         self._convert("gauge_bead")
@@ -154,6 +166,10 @@ class Striker(_Part):
     gap: float = 0.0
     kind = "striker"
 
+    if TYPE_CHECKING:  # what the constructor takes (a quantity with its unit); the fields hold SI floats
+        def __init__(self, material: Material | str = "alumina", mass: Quantity = 0.47e-3, velocity: Quantity = 0.89,
+                     diameter: Quantity = 4.76e-3, gap: Quantity = 0.0) -> None: ...
+
     def __post_init__(self):
         self._convert("striker")
         self._positive("striker", "mass", "velocity", "diameter")
@@ -186,6 +202,10 @@ class Wall(_Part):
     plate_mass: float | None = None
     rod_stiffness: float | None = None
     kind = "wall"
+
+    if TYPE_CHECKING:  # what the constructor takes (a quantity with its unit); the fields hold SI floats
+        def __init__(self, material: Material | str = "brass", plate_mass: Quantity | None = None,
+                     rod_stiffness: Quantity | None = None) -> None: ...
 
     def __post_init__(self):
         self._convert("wall")
