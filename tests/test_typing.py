@@ -69,7 +69,8 @@ def test_the_parts_constructors_as_checkers_see_them_are_the_dataclasses():
             continue
         cls, args = getattr(parts, node.name), init.args.args[1:]
         defaults = [None] * (len(args) - len(init.args.defaults)) + init.args.defaults
-        declared = [(a.arg, MISSING if d is None else eval(ast.unparse(d), vars(parts))) for a, d in zip(args, defaults)]
+        declared = [(a.arg, MISSING if d is None else eval(ast.unparse(d), vars(parts)))
+                    for a, d in zip(args, defaults)]
         assert declared == [(f.name, f.default) for f in fields(cls) if f.init], node.name
         seen.append(node.name)
     assert {"Bead", "MagneticBead", "GaugeBead", "Striker", "Wall"} <= set(seen)
