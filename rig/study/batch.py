@@ -14,6 +14,7 @@ import numpy as np
 
 from instruments import batch as instrument_batch
 from instruments import streams
+from instruments.oscilloscope import AcquisitionStatus
 from instruments.pipeline import analyze_record
 from rig.errors import RigError, invalid
 from rig.experiment.measure import setup_for
@@ -23,19 +24,17 @@ from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution
 from rig.solver.stepsize import stepping_at
-from rig.study.mc_spec import FAILURES, OUTPUTS, Study
+from rig.study.mc_spec import OUTPUTS, Failure, Study
 from rig.study.nominal import copied_table, nominal
 from rig.study.shots import array_keys, shots_of, wave_speeds, wiring_of
 from rig.study.sobol import sobol_matrix
-
-IMPOSSIBLE, UNSTABLE, NO_TRIGGER, SHORT_WINDOW, NON_FINITE, CLIPPED = range(1, len(FAILURES))
 
 
 @dataclass(frozen=True, eq=False)
 class BatchResult:
     """What batch ``batch`` gives: the shots' indices, inputs (shots, K) in the study's key
     order, instrument seeds, outputs {name: (shots,)} (OUTPUTS; nan where nothing was
-    measured; "failure": the index of FAILURES, 0 for a shot that did not fail) and, for a
+    measured; "failure": the shot's Failure code, Failure.NONE (0) for a shot that did not fail) and, for a
     study with traces, each shot's archive Entry."""
 
     batch: int
@@ -127,7 +126,7 @@ def _batch(study: Study, b: int) -> BatchResult:
     base = nom.rig
     design = sobol_matrix(study)[0] if study.sobol else None
     out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
-    out["failure"][:] = 0
+    out["failure"][:] = Failure.NONE
     drawn = batch_inputs(study, lo, hi, base.values["chain"]["beads"], design)
     seeds = [seed for *_, seed in drawn]
     xs = np.array([[x[k] for k in study.keys] for x, *_ in drawn], dtype=float).reshape(hi - lo, len(study.keys))
@@ -139,7 +138,7 @@ def _batch(study: Study, b: int) -> BatchResult:
             try:
                 rigs[j], draws[j] = shot_rig(study, x, masses)
             except ValueError:  # inputs no rig can have (a negative velocity): counted, not fatal
-                out["failure"][j] = IMPOSSIBLE
+                out["failure"][j] = Failure.IMPOSSIBLE
         if rigs:
             _fire_rigs(study, nom, rigs, draws, seeds, out, traces, lo)
     else:
@@ -159,7 +158,7 @@ def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
     """The batch with no rig built per shot (rig/study/shots.py): one batched solve, one
     batched acquisition and one batched analysis of the leading pulse."""
     shots = shots_of(template, [x for x, *_ in drawn], [m for _, m, _ in drawn])
-    out["failure"][~shots.possible] = IMPOSSIBLE
+    out["failure"][~shots.possible] = Failure.IMPOSSIBLE
     keep = np.flatnonzero(shots.possible)
     if not keep.size:
         return
@@ -179,12 +178,12 @@ def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
     succeeded, energy_errors = ens.succeeded, ens.energy_errors
     for e, j in enumerate(keep):
         if not succeeded[e]:
-            out["failure"][j] = UNSTABLE
+            out["failure"][j] = Failure.UNSTABLE
             continue
-        if records.status[e] == instrument_batch.PAST_INPUT:  # the scope's record ends after the simulated window
-            out["failure"][j] = SHORT_WINDOW
+        if records.outcome(e) is AcquisitionStatus.PAST_INPUT:  # the scope's record ends after the simulated window
+            out["failure"][j] = Failure.SHORT_WINDOW
             continue
-        triggered = records.status[e] == instrument_batch.OK
+        triggered = records.outcome(e) is AcquisitionStatus.OK
         _outputs(out, j, reports[e], None, float(energy_errors[e]), ens.dt, triggered,
                  bool(records.over[e, roles].any()))
 
@@ -198,9 +197,9 @@ def _outputs(out: dict, j: int, m, t, energy_error: float, dt: float, triggered:
                      ("energy_error", energy_error), ("dt_s", dt)):
         out[key][j] = np.nan if val is None else val
     if not triggered:
-        out["failure"][j] = NO_TRIGGER
+        out["failure"][j] = Failure.NO_TRIGGER
     elif not (np.isfinite(out["speed_m_per_s"][j]) and np.isfinite(out["amplitude_N"][j])):
-        out["failure"][j] = CLIPPED if clipped else NON_FINITE
+        out["failure"][j] = Failure.CLIPPED if clipped else Failure.NON_FINITE
 
 
 def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dict, traces: list, lo: int):
@@ -216,7 +215,7 @@ def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dic
     setup = setup_for(template, beta, F0)
     for e, ((j, rig), p) in enumerate(zip(rigs.items(), problems)):
         if not ens.succeeded[e]:
-            out["failure"][j] = UNSTABLE
+            out["failure"][j] = Failure.UNSTABLE
             continue
         stats = ens.stats(e, pilot.accuracy, pilot.error_estimate)
         forces = {name: a[e] for name, a in ens.forces.items()}
@@ -224,7 +223,7 @@ def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dic
         try:
             shot = rig.fire(seed=seeds[j], fixed=draws[j], truth=False)
         except RigError:  # the scope's record ends after the simulated window
-            out["failure"][j] = SHORT_WINDOW
+            out["failure"][j] = Failure.SHORT_WINDOW
             continue
         if study.traces:  # each shot has its own scene values and truth: nothing shared between shots
             from rig.experiment.entry import shot_entry  # the archive's Entry (h5py): only with traces

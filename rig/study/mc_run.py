@@ -14,7 +14,7 @@ from instruments.files import write_text
 from rig.errors import Interrupted, RigError
 from rig.experiment.measure import midway_static_force
 from rig.study.executors import DEFAULT_WORKER_TIMEOUT, run_study
-from rig.study.mc_spec import Study
+from rig.study.mc_spec import Failure, Study
 from rig.study.nominal import nominal
 from rig.study.report import failures, figures, jcgm101
 from rig.study.sobol import sobol_indices, sobol_matrix
@@ -80,7 +80,7 @@ def run_in(store: Store, study: Study, workers: int = 1, scheduler: str | None =
 
 def summarise(study: Study, results: StudyResults, shots_per_s) -> dict:
     """The JCGM 101 summary of each output, the inputs, and the Sobol indices if asked."""
-    ok = results.outputs["failure"] == 0  # failed shots are counted, and left out of every estimate
+    ok = results.outputs["failure"] == Failure.NONE  # failed shots are counted, and left out of every estimate
     out = {k: np.where(ok, v, np.nan) for k, v in results.outputs.items()}
     report = {"shots": int(results.index.size), "shots_per_s": shots_per_s,
               "failed": failures(results.outputs["failure"]),

@@ -164,3 +164,15 @@ def test_a_killed_study_leaves_no_orphan_and_resumes_bit_identically(tmp_path):
         for key in a["outputs"]:
             np.testing.assert_array_equal(a[f"outputs/{key}"][()], b[f"outputs/{key}"][()])
         np.testing.assert_array_equal(a["seed"][()], b["seed"][()])
+
+
+def test_a_failure_code_names_its_reason_as_the_report_counts_it():
+    from rig.study.mc_spec import Failure
+    from rig.study.report import failures
+
+    assert [int(f) for f in Failure] == list(range(len(FAILURES)))  # every stored code has its reason
+    assert [f.message for f in Failure] == list(FAILURES) and FAILURES[:6] == FAILURES_BEFORE
+    assert Failure.SHORT_WINDOW == 4 and "--window record" in Failure.SHORT_WINDOW.message
+    counted = failures(np.array([0.0, 4, 4, 6]))  # the stored outputs are floats
+    assert counted == {"count": 3, "share": 0.75,
+                       "reasons": {Failure.SHORT_WINDOW.message: 2, Failure.CLIPPED.message: 1}}
