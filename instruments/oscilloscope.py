@@ -10,8 +10,8 @@ the scope's noise floor.
 """
 from __future__ import annotations
 
-import math
 import enum
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -193,8 +193,8 @@ class Oscilloscope:
             analog[c] = condition(v, front.probe[c], front.ac[c], front.lowpass[c])
         return analog
 
-    def record_of(self, status: int | AcquisitionStatus, t_cross: float, x_zero: float, codes, over, n_in: int, h: float,
-                  read=None) -> ScopeRecord:
+    def record_of(self, status: int | AcquisitionStatus, t_cross: float, x_zero: float, codes, over, n_in: int,
+                  h: float, read=None) -> ScopeRecord:
         """The ScopeRecord of one acquisition (acquisition.scope_shot's status and times,
         codes (channels, samples), over-range flags; read (channels,): the channels
         converted, None: all), or InstrumentError where the record would run past the input

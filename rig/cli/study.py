@@ -21,7 +21,7 @@ def cmd_mc(args) -> dict:
     from rig.study.distributions import parse_vary
     from rig.study.executors import DEFAULT_WORKER_TIMEOUT
     from rig.study.mc_run import run_in
-    from rig.study.mc_spec import DEFAULT_BATCH, Study
+    from rig.study.mc_spec import DEFAULT_BATCH, MonteCarloStudy
     from rig.study.sobol import sobol_shots
     from rig.study.store import Store
 
@@ -30,7 +30,7 @@ def cmd_mc(args) -> dict:
     batch = args.batch or Store.stored_batch(args.out) or DEFAULT_BATCH  # a study resumed keeps its batches
     if args.sobol:
         shots = sobol_shots(args.shots, len(dists))
-    study = Study(args.scene, dists, shots, args.seed, tuple(args.set or ()), batch, args.accuracy,
+    study = MonteCarloStudy(args.scene, dists, shots, args.seed, tuple(args.set or ()), batch, args.accuracy,
                   args.sobol, args.truth, args.window, args.traces)
     from rig.study.nominal import nominal
 

@@ -14,7 +14,7 @@ from instruments.files import write_text
 from rig.errors import Interrupted, RigError
 from rig.experiment.measure import midway_static_force
 from rig.study.executors import DEFAULT_WORKER_TIMEOUT, run_study
-from rig.study.mc_spec import Failure, Study
+from rig.study.mc_spec import Failure, MonteCarloStudy
 from rig.study.nominal import nominal
 from rig.study.report import failures, figures, jcgm101
 from rig.study.sobol import sobol_indices, sobol_matrix
@@ -22,7 +22,7 @@ from rig.study.store import Store, StudyResults
 from rig.theory.longwave import solitary_wave_speed
 
 
-def check(study: Study):
+def check(study: MonteCarloStudy):
     """Refuse a study that cannot run, before any shot: no uncertain input, a varied gauge
     the scene does not have, a Sobol design that SALib cannot build."""
     if not study.dists:
@@ -45,14 +45,14 @@ class StudyRun:
     ran_now: int
 
 
-def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None, progress=None,
+def run_to(folder, study: MonteCarloStudy, workers: int = 1, scheduler: str | None = None, progress=None,
            on_start=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> StudyRun:
     """Run (or resume) ``study`` in ``folder``, held by this run (``Store.held``)."""
     with Store(folder, study).held() as store:  # one run at a time into a folder
         return run_in(store, study, workers, scheduler, progress, on_start, worker_timeout)
 
 
-def run_in(store: Store, study: Study, workers: int = 1, scheduler: str | None = None, progress=None,
+def run_in(store: Store, study: MonteCarloStudy, workers: int = 1, scheduler: str | None = None, progress=None,
            on_start=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> StudyRun:
     """Run (or resume) ``study`` in ``store``, a folder this run holds. ``progress(n)`` is
     told each finished batch's shots; ``on_start(done)`` how many shots were already stored;
@@ -78,7 +78,7 @@ def run_in(store: Store, study: Study, workers: int = 1, scheduler: str | None =
     return StudyRun(report, ran)
 
 
-def summarise(study: Study, results: StudyResults, shots_per_s) -> dict:
+def summarise(study: MonteCarloStudy, results: StudyResults, shots_per_s) -> dict:
     """The JCGM 101 summary of each output, the inputs, and the Sobol indices if asked."""
     ok = results.outputs["failure"] == Failure.NONE  # failed shots are counted, and left out of every estimate
     out = {k: np.where(ok, v, np.nan) for k, v in results.outputs.items()}
@@ -95,7 +95,7 @@ def summarise(study: Study, results: StudyResults, shots_per_s) -> dict:
     return report
 
 
-def write_report(folder: Path, study: Study, store: Store, results: StudyResults, report: dict):
+def write_report(folder: Path, study: MonteCarloStudy, store: Store, results: StudyResults, report: dict):
     """The figures (with the Eq (1) curve at the nominal F_0), study.h5 and report.json."""
     base = nominal(study.scene, study.overrides).rig
     F0 = midway_static_force(base)

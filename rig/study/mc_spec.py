@@ -49,7 +49,10 @@ DEFAULT_BATCH = 256  # shots per batch: a batch's fixed costs (threads, arrays) 
 
 
 @dataclass(frozen=True)
-class Study:
+class MonteCarloStudy:
+    """A Monte Carlo study (module doc); a StudySpec (rig/study/protocol.py): its batches
+    run on any executor and are kept in its folder (rig/study/store.py)."""
+
     scene: str
     dists: tuple
     shots: int
@@ -98,6 +101,16 @@ class Study:
     @property
     def n_batches(self) -> int:
         return -(-self.shots // self.batch)
+
+    def batches(self) -> range:
+        """Every batch's number (rig/study/protocol.py: a StudySpec)."""
+        return range(self.n_batches)
+
+    def run_batch(self, b: int):
+        """Batch b's BatchResult (rig/study/batch.py)."""
+        from rig.study.batch import run_batch
+
+        return run_batch(self, b)
 
     def shots_of(self, b: int) -> range:
         """The shots of batch b: shot i always belongs to batch i // batch."""

@@ -16,7 +16,7 @@ from rig.cli import main
 from rig.errors import RigError
 from rig.study.distributions import parse_vary
 from rig.study.executors import WorkerWatch, run_study
-from rig.study.mc_spec import FAILURES, Study
+from rig.study.mc_spec import FAILURES, MonteCarloStudy
 from rig.study.store import Store
 
 WIDE = ["--vary", "striker.velocity=truncnormal(0.89 m/s, 0.3 m/s, 0.05 m/s, 3 m/s)",
@@ -90,7 +90,7 @@ def test_worker_watch_stops_after_the_timeout_without_workers():
 
 def _study(shots=8):
     vary = ["striker.velocity=normal(0.89 m/s, 0.01 m/s)"]
-    return Study("ptfe52_magnetic", tuple(parse_vary(vary)), shots, seed=5, batch=2)
+    return MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(vary)), shots, seed=5, batch=2)
 
 
 def test_a_dask_study_without_workers_stops_and_resumes(tmp_path):
