@@ -3,7 +3,20 @@ from __future__ import annotations
 
 import sys
 
-from rig.cli.common import check_size, compile_cold, progress_bar, scene_overrides, writing_to
+from rig.cli.common import (
+    allow_large,
+    check_size,
+    command,
+    compile_cold,
+    count_arg,
+    fraction_arg,
+    plain,
+    positive_seconds,
+    progress_bar,
+    scene_overrides,
+    seed_arg,
+    writing_to,
+)
 from rig.errors import invalid
 
 
@@ -75,3 +88,35 @@ def print_study(report: dict, ran: int, out):
         print(f"  failed: {failed['count']} of {report['shots']} shots ({failed['share']:.1%}), left out of "
               "the estimates: " + "; ".join(f"{n} {why}" for why, n in failed["reasons"].items()))
     print("  wrote study.h5, report.json, histograms.png, speed_vs_amplitude.png")
+
+
+def add_mc(sub) -> None:
+    """The parser of ``rig mc``."""
+    mc = command(sub, "mc", "Monte Carlo study over many virtual shots", cmd_mc)
+    mc.add_argument("scene")
+    mc.add_argument("--shots", type=count_arg, required=True, help="number of shots (>= 1)")
+    mc.add_argument("--vary", action="append", metavar="KEY=DIST",
+                    help='e.g. striker.velocity="normal(0.89 m/s, 0.01 m/s)"; also chain.bead_mass, '
+                         'gauges.NAME.gain, gauges.NAME.misalignment')
+    mc.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides")
+    mc.add_argument("--seed", type=seed_arg, default=0, help="the study's seed (default 0)")
+    mc.add_argument("--batch", type=count_arg, help="shots per batch (default 256; resuming a study in --out: "
+                                                    "its own)")
+    mc.add_argument("--accuracy", type=plain(float), help="solver accuracy (default: the scene's)")
+    mc.add_argument("--workers", type=count_arg,
+                    help="local worker processes, or with --scheduler local the cluster's (default 1)")
+    mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")
+    mc.add_argument("--sobol", action="store_true", help="Sobol design and indices (needs SALib)")
+    mc.add_argument("--truth", action="store_true", help="also analyse each shot's noise-free truth (slower)")
+    mc.add_argument("--window", choices=["leading", "record"], default="leading",
+                    help="simulate until the leading pulse has passed the last gauge (default), "
+                         "or the scene's whole record")
+    mc.add_argument("--traces", action="store_true",
+                    help="also archive every shot's scope record and truth in DIR/traces/ (one archive per batch)")
+    mc.add_argument("--out", required=True, metavar="DIR")
+    mc.add_argument("--quiet", action="store_true", help="no progress bar")
+    mc.add_argument("--max-failed", type=fraction_arg, default=0.05, metavar="PERCENT",
+                    help="fail the study (exit 1) when more shots than this fail (default 5%%)")
+    mc.add_argument("--worker-timeout", type=positive_seconds, metavar="SECONDS",
+                    help="with --scheduler: stop when no Dask worker is alive for this long (default 300)")
+    allow_large(mc)
