@@ -1,6 +1,7 @@
 """`rig mc`: a Monte Carlo study over many virtual shots."""
 from __future__ import annotations
 
+import contextlib
 import sys
 
 from rig.cli.common import (
@@ -21,7 +22,7 @@ from rig.errors import invalid
 
 
 def cmd_mc(args) -> dict:
-    """Parse the study, run it with a progress bar, print its summary."""
+    """Parse the study, run it (rig.study.mc_run) with a progress bar, print its summary."""
     from rig.experiment.scene import load
 
     remote = args.scheduler not in (None, "local")
@@ -31,35 +32,30 @@ def cmd_mc(args) -> dict:
         raise invalid("--workers", args.workers, f"the workers of --scheduler {args.scheduler} are the cluster's; "
                                                  "--workers sizes a local run or --scheduler local")
     load(args.scene, scene_overrides(args))  # a bad scene stops here, before numba is loaded
-    from rig.study.distributions import parse_vary
     from rig.study.executors import DEFAULT_WORKER_TIMEOUT
-    from rig.study.mc_run import run_in
-    from rig.study.mc_spec import DEFAULT_BATCH, MonteCarloStudy
-    from rig.study.sobol import sobol_shots
-    from rig.study.store import Store
+    from rig.study.mc_run import described, run_to
 
-    dists = tuple(parse_vary(args.vary or []))
-    shots = args.shots
-    batch = args.batch or Store.stored_batch(args.out) or DEFAULT_BATCH  # a study resumed keeps its batches
-    if args.sobol:
-        shots = sobol_shots(args.shots, len(dists))
-    study = MonteCarloStudy(args.scene, dists, shots, args.seed, tuple(args.set or ()), batch, args.accuracy,
-                  args.sobol, args.truth, args.window, args.traces)
-    from rig.study.nominal import nominal
+    study = described(args.scene, args.vary or [], args.shots, args.out, args.seed, tuple(args.set or ()), args.batch,
+                      args.accuracy, args.sobol, args.truth, args.window, args.traces)
 
-    with writing_to(args.out), Store(args.out, study).held() as store:  # held before anything is printed
-        if shots != args.shots and not args.json:
-            print(f"Sobol design over {len(dists)} inputs: {shots} shots "
-                  f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
-        held = min(study.batch, study.shots)  # the shots a batch holds at once
+    def admit(cost):  # the folder held, before anything is solved
+        if study.shots != args.shots and not args.json:
+            keys = len(study.dists)
+            print(f"Sobol design over {keys} inputs: {study.shots} shots ({study.shots // (keys + 2)} x {keys + 2})",
+                  file=sys.stderr)
         compile_cold("mc", "study", args.quiet)
-        rig = nominal(study.scene, study.overrides).rig
-        rig.check_record()  # settings that can give no record (or a made-up one) are refused before any solve
-        whole = rig.estimate(controlled=False).times(study.shots, held)
-        check_size(whole, args, f"the study's {study.shots} shots (batches of {held} held at once)")
-        with progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot") as bar:
-            run = run_in(store, study, args.workers or 1, args.scheduler, bar.update, bar.update,
-                         args.worker_timeout or DEFAULT_WORKER_TIMEOUT)
+        check_size(cost(), args, f"the study's {study.shots} shots (batches of {min(study.batch, study.shots)} "
+                                  "held at once)")
+
+    with writing_to(args.out), contextlib.ExitStack() as shown:
+        bar = []
+
+        def on_start(done: int):  # the study admitted, its batches about to run: the bar from here
+            bar.append(shown.enter_context(progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot")))
+            bar[0].update(done)
+
+        run = run_to(args.out, study, args.workers or 1, args.scheduler, lambda n: bar[0].update(n), on_start,
+                     args.worker_timeout or DEFAULT_WORKER_TIMEOUT, admit)
     if not args.json:
         print_study(run.report, run.ran_now, args.out)
     failed = run.report["failed"]

@@ -13,11 +13,12 @@ import numpy as np
 from instruments.files import write_text
 from rig.errors import Interrupted, RigError
 from rig.experiment.measure import midway_static_force
+from rig.study.distributions import parse_vary
 from rig.study.executors import DEFAULT_WORKER_TIMEOUT, run_study
-from rig.study.mc_spec import Failure, MonteCarloStudy
+from rig.study.mc_spec import DEFAULT_BATCH, Failure, MonteCarloStudy
 from rig.study.nominal import nominal
 from rig.study.report import failures, figures, jcgm101
-from rig.study.sobol import sobol_indices, sobol_matrix
+from rig.study.sobol import sobol_indices, sobol_matrix, sobol_shots
 from rig.study.store import Store, StudyResults
 from rig.theory.longwave import solitary_wave_speed
 
@@ -45,10 +46,37 @@ class StudyRun:
     ran_now: int
 
 
+def described(scene, vary: list, shots: int, folder, seed: int = 0, overrides: tuple = (), batch: int | None = None,
+              accuracy: float | None = None, sobol: bool = False, truth: bool = False, window: str = "leading",
+              traces: bool = False) -> MonteCarloStudy:
+    """The study `rig mc` describes: ``vary`` its --vary texts (KEY=DIST); a Sobol design's
+    shots (``sobol``: ``shots`` base samples' worth, rig.study.sobol); the batch size
+    ``batch``, else the one of the study already in ``folder`` (a study resumed keeps its
+    batches), else DEFAULT_BATCH."""
+    dists = tuple(parse_vary(vary))
+    return MonteCarloStudy(scene, dists, sobol_shots(shots, len(dists)) if sobol else shots, seed, tuple(overrides),
+                           batch or Store.stored_batch(folder) or DEFAULT_BATCH, accuracy, sobol, truth, window,
+                           traces)
+
+
+def cost(study: MonteCarloStudy):
+    """The whole study's estimated memory and CPU time (rig.solver.estimate, batches of
+    ``study.batch`` shots held at once), after refusing settings that can give no record
+    (or a made-up one) before any solve."""
+    rig = nominal(study.scene, study.overrides).rig
+    rig.check_record()
+    return rig.estimate(controlled=False).times(study.shots, min(study.batch, study.shots))
+
+
 def run_to(folder, study: MonteCarloStudy, workers: int = 1, scheduler: str | None = None, progress=None,
-           on_start=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> StudyRun:
-    """Run (or resume) ``study`` in ``folder``, held by this run (``Store.held``)."""
+           on_start=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT, admit=None) -> StudyRun:
+    """Run (or resume) ``study`` in ``folder``, held by this run (``Store.held``).
+    ``admit(cost)``, where given, is called once the folder is held and before anything is
+    solved, with a function giving the study's estimated cost (``cost``): where a caller
+    refuses a study too large, or prepares for it (compiles kernels)."""
     with Store(folder, study).held() as store:  # one run at a time into a folder
+        if admit is not None:
+            admit(lambda: cost(study))
         return run_in(store, study, workers, scheduler, progress, on_start, worker_timeout)
 
 
