@@ -23,6 +23,9 @@ from .frontend import highpass_coefficients, lowpass_coefficients
 from .records import Preamble, ScopeRecord, Waveform
 
 CHANNELS = ("CH1", "CH2", "CH3", "CH4")
+CODES_PER_DIV = 25.0
+CODE_MIN, CODE_MAX = -128, 127
+AC_CORNER_HZ = 10.0  # AC coupling's high-pass corner
 
 
 class AcquisitionStatus(enum.IntEnum):
@@ -41,9 +44,6 @@ class AcquisitionStatus(enum.IntEnum):
 _ACQUISITION_MESSAGES = {AcquisitionStatus.OK: "the scope triggered and its record lies within the input",
                          AcquisitionStatus.NO_TRIGGER: "the scope did not trigger",
                          AcquisitionStatus.PAST_INPUT: "the scope's record runs past the input"}
-CODES_PER_DIV = 25.0
-CODE_MIN, CODE_MAX = -128, 127
-AC_CORNER_HZ = 10.0  # AC coupling's high-pass corner
 
 
 @dataclass(frozen=True)

@@ -34,8 +34,8 @@ from rig.study.sobol import sobol_matrix
 class BatchResult:
     """What batch ``batch`` gives: the shots' indices, inputs (shots, K) in the study's key
     order, instrument seeds, outputs {name: (shots,)} (OUTPUTS; nan where nothing was
-    measured; "failure": the shot's Failure code, Failure.NONE (0) for a shot that did not fail) and, for a
-    study with traces, each shot's archive Entry."""
+    measured; "failure": the shot's Failure code, Failure.NONE (0) for a shot that did not
+    fail) and, for a study with traces, each shot's archive Entry."""
 
     batch: int
     index: np.ndarray
