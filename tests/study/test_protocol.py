@@ -72,3 +72,22 @@ def test_the_monte_carlo_study_and_the_sweep_have_the_protocol_s_shape():
         for b in (1, 0):
             sink.put(SweepPoint(float(b), None, None, None, "no record", b, batch=b))
     assert store.done() == {0, 1} and [p.value for p in store.points] == [0.0, 1.0]  # in the sweep's order
+
+
+def test_the_study_rig_mc_describes_keeps_a_resumed_study_s_batches_and_sizes_a_sobol_design(tmp_path):
+    import json
+
+    from rig.study.mc_run import described
+    from rig.study.mc_spec import DEFAULT_BATCH
+    from rig.study.sobol import sobol_shots
+
+    vary = ["striker.velocity=normal(0.89 m/s, 0.01 m/s)", "gauges.upper.gain=normal(1, 0.01)"]
+    fresh = described("ptfe52_magnetic", vary, 40, tmp_path / "new", seed=3)
+    assert (fresh.shots, fresh.batch, fresh.seed, fresh.keys) == (40, DEFAULT_BATCH, 3, ["striker.velocity",
+                                                                                       "gauges.upper.gain"])
+    (tmp_path / "old").mkdir()
+    (tmp_path / "old" / "study.json").write_text(json.dumps({"batch": 7}))
+    assert described("ptfe52_magnetic", vary, 40, tmp_path / "old").batch == 7  # resumed: its own batches
+    assert described("ptfe52_magnetic", vary, 40, tmp_path / "old", batch=5).batch == 5  # --batch says otherwise
+    sobol = described("ptfe52_magnetic", vary, 40, tmp_path / "new", sobol=True)
+    assert sobol.shots == sobol_shots(40, 2) == 32 and sobol.sobol  # whole base samples of 2 + 2 shots
