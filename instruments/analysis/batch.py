@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ..devices.batch import NO_TRIGGER, OK, Records
+from ..devices.batch import OK, Records
 from ..rails import Rail, clipping, code_rails, rail_of_codes
 from ._kernels import batch_analysis, pulses
 from .pipeline import Setup, report_of
@@ -39,9 +39,8 @@ def analysed(records: Records, setup: Setup) -> list:
     out = []
     for s in range(S):
         rep = Report(beta=setup.beta, static_force_N=setup.static_force_N)
-        if records.status[s] != OK:
-            out.append(rep.refuse("the scope did not trigger" if records.status[s] == NO_TRIGGER
-                                  else "the scope's record runs past the input"))
+        if records.outcome(s) is not OK:
+            out.append(rep.refuse(records.outcome(s).message))
         elif not finite[s]:
             out.append(rep.refuse("samples that are not finite numbers"))
         else:

@@ -16,9 +16,9 @@ import numpy as np
 from ..records import ScopeRecord
 from ._kernels import acquisition
 from .frontend import highpass_coefficients
-from .oscilloscope import CODE_MAX, CODE_MIN, Oscilloscope
+from .oscilloscope import CODE_MAX, CODE_MIN, AcquisitionStatus, Oscilloscope
 
-OK, NO_TRIGGER, PAST_INPUT = acquisition.OK, acquisition.NO_TRIGGER, acquisition.PAST_INPUT  # a record's status
+OK, NO_TRIGGER, PAST_INPUT = AcquisitionStatus  # a record's status (Records.outcome)
 
 
 @dataclass(frozen=True)
@@ -43,7 +43,8 @@ class Wiring:
 @dataclass(frozen=True, eq=False)
 class Records:
     """The scope records of a batch: codes (shots, channels, samples) int8, over-range
-    flags (shots, channels), status (OK, NO_TRIGGER, PAST_INPUT), times
+    flags (shots, channels), status (shots,) the compiled acquisition's codes (a shot's
+    AcquisitionStatus: ``outcome``), times
     (shots, 2: the trigger crossing and the first sample, s), the gauges' draws (shots,
     gauges, 2: gain factor and position error m), the input they read (n_in samples
     every h s) and which channels were converted (read (channels,): the others hold code
@@ -59,10 +60,14 @@ class Records:
     h: float
     read: np.ndarray
 
+    def outcome(self, s: int) -> AcquisitionStatus:
+        """How shot s's acquisition ended."""
+        return AcquisitionStatus(int(self.status[s]))
+
     def record(self, s: int) -> ScopeRecord:
         """Shot s's ScopeRecord of the channels read, as Oscilloscope.acquire returns it
         (InstrumentError where its record runs past the input)."""
-        return self.wiring.scope.record_of(int(self.status[s]), float(self.times[s, 0]), float(self.times[s, 1]),
+        return self.wiring.scope.record_of(self.outcome(s), float(self.times[s, 0]), float(self.times[s, 1]),
                                            self.codes[s], self.over[s], self.n_in, self.h, self.read)
 
 

@@ -10,6 +10,7 @@ the scope's noise floor.
 """
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass, field
 
@@ -17,13 +18,32 @@ import numpy as np
 
 from ..errors import InstrumentError, check
 from ..records import Preamble, ScopeRecord, Waveform
-from ._kernels.acquisition import NO_TRIGGER, PAST_INPUT, at_rest_before, condition, samples_before_input, scope_shot
+from ._kernels import acquisition
+from ._kernels.acquisition import at_rest_before, condition, samples_before_input, scope_shot
 from .frontend import highpass_coefficients, lowpass_coefficients
 
 CHANNELS = ("CH1", "CH2", "CH3", "CH4")
 CODES_PER_DIV = 25.0
 CODE_MIN, CODE_MAX = -128, 127
 AC_CORNER_HZ = 10.0  # AC coupling's high-pass corner
+
+
+class AcquisitionStatus(enum.IntEnum):
+    """How an acquisition ended: the compiled acquisition's codes (_kernels/acquisition.py,
+    plain ints there), named where they leave it."""
+
+    OK = acquisition.OK
+    NO_TRIGGER = acquisition.NO_TRIGGER
+    PAST_INPUT = acquisition.PAST_INPUT  # the record would run past the input
+
+    @property
+    def message(self) -> str:
+        return _ACQUISITION_MESSAGES[self]
+
+
+_ACQUISITION_MESSAGES = {AcquisitionStatus.OK: "the scope triggered and its record lies within the input",
+                         AcquisitionStatus.NO_TRIGGER: "the scope did not trigger",
+                         AcquisitionStatus.PAST_INPUT: "the scope's record runs past the input"}
 
 
 @dataclass(frozen=True)
@@ -173,17 +193,18 @@ class Oscilloscope:
             analog[c] = condition(v, front.probe[c], front.ac[c], front.lowpass[c])
         return analog
 
-    def record_of(self, status: int, t_cross: float, x_zero: float, codes, over, n_in: int, h: float,
-                  read=None) -> ScopeRecord:
+    def record_of(self, status: int | AcquisitionStatus, t_cross: float, x_zero: float, codes, over, n_in: int,
+                  h: float, read=None) -> ScopeRecord:
         """The ScopeRecord of one acquisition (acquisition.scope_shot's status and times,
         codes (channels, samples), over-range flags; read (channels,): the channels
         converted, None: all), or InstrumentError where the record would run past the input
         of n_in samples every h s."""
         tb, tr = self.timebase, self.trigger
-        if status == NO_TRIGGER:
+        status = AcquisitionStatus(status)
+        if status is AcquisitionStatus.NO_TRIGGER:
             return ScopeRecord({}, False,
                                f"no {tr.slope} crossing of {tr.level:g} V on {tr.source} in {n_in * h:.4g} s")
-        if status == PAST_INPUT:
+        if status is AcquisitionStatus.PAST_INPUT:
             last = t_cross + x_zero + tb.sample_interval * (int(tb.record_length) - 1)
             raise InstrumentError(
                 f"scope record ends {last:.4g} s after t = 0 but the input stops at {(n_in - 1) * h:.4g} s: "

@@ -41,7 +41,7 @@ from rig.solver.stepsize import Stepping, stepping_at
 from rig.study.batch import batch_inputs, collector_paused, run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
-from rig.study.mc_spec import DEFAULT_BATCH, Study
+from rig.study.mc_spec import DEFAULT_BATCH, MonteCarloStudy
 from rig.study.nominal import Nominal, nominal
 from rig.study.shots import shots_of, wave_speeds, wiring_of
 from rig.study.store import Store
@@ -72,21 +72,21 @@ class Setting:
     stepping: Stepping
 
     @classmethod
-    def of(cls, study: Study) -> "Setting":
+    def of(cls, study: MonteCarloStudy) -> "Setting":
         nom = nominal(study.scene, ())
         template = nom.template(study.window)
         save = template.save_at(contacts=False, averages=True)
         pilot = nom.pilot(study.window, save, study.accuracy)
         return cls(nom, template, save, pilot, stepping_at(pilot.problem, pilot.stats.dt_s))
 
-    def shots(self, study: Study, lo: int, hi: int) -> tuple:
+    def shots(self, study: MonteCarloStudy, lo: int, hi: int) -> tuple:
         """(shots lo..hi-1 as the solver's arrays (rig/study/shots.py), their instruments' seeds)."""
         beads = self.nominal.rig.values["chain"]["beads"]
         drawn = batch_inputs(study, lo, hi, beads)
         return shots_of(self.template, [x for x, *_ in drawn], [m for _, m, _ in drawn]), [s for *_, s in drawn]
 
 
-def _solver(study: Study, shots: int) -> dict:
+def _solver(study: MonteCarloStudy, shots: int) -> dict:
     setting = Setting.of(study)
     template, save, pilot, dt = setting.template, setting.save, setting.pilot, setting.stepping
     t_end = template.solver.duration
@@ -114,7 +114,7 @@ WARM_UP = 3  # batches before the timed ones: numba's threads started, and the b
 # (tens of MB) reused by the allocator instead of fresh pages faulted in (about a third of a batch's time)
 
 
-def _one_process(study: Study) -> dict:
+def _one_process(study: MonteCarloStudy) -> dict:
     for b in range(WARM_UP):
         run_batch(study, b)
     wall, cpu = [], []
@@ -134,7 +134,7 @@ STAGES = {"inputs": "each shot's inputs drawn, the shots' arrays built",
           "analysis": "leading pulses, delays, each shot's Report"}
 
 
-def _stages(study: Study, batches: int = 4) -> dict:
+def _stages(study: MonteCarloStudy, batches: int = 4) -> dict:
     """Wall time per shot (us) of each stage of a batch, run in turn as run_batch runs them
     (numba's threads, Python's cycle collector paused; after WARM_UP batches of the study,
     which is made long enough to hold them)."""
@@ -153,7 +153,7 @@ def _stages(study: Study, batches: int = 4) -> dict:
     return {f"stage_{key}_us_per_shot": v / (batches * BATCH) * 1e6 for key, v in spent.items()}
 
 
-def _stage_times(study: Study, setting: Setting, template: Rig, wiring, setup, b: int) -> list:
+def _stage_times(study: MonteCarloStudy, setting: Setting, template: Rig, wiring, setup, b: int) -> list:
     """The clock (s) before batch b and after each of its stages."""
     t = [time.perf_counter()]
     shots, seeds = setting.shots(study, b * BATCH, (b + 1) * BATCH)
@@ -169,7 +169,7 @@ def _stage_times(study: Study, setting: Setting, template: Rig, wiring, setup, b
     return t
 
 
-def _workers(study: Study, workers: int) -> dict:
+def _workers(study: MonteCarloStudy, workers: int) -> dict:
     ticks = []
     with tempfile.TemporaryDirectory() as folder:
         store = Store(folder, study).open()
@@ -188,12 +188,12 @@ def measure(shots: int = 512, study_shots: int = 8192) -> dict:
     """One round of every figure of this revision."""
     import numba
 
-    study = Study("ptfe52_magnetic", tuple(parse_vary(VARY)), shots, batch=BATCH)
+    study = MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(VARY)), shots, batch=BATCH)
     workers = os.cpu_count() or 1
     out = {"scene": "ptfe52_magnetic", "shots": shots, "threads": numba.get_num_threads(), "workers": workers,
            "study_shots": study_shots, **_solver(study, shots), **_stages(study)}
-    out.update(_one_process(Study("ptfe52_magnetic", tuple(parse_vary(VARY)), study_shots, batch=BATCH)))
-    out.update(_workers(Study("ptfe52_magnetic", tuple(parse_vary(VARY)), study_shots, seed=1, batch=BATCH),
+    out.update(_one_process(MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(VARY)), study_shots, batch=BATCH)))
+    out.update(_workers(MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(VARY)), study_shots, seed=1, batch=BATCH),
                         workers))
     return out
 

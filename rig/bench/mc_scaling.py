@@ -30,7 +30,7 @@ import time
 from rig.study.batch import run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
-from rig.study.mc_spec import Study
+from rig.study.mc_spec import MonteCarloStudy
 from rig.study.store import Store
 
 MODES = {"workers": "rig mc --workers N (processes, 1 numba thread each), steady",
@@ -50,8 +50,8 @@ def counts(cores: int) -> list:
     return out + ([cores] if out[-1] != cores else [])
 
 
-def _study(vary: tuple, workers: int, batch: int, seed: int) -> Study:
-    return Study("ptfe52_magnetic", tuple(parse_vary(vary)), PER_WORKER * workers * batch, seed=seed, batch=batch)
+def _study(vary: tuple, workers: int, batch: int, seed: int) -> MonteCarloStudy:
+    return MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(vary)), PER_WORKER * workers * batch, seed=seed, batch=batch)
 
 
 def _children_cpu() -> float:
@@ -59,7 +59,7 @@ def _children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def steady_run(study: Study, workers: int, scheduler: str | None = None) -> dict:
+def steady_run(study: MonteCarloStudy, workers: int, scheduler: str | None = None) -> dict:
     """Run ``study`` on ``workers`` (one worker: in this process, on one numba thread); its
     steady rate (shots/s), the parent's CPU per batch over the same steady part (ms), and
     the workers' CPU per batch (ms: reaped children, their start-up included)."""
@@ -85,7 +85,7 @@ def steady_run(study: Study, workers: int, scheduler: str | None = None) -> dict
             "worker_cpu_ms_per_batch": children / study.n_batches * 1e3}
 
 
-def thread_rate(study: Study, threads: int) -> float:
+def thread_rate(study: MonteCarloStudy, threads: int) -> float:
     """Shots/s of the batch path in this process on ``threads`` numba threads (median batch)."""
     import numba
 
@@ -135,7 +135,7 @@ def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
             "store_ms_per_batch": store_time(study, result)}
 
 
-def store_time(study: Study, result, group: int = STORE_GROUP, groups: int = 3) -> dict:
+def store_time(study: MonteCarloStudy, result, group: int = STORE_GROUP, groups: int = 3) -> dict:
     """Wall time (ms) the store takes per batch, one batch at a time and in groups of
     ``group`` (as its writer stores batches that come while it is busy), in a temporary
     folder as the scaling studies' stores are: 1000 / ms is the batches/s one writer sustains."""

@@ -20,6 +20,14 @@ class OneLineParser(argparse.ArgumentParser):
         sys.exit(2)
 
 
+def command(sub, name: str, help_text: str, func):
+    """A subcommand with its --json flag, run by ``func(args)``."""
+    parser = sub.add_parser(name, help=help_text)
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    parser.set_defaults(func=func)
+    return parser
+
+
 def whole_number(text: str, low: int, high: float, allowed: str) -> int:
     """The command-line whole number ``text`` in [low, high]; else argparse's refusal
     ``'TEXT': allowed``."""

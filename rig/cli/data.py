@@ -1,7 +1,7 @@
 """`rig verify`, `rig upgrade`, `rig import`, `rig analyze` and `rig ls`."""
 from __future__ import annotations
 
-from rig.cli.common import missing_lines
+from rig.cli.common import command, missing_lines, plain, quantity_type
 from rig.errors import RigError
 
 
@@ -186,3 +186,51 @@ def cmd_ls(args) -> list:
     return rows
 
 
+def add_verify(sub) -> None:
+    """The parser of ``rig verify``."""
+    ve = command(sub, "verify", "check every shot of an archive (exit 1 if any is bad)", cmd_verify)
+    ve.add_argument("archive")
+
+
+def add_upgrade(sub) -> None:
+    """The parser of ``rig upgrade``."""
+    up = command(sub, "upgrade", "rewrite an archive of an older layout in the current one", cmd_upgrade)
+    up.add_argument("archive")
+
+
+def add_import_(sub) -> None:
+    """The parser of ``rig import``."""
+    im = command(sub, "import", "import real scope files into an archive", cmd_import)
+    im.add_argument("files", nargs="+", metavar="FILE")
+    im.add_argument("--into", required=True, metavar="ARCHIVE.h5")
+    im.add_argument("--together", action="store_true", help="the files are the channels of one shot")
+
+
+def add_analyze(sub) -> None:
+    """The parser of ``rig analyze``."""
+    an = command(sub, "analyze", "speeds and amplitudes from scope files or an archive, each channel's SNR, "
+                                  "and why any figure is missing (exit 1 when no source gives a speed)",
+                  cmd_analyze)
+    an.add_argument("files", nargs="+", metavar="FILE", help=".isf, .csv, .wfm (Tektronix) or .h5 (an archive)")
+    an.add_argument("--shot", type=plain(int),
+                    help="one shot of an archive, by its number (shots are numbered from 1; default: every shot)")
+    an.add_argument("--gauge-distance", type=quantity_type("m", "--gauge-distance"),
+                    help="distance between the two gauges (plain number: m), for real files")
+    an.add_argument("--channels", help="UPPER,LOWER[,WALL] channel names (default: file order)")
+    an.add_argument("--wall", action="store_true", help="the third channel is the wall sensor")
+    an.add_argument("--sensitivity", type=quantity_type("V/N", "--sensitivity"),
+                    help="gauge sensitivity, e.g. '0.05 V/N' (plain number: V/N; default 1: volts)")
+    an.add_argument("--tau", type=quantity_type("s", "--tau"), help="gauge RC time constant to invert (s)")
+    an.add_argument("--beta", type=plain(float), default=1.0,
+                    help="beta = F_d / F_m,e, dimensionless, > 0 (default 1)")
+    an.add_argument("--f0", type=quantity_type("N", "--f0"), default=0.0, help="precompression F_0 (N)")
+    an.add_argument("--diameter", type=quantity_type("m", "--diameter"), default=4.76e-3,
+                    help="bead diameter (plain number: m; default 4.76 mm)")
+    an.add_argument("--material", help="bead material: adds the Eq (1) speed and checks the measured one "
+                                       "against it and the material's bar speed")
+
+
+def add_ls(sub) -> None:
+    """The parser of ``rig ls``."""
+    ls = command(sub, "ls", "list the shots of an archive", cmd_ls)
+    ls.add_argument("archive")

@@ -9,6 +9,8 @@ if TYPE_CHECKING:
     from rig.fit.points import PointObjective
     from rig.fit.traces import TraceObjective
 
+from rig.cli.common import command, count_arg, seed_arg
+
 
 def _records(args) -> list:
     """The scope records to fit: one shot's files (--records), or an archive's shots."""
@@ -140,3 +142,31 @@ def cmd_fit(args) -> dict:
               file=sys.stderr)
         args.exit_code = 1
     return block
+
+
+def add_fit(sub) -> None:
+    """The parser of ``rig fit``."""
+    fi = command(sub, "fit", "fit scene keys to measured points, scope records or observations", cmd_fit)
+    fi.add_argument("scene", help="the model: a scene file, or a published scene's name")
+    fi.add_argument("--param", action="append", metavar="KEY=LO:HI",
+                    help="a scene key to fit with its bounds in units, e.g. 'chain.youngs_modulus=0.4 GPa:2 GPa' "
+                         "(a dimensionless key: plain numbers, e.g. chain.contact_exponent=1.2:2.4)")
+    fi.add_argument("--records", nargs="+", metavar="FILE", help="one shot's scope files (ISF, CSV, WFM)")
+    fi.add_argument("--archive", metavar="A.h5", help="an archive: every shot (or --shot N)")
+    fi.add_argument("--shot", type=count_arg, help="with --archive: one shot")
+    fi.add_argument("--points", metavar="TABLE.csv",
+                    help="measured points: columns 'F_d [N]', 'F_d_sd [N]', 'V_s [m/s]', 'V_s_sd [m/s]' "
+                         "and scene keys per row, e.g. 'magnet.force [N]'")
+    fi.add_argument("--observations", metavar="FILE.toml",
+                    help="observed figures of shots ([[observation]] kind, value, sd, scene, set, gauge: a speed, "
+                         "a gauge reading's peak, fwhm, duration, pulses, wall_peak, tail, ratio)")
+    fi.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides of the scene")
+    fi.add_argument("--out", required=True, metavar="DIR",
+                    help="folder for fit.json, residuals.csv, fit.png, fitted.toml; its evaluations/ resume a fit")
+    fi.add_argument("--max-evaluations", type=count_arg, default=400, help="the fit's budget (default 400)")
+    fi.add_argument("--posterior", type=count_arg, default=0, metavar="STEPS",
+                    help="then sample the posterior by MCMC for STEPS steps (needs the extra: "
+                         "pip install 'sonic-rig[posterior]'); resumes in DIR/posterior.h5")
+    fi.add_argument("--walkers", type=count_arg, help="with --posterior: walkers (default 4 per parameter, at least 8)")
+    fi.add_argument("--seed", type=seed_arg, help="with --posterior: the walkers' seed (default 0)")
+    fi.add_argument("--quiet", action="store_true", help="no progress lines")

@@ -1,8 +1,21 @@
 """`rig shot` and `rig animate`: one virtual shot, summarised, exported or rendered."""
 from __future__ import annotations
 
-from rig.cli.common import (check_archive_out, check_export_folder, check_size, compile_cold, flag_lines,
-                            missing_lines, progress_bar, scene_overrides, writing_to)
+from rig.cli.common import (
+    allow_large,
+    check_archive_out,
+    check_export_folder,
+    check_size,
+    command,
+    compile_cold,
+    flag_lines,
+    missing_lines,
+    plain,
+    progress_bar,
+    scene_overrides,
+    seed_arg,
+    writing_to,
+)
 from rig.errors import RigError, invalid
 
 
@@ -149,3 +162,32 @@ def cmd_animate(args) -> dict:
         print(f"wrote {out['out']}: {what}, displacements x {out['exaggerate']:.3g}, "
               f"seed {out['seed']}, {out['seconds']:.1f} s")
     return out
+
+
+def add_shot(sub) -> None:
+    """The parser of ``rig shot``."""
+    sh = command(sub, "shot", "fire one virtual shot of a scene", cmd_shot)
+    sh.add_argument("scene", help="a scene file, or a published scene's name (e.g. ptfe52_magnetic)")
+    sh.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="override a scene key, e.g. striker.velocity=1.2 (plain numbers in SI)")
+    sh.add_argument("--seed", type=seed_arg, help="seed of every random draw (default: a fresh one, printed)")
+    sh.add_argument("--export", metavar="DIR", help="write the scope records to DIR")
+    sh.add_argument("--format", choices=["isf", "csv"], help="with --export: scope file format (default isf)")
+    sh.add_argument("--out", metavar="ARCHIVE.h5", help="append the shot to an HDF5 archive")
+    allow_large(sh)
+
+
+def add_animate(sub) -> None:
+    """The parser of ``rig animate``."""
+    an = command(sub, "animate", "render a virtual shot to a movie or still, off-screen", cmd_animate)
+    an.add_argument("scene")
+    an.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene key")
+    an.add_argument("--seed", type=seed_arg, help="seed of the instruments' draws (default: a fresh one, printed)")
+    an.add_argument("--out", required=True, metavar="FILE", help="FILE.mp4, FILE.gif or FILE.png (one still)")
+    an.add_argument("--frames", type=plain(int), default=100,
+                    help="frames over the scene's duration (default 100); for a .png still, the instants "
+                         "it is picked from (the one nearest the leading pulse at the last gauge)")
+    an.add_argument("--exaggerate", type=plain(float),
+                    help="displacement factor (default: the largest displacement shown as 1/3 diameter)")
+    an.add_argument("--quiet", action="store_true", help="no progress bar")
+    allow_large(an)

@@ -1,14 +1,28 @@
 """`rig mc`: a Monte Carlo study over many virtual shots."""
 from __future__ import annotations
 
+import contextlib
 import sys
 
-from rig.cli.common import check_size, compile_cold, progress_bar, scene_overrides, writing_to
+from rig.cli.common import (
+    allow_large,
+    check_size,
+    command,
+    compile_cold,
+    count_arg,
+    fraction_arg,
+    plain,
+    positive_seconds,
+    progress_bar,
+    scene_overrides,
+    seed_arg,
+    writing_to,
+)
 from rig.errors import invalid
 
 
 def cmd_mc(args) -> dict:
-    """Parse the study, run it with a progress bar, print its summary."""
+    """Parse the study, run it (rig.study.mc_run) with a progress bar, print its summary."""
     from rig.experiment.scene import load
 
     remote = args.scheduler not in (None, "local")
@@ -18,35 +32,30 @@ def cmd_mc(args) -> dict:
         raise invalid("--workers", args.workers, f"the workers of --scheduler {args.scheduler} are the cluster's; "
                                                  "--workers sizes a local run or --scheduler local")
     load(args.scene, scene_overrides(args))  # a bad scene stops here, before numba is loaded
-    from rig.study.distributions import parse_vary
     from rig.study.executors import DEFAULT_WORKER_TIMEOUT
-    from rig.study.mc_run import run_in
-    from rig.study.mc_spec import DEFAULT_BATCH, Study
-    from rig.study.sobol import sobol_shots
-    from rig.study.store import Store
+    from rig.study.mc_run import described, run_to
 
-    dists = tuple(parse_vary(args.vary or []))
-    shots = args.shots
-    batch = args.batch or Store.stored_batch(args.out) or DEFAULT_BATCH  # a study resumed keeps its batches
-    if args.sobol:
-        shots = sobol_shots(args.shots, len(dists))
-    study = Study(args.scene, dists, shots, args.seed, tuple(args.set or ()), batch, args.accuracy,
-                  args.sobol, args.truth, args.window, args.traces)
-    from rig.study.nominal import nominal
+    study = described(args.scene, args.vary or [], args.shots, args.out, args.seed, tuple(args.set or ()), args.batch,
+                      args.accuracy, args.sobol, args.truth, args.window, args.traces)
 
-    with writing_to(args.out), Store(args.out, study).held() as store:  # held before anything is printed
-        if shots != args.shots and not args.json:
-            print(f"Sobol design over {len(dists)} inputs: {shots} shots "
-                  f"({shots // (len(dists) + 2)} x {len(dists) + 2})", file=sys.stderr)
-        held = min(study.batch, study.shots)  # the shots a batch holds at once
+    def admit(cost):  # the folder held, before anything is solved
+        if study.shots != args.shots and not args.json:
+            keys = len(study.dists)
+            print(f"Sobol design over {keys} inputs: {study.shots} shots ({study.shots // (keys + 2)} x {keys + 2})",
+                  file=sys.stderr)
         compile_cold("mc", "study", args.quiet)
-        rig = nominal(study.scene, study.overrides).rig
-        rig.check_record()  # settings that can give no record (or a made-up one) are refused before any solve
-        whole = rig.estimate(controlled=False).times(study.shots, held)
-        check_size(whole, args, f"the study's {study.shots} shots (batches of {held} held at once)")
-        with progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot") as bar:
-            run = run_in(store, study, args.workers or 1, args.scheduler, bar.update, bar.update,
-                         args.worker_timeout or DEFAULT_WORKER_TIMEOUT)
+        check_size(cost(), args, f"the study's {study.shots} shots (batches of {min(study.batch, study.shots)} "
+                                  "held at once)")
+
+    with writing_to(args.out), contextlib.ExitStack() as shown:
+        bar = []
+
+        def on_start(done: int):  # the study admitted, its batches about to run: the bar from here
+            bar.append(shown.enter_context(progress_bar(args.quiet, total=study.shots, desc="mc", unit="shot")))
+            bar[0].update(done)
+
+        run = run_to(args.out, study, args.workers or 1, args.scheduler, lambda n: bar[0].update(n), on_start,
+                     args.worker_timeout or DEFAULT_WORKER_TIMEOUT, admit)
     if not args.json:
         print_study(run.report, run.ran_now, args.out)
     failed = run.report["failed"]
@@ -75,3 +84,35 @@ def print_study(report: dict, ran: int, out):
         print(f"  failed: {failed['count']} of {report['shots']} shots ({failed['share']:.1%}), left out of "
               "the estimates: " + "; ".join(f"{n} {why}" for why, n in failed["reasons"].items()))
     print("  wrote study.h5, report.json, histograms.png, speed_vs_amplitude.png")
+
+
+def add_mc(sub) -> None:
+    """The parser of ``rig mc``."""
+    mc = command(sub, "mc", "Monte Carlo study over many virtual shots", cmd_mc)
+    mc.add_argument("scene")
+    mc.add_argument("--shots", type=count_arg, required=True, help="number of shots (>= 1)")
+    mc.add_argument("--vary", action="append", metavar="KEY=DIST",
+                    help='e.g. striker.velocity="normal(0.89 m/s, 0.01 m/s)"; also chain.bead_mass, '
+                         'gauges.NAME.gain, gauges.NAME.misalignment')
+    mc.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides")
+    mc.add_argument("--seed", type=seed_arg, default=0, help="the study's seed (default 0)")
+    mc.add_argument("--batch", type=count_arg, help="shots per batch (default 256; resuming a study in --out: "
+                                                    "its own)")
+    mc.add_argument("--accuracy", type=plain(float), help="solver accuracy (default: the scene's)")
+    mc.add_argument("--workers", type=count_arg,
+                    help="local worker processes, or with --scheduler local the cluster's (default 1)")
+    mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")
+    mc.add_argument("--sobol", action="store_true", help="Sobol design and indices (needs SALib)")
+    mc.add_argument("--truth", action="store_true", help="also analyse each shot's noise-free truth (slower)")
+    mc.add_argument("--window", choices=["leading", "record"], default="leading",
+                    help="simulate until the leading pulse has passed the last gauge (default), "
+                         "or the scene's whole record")
+    mc.add_argument("--traces", action="store_true",
+                    help="also archive every shot's scope record and truth in DIR/traces/ (one archive per batch)")
+    mc.add_argument("--out", required=True, metavar="DIR")
+    mc.add_argument("--quiet", action="store_true", help="no progress bar")
+    mc.add_argument("--max-failed", type=fraction_arg, default=0.05, metavar="PERCENT",
+                    help="fail the study (exit 1) when more shots than this fail (default 5%%)")
+    mc.add_argument("--worker-timeout", type=positive_seconds, metavar="SECONDS",
+                    help="with --scheduler: stop when no Dask worker is alive for this long (default 300)")
+    allow_large(mc)

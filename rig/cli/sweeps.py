@@ -3,12 +3,21 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rig.cli.common import (check_archive_out, check_size, flag_lines, folder_shown, missing_lines, progress_bar,
-                            scene_overrides, writing_to)
+from rig.cli.common import (
+    check_archive_out,
+    check_size,
+    flag_lines,
+    folder_shown,
+    missing_lines,
+    progress_bar,
+    scene_overrides,
+    writing_to,
+)
 from rig.cli.shots import shot_summary
 from rig.errors import Interrupted, RigError, invalid
 
 MAX_SWEEP_POINTS = 10_000  # more needs --allow-large (each point's shot is kept to the end)
+from rig.cli.common import allow_large, command, count_arg, seed_arg
 
 
 def cmd_sweep(args) -> dict:
@@ -132,3 +141,43 @@ def cmd_reproduce(args) -> dict:
         print(f"wrote {folder_shown(args.out)}: table1.md, table1.csv, summary.md, results.json and the figures"
               + (", fitted.md, fitted.json" if args.fitted else ""))
     return block
+
+
+def add_sweep(sub) -> None:
+    """The parser of ``rig sweep``."""
+    sw = command(sub, "sweep", "one shot per value of a scene key", cmd_sweep)
+    sw.add_argument("scene")
+    sw.add_argument("--vary", required=True, action="append", metavar="KEY=START:STOP:COUNT",
+                    help="the one key to sweep, e.g. striker.velocity=0.3:1.5:7 (plain numbers in the key's SI unit)")
+    sw.add_argument("--set", action="append", metavar="KEY=VALUE", help="other overrides")
+    sw.add_argument("--seed", type=seed_arg, default=0, help="the sweep's seed (default 0)")
+    sw.add_argument("--out", metavar="ARCHIVE.h5", help="append every shot to an archive")
+    sw.add_argument("--quiet", action="store_true", help="no progress bar")
+    allow_large(sw)
+
+
+def add_reproduce(sub) -> None:
+    """The parser of ``rig reproduce``."""
+    rp = command(sub, "reproduce", "re-run a published study (daraio2006)", cmd_reproduce)
+    rp.add_argument("study", choices=["daraio2006"], help="the published study to re-run")
+    rp.add_argument("--out", required=True, metavar="DIR", help="folder for tables and figures")
+    rp.add_argument("--fitted", action="store_true",
+                    help="also fit the PTFE model to the published experiment (Table 1) and compare its shots")
+    rp.add_argument("--family", action="append", metavar="NAME",
+                    help="with --fitted: fit only this model family (repeat for more; default: every one)")
+    rp.add_argument("--identifiability", action="store_true",
+                    help="instead: fit each new contact parameter to noisy virtual Fig. 3 observations (20 data "
+                         "sets each) and count the 95%% intervals that hold the truth (identifiability.json, .md)")
+    rp.add_argument("--sensitivity", action="store_true",
+                    help="instead: each Fig. 3 figure's d ln(figure)/d ln(p) and each key's window meeting every "
+                         "Fig. 3 target, at the Fig. 3 parameter set or --set (sensitivity.json, .md)")
+    rp.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="with --identifiability or --sensitivity: overrides of the Fig. 3 parameter set")
+    rp.add_argument("--param", action="append", metavar="KEY=LO:HI",
+                    help="with --identifiability: a key to find again (with --truth), instead of the five new ones")
+    rp.add_argument("--truth", action="append", metavar="VALUE",
+                    help="with --param: its truth, a quantity in the key's unit (one per --param, in order)")
+    rp.add_argument("--draws", type=count_arg, default=20,
+                    help="with --identifiability: data sets per key (default 20)")
+    rp.add_argument("--seed", type=seed_arg, default=0, help="with --identifiability: the noise's seed (default 0)")
+    rp.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 import sys
 
+from rig.cli.common import command, rounds_arg
 from rig.errors import RigError, invalid
 from rig.units import typed_quantity
 
@@ -112,3 +113,34 @@ def cmd_bench(args) -> dict:
                   f"{module.PROBE} (machine: {result['machine']})")
         print(module.table(result))
     return result
+
+
+def add_theory(sub) -> None:
+    """The parser of ``rig theory``."""
+    th = command(sub, "theory", "long-wave and exact discrete solitary wave speeds", cmd_theory)
+    th.add_argument("--material", default="ptfe", help="ptfe | steel316 | ... (default ptfe)")
+    th.add_argument("--diameter", default="4.76 mm", help="bead diameter, e.g. 4.76mm (plain number: m)")
+    th.add_argument("--f0", required=True, help="precompression F0 (plain number: N)")
+    th.add_argument("--fm", help="maximum contact force Fm of the wave (plain number: N)")
+
+
+def add_bench(sub) -> None:
+    """The parser of ``rig bench``."""
+    be = command(sub, "bench", "benchmarks", cmd_bench)
+    be.add_argument("what", choices=["solver", "accuracy", "models", "fit", "shot", "archive", "pipeline", "mc",
+                                     "animate", "startup", "serve"],
+                    help="what to benchmark")
+    be.add_argument("--quick", action="store_true", help="solver, accuracy, models, fit: fewer settings, one repeat")
+    be.add_argument("--peers", action="store_true",
+                    help="solver: also scipy's DOP853, a numba-compiled DOP853 and LAMMPS (when installed)")
+    be.add_argument("--cold", action="store_true",
+                    help="startup: the first rig shot and rig mc with an empty numba cache (everything compiled), "
+                         "beside the warm ones")
+    be.add_argument("--baseline", metavar="REV",
+                    help="solver, mc, startup --cold: measure git revision REV of this checkout too, in turns with the current code")
+    be.add_argument("--rounds", type=rounds_arg, metavar="N",
+                    help="solver, mc, startup --cold: rounds, 1 to 100, of the figures that run in turns with --baseline "
+                         "(solver: its kernel figure only, default 3, 1 with --quick; mc: every figure, default 3; "
+                         "startup --cold: default 1); more "
+                         "rounds steady the ratios on a machine whose speed swings")
+

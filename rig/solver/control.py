@@ -58,7 +58,7 @@ from rig.solver.methods import Method
 from rig.solver.problem import ChainProblem
 from rig.solver.run import Unstable, integrate_at, time_grid
 from rig.solver.saveat import SaveAt
-from rig.solver.solution import STATIC, Solution, relative_error
+from rig.solver.solution import STATIC, Solution, Status, relative_error
 from rig.solver.stepsize import COARSEST_ACCURACY, Stepping, default_step, largest_step
 
 RICHARDSON = 10.0    # e(h) / e(h/2), order ~3.3: the median over the measured problems (docs/solver.md)
@@ -91,11 +91,8 @@ def companion_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method
     if not save.names:
         return None, "nothing recorded"
     companion = Stepping(sol.stats.dt_s / COMPANION, stepping.head, stepping.inner_dt / COMPANION)
-    try:
-        return integrate_at(problem, t_end, SaveAt(save.probes, save.sample_interval), m, companion), \
-            "companion at dt/2"
-    except Unstable:
-        return None, "the companion at dt/2 was unstable"
+    comp = integrate_at(problem, t_end, SaveAt(save.probes, save.sample_interval), m, companion)
+    return (comp, "companion at dt/2") if comp.success else (None, "the companion at dt/2 was unstable")
 
 
 def error_over_time(forces: dict, reference: dict) -> np.ndarray:
@@ -125,7 +122,7 @@ def estimated_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method
                     estimate: bool = True) -> Solution:
     """One solve at ``stepping``, with its companion estimate unless ``estimate`` is False."""
     t0 = time.process_time()
-    sol = integrate_at(problem, t_end, save, m, stepping)
+    sol = Unstable.check(integrate_at(problem, t_end, save, m, stepping), stepping)
     est, basis = companion_estimate(problem, t_end, save, m, stepping, sol) if estimate else (None, "not asked")
     return with_estimate(sol, est, basis, 1, time.process_time() - t0)
 
@@ -136,7 +133,7 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
     shorter than ``shortest`` (s; a caller's bound on the cost) and all of them, companions
     included, within WORK_BUDGET solves at the first step. Where the bound ends the control
     above the accuracy: AccuracyNotReached if ``strict``, else the most accurate try,
-    its estimate above the accuracy."""
+    its estimate above the accuracy, with status ACCURACY_NOT_REACHED (its message says why)."""
     t0 = time.process_time()
     first = default_step(problem, m, accuracy, t_end)
     longest = largest_step(problem, m, t_end)
@@ -147,9 +144,8 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
     tried = []  # (solution, estimate, basis)
     for _ in range(MAX_ATTEMPTS):
         stepping = Stepping(dt, first.head, first.inner_dt * dt / first.dt)
-        try:
-            sol = integrate_at(problem, t_end, save, m, stepping, accuracy)
-        except Unstable:
+        sol = integrate_at(problem, t_end, save, m, stepping, accuracy)
+        if not sol.success:
             spent += time_grid(t_end, dt, t_end)[0]
             dt *= 0.5
             continue
@@ -176,8 +172,11 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
     if not tried:
         raise Unstable(f"unstable at every step tried down to dt = {2 * dt:.4g} s", stepping)
     sol, est, basis, _ = _choice(tried, accuracy)
-    if strict and est is not None and est > accuracy:
-        raise AccuracyNotReached(_not_reached(tried, accuracy, first.dt, stop, t_end))
+    if est is not None and est > accuracy:
+        why = _not_reached(tried, accuracy, first.dt, stop, t_end)
+        if strict:
+            raise AccuracyNotReached(why)
+        sol = replace(sol, status=Status.ACCURACY_NOT_REACHED, detail=f" ({why})")
     return with_estimate(sol, est, basis, len(tried), time.process_time() - t0)
 
 

@@ -109,11 +109,19 @@ def kernel_inputs(problems: ChainProblem | ProblemArrays, take: Callable[[str], 
 
 class Unstable(RigError):
     """An integration that blew up (an overlap beyond half a bead radius): the step is too
-    large. Carries the stepping that failed."""
+    large. Carries the stepping that failed. What the solve functions raise from an
+    UNSTABLE Solution (``Unstable.check``)."""
 
     def __init__(self, message: str, stepping: Stepping):
         super().__init__(message)
         self.stepping = stepping
+
+    @classmethod
+    def check(cls, sol: Solution, stepping: Stepping) -> Solution:
+        """``sol`` where it did not blow up; else Unstable with its message."""
+        if sol.status is Status.UNSTABLE:
+            raise cls(sol.message, stepping)
+        return sol
 
 
 def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, stepping: Stepping,
@@ -146,9 +154,8 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     integrate(u, v, f, *k, diag, front)
     wall = time.perf_counter() - t0
     report = KernelReport.of(diag)
-    if report.status is not Status.SUCCESS:
-        raise Unstable(f"{report.status.message} (near t = {report.end_time_s:.4g} s, "
-                       f"dt = {step:.4g} s, method {m.name})", stepping)
+    detail = "" if report.status is Status.SUCCESS else \
+        f" (near t = {report.end_time_s:.4g} s, dt = {step:.4g} s, method {m.name})"
     stats = SolverStats(m.name, step, n_steps, n_steps * m.force_evaluations, wall,
                         report.energy_error, report.momentum_error, report.wall_impulse_Ns, accuracy,
                         dissipated_energy_J=report.dissipated_energy_J, bodies_stepped=report.bodies_stepped)
@@ -157,4 +164,4 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     frames_abs = frames[:, shown] + frame_origin(problem.chain) if n_frames else None
     return Solution(dict(zip(save.names, out)), save.sample_interval, frames_abs,
                     save.frame_interval, u[moving].copy(), v[moving].copy(), stats, problem,
-                    report.status)
+                    report.status, detail)

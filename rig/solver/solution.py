@@ -15,16 +15,24 @@ if TYPE_CHECKING:
 
 
 class Status(enum.IntEnum):
-    """How a solve ended, as the kernels report it (like scipy's OdeResult.status)."""
+    """How a solve ended (like scipy's OdeResult.status). SUCCESS and UNSTABLE are what the
+    kernels write in their report's STATUS slot; ACCURACY_NOT_REACHED is the accuracy
+    control's (rig/solver/control.py): its bound on the work ended it above the accuracy."""
 
     SUCCESS = 0
     UNSTABLE = 1  # an overlap grew beyond half a bead radius: the step is too large
+    ACCURACY_NOT_REACHED = 2  # the most accurate try returned, its error estimate above the accuracy
 
     @property
     def message(self) -> str:
-        return {Status.SUCCESS: "the integration reached the end time",
-                Status.UNSTABLE: "the integration became unstable (an overlap grew beyond half a "
-                                 "bead radius); use a smaller dt or a tighter accuracy"}[self]
+        return _STATUS_MESSAGES[self]
+
+
+_STATUS_MESSAGES = {
+    Status.SUCCESS: "the integration reached the end time",
+    Status.UNSTABLE: "the integration became unstable (an overlap grew beyond half a bead radius); use a smaller "
+                     "dt or a tighter accuracy",
+    Status.ACCURACY_NOT_REACHED: "the integration reached the end time, its error estimate above the accuracy"}
 
 
 @dataclass(frozen=True)
@@ -123,6 +131,9 @@ class Solution:
     frames: positions (m, down from bead 0's equilibrium centre) of the striker (if any)
     and the beads at t = j * frame_interval, only when frames were asked for.
     final_u, final_v: each body's displacement (m) and velocity (m/s) at the end.
+    status: how the solve ended (Status); detail: what it adds to the status's message for
+    this solve (where and at what step it blew up, how far the control got), "" where
+    nothing. A solve that is not SUCCESS returns its record as far as it went.
     """
 
     forces: dict
@@ -134,10 +145,16 @@ class Solution:
     stats: SolverStats
     problem: ChainProblem
     status: Status = Status.SUCCESS
+    detail: str = ""
 
     @property
     def message(self) -> str:
-        return self.status.message
+        """How the solve ended, in one line: the status's message and this solve's detail."""
+        return f"{self.status.message}{self.detail}"
+
+    @property
+    def success(self) -> bool:
+        return self.status is Status.SUCCESS
 
     @property
     def time(self) -> np.ndarray:

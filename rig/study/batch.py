@@ -16,6 +16,7 @@ from instruments import streams
 from instruments.analysis.batch import analysed
 from instruments.analysis.pipeline import analyze_record
 from instruments.devices import batch as instrument_batch
+from instruments.devices.oscilloscope import AcquisitionStatus
 from rig.errors import RigError, invalid
 from rig.experiment.measure import setup_for
 from rig.experiment.shot import Rig
@@ -24,20 +25,18 @@ from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution
 from rig.solver.stepsize import stepping_at
-from rig.study.mc_spec import FAILURES, OUTPUTS, Study
+from rig.study.mc_spec import OUTPUTS, Failure, MonteCarloStudy
 from rig.study.nominal import copied_table, nominal
 from rig.study.shots import array_keys, shots_of, wave_speeds, wiring_of
 from rig.study.sobol import sobol_matrix
-
-IMPOSSIBLE, UNSTABLE, NO_TRIGGER, SHORT_WINDOW, NON_FINITE, CLIPPED = range(1, len(FAILURES))
 
 
 @dataclass(frozen=True, eq=False)
 class BatchResult:
     """What batch ``batch`` gives: the shots' indices, inputs (shots, K) in the study's key
     order, instrument seeds, outputs {name: (shots,)} (OUTPUTS; nan where nothing was
-    measured; "failure": the index of FAILURES, 0 for a shot that did not fail) and, for a
-    study with traces, each shot's archive Entry."""
+    measured; "failure": the shot's Failure code, Failure.NONE (0) for a shot that did not
+    fail) and, for a study with traces, each shot's archive Entry."""
 
     batch: int
     index: np.ndarray
@@ -46,13 +45,17 @@ class BatchResult:
     outputs: dict
     traces: tuple = ()
 
+    @property
+    def shots(self) -> int:
+        return int(self.index.size)
 
-def shot_inputs(study: Study, i: int, n_plain: int, design=None):
+
+def shot_inputs(study: MonteCarloStudy, i: int, n_plain: int, design=None):
     """Shot i's inputs {key: value}, bead masses (or None) and instrument seed."""
     return batch_inputs(study, i, i + 1, n_plain, design)[0]
 
 
-def batch_inputs(study: Study, lo: int, hi: int, n_plain: int, design=None) -> list:
+def batch_inputs(study: MonteCarloStudy, lo: int, hi: int, n_plain: int, design=None) -> list:
     """(inputs {key: value}, bead masses or None, instrument seed) of shots lo..hi-1, each
     drawn from its own stream, np.random.default_rng(SeedSequence(study.seed,
     spawn_key=(i,))) (instruments.streams: every shot's draws in one compiled call, the
@@ -78,7 +81,7 @@ def batch_inputs(study: Study, lo: int, hi: int, n_plain: int, design=None) -> l
     return out
 
 
-def shot_rig(study: Study, x: dict, masses) -> tuple:
+def shot_rig(study: MonteCarloStudy, x: dict, masses) -> tuple:
     """Shot inputs x (and bead masses) -> (the shot's rig, its instrument draws)."""
     template = nominal(study.scene, tuple(study.overrides)).template(study.window)
     v = dict(template.values)
@@ -94,7 +97,7 @@ def shot_rig(study: Study, x: dict, masses) -> tuple:
     return Rig(template.scene.with_values(v), bead_masses=masses, like=template), draws
 
 
-def study_save(study: Study, rig: Rig) -> SaveAt:
+def study_save(study: MonteCarloStudy, rig: Rig) -> SaveAt:
     """What a study's solver records: the gauges' averages (what their plates read) and the
     wall; each gauge's two contacts too where the truth analysis or the traces need them.
     The averages feed the gauges either way, so traces do not change the results."""
@@ -115,20 +118,20 @@ def collector_paused():
             gc.enable()
 
 
-def run_batch(study: Study, b: int) -> BatchResult:
+def run_batch(study: MonteCarloStudy, b: int) -> BatchResult:
     """Batch b of the study."""
     with collector_paused():
         return _batch(study, b)
 
 
-def _batch(study: Study, b: int) -> BatchResult:
+def _batch(study: MonteCarloStudy, b: int) -> BatchResult:
     shots = study.shots_of(b)
     lo, hi = shots.start, shots.stop
     nom = nominal(study.scene, tuple(study.overrides))
     base = nom.rig
     design = sobol_matrix(study)[0] if study.sobol else None
     out = {k: np.full(hi - lo, np.nan) for k in OUTPUTS}
-    out["failure"][:] = 0
+    out["failure"][:] = Failure.NONE
     drawn = batch_inputs(study, lo, hi, base.values["chain"]["beads"], design)
     seeds = [seed for *_, seed in drawn]
     xs = np.array([[x[k] for k in study.keys] for x, *_ in drawn], dtype=float).reshape(hi - lo, len(study.keys))
@@ -140,7 +143,7 @@ def _batch(study: Study, b: int) -> BatchResult:
             try:
                 rigs[j], draws[j] = shot_rig(study, x, masses)
             except ValueError:  # inputs no rig can have (a negative velocity): counted, not fatal
-                out["failure"][j] = IMPOSSIBLE
+                out["failure"][j] = Failure.IMPOSSIBLE
         if rigs:
             _fire_rigs(study, nom, rigs, draws, seeds, out, traces, lo)
     else:
@@ -148,7 +151,7 @@ def _batch(study: Study, b: int) -> BatchResult:
     return BatchResult(b, np.arange(lo, hi), xs, np.array(seeds, dtype=np.int64), out, tuple(traces))
 
 
-def _pilot(study: Study, nom, template: Rig):
+def _pilot(study: MonteCarloStudy, nom, template: Rig):
     """(the stepping every shot takes, the pilot's stats): the step is calibrated once, on
     what every study measures (the gauges' averages, the wall), so that recording the
     contacts too (--truth, --traces) changes no result."""
@@ -156,11 +159,11 @@ def _pilot(study: Study, nom, template: Rig):
     return stepping_at(pilot.problem, pilot.stats.dt_s), pilot.stats
 
 
-def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
+def _fire_arrays(study: MonteCarloStudy, nom, template: Rig, drawn: list, out: dict):
     """The batch with no rig built per shot (rig/study/shots.py): one batched solve, one
     batched acquisition and one batched analysis of the leading pulse."""
     shots = shots_of(template, [x for x, *_ in drawn], [m for _, m, _ in drawn])
-    out["failure"][~shots.possible] = IMPOSSIBLE
+    out["failure"][~shots.possible] = Failure.IMPOSSIBLE
     keep = np.flatnonzero(shots.possible)
     if not keep.size:
         return
@@ -180,12 +183,12 @@ def _fire_arrays(study: Study, nom, template: Rig, drawn: list, out: dict):
     succeeded, energy_errors = ens.succeeded, ens.energy_errors
     for e, j in enumerate(keep):
         if not succeeded[e]:
-            out["failure"][j] = UNSTABLE
+            out["failure"][j] = Failure.UNSTABLE
             continue
-        if records.status[e] == instrument_batch.PAST_INPUT:  # the scope's record ends after the simulated window
-            out["failure"][j] = SHORT_WINDOW
+        if records.outcome(e) is AcquisitionStatus.PAST_INPUT:  # the scope's record ends after the simulated window
+            out["failure"][j] = Failure.SHORT_WINDOW
             continue
-        triggered = records.status[e] == instrument_batch.OK
+        triggered = records.outcome(e) is AcquisitionStatus.OK
         _outputs(out, int(j), reports[e], None, float(energy_errors[e]), ens.dt, triggered,
                  bool(records.over[e, roles].any()))
 
@@ -199,12 +202,12 @@ def _outputs(out: dict, j: int, m, t, energy_error: float, dt: float, triggered:
                      ("energy_error", energy_error), ("dt_s", dt)):
         out[key][j] = np.nan if val is None else val
     if not triggered:
-        out["failure"][j] = NO_TRIGGER
+        out["failure"][j] = Failure.NO_TRIGGER
     elif not (np.isfinite(out["speed_m_per_s"][j]) and np.isfinite(out["amplitude_N"][j])):
-        out["failure"][j] = CLIPPED if clipped else NON_FINITE
+        out["failure"][j] = Failure.CLIPPED if clipped else Failure.NON_FINITE
 
 
-def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dict, traces: list, lo: int):
+def _fire_rigs(study: MonteCarloStudy, nom, rigs: dict, draws: dict, seeds: list, out: dict, traces: list, lo: int):
     """The batch with a rig per shot (a key that changes the rig's parts, --truth,
     --traces): one batched solve, then each shot read and analysed as a lone shot is."""
     base = nom.rig
@@ -217,7 +220,7 @@ def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dic
     setup = setup_for(template, beta, F0)
     for e, ((j, rig), p) in enumerate(zip(rigs.items(), problems)):
         if not ens.succeeded[e]:
-            out["failure"][j] = UNSTABLE
+            out["failure"][j] = Failure.UNSTABLE
             continue
         stats = ens.stats(e, pilot.accuracy, pilot.error_estimate)
         forces = {name: a[e] for name, a in ens.forces.items()}
@@ -225,7 +228,7 @@ def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dic
         try:
             shot = rig.fire(seed=seeds[j], fixed=draws[j], truth=False)
         except RigError:  # the scope's record ends after the simulated window
-            out["failure"][j] = SHORT_WINDOW
+            out["failure"][j] = Failure.SHORT_WINDOW
             continue
         if study.traces:  # each shot has its own scene values and truth: nothing shared between shots
             from rig.experiment.entry import shot_entry  # the archive's Entry (h5py): only with traces
@@ -242,7 +245,7 @@ def _fire_rigs(study: Study, nom, rigs: dict, draws: dict, seeds: list, out: dic
                  shot.scope.triggered, clipped)
 
 
-def refire(study: Study, i: int) -> dict:
+def refire(study: MonteCarloStudy, i: int) -> dict:
     """Shot i alone, with its stored step: the same outputs as in the study."""
     if not 0 <= i < study.shots:
         raise invalid("shot", i, f"a shot of the study, 0..{study.shots - 1}")

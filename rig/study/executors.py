@@ -1,7 +1,9 @@
 """Where a study's batches run: in this process, in a pool of local processes, or on a Dask
-cluster (optional extra: pip install ".[dask]"). Batches are the same whatever runs them,
-so the results are identical; each finished batch goes at once to the store's writer
-(a thread of its own), so the loop that feeds the workers never waits on the disk."""
+cluster (optional extra: pip install ".[dask]"), for any study (rig/study/protocol.py: a
+StudySpec and its StudyStore; the Monte Carlo study, the sweep). Batches are the same
+whatever runs them, so the results are identical; each finished batch goes at once to the
+store's writer (the Monte Carlo store's: a thread of its own), so the loop that feeds the
+workers never waits on the disk."""
 from __future__ import annotations
 
 import concurrent.futures as cf
@@ -11,9 +13,7 @@ import os
 import queue
 
 from rig.errors import RigError
-from rig.study.batch import run_batch
-from rig.study.mc_spec import Study
-from rig.study.store import Store
+from rig.study.protocol import StudySpec, StudyStore
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 DEFAULT_WORKER_TIMEOUT = 300.0  # s without any live Dask worker before a study stops
@@ -71,30 +71,31 @@ class WorkerWatch:
                            f"{kept} finished batches are kept: run the same command again to resume")
 
 
-def run_study(study: Study, store: Store, workers: int = 1, scheduler: str | None = None,
+def run_study(study: StudySpec, store: StudyStore, workers: int = 1, scheduler: str | None = None,
               progress=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> int:
-    """Run the batches not yet stored; returns how many batches ran. ``progress(n)`` is told
-    the shots of each batch once it is stored. The batches are stored on a thread of their
-    own (``Store.writer``), so that neither the workers nor this loop wait on the disk. On
-    Dask, a study with no live worker for ``worker_timeout`` seconds stops (RigError)."""
-    todo = [b for b in range(study.n_batches) if b not in store.done()]
+    """Run the batches of ``study`` that ``store`` does not hold yet; returns how many
+    batches ran. ``progress(n)`` is told the shots of each batch once it is stored. The
+    batches go to the store's writer as they finish (the Monte Carlo store's writes on a
+    thread of its own, so that neither the workers nor this loop wait on the disk). On Dask,
+    a study with no live worker for ``worker_timeout`` seconds stops (RigError)."""
+    todo = [b for b in study.batches() if b not in store.done()]
     tick = progress or (lambda n: None)
-    with store.writer(lambda result: tick(len(result.index))) as writer:
+    with store.writer(lambda result: tick(result.shots)) as writer:
         if scheduler:
             _dask(study, store, todo, scheduler, workers, writer, WorkerWatch(worker_timeout))
         elif workers <= 1:
             for b in todo:
-                writer.put(run_batch(study, b))
+                writer.put(study.run_batch(b))
         else:
             _local_pool(study, todo, workers, writer)
     return len(todo)
 
 
-def _local_pool(study: Study, todo: list, workers: int, writer):
+def _local_pool(study: StudySpec, todo: list, workers: int, writer):
     ctx = multiprocessing.get_context("spawn")  # numba's threads and fork do not mix
     with cf.ProcessPoolExecutor(workers, mp_context=ctx, initializer=_worker_start,
                                 initargs=(os.getpid(),)) as pool:
-        futures = [pool.submit(run_batch, study, b) for b in todo]
+        futures = [pool.submit(study.run_batch, b) for b in todo]
         try:
             for fut in cf.as_completed(futures):
                 writer.put(fut.result())
@@ -104,14 +105,14 @@ def _local_pool(study: Study, todo: list, workers: int, writer):
             raise
 
 
-def run_batch_alone(study: Study, b: int):
+def run_batch_alone(study: StudySpec, b: int):
     """Batch b on one numba thread: what a Dask task runs. Dask runs one task per worker
     thread; numba's own threads (one per core by default) in every worker would put
     workers x cores threads on the cores."""
     import numba
 
     numba.set_num_threads(1)  # this thread's (numba's thread count is per calling thread)
-    return run_batch(study, b)
+    return study.run_batch(b)
 
 
 def _dask(study, store, todo, scheduler, workers, writer, watch: WorkerWatch):

@@ -13,16 +13,17 @@ import numpy as np
 from instruments.files import write_text
 from rig.errors import Interrupted, RigError
 from rig.experiment.measure import midway_static_force
+from rig.study.distributions import parse_vary
 from rig.study.executors import DEFAULT_WORKER_TIMEOUT, run_study
-from rig.study.mc_spec import Study
+from rig.study.mc_spec import DEFAULT_BATCH, Failure, MonteCarloStudy
 from rig.study.nominal import nominal
 from rig.study.report import failures, figures, jcgm101
-from rig.study.sobol import sobol_indices, sobol_matrix
+from rig.study.sobol import sobol_indices, sobol_matrix, sobol_shots
 from rig.study.store import Store, StudyResults
 from rig.theory.longwave import solitary_wave_speed
 
 
-def check(study: Study):
+def check(study: MonteCarloStudy):
     """Refuse a study that cannot run, before any shot: no uncertain input, a varied gauge
     the scene does not have, a Sobol design that SALib cannot build."""
     if not study.dists:
@@ -45,14 +46,41 @@ class StudyRun:
     ran_now: int
 
 
-def run_to(folder, study: Study, workers: int = 1, scheduler: str | None = None, progress=None,
-           on_start=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> StudyRun:
-    """Run (or resume) ``study`` in ``folder``, held by this run (``Store.held``)."""
+def described(scene, vary: list, shots: int, folder, seed: int = 0, overrides: tuple = (), batch: int | None = None,
+              accuracy: float | None = None, sobol: bool = False, truth: bool = False, window: str = "leading",
+              traces: bool = False) -> MonteCarloStudy:
+    """The study `rig mc` describes: ``vary`` its --vary texts (KEY=DIST); a Sobol design's
+    shots (``sobol``: ``shots`` base samples' worth, rig.study.sobol); the batch size
+    ``batch``, else the one of the study already in ``folder`` (a study resumed keeps its
+    batches), else DEFAULT_BATCH."""
+    dists = tuple(parse_vary(vary))
+    return MonteCarloStudy(scene, dists, sobol_shots(shots, len(dists)) if sobol else shots, seed, tuple(overrides),
+                           batch or Store.stored_batch(folder) or DEFAULT_BATCH, accuracy, sobol, truth, window,
+                           traces)
+
+
+def cost(study: MonteCarloStudy):
+    """The whole study's estimated memory and CPU time (rig.solver.estimate, batches of
+    ``study.batch`` shots held at once), after refusing settings that can give no record
+    (or a made-up one) before any solve."""
+    rig = nominal(study.scene, study.overrides).rig
+    rig.check_record()
+    return rig.estimate(controlled=False).times(study.shots, min(study.batch, study.shots))
+
+
+def run_to(folder, study: MonteCarloStudy, workers: int = 1, scheduler: str | None = None, progress=None,
+           on_start=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT, admit=None) -> StudyRun:
+    """Run (or resume) ``study`` in ``folder``, held by this run (``Store.held``).
+    ``admit(cost)``, where given, is called once the folder is held and before anything is
+    solved, with a function giving the study's estimated cost (``cost``): where a caller
+    refuses a study too large, or prepares for it (compiles kernels)."""
     with Store(folder, study).held() as store:  # one run at a time into a folder
+        if admit is not None:
+            admit(lambda: cost(study))
         return run_in(store, study, workers, scheduler, progress, on_start, worker_timeout)
 
 
-def run_in(store: Store, study: Study, workers: int = 1, scheduler: str | None = None, progress=None,
+def run_in(store: Store, study: MonteCarloStudy, workers: int = 1, scheduler: str | None = None, progress=None,
            on_start=None, worker_timeout: float = DEFAULT_WORKER_TIMEOUT) -> StudyRun:
     """Run (or resume) ``study`` in ``store``, a folder this run holds. ``progress(n)`` is
     told each finished batch's shots; ``on_start(done)`` how many shots were already stored;
@@ -78,9 +106,9 @@ def run_in(store: Store, study: Study, workers: int = 1, scheduler: str | None =
     return StudyRun(report, ran)
 
 
-def summarise(study: Study, results: StudyResults, shots_per_s) -> dict:
+def summarise(study: MonteCarloStudy, results: StudyResults, shots_per_s) -> dict:
     """The JCGM 101 summary of each output, the inputs, and the Sobol indices if asked."""
-    ok = results.outputs["failure"] == 0  # failed shots are counted, and left out of every estimate
+    ok = results.outputs["failure"] == Failure.NONE  # failed shots are counted, and left out of every estimate
     out = {k: np.where(ok, v, np.nan) for k, v in results.outputs.items()}
     report = {"shots": int(results.index.size), "shots_per_s": shots_per_s,
               "failed": failures(results.outputs["failure"]),
@@ -95,7 +123,7 @@ def summarise(study: Study, results: StudyResults, shots_per_s) -> dict:
     return report
 
 
-def write_report(folder: Path, study: Study, store: Store, results: StudyResults, report: dict):
+def write_report(folder: Path, study: MonteCarloStudy, store: Store, results: StudyResults, report: dict):
     """The figures (with the Eq (1) curve at the nominal F_0), study.h5 and report.json."""
     base = nominal(study.scene, study.overrides).rig
     F0 = midway_static_force(base)

@@ -4,6 +4,7 @@ belongs to batch i // batch and draws its inputs from child i of the study's num
 SeedSequence, so results depend on none of the executor, the workers or the order."""
 from __future__ import annotations
 
+import enum
 import hashlib
 import json
 import math
@@ -16,20 +17,42 @@ from rig.units import MAX_SEED, is_whole
 WINDOWS = ("leading", "record")
 OUTPUTS = ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_amplitude_N",
            "truth_speed_m_per_s", "truth_amplitude_N", "energy_error", "dt_s", "failure")
-# Why a shot gave no result: its "failure" output is the index in FAILURES (0: it did not fail).
+
+
+class Failure(enum.IntEnum):
+    """Why a shot gave no result: its "failure" output is this code (NONE: it did not fail).
+    The codes are stored: a new reason goes at the end, none is ever moved."""
+
+    NONE = 0
+    IMPOSSIBLE = 1
+    UNSTABLE = 2
+    NO_TRIGGER = 3
+    SHORT_WINDOW = 4
+    NON_FINITE = 5
+    CLIPPED = 6
+
+    @property
+    def message(self) -> str:
+        """The reason as the report names it (report.json's "failed" reasons)."""
+        return FAILURES[self]
+
+
 FAILURES = ("none", "impossible inputs (the rig refuses them)", "solver unstable",
             "the scope did not trigger",
             "the scope record ends after the simulated window (--window record simulates the whole record)",
             "non-finite measured speed or amplitude",
             "a gauge channel clipped (its signal ran off the scope's range: raise scope.channels.CHn.volts_per_div)")
-# the order is the stored one: a new reason goes at the end
+"""Each Failure's message, by code."""
 
 
 DEFAULT_BATCH = 256  # shots per batch: a batch's fixed costs (threads, arrays) spread over more shots
 
 
 @dataclass(frozen=True)
-class Study:
+class MonteCarloStudy:
+    """A Monte Carlo study (module doc); a StudySpec (rig/study/protocol.py): its batches
+    run on any executor and are kept in its folder (rig/study/store.py)."""
+
     scene: str
     dists: tuple
     shots: int
@@ -78,6 +101,16 @@ class Study:
     @property
     def n_batches(self) -> int:
         return -(-self.shots // self.batch)
+
+    def batches(self) -> range:
+        """Every batch's number (rig/study/protocol.py: a StudySpec)."""
+        return range(self.n_batches)
+
+    def run_batch(self, b: int):
+        """Batch b's BatchResult (rig/study/batch.py)."""
+        from rig.study.batch import run_batch
+
+        return run_batch(self, b)
 
     def shots_of(self, b: int) -> range:
         """The shots of batch b: shot i always belongs to batch i // batch."""

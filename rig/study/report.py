@@ -37,14 +37,14 @@ def jcgm101(y: np.ndarray, n_dig: int = 2, blocks: int = 10) -> dict:
 
 def failures(codes: np.ndarray) -> dict:
     """The failed shots: how many, their share of all shots and how many per reason
-    (``codes``: each shot's "failure" output, an index of FAILURES, 0 for none)."""
-    from rig.study.mc_spec import FAILURES
+    (``codes``: each shot's "failure" output, a Failure code, Failure.NONE for none)."""
+    from rig.study.mc_spec import Failure
 
     codes = np.asarray(codes, dtype=int)
-    bad = codes[codes > 0]
+    bad = codes[codes != Failure.NONE]
     kinds, counts = np.unique(bad, return_counts=True)
     return {"count": int(bad.size), "share": float(bad.size / codes.size) if codes.size else 0.0,
-            "reasons": {FAILURES[k]: int(n) for k, n in zip(kinds, counts)}}
+            "reasons": {Failure(k).message: int(n) for k, n in zip(kinds, counts)}}
 
 
 def figures(folder, results, keys, theory_curve=None):

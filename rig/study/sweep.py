@@ -2,10 +2,14 @@
 
 Every point's rig is assembled before any shot is fired, so a bad key, a value outside
 its range or an impossible sweep is refused with nothing fired. Seeds come from one
-numpy SeedSequence (the sweep's seed) so that any point can be fired again alone.
+numpy SeedSequence (the sweep's seed) so that any point can be fired again alone. A
+sweep is a study (rig/study/protocol.py): one batch per point, run by the study executor
+and kept by a SweepStore.
 """
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -15,6 +19,7 @@ from rig.experiment.entry import shot_entry
 from rig.experiment.measure import shot_blocks
 from rig.experiment.scene import schema_node
 from rig.experiment.shot import Rig, ShotRecord
+from rig.study.executors import run_study
 from rig.units import typed_quantity, whole
 
 
@@ -81,7 +86,9 @@ def _unit_of(key: str):
 @dataclass(frozen=True, eq=False)
 class SweepPoint:
     """One point of a sweep: its shot and figures, or (shot None) why it gave no record and
-    the seed it was fired with (the same scene, overrides and seed fire it again alone)."""
+    the seed it was fired with (the same scene, overrides and seed fire it again alone);
+    ``batch``: its number in the sweep (a sweep's batch is one point: a StudyBatch of
+    rig/study/protocol.py)."""
 
     value: float
     rig: Rig
@@ -89,6 +96,11 @@ class SweepPoint:
     blocks: dict | None
     reason: str | None = None
     seed: int | None = None
+    batch: int = 0
+
+    @property
+    def shots(self) -> int:
+        return 1
 
 
 def seeds_for(seed: int, count: int) -> list:
@@ -97,35 +109,93 @@ def seeds_for(seed: int, count: int) -> list:
     return [int(s >> np.uint64(1)) for s in state]
 
 
-def run_sweep(scene, vary: Vary, overrides=(), seed: int = 0, progress=None, archive=None) -> list:
-    """Fire one shot per value; archive those that gave a record (if an archive is given),
-    even when the sweep is interrupted.
+@dataclass(frozen=True, eq=False)
+class Sweep:
+    """A sweep as a study (a StudySpec of rig/study/protocol.py): point b, batch b, is the
+    shot of ``rigs[b]`` (assembled and checked, for ``vary.values[b]``) fired with
+    ``seeds[b]``."""
 
-    A point that fires but gives no record (the solver or the scope refuses it: a RigError
-    raised by the shot, after every point was assembled) is a point with its reason, and
-    the sweep goes on to the next value."""
-    rigs = []
-    for v in vary.values:  # assemble (validate) every point before firing any
-        try:
-            rigs.append(Rig.from_scene(scene, list(overrides) + [vary.override(v)]))
-            rigs[-1].check_record()
-        except ValueError as exc:
-            raise RigError(f"--vary {vary.key} = {v:g}: {exc}") from None
-    points, entries = [], []
-    try:
-        for v, rig, s in zip(vary.values, rigs, seeds_for(seed, len(rigs))):
+    vary: Vary
+    rigs: tuple
+    seeds: tuple
+
+    @classmethod
+    def of(cls, scene, vary: Vary, overrides=(), seed: int = 0) -> Sweep:
+        """Every point's rig assembled (validated) before any is fired: a bad key, a value
+        outside its range or an impossible point is refused (RigError naming the point)."""
+        rigs = []
+        for v in vary.values:
             try:
-                shot = rig.fire(seed=s)
-            except RigError as exc:
-                points.append(SweepPoint(v, rig, None, None, str(exc), s))
-            else:
-                points.append(SweepPoint(v, rig, shot, shot_blocks(rig, shot)))
-                entries.append(shot_entry(shot))
-            if progress:
-                progress()
-    finally:
-        if archive is not None and entries:
-            from instruments.archive import Archive
+                rigs.append(Rig.from_scene(scene, list(overrides) + [vary.override(v)]))
+                rigs[-1].check_record()
+            except ValueError as exc:
+                raise RigError(f"--vary {vary.key} = {v:g}: {exc}") from None
+        return cls(vary, tuple(rigs), tuple(seeds_for(seed, len(rigs))))
 
-            Archive(archive).append(entries)
-    return points
+    def batches(self) -> range:
+        return range(len(self.rigs))
+
+    def run_batch(self, b: int) -> SweepPoint:
+        """Point b: its shot and figures; a point that fires but gives no record (the solver
+        or the scope refuses it: a RigError raised by the shot) is a point with its reason."""
+        v, rig, s = self.vary.values[b], self.rigs[b], self.seeds[b]
+        try:
+            shot = rig.fire(seed=s)
+        except RigError as exc:
+            return SweepPoint(v, rig, None, None, str(exc), s, b)
+        return SweepPoint(v, rig, shot, shot_blocks(rig, shot), batch=b)
+
+
+class SweepStore:
+    """Where a sweep keeps its points (a StudyStore of rig/study/protocol.py): in memory, and
+    the shots that gave a record appended to ``archive`` (if any) in one transaction when
+    the writer's block ends, interrupted or not."""
+
+    def __init__(self, archive=None):
+        self.archive = archive
+        self.kept = {}  # point number -> SweepPoint
+
+    def done(self) -> set:
+        return set(self.kept)
+
+    @property
+    def points(self) -> list:
+        """The points kept, in the sweep's order."""
+        return [self.kept[b] for b in sorted(self.kept)]
+
+    @contextlib.contextmanager
+    def writer(self, stored=None):
+        """The BatchSink of the block; ``stored(point)`` is told each point kept."""
+        entries: list = []  # the archive entries of the points kept, appended once at the end
+        try:
+            yield _Collector(self, entries, stored or (lambda point: None))
+        finally:
+            if self.archive is not None and entries:
+                from instruments.archive import Archive
+
+                Archive(self.archive).append(entries)
+
+
+@dataclass(frozen=True)
+class _Collector:
+    """A SweepStore's writer: each point kept, the archive Entry of each shot gathered."""
+
+    store: SweepStore
+    entries: list
+    stored: Callable
+
+    def put(self, point: SweepPoint) -> None:
+        self.store.kept[point.batch] = point
+        if point.shot is not None:
+            self.entries.append(shot_entry(point.shot))
+        self.stored(point)
+
+
+def run_sweep(scene, vary: Vary, overrides=(), seed: int = 0, progress=None, archive=None) -> list:
+    """Fire one shot per value (``Sweep``, on the study executor, in this process); archive
+    those that gave a record (if an archive is given), even when the sweep is interrupted.
+    ``progress()`` is told each point fired. A point that gives no record is a point with
+    its reason, and the sweep goes on to the next value."""
+    store = SweepStore(archive)
+    run_study(Sweep.of(scene, vary, overrides, seed), store, progress=progress and (lambda n: progress()))
+    return store.points

@@ -27,13 +27,13 @@ def test_the_mc_benchmarks_stages_run_on_a_small_study(monkeypatch):
     # positive rate or time (its stage timing once drew shots past its study's end)
     from rig.bench import mc
     from rig.study.distributions import parse_vary
-    from rig.study.mc_spec import Study
+    from rig.study.mc_spec import MonteCarloStudy
 
     monkeypatch.setattr(mc, "BATCH", 8)
     monkeypatch.setattr(mc, "WARM_UP", 1)
-    study = Study("ptfe52_magnetic", tuple(parse_vary(mc.VARY)), 16, batch=8)
+    study = MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(mc.VARY)), 16, batch=8)
     figures = {**mc._solver(study, 16), **mc._stages(study, batches=2),
-               **mc._one_process(Study("ptfe52_magnetic", study.dists, 56, batch=8))}
+               **mc._one_process(MonteCarloStudy("ptfe52_magnetic", study.dists, 56, batch=8))}
     for key in ("solver_kernel_shots_per_s", "solver_shots_per_s", "pipeline_shots_per_s",
                 *(f"stage_{k}_us_per_shot" for k in mc.STAGES)):
         assert figures[key] > 0, key

@@ -11,7 +11,7 @@ from instruments.analysis.batch import analysed
 from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.devices import batch
 from instruments.devices.gauges import GaugeDraw, GaugeSettings, PiezoGauge
-from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
+from instruments.devices.oscilloscope import AcquisitionStatus, ChannelSettings, Oscilloscope, Timebase, Trigger
 
 H = 2e-7
 N = 3000
@@ -131,6 +131,12 @@ def test_a_shot_that_does_not_trigger_or_outlasts_its_input_says_so():
     assert not records.record(0).triggered
     setup = Setup(GaugeSetup("CH2"), GaugeSetup("CH1", 0.0043))
     assert "did not trigger" in analysed(records, setup)[0].reasons["speed_m_per_s"]
+    # the compiled codes leave the batch as the scope's named status, with the reason the analysis gives
+    assert [records.outcome(s) for s in (0, 1)] == [AcquisitionStatus.NO_TRIGGER, AcquisitionStatus.PAST_INPUT]
+    assert all(type(records.outcome(s)) is AcquisitionStatus for s in (0, 1))
+    reasons = [r.reasons["speed_m_per_s"] for r in analysed(records, setup)]
+    assert [records.outcome(s).message in reasons[s] for s in (0, 1)] == [True, True]
+    assert "runs past the input" in reasons[1]
 
 
 def test_a_clipped_gauge_channel_gives_no_figure_alone_or_in_a_batch():

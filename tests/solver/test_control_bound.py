@@ -14,6 +14,7 @@ from rig.solver.control import WORK_BUDGET, AccuracyNotReached, controlled_solve
 from rig.solver.methods import method
 from rig.solver.problem import ChainProblem
 from rig.solver.run import time_grid
+from rig.solver.solution import Status
 from rig.solver.stepsize import default_step
 
 HARD = ("ptfe52_magnetic", ["chain.material=steel316"])  # steel beads of PTFE's mass: 4 minutes unbounded
@@ -47,6 +48,9 @@ def test_a_lenient_caller_gets_the_best_try_flagged_by_its_estimate():
     first = default_step(p, m, s.accuracy, s.duration).dt
     assert sol.stats.error_estimate > 1000 * s.accuracy  # above the setting, and it says so
     assert sol.stats.attempts == 2 and sol.stats.dt_s == pytest.approx(first / 16, rel=1e-3)  # not 16 x 16 times finer
+    # what happened is the solution's status, with the refusal's reason as its message
+    assert sol.status is Status.ACCURACY_NOT_REACHED and not sol.success
+    assert "accuracy = 0.0001: not reached" in sol.message and "\n" not in sol.message
 
 
 def test_the_control_spends_at_most_its_work_budget(monkeypatch):

@@ -111,3 +111,25 @@ def test_what_a_solve_is_given_is_checked_in_one_line():
         assert message in str(exc.value)
     sol = solve(c, np.float32(2e-4), save=SaveAt({"c": c.contact_probe(5)}), dt=np.float64(1e-7), estimate=False)
     assert sol.stats.steps == 2000
+
+
+def test_a_solve_that_blows_up_reports_it_and_solve_refuses_it_in_one_line():
+    """integrate_at returns what happened (status UNSTABLE, where and at what step); the
+    solve functions raise Unstable from that status, with the same message."""
+    from rig.solver.methods import method
+    from rig.solver.run import Unstable, integrate_at
+    from rig.solver.solution import Status
+    from rig.solver.stepsize import Stepping, contact_time_scale
+
+    p = ChainProblem.from_chain(steel_sonic_vacuum(n=20))
+    stepping = Stepping(10 * contact_time_scale(p))  # beyond the stability limit (about 1.6 contact times)
+    sol = integrate_at(p, 5e-4, SaveAt(), method("srkn6b"), stepping)
+    assert sol.status is Status.UNSTABLE and not sol.success
+    assert sol.message.startswith(Status.UNSTABLE.message) and "near t = " in sol.message
+    assert "\n" not in sol.message
+    with pytest.raises(Unstable, match=r"became unstable .* \(near t = ") as err:
+        Unstable.check(sol, stepping)
+    assert str(err.value) == sol.message and err.value.stepping is stepping
+    good = integrate_at(p, 5e-4, SaveAt(), method("srkn6b"), Stepping(contact_time_scale(p) / 6))
+    assert good.status is Status.SUCCESS and good.success and good.message == Status.SUCCESS.message
+    assert Unstable.check(good, stepping) is good

@@ -16,7 +16,7 @@ from rig.cli import main
 from rig.errors import RigError
 from rig.study.distributions import parse_vary
 from rig.study.executors import WorkerWatch, run_study
-from rig.study.mc_spec import FAILURES, Study
+from rig.study.mc_spec import FAILURES, MonteCarloStudy
 from rig.study.store import Store
 
 WIDE = ["--vary", "striker.velocity=truncnormal(0.89 m/s, 0.3 m/s, 0.05 m/s, 3 m/s)",
@@ -90,7 +90,7 @@ def test_worker_watch_stops_after_the_timeout_without_workers():
 
 def _study(shots=8):
     vary = ["striker.velocity=normal(0.89 m/s, 0.01 m/s)"]
-    return Study("ptfe52_magnetic", tuple(parse_vary(vary)), shots, seed=5, batch=2)
+    return MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(vary)), shots, seed=5, batch=2)
 
 
 def test_a_dask_study_without_workers_stops_and_resumes(tmp_path):
@@ -164,3 +164,15 @@ def test_a_killed_study_leaves_no_orphan_and_resumes_bit_identically(tmp_path):
         for key in a["outputs"]:
             np.testing.assert_array_equal(a[f"outputs/{key}"][()], b[f"outputs/{key}"][()])
         np.testing.assert_array_equal(a["seed"][()], b["seed"][()])
+
+
+def test_a_failure_code_names_its_reason_as_the_report_counts_it():
+    from rig.study.mc_spec import Failure
+    from rig.study.report import failures
+
+    assert [int(f) for f in Failure] == list(range(len(FAILURES)))  # every stored code has its reason
+    assert [f.message for f in Failure] == list(FAILURES) and FAILURES[:6] == FAILURES_BEFORE
+    assert Failure.SHORT_WINDOW == 4 and "--window record" in Failure.SHORT_WINDOW.message
+    counted = failures(np.array([0.0, 4, 4, 6]))  # the stored outputs are floats
+    assert counted == {"count": 3, "share": 0.75,
+                       "reasons": {Failure.SHORT_WINDOW.message: 2, Failure.CLIPPED.message: 1}}

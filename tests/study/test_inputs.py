@@ -9,14 +9,14 @@ from scipy import stats
 
 from rig.study.batch import batch_inputs, shot_inputs
 from rig.study.distributions import parse_vary
-from rig.study.mc_spec import Study
+from rig.study.mc_spec import MonteCarloStudy
 
 VARY = ("striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)",
         "gauges.upper.gain=lognormal(1, 0.05)", "magnet.force=uniform(2 N, 3 N)",
         "gauges.lower.gain=truncnormal(1, 0.1, 0.9, 1.2)")
 
 
-def _numpy_inputs(study: Study, i: int, n_plain: int, design=None):
+def _numpy_inputs(study: MonteCarloStudy, i: int, n_plain: int, design=None):
     """Shot i's inputs as numpy's Generator methods draw them from its stream."""
     child = np.random.SeedSequence(study.seed, spawn_key=(i,))
     rng = np.random.default_rng(child)
@@ -48,7 +48,7 @@ def _same(a, b) -> bool:
 
 @pytest.mark.parametrize("seed", [0, 11, 2**40 + 3, 2**63 - 1])
 def test_a_batch_draws_each_shots_inputs_as_numpy_does_for_it_alone(seed):
-    study = Study("ptfe52_magnetic", tuple(parse_vary(VARY)), 300, seed=seed)
+    study = MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(VARY)), 300, seed=seed)
     got = batch_inputs(study, 250, 300, 52)
     for s, i in enumerate(range(250, 300)):
         x, masses, instrument_seed = _numpy_inputs(study, i, 52)
@@ -59,7 +59,7 @@ def test_a_batch_draws_each_shots_inputs_as_numpy_does_for_it_alone(seed):
 
 
 def test_a_sobol_design_sets_the_keys_but_the_masses_are_still_drawn():
-    study = Study("ptfe52_magnetic", tuple(parse_vary(VARY)), 8, seed=3)
+    study = MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(VARY)), 8, seed=3)
     design = np.random.default_rng(0).uniform(size=(8, len(VARY)))
     got = batch_inputs(study, 0, 8, 52, design)
     for i in range(8):
@@ -73,8 +73,8 @@ def test_a_seed_no_stream_can_have_is_refused_in_one_line(seed):
     from rig.errors import RigError
 
     with pytest.raises(RigError, match=r"--seed = .*: a whole number from 0 to 2\^63 - 1"):
-        Study("ptfe52_magnetic", tuple(parse_vary(VARY[:1])), 4, seed=seed)
+        MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(VARY[:1])), 4, seed=seed)
 
 
 def test_numpys_integers_are_taken_as_seeds():
-    assert Study("ptfe52_magnetic", tuple(parse_vary(VARY[:1])), 4, seed=np.int64(9)).seed == 9
+    assert MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(VARY[:1])), 4, seed=np.int64(9)).seed == 9

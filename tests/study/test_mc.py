@@ -10,7 +10,7 @@ from rig.cli import main
 from rig.study.batch import refire, run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
-from rig.study.mc_spec import Study
+from rig.study.mc_spec import MonteCarloStudy
 from rig.study.report import jcgm101
 from rig.study.store import Store
 
@@ -19,7 +19,7 @@ VARY = ["striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0
 
 
 def _study(shots=48, **kw):
-    return Study("ptfe52_magnetic", tuple(parse_vary(VARY)), shots, seed=kw.pop("seed", 3), batch=16, **kw)
+    return MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(VARY)), shots, seed=kw.pop("seed", 3), batch=16, **kw)
 
 
 def _outputs(folder):
@@ -68,12 +68,12 @@ def test_the_python_api_refuses_what_no_study_has_in_one_line():
     from rig.errors import RigError
     from rig.study.batch import batch_inputs, shot_inputs
 
-    study = Study("ptfe52_magnetic", tuple(parse_vary(VARY[:1])), 10, batch=4)
+    study = MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(VARY[:1])), 10, batch=4)
     for call, message in ((lambda: run_batch(study, 3), "batch = 3: a whole number from 0 to 2"),
                           (lambda: refire(study, 10), "shot = 10: a shot of the study, 0..9"),
                           (lambda: shot_inputs(study, 10, 52), "shots of the study, 0..9"),
                           (lambda: batch_inputs(study, 5, 3, 52), "shots of the study, 0..9"),
-                          (lambda: Study("ptfe52_magnetic", study.dists, 10, batch=2.5), "--batch = 2.5"),
+                          (lambda: MonteCarloStudy("ptfe52_magnetic", study.dists, 10, batch=2.5), "--batch = 2.5"),
                           (lambda: parse_vary(VARY[0]), "a list of KEY=DIST texts")):
         with pytest.raises(RigError, match=message):
             call()
@@ -83,7 +83,7 @@ def test_the_python_api_refuses_what_no_study_has_in_one_line():
                           (("normal", [1]), "two sequences of one length")):
         with pytest.raises(InstrumentError, match=message):
             spawned_draws(1, 0, 2, *args)
-    assert Study("ptfe52_magnetic", study.dists, np.int64(10), batch=np.int64(4)).digest() == study.digest()
+    assert MonteCarloStudy("ptfe52_magnetic", study.dists, np.int64(10), batch=np.int64(4)).digest() == study.digest()
 
 
 @pytest.mark.slow
@@ -340,9 +340,9 @@ def test_a_small_study_is_sized_by_its_shots_not_its_batch(tmp_path, capsys):
 HOLD = """
 import sys, time
 from rig.study.store import Store
-from rig.study.mc_spec import Study
+from rig.study.mc_spec import MonteCarloStudy
 from rig.study.distributions import parse_vary
-study = Study("ptfe52_magnetic", tuple(parse_vary([sys.argv[2]])), 4, seed=3, batch=2)
+study = MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary([sys.argv[2]])), 4, seed=3, batch=2)
 with Store(sys.argv[1], study).held():
     print("held", flush=True)
     time.sleep(600)

@@ -11,15 +11,15 @@ import pytest
 
 from rig.study.batch import BatchResult
 from rig.study.distributions import parse_vary
-from rig.study.mc_spec import OUTPUTS, Study
+from rig.study.mc_spec import OUTPUTS, MonteCarloStudy
 from rig.study.store import Store
 
 BATCH = 4
 
 
 def _study():
-    return Study("ptfe52_magnetic", tuple(parse_vary(["striker.velocity=normal(0.89 m/s, 0.01 m/s)"])), 6 * BATCH,
-                 batch=BATCH)
+    return MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(["striker.velocity=normal(0.89 m/s, 0.01 m/s)"])),
+                           6 * BATCH, batch=BATCH)
 
 
 def _result(b: int) -> BatchResult:
