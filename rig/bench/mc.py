@@ -41,7 +41,8 @@ from rig.solver.stepsize import Stepping, stepping_at
 from rig.study.batch import batch_inputs, collector_paused, run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
-from rig.study.mc_spec import DEFAULT_BATCH, MonteCarloStudy
+from rig.study.mc_spec import DEFAULT_BATCH
+from rig.study.montecarlo import MonteCarloStudy
 from rig.study.nominal import Nominal, nominal
 from rig.study.shots import shots_of, wave_speeds, wiring_of
 from rig.study.store import Store

@@ -30,7 +30,7 @@ import time
 from rig.study.batch import run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
-from rig.study.mc_spec import MonteCarloStudy
+from rig.study.montecarlo import MonteCarloStudy
 from rig.study.store import Store
 
 MODES = {"workers": "rig mc --workers N (processes, 1 numba thread each), steady",

@@ -25,7 +25,7 @@ from rig.solver.problem import ChainProblem
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution
 from rig.solver.stepsize import stepping_at
-from rig.study.mc_spec import OUTPUTS, Failure, MonteCarloStudy
+from rig.study.mc_spec import OUTPUTS, Failure, MonteCarloSpec
 from rig.study.nominal import copied_table, nominal
 from rig.study.shots import array_keys, shots_of, wave_speeds, wiring_of
 from rig.study.sobol import sobol_matrix
@@ -50,12 +50,12 @@ class BatchResult:
         return int(self.index.size)
 
 
-def shot_inputs(study: MonteCarloStudy, i: int, n_plain: int, design=None):
+def shot_inputs(study: MonteCarloSpec, i: int, n_plain: int, design=None):
     """Shot i's inputs {key: value}, bead masses (or None) and instrument seed."""
     return batch_inputs(study, i, i + 1, n_plain, design)[0]
 
 
-def batch_inputs(study: MonteCarloStudy, lo: int, hi: int, n_plain: int, design=None) -> list:
+def batch_inputs(study: MonteCarloSpec, lo: int, hi: int, n_plain: int, design=None) -> list:
     """(inputs {key: value}, bead masses or None, instrument seed) of shots lo..hi-1, each
     drawn from its own stream, np.random.default_rng(SeedSequence(study.seed,
     spawn_key=(i,))) (instruments.streams: every shot's draws in one compiled call, the
@@ -81,7 +81,7 @@ def batch_inputs(study: MonteCarloStudy, lo: int, hi: int, n_plain: int, design=
     return out
 
 
-def shot_rig(study: MonteCarloStudy, x: dict, masses) -> tuple:
+def shot_rig(study: MonteCarloSpec, x: dict, masses) -> tuple:
     """Shot inputs x (and bead masses) -> (the shot's rig, its instrument draws)."""
     template = nominal(study.scene, tuple(study.overrides)).template(study.window)
     v = dict(template.values)
@@ -97,7 +97,7 @@ def shot_rig(study: MonteCarloStudy, x: dict, masses) -> tuple:
     return Rig(template.scene.with_values(v), bead_masses=masses, like=template), draws
 
 
-def study_save(study: MonteCarloStudy, rig: Rig) -> SaveAt:
+def study_save(study: MonteCarloSpec, rig: Rig) -> SaveAt:
     """What a study's solver records: the gauges' averages (what their plates read) and the
     wall; each gauge's two contacts too where the truth analysis or the traces need them.
     The averages feed the gauges either way, so traces do not change the results."""
@@ -118,13 +118,13 @@ def collector_paused():
             gc.enable()
 
 
-def run_batch(study: MonteCarloStudy, b: int) -> BatchResult:
+def run_batch(study: MonteCarloSpec, b: int) -> BatchResult:
     """Batch b of the study."""
     with collector_paused():
         return _batch(study, b)
 
 
-def _batch(study: MonteCarloStudy, b: int) -> BatchResult:
+def _batch(study: MonteCarloSpec, b: int) -> BatchResult:
     shots = study.shots_of(b)
     lo, hi = shots.start, shots.stop
     nom = nominal(study.scene, tuple(study.overrides))
@@ -151,7 +151,7 @@ def _batch(study: MonteCarloStudy, b: int) -> BatchResult:
     return BatchResult(b, np.arange(lo, hi), xs, np.array(seeds, dtype=np.int64), out, tuple(traces))
 
 
-def _pilot(study: MonteCarloStudy, nom, template: Rig):
+def _pilot(study: MonteCarloSpec, nom, template: Rig):
     """(the stepping every shot takes, the pilot's stats): the step is calibrated once, on
     what every study measures (the gauges' averages, the wall), so that recording the
     contacts too (--truth, --traces) changes no result."""
@@ -159,7 +159,7 @@ def _pilot(study: MonteCarloStudy, nom, template: Rig):
     return stepping_at(pilot.problem, pilot.stats.dt_s), pilot.stats
 
 
-def _fire_arrays(study: MonteCarloStudy, nom, template: Rig, drawn: list, out: dict):
+def _fire_arrays(study: MonteCarloSpec, nom, template: Rig, drawn: list, out: dict):
     """The batch with no rig built per shot (rig/study/shots.py): one batched solve, one
     batched acquisition and one batched analysis of the leading pulse."""
     shots = shots_of(template, [x for x, *_ in drawn], [m for _, m, _ in drawn])
@@ -207,7 +207,7 @@ def _outputs(out: dict, j: int, m, t, energy_error: float, dt: float, triggered:
         out["failure"][j] = Failure.CLIPPED if clipped else Failure.NON_FINITE
 
 
-def _fire_rigs(study: MonteCarloStudy, nom, rigs: dict, draws: dict, seeds: list, out: dict, traces: list, lo: int):
+def _fire_rigs(study: MonteCarloSpec, nom, rigs: dict, draws: dict, seeds: list, out: dict, traces: list, lo: int):
     """The batch with a rig per shot (a key that changes the rig's parts, --truth,
     --traces): one batched solve, then each shot read and analysed as a lone shot is."""
     base = nom.rig
@@ -245,7 +245,7 @@ def _fire_rigs(study: MonteCarloStudy, nom, rigs: dict, draws: dict, seeds: list
                  shot.scope.triggered, clipped)
 
 
-def refire(study: MonteCarloStudy, i: int) -> dict:
+def refire(study: MonteCarloSpec, i: int) -> dict:
     """Shot i alone, with its stored step: the same outputs as in the study."""
     if not 0 <= i < study.shots:
         raise invalid("shot", i, f"a shot of the study, 0..{study.shots - 1}")

@@ -15,7 +15,8 @@ from rig.errors import Interrupted, RigError
 from rig.experiment.measure import midway_static_force
 from rig.study.distributions import parse_vary
 from rig.study.executors import DEFAULT_WORKER_TIMEOUT, run_study
-from rig.study.mc_spec import DEFAULT_BATCH, Failure, MonteCarloStudy
+from rig.study.mc_spec import DEFAULT_BATCH, Failure
+from rig.study.montecarlo import MonteCarloStudy
 from rig.study.nominal import nominal
 from rig.study.report import failures, figures, jcgm101
 from rig.study.sobol import sobol_indices, sobol_matrix, sobol_shots

@@ -49,9 +49,10 @@ DEFAULT_BATCH = 256  # shots per batch: a batch's fixed costs (threads, arrays) 
 
 
 @dataclass(frozen=True)
-class MonteCarloStudy:
-    """A Monte Carlo study (module doc); a StudySpec (rig/study/protocol.py): its batches
-    run on any executor and are kept in its folder (rig/study/store.py)."""
+class MonteCarloSpec:
+    """What a Monte Carlo study is (module doc): its draws, shots and batches. The study
+    that runs them, a StudySpec of rig/study/protocol.py, is rig/study/montecarlo.py's
+    MonteCarloStudy; the batch code (rig/study/batch.py) reads this spec only."""
 
     scene: str
     dists: tuple
@@ -105,12 +106,6 @@ class MonteCarloStudy:
     def batches(self) -> range:
         """Every batch's number (rig/study/protocol.py: a StudySpec)."""
         return range(self.n_batches)
-
-    def run_batch(self, b: int):
-        """Batch b's BatchResult (rig/study/batch.py)."""
-        from rig.study.batch import run_batch
-
-        return run_batch(self, b)
 
     def shots_of(self, b: int) -> range:
         """The shots of batch b: shot i always belongs to batch i // batch."""

@@ -6,7 +6,7 @@ cut into numbered batches, each run alone into a finished batch, which the store
 A batch is the same whoever runs it (this process, a local worker, a Dask worker), so a
 spec and its batches must pickle; a store says which batches it already holds (``done``:
 a study run again resumes) and takes finished ones on its writer. The Monte Carlo study
-(rig/study/mc_spec.py: ``MonteCarloStudy``, its ``BatchResult``, its folder
+(rig/study/montecarlo.py: ``MonteCarloStudy``, its ``BatchResult``, its folder
 rig/study/store.py) and the sweep (rig/study/sweep.py: ``Sweep``, a ``SweepPoint`` per
 batch, ``SweepStore``) are two such studies; a new one is a spec, a batch and a store of
 these shapes, and runs on every executor.

@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from rig.errors import RigError, invalid
-from rig.study.mc_spec import MonteCarloStudy
+from rig.study.mc_spec import MonteCarloSpec
 
 
 def sobol_shots(requested: int, n_inputs: int) -> int:
@@ -20,14 +20,14 @@ def sobol_shots(requested: int, n_inputs: int) -> int:
     return base * (n_inputs + 2)
 
 
-def sobol_problem(study: MonteCarloStudy) -> dict:
+def sobol_problem(study: MonteCarloSpec) -> dict:
     """The SALib problem of the study's inputs: their names, distributions and bounds."""
     return {"num_vars": len(study.dists), "names": study.keys,
             "dists": [d.salib()[0] for d in study.dists], "bounds": [d.salib()[1] for d in study.dists]}
 
 
 @functools.lru_cache(maxsize=4)
-def sobol_matrix(study: MonteCarloStudy):
+def sobol_matrix(study: MonteCarloSpec):
     """SALib's Sobol design for the study's inputs: (shots, K) and the SALib problem.
     Kept per study in a process: every batch takes its rows from it (drawing it costs as
     much as a few shots)."""

@@ -24,7 +24,7 @@ import numpy as np
 from instruments.files import atomic_writes, folder_lock, hdf5_image, left_as_found, write_hdf5, write_text
 from rig.errors import RigError
 from rig.study.batch import BatchResult
-from rig.study.mc_spec import OUTPUTS, MonteCarloStudy
+from rig.study.mc_spec import OUTPUTS, MonteCarloSpec
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,7 +41,7 @@ class Store:
     """The study's folder (see the module's docstring): a Monte Carlo study's StudyStore
     (rig/study/protocol.py)."""
 
-    def __init__(self, folder, study: MonteCarloStudy):
+    def __init__(self, folder, study: MonteCarloSpec):
         self.folder = Path(folder)
         self.study = study
         self.batches = self.folder / "batches"

@@ -27,7 +27,7 @@ def test_the_mc_benchmarks_stages_run_on_a_small_study(monkeypatch):
     # positive rate or time (its stage timing once drew shots past its study's end)
     from rig.bench import mc
     from rig.study.distributions import parse_vary
-    from rig.study.mc_spec import MonteCarloStudy
+    from rig.study.montecarlo import MonteCarloStudy
 
     monkeypatch.setattr(mc, "BATCH", 8)
     monkeypatch.setattr(mc, "WARM_UP", 1)

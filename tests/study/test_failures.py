@@ -16,7 +16,8 @@ from rig.cli import main
 from rig.errors import RigError
 from rig.study.distributions import parse_vary
 from rig.study.executors import WorkerWatch, run_study
-from rig.study.mc_spec import FAILURES, MonteCarloStudy
+from rig.study.mc_spec import FAILURES
+from rig.study.montecarlo import MonteCarloStudy
 from rig.study.store import Store
 
 WIDE = ["--vary", "striker.velocity=truncnormal(0.89 m/s, 0.3 m/s, 0.05 m/s, 3 m/s)",

@@ -9,7 +9,7 @@ from scipy import stats
 
 from rig.study.batch import batch_inputs, shot_inputs
 from rig.study.distributions import parse_vary
-from rig.study.mc_spec import MonteCarloStudy
+from rig.study.montecarlo import MonteCarloStudy
 
 VARY = ("striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0.1226 g, 0.0008 g)",
         "gauges.upper.gain=lognormal(1, 0.05)", "magnet.force=uniform(2 N, 3 N)",

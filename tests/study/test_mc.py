@@ -10,7 +10,7 @@ from rig.cli import main
 from rig.study.batch import refire, run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
-from rig.study.mc_spec import MonteCarloStudy
+from rig.study.montecarlo import MonteCarloStudy
 from rig.study.report import jcgm101
 from rig.study.store import Store
 
@@ -340,7 +340,7 @@ def test_a_small_study_is_sized_by_its_shots_not_its_batch(tmp_path, capsys):
 HOLD = """
 import sys, time
 from rig.study.store import Store
-from rig.study.mc_spec import MonteCarloStudy
+from rig.study.montecarlo import MonteCarloStudy
 from rig.study.distributions import parse_vary
 study = MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary([sys.argv[2]])), 4, seed=3, batch=2)
 with Store(sys.argv[1], study).held():

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 from rig.study.batch import BatchResult
 from rig.study.executors import run_study
-from rig.study.mc_spec import MonteCarloStudy
+from rig.study.montecarlo import MonteCarloStudy
 from rig.study.sweep import Sweep, SweepPoint, SweepStore
 
 

@@ -11,7 +11,8 @@ import pytest
 
 from rig.study.batch import BatchResult
 from rig.study.distributions import parse_vary
-from rig.study.mc_spec import OUTPUTS, MonteCarloStudy
+from rig.study.mc_spec import OUTPUTS
+from rig.study.montecarlo import MonteCarloStudy
 from rig.study.store import Store
 
 BATCH = 4
