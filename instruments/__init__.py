@@ -17,27 +17,27 @@ TYPE_CHECKING = False  # typing.TYPE_CHECKING without loading typing; mypy and p
 if TYPE_CHECKING:  # the names above, for type checkers and editors (tests/test_typing.py holds them equal);
     # "X as X": re-exported, as a typed package's checkers read it
     from .analysis.batch import analysed as analysed
-    from .analysis.pipeline import GaugeSetup as GaugeSetup
-    from .analysis.pipeline import Setup as Setup
+    from .analysis.condition import MIN_BASELINE as MIN_BASELINE
+    from .analysis.condition import invert_rc as invert_rc
+    from .analysis.condition import noise_level as noise_level
+    from .analysis.condition import record_forces as record_forces
+    from .analysis.find import find_pulses as find_pulses
+    from .analysis.find import first_peak_time as first_peak_time
+    from .analysis.find import leading as leading
+    from .analysis.find import reflection_time as reflection_time
+    from .analysis.find import solitary_train as solitary_train
     from .analysis.pipeline import analyze_forces as analyze_forces
     from .analysis.pipeline import analyze_record as analyze_record
-    from .analysis.pipeline import record_forces as record_forces
-    from .analysis.pipeline import reflection_time as reflection_time
-    from .analysis.pipeline import solitary_train as solitary_train
     from .analysis.plausibility import Limits as Limits
-    from .analysis.pulses import MIN_BASELINE as MIN_BASELINE
-    from .analysis.pulses import PeakRules as PeakRules
-    from .analysis.pulses import Pulse as Pulse
-    from .analysis.pulses import find_pulses as find_pulses
-    from .analysis.pulses import first_peak_time as first_peak_time
-    from .analysis.pulses import invert_rc as invert_rc
-    from .analysis.pulses import leading as leading
-    from .analysis.pulses import noise_level as noise_level
-    from .analysis.pulses import refined as refined
-    from .analysis.pulses import xcorr_delay as xcorr_delay
+    from .analysis.pulse import PeakRules as PeakRules
+    from .analysis.pulse import Pulse as Pulse
+    from .analysis.refine import refined as refined
+    from .analysis.refine import xcorr_delay as xcorr_delay
     from .analysis.report import FIGURES as FIGURES
     from .analysis.report import SPEED_FIGURES as SPEED_FIGURES
     from .analysis.report import Report as Report
+    from .analysis.setup import GaugeSetup as GaugeSetup
+    from .analysis.setup import Setup as Setup
     from .devices.batch import NO_TRIGGER as NO_TRIGGER
     from .devices.batch import OK as OK
     from .devices.batch import PAST_INPUT as PAST_INPUT

@@ -10,8 +10,9 @@ import numpy as np
 from ..devices.batch import OK, Records
 from ..rails import Rail, clipping, code_rails, rail_of_codes
 from ._kernels import batch_analysis, pulses
-from .pipeline import Setup, report_of
+from .judge import report_of
 from .report import Report
+from .setup import Setup
 
 
 def analysed(records: Records, setup: Setup) -> list:

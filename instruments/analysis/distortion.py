@@ -1,6 +1,6 @@
 """What the scope does to a pulse that no figure may hide: its rails (a clipped top), its
 bandwidth limit (a pulse lowered, widened and delayed) and the end of its record (a pulse
-cut). The pipeline (instruments/analysis/pipeline.py) asks these rules of every record, real or
+cut). The judge (instruments/analysis/judge.py) asks these rules of every record, real or
 virtual, before it gives a figure."""
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from .pulses import PeakRules
+from .pulse import PeakRules
 from .report import FIGURES, Report
 
 CLIPPED_FIGURES = ("averaged_amplitude_N", "amplitude_N", "total_force_N", "duration_s", "base_duration_s",

@@ -6,7 +6,7 @@ from __future__ import annotations
 import statistics
 import time
 
-from instruments.analysis.pipeline import analyze_record
+from instruments.analysis import analyze_record
 from rig.experiment.measure import midway_static_force, setup_for
 from rig.experiment.shot import Rig
 

@@ -18,8 +18,7 @@ import math
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
-from instruments.analysis import PeakRules
-from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.analysis import GaugeSetup, PeakRules, Setup, analyze_record
 from instruments.analysis.plausibility import Limits
 from instruments.analysis.report import SPEED_FIGURES, Report
 from instruments.archive import Archive, Entry

@@ -14,8 +14,7 @@ import math
 
 import numpy as np
 
-from instruments.analysis import PeakRules
-from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_forces, analyze_record
+from instruments.analysis import GaugeSetup, PeakRules, Setup, analyze_forces, analyze_record
 from instruments.analysis.report import Report
 from rig.errors import RigError
 from rig.theory.longwave import solitary_wave_speed, sound_speed

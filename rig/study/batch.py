@@ -13,8 +13,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from instruments import streams
+from instruments.analysis import analyze_record
 from instruments.analysis.batch import analysed
-from instruments.analysis.pipeline import analyze_record
 from instruments.devices import batch as instrument_batch
 from instruments.devices.oscilloscope import AcquisitionStatus
 from rig.errors import RigError, invalid

@@ -16,8 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from instruments.analysis import PeakRules, find_pulses, leading
-from instruments.analysis.pipeline import reflection_time, solitary_train
+from instruments.analysis import PeakRules, find_pulses, leading, reflection_time, solitary_train
 from instruments.files import atomic_write, write_text
 from rig.errors import invalid
 from rig.experiment.measure import midway_static_force, setup_for, shot_blocks

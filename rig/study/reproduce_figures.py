@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from instruments.analysis.pipeline import record_forces
+from instruments.analysis import record_forces
 from rig.experiment.measure import setup_for
 from rig.study.sweep import seeds_for
 from rig.theory.longwave import solitary_wave_speed, sonic_vacuum_speed, sound_speed

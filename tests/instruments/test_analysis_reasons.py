@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from test_analysis_snr import SETUP, N, record, sech2
 
-from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.analysis import GaugeSetup, Setup, analyze_record
 from instruments.analysis.plausibility import Limits
 from instruments.analysis.report import FIGURES, SPEED_FIGURES
 from instruments.errors import InstrumentError

@@ -5,8 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from instruments.analysis import PeakRules, noise_level
-from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.analysis import GaugeSetup, PeakRules, Setup, analyze_record, noise_level
 from instruments.records import Preamble, ScopeRecord, Waveform
 
 H = 1e-7

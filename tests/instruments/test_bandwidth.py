@@ -7,8 +7,8 @@ import re
 import numpy as np
 import pytest
 
+from instruments.analysis import GaugeSetup, Setup, analyze_record
 from instruments.analysis.distortion import too_slow
-from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.formats import read_waveforms
 from instruments.formats.isf import isf_bytes
 from instruments.records import Preamble, ScopeRecord, Waveform

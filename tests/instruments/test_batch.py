@@ -6,9 +6,8 @@ import re
 import numpy as np
 import pytest
 
-from instruments.analysis import PeakRules
+from instruments.analysis import GaugeSetup, PeakRules, Setup, analyze_record
 from instruments.analysis.batch import analysed
-from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
 from instruments.devices import batch
 from instruments.devices.gauges import GaugeDraw, GaugeSettings, PiezoGauge
 from instruments.devices.oscilloscope import AcquisitionStatus, ChannelSettings, Oscilloscope, Timebase, Trigger

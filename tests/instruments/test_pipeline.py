@@ -5,8 +5,17 @@ import sys
 import numpy as np
 import pytest
 
-from instruments.analysis import PeakRules, find_pulses, invert_rc, leading, xcorr_delay
-from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_forces, analyze_record
+from instruments.analysis import (
+    GaugeSetup,
+    PeakRules,
+    Setup,
+    analyze_forces,
+    analyze_record,
+    find_pulses,
+    invert_rc,
+    leading,
+    xcorr_delay,
+)
 from instruments.devices.frontend import rc_highpass
 from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 

@@ -7,7 +7,7 @@ import re
 import numpy as np
 import pytest
 
-from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.analysis import GaugeSetup, Setup, analyze_record
 from instruments.formats import read_record, read_waveforms
 from instruments.formats.isf import isf_bytes
 from instruments.formats.tek_csv import write_csv

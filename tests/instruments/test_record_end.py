@@ -3,7 +3,7 @@ it ends and what to change, not as a pulse that fails the peak rules."""
 import numpy as np
 import pytest
 
-from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.analysis import GaugeSetup, Setup, analyze_record
 from instruments.records import Preamble, ScopeRecord, Waveform
 
 DT = 2e-7

@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from instruments.analysis.pipeline import GaugeSetup, Setup, analyze_record
+from instruments.analysis import GaugeSetup, Setup, analyze_record
 from instruments.errors import InstrumentError
 from instruments.formats import check_one_time_base, read_record, read_waveforms
 from instruments.formats.isf import isf_bytes

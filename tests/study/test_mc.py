@@ -231,7 +231,7 @@ def test_leading_window_measures_what_the_whole_record_measures():
 def test_traces_are_archived_only_when_asked_and_analyse_to_the_stored_outputs(tmp_path):
     # --traces: each batch's shots go to a shot archive of their own (scope codes and truth),
     # and the pipeline run on an archived record gives the speed the study stored
-    from instruments.analysis.pipeline import analyze_record
+    from instruments.analysis import analyze_record
     from instruments.archive import Archive
     from rig.experiment.measure import setup_for
     from rig.study.nominal import nominal
@@ -288,7 +288,7 @@ def test_a_batch_shot_has_the_bits_of_the_shot_fired_alone():
     # no rig is built per shot in a batch (arrays all the way); the same shot built as a rig,
     # solved alone at the study's step, fired with its seed and draws and analysed as one
     # record gives the very same numbers
-    from instruments.analysis.pipeline import analyze_record
+    from instruments.analysis import analyze_record
     from rig.experiment.measure import setup_for
     from rig.solver.problem import ChainProblem
     from rig.solver.solve import solve
