@@ -38,11 +38,12 @@ def sha(data: bytes) -> str:
 
 
 def address(obj) -> tuple:
-    """The object's file and address in it: equal for every hard link to it, and for the
-    paths that reach it through external links (layout 3's part files)."""
+    """The object's file (its absolute path) and address in it: equal for every hard link to
+    it, for the paths that reach it through external links (the part files of layouts 3 and
+    4), and for a part opened directly (instruments/archive/links.py)."""
     import h5py
 
-    return os.path.normpath(h5py.h5f.get_name(obj.id).decode()), h5py.h5o.get_info(obj.id).addr
+    return os.path.abspath(h5py.h5f.get_name(obj.id).decode()), h5py.h5o.get_info(obj.id).addr
 
 
 def external(g, name: str) -> str | None:

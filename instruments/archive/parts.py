@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .verify import member_list
+from .verify import compact, member_list
 
 LAYOUT3 = 3
 PARTS_TEXT = """Layout version 3: this file is the master of the archive; each shot_NNNNNN and
@@ -55,20 +55,38 @@ def stored_shared(f) -> dict:
     return out
 
 
-def recorded_members(f) -> dict:
-    """The root's member lists as its sealed attribute records them ({"/": names, "/shared":
-    names}; the walk over the root where the attribute is missing or unreadable): a large
-    master's names are read as one small attribute, not link by link."""
+def recorded_ranges(f) -> dict:
+    """The root's member lists as its sealed attribute records them, shots as ranges of ids
+    ({"/": other names, "/shared": names, "shot_ids": [[first, last], ...]}; the walk over the
+    root where the attribute is missing or unreadable): a large master's shots are read as a
+    few numbers, never as one name each."""
     try:
-        members = member_list(f)
-        return {"/": list(members["/"]), "/shared": list(members.get("/shared", []))}
+        members = member_list(f, expand=False)
+        if members is None:  # a version-1 root table: no list recorded
+            raise ValueError("no member list")
+        out = {"/": list(members["/"]), "/shared": list(members.get("/shared", []))}
+        return compact(out) if "shot_ids" not in members else {**out, "shot_ids": members["shot_ids"]}
     except Exception:  # noqa: BLE001 - a damaged list: the writer builds on what the root holds
-        return {"/": sorted(f), "/shared": sorted(f["shared"]) if "shared" in f else []}
+        return compact({"/": sorted(f), "/shared": sorted(f["shared"]) if "shared" in f else []})
 
 
-def with_new(members: dict, shots: list, shared: list) -> dict:
-    """``members`` with the names a transaction adds (``/shared`` listed once it exists)."""
-    out = {"/": sorted({*members["/"], *shots, *(["shared"] if shared or members["/shared"] else [])})}
-    if "shared" in out["/"]:
+def next_id(members: dict) -> int:
+    """The id of the next shot after those ``members`` (recorded_ranges) lists."""
+    return max([int(last) for _, last in members["shot_ids"]] + [0]) + 1
+
+
+def add_shots(members: dict, ids: list, shared: list) -> dict:
+    """``members`` (recorded_ranges) with the shots ``ids`` and the shared groups ``shared``
+    a transaction adds (``/shared`` listed once it exists)."""
+    ranges = [list(r) for r in members["shot_ids"]]
+    for i in sorted(ids):
+        if ranges and int(ranges[-1][1]) == i - 1:
+            ranges[-1][1] = i
+        else:
+            ranges.append([i, i])
+    ranges.sort()
+    names = sorted({*members["/"], *(["shared"] if shared or members["/shared"] else [])})
+    out = {"/": names, "shot_ids": ranges}
+    if "shared" in names:
         out["/shared"] = sorted({*members["/shared"], *shared})
     return out

@@ -18,6 +18,7 @@ import re
 from typing import TYPE_CHECKING
 
 from .digest import TABLE, address, damage, linked_groups, sha
+from .links import OpenParts
 
 if TYPE_CHECKING:
     import h5py
@@ -92,8 +93,9 @@ def _expanded(stored: dict) -> dict:
     return {**{k: v for k, v in stored.items() if k != "shot_ids"}, "/": sorted([*stored.get("/", []), *names])}
 
 
-def member_list(f) -> dict | None:
-    """The root's recorded member lists ({group: names}); None for a version-1 table.
+def member_list(f, expand: bool = True) -> dict | None:
+    """The root's recorded member lists ({group: names}; not ``expand``: shots as ranges of
+    ids where the root records them so, ``compact``); None for a version-1 table.
     ValueError where they are missing though the root's table names them, unreadable, or
     not what the root's table holds the SHA-256 of."""
     try:
@@ -113,7 +115,7 @@ def member_list(f) -> dict | None:
     if not isinstance(stored, dict):
         raise ValueError(f"@{MEMBERS} is not a JSON object")
     try:
-        return _expanded(stored)
+        return _expanded(stored) if expand else stored
     except Exception as exc:  # noqa: BLE001 - ranges that are not pairs of numbers
         raise ValueError(f"@{MEMBERS} unreadable ({_line(exc)})") from None
 
@@ -173,18 +175,19 @@ def check(f: h5py.File) -> dict:
         bad.append(_row(_shot_id(path), path, f"missing: {path}"))
     shared, problems, linked = _shared_groups(f, bad, added)
     users = {}
-    for name in names:
-        shot_id = int(name.split("_", 1)[1])
-        try:
-            g = f[name]
-            found = named(damage(g, linked), f"/{name}")
-            for key in linked_groups(g, "/shared/"):
-                users.setdefault(key, []).append(shot_id)
-        except Exception as exc:  # noqa: BLE001
-            found = [f"unreadable ({_line(exc)})"]
-        for p in found:
-            bad.append(_row(shot_id, _where(p, f"/{name}"), p))
-            shot_bad.add(shot_id)
+    with OpenParts() as parts:  # each part opened once, directly
+        for name in names:
+            shot_id = int(name.split("_", 1)[1])
+            try:
+                g = parts.group(f, name)
+                found = named(damage(g, linked), f"/{name}")
+                for key in linked_groups(g, "/shared/"):
+                    users.setdefault(key, []).append(shot_id)
+            except Exception as exc:  # noqa: BLE001
+                found = [f"unreadable ({_line(exc)})"]
+            for p in found:
+                bad.append(_row(shot_id, _where(p, f"/{name}"), p))
+                shot_bad.add(shot_id)
     for path in missing:  # a deleted shared group: the shots that linked to it
         key = path.removeprefix("/shared/")
         if path.startswith("/shared/") and key in users:

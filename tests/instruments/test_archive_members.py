@@ -31,7 +31,7 @@ CHANGES = {
     "a group added at the root": (lambda f: f.create_group("shot_000009"), None, "added: /shot_000009"),
     "a shot deleted": (lambda f: f.__delitem__("shot_000002"), 2, "missing: /shot_000002"),
     "a channel deleted": (lambda f: f.__delitem__("shot_000003/data/CH2"), 3, "missing: /shot_000003/data/CH2"),
-    "a group deleted in a shot": (lambda f: f.__delitem__("shot_000001/instrument"), 1, "missing: /shot_000001/instrument"),
+    "a group deleted in a shot": (lambda f: f.__delitem__("shot_000001/truth"), 1, "missing: /shot_000001/truth"),
     "a group added in a shot": (lambda f: f.create_group("shot_000003/notes").create_dataset("x", data=1), 3,
                                 "added: /shot_000003/notes"),
     "a dataset added in a shot": (lambda f: f.create_dataset("shot_000001/data/extra", data=1), 1,
