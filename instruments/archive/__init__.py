@@ -159,7 +159,7 @@ class Archive:
         """Layout 2: the shots written into the archive's copy."""
         start = max([int(n.split("_", 1)[1]) for n in shot_names(f)] + [0]) + 1
         ids = [start + i for i in range(len(entries))]
-        checked = set()
+        checked = {}
         for shot_id, e in zip(ids, entries):
             write_entry(f, shot_id, e, checked)
         f.attrs.update({"NX_class": "NXroot", "creator": "sonic-rig", "layout_version": LAYOUT_VERSION,

@@ -39,12 +39,12 @@ def commit_parts(path: Path, entries: list, transaction, master=None, ids=None, 
     part = part or (part_name(ids[0]) if ids else part_name(start))
     where = folder(path)
     made = not where.exists()
-    checked = set()
-    write = WRITERS[layout]
+    checked, axes = {}, {}
+    extra = (axes,) if layout == LAYOUT4 else ()  # layout 4: the time axes shared inside the part
 
     def fill(f):
         for shot_id, e in zip(ids, entries):
-            write(f, shot_id, e, checked, stored)
+            WRITERS[layout](f, shot_id, e, checked, stored, *extra)
         f.attrs.update({"NX_class": "NXroot", "layout_version": layout, "part_of": path.name})
         return sorted(f["shared"]) if "shared" in f else []
 

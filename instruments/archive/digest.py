@@ -28,7 +28,7 @@ import numpy as np
 if TYPE_CHECKING:
     import h5py
 
-TABLE = "checksums"  # the dataset that holds a group's table
+TABLE = "checksums"  # the dataset (layout 4: the attribute) that holds a group's table
 DIGEST = "sha256"  # the group attribute that holds the table's own SHA-256
 _REFERENCE_ATTRS = ("DIMENSION_LIST", "REFERENCE_LIST")
 
@@ -86,10 +86,11 @@ def _enter(g, prefix: str, out: dict, linked: dict):
 def table(group: h5py.Group, linked: dict, written: dict | None = None) -> dict:
     """The rows of ``group``'s table as the file reads now. An item that cannot be read
     gets the row ``unreadable: <cause>`` (never an exception). ``written`` ({address: the
-    value_digest of the values a writer has just given a dataset}) spares reading those
-    datasets back: the writer hashes the bytes it wrote, in one pass."""
-    rows = {}
-    _walk(group, "", _Tree(group, {address(group): "."}, {}, linked, rows, written or {}))
+    value_digest of the values a writer has just given a dataset}, and {(address, name):
+    the attribute_digest of an attribute's}) spares reading those back: the writer hashes
+    what it wrote, in one pass."""
+    rows, a = {}, address(group)
+    _walk(group, a, "", _Tree(group, {a: "."}, {}, linked, rows, written or {}))
     return rows
 
 
@@ -109,12 +110,12 @@ class _Tree:
     written: dict
 
 
-def _attrs(obj, path: str, t: _Tree):
+def _attrs(obj, a, path: str, t: _Tree):
     for key in sorted(obj.attrs):
-        if obj is t.group and key == DIGEST:
+        if obj is t.group and key in (DIGEST, TABLE):
             continue
         refs = names(t) if key in _REFERENCE_ATTRS else {}
-        t.rows[f"{path}@{key}"] = _guard(functools.partial(_attr_digest, obj, key, refs))
+        t.rows[f"{path}@{key}"] = t.written.get((a, key)) or _guard(functools.partial(_attr_digest, obj, key, refs))
 
 
 def names(t) -> dict:
@@ -125,12 +126,12 @@ def names(t) -> dict:
     return t.names
 
 
-def _walk(g, prefix: str, t: _Tree):
+def _walk(g, a, prefix: str, t: _Tree):
     import h5py
 
     members = sorted(n for n in g if n != TABLE or g is not t.group)
     t.rows[prefix or "/"] = sha(json.dumps(members).encode())
-    _attrs(g, prefix.rstrip("/"), t)
+    _attrs(g, a, prefix.rstrip("/"), t)
     for name in members:
         path = prefix + name
         link = external(g, name)
@@ -149,19 +150,29 @@ def _walk(g, prefix: str, t: _Tree):
             t.rows[path] = "link:./" + t.where[a]
         elif isinstance(obj, h5py.Group):
             t.where[a] = path
-            _walk(obj, path + "/", t)
+            _walk(obj, a, path + "/", t)
         else:
             t.where[a] = path
             t.rows[path] = t.written.get(a) or _guard(lambda: _dataset_digest(obj))
-            _attrs(obj, path, t)
+            _attrs(obj, a, path, t)
 
 
-def seal(group: h5py.Group, linked: dict, written: dict | None = None):
+def seal(group: h5py.Group, linked: dict, written: dict | None = None, attribute: bool = False):
     """Write ``group``'s table and its digest (after everything else in it is written;
-    ``written``: as for table())."""
+    ``written``: as for table()); the table is a dataset, or with ``attribute`` (layout 4:
+    one object fewer per shot) an attribute of the group."""
     text = json.dumps(table(group, linked, written), sort_keys=True, indent=0)
-    group.create_dataset(TABLE, data=text)
+    if attribute:
+        group.attrs[TABLE] = text
+    else:
+        group.create_dataset(TABLE, data=text)
     group.attrs[DIGEST] = sha(text.encode())
+
+
+def stored_table(group: h5py.Group) -> str:
+    """The text of ``group``'s table as stored (an attribute, or a dataset)."""
+    text = group.attrs[TABLE] if TABLE in group.attrs else group[TABLE][()]
+    return text.decode() if isinstance(text, bytes) else str(text)
 
 
 def damage(group: h5py.Group, linked: dict, read=None) -> list:
@@ -171,8 +182,7 @@ def damage(group: h5py.Group, linked: dict, read=None) -> list:
     computed, item by item, without walking the rest; where one differs, the whole table is
     compared and the lines about those rows given."""
     try:
-        text = group[TABLE][()]
-        text = text.decode() if isinstance(text, bytes) else str(text)
+        text = stored_table(group)
         if sha(text.encode()) != str(group.attrs.get(DIGEST, "")):
             return [f"{TABLE}: the table of checksums (or the attribute {DIGEST}) is damaged"]
         stored = json.loads(text)
@@ -248,7 +258,7 @@ def linked_groups(group: h5py.Group, under: str) -> set:
     """The groups below ``under`` (e.g. "/shared/") that ``group``'s stored table links to,
     by name ({"scene_ab12"}); empty when the table is unreadable (its check says why)."""
     try:
-        rows = json.loads(group[TABLE][()])
+        rows = json.loads(stored_table(group))
     except Exception:  # noqa: BLE001
         return set()
     return {v[len("link:") + len(under):].split("/", 1)[0] for v in rows.values()
@@ -271,7 +281,15 @@ def value_digest(value) -> str:
 def _attr_digest(obj, key, names) -> str:
     if key in _REFERENCE_ATTRS:
         return sha(json.dumps(_references(obj, key, names)).encode())
-    value = obj.attrs[key]
+    return attribute_digest(obj.attrs[key])
+
+
+def attribute_digest(value) -> str:
+    """The row of an attribute holding ``value`` as h5py reads it back (a text, a numpy
+    scalar or array, an array of texts); a writer gives it the value it writes, which h5py
+    reads back alike for a text, a list of texts and a numpy scalar."""
+    if isinstance(value, list):
+        value = np.array(value, dtype=object)
     if isinstance(value, (bytes, str)):
         return sha(b"s" + (value.encode() if isinstance(value, str) else value))
     value = np.asarray(value)

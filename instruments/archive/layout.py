@@ -41,9 +41,9 @@ SHA-256 of every dataset and attribute, and its attribute 'sha256' that of the t
 COMPRESSION = dict(compression="gzip", compression_opts=1, shuffle=True, fletcher32=True)
 
 
-def write_entry(f: h5py.File, shot_id: int, e: Entry, checked: set, stored: dict | None = None):
+def write_entry(f: h5py.File, shot_id: int, e: Entry, checked: dict, stored: dict | None = None):
     """Write one NXentry, then seal its table of checksums; ``checked`` holds the shared
-    groups already compared this transaction. ``stored`` (layout 3, a part file; {key: (part
+    groups already compared this transaction ({} at its start; scene_group). ``stored`` (layout 3, a part file; {key: (part
     file, group)}) names the shared groups an earlier transaction wrote into another part,
     which the entry links to with HDF5 external links; in a part, the axes are dimension
     scales attached to nothing (h5netcdf reads an attached scale's reference in the file it
@@ -82,16 +82,23 @@ def write_entry(f: h5py.File, shot_id: int, e: Entry, checked: set, stored: dict
     seal(g, linked, written)
 
 
-def scene_group(f, shot_id: int, e: Entry, checked: set, stored: dict | None, written: dict) -> tuple:
+def scene_group(f, shot_id: int, e: Entry, checked: dict, stored: dict | None, written: dict) -> tuple:
     """(the objects a shot links to: {"scene_text", "settings", "forces"}, {address: path}
     of those that lie in this file): its scene's shared group, written where this file does
     not hold it yet and no earlier part does (``stored``, as for write_entry), else compared
-    with the shot's texts (once per transaction, ``checked``)."""
-    key, where = shared_name(e, shot_id), f"shot {shot_id}"
+    with the shot's texts (once per transaction: ``checked``, {key: {with truth: what this
+    returned}})."""
+    key, where, truth = shared_name(e, shot_id), f"shot {shot_id}", e.truth is not None
+    known = checked.get(key, {}).get(truth)
+    if known:  # a shot of a scene this transaction met already: its group's objects, not walked again
+        return known
     if stored and key in stored:
-        return _stored(key, e, where, checked, *stored[key])
-    shared = _shared(f, key, e, where, checked, stored is None, written)
-    return shared, {address(o): o.name for o in _objects(shared)}
+        out = _stored(key, e, where, checked, *stored[key])
+    else:
+        shared = _shared(f, key, e, where, checked, stored is None, written)
+        out = shared, {address(o): o.name for o in _objects(shared)}
+    checked[key][truth] = out
+    return out
 
 
 def _compare(s, key: str, e: Entry, where: str):
@@ -100,7 +107,7 @@ def _compare(s, key: str, e: Entry, where: str):
             raise InstrumentError(f"{where}: shared/{key}/{name} differs from this shot's {name}")
 
 
-def _stored(key: str, e: Entry, where: str, checked: set, part: str, s) -> tuple:
+def _stored(key: str, e: Entry, where: str, checked: dict, part: str, s) -> tuple:
     """External links to shared/<key> in the part file ``part`` (``s``: that group, read),
     and no linked objects (an external link is its own row in the table)."""
     import h5py
@@ -110,12 +117,12 @@ def _stored(key: str, e: Entry, where: str, checked: set, part: str, s) -> tuple
         if e.truth is not None and "forces" not in s:
             raise InstrumentError(f"{where}: shared/{key} was stored without truth forces; this shot has them "
                                   "(give it another truth_key)")
-        checked.add(key)
+        checked.setdefault(key, {})
     names = ["scene_text", "settings"] + (["forces"] if e.truth is not None else [])
     return {n: h5py.ExternalLink(part, f"/shared/{key}/{n}") for n in names}, {}
 
 
-def _shared(f, key: str, e: Entry, where: str, checked: set, attach: bool, written: dict):
+def _shared(f, key: str, e: Entry, where: str, checked: dict, attach: bool, written: dict):
     """shared/<key>: scene text, settings and truth forces, stored once per scene."""
     root = nx_group(f, "shared", "NXcollection")
     scene_texts = texts(e)
@@ -133,7 +140,7 @@ def _shared(f, key: str, e: Entry, where: str, checked: set, attach: bool, writt
         if "checksums" in s:
             del s["checksums"]
         seal(s, {}, written)
-    checked.add(key)
+    checked.setdefault(key, {})
     return s
 
 

@@ -2,6 +2,7 @@
 layout a file is, a shot's stored SHA-256 of its raw data, the range of its shot ids."""
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -58,9 +59,11 @@ def check_archive_path(path):
 
 
 def stored_raw_digest(g) -> str:
-    """The stored SHA-256 of a shot's raw data (an attribute of its entry in layout 4, a
+    """The stored SHA-256 of a shot's raw data (in its entry's metadata in layout 4, a
     dataset before)."""
-    value = g.attrs["raw_sha256"] if "raw_sha256" in g.attrs else g["raw_sha256"][()]
+    if "metadata" in g.attrs:
+        return json.loads(g.attrs["metadata"])["raw_sha256"]
+    value = g["raw_sha256"][()]
     return value.decode() if isinstance(value, bytes) else str(value)
 
 

@@ -30,26 +30,17 @@ def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool
     ``keyed`` as for read_entry."""
     shot_id = int(g.name.rsplit("_", 1)[1])
     where = f"{path}: shot {shot_id}"
-    a = dict(g.attrs)
-    waves = {}
-    for d in g["data"].values():
-        if "preamble" in d.attrs:  # not a time axis
-            ch, wave = _waveform(d, d.attrs["preamble"], where)
-            waves[ch] = wave
-    record = ScopeRecord(dict(sorted(waves.items())), bool(a["triggered"]), _str(a.get("no_trigger_reason")) or None)
-    truth, facts = None, None
-    if "truth" in g:
-        tg = g["truth"]
-        stored = json.loads(tg.attrs["facts"])
-        facts = ShotFacts.from_dict(stored, f"{where}: facts") if stored else None
-        if with_truth:
-            truth = _forces(tg["forces"])
+    meta = json.loads(g.attrs["metadata"])
+    data = g["data"]
+    waves = dict(_waveform(data[ch.replace("#", "_")], p, where) for ch, p in meta["preambles"].items())
+    record = ScopeRecord(dict(sorted(waves.items())), bool(meta["triggered"]), meta["no_trigger_reason"] or None)
+    facts = ShotFacts.from_dict(meta["facts"], f"{where}: facts") if meta.get("facts") else None
+    truth = _forces(g["truth/forces"]) if with_truth and "truth" in g else None
     keys = sorted(k for k in linked_groups(g, "/shared/") if k.startswith("scene_")) if keyed else []
-    start = g["start_time"]
-    return Entry(record, bool(a["simulated"]), int(a["seed"]) if "seed" in a else None, _str(a.get("scene")),
-                 _text(g, "scene_text"), json.loads(_text(g, "settings")), truth, facts,
-                 keys[0].removeprefix("scene_") if keys else None, _str(start[()]), _str(a.get("program_version")),
-                 shot_id, _str(start.attrs["source"]), _str(a.get("file_modification_time")), _text(g, "title"))
+    return Entry(record, bool(meta["simulated"]), meta["seed"], meta["scene"], _text(g, "scene_text"),
+                 json.loads(_text(g, "settings")), truth, facts, keys[0].removeprefix("scene_") if keys else None,
+                 _text(g, "start_time"), meta["program_version"], shot_id, meta["start_time_source"],
+                 meta["file_modification_time"], _text(g, "title"))
 
 
 def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False) -> Entry:
@@ -61,7 +52,7 @@ def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False
     waves = {}
     for d in g["instrument/oscilloscope"].values():
         if "preamble" in d.attrs:  # not the sample axis
-            ch, wave = _waveform(d, d.attrs["preamble"], where)
+            ch, wave = _waveform(d, json.loads(d.attrs["preamble"]), where)
             waves[ch] = wave
     reason = _text(g, "no_trigger_reason")
     record = ScopeRecord(dict(sorted(waves.items())), bool(g["triggered"][()]), reason or None)
@@ -88,9 +79,10 @@ def summary_row(e: Entry) -> dict:
             "settings": e.settings.get("striker", {})}
 
 
-def _waveform(d, preamble: str, where: str) -> tuple:
-    """(channel, Waveform) of a dataset of raw codes (or volts) and its preamble (JSON)."""
-    meta = json.loads(preamble)
+def _waveform(d, preamble: dict, where: str) -> tuple:
+    """(channel, Waveform) of a dataset of raw codes (or volts) and its preamble (with the
+    channel's name and over-range flag)."""
+    meta = dict(preamble)
     ch, overrange = meta.pop("channel"), meta.pop("overrange")
     unknown = set(meta) - {f.name for f in fields(Preamble)}
     if unknown:

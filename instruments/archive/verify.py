@@ -10,7 +10,8 @@ Version 2 adds the attribute ``members``, the names in the root group and in ``/
 two groups that no table of their own covers); its SHA-256 is a row of ``checksums`` like
 any attribute's. A layout-3 master lists its shots as ranges of ids (``"shot_ids": [[1,
 10000]]``, ``compact``), so that the attribute an append rewrites stays small. An archive without ``members`` is checked as version 1; its next append
-(or ``rig upgrade``) writes version 2."""
+(or ``rig upgrade``) writes version 2. From layout 4 on, the root's table also holds a row
+per attribute of ``/shared`` ("/shared@NX_class")."""
 from __future__ import annotations
 
 import json
@@ -26,6 +27,7 @@ if TYPE_CHECKING:
 ROOT_TABLE = "checksums"  # root attribute: {attribute: SHA-256} of the root's other attributes
 MEMBERS = "members"  # root attribute (version 2): {"/": root's member names, "/shared": shared's}
 _ADDED = "not in the table of checksums"  # how digest.damage words an added item
+SHARED_ATTRS_SINCE = 4  # the layout from which the root's table covers /shared's attributes
 
 
 def root_seal(f: h5py.File, members: dict | None = None):
@@ -127,7 +129,7 @@ def uncovered(f: h5py.File) -> list:
     linked, out = set(), []
     for name in sorted(f):
         obj = f[name]
-        if name.startswith("shot_") and hasattr(obj, "keys") and TABLE in obj:
+        if name.startswith("shot_") and hasattr(obj, "keys") and (TABLE in obj or TABLE in obj.attrs):
             linked |= linked_groups(obj, "/shared/")
         elif name != "shared":
             out.append(f"/{name}")
@@ -142,16 +144,25 @@ def root_damage(f: h5py.File) -> list:
         now = _root_rows(f)
     except Exception as exc:  # noqa: BLE001
         return [f"attribute @{ROOT_TABLE}: unreadable ({_line(exc)})"]
-    return [f"attribute @{k}: damaged" for k in sorted(set(stored) | set(now)) if stored.get(k) != now.get(k)]
+    return [f"attribute {k if k.startswith('/') else '@' + k}: damaged" for k in sorted(set(stored) | set(now))
+            if stored.get(k) != now.get(k)]
 
 
 def _root_rows(f) -> dict:
+    """{attribute: SHA-256} of the root's attributes; from layout 4 on, also of /shared's
+    ("/shared@NX_class"), which no group's own table covers."""
     out = {}
     for k in sorted(f.attrs):
         if k != ROOT_TABLE:
-            v = f.attrs[k]
-            out[k] = sha(repr(v.tolist() if hasattr(v, "tolist") else v).encode())
+            out[k] = _value_sha(f.attrs[k])
+    if f.attrs.get("layout_version", 0) >= SHARED_ATTRS_SINCE and "shared" in f:
+        shared = f["shared"]
+        out.update({f"/shared@{k}": _value_sha(shared.attrs[k]) for k in sorted(shared.attrs)})
     return out
+
+
+def _value_sha(v) -> str:
+    return sha(repr(v.tolist() if hasattr(v, "tolist") else v).encode())
 
 
 def shot_names(f: h5py.File) -> list:
@@ -161,7 +172,7 @@ def shot_names(f: h5py.File) -> list:
 def check(f: h5py.File) -> dict:
     """{"shots", "ok", "bad"}: bad rows {"shot", "shots", "where", "reason"}; "shots" counts
     the shots the root lists, a deleted shot (bad) included."""
-    bad = [_row(None, "/" + _item(r), r) for r in root_damage(f)]
+    bad = [_row(None, _item(r) if _item(r).startswith("/") else "/" + _item(r), r) for r in root_damage(f)]
     try:
         names = shot_names(f)
         added, missing = member_changes(f)
