@@ -17,13 +17,12 @@ such error is caught and reported against the item that raised.
 from __future__ import annotations
 
 import functools
-import hashlib
 import json
 import os
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import numpy as np
+from .hashes import attribute_digest, sha, value_digest
 
 if TYPE_CHECKING:
     import h5py
@@ -31,10 +30,6 @@ if TYPE_CHECKING:
 TABLE = "checksums"  # the dataset (layout 4: the attribute) that holds a group's table
 DIGEST = "sha256"  # the group attribute that holds the table's own SHA-256
 _REFERENCE_ATTRS = ("DIMENSION_LIST", "REFERENCE_LIST")
-
-
-def sha(data: bytes) -> str:
-    return hashlib.sha256(data).hexdigest()
 
 
 def address(obj) -> tuple:
@@ -269,33 +264,10 @@ def _dataset_digest(d) -> str:
     return value_digest(d[()])  # fletcher32 is checked chunk by chunk here
 
 
-def value_digest(value) -> str:
-    """The row of a dataset holding ``value`` (a text, or what numpy makes an array of):
-    the SHA-256 of its dtype, shape and bytes; of "s" and its UTF-8 bytes for a text."""
-    if isinstance(value, (bytes, str)):
-        return sha(b"s" + (value.encode() if isinstance(value, str) else value))
-    value = np.asarray(value)
-    return sha(f"{value.dtype.str}{value.shape}".encode() + np.ascontiguousarray(value).tobytes())
-
-
 def _attr_digest(obj, key, names) -> str:
     if key in _REFERENCE_ATTRS:
         return sha(json.dumps(_references(obj, key, names)).encode())
     return attribute_digest(obj.attrs[key])
-
-
-def attribute_digest(value) -> str:
-    """The row of an attribute holding ``value`` as h5py reads it back (a text, a numpy
-    scalar or array, an array of texts); a writer gives it the value it writes, which h5py
-    reads back alike for a text, a list of texts and a numpy scalar."""
-    if isinstance(value, list):
-        value = np.array(value, dtype=object)
-    if isinstance(value, (bytes, str)):
-        return sha(b"s" + (value.encode() if isinstance(value, str) else value))
-    value = np.asarray(value)
-    if value.dtype.kind == "O":
-        return sha(json.dumps([v.decode() if isinstance(v, bytes) else str(v) for v in value.ravel()]).encode())
-    return sha(f"{value.dtype.str}{value.shape}".encode() + np.ascontiguousarray(value).tobytes())
 
 
 def _references(obj, key, names) -> list:

@@ -16,7 +16,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .verify import compact, member_list
+from .members import compact
+from .verify import member_list
 
 LAYOUT3 = 3
 PARTS_TEXT = """Layout version 3: this file is the master of the archive; each shot_NNNNNN and

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 
 from .digest import TABLE, address, damage, linked_groups, sha
 from .links import OpenParts
+from .members import expanded
 
 if TYPE_CHECKING:
     import h5py
@@ -74,27 +75,6 @@ def member_changes(f: h5py.File) -> tuple:
     return [p for p in added if not drop(p)], [p for p in missing if not drop(p)]
 
 
-def compact(members: dict) -> dict:
-    """``members`` with the root's shot names as ranges of ids, ``"shot_ids": [[first, last],
-    ...]`` (the form a layout-3 master records)."""
-    ids = sorted(int(n[5:]) for n in members["/"] if re.fullmatch(r"shot_\d{6}", n))
-    ranges = []
-    for i in ids:
-        if ranges and ranges[-1][1] == i - 1:
-            ranges[-1][1] = i
-        else:
-            ranges.append([i, i])
-    return {**members, "/": [n for n in members["/"] if not re.fullmatch(r"shot_\d{6}", n)], "shot_ids": ranges}
-
-
-def _expanded(stored: dict) -> dict:
-    """A recorded member list with its ranges of shot ids (``compact``) as names again."""
-    if "shot_ids" not in stored:
-        return stored
-    names = [f"shot_{i:06d}" for first, last in stored["shot_ids"] for i in range(int(first), int(last) + 1)]
-    return {**{k: v for k, v in stored.items() if k != "shot_ids"}, "/": sorted([*stored.get("/", []), *names])}
-
-
 def member_list(f, expand: bool = True) -> dict | None:
     """The root's recorded member lists ({group: names}; not ``expand``: shots as ranges of
     ids where the root records them so, ``compact``); None for a version-1 table.
@@ -117,7 +97,7 @@ def member_list(f, expand: bool = True) -> dict | None:
     if not isinstance(stored, dict):
         raise ValueError(f"@{MEMBERS} is not a JSON object")
     try:
-        return _expanded(stored) if expand else stored
+        return expanded(stored) if expand else stored
     except Exception as exc:  # noqa: BLE001 - ranges that are not pairs of numbers
         raise ValueError(f"@{MEMBERS} unreadable ({_line(exc)})") from None
 
