@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import InstrumentError
 from ..records import ScopeRecord
 from .digest import address, attribute_digest, seal
-from .entry import NAME, Entry, facts_json, preamble_json, raw_digest, raw_values
+from .entry import NAME, Entry, facts_json, jsonable, preamble_json, raw_digest, raw_values
 from .layout import scene_group, store
 
 LAYOUT4 = 4
@@ -32,7 +32,8 @@ for a real one), simulated, triggered, no_trigger_reason, program_name, program_
 raw_sha256 (of the raw codes and their scaling), start_time_source (what start_time is),
 file_modification_time (imported files without an acquisition time), facts (virtual shots),
 preambles ({channel: its Tektronix scaling and over-range flag}). scene_text (TOML as fired)
-and settings (JSON, SI) are links to the scene's shared group. data/ (NXdata, the default
+and settings (JSON, SI) are links to the scene's shared group where shots share one (virtual
+shots: their truth's key); a shot alone (an imported file) holds them in metadata instead. data/ (NXdata, the default
 plot): CHn, the raw ADC codes as the scope sent them (volts, float64, where a file held
 volts only), with CF packing attributes: volts = scale_factor * codes + add_offset
 (= y_zero + y_multiplier * (codes - y_offset)), units 'V' (of the volts); time, the sample
@@ -60,19 +61,25 @@ def write_compact_entry(f, shot_id: int, e: Entry, checked: set, stored: dict, a
             "file_modification_time": e.file_modification_time,
             "facts": json.loads(facts_json(e, f"{where}: facts")) if e.truth is not None else None,
             "preambles": {ch: json.loads(preamble_json(w)) for ch, w in sorted(e.record.waveforms.items())}}
-    members, linked = scene_group(f, shot_id, e, checked, stored, written)
+    shares = e.truth_key is not None or e.truth is not None  # a scene's shots share its group
+    if shares:
+        members, linked = scene_group(f, shot_id, e, checked, stored, written)
+    else:  # a shot alone (an imported file): its texts in its metadata, no group of its own under shared/
+        meta.update(scene_text=e.scene_text, settings=e.settings)
     g = f.create_group(f"shot_{shot_id:06d}")
-    label(g, {"NX_class": "NXentry", "default": "data", "metadata": json.dumps(meta, sort_keys=True)}, written)
+    text = json.dumps(meta, sort_keys=True, default=jsonable)
+    label(g, {"NX_class": "NXentry", "default": "data", "metadata": text}, written)
     title = e.title or (f"{e.scene} seed {e.seed}" if e.simulated else ", ".join(e.settings.get("source_files", [])))
     store(g, "title", title or f"shot {shot_id}", written)
     store(g, "start_time", e.start_time or datetime.now(timezone.utc).isoformat(), written)
-    g["scene_text"] = members["scene_text"]
-    g["settings"] = members["settings"]
+    if shares:
+        g["scene_text"] = members["scene_text"]
+        g["settings"] = members["settings"]
     _write_channels(g, e.record, written, axes)
     if e.truth is not None:
         label(g.create_group("truth"), {"NX_class": "NXcollection"}, written)
         g["truth/forces"] = members["forces"]  # one link to the arrays stored once per scene
-    seal(g, linked, written, attribute=True)
+    seal(g, linked if shares else {}, written, attribute=True)
 
 
 def _write_channels(g, record: ScopeRecord, written: dict, axes: dict):

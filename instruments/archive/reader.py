@@ -37,8 +37,10 @@ def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool
     facts = ShotFacts.from_dict(meta["facts"], f"{where}: facts") if meta.get("facts") else None
     truth = _forces(g["truth/forces"]) if with_truth and "truth" in g else None
     keys = sorted(k for k in linked_groups(g, "/shared/") if k.startswith("scene_")) if keyed else []
-    return Entry(record, bool(meta["simulated"]), meta["seed"], meta["scene"], _text(g, "scene_text"),
-                 json.loads(_text(g, "settings")), truth, facts, keys[0].removeprefix("scene_") if keys else None,
+    scene_text = meta["scene_text"] if "scene_text" in meta else _text(g, "scene_text")
+    settings = meta["settings"] if "settings" in meta else json.loads(_text(g, "settings"))
+    return Entry(record, bool(meta["simulated"]), meta["seed"], meta["scene"], scene_text,
+                 settings, truth, facts, keys[0].removeprefix("scene_") if keys else None,
                  _text(g, "start_time"), meta["program_version"], shot_id, meta["start_time_source"],
                  meta["file_modification_time"], _text(g, "title"))
 

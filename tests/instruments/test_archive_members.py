@@ -63,11 +63,12 @@ def test_a_shared_group_edited_names_the_shots_that_use_it(archive):
 
 
 def test_a_deleted_shared_group_names_the_shots_that_linked_to_it(archive):
-    report = _edit(archive, lambda f: f.__delitem__("shared/of_shot_000003"))
+    # layout 4: only a scene's shots share a group (a real shot alone holds its texts itself)
+    report = _edit(archive, lambda f: f.__delitem__("shared/scene_tiny"))
     rows = [b for b in report["bad"] if b["reason"].startswith("missing: ")]
     assert [(b["where"], b["shots"], b["reason"]) for b in rows] == \
-        [("/shared/of_shot_000003", [3], "missing: /shared/of_shot_000003 (shared by shot 3)")], report["bad"]
-    assert report["ok"] == 2
+        [("/shared/scene_tiny", [1, 2], "missing: /shared/scene_tiny (shared by shots 1, 2)")], report["bad"]
+    assert report["ok"] == 1
 
 
 def test_an_untouched_archive_verifies_clean(archive):

@@ -36,7 +36,7 @@ def test_an_append_writes_its_own_part_and_leaves_the_others_untouched(tmp_path)
         assert isinstance(link, h5py.ExternalLink) and link.filename == "a.h5.d/shots_000004.h5"
         # shot 5's scene was stored by the first part: its truth is that part's, not a copy
         assert f["shot_000005/truth/forces"].file.filename.endswith("shots_000001.h5")
-        assert sorted(f["shared"]) == ["of_shot_000004", "scene_tiny"]
+        assert sorted(f["shared"]) == ["scene_tiny"]  # a real shot alone holds its texts itself
     assert path.stat().st_size < 20_000  # the master holds links, not shots
     assert a.verify() == {"shots": 5, "ok": 5, "bad": []}
     assert a.read(5).seed == 5 and a.read(5).truth["wall_force"][0] == 1.0
@@ -79,7 +79,8 @@ def test_upgrade_converts_layout_2_keeping_every_shot_and_its_sharing(tmp_path):
     before, entries = a.digests(), [a.read(i) for i in a.ids()]
     assert a.upgrade() == len(entries) and a.upgrade() == 0
     with h5py.File(a.path, "r") as f:
-        assert f.attrs["layout_version"] == 4 and sorted(f["shared"]) == shared
+        # each scene's group kept, shared as before; a shot alone (of_shot_N) holds its texts itself
+        assert f.attrs["layout_version"] == 4 and sorted(f["shared"]) == [k for k in shared if k.startswith("scene_")]
     assert a.digests() == before and a.verify()["bad"] == []
     for e in entries:
         back = a.read(e.shot_id)
@@ -118,8 +119,8 @@ def test_layout_3_grows_in_layout_3_until_upgraded_to_4(tmp_path):
         shared = sorted(f["shared"])
     assert a.verify() == {"shots": 5, "ok": 5, "bad": []}
     assert a.upgrade() == 5 and a.upgrade() == 0
-    with h5py.File(a.path, "r") as f:  # each scene's group kept, shared as before
-        assert f.attrs["layout_version"] == 4 and sorted(f["shared"]) == shared and "scene_tiny" in shared
+    with h5py.File(a.path, "r") as f:  # each scene's group kept; a shot alone holds its texts itself
+        assert f.attrs["layout_version"] == 4 and sorted(f["shared"]) == ["scene_tiny"] and "scene_tiny" in shared
         assert "instrument" not in f["shot_000005"] and "scale_factor" in f["shot_000005/data/CH1"].attrs
     # the old parts are gone once the new master names its own
     assert [p.name for p in a.path.with_name(a.path.name + ".d").glob("*.h5")] == ["upgraded_000001.h5"]
