@@ -215,9 +215,12 @@ class Archive:
             except Exception as exc:  # noqa: BLE001 - a missing or damaged part, one line
                 raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({cause(exc)})") from None
             try:
-                if verify:
-                    self._check_shot(f, g, with_truth)
-                e = read_shot(g, self.path, with_truth)
+                e, seen = None, {}
+                if verify:  # read first: what it read is checked as read, not read again
+                    with contextlib.suppress(Exception):  # a damaged shot: the check says what
+                        e = read_shot(g, self.path, with_truth, seen=seen)
+                    self._check_shot(f, g, with_truth, seen if e is not None else {})
+                e = e or read_shot(g, self.path, with_truth)
             except InstrumentError:
                 raise
             except Exception as exc:  # noqa: BLE001 - a damaged file, one line
@@ -226,12 +229,12 @@ class Archive:
                 raise InstrumentError(f"{self.path}: shot {shot_id}: raw_sha256 does not match the raw data")
             return e
 
-    def _check_shot(self, f, g, with_truth: bool = True):
+    def _check_shot(self, f, g, with_truth: bool = True, read_rows: dict | None = None):
         """The shot's table, and those of the shared groups it links to (scene text and
         settings, and the truth's forces where ``with_truth``; once per version of the file
         that holds them: a part, never changed, or a layout-2 archive, replaced whole by each
         transaction): a shot read without its truth is not refused for damaged truth forces,
-        which it does not read."""
+        which it does not read; ``read_rows``: the rows the read computed from what it read."""
         linked, name = {}, f"{self.path}: shot {int(g.name.rsplit('_', 1)[1])}"
         for key in sorted(linked_groups(g, "/shared/")):
             s = f["shared"][key]
@@ -250,7 +253,7 @@ class Archive:
                 raise InstrumentError(f"{name}: shared/{key}/{read[0]}")
             if not problems:
                 self._sound_shared[(held, key)] = (identity, here)
-        problems = damage(g, linked, read=returned_by_read(g))
+        problems = damage(g, linked, read=returned_by_read(g), known=read_rows)
         if problems:
             raise InstrumentError(f"{name}: {problems[0]}")
 

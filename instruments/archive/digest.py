@@ -170,12 +170,13 @@ def stored_table(group: h5py.Group) -> str:
     return text.decode() if isinstance(text, bytes) else str(text)
 
 
-def damage(group: h5py.Group, linked: dict, read=None) -> list:
+def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None) -> list:
     """What differs between ``group``'s stored table and the file: a list of
     "path: what is wrong" lines, empty when every item matches. ``read`` (a test of a row's
     key, e.g. ``lambda key: not key.startswith("data/")``): only the rows a reader reads are
-    computed, item by item, without walking the rest; where one differs, the whole table is
-    compared and the lines about those rows given."""
+    computed, item by item, without walking the rest (``known``: {row key: its row} that a
+    reader computed from the values it read, not read again); where one differs, the whole
+    table is compared and the lines about those rows given."""
     try:
         text = stored_table(group)
         if sha(text.encode()) != str(group.attrs.get(DIGEST, "")):
@@ -185,7 +186,8 @@ def damage(group: h5py.Group, linked: dict, read=None) -> list:
         return [f"{TABLE}: unreadable ({_first_line(exc)})"]
     if read is not None:
         keys = [k for k in stored if read(k)]
-        if rows(group, keys, linked, stored) == {k: stored[k] for k in keys}:
+        if rows(group, [k for k in keys if k not in (known or {})], linked, stored, known) == \
+                {k: stored[k] for k in keys}:
             return []
         found = _differences(stored, table(group, linked))
         return [p for p in found if read(p.removeprefix("attribute ").split(": ", 1)[0])] or found
@@ -206,10 +208,11 @@ def _differences(stored: dict, now: dict) -> list:
     return out
 
 
-def rows(group: h5py.Group, keys: list, linked: dict, stored: dict) -> dict:
+def rows(group: h5py.Group, keys: list, linked: dict, stored: dict, known: dict | None = None) -> dict:
     """The rows ``keys`` of ``group``'s table as the file reads now, each computed alone (no
-    walk over the rest of the group); ``stored``: the table as sealed, which says where a row
-    is a hard link inside the group (only then is the group walked for its paths)."""
+    walk over the rest of the group), and those of ``known`` (rows a reader computed) that the
+    table holds; ``stored``: the table as sealed, which says where a row is a hard link
+    inside the group (only then is the group walked for its paths)."""
     t, objects = _Tree(group, {}, {}, linked, {}, {}), {"": group}
 
     def at(path: str):  # each object looked up once (a path lookup costs as much as a small read)
@@ -217,7 +220,7 @@ def rows(group: h5py.Group, keys: list, linked: dict, stored: dict) -> dict:
             objects[path] = group[path]
         return objects[path]
 
-    out = {}
+    out = {k: v for k, v in (known or {}).items() if k in stored}
     for key in keys:
         try:
             out[key] = _row(at, key, stored.get(key, ""), t)

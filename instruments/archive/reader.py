@@ -12,6 +12,7 @@ from ..errors import InstrumentError
 from ..records import Preamble, ScopeRecord, Waveform
 from .compact import LAYOUT4
 from .digest import linked_groups
+from .hashes import attribute_digest, value_digest
 from .entry import Entry
 from .facts import ShotFacts
 
@@ -19,20 +20,27 @@ if TYPE_CHECKING:
     import h5py
 
 
-def read_shot(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False) -> Entry:
-    """The Entry of an NXentry of any current layout (the file that holds it says which)."""
-    read = read_compact_entry if g.file.attrs.get("layout_version") == LAYOUT4 else read_entry
-    return read(g, path, with_truth, keyed)
+def read_shot(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False, seen: dict | None = None) -> Entry:
+    """The Entry of an NXentry of any current layout (the file that holds it says which);
+    ``seen`` (layout 4): filled with the rows of the shot's table of what was read."""
+    if g.file.attrs.get("layout_version") == LAYOUT4:
+        return read_compact_entry(g, path, with_truth, keyed, {} if seen is None else seen)
+    return read_entry(g, path, with_truth, keyed)
 
 
-def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False) -> Entry:
+def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False,
+                       seen: dict | None = None) -> Entry:
     """The Entry of an NXentry of layout 4 (its checksums are checked by the caller);
-    ``keyed`` as for read_entry."""
+    ``keyed`` as for read_entry; ``seen``: filled with {row key: row} (digest.table) of the
+    metadata, texts and codes read, which the caller's check takes rather than read again."""
     shot_id = int(g.name.rsplit("_", 1)[1])
     where = f"{path}: shot {shot_id}"
-    meta = json.loads(g.attrs["metadata"])
+    seen = {} if seen is None else seen
+    text = g.attrs["metadata"]
+    seen["@metadata"] = attribute_digest(text)
+    meta = json.loads(text)
     data = g["data"]
-    waves = dict(_waveform(data[ch.replace("#", "_")], p, where) for ch, p in meta["preambles"].items())
+    waves = dict(_waveform(data[ch.replace("#", "_")], p, where, seen) for ch, p in meta["preambles"].items())
     record = ScopeRecord(dict(sorted(waves.items())), bool(meta["triggered"]), meta["no_trigger_reason"] or None)
     facts = ShotFacts.from_dict(meta["facts"], f"{where}: facts") if meta.get("facts") else None
     truth = _forces(g["truth/forces"]) if with_truth and "truth" in g else None
@@ -41,8 +49,8 @@ def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool
     settings = meta["settings"] if "settings" in meta else json.loads(_text(g, "settings"))
     return Entry(record, bool(meta["simulated"]), meta["seed"], meta["scene"], scene_text,
                  settings, truth, facts, keys[0].removeprefix("scene_") if keys else None,
-                 _text(g, "start_time"), meta["program_version"], shot_id, meta["start_time_source"],
-                 meta["file_modification_time"], _text(g, "title"))
+                 _text(g, "start_time", seen), meta["program_version"], shot_id, meta["start_time_source"],
+                 meta["file_modification_time"], _text(g, "title", seen))
 
 
 def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False) -> Entry:
@@ -81,7 +89,7 @@ def summary_row(e: Entry) -> dict:
             "settings": e.settings.get("striker", {})}
 
 
-def _waveform(d, preamble: dict, where: str) -> tuple:
+def _waveform(d, preamble: dict, where: str, seen: dict | None = None) -> tuple:
     """(channel, Waveform) of a dataset of raw codes (or volts) and its preamble (with the
     channel's name and over-range flag)."""
     meta = dict(preamble)
@@ -90,6 +98,8 @@ def _waveform(d, preamble: dict, where: str) -> tuple:
     if unknown:
         raise InstrumentError(f"{where}: channel {ch}: preamble.{sorted(unknown)[0]}: unknown key")
     values = d[()]
+    if seen is not None:
+        seen[d.name.split("/", 2)[2]] = value_digest(values)  # "data/CH1", its row in the shot's table
     kind = "samples" if values.dtype.kind == "f" else "codes"  # volts from a file that held volts only
     return ch, Waveform(ch, Preamble(**meta), overrange=overrange, **{kind: values})
 
@@ -105,7 +115,10 @@ def _str(value) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
-def _text(g, name: str) -> str:
+def _text(g, name: str, seen: dict | None = None) -> str:
     if name not in g:
         return ""
-    return _str(g[name][()])
+    value = g[name][()]
+    if seen is not None:
+        seen[name] = value_digest(value)
+    return _str(value)
