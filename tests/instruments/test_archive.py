@@ -214,7 +214,7 @@ def test_files_open_with_plain_h5py_and_xarray(tmp_path):
     with h5py.File(path, "r") as f:
         g = f["shot_000001"]
         assert g.attrs["NX_class"] == "NXentry" and g["data"].attrs["signal"] == "CH1"
-        assert g.attrs["seed"] == 5 and "volts = scale_factor" in f.attrs["layout"] and f.attrs["layout_version"] == 4
+        assert json.loads(g.attrs["metadata"])["seed"] == 5 and "volts = scale_factor" in f.attrs["layout"] and f.attrs["layout_version"] == 4
         assert g["title"][()].decode() == "synthetic seed 5" and g["start_time"][()].decode().startswith("20")
         for name, obj in _all_datasets(g):
             assert obj.ndim == 0 or (obj.fletcher32 and obj.chunks), name  # arrays carry fletcher32
@@ -230,7 +230,7 @@ def test_files_open_with_plain_h5py_and_xarray(tmp_path):
     assert np.array_equal(forces["wall_force"].values, e.truth["wall_force"])
     assert forces["time"].values[1] == pytest.approx(e.facts.sample_interval_s, rel=1e-12)
     assert forces["wall_force"].attrs["units"] == "N" and forces["time"].attrs["units"] == "s"
-    assert tree["shot_000002"].attrs["seed"] == 6 and "truth" not in tree["shot_000002"]
+    assert json.loads(tree["shot_000002"].attrs["metadata"])["seed"] == 6 and "truth" not in tree["shot_000002"]
 
 
 def _all_datasets(group):
