@@ -9,14 +9,20 @@ import re
 def compact(members: dict) -> dict:
     """``members`` with the root's shot names as ranges of ids, ``"shot_ids": [[first, last],
     ...]`` (the form a master of layout 3 or 4 records)."""
-    ids = sorted(int(n[5:]) for n in members["/"] if re.fullmatch(r"shot_\d{6}", n))
-    ranges = []
-    for i in ids:
-        if ranges and ranges[-1][1] == i - 1:
-            ranges[-1][1] = i
+    ids = [int(n[5:]) for n in members["/"] if re.fullmatch(r"shot_\d{6}", n)]
+    return {**members, "/": [n for n in members["/"] if not re.fullmatch(r"shot_\d{6}", n)],
+            "shot_ids": with_ids([], ids)}
+
+
+def with_ids(ranges: list, ids) -> list:
+    """The ranges of shot ids ``ranges`` ([[first, last], ...], sorted) with ``ids`` added."""
+    out = [list(r) for r in ranges]
+    for i in sorted(ids):
+        if out and int(out[-1][1]) == i - 1:
+            out[-1][1] = i
         else:
-            ranges.append([i, i])
-    return {**members, "/": [n for n in members["/"] if not re.fullmatch(r"shot_\d{6}", n)], "shot_ids": ranges}
+            out.append([i, i])
+    return sorted(out)
 
 
 def expanded(stored: dict) -> dict:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .members import compact
+from .members import compact, with_ids
 from .verify import member_list
 
 LAYOUT3 = 3
@@ -79,13 +79,7 @@ def next_id(members: dict) -> int:
 def add_shots(members: dict, ids: list, shared: list) -> dict:
     """``members`` (recorded_ranges) with the shots ``ids`` and the shared groups ``shared``
     a transaction adds (``/shared`` listed once it exists)."""
-    ranges = [list(r) for r in members["shot_ids"]]
-    for i in sorted(ids):
-        if ranges and int(ranges[-1][1]) == i - 1:
-            ranges[-1][1] = i
-        else:
-            ranges.append([i, i])
-    ranges.sort()
+    ranges = with_ids(members["shot_ids"], ids)
     names = sorted({*members["/"], *(["shared"] if shared or members["/shared"] else [])})
     out = {"/": names, "shot_ids": ranges}
     if "shared" in names:

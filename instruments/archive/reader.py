@@ -12,9 +12,9 @@ from ..errors import InstrumentError
 from ..records import Preamble, ScopeRecord, Waveform
 from .compact import LAYOUT4
 from .digest import linked_groups
-from .hashes import attribute_digest, value_digest
 from .entry import Entry
 from .facts import ShotFacts
+from .hashes import attribute_digest, value_digest
 
 if TYPE_CHECKING:
     import h5py

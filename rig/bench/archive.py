@@ -16,9 +16,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from rig.bench.archive_large import build
-
 from instruments.archive import Archive
+from rig.bench.archive_large import build
 from rig.experiment.entry import shot_entry
 from rig.experiment.shot import Rig
 
@@ -81,8 +80,8 @@ def _held(entries: list, n: int, batch: int, direct: bool = False, repeats: int 
 
 def table(r: dict) -> str:
     return "\n".join([
-        f"archive: {r['shots']} virtual shots, {r['channels']} channels x {r['points_per_channel']} points, "
-        "one core, CPU time",
+        (f"archive: {r['shots']} virtual shots, {r['channels']} channels x {r['points_per_channel']} points, "
+         "one core, CPU time"),
         f"  append, {r['batch']} shots per transaction   {r['batched_shots_per_s']:8.0f} shots/s",
         f"  append, one shot per transaction   {r['single_shots_per_s']:8.0f} shots/s",
         f"  verify (fletcher32 + sha256)       {r['verify_shots_per_s']:8.0f} shots/s",
