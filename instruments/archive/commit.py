@@ -15,8 +15,8 @@ from .layout import LAYOUT, write_entry
 from .parts import LAYOUT3, PARTS_TEXT, add_shots, folder, link_into, next_id, part_name, recorded_ranges, stored_shared
 from .verify import root_seal
 
-TEXTS = {LAYOUT3: PARTS_TEXT + "\n\n" + LAYOUT, LAYOUT4: PARTS_TEXT.replace("version 3", "version 4").replace(
-    "of layout 2, described below", "of layout 4, described below") + "\n\n" + LAYOUT4_TEXT}
+TEXTS = {LAYOUT3: PARTS_TEXT.format(version=3, groups=2) + "\n\n" + LAYOUT,
+         LAYOUT4: PARTS_TEXT.format(version=4, groups=4) + "\n\n" + LAYOUT4_TEXT}
 WRITERS = {LAYOUT3: write_entry, LAYOUT4: write_compact_entry}
 
 

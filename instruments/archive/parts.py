@@ -1,12 +1,13 @@
-"""Layout 3: an archive is a small master file and a folder of part files, one per
+"""Layouts 3 and 4: an archive is a small master file and a folder of part files, one per
 transaction, that the master links to with HDF5 external links.
 
 ``shots.h5`` (the master) holds the root's attributes (layout, member lists, the root's
 table of checksums) and one external link per shot (``/shot_000042`` ->
 ``shots.h5.d/shots_000040.h5:/shot_000042``) and per shared group (``/shared/scene_x`` ->
 the part that stored it first). ``shots.h5.d/shots_NNNNNN.h5`` (a part, named by the first
-shot it holds) is an HDF5 file of layout 2's groups: the transaction's NXentry groups and the
-shared groups of scenes new to the archive; a shot of a scene stored by an earlier part
+shot it holds) is an HDF5 file of the transaction's NXentry groups (layout 3: layout 2's
+groups; layout 4: instruments/archive/compact.py) and the shared groups of scenes new to the
+archive; a shot of a scene stored by an earlier part
 links to that part's shared group with external links. A part is written once, whole, and
 never changed. h5py, h5netcdf (xarray) and nexusformat follow the links, relative to the
 folder of the file that holds them; copying an archive means copying the master and its
@@ -20,10 +21,10 @@ from .members import compact, with_ids
 from .verify import member_list
 
 LAYOUT3 = 3
-PARTS_TEXT = """Layout version 3: this file is the master of the archive; each shot_NNNNNN and
+PARTS_TEXT = """Layout version {version}: this file is the master of the archive; each shot_NNNNNN and
 each shared/<key> is an HDF5 external link into a part file in the folder <this file's
 name>.d beside it (one part per transaction, written once, never changed); the groups they
-link to are of layout 2, described below. Copy the file and its folder together."""
+link to are of layout {groups}, described below. Copy the file and its folder together."""
 
 
 def folder(master: Path) -> Path:
