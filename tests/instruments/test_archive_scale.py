@@ -2,8 +2,6 @@
 back, one more appended; an append writes its own part and a master of links, so its cost
 does not grow with what the archive holds. The shots are the smallest real ones (one
 channel of 16 int8 codes, no truth): what is measured is the archive's cost per shot."""
-import time
-
 import numpy as np
 import pytest
 
@@ -23,9 +21,11 @@ def test_ten_thousand_shots_append_verify_read_and_take_one_more(tmp_path):
     first, last = a.read(1), a.read(SHOTS)
     assert np.array_equal(first.record["CH1"].codes, small(0).record["CH1"].codes)
     assert np.array_equal(last.record["CH1"].codes, small(SHOTS - 1).record["CH1"].codes)
-    t0 = time.process_time()
+    parts = {p.name: (p.stat().st_ino, p.stat().st_mtime_ns, p.stat().st_size) for p in tmp_path.glob("big.h5.d/*.h5")}
     assert a.append([small(SHOTS)]) == [SHOTS + 1]
-    one = time.process_time() - t0
     assert a.read(SHOTS + 1).settings == {"source_files": [f"s{SHOTS}.isf"]}
     assert len(list(tmp_path.glob("big.h5.d/*.h5"))) == SHOTS // BATCH + 1  # a part per transaction
-    assert one < 0.25, f"one-shot append at {SHOTS:,} shots took {one:.2f} s of CPU"  # 10-30 ms measured
+    # what the append wrote is its own part and the master: every part already stored is the same file, untouched
+    # (its cost is what rig bench archive's one-shot rows at 10, 10,000 and 100,000 shots measure)
+    assert {p.name: (p.stat().st_ino, p.stat().st_mtime_ns, p.stat().st_size)
+            for p in tmp_path.glob("big.h5.d/*.h5") if p.name in parts} == parts
