@@ -312,10 +312,10 @@ def api() -> str:
 
 def archive() -> str:
     from instruments import archive as archive_module
-    from instruments.archive import LAYOUT, LAYOUT_VERSION
+    from instruments.archive import CURRENT_LAYOUT, LAYOUT
 
     lines = ["# Archive layout (generated)", "",
-             f"Written from the archive's code when the site is built: layout version {LAYOUT_VERSION}, "
+             f"Written from the archive's code when the site is built: layout version {CURRENT_LAYOUT}, "
              "as every archive states it in its root attribute `layout` (and `layout_version`). "
              "[The archive's guarantees](../explanation/archive.md) explain the checksums and the "
              "transactions.", "", "## The layout", "", "```text", inspect.cleandoc(LAYOUT), "```", ""]

@@ -17,32 +17,28 @@ such error is caught and reported against the item that raised.
 from __future__ import annotations
 
 import functools
-import hashlib
 import json
 import os
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import numpy as np
+from .hashes import attribute_digest, sha, value_digest
 
 if TYPE_CHECKING:
     import h5py
 
-TABLE = "checksums"  # the dataset that holds a group's table
+TABLE = "checksums"  # the dataset (layout 4: the attribute) that holds a group's table
 DIGEST = "sha256"  # the group attribute that holds the table's own SHA-256
 _REFERENCE_ATTRS = ("DIMENSION_LIST", "REFERENCE_LIST")
 
 
-def sha(data: bytes) -> str:
-    return hashlib.sha256(data).hexdigest()
-
-
 def address(obj) -> tuple:
-    """The object's file and address in it: equal for every hard link to it, and for the
-    paths that reach it through external links (layout 3's part files)."""
+    """The object's file (its absolute path) and address in it: equal for every hard link to
+    it, for the paths that reach it through external links (the part files of layouts 3 and
+    4), and for a part opened directly (instruments/archive/links.py)."""
     import h5py
 
-    return os.path.normpath(h5py.h5f.get_name(obj.id).decode()), h5py.h5o.get_info(obj.id).addr
+    return os.path.abspath(h5py.h5f.get_name(obj.id).decode()), h5py.h5o.get_info(obj.id).addr
 
 
 def external(g, name: str) -> str | None:
@@ -85,10 +81,12 @@ def _enter(g, prefix: str, out: dict, linked: dict):
 def table(group: h5py.Group, linked: dict, written: dict | None = None) -> dict:
     """The rows of ``group``'s table as the file reads now. An item that cannot be read
     gets the row ``unreadable: <cause>`` (never an exception). ``written`` ({address: the
-    value_digest of the values a writer has just given a dataset}) spares reading those
-    datasets back: the writer hashes the bytes it wrote, in one pass."""
+    value_digest of the values a writer has just given a dataset}, and {(address, name):
+    the attribute_digest of an attribute's}) spares reading those back: the writer hashes
+    what it wrote, in one pass."""
     rows: dict[str, str] = {}
-    _walk(group, "", _Tree(group, {address(group): "."}, {}, linked, rows, written or {}))
+    a = address(group)
+    _walk(group, a, "", _Tree(group, {a: "."}, {}, linked, rows, written or {}))
     return rows
 
 
@@ -108,12 +106,12 @@ class _Tree:
     written: dict
 
 
-def _attrs(obj, path: str, t: _Tree):
+def _attrs(obj, a, path: str, t: _Tree):
     for key in sorted(obj.attrs):
-        if obj is t.group and key == DIGEST:
+        if obj is t.group and key in (DIGEST, TABLE):
             continue
         refs = names(t) if key in _REFERENCE_ATTRS else {}
-        t.rows[f"{path}@{key}"] = _guard(functools.partial(_attr_digest, obj, key, refs))
+        t.rows[f"{path}@{key}"] = t.written.get((a, key)) or _guard(functools.partial(_attr_digest, obj, key, refs))
 
 
 def names(t) -> dict:
@@ -124,12 +122,12 @@ def names(t) -> dict:
     return t.names
 
 
-def _walk(g, prefix: str, t: _Tree):
+def _walk(g, a, prefix: str, t: _Tree):
     import h5py
 
     members = sorted(n for n in g if n != TABLE or g is not t.group)
     t.rows[prefix or "/"] = sha(json.dumps(members).encode())
-    _attrs(g, prefix.rstrip("/"), t)
+    _attrs(g, a, prefix.rstrip("/"), t)
     for name in members:
         path = prefix + name
         link = external(g, name)
@@ -148,30 +146,40 @@ def _walk(g, prefix: str, t: _Tree):
             t.rows[path] = "link:./" + t.where[a]
         elif isinstance(obj, h5py.Group):
             t.where[a] = path
-            _walk(obj, path + "/", t)
+            _walk(obj, a, path + "/", t)
         else:
             t.where[a] = path
             t.rows[path] = t.written.get(a) or _guard(lambda: _dataset_digest(obj))
-            _attrs(obj, path, t)
+            _attrs(obj, a, path, t)
 
 
-def seal(group: h5py.Group, linked: dict, written: dict | None = None):
+def seal(group: h5py.Group, linked: dict, written: dict | None = None, attribute: bool = False):
     """Write ``group``'s table and its digest (after everything else in it is written;
-    ``written``: as for table())."""
+    ``written``: as for table()); the table is a dataset, or with ``attribute`` (layout 4:
+    one object fewer per shot) an attribute of the group."""
     text = json.dumps(table(group, linked, written), sort_keys=True, indent=0)
-    group.create_dataset(TABLE, data=text)
+    if attribute:
+        group.attrs[TABLE] = text
+    else:
+        group.create_dataset(TABLE, data=text)
     group.attrs[DIGEST] = sha(text.encode())
 
 
-def damage(group: h5py.Group, linked: dict, read=None) -> list:
+def stored_table(group: h5py.Group) -> str:
+    """The text of ``group``'s table as stored (an attribute, or a dataset)."""
+    text = group.attrs[TABLE] if TABLE in group.attrs else group[TABLE][()]
+    return text.decode() if isinstance(text, bytes) else str(text)
+
+
+def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None) -> list:
     """What differs between ``group``'s stored table and the file: a list of
     "path: what is wrong" lines, empty when every item matches. ``read`` (a test of a row's
     key, e.g. ``lambda key: not key.startswith("data/")``): only the rows a reader reads are
-    computed, item by item, without walking the rest; where one differs, the whole table is
-    compared and the lines about those rows given."""
+    computed, item by item, without walking the rest (``known``: {row key: its row} that a
+    reader computed from the values it read, not read again); where one differs, the whole
+    table is compared and the lines about those rows given."""
     try:
-        text = group[TABLE][()]
-        text = text.decode() if isinstance(text, bytes) else str(text)
+        text = stored_table(group)
         if sha(text.encode()) != str(group.attrs.get(DIGEST, "")):
             return [f"{TABLE}: the table of checksums (or the attribute {DIGEST}) is damaged"]
         stored = json.loads(text)
@@ -179,7 +187,8 @@ def damage(group: h5py.Group, linked: dict, read=None) -> list:
         return [f"{TABLE}: unreadable ({_first_line(exc)})"]
     if read is not None:
         keys = [k for k in stored if read(k)]
-        if rows(group, keys, linked, stored) == {k: stored[k] for k in keys}:
+        if rows(group, [k for k in keys if k not in (known or {})], linked, stored, known) == \
+                {k: stored[k] for k in keys}:
             return []
         found = _differences(stored, table(group, linked))
         return [p for p in found if read(p.removeprefix("attribute ").split(": ", 1)[0])] or found
@@ -200,10 +209,11 @@ def _differences(stored: dict, now: dict) -> list:
     return out
 
 
-def rows(group: h5py.Group, keys: list, linked: dict, stored: dict) -> dict:
+def rows(group: h5py.Group, keys: list, linked: dict, stored: dict, known: dict | None = None) -> dict:
     """The rows ``keys`` of ``group``'s table as the file reads now, each computed alone (no
-    walk over the rest of the group); ``stored``: the table as sealed, which says where a row
-    is a hard link inside the group (only then is the group walked for its paths)."""
+    walk over the rest of the group), and those of ``known`` (rows a reader computed) that the
+    table holds; ``stored``: the table as sealed, which says where a row is a hard link
+    inside the group (only then is the group walked for its paths)."""
     t, objects = _Tree(group, {}, {}, linked, {}, {}), {"": group}
 
     def at(path: str):  # each object looked up once (a path lookup costs as much as a small read)
@@ -211,7 +221,7 @@ def rows(group: h5py.Group, keys: list, linked: dict, stored: dict) -> dict:
             objects[path] = group[path]
         return objects[path]
 
-    out = {}
+    out = {k: v for k, v in (known or {}).items() if k in stored}
     for key in keys:
         try:
             out[key] = _row(at, key, stored.get(key, ""), t)
@@ -247,7 +257,7 @@ def linked_groups(group: h5py.Group, under: str) -> set:
     """The groups below ``under`` (e.g. "/shared/") that ``group``'s stored table links to,
     by name ({"scene_ab12"}); empty when the table is unreadable (its check says why)."""
     try:
-        rows = json.loads(group[TABLE][()])
+        rows = json.loads(stored_table(group))
     except Exception:  # noqa: BLE001
         return set()
     return {v[len("link:") + len(under):].split("/", 1)[0] for v in rows.values()
@@ -258,25 +268,10 @@ def _dataset_digest(d) -> str:
     return value_digest(d[()])  # fletcher32 is checked chunk by chunk here
 
 
-def value_digest(value) -> str:
-    """The row of a dataset holding ``value`` (a text, or what numpy makes an array of):
-    the SHA-256 of its dtype, shape and bytes; of "s" and its UTF-8 bytes for a text."""
-    if isinstance(value, (bytes, str)):
-        return sha(b"s" + (value.encode() if isinstance(value, str) else value))
-    value = np.asarray(value)
-    return sha(f"{value.dtype.str}{value.shape}".encode() + np.ascontiguousarray(value).tobytes())
-
-
 def _attr_digest(obj, key, names) -> str:
     if key in _REFERENCE_ATTRS:
         return sha(json.dumps(_references(obj, key, names)).encode())
-    value = obj.attrs[key]
-    if isinstance(value, (bytes, str)):
-        return sha(b"s" + (value.encode() if isinstance(value, str) else value))
-    value = np.asarray(value)
-    if value.dtype.kind == "O":
-        return sha(json.dumps([v.decode() if isinstance(v, bytes) else str(v) for v in value.ravel()]).encode())
-    return sha(f"{value.dtype.str}{value.shape}".encode() + np.ascontiguousarray(value).tobytes())
+    return attribute_digest(obj.attrs[key])
 
 
 def _references(obj, key, names) -> list:

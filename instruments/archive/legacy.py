@@ -13,8 +13,8 @@ from typing import TYPE_CHECKING
 
 from ..errors import InstrumentError
 from ..records import Preamble, ScopeRecord, Waveform
+from .entry import Entry, raw_digest
 from .facts import ShotFacts
-from .layout import Entry, raw_digest
 
 if TYPE_CHECKING:
     import h5py

@@ -1,7 +1,7 @@
-"""Reading one NXentry of the current layout (instruments/archive/layout.py) back into
-the Entry it was written from: the same scope records (codes, preamble with its point
-format, channel names), facts and truth. The checksums are checked by the caller
-(instruments/archive/__init__.py)."""
+"""Reading one NXentry of layout 2 or 3 (instruments/archive/layout.py) or of layout 4
+(instruments/archive/compact.py) back into the Entry it was written from: the same scope
+records (codes, preamble with its point format, channel names), facts and truth. The
+checksums are checked by the caller (instruments/archive/__init__.py)."""
 from __future__ import annotations
 
 import json
@@ -10,12 +10,47 @@ from typing import TYPE_CHECKING
 
 from ..errors import InstrumentError
 from ..records import Preamble, ScopeRecord, Waveform
+from .compact import LAYOUT4
 from .digest import linked_groups
+from .entry import Entry
 from .facts import ShotFacts
-from .layout import Entry
+from .hashes import attribute_digest, value_digest
 
 if TYPE_CHECKING:
     import h5py
+
+
+def read_shot(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False, seen: dict | None = None) -> Entry:
+    """The Entry of an NXentry of any current layout (the file that holds it says which);
+    ``seen`` (layout 4): filled with the rows of the shot's table of what was read."""
+    if g.file.attrs.get("layout_version") == LAYOUT4:
+        return read_compact_entry(g, path, with_truth, keyed, {} if seen is None else seen)
+    return read_entry(g, path, with_truth, keyed)
+
+
+def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False,
+                       seen: dict | None = None) -> Entry:
+    """The Entry of an NXentry of layout 4 (its checksums are checked by the caller);
+    ``keyed`` as for read_entry; ``seen``: filled with {row key: row} (digest.table) of the
+    metadata, texts and codes read, which the caller's check takes rather than read again."""
+    shot_id = int(g.name.rsplit("_", 1)[1])
+    where = f"{path}: shot {shot_id}"
+    seen = {} if seen is None else seen
+    text = g.attrs["metadata"]
+    seen["@metadata"] = attribute_digest(text)
+    meta = json.loads(text)
+    data = g["data"]
+    waves = dict(_waveform(data[ch.replace("#", "_")], p, where, seen) for ch, p in meta["preambles"].items())
+    record = ScopeRecord(dict(sorted(waves.items())), bool(meta["triggered"]), meta["no_trigger_reason"] or None)
+    facts = ShotFacts.from_dict(meta["facts"], f"{where}: facts") if meta.get("facts") else None
+    truth = _forces(g["truth/forces"]) if with_truth and "truth" in g else None
+    keys = sorted(k for k in linked_groups(g, "/shared/") if k.startswith("scene_")) if keyed else []
+    scene_text = meta["scene_text"] if "scene_text" in meta else _text(g, "scene_text")
+    settings = meta["settings"] if "settings" in meta else json.loads(_text(g, "settings"))
+    return Entry(record, bool(meta["simulated"]), meta["seed"], meta["scene"], scene_text,
+                 settings, truth, facts, keys[0].removeprefix("scene_") if keys else None,
+                 _text(g, "start_time", seen), meta["program_version"], shot_id, meta["start_time_source"],
+                 meta["file_modification_time"], _text(g, "title", seen))
 
 
 def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False) -> Entry:
@@ -25,18 +60,10 @@ def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False
     shot_id = int(g.name.rsplit("_", 1)[1])
     where = f"{path}: shot {shot_id}"
     waves = {}
-    for name, d in g["instrument/oscilloscope"].items():
-        if "preamble" not in d.attrs:
-            continue  # the sample axis
-        meta = json.loads(d.attrs["preamble"])
-        ch, overrange = meta.pop("channel"), meta.pop("overrange")
-        unknown = set(meta) - {f.name for f in fields(Preamble)}
-        if unknown:
-            raise InstrumentError(f"{where}: channel {ch}: preamble.{sorted(unknown)[0]}: unknown key")
-        pre = Preamble(**meta)
-        values = d[()]
-        kind = "samples" if values.dtype.kind == "f" else "codes"  # volts from a file that held volts only
-        waves[ch] = Waveform(ch, pre, overrange=overrange, **{kind: values})
+    for d in g["instrument/oscilloscope"].values():
+        if "preamble" in d.attrs:  # not the sample axis
+            ch, wave = _waveform(d, json.loads(d.attrs["preamble"]), where)
+            waves[ch] = wave
     reason = _text(g, "no_trigger_reason")
     record = ScopeRecord(dict(sorted(waves.items())), bool(g["triggered"][()]), reason or None)
     truth, facts = None, None
@@ -44,9 +71,7 @@ def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False
         stored = json.loads(_text(g["truth"], "facts"))
         facts = ShotFacts.from_dict(stored, f"{where}: facts") if stored else None
         if with_truth:
-            forces = g["truth/forces"]
-            axis = forces.attrs["axes"][0]
-            truth = {k: v[()] for k, v in forces.items() if k != axis}
+            truth = _forces(g["truth/forces"])
     keys = sorted(k for k in linked_groups(g, "/shared/") if k.startswith("scene_")) if keyed else []
     return Entry(record, bool(g["simulated"][()]), int(g["seed"][()]) if "seed" in g else None,
                  _text(g, "scene"), _text(g, "scene_text"), json.loads(_text(g, "settings")), truth, facts,
@@ -55,8 +80,45 @@ def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False
                  g["start_time"].attrs["source"], _text(g, "file_modification_time"), _text(g, "title"))
 
 
-def _text(g, name: str) -> str:
+def summary_row(e: Entry) -> dict:
+    """A shot's row of ``rig list``: id, title, start time (and what it is), simulated,
+    scene, seed, triggered, channels, source files, the striker's settings."""
+    return {"shot": e.shot_id, "title": e.title, "start_time": e.start_time, "start_time_source": e.start_time_source,
+            "simulated": e.simulated, "scene": e.scene, "seed": e.seed, "triggered": e.record.triggered,
+            "channels": sorted(e.record.waveforms), "sources": e.settings.get("source_files", []),
+            "settings": e.settings.get("striker", {})}
+
+
+def _waveform(d, preamble: dict, where: str, seen: dict | None = None) -> tuple:
+    """(channel, Waveform) of a dataset of raw codes (or volts) and its preamble (with the
+    channel's name and over-range flag)."""
+    meta = dict(preamble)
+    ch, overrange = meta.pop("channel"), meta.pop("overrange")
+    unknown = set(meta) - {f.name for f in fields(Preamble)}
+    if unknown:
+        raise InstrumentError(f"{where}: channel {ch}: preamble.{sorted(unknown)[0]}: unknown key")
+    values = d[()]
+    if seen is not None:
+        seen[d.name.split("/", 2)[2]] = value_digest(values)  # "data/CH1", its row in the shot's table
+    kind = "samples" if values.dtype.kind == "f" else "codes"  # volts from a file that held volts only
+    return ch, Waveform(ch, Preamble(**meta), overrange=overrange, **{kind: values})
+
+
+def _forces(forces) -> dict:
+    axis = forces.attrs["axes"][0]
+    return {k: v[()] for k, v in forces.items() if k != axis}
+
+
+def _str(value) -> str:
+    if value is None:
+        return ""
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _text(g, name: str, seen: dict | None = None) -> str:
     if name not in g:
         return ""
     value = g[name][()]
-    return value.decode() if isinstance(value, bytes) else str(value)
+    if seen is not None:
+        seen[name] = value_digest(value)
+    return _str(value)

@@ -10,7 +10,8 @@ Version 2 adds the attribute ``members``, the names in the root group and in ``/
 two groups that no table of their own covers); its SHA-256 is a row of ``checksums`` like
 any attribute's. A layout-3 master lists its shots as ranges of ids (``"shot_ids": [[1,
 10000]]``, ``compact``), so that the attribute an append rewrites stays small. An archive without ``members`` is checked as version 1; its next append
-(or ``rig upgrade``) writes version 2."""
+(or ``rig upgrade``) writes version 2. From layout 4 on, the root's table also holds a row
+per attribute of ``/shared`` ("/shared@NX_class")."""
 from __future__ import annotations
 
 import json
@@ -18,6 +19,8 @@ import re
 from typing import TYPE_CHECKING
 
 from .digest import TABLE, address, damage, linked_groups, sha
+from .links import OpenParts
+from .members import expanded
 
 if TYPE_CHECKING:
     import h5py
@@ -25,6 +28,7 @@ if TYPE_CHECKING:
 ROOT_TABLE = "checksums"  # root attribute: {attribute: SHA-256} of the root's other attributes
 MEMBERS = "members"  # root attribute (version 2): {"/": root's member names, "/shared": shared's}
 _ADDED = "not in the table of checksums"  # how digest.damage words an added item
+SHARED_ATTRS_SINCE = 4  # the layout from which the root's table covers /shared's attributes
 
 
 def root_seal(f: h5py.File, members: dict | None = None):
@@ -71,29 +75,9 @@ def member_changes(f: h5py.File) -> tuple:
     return [p for p in added if not drop(p)], [p for p in missing if not drop(p)]
 
 
-def compact(members: dict) -> dict:
-    """``members`` with the root's shot names as ranges of ids, ``"shot_ids": [[first, last],
-    ...]`` (the form a layout-3 master records)."""
-    ids = sorted(int(n[5:]) for n in members["/"] if re.fullmatch(r"shot_\d{6}", n))
-    ranges: list[list[int]] = []
-    for i in ids:
-        if ranges and ranges[-1][1] == i - 1:
-            ranges[-1][1] = i
-        else:
-            ranges.append([i, i])
-    return {**members, "/": [n for n in members["/"] if not re.fullmatch(r"shot_\d{6}", n)], "shot_ids": ranges}
-
-
-def _expanded(stored: dict) -> dict:
-    """A recorded member list with its ranges of shot ids (``compact``) as names again."""
-    if "shot_ids" not in stored:
-        return stored
-    names = [f"shot_{i:06d}" for first, last in stored["shot_ids"] for i in range(int(first), int(last) + 1)]
-    return {**{k: v for k, v in stored.items() if k != "shot_ids"}, "/": sorted([*stored.get("/", []), *names])}
-
-
-def member_list(f) -> dict | None:
-    """The root's recorded member lists ({group: names}); None for a version-1 table.
+def member_list(f, expand: bool = True) -> dict | None:
+    """The root's recorded member lists ({group: names}; not ``expand``: shots as ranges of
+    ids where the root records them so, ``compact``); None for a version-1 table.
     ValueError where they are missing though the root's table names them, unreadable, or
     not what the root's table holds the SHA-256 of."""
     try:
@@ -113,7 +97,7 @@ def member_list(f) -> dict | None:
     if not isinstance(stored, dict):
         raise ValueError(f"@{MEMBERS} is not a JSON object")
     try:
-        return _expanded(stored)
+        return expanded(stored) if expand else stored
     except Exception as exc:  # noqa: BLE001 - ranges that are not pairs of numbers
         raise ValueError(f"@{MEMBERS} unreadable ({_line(exc)})") from None
 
@@ -125,7 +109,7 @@ def uncovered(f: h5py.File) -> list:
     linked, out = set(), []
     for name in sorted(f):
         obj = f[name]
-        if name.startswith("shot_") and hasattr(obj, "keys") and TABLE in obj:
+        if name.startswith("shot_") and hasattr(obj, "keys") and (TABLE in obj or TABLE in obj.attrs):
             linked |= linked_groups(obj, "/shared/")
         elif name != "shared":
             out.append(f"/{name}")
@@ -140,16 +124,25 @@ def root_damage(f: h5py.File) -> list:
         now = _root_rows(f)
     except Exception as exc:  # noqa: BLE001
         return [f"attribute @{ROOT_TABLE}: unreadable ({_line(exc)})"]
-    return [f"attribute @{k}: damaged" for k in sorted(set(stored) | set(now)) if stored.get(k) != now.get(k)]
+    return [f"attribute {k if k.startswith('/') else '@' + k}: damaged" for k in sorted(set(stored) | set(now))
+            if stored.get(k) != now.get(k)]
 
 
 def _root_rows(f) -> dict:
+    """{attribute: SHA-256} of the root's attributes; from layout 4 on, also of /shared's
+    ("/shared@NX_class"), which no group's own table covers."""
     out = {}
     for k in sorted(f.attrs):
         if k != ROOT_TABLE:
-            v = f.attrs[k]
-            out[k] = sha(repr(v.tolist() if hasattr(v, "tolist") else v).encode())
+            out[k] = _value_sha(f.attrs[k])
+    if f.attrs.get("layout_version", 0) >= SHARED_ATTRS_SINCE and "shared" in f:
+        shared = f["shared"]
+        out.update({f"/shared@{k}": _value_sha(shared.attrs[k]) for k in sorted(shared.attrs)})
     return out
+
+
+def _value_sha(v) -> str:
+    return sha(repr(v.tolist() if hasattr(v, "tolist") else v).encode())
 
 
 def shot_names(f: h5py.File) -> list:
@@ -159,7 +152,7 @@ def shot_names(f: h5py.File) -> list:
 def check(f: h5py.File) -> dict:
     """{"shots", "ok", "bad"}: bad rows {"shot", "shots", "where", "reason"}; "shots" counts
     the shots the root lists, a deleted shot (bad) included."""
-    bad = [_row(None, "/" + _item(r), r) for r in root_damage(f)]
+    bad = [_row(None, _item(r) if _item(r).startswith("/") else "/" + _item(r), r) for r in root_damage(f)]
     try:
         names = shot_names(f)
         added, missing = member_changes(f)
@@ -173,18 +166,19 @@ def check(f: h5py.File) -> dict:
         bad.append(_row(_shot_id(path), path, f"missing: {path}"))
     shared, problems, linked = _shared_groups(f, bad, added)
     users: dict = {}
-    for name in names:
-        shot_id = int(name.split("_", 1)[1])
-        try:
-            g = f[name]
-            found = named(damage(g, linked), f"/{name}")
-            for key in linked_groups(g, "/shared/"):
-                users.setdefault(key, []).append(shot_id)
-        except Exception as exc:  # noqa: BLE001
-            found = [f"unreadable ({_line(exc)})"]
-        for p in found:
-            bad.append(_row(shot_id, _where(p, f"/{name}"), p))
-            shot_bad.add(shot_id)
+    with OpenParts() as parts:  # each part opened once, directly
+        for name in names:
+            shot_id = int(name.split("_", 1)[1])
+            try:
+                g = parts.group(f, name)
+                found = named(damage(g, linked), f"/{name}")
+                for key in linked_groups(g, "/shared/"):
+                    users.setdefault(key, []).append(shot_id)
+            except Exception as exc:  # noqa: BLE001
+                found = [f"unreadable ({_line(exc)})"]
+            for p in found:
+                bad.append(_row(shot_id, _where(p, f"/{name}"), p))
+                shot_bad.add(shot_id)
     for path in missing:  # a deleted shared group: the shots that linked to it
         key = path.removeprefix("/shared/")
         if path.startswith("/shared/") and key in users:

@@ -269,15 +269,15 @@ def test_a_bad_shot_of_an_archive_is_a_row_with_its_reason(gauge_files, tmp_path
     assert main(["import", str(realdata / "tek_16bit_dpo.isf"), "--into", path]) == 0
     capsys.readouterr()
     with h5py.File(path, "r+") as f:
-        f["shot_000002/instrument/oscilloscope/CH1"][100] += 3
+        f["shot_000002/data/CH1"][100] += 3
     code, rows, _ = run(capsys, "analyze", path, "--gauge-distance", "43 mm")
     assert code == 0 and [r["source"] for r in rows] == [f"{path}#{i}" for i in (1, 2, 3)]
     assert rows[0]["speed_m_per_s"] is not None and set(rows[1]) == set(rows[0])
-    assert rows[1]["reasons"]["speed_m_per_s"] == "shot 2: instrument/oscilloscope/CH1: damaged (SHA-256 differs)"
+    assert rows[1]["reasons"]["speed_m_per_s"] == "shot 2: data/CH1: damaged (SHA-256 differs)"
     assert rows[2]["reasons"]["amplitude_N"].startswith("shot 3: two gauge channels are needed; the record holds")
     assert all(rows[k][f] is None for k in (1, 2) for f in FIGURES)
     code, _, err = run(capsys, "analyze", path, "--shot", "2")
-    assert code == 2 and "shot 2: instrument/oscilloscope/CH1: damaged" in err
+    assert code == 2 and "shot 2: data/CH1: damaged" in err
 
 
 def test_a_noise_refusal_states_the_noise_in_the_forces_unit(realdata, capsys):

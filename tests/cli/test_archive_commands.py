@@ -254,7 +254,7 @@ def test_ls_lists_the_good_shots_beside_a_damaged_one(tmp_path, capsys):
     rig = Rig.from_scene("steel21_gravity")
     Archive(path).append([shot_entry(rig.fire(seed=s)) for s in (1, 2, 3)])
     with h5py.File(path, "a") as f:
-        f["shot_000002/instrument/oscilloscope/CH1"].attrs["preamble"] = "{damaged"
+        f["shot_000002"].attrs["metadata"] = "{damaged"  # layout 4: the preambles are in the metadata
     assert main(["ls", str(path)]) == 1
     out = capsys.readouterr().out
     assert "    2  DAMAGED: unreadable (" in out and f"run `rig verify {path}`" in out

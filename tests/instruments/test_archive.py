@@ -95,10 +95,11 @@ def test_round_trip_is_bit_identical(tmp_path):
     with h5py.File(tmp_path / "a.h5") as f:  # the shared truth is stored once
         assert len(f["shared"]) == 1
         assert f["shot_000001/truth/forces"].id == f["shot_000030/truth/forces"].id
-        w = shots[0].record["CH1"]  # the plot holds volts and seconds, the instrument the codes
-        assert np.array_equal(f["shot_000001/data/CH1"][()], w.volts())
-        assert np.array_equal(f["shot_000001/data/time"][()], w.time())
-        assert np.array_equal(f["shot_000001/instrument/oscilloscope/CH1"][()], w.codes)
+        w = shots[0].record["CH1"]  # the plot holds the codes, CF-packed volts, and the packed sample index
+        ch1, t = f["shot_000001/data/CH1"], f["shot_000001/data/time"]
+        assert np.array_equal(ch1[()], w.codes)
+        assert np.allclose(ch1[()] * ch1.attrs["scale_factor"] + ch1.attrs["add_offset"], w.volts(), rtol=1e-12)
+        assert np.allclose(t[()] * t.attrs["scale_factor"] + t.attrs["add_offset"], w.time(), rtol=1e-12, atol=1e-18)
 
 
 KILL_POINTS = ("idle", "copied", "written", "replaced")  # between appends, then inside one
@@ -149,8 +150,8 @@ def test_flipped_byte_in_a_data_chunk_is_reported_with_the_shot(tmp_path):
     path = tmp_path / "c.h5"
     a = Archive(path)
     a.append([entry(s, truth=False) for s in range(3)])
-    with h5py.File(path) as f:  # layout 3: the chunk lies in the part file the shot's link leads to
-        d = f["shot_000002/instrument/oscilloscope/CH2"]
+    with h5py.File(path) as f:  # the chunk lies in the part file the shot's link leads to
+        d = f["shot_000002/data/CH2"]
         offset, holder = d.id.get_chunk_info(0).byte_offset, d.file.filename
     with open(holder, "r+b") as fh:
         fh.seek(offset + 100)
@@ -213,7 +214,7 @@ def test_files_open_with_plain_h5py_and_xarray(tmp_path):
     with h5py.File(path, "r") as f:
         g = f["shot_000001"]
         assert g.attrs["NX_class"] == "NXentry" and g["data"].attrs["signal"] == "CH1"
-        assert g["seed"][()] == 5 and "volts = y_zero" in f.attrs["layout"] and f.attrs["layout_version"] == 3
+        assert json.loads(g.attrs["metadata"])["seed"] == 5 and "volts = scale_factor" in f.attrs["layout"] and f.attrs["layout_version"] == 4
         assert g["title"][()].decode() == "synthetic seed 5" and g["start_time"][()].decode().startswith("20")
         for name, obj in _all_datasets(g):
             assert obj.ndim == 0 or (obj.fletcher32 and obj.chunks), name  # arrays carry fletcher32
@@ -221,14 +222,15 @@ def test_files_open_with_plain_h5py_and_xarray(tmp_path):
         json.loads(g["settings"][()])
     ds = xr.open_dataset(path, group="shot_000001/data", engine="h5netcdf")
     w = e.record["CH1"]
-    assert np.array_equal(ds["CH1"].values, w.volts()) and np.array_equal(ds["time"].values, w.time())
+    assert np.allclose(ds["CH1"].values, w.volts(), rtol=1e-12) and ds["CH1"].dims == ("time",)
+    assert np.allclose(ds["time"].values, w.time(), rtol=1e-12, atol=1e-18)
     assert ds["CH1"].attrs["units"] == "V" and ds["time"].attrs["units"] == "s"
     tree = xr.open_datatree(path, engine="h5netcdf")  # the whole file
     forces = tree["shot_000001/truth/forces"]
     assert np.array_equal(forces["wall_force"].values, e.truth["wall_force"])
     assert forces["time"].values[1] == pytest.approx(e.facts.sample_interval_s, rel=1e-12)
     assert forces["wall_force"].attrs["units"] == "N" and forces["time"].attrs["units"] == "s"
-    assert tree["shot_000002"]["seed"].values == 6 and "truth" not in tree["shot_000002"]
+    assert json.loads(tree["shot_000002"].attrs["metadata"])["seed"] == 6 and "truth" not in tree["shot_000002"]
 
 
 def _all_datasets(group):

@@ -194,10 +194,11 @@ def test_a_shot_read_without_its_truth_ignores_only_damaged_truth(tmp_path, item
             archive.read(1)  # the same Archive: the shared group was not remembered as sound
 
 
-@pytest.mark.parametrize("item", ["instrument/oscilloscope/CH2@preamble", "seed", "data/CH2", "data/CH2@units"])
+@pytest.mark.parametrize("item", ["@metadata", "data/CH2", "data/time", "data/CH2@units"])
 def test_a_read_checks_what_it_returns_and_verify_checks_the_rest(tmp_path, item):
-    # a read refuses a shot whose returned items (codes, preambles, metadata) are damaged; the
-    # volts and time of its NXdata plot, which a read does not return, are left to verify
+    # a read refuses a shot whose returned items (codes; preambles and the rest in metadata) are damaged; the
+    # time axis and the plot's units, which a read does not return (it computes them from the
+    # preambles), are left to verify
     import h5py
 
     path = tmp_path / "a.h5"
@@ -206,15 +207,17 @@ def test_a_read_checks_what_it_returns_and_verify_checks_the_rest(tmp_path, item
         name, _, attr = item.partition("@")
         obj = f[f"shot_000002/{name}"]
         if attr:
-            obj.attrs[attr] = obj.attrs[attr].replace('"y_zero": 0.0', '"y_zero": 0.5') if attr == "preamble" else "mV"
+            obj.attrs[attr] = obj.attrs[attr].replace('"y_zero": 0.0', '"y_zero": 0.5') if attr == "metadata" else "mV"
         elif obj.dtype.kind == "f":
             obj[5] = obj[5] + 1.0
         else:
             obj[()] = 7
     bad = Archive(path).verify()["bad"]
-    assert [b["shot"] for b in bad] == [2] and bad[0]["where"] == f"/shot_000002/{item}"
+    # the shots of one transaction share their time axis (one dataset, hard-linked): both see it damaged
+    assert [b["shot"] for b in bad] == ([1, 2] if item == "data/time" else [2])
+    assert bad[-1]["where"] == f"/shot_000002/{item}"
     assert Archive(path).read(1).seed == 1
-    if name.startswith("data/"):
+    if item in ("data/time", "data/CH2@units"):
         back = Archive(path).read(2)
         assert np.array_equal(back.record.waveforms["CH2"].codes, tiny_entry(2).record.waveforms["CH2"].codes)
     else:

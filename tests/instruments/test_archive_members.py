@@ -31,7 +31,7 @@ CHANGES = {
     "a group added at the root": (lambda f: f.create_group("shot_000009"), None, "added: /shot_000009"),
     "a shot deleted": (lambda f: f.__delitem__("shot_000002"), 2, "missing: /shot_000002"),
     "a channel deleted": (lambda f: f.__delitem__("shot_000003/data/CH2"), 3, "missing: /shot_000003/data/CH2"),
-    "a group deleted in a shot": (lambda f: f.__delitem__("shot_000001/instrument"), 1, "missing: /shot_000001/instrument"),
+    "a group deleted in a shot": (lambda f: f.__delitem__("shot_000001/truth"), 1, "missing: /shot_000001/truth"),
     "a group added in a shot": (lambda f: f.create_group("shot_000003/notes").create_dataset("x", data=1), 3,
                                 "added: /shot_000003/notes"),
     "a dataset added in a shot": (lambda f: f.create_dataset("shot_000001/data/extra", data=1), 1,
@@ -63,11 +63,12 @@ def test_a_shared_group_edited_names_the_shots_that_use_it(archive):
 
 
 def test_a_deleted_shared_group_names_the_shots_that_linked_to_it(archive):
-    report = _edit(archive, lambda f: f.__delitem__("shared/of_shot_000003"))
+    # layout 4: only a scene's shots share a group (a real shot alone holds its texts itself)
+    report = _edit(archive, lambda f: f.__delitem__("shared/scene_tiny"))
     rows = [b for b in report["bad"] if b["reason"].startswith("missing: ")]
     assert [(b["where"], b["shots"], b["reason"]) for b in rows] == \
-        [("/shared/of_shot_000003", [3], "missing: /shared/of_shot_000003 (shared by shot 3)")], report["bad"]
-    assert report["ok"] == 2
+        [("/shared/scene_tiny", [1, 2], "missing: /shared/scene_tiny (shared by shots 1, 2)")], report["bad"]
+    assert report["ok"] == 1
 
 
 def test_an_untouched_archive_verifies_clean(archive):

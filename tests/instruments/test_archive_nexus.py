@@ -1,6 +1,7 @@
 """The archive is NeXus that a validator accepts (nexusformat's, as ``nxcheck`` runs it),
 plus the rules the validators do not all check: valid names, NX_class on every group,
-title and start_time, signal/axes/units, volts and seconds in data/, the truth's own time."""
+title and start_time, signal/axes/units, volts and seconds in data/ (layout 4: the codes and
+the sample index, CF-packed), the truth's own time."""
 import re
 
 import h5py
@@ -45,9 +46,17 @@ def test_names_classes_and_entry_fields(archive):
         assert data.attrs["NX_class"] == "NXdata" and data.attrs["signal"] == "CH1"
         assert list(data.attrs["auxiliary_signals"]) == ["CH2"]  # every other channel, for viewers
         assert list(data.attrs["axes"]) == ["time"]
-        assert data["CH1"].dtype == np.float64 and data["CH1"].attrs["units"] == "V"
-        assert data["time"].dtype == np.float64 and data["time"].attrs["units"] == "s"
-        assert data["time"][1] - data["time"][0] == pytest.approx(1e-6, rel=1e-12)
+        # the plot is the raw codes, packed volts (CF: scale_factor, add_offset), against the
+        # sample index packed the same way into seconds
+        w = tiny_entry(1).record["CH1"]
+        ch1, time = data["CH1"], data["time"]
+        assert ch1.dtype == np.int8 and ch1.attrs["units"] == "V" and np.array_equal(ch1[()], w.codes)
+        volts = ch1[()] * ch1.attrs["scale_factor"] + ch1.attrs["add_offset"]
+        assert np.allclose(volts, w.volts(), rtol=1e-12, atol=1e-15)
+        assert time.dtype.kind == "u" and time.attrs["units"] == "s"
+        seconds = time[()] * time.attrs["scale_factor"] + time.attrs["add_offset"]
+        assert seconds[1] - seconds[0] == pytest.approx(1e-6, rel=1e-12)
+        assert np.allclose(seconds, w.time(), rtol=1e-12, atol=1e-18)
         forces = shot["truth/forces"]
         assert forces.attrs["NX_class"] == "NXdata" and list(forces.attrs["axes"]) == ["time"]
         assert forces["time"].attrs["units"] == "s" and forces["time"][1] == pytest.approx(1e-6, rel=1e-12)

@@ -7,6 +7,7 @@ from dataclasses import replace
 import h5py
 import pytest
 from test_archive import entry
+from test_archive_parts import _layout3
 
 from instruments.archive import Archive
 from instruments.archive.facts import FACTS_VERSION, GaugeFact, ShotFacts
@@ -60,41 +61,42 @@ def test_bad_facts_are_refused_naming_the_field(change, message):
         ShotFacts.from_dict(d)
 
 
-def test_unversioned_facts_of_older_archives_still_read(tmp_path):
-    path = tmp_path / "old.h5"
-    e = entry(3)
-    Archive(path).append([e])
+@pytest.mark.parametrize("layout", [3, 4])
+def test_unversioned_facts_of_older_archives_still_read(tmp_path, layout):
+    a, e = _archive(tmp_path, layout), entry(3)
+    (shot,) = a.append([e])
     old = e.facts.to_dict()
     del old["version"], old["study_shot"], old["study"], old["overrides"]
-    with h5py.File(path, "r+") as f:  # as an archive written before the version was recorded
-        _rewrite_facts(f, json.dumps(old))
-    assert Archive(path).read(1, verify=False).facts == e.facts
+    with h5py.File(a.path, "r+") as f:  # as an archive written before the version was recorded
+        _rewrite_facts(f, json.dumps(old), shot)
+    assert Archive(a.path).read(shot, verify=False).facts == e.facts
 
 
-def test_damaged_facts_name_the_shot_and_the_field(tmp_path):
-    path = tmp_path / "bad.h5"
-    Archive(path).append([entry(4)])
-    with h5py.File(path, "r+") as f:
-        d = json.loads(f["shot_000001/truth/facts"][()])
+@pytest.mark.parametrize("layout,damaged", [(3, "truth/facts"), (4, "attribute @metadata")])
+def test_damaged_facts_name_the_shot_and_the_field(tmp_path, layout, damaged):
+    a = _archive(tmp_path, layout)
+    (shot,) = a.append([entry(4)])
+    with h5py.File(a.path, "r+") as f:
+        d = _facts(f, shot)
         d["gauges"]["upper"]["position_m"] = "far"
         d["unexpected"] = 1
-        _rewrite_facts(f, json.dumps(d))
-    with pytest.raises(InstrumentError, match="shot 1: facts.unexpected: unknown key"):
-        Archive(path).read(1, verify=False)  # what a reader that skips the checksums still refuses
-    with pytest.raises(InstrumentError, match="shot 1: truth/facts: damaged"):
-        Archive(path).read(1)
+        _rewrite_facts(f, json.dumps(d), shot)
+    with pytest.raises(InstrumentError, match=f"shot {shot}: facts.unexpected: unknown key"):
+        Archive(a.path).read(shot, verify=False)  # what a reader that skips the checksums still refuses
+    with pytest.raises(InstrumentError, match=f"shot {shot}: {damaged}: damaged"):
+        Archive(a.path).read(shot)
 
 
-def test_unversioned_facts_with_a_study_s_keys_still_read(tmp_path):
-    path = tmp_path / "old.h5"
-    e = entry(5)
-    Archive(path).append([e])
+@pytest.mark.parametrize("layout", [3, 4])
+def test_unversioned_facts_with_a_study_s_keys_still_read(tmp_path, layout):
+    a, e = _archive(tmp_path, layout), entry(5)
+    (shot,) = a.append([e])
     old = e.facts.to_dict()
     del old["version"]
     old.update(study_shot=7, study="d1g35t")
-    with h5py.File(path, "r+") as f:
-        _rewrite_facts(f, json.dumps(old))
-    assert Archive(path).read(1, verify=False).facts == replace(e.facts, study_shot=7, study="d1g35t")
+    with h5py.File(a.path, "r+") as f:
+        _rewrite_facts(f, json.dumps(old), shot)
+    assert Archive(a.path).read(shot, verify=False).facts == replace(e.facts, study_shot=7, study="d1g35t")
 
 
 @pytest.mark.parametrize("facts,message", [
@@ -120,9 +122,25 @@ def test_a_shot_without_facts_reads_none(tmp_path):
     assert Archive(path).read(2).facts is None and Archive(path).read(2).truth is None
 
 
-def _rewrite_facts(f, text: str):
-    del f["shot_000001/truth/facts"]
-    f["shot_000001/truth"].create_dataset("facts", data=text)
+def _archive(tmp_path, layout: int) -> Archive:
+    """A new archive (layout 4), or a copy of a layout-3 one, which is appended to in layout 3."""
+    return _layout3(tmp_path) if layout == 3 else Archive(tmp_path / "new.h5")
+
+
+def _facts(f, shot: int) -> dict:
+    """Shot ``shot``'s stored facts: layout 4 keeps them in the shot's metadata attribute,
+    older layouts in truth/facts."""
+    g = f[f"shot_{shot:06d}"]
+    return json.loads(g.attrs["metadata"])["facts"] if "metadata" in g.attrs else json.loads(g["truth/facts"][()])
+
+
+def _rewrite_facts(f, text: str, shot: int):
+    g = f[f"shot_{shot:06d}"]
+    if "metadata" in g.attrs:
+        g.attrs["metadata"] = json.dumps(json.loads(g.attrs["metadata"]) | {"facts": json.loads(text)})
+    else:
+        del g["truth/facts"]
+        g["truth"].create_dataset("facts", data=text)
 
 
 def test_facts_and_entries_need_no_h5py():
