@@ -71,7 +71,7 @@ def atomic_writes(writes: dict) -> list:
 def cause(exc: BaseException) -> str:
     """A failure's cause in one line: the OS's words for an I/O error with an errno (ENOSPC:
     'No space left on device'), else the first line of its message."""
-    if isinstance(exc, OSError) and exc.errno in errno.errorcode:
+    if isinstance(exc, OSError) and exc.errno is not None and exc.errno in errno.errorcode:
         return os.strerror(exc.errno)
     return (str(exc).splitlines() or [type(exc).__name__])[0] or type(exc).__name__
 

@@ -45,6 +45,7 @@ class Waveform:
 
     def volts(self) -> np.ndarray:
         if self.codes is None:
+            assert self.samples is not None, f"channel {self.channel}: every reader gives codes or volts"
             return self.samples
         p = self.preamble
         return p.y_zero + p.y_multiplier * (self.codes.astype(np.float64) - p.y_offset)

@@ -29,7 +29,7 @@ def spawned_draws(seed: int, first: int, count: int, kinds, sizes) -> tuple:
     the stream of SeedSequence(seed, spawn_key=(first + s,)), and heads[s] is that
     sequence's generate_state(1, np.uint64)[0]."""
     def whole(value) -> bool:
-        return not isinstance(value, bool) and isinstance(value, numbers.Integral) and value >= 0
+        return not isinstance(value, bool) and isinstance(value, numbers.Integral) and int(value) >= 0
 
     if not whole(seed):
         raise InstrumentError(f"seed = {seed!r}: allowed a whole number >= 0")

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import importlib
+import inspect
 import os
 import pkgutil
 from pathlib import Path
@@ -86,20 +87,20 @@ def drop_stale_cache(package: str, constants: tuple = ()) -> None:
     from numba.core.dispatcher import Dispatcher
 
     root = importlib.import_module(package)
-    folder = Path(root.__file__).parent
+    folder = Path(inspect.getfile(root)).parent
     digest = hashlib.sha256()
-    sources = sorted(folder.glob("*.py")) + [Path(importlib.import_module(m).__file__) for m in constants]
+    sources = sorted(folder.glob("*.py")) + [Path(inspect.getfile(importlib.import_module(m))) for m in constants]
     for path in sources:
         digest.update(path.name.encode() + b"\0" + path.read_bytes())
     modules = [importlib.import_module(f"{package}.{m.name}") for m in pkgutil.iter_modules([str(folder)])]
-    caches = {}
+    caches: dict[str, list] = {}
     for module in modules:
         for obj in vars(module).values():
             cache = getattr(obj, "_cache", None) if isinstance(obj, Dispatcher) else None
-            if getattr(cache, "cache_path", None) and hasattr(cache, "flush"):  # None: not cached
+            if cache is not None and getattr(cache, "cache_path", None) and hasattr(cache, "flush"):  # None: not cached
                 caches.setdefault(cache.cache_path, []).append(cache)
-    for path, members in caches.items():
-        stamp = Path(path) / f"{package}.sources"
+    for cache_dir, members in caches.items():
+        stamp = Path(cache_dir) / f"{package}.sources"
         try:
             if stamp.is_file() and stamp.read_text() == digest.hexdigest():
                 continue

@@ -26,6 +26,10 @@ def _registry():
 
 MAX_SEED = 2**63 - 1  # seeds are stored as signed 64-bit integers
 
+Quantity = float | str
+"""What a part takes for a physical value: a number in SI units, or a string with its unit
+("4.76 mm", "0.47 g"); the part keeps the SI float (``quantity``)."""
+
 
 def is_real(x) -> bool:
     """A real number, numpy's scalars included, and not a bool (True is not 1 s)."""
@@ -128,7 +132,7 @@ def typed_quantity(text: str, unit: str | None, field: str) -> float:
     return number(text, field, "a finite number" + (f" (plain number: {unit})" if unit else ""))
 
 
-def quantity(value, unit: str, field: str, *, bare_ok: bool = False) -> float:
+def quantity(value: Quantity, unit: str, field: str, *, bare_ok: bool = False) -> float:
     """Return ``value`` expressed in ``unit`` (an SI unit such as "m", "kg", "Pa").
 
     ``value`` is a string with a unit ("0.47 g", "1.46 GPa"), or a plain number when

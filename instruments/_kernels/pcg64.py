@@ -50,7 +50,8 @@ def lcg128(typingctx, hi, lo, inc_hi, inc_lo):
 @jit(inline="always")
 def next64(st):
     """The next uint64 of state st (uint64[4], advanced in place): step, then XSL-RR."""
-    hi, lo = lcg128(st[0], st[1], st[2], st[3])
+    # an intrinsic takes the values in a kernel; its Python signature starts with numba's typing context
+    hi, lo = lcg128(st[0], st[1], st[2], st[3])  # type: ignore[call-arg,var-annotated]
     st[0], st[1] = hi, lo
     x = hi ^ lo
     r = hi >> U(58)
@@ -142,7 +143,7 @@ def seeded_by(entropy):
     st = np.empty(4, np.uint64)
     st[2] = (drawn[2] << U(1)) | (drawn[3] >> U(63))
     st[3] = (drawn[3] << U(1)) | U(1)
-    st[0], st[1] = lcg128(U(0), U(0), st[2], st[3])
+    st[0], st[1] = lcg128(U(0), U(0), st[2], st[3])  # type: ignore[call-arg]  # an intrinsic: see next64
     lo = st[1] + drawn[1]
     st[0] = st[0] + drawn[0] + (U(1) if lo < st[1] else U(0))
     st[1] = lo

@@ -31,3 +31,29 @@ PUBLIC = {  # {module: its public names}
     "batch": ("analysed",),
 }
 __getattr__, __all__ = lazy_names(__name__, PUBLIC)
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without loading typing; mypy and pyright read the name
+if TYPE_CHECKING:  # the names above, for type checkers and editors (tests/test_typing.py holds them equal);
+    # "X as X": re-exported, as a typed package's checkers read it
+    from .batch import analysed as analysed
+    from .condition import MIN_BASELINE as MIN_BASELINE
+    from .condition import invert_rc as invert_rc
+    from .condition import noise_level as noise_level
+    from .condition import record_forces as record_forces
+    from .find import find_pulses as find_pulses
+    from .find import first_peak_time as first_peak_time
+    from .find import leading as leading
+    from .find import reflection_time as reflection_time
+    from .find import solitary_train as solitary_train
+    from .pipeline import analyze_forces as analyze_forces
+    from .pipeline import analyze_record as analyze_record
+    from .plausibility import Limits as Limits
+    from .pulse import PeakRules as PeakRules
+    from .pulse import Pulse as Pulse
+    from .refine import refined as refined
+    from .refine import xcorr_delay as xcorr_delay
+    from .report import FIGURES as FIGURES
+    from .report import SPEED_FIGURES as SPEED_FIGURES
+    from .report import Report as Report
+    from .setup import GaugeSetup as GaugeSetup
+    from .setup import Setup as Setup

@@ -11,7 +11,7 @@ import numpy as np
 
 from .._kernels.filters import undo_highpass
 from ..errors import InstrumentError
-from ..records import ScopeRecord, time_base_mismatch
+from ..records import ScopeRecord, Waveform, time_base_mismatch
 from ._kernels import pulses
 from .setup import Setup
 
@@ -21,7 +21,8 @@ MIN_BASELINE = pulses.MIN_BASELINE  # pre-trigger samples needed to measure the 
 def record_forces(record: ScopeRecord, setup: Setup):
     """Calibrated dynamic forces (N) from a scope record: t (s from the trigger) and
     {"upper", "lower"[, "wall"]}: baseline from the pre-trigger samples, RC inverted."""
-    out, t, first = {}, None, None
+    first: Waveform | None = None
+    out, t = {}, None
     for role in ("upper", "lower", "wall"):
         g = getattr(setup, role)
         if g is None:

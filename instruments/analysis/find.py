@@ -50,7 +50,7 @@ def solitary_train(t, f, lead, cut: float, rules: PeakRules = PeakRules(), refin
     pulse, the highest (the first of equals): the flat top of a quantised pulse, whose
     flickers between two codes each reach the top code, is not a train of its own."""
     floor = 0.05 * lead.amplitude if noise is None else max(0.05 * lead.amplitude, rules.snr * noise)
-    train = []
+    train: list[Pulse] = []
     for p in find_pulses(t, f, rules, floor=floor, refine=refine):
         if not lead.time - 0.5 * lead.fwhm <= p.time < cut:
             continue

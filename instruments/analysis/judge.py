@@ -103,7 +103,7 @@ def _report(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, train
                  "the cross-correlation of the leading pulses found no positive delay")
     rep.give("width_diameters", up.fwhm * rep.speed_m_per_s / setup.bead_diameter_m, rep.reasons.get("duration_s", ""))
     if train:
-        sigma = noise and noise.get("lower")
+        sigma = noise.get("lower") if noise else None
         cut = reflection_time(t, forces, setup, low, rep.speed_m_per_s, noise)
         rep.pulses = len(solitary_train(t, forces["lower"], low, cut, rules, noise=sigma))
     else:

@@ -159,7 +159,7 @@ class Archive:
         """Layout 2: the shots written into the archive's copy."""
         start = max([int(n.split("_", 1)[1]) for n in shot_names(f)] + [0]) + 1
         ids = [start + i for i in range(len(entries))]
-        checked = {}
+        checked: dict = {}
         for shot_id, e in zip(ids, entries):
             write_entry(f, shot_id, e, checked)
         f.attrs.update({"NX_class": "NXroot", "creator": "sonic-rig", "layout_version": LAYOUT_VERSION,
@@ -215,7 +215,8 @@ class Archive:
             except Exception as exc:  # noqa: BLE001 - a missing or damaged part, one line
                 raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({cause(exc)})") from None
             try:
-                e, seen = None, {}
+                e = None
+                seen: dict = {}
                 if verify:  # read first: what it read is checked as read, not read again
                     with contextlib.suppress(Exception):  # a damaged shot: the check says what
                         e = read_shot(g, self.path, with_truth, seen=seen)

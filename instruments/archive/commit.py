@@ -6,6 +6,7 @@ memory, flushed and renamed into place) are the Archive's ``_transaction``, hand
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Callable
 from pathlib import Path
 
 from ..errors import InstrumentError
@@ -17,7 +18,7 @@ from .verify import root_seal
 
 TEXTS = {LAYOUT3: PARTS_TEXT.format(version=3, groups=2) + "\n\n" + LAYOUT,
          LAYOUT4: PARTS_TEXT.format(version=4, groups=4) + "\n\n" + LAYOUT4_TEXT}
-WRITERS = {LAYOUT3: write_entry, LAYOUT4: write_compact_entry}
+WRITERS: dict[int, Callable[..., None]] = {LAYOUT3: write_entry, LAYOUT4: write_compact_entry}
 
 
 def commit_parts(path: Path, entries: list, transaction, master=None, ids=None, part: str = "") -> list:
@@ -39,7 +40,8 @@ def commit_parts(path: Path, entries: list, transaction, master=None, ids=None, 
     part = part or (part_name(ids[0]) if ids else part_name(start))
     where = folder(path)
     made = not where.exists()
-    checked, axes = {}, {}
+    checked: dict = {}
+    axes: dict = {}
     extra = (axes,) if layout == LAYOUT4 else ()  # layout 4: the time axes shared inside the part
 
     def fill(f):

@@ -47,12 +47,12 @@ CODES = {"fletcher32": True}  # chunked (fletcher32 needs chunks), not compresse
 INDEX = {"compression": "gzip", "compression_opts": 1, "shuffle": True, "fletcher32": True}
 
 
-def write_compact_entry(f, shot_id: int, e: Entry, checked: set, stored: dict, axes: dict):
+def write_compact_entry(f, shot_id: int, e: Entry, checked: dict, stored: dict, axes: dict):
     """Write one NXentry of layout 4 into a part file, then seal its table of checksums (an
     attribute); ``checked`` and ``stored`` as for instruments.archive.layout.write_entry;
     ``axes``: the time axes this transaction wrote ({(time base, name): (dataset, digest)}),
     which a later shot of the same time base hard-links to rather than writing its own."""
-    written = {}  # digests of what this call writes, by address (digest.table)
+    written: dict = {}  # digests of what this call writes, by address (digest.table)
     where = f"shot {shot_id}"
     meta = {"scene": e.scene, "seed": e.seed, "simulated": bool(e.simulated), "triggered": bool(e.record.triggered),
             "no_trigger_reason": e.record.reason or "", "program_name": "sonic-rig",
@@ -94,7 +94,7 @@ def _write_channels(g, record: ScopeRecord, written: dict, axes: dict):
     if len(names) > 1:  # NeXus: the other channels, plotted with the signal by viewers (silx, nexpy)
         plot["auxiliary_signals"] = names[1:]
     label(data, plot, written)
-    named = {}  # {(points, x_zero, x_increment, x_unit): the axis's name in this shot}
+    named: dict = {}  # {(points, x_zero, x_increment, x_unit): the axis's name in this shot}
     for ch, name in zip(chans, names):
         w = record.waveforms[ch]
         p = w.preamble

@@ -84,7 +84,8 @@ def table(group: h5py.Group, linked: dict, written: dict | None = None) -> dict:
     value_digest of the values a writer has just given a dataset}, and {(address, name):
     the attribute_digest of an attribute's}) spares reading those back: the writer hashes
     what it wrote, in one pass."""
-    rows, a = {}, address(group)
+    rows: dict[str, str] = {}
+    a = address(group)
     _walk(group, a, "", _Tree(group, {a: "."}, {}, linked, rows, written or {}))
     return rows
 

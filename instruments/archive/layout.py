@@ -50,7 +50,7 @@ def write_entry(f: h5py.File, shot_id: int, e: Entry, checked: dict, stored: dic
     opened, the master, where it does not lie; it gives an unattached variable the
     dimension of its length in its group: ``time``)."""
     attach = stored is None
-    written = {}  # {address: value_digest} of the datasets this call writes (digest.table)
+    written: dict = {}  # {address: value_digest} of the datasets this call writes (digest.table)
     put = lambda parent, name, data, **kw: store(parent, name, data, written, **kw)
     where = f"shot {shot_id}"
     facts = facts_json(e, f"{where}: facts") if e.truth is not None else None
@@ -145,6 +145,7 @@ def _shared(f, key: str, e: Entry, where: str, checked: dict, attach: bool, writ
 
 
 def _write_forces(s, e: Entry, where: str, attach: bool, written: dict):
+    assert e.truth is not None, "written for a shot with a truth"
     names = list(e.truth)
     bad = [n for n in names if not NAME.match(n) or n in ("time", "sample")]
     if bad:

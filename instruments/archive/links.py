@@ -39,7 +39,7 @@ class OpenParts:
         if not isinstance(link, h5py.ExternalLink):
             return f[name]
         path = os.path.join(os.path.dirname(f.filename), link.filename)
-        if path != self.path:
+        if path != self.path or self.file is None:  # (a path is kept with its open file)
             self.close()
             self.file, self.path = h5py.File(path, "r"), path
         return self.file[link.path]

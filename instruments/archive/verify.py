@@ -165,7 +165,7 @@ def check(f: h5py.File) -> dict:
     for path in missing:
         bad.append(_row(_shot_id(path), path, f"missing: {path}"))
     shared, problems, linked = _shared_groups(f, bad, added)
-    users = {}
+    users: dict = {}
     with OpenParts() as parts:  # each part opened once, directly
         for name in names:
             shot_id = int(name.split("_", 1)[1])
@@ -237,7 +237,9 @@ def _shot_id(path: str):
 def _shared_groups(f, bad, added=()) -> tuple:
     """({key: group} of the readable shared groups, {key: problems} of the damaged ones,
     {address: path} of every object in them); groups in ``added`` (root paths) are left out."""
-    shared, problems, linked = {}, {}, {}
+    shared: dict = {}
+    problems: dict[str, list] = {}
+    linked: dict = {}
     try:
         keys = sorted(f["shared"]) if "shared" in f else []
     except Exception as exc:  # noqa: BLE001
@@ -266,7 +268,7 @@ def _item(problem: str) -> str:
 
 def addresses(group) -> dict:
     """{address: path} of ``group`` and every object below it."""
-    out = {}
+    out: dict = {}
 
     def visit(name, obj):
         out.setdefault(address(obj), obj.name)

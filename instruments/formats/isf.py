@@ -89,7 +89,8 @@ def read_isf(path) -> list:
     """
     path = Path(path)
     data = path.read_bytes()
-    out, pos = [], 0
+    out: list[Waveform] = []
+    pos = 0
     while pos < len(data) and data[pos:].strip():
         m = _CURVE.search(data, pos)
         if m is None:

@@ -129,7 +129,7 @@ class Engine:
             if found is not None and not unit.common:
                 path = tokens[:-1]
             handler = None if found is None else (found.command.read if unit.query else found.command.write)
-            if handler is None:
+            if found is None or handler is None:
                 self.status.post(-113, unit.header[:60])
                 continue
             try:

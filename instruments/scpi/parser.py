@@ -74,10 +74,11 @@ def split_units(message: bytes) -> list:
 def parse_unit(text: str) -> Unit:
     """One unit's header and arguments; ScpiError for a malformed one."""
     body = text.strip(" \t\r\n")
-    head, rest = re.match(r"(\S*)\s*(.*)", body, re.DOTALL).groups()
+    head, rest = (re.split(r"\s+", body, maxsplit=1) + [""])[:2]
     if not head.isascii() or not head.isprintable():
         raise ScpiError(-101, f"in header {head[:40]!r}")
     query = head.endswith("?")
+    mnemonics: tuple[str, ...]
     if COMMON.fullmatch(head):
         mnemonics, common, absolute = (head.rstrip("?").upper(),), True, True
     else:
@@ -91,7 +92,8 @@ def parse_unit(text: str) -> Unit:
 
 def parse_arguments(text: str) -> tuple:
     """The comma-separated arguments of a unit."""
-    args, i, n = [], 0, len(text)
+    args: list[Argument] = []
+    i, n = 0, len(text)
     while True:
         while i < n and text[i] in " \t\r\n":
             i += 1

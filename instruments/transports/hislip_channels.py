@@ -135,6 +135,7 @@ def _start(link: Link, header: Header) -> None:
 
 def _async_loop(link: Link) -> None:
     conn = link.asynchronous
+    assert conn is not None, "served once both channels are paired"
     while not link.closed.is_set():
         header = read_header(conn)
         kind = header.kind
@@ -168,6 +169,7 @@ def _async_loop(link: Link) -> None:
 def _lock(link: Link, header: Header) -> int:
     """An AsyncLock request (control 1) or release (control 0): the AsyncLockResponse code."""
     conn = link.asynchronous
+    assert conn is not None, "served once both channels are paired"
     if header.control == 0:
         discard(conn, header.length)
         held, link.held = link.held, None

@@ -53,6 +53,7 @@ class Link:
             self.sync.sendall(message(kind, control, parameter, payload))
 
     def send_async(self, kind: int, control: int = 0, parameter: int = 0, payload: bytes = b"") -> None:
+        assert self.asynchronous is not None, "the channels are served once both are paired"
         with self._async_out:
             self.asynchronous.sendall(message(kind, control, parameter, payload))
 

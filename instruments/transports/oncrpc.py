@@ -10,6 +10,7 @@ bounded before anything is allocated: a record fragment over the connection's li
 protocol violation (``RecordTooLarge``) on which the connection is closed unread."""
 from __future__ import annotations
 
+import builtins
 import itertools
 import socket
 import struct
@@ -104,7 +105,7 @@ class XdrReader:
             raise XdrError(f"XDR bool = {value}: allowed 0 or 1")
         return value == 1
 
-    def opaque(self, max_bytes: int = 0xFFFF_FFFF) -> bytes:
+    def opaque(self, max_bytes: builtins.int = 0xFFFF_FFFF) -> bytes:
         """Variable-length opaque data of at most ``max_bytes`` (checked before reading)."""
         n = self.uint()
         if n > max_bytes:
@@ -116,7 +117,7 @@ class XdrReader:
     string = opaque
 
     @property
-    def remaining(self) -> int:
+    def remaining(self) -> builtins.int:
         """Bytes not read yet."""
         return len(self._data) - self._pos
 

@@ -374,7 +374,7 @@ class Vxi11Server:
 
     def _device_readstb(self, r: oncrpc.XdrReader) -> bytes:
         link, error, _ = self._generic(r)
-        if error:
+        if error or link is None:  # no link: error is INVALID_LINK
             return _reply(error, 0)
         with link.cond:
             unread = link.unread()
@@ -382,16 +382,17 @@ class Vxi11Server:
 
     def _device_trigger(self, r: oncrpc.XdrReader) -> bytes:
         link, error, io_timeout_ms = self._generic(r)
-        if not error:
-            with link.cond:  # in order: after the message before it
-                error = self._await(link, lambda: not link.busy, io_timeout_ms)
+        if error or link is None:  # no link: error is INVALID_LINK
+            return _reply(error)
+        with link.cond:  # in order: after the message before it
+            error = self._await(link, lambda: not link.busy, io_timeout_ms)
         if not error:
             link.session.trigger()
         return _reply(error)
 
     def _device_clear(self, r: oncrpc.XdrReader) -> bytes:
         link, error, _ = self._generic(r)
-        if error:
+        if error or link is None:  # no link: error is INVALID_LINK
             return _reply(error)
         with link.cond:
             link.generation += 1

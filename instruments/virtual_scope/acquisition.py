@@ -110,7 +110,7 @@ class Acquisition:
             if armed and self.period_s is None:
                 return True
             now = time.monotonic()
-            if armed and now >= self.next_tick:
+            if armed and self.period_s is not None and now >= self.next_tick:
                 self.next_tick += self.period_s * (1 + math.floor((now - self.next_tick) / self.period_s))
                 return True
             self.cond.wait(self.next_tick - now if armed else None)

@@ -145,7 +145,7 @@ def register(tree, scope) -> None:
         on = c.boolean() if a.kind == "number" else c.word(("ON", "OFF", "RUN", "STOP")) in ("ON", "RUN")
         scope.acq.run(on)
 
-    def set_mode(c: Call):
+    def set_acquire_mode(c: Call):
         mode = c.word(("SAMple", "AVErage", "PEAKdetect", "HIRes", "ENVelope"))
         if mode not in ("SAMple", "AVErage"):
             raise ScpiError(-221, f"{c.header} {c.arg().text}: only SAMple and AVErage are emulated")
@@ -163,7 +163,7 @@ def register(tree, scope) -> None:
     tree.add("ACQuire:STATE", write=set_state, read=lambda c: "1" if scope.acq.acquiring else "0")
     tree.add("ACQuire:STOPAfter", write=lambda c: setattr(scope.acq, "stop_after", c.word(("RUNSTop", "SEQuence"))),
              read=lambda c: Word(scope.acq.stop_after))
-    tree.add("ACQuire:MODe", write=set_mode,
+    tree.add("ACQuire:MODe", write=set_acquire_mode,
              read=lambda c: Word("SAMple" if scope.settings["scope.mode"] == "sample" else "AVErage"))
     tree.add("ACQuire:NUMAVg", write=set_numavg, read=lambda c: str(scope.numavg))
     tree.add("ACQuire:NUMACq", read=lambda c: str(scope.acq.count))

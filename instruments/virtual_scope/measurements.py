@@ -6,6 +6,9 @@ MINimum, HIGH, LOW, MEAN, RMS, in volts. Without a record the value is 9.91E37 w
 2225, as the scopes answer; a source that is off is 2244."""
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 
 from ..scpi.engine import Call, Word
@@ -15,9 +18,10 @@ from .waveform_commands import source_waveform
 
 NO_VALUE = 9.91e37  # what a Tek scope answers for a measurement it cannot make
 SLOTS = 8
-MEASUREMENTS = {"AMPlitude": lambda v: v.max() - v.min(), "PK2pk": lambda v: v.max() - v.min(),
-                "MAXimum": np.max, "MINimum": np.min, "HIGH": np.max, "LOW": np.min, "MEAN": np.mean,
-                "RMS": lambda v: np.sqrt(np.mean(v * v))}
+MEASUREMENTS: dict[str, Callable[[np.ndarray], Any]] = {
+    "AMPlitude": lambda v: v.max() - v.min(), "PK2pk": lambda v: v.max() - v.min(),
+    "MAXimum": np.max, "MINimum": np.min, "HIGH": np.max, "LOW": np.min, "MEAN": np.mean,
+    "RMS": lambda v: np.sqrt(np.mean(v * v))}
 
 
 def default_slots(channel: str) -> dict:

@@ -58,7 +58,7 @@ class Personality:
         if self.engineering:
             exp = 3 * math.floor(exp / 3)
         mant = d.scaleb(-exp).normalize()
-        decimals = max(4 if self.engineering else 1, -mant.as_tuple().exponent)
+        decimals = max(4 if self.engineering else 1, -int(mant.as_tuple().exponent))
         text = f"{mant:.{decimals}f}"
         if self.engineering:
             return text if exp == 0 else f"{text}E{exp:+d}"

@@ -24,7 +24,7 @@ SCENES = ("ptfe52_gravity", "ptfe52_magnetic", "ptfe52_magnetic_4p25", "ptfe20_g
           "steel21_gravity", "steel21_magnetic")
 SETTINGS = (1e-3, 1e-4, 1e-5, 1e-6)
 REFERENCE_DIVISION = 1000
-QUICK = dict(cases=("ptfe52_magnetic", "steel21_magnetic"), settings=(1e-3, 1e-4))
+QUICK: dict = dict(cases=("ptfe52_magnetic", "steel21_magnetic"), settings=(1e-3, 1e-4))
 
 
 def cases(names=None):

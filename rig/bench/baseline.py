@@ -28,7 +28,7 @@ def machine(cpuinfo: str = "/proc/cpuinfo") -> str:
     """The CPU a benchmark's figures come from: its model, its widest vector extension
     (AVX-512, AVX2 or neither, from the flags in ``cpuinfo``: the kernels' floor, the square
     roots' throughput, depends on it) and the cores Python sees."""
-    model, flags = "", set()
+    model, flags = "", set[str]()
     try:
         with open(cpuinfo) as fh:
             for line in fh:

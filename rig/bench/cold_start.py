@@ -87,12 +87,12 @@ def run(rounds: int = ROUNDS, baseline: str | None = None) -> dict:
     with contextlib.ExitStack() as stack:
         if baseline:
             revisions[f"baseline {baseline}"] = stack.enter_context(checkout(baseline))
-        got = {name: [] for name in revisions}
+        got: dict[str, list] = {name: [] for name in revisions}
         for _ in range(rounds):
             for name, tree in revisions.items():
                 with tempfile.TemporaryDirectory() as tmp:
                     got[name].append(measure_revision(tree, Path(tmp)))
-    result = {"rounds": rounds, "cores": os.cpu_count(), "scene": SCENE, "study": " ".join(STUDY),
+    result: dict = {"rounds": rounds, "cores": os.cpu_count(), "scene": SCENE, "study": " ".join(STUDY),
               "targets_s": TARGETS, "revisions": {}}
     for name, runs in got.items():
         commands = runs[0]["wall_s"]

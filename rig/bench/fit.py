@@ -54,8 +54,8 @@ def run(quick: bool = False, progress=None) -> dict:
     rounds = 1 if quick else ROUNDS
     cases = {"one evaluation (baseline)": (MODELS["power law"], 1)} | {
         f"{name} ({len(bounds)} parameters)": (bounds, None) for name, bounds in MODELS.items()}
-    times = {name: [] for name in cases}
-    blocks = {}
+    times: dict[str, list] = {name: [] for name in cases}
+    blocks: dict = {}
     csv = resources.files("rig") / "scenes" / "daraio2006" / "table1_experiment.csv"
     with resources.as_file(csv) as points, tempfile.TemporaryDirectory() as tmp:
         for k in range(rounds):

@@ -80,7 +80,7 @@ def kernel_figures(repeats: int, rounds: int, baseline: str | None, progress=Non
     sizes = tuple((n, steps, min(r, repeats)) for n, steps, r in KERNEL_SIZES)
     snippet = f"import dataclasses\nimport numpy as np\nSIZES = {sizes!r}\n" + inspect.getsource(in_motion) + \
         KERNEL_SNIPPET
-    runs = {"current": [], "baseline": []}
+    runs: dict[str, list] = {"current": [], "baseline": []}
     with checkout(baseline) if baseline else contextlib.nullcontext() as tree:
         for k in range(rounds):
             if progress:
@@ -88,7 +88,7 @@ def kernel_figures(repeats: int, rounds: int, baseline: str | None, progress=Non
             runs["current"].append(measure(ROOT, snippet))
             if tree is not None:
                 runs["baseline"].append(measure(tree, snippet))
-    out = {"beads": [n for n, *_ in KERNEL_SIZES], "baseline_rev": baseline, "rounds": rounds}
+    out: dict = {"beads": [n for n, *_ in KERNEL_SIZES], "baseline_rev": baseline, "rounds": rounds}
     for who, rs in runs.items():
         if rs:
             out[who] = {str(n): statistics.median(r[str(n)] for r in rs) for n, *_ in KERNEL_SIZES}
@@ -126,6 +126,6 @@ def scaling(chain, progress=None) -> dict:
         solve(p, 2 * stepping.dt, save=save, dt=stepping, estimate=False)
         _, cpu = median_cpu(lambda: solve(p, span, save=save, dt=stepping, estimate=False), 3)
         rows.append({"beads": n, "cpu_per_simulated_s": cpu / span, "steps": steps})
-    n = np.log([r["beads"] for r in rows])
-    c = np.log([r["cpu_per_simulated_s"] for r in rows])
-    return {"dt_s": stepping.dt, "rows": rows, "exponent": float(np.polyfit(n, c, 1)[0])}
+    log_n = np.log([r["beads"] for r in rows])
+    log_c = np.log([r["cpu_per_simulated_s"] for r in rows])
+    return {"dt_s": stepping.dt, "rows": rows, "exponent": float(np.polyfit(log_n, log_c, 1)[0])}

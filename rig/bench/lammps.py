@@ -57,11 +57,12 @@ class LammpsChain:
         the last bead's radius touching at the wall's surface. A sphere of any radius
         carries the problem's constant A: k_n is set per pair of types."""
         check_conservative(problem)
-        chain, off = problem.chain, problem.offset
+        chain = problem.chain
         x_beads = chain.equilibrium_positions()
         r_beads = np.array([b.radius for b in chain.beads])
-        x, radius, kinds = list(x_beads), list(r_beads), [(b.material.name, b.diameter) for b in chain.beads]
-        if off:
+        x, radius = list(x_beads), list(r_beads)
+        kinds: list = [(b.material.name, b.diameter) for b in chain.beads]  # and "striker", "wall"
+        if chain.striker is not None:
             r_s = 0.5 * chain.striker.diameter
             x.insert(0, x_beads[0] - r_beads[0] - chain.striker.gap - r_s)
             radius.insert(0, r_s)
@@ -72,16 +73,16 @@ class LammpsChain:
             kinds.append("wall")
         types = {kind: n + 1 for n, kind in enumerate(dict.fromkeys(kinds))}
         atom_type = np.array([types[k] for k in kinds])
-        radius = np.array(radius)
-        stiffness = {}
+        radii = np.array(radius)
+        stiffness: dict[tuple, float] = {}
         for i in range(1, problem.n_bodies):
             pair = tuple(sorted((int(atom_type[i - 1]), int(atom_type[i]))))
-            reduced = radius[i - 1] * radius[i] / (radius[i - 1] + radius[i])
+            reduced = radii[i - 1] * radii[i] / (radii[i - 1] + radii[i])
             k_n = problem.A[i] / math.sqrt(reduced)
             if not math.isclose(stiffness.setdefault(pair, k_n), k_n, rel_tol=1e-12):
                 raise invalid("chain", f"types {pair}", "one pair of atom types with two Hertz constants")
         mobile = problem.invm > 0
-        return cls(np.array(x), radius, problem.mass.copy(), atom_type, stiffness, mobile)
+        return cls(np.array(x), radii, problem.mass.copy(), atom_type, stiffness, mobile)
 
     def data_file(self, shift: np.ndarray) -> str:
         """A LAMMPS data file (atom_style sphere: id type diameter density x y z), the

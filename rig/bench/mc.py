@@ -206,7 +206,7 @@ def run(rounds: int = 3, baseline: str | None = None, scaling: bool = True) -> d
     from rig.bench.baseline import ROOT, checkout, machine
     from rig.bench.baseline import measure as measure_in
 
-    runs = {"current": [], "baseline": []}
+    runs: dict[str, list] = {"current": [], "baseline": []}
     with checkout(baseline) if baseline else contextlib.nullcontext() as tree:
         for _ in range(rounds):
             runs["current"].append(measure() if tree is None else measure_in(ROOT, SNIPPET, timeout=1800))

@@ -116,12 +116,13 @@ def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
         modes = list(MODES)
     except ImportError:
         modes = ["workers", "threads"]
-    rows = {m: {} for m in modes}
+    rows: dict[str, dict] = {m: {} for m in modes}
     for n in ns:
         rows["workers"][n] = steady_run(_study(vary, n, batch, seed=1), n)
         if "dask" in rows:
             rows["dask"][n] = steady_run(_study(vary, n, batch, seed=2), n, scheduler="local")
-        if n <= numba.config.NUMBA_NUM_THREADS:
+        # numba.config sets its options at import: a checker does not see them
+        if n <= numba.config.NUMBA_NUM_THREADS:  # type: ignore[attr-defined]
             rows["threads"][n] = {"shots_per_s": thread_rate(_study(vary, 1, batch, seed=3), n)}
     for by_n in rows.values():
         for n, row in by_n.items():

@@ -78,7 +78,7 @@ def _per_step(cases: dict, rounds: int, progress) -> dict:
     dt = contact_time_scale(setups["hertz"][0]) / 8
     for p, save in setups.values():  # compile outside the clock
         solve(p, 2 * dt, save=save, dt=dt, estimate=False)
-    ns = {name: [] for name in cases}
+    ns: dict[str, list] = {name: [] for name in cases}
     for k in range(rounds):
         if progress:
             progress(f"models per step, round {k + 1} of {rounds}")
@@ -94,7 +94,7 @@ def _controlled(cases: dict, repeats: int, progress) -> dict:
     """Each case at the accuracy contract on the 52-bead scene: step, CPU (median), ratio to
     Hertz, the a-posteriori estimate, the dissipated share of the impact energy, and the
     recorded forces (for the bit comparison of the off rows)."""
-    out = {}
+    out: dict[str, dict] = {}
     for name, ov in cases.items():
         if progress:
             progress(f"models at accuracy {ACCURACY:g}: {name}")

@@ -58,10 +58,10 @@ def run(scene: str = SCENE, rounds: int = ROUNDS, cycles: int = CYCLES) -> dict:
         rig = Rig.from_scene(scene, overrides)
         rig.fire(seed=0)
         velocities = [f"{0.85 + 0.001 * k:.3f} m/s" for k in range(rounds)]
-        rows = {f"arm to record ready ({kind})": [] for kind in clients} | {"new striker velocity": [],
+        rows: dict[str, list] = {f"arm to record ready ({kind})": [] for kind in clients} | {"new striker velocity": [],
                                                                              "CURVe? 10,000 points 16-bit": [],
                                                                              f"{cycles} acquire cycles": []}
-        base = {"fire": [], "fire, new velocity": [], f"{cycles} fires": []}
+        base: dict[str, list] = {"fire": [], "fire, new velocity": [], f"{cycles} fires": []}
         for k in range(rounds):
             for kind, inst in clients.items():
                 rows[f"arm to record ready ({kind})"].append(_cpu(lambda: _arm(inst)))

@@ -151,7 +151,7 @@ def at_equal_error(rows: list, errors=EQUAL_ERRORS) -> list:
     it), and that time over srkn6b's at fixed steps."""
     out = []
     for name in dict.fromkeys(r["scenario"] for r in rows):
-        curves = {}
+        curves: dict = {}
         for r in rows:
             if r["scenario"] == name and r["error"] > 0:
                 curves.setdefault(r["method"], []).append((r["error"], r["cpu_s"]))
@@ -189,7 +189,8 @@ def run(quick: bool = False, peers: bool = False, baseline: str | None = None, p
     names = QUICK["scenarios"] if quick else tuple(SCENARIOS)
     peer_settings = QUICK["peers"] if quick else PEERS
     rounds = 1 if quick else ROUNDS
-    per_round, notes = [[] for _ in range(rounds)], []
+    per_round: list[list] = [[] for _ in range(rounds)]
+    notes: list = []
     for name, p, save, t_end in cases(names):
         if progress:
             progress(f"{name}: reference")

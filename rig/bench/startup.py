@@ -76,8 +76,8 @@ def run(rounds: int = ROUNDS) -> dict:
         cmds = _commands(Path(tmp))
         for cmd in cmds.values():  # warm the caches (numba, the file system)
             timed_child(cmd, tmp)
-        wall = {name: [] for name in cmds}
-        cpu = {name: [] for name in cmds}
+        wall: dict[str, list] = {name: [] for name in cmds}
+        cpu: dict[str, list] = {name: [] for name in cmds}
         for _ in range(rounds):
             for name, cmd in cmds.items():
                 w, c, _ = timed_child(cmd, tmp)

@@ -108,12 +108,13 @@ def scene_overrides(args, given_elsewhere: dict | None = None) -> tuple:
     that option's words}, e.g. a swept or fitted key), is refused naming both."""
     from rig.errors import invalid
 
-    items, first = tuple(args.set or ()), {}
+    items = tuple(args.set or ())
+    first: dict[str, str] = {}
     for item in items:
         key = item.split("=", 1)[0].strip()
         if key in first:
             raise invalid("--set", key, f"set twice ({first[key]!r} and {item!r}); set each key once")
-        if key in (given_elsewhere or {}):
+        if given_elsewhere and key in given_elsewhere:
             raise invalid("--set", item, f"{given_elsewhere[key]} already gives {key}; give it once")
         first[key] = item
     return items
@@ -236,7 +237,7 @@ def missing_lines(reasons: dict) -> list:
     reason", or "no result: reason" where every figure is missing for it."""
     from instruments.analysis.report import FIGURES
 
-    why = {}
+    why: dict[str, list] = {}
     for figure, reason in reasons.items():
         why.setdefault(reason, []).append(figure)
     return [f"no {'result' if set(FIGURES) <= set(figures) else ', '.join(figures)}: {reason}"
@@ -246,7 +247,7 @@ def missing_lines(reasons: dict) -> list:
 def flag_lines(flags: dict) -> list:
     """One line per reason of a block's flagged figures ({figure: why they cannot be
     trusted as they are}): "flagged F1, F2: reason"."""
-    why = {}
+    why: dict[str, list] = {}
     for figure, reason in flags.items():
         why.setdefault(reason, []).append(figure)
     return [f"flagged {', '.join(figures)}: {reason}" for reason, figures in why.items()]

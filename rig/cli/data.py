@@ -74,7 +74,7 @@ def cmd_import(args) -> dict:
         mtime = datetime.fromtimestamp(min(Path(f).stat().st_mtime for f in files), timezone.utc).isoformat()
         record = read_record(files)
         if any("@" in ch for ch in record.waveforms):  # a channel name met in two files: name them
-            seen = {}
+            seen: dict[str, str] = {}
             for f in files:
                 for w in read_waveforms(f):
                     if w.channel in seen:
@@ -89,7 +89,7 @@ def cmd_import(args) -> dict:
                              start_time=mtime, file_modification_time=mtime,
                              start_time_source="file modification time (the file holds no acquisition time)"))
     archive = Archive(args.into)
-    stored = {}  # raw-data digest -> the first shot that holds it
+    stored: dict[str, int] = {}  # raw-data digest -> the first shot that holds it
     for i, d in sorted(archive.digests().items() if Path(args.into).exists() else []):
         stored.setdefault(d, i)
     duplicates, this_import = [], set()

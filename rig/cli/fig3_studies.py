@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import types
 from pathlib import Path
 
 from rig.cli.common import check_export_folder, folder_shown, progress_bar, scene_overrides, writing_to
@@ -60,6 +61,7 @@ def run_fig3_studies(args) -> dict:
     if args.sensitivity:
         plans.append(("sensitivity", overrides))
     block, out = {"out": args.out}, Path(args.out)
+    study: types.ModuleType  # identifiability or sensitivity: each has study() and table()
     for name, plan in plans:
         if name == "identifiability":
             from rig.study import identifiability as study

@@ -2,6 +2,12 @@
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from rig.fit.observations.objective import ObservationObjective
+    from rig.fit.points import PointObjective
+    from rig.fit.traces import TraceObjective
 
 from rig.cli.common import command, count_arg, seed_arg
 
@@ -66,13 +72,14 @@ def cmd_fit(args) -> dict:
         if both:
             raise invalid("--param", both[0], f"{columns[both[0]]} already gives it: a fitted key cannot also be fixed")
         scene_overrides(args, columns)
+    objective: ObservationObjective | PointObjective | TraceObjective
     if args.observations:
         from rig.fit.observations.objective import ObservationObjective
         from rig.fit.observations.reading import read_observations
 
         observations = read_observations(args.observations, args.scene)
         objective = ObservationObjective(args.scene, params, observations, overrides, args.observations)
-    elif args.points:
+    elif points is not None:  # --points
         from rig.fit.points import PointObjective
 
         objective = PointObjective(args.scene, params, points, overrides)

@@ -54,7 +54,7 @@ def cmd_sweep(args) -> dict:
     if all(p.shot is None for p in points):  # nothing measured: a failure, not a table of reasons
         raise RigError(f"no point of the sweep gave a record; point 1 of {n} ({vary.key} = {points[0].value:g}): "
                        f"{points[0].reason}")
-    out = {"points": []}
+    out: dict[str, list] = {"points": []}
     for p in points:
         if p.shot is None:
             one = {"scenario": p.rig.name, "seed": p.seed, "overrides": list(p.rig.scene.overrides),

@@ -27,7 +27,7 @@ def cmd_theory(args) -> dict:
     if not 0 <= F0 < math.inf:
         raise RigError(f"--f0 = {args.f0!r}: precompression must be >= 0 N")
     A = hertz_constant(m.E, m.nu, a / 2, m.E, m.nu, a / 2)
-    out = {"material": m.name, "diameter_m": a, "f0_N": F0, "fm_N": None, "sound_speed_m_per_s": None,
+    out: dict = {"material": m.name, "diameter_m": a, "f0_N": F0, "fm_N": None, "sound_speed_m_per_s": None,
            "speed_m_per_s": None, "sonic_vacuum_speed_m_per_s": None, "discrete_speed_m_per_s": None,
            "discrete_lab_speed_m_per_s": None, "reasons": {}}
     reasons = out["reasons"]

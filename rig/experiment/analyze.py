@@ -21,7 +21,7 @@ from pathlib import Path
 from instruments.analysis import GaugeSetup, PeakRules, Setup, analyze_record
 from instruments.analysis.plausibility import Limits
 from instruments.analysis.report import SPEED_FIGURES, Report
-from instruments.archive import Archive
+from instruments.archive import Archive, Entry
 from instruments.errors import InstrumentError
 from instruments.formats import read_record
 from instruments.records import ScopeRecord
@@ -78,7 +78,8 @@ def analyze_paths(options: AnalyzeOptions) -> list:
     files = [p for p in paths if p not in archives]
     if options.shot is not None and not archives:
         raise invalid("--shot", options.shot, "picks a shot of an archive (.h5); scope files are one shot together")
-    shots, unread = [], {}
+    shots: list[tuple[str, Entry | None]] = []
+    unread = {}
     for a in archives:
         archive = Archive(a)
         ids = [options.shot] if options.shot is not None else archive.ids()

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+from typing import TypeGuard
 
 from instruments.devices.gauges import GaugeSettings
 from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
@@ -52,6 +53,15 @@ class Assembly:
     shots share all but the tables their draws change).
     """
 
+    holder: Holder
+    gauges: tuple[GaugeWiring, ...]
+    striker: Striker
+    magnet: RingMagnet | None
+    chain: Chain
+    wall_sensor: WallWiring | None
+    scope: Oscilloscope
+    solver: SolverSettings
+
     def __init__(self, scene: Scene, bead_masses=None, like: Assembly | None = None):
         if not isinstance(scene, Scene):
             raise invalid("scene", scene, "a Scene (rig.experiment.scene.load); Rig.from_scene takes a name or path")
@@ -74,18 +84,19 @@ class Assembly:
             if table not in v:
                 raise invalid(f"scene [{table}]", None, "this table is required")
 
-        def shared(*tables):  # built from the very same tables as like's: take like's
+        def shared(like: Assembly | None, *tables: str) -> TypeGuard[Assembly]:
+            """Built from the very same tables as ``like``'s: take like's."""
             return like is not None and all(v.get(t) is like.values.get(t) for t in tables)
 
         with scene_key("holder"):
-            self.holder = like.holder if shared("holder") else Holder(**v["holder"])
+            self.holder = like.holder if shared(like, "holder") else Holder(**v["holder"])
         beads, first = self._beads(v["chain"])
-        if shared("gauges", "chain"):
+        if shared(like, "gauges", "chain"):
             self.gauges = like.gauges
         else:
             self.gauges = tuple(self._gauge(name, dict(g), first, len(beads))
                                 for name, g in sorted(v.get("gauges", {}).items()))
-            on = {}
+            on: dict[int, str] = {}
             for g in self.gauges:  # one gauge per bead: a bead holds one piezo plate
                 if g.bead in on:
                     raise RigError(f"gauges.{on[g.bead]} and gauges.{g.name} are both on bead {g.bead - first + 1} "
@@ -100,9 +111,9 @@ class Assembly:
             with scene_key(f"gauges.{g.name}"):
                 beads[g.bead] = GaugeBead.like(beads[g.bead], mass=g.mass)
         with scene_key("striker"):
-            self.striker = like.striker if shared("striker") else Striker(**v["striker"])
+            self.striker = like.striker if shared(like, "striker") else Striker(**v["striker"])
         self.holder.check(beads, self.striker)
-        if shared("magnet"):
+        if shared(like, "magnet"):
             self.magnet = like.magnet
         else:
             with scene_key("magnet"):
@@ -110,7 +121,7 @@ class Assembly:
         if self.magnet is not None and not first:
             raise invalid("magnet", "set", "a ring magnet needs chain.magnetic_bead = true")
         with scene_key("wall"):
-            wall = like.chain.wall if shared("wall") else Wall(**v["wall"])
+            wall = like.chain.wall if shared(like, "wall") else Wall(**v["wall"])
         c, h = v["chain"], self.holder
         self.chain = Chain(beads, striker=self.striker, wall=wall, gravity=h.gravity,
                            top_force=self.magnet.top_force() if self.magnet else 0.0,
@@ -118,7 +129,7 @@ class Assembly:
                            **{key: c[key] for key in LAW_PARAMETERS if key in c},
                            drag=h.drag, friction=h.friction, slip_speed=h.slip_speed,
                            hold=self.magnet.held if self.magnet else 0.0)
-        if shared("wall_sensor"):
+        if shared(like, "wall_sensor"):
             self.wall_sensor = like.wall_sensor
         elif "wall_sensor" in v:
             ws = dict(v["wall_sensor"])
@@ -126,11 +137,11 @@ class Assembly:
                 self.wall_sensor = WallWiring(ws.pop("channel", None), GaugeSettings(misalignment_sd=0.0, **ws))
         else:
             self.wall_sensor = None
-        self.scope = like.scope if shared("scope") else self._scope(v["scope"])
-        if not shared("gauges", "chain", "wall_sensor", "scope"):
+        self.scope = like.scope if shared(like, "scope") else self._scope(v["scope"])
+        if not shared(like, "gauges", "chain", "wall_sensor", "scope"):
             self._check_connections()
         with scene_key("solver"):
-            self.solver = like.solver if shared("solver") else SolverSettings.from_table(v["solver"])
+            self.solver = like.solver if shared(like, "solver") else SolverSettings.from_table(v["solver"])
 
     def _beads(self, table: dict) -> tuple:
         """(the chain's beads, 1 if the top one is the magnetic bead else 0)."""
@@ -144,10 +155,11 @@ class Assembly:
             if "youngs_modulus" in c or "poisson_ratio" in c:
                 mat = Material(mat.name, c.get("youngs_modulus", mat.E), c.get("poisson_ratio", mat.nu), mat.rho,
                                mat.source + "; elastic constants set by the scene")
-            plain = Bead(mat, c.get("diameter"), c.get("mass"))
+            # a missing diameter (None) is refused by Bead, naming the key
+            plain = Bead(mat, c.get("diameter"), c.get("mass"))  # type: ignore[arg-type]
         magnetic = MagneticBead()
         if "magnetic_youngs_modulus" in c or "magnetic_poisson_ratio" in c:
-            m = magnetic.material
+            m = material(magnetic.material)
             with scene_key("chain", "magnetic_"):
                 magnetic = MagneticBead(Material(m.name, c.get("magnetic_youngs_modulus", m.E),
                                                  c.get("magnetic_poisson_ratio", m.nu), m.rho,
@@ -192,7 +204,7 @@ class Assembly:
             return Oscilloscope(channels=channels, timebase=timebase, trigger=trigger, **s)
 
     def _check_connections(self):
-        used = {}
+        used: dict[str, str] = {}  # {channel: the key that took it}
         wiring = [(f"gauges.{g.name}.channel", g.channel) for g in self.gauges]
         if self.wall_sensor is not None:
             wiring.append(("wall_sensor.channel", self.wall_sensor.channel))

@@ -70,7 +70,7 @@ def truth_report(rig, truth) -> Report:
         forces["wall"] = truth.wall_force - truth.wall_force[0]
     t = np.arange(forces["upper"].size) * h
     rep = analyze_forces(t, forces, setup)
-    if rep.speed_m_per_s is None:
+    if rep.speed_m_per_s is None or rep.averaged_amplitude_N is None:
         return rep
     peaks = []
     for g, lead in ((up, rep.leading["upper"]), (low, rep.leading["lower"])):

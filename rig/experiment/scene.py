@@ -133,7 +133,7 @@ def apply_override(raw: dict, item: str):
 def schema_node(key: str):
     """The SCHEMA entry of a dotted key: a type, a unit string, or a table (dict).
     KeyError(i) names the first part of the key that the schema does not know."""
-    node = SCHEMA
+    node: object = SCHEMA
     for i, p in enumerate(key.split(".")):
         if not isinstance(node, dict) or (p not in node and "*" not in node):
             raise KeyError(i)

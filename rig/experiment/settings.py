@@ -39,7 +39,7 @@ class SolverSettings:
 
     method: str = "srkn6b"
     accuracy: float | None = None
-    duration: float | None = None
+    duration: float = math.nan  # required: __post_init__ refuses a missing one
     sample_interval: float = 1e-7
 
     def __post_init__(self):
@@ -57,5 +57,6 @@ class SolverSettings:
 
     @classmethod
     def from_table(cls, table: dict) -> "SolverSettings":
-        return cls(table.get("method", "srkn6b"), table.get("accuracy"), table.get("duration"),
+        duration = table.get("duration")  # None (missing): refused by __post_init__, naming the key
+        return cls(table.get("method", "srkn6b"), table.get("accuracy"), duration,  # type: ignore[arg-type]
                    table.get("sample_interval", 1e-7))

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from instruments.analysis.report import Report
 from instruments.devices.gauges import GaugeDraw, PiezoGauge
 from instruments.records import ScopeRecord
 from rig.errors import RigError, invalid
@@ -78,8 +79,8 @@ class Rig(Assembly):
 
     def __init__(self, scene, bead_masses=None, like: Assembly | None = None):
         super().__init__(scene, bead_masses, like)
-        self._solution = None
-        self._truth_report = None
+        self._solution: Solution | None = None
+        self._truth_report: Report | None = None
 
     @classmethod
     def from_scene(cls, name_or_path, overrides=()) -> "Rig":
@@ -157,7 +158,7 @@ class Rig(Assembly):
             inputs[g.channel] = PiezoGauge(g.settings).read(forces.gauges[g.name].average_force, h, draw, rng,
                                                             forces.wave_speed_m_per_s)
             rest[g.channel] = g.settings.noise
-        if self.wall_sensor is not None:
+        if self.wall_sensor is not None and forces.wall_force is not None:  # a wall sensor's truth has it
             draw = GaugeDraw.draw(self.wall_sensor.settings, rng)
             draws["wall_sensor"] = {"gain": draw.gain}
             inputs[self.wall_sensor.channel] = PiezoGauge(self.wall_sensor.settings).read(forces.wall_force, h,

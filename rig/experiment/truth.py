@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from instruments.analysis import first_peak_time
+from rig.errors import RigError
 
 
 @dataclass(frozen=True, eq=False)
@@ -31,6 +32,12 @@ class Truth:
     gauges: dict
     wall_force: np.ndarray | None
     wave_speed_m_per_s: float | None
+
+    def wall(self) -> np.ndarray:
+        """The wall sensor's force (N); RigError where the scene has no wall sensor."""
+        if self.wall_force is None:
+            raise RigError("the scene has no [wall_sensor]: no wall force was recorded")
+        return self.wall_force
 
 
 def truth_of(assembly, solution) -> Truth:

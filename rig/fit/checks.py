@@ -68,7 +68,7 @@ def check_data_count(n_data: int, n_params: int, n_nuisance: int, what: str) -> 
 
 def check_distinct_files(field: str, paths) -> None:
     """Refuse the same file (or the same bytes under another name) given twice."""
-    seen = {}
+    seen: dict[str, str] = {}
     for path in paths:
         try:
             digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()
@@ -82,7 +82,7 @@ def check_distinct_files(field: str, paths) -> None:
 
 def check_distinct_channels(channels: list) -> None:
     """Refuse two fitted channels with the same samples (the same shot twice in an archive)."""
-    seen = {}
+    seen: dict[str, str] = {}
     for c in channels:
         digest = hashlib.sha256(c.t.tobytes() + c.y.tobytes()).hexdigest()
         if digest in seen:

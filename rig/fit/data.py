@@ -92,7 +92,7 @@ def read_points(path) -> Points:
     missing = [c for c in POINT_COLUMNS if c not in names]
     if missing:
         raise invalid(f"--points {path}", ", ".join(names), f"columns missing: {', '.join(missing)}")
-    data = {n: [] for n in names}
+    data: dict[str, list[float]] = {n: [] for n in names}
     for i, row in zip(lines[1:], rows[1:]):
         if len(row) != len(columns):
             raise invalid(f"--points {path} line {i}", ",".join(row), f"{len(columns)} values")
@@ -113,7 +113,7 @@ def read_points(path) -> Points:
             j = int(np.flatnonzero(arr[name] <= 0)[0])
             raise invalid(f"--points {path} line {lines[j + 1]} {name}", float(arr[name][j]),
                           "> 0 (forces, speeds and uncertainties)")
-    first = {}
+    first: dict[tuple, int] = {}
     for j, values in enumerate(zip(*(arr[n] for n in names))):
         if values in first:
             raise invalid(f"--points {path} line {lines[j + 1]}", ",".join(rows[j + 1]),

@@ -74,9 +74,10 @@ def leading_window(rigs: list) -> float:
     at the a-priori step over its scene's duration (at most that duration); inf where a
     shot shows no leading pulse."""
     ends = [leading_end(r.truth_analysis()) if good else None for r, good in zip(rigs, solve_rigs(rigs))]
-    if not ends or None in ends:
+    found = [end for end in ends if end is not None]
+    if not ends or len(found) < len(ends):
         return math.inf
-    window = WINDOW_MARGIN * max(ends)
+    window = WINDOW_MARGIN * max(found)
     return window if window < min(r.solver.duration for r in rigs) else math.inf
 
 

@@ -20,6 +20,7 @@ import math
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy import optimize, stats
@@ -58,7 +59,7 @@ class FitResult:
     at_bound: tuple
     nuisance: dict = field(default_factory=dict)
     eta: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    model: object = None
+    model: Any = None  # the objective's own form of its model at the fit (curves, traces, figures)
     replayed: int = 0  # candidates read back from the cache of an earlier run (evaluations: solved in this one)
     bounds: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (lo, hi) of each parameter, SI
     jacobian: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  # of the residuals at the estimate,
@@ -114,7 +115,7 @@ class EvaluationCache:
 
     def __init__(self, objective, folder: Path | None):
         self.objective = objective
-        self.memory = {}
+        self.memory: dict[tuple, object] = {}
         self.folder = None if folder is None else Path(folder)
         self.spec = hashlib.sha256(json.dumps(objective.spec(), sort_keys=True).encode()).hexdigest()[:16]
         self.solved = 0  # candidates solved in this run (not replayed from disk)
@@ -126,6 +127,7 @@ class EvaluationCache:
                 raise RigError(f"fit cache {self.folder}: cannot create ({exc.strerror})") from None
 
     def _path(self, key: tuple) -> Path:
+        assert self.folder is not None, "only a cache with a folder keeps files"
         digest = hashlib.sha256((self.spec + repr(key)).encode()).hexdigest()[:20]
         return self.folder / f"{digest}.npz"
 

@@ -84,8 +84,13 @@ def profiled_chi2(objective, model, eta0: np.ndarray, bounds) -> float:
     if eta0.size == 0:
         r = objective.residuals(model, eta0)
         return float(r @ r)
-    res = optimize.least_squares(lambda e: objective.residuals(model, e), eta0,
-                                 jac=lambda e: objective.nuisance_jacobian(model, e), bounds=bounds,
+    def residuals(eta: np.ndarray) -> np.ndarray:
+        return objective.residuals(model, eta)
+
+    def jacobian(eta: np.ndarray) -> np.ndarray:
+        return objective.nuisance_jacobian(model, eta)
+
+    res = optimize.least_squares(residuals, eta0, jac=jacobian, bounds=bounds,
                                  method="trf", xtol=1e-8, ftol=1e-10)
     return float(2.0 * res.cost)
 

@@ -103,12 +103,13 @@ def model_traces(rig: Rig) -> dict:
     truth = rig.truth()
     h = truth.sample_interval
     inputs = {}
+    silent = np.random.default_rng(0)  # the gauges have no noise: nothing is drawn from it
     for g in rig.gauges:
         gauge = PiezoGauge(replace(g.settings, noise=0.0))
-        inputs[g.channel] = gauge.read(truth.gauges[g.name].average_force, h, GaugeDraw(1.0, 0.0), None)
-    if rig.wall_sensor is not None:
+        inputs[g.channel] = gauge.read(truth.gauges[g.name].average_force, h, GaugeDraw(1.0, 0.0), silent)
+    if rig.wall_sensor is not None and truth.wall_force is not None:  # a wall sensor's truth has it
         gauge = PiezoGauge(replace(rig.wall_sensor.settings, noise=0.0))
-        inputs[rig.wall_sensor.channel] = gauge.read(truth.wall_force, h, GaugeDraw(1.0, 0.0), None)
+        inputs[rig.wall_sensor.channel] = gauge.read(truth.wall_force, h, GaugeDraw(1.0, 0.0), silent)
     analog = rig.scope.analog(inputs, h)
     return {"h": np.array([h]), **{ch: analog[c] for c, ch in enumerate(rig.scope.channels) if ch in inputs}}
 
@@ -213,7 +214,7 @@ class TraceObjective:
         t0, gains, delays = self._split(eta)
         h = float(model["h"][0])
         t0 = t0 + self.trigger_time(model) / US
-        out = []
+        out: list[np.ndarray | None] = []
         for k, c in enumerate(self.channels):
             m = model.get(c.name)
             if m is None or not math.isfinite(h):

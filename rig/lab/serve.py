@@ -134,7 +134,7 @@ class ScopeServer:
                              "RIG: commands, raw socket", "--rig-port", s.rig_port)
             self.resources.append(f"{rp.resource} (RIG: commands)")
 
-    def _start(self, make, what: str, option: str, port: int):
+    def _start(self, make, what: str, option: str, port: int | str):
         """Start the server ``make()`` builds; a port it cannot take is one line naming the
         option."""
         try:

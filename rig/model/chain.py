@@ -77,6 +77,18 @@ class Chain:
     chain before the shot (a yielding law flattens the loaded contacts at its static yield).
     """
 
+    # the laws' parameters (rig.model.laws.PARAMETERS, SI units), set from ``contact`` in __init__
+    contact_exponent: float
+    reference_force: float
+    damping_time: float
+    contact_damping: float
+    dashpot_gamma: float
+    dashpot_exponent: float
+    yield_force: float
+    yield_rate_exponent: float
+    yield_reference_rate: float
+    static_yield_ratio: float
+
     def __init__(self, beads, *, striker: Striker | None = None, wall: Wall | None = None,
                  gravity: float = STANDARD_GRAVITY, top_force=0.0,
                  contact_law: str = "hertz", drag=0.0, friction=0.0, slip_speed=1e-3, hold=0.0, **contact):
@@ -98,6 +110,7 @@ class Chain:
         self.gravity = quantity(gravity, "m/s^2", "chain.gravity", bare_ok=True)
         if self.gravity < 0:
             raise invalid("chain.gravity", gravity, "must be >= 0 m/s^2 (x points down)")
+        self.top_force: float | ForceSchedule
         if isinstance(top_force, ForceSchedule):
             self.top_force = top_force
         else:
@@ -138,7 +151,7 @@ class Chain:
     @property
     def body_masses(self) -> np.ndarray:
         """The beads' masses (kg), and a compliant wall's plate last."""
-        if self.wall is not None and self.wall.compliant:
+        if self.wall is not None and self.wall.plate_mass is not None:  # a compliant wall
             return np.append(self.masses, self.wall.plate_mass)
         return self.masses
 

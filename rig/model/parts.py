@@ -9,10 +9,11 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING
 
 from rig.errors import invalid
 from rig.model.materials import Material, material
-from rig.units import is_real, quantity
+from rig.units import Quantity, is_real, quantity
 
 # Published PTFE gauge bead (Daraio et al. 2006): caps 0.093 g, plate 0.023 g, of a 0.1226 g bead.
 PTFE_GAUGE_CAPS_FRACTION = 0.093 / 0.1226
@@ -31,10 +32,13 @@ def _unit_fields(cls) -> tuple:
 class _Part:
     """Shared construction: look the material up, convert quantities, validate."""
 
+    material: Material | str
+
     def _convert(self, prefix: str):
         if not isinstance(self.material, Material):
             object.__setattr__(self, "material", material(self.material))
-        for name in _unit_fields(type(self)):
+        # a class is hashable: typeshed's Hashable check trips on a dataclass's __hash__
+        for name in _unit_fields(type(self)):  # type: ignore[arg-type]
             value = getattr(self, name)
             if value is None:
                 continue
@@ -57,11 +61,14 @@ class Bead(_Part):
     diameter: float
     mass: float | None = None
 
+    if TYPE_CHECKING:  # what the constructor takes (a quantity with its unit); the fields hold SI floats
+        def __init__(self, material: Material | str, diameter: Quantity, mass: Quantity | None = None) -> None: ...
+
     def __post_init__(self):
         self._convert("bead")
         self._positive("bead", "diameter")
         if self.mass is None:
-            object.__setattr__(self, "mass", self.material.rho * math.pi * self.diameter**3 / 6.0)
+            object.__setattr__(self, "mass", material(self.material).rho * math.pi * self.diameter**3 / 6.0)
         self._positive("bead", "mass")
 
     @property
@@ -90,6 +97,10 @@ class MagneticBead(Bead):
     mass: float | None = 0.5e-3
     kind = "magnetic"
 
+    if TYPE_CHECKING:  # what the constructor takes (a quantity with its unit); the fields hold SI floats
+        def __init__(self, material: Material | str = "chrome_steel", diameter: Quantity = 5e-3,
+                     mass: Quantity | None = 0.5e-3) -> None: ...
+
 
 @dataclass(frozen=True)
 class GaugeBead(Bead):
@@ -105,15 +116,21 @@ class GaugeBead(Bead):
     plate_mass: float | None = PZT_PLATE_MASS
     kind = "gauge"
 
+    if TYPE_CHECKING:  # what the constructor takes (a quantity with its unit); the fields hold SI floats
+        def __init__(self, material: Material | str, diameter: Quantity, mass: Quantity | None = None,
+                     caps_mass: Quantity | None = None, plate_mass: Quantity | None = PZT_PLATE_MASS) -> None: ...
+
     def __post_init__(self):
         self._convert("gauge_bead")
         self._positive("gauge_bead", "diameter", "plate_mass")
         if self.caps_mass is None:
             plain = self.mass if self.mass is not None else (
-                self.material.rho * math.pi * self.diameter**3 / 6.0)
+                material(self.material).rho * math.pi * self.diameter**3 / 6.0)
             object.__setattr__(self, "caps_mass", self.caps_of(plain))
         self._positive("gauge_bead", "caps_mass")
-        object.__setattr__(self, "mass", self.caps_mass + self.plate_mass)
+        caps, plate = self.caps_mass, self.plate_mass
+        assert caps is not None and plate is not None, "both were just checked > 0"
+        object.__setattr__(self, "mass", caps + plate)
 
     @staticmethod
     def caps_of(plain_mass):
@@ -149,6 +166,10 @@ class Striker(_Part):
     gap: float = 0.0
     kind = "striker"
 
+    if TYPE_CHECKING:  # what the constructor takes (a quantity with its unit); the fields hold SI floats
+        def __init__(self, material: Material | str = "alumina", mass: Quantity = 0.47e-3, velocity: Quantity = 0.89,
+                     diameter: Quantity = 4.76e-3, gap: Quantity = 0.0) -> None: ...
+
     def __post_init__(self):
         self._convert("striker")
         self._positive("striker", "mass", "velocity", "diameter")
@@ -163,7 +184,7 @@ class Striker(_Part):
     @property
     def length(self) -> float:
         """Cylinder length (m) from mass, density and diameter."""
-        return self.mass / (self.material.rho * math.pi * self.diameter**2 / 4.0)
+        return self.mass / (material(self.material).rho * math.pi * self.diameter**2 / 4.0)
 
 
 @dataclass(frozen=True)
@@ -181,6 +202,10 @@ class Wall(_Part):
     plate_mass: float | None = None
     rod_stiffness: float | None = None
     kind = "wall"
+
+    if TYPE_CHECKING:  # what the constructor takes (a quantity with its unit); the fields hold SI floats
+        def __init__(self, material: Material | str = "brass", plate_mass: Quantity | None = None,
+                     rod_stiffness: Quantity | None = None) -> None: ...
 
     def __post_init__(self):
         self._convert("wall")

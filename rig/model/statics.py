@@ -9,7 +9,7 @@ d0 = (F/A)^(1/n) ((F/A)^(2/3) for Hertz), so nothing moves before impact.
 from __future__ import annotations
 
 import math
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -63,7 +63,7 @@ def contact_constants_of(chain: Layout, E=None, nu=None) -> np.ndarray:
     b = chain.beads
     plain = next((x.material for x in b if x.kind != "magnetic"), None)
 
-    def elastic(m):
+    def elastic(m) -> tuple[Any, Any]:
         if m is plain and E is not None:
             return np.asarray(E, dtype=float), np.asarray(nu, dtype=float)
         return m.E, m.nu

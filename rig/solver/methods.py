@@ -54,7 +54,7 @@ def harmonic_stability_limit(drifts: tuple, kicks: tuple, z_max: float = 20.0) -
     return float(z[np.argmax(unstable)]) if unstable.any() else z_max
 
 
-def _srkn6b():
+def _srkn6b() -> tuple[tuple, tuple]:
     # Blanes & Moan, J. Comput. Appl. Math. 142, 313 (2002), Table 3, SRKN_6^b (order 4).
     b1, b2, b3 = 0.0829844064174052, 0.396309801498368, -0.0390563049223486
     a1, a2 = 0.245298957184271, 0.604872665711080

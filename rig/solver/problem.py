@@ -121,12 +121,13 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     top = np.asarray(top_force, dtype=float).reshape(-1)
     S, n = masses.shape
     off = 1 if chain.striker is not None else 0
-    plate = chain.wall is not None and chain.wall.compliant
+    plate_mass = None if chain.wall is None else chain.wall.plate_mass  # None: no wall, or a rigid one
+    plate = plate_mass is not None
     nb = off + n + (1 if chain.wall is not None else 0) + (1 if plate else 0)
-    bodies = np.concatenate((masses, np.full((S, 1), chain.wall.plate_mass)), axis=1) if plate else masses
+    bodies = np.concatenate((masses, np.full((S, 1), plate_mass)), axis=1) if plate else masses
     mass = np.zeros((S, nb))
     mass[:, off:off + bodies.shape[1]] = bodies
-    if off:
+    if chain.striker is not None:
         striker_mass = np.full(S, chain.striker.mass) if striker_mass is None else np.asarray(striker_mass, float)
         velocity = np.full(S, chain.striker.velocity) if velocity is None else np.asarray(velocity, float)
         mass[:, 0] = striker_mass
@@ -160,7 +161,7 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     yield_rate_exponent, yield_reference_rate = np.zeros((S, nb)), np.ones((S, nb))
     yield_rate_exponent[:, slot[live]], yield_reference_rate[:, slot[live]] = m_c[live], r_c[live]
     d_limit[:, slot[live]] = 0.5 * near[live]
-    if off:
+    if chain.striker is not None:
         d0[:, 1] = -chain.striker.gap
     balance_at_rest(load, A, d0, expo, invm)  # before d_limit, f0, e_scale read d0
     state[STATE_ROWS.index("shifted_rest_overlap")] = d0 - state[STATE_ROWS.index("permanent_overlap")]

@@ -3,11 +3,15 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rig.model.contact import hertz_energy
 from rig.solver.kernels import report as slot
+
+if TYPE_CHECKING:
+    from rig.solver.problem import ChainProblem
 
 
 class Status(enum.IntEnum):
@@ -139,7 +143,7 @@ class Solution:
     final_u: np.ndarray
     final_v: np.ndarray
     stats: SolverStats
-    problem: object
+    problem: ChainProblem
     status: Status = Status.SUCCESS
     detail: str = ""
 

@@ -85,7 +85,7 @@ def shot_rig(study: MonteCarloSpec, x: dict, masses) -> tuple:
     """Shot inputs x (and bead masses) -> (the shot's rig, its instrument draws)."""
     template = nominal(study.scene, tuple(study.overrides)).template(study.window)
     v = dict(template.values)
-    draws = {}
+    draws: dict = {}
     for key, val in x.items():
         parts = key.split(".")
         if parts[0] == "gauges" and parts[-1] in ("gain", "misalignment"):
@@ -136,7 +136,7 @@ def _batch(study: MonteCarloSpec, b: int) -> BatchResult:
     seeds = [seed for *_, seed in drawn]
     xs = np.array([[x[k] for k in study.keys] for x, *_ in drawn], dtype=float).reshape(hi - lo, len(study.keys))
     template = nom.template(study.window)
-    traces = []
+    traces: list = []
     if study.truth or study.traces or not array_keys(study.keys, template):
         rigs, draws = {}, {}
         for j, (x, masses, _) in enumerate(drawn):
@@ -189,7 +189,7 @@ def _fire_arrays(study: MonteCarloSpec, nom, template: Rig, drawn: list, out: di
             out["failure"][j] = Failure.SHORT_WINDOW
             continue
         triggered = records.outcome(e) is AcquisitionStatus.OK
-        _outputs(out, j, reports[e], None, float(energy_errors[e]), ens.dt, triggered,
+        _outputs(out, int(j), reports[e], None, float(energy_errors[e]), ens.dt, triggered,
                  bool(records.over[e, roles].any()))
 
 
@@ -234,6 +234,7 @@ def _fire_rigs(study: MonteCarloSpec, nom, rigs: dict, draws: dict, seeds: list,
             from rig.experiment.entry import shot_entry  # the archive's Entry (h5py): only with traces
 
             entry = shot_entry(shot)
+            assert entry.facts is not None, "shot_entry writes the shot's facts"
             calibration = {"beta": beta, "static_force_N": F0, "basis": "the study's nominal shot"}  # what it applied
             traces.append(replace(entry, truth_key=None, facts=replace(entry.facts, study_shot=lo + j,
                                                                        study=study.digest(), analysis=calibration)))

@@ -108,6 +108,7 @@ class Distribution:
                    "truncnormal": (p[2], p[3]) if k == "truncnormal" else None,
                    "uniform": (p[0], p[1]) if k == "uniform" else None,
                    "lognormal": (0.0, math.inf)}[k]
+        assert support is not None, "k is one of the four kinds"
         below = support[0] <= lo if lo_open else support[0] < lo
         above = support[1] >= hi if math.isfinite(hi) else False
         if k == "lognormal" and lo >= 0:

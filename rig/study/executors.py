@@ -53,7 +53,7 @@ class WorkerWatch:
 
         self.timeout = timeout
         self.clock = clock or time.monotonic
-        self.since = None
+        self.since: float | None = None
 
     def seen(self):
         """A worker just delivered a batch: it is alive."""
@@ -134,7 +134,8 @@ def _dask(study, store, todo, scheduler, workers, writer, watch: WorkerWatch):
             raise RigError(f"--scheduler = {scheduler!r}: allowed 'local' or a scheduler's address such as "
                            f"tcp://HOST:PORT ({exc})") from None
     try:
-        finished = queue.SimpleQueue()  # each future once it is done (Dask calls back on a thread of its own)
+        # each future once it is done (Dask calls back on a thread of its own)
+        finished: queue.SimpleQueue = queue.SimpleQueue()
         futures = [client.submit(run_batch_alone, study, b, pure=False) for b in todo]
         for fut in futures:
             fut.add_done_callback(finished.put)

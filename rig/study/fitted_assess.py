@@ -130,7 +130,7 @@ def assess(family: Family, points, observations, tell, done=()) -> Assessment:
     """The family's joint fit and held-out prediction (module doc), its fit starting where
     the Assessment in ``done`` of the family it starts from ended; a family this version
     cannot fit is skipped, one whose fit the rig refuses is failed, each with the reason."""
-    row = {"note": family.note, "fitted_keys": list(family.params), "fixed": list(family.fixed),
+    row: dict = {"note": family.note, "fitted_keys": list(family.params), "fixed": list(family.fixed),
            "magnetic_only": list(family.magnetic), "skipped": unavailable(family) or None, "failed": None}
     if row["skipped"]:
         tell(f"{family.name}: skipped")

@@ -170,7 +170,7 @@ def objective(family: Family, points: Points, observations: tuple, start: dict |
     values for the others."""
     params = parse_parameters(family.params)
     points, observations = with_magnetic(family, points, observations)
-    parts = []
+    parts: list[PointObjective | ObservationObjective] = []
     if points.n:
         parts.append(PointObjective(SCENE, params, points, family.fixed))
     if observations:

@@ -167,9 +167,9 @@ def coverage(param: FitParameter, truth: float, overrides=(), observations=None,
         rows.append((est, std, ok, ok and lo <= truth <= hi, (lo, hi)))
         tell(f"{param.key}: fit {i + 1}/{n}: {param.shown(est)} +- {param.shown(std)} "
              f"({sum(r[3] for r in rows)}/{i + 1} intervals hold the truth)")
-    est, std, ok, holds, intervals = (tuple(col) for col in zip(*rows))
-    return Coverage(param.key, param.unit, truth, param.lo, param.hi, overrides[:-1], seed, est, std, ok, holds,
-                    intervals, time.perf_counter() - start)
+    estimates, stds, converged, holds, intervals = (tuple(col) for col in zip(*rows))
+    return Coverage(param.key, param.unit, truth, param.lo, param.hi, overrides[:-1], seed, estimates, stds, converged,
+                    holds, intervals, time.perf_counter() - start)
 
 
 def question_coverage(question: Question, n: int = DRAWS, seed: int = 0, progress=None) -> Coverage:

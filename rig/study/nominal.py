@@ -37,8 +37,8 @@ class Nominal:
 
     def __init__(self, scene: str, overrides: tuple):
         self.rig = Rig(scene_io.load(scene, overrides))  # validates
-        self._templates = {}
-        self._pilots = {}
+        self._templates: dict[str, Rig] = {}
+        self._pilots: dict[tuple, object] = {}
 
     @functools.cached_property
     def calibration(self) -> tuple:

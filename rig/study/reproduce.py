@@ -49,7 +49,7 @@ def autoscaled(scene: str, overrides=()) -> Rig:
         peaks[gauge.channel] = gauge.settings.sensitivity * float(np.max(g.average_force - g.average_force[0]))
     if rig.wall_sensor is not None:
         ws = rig.wall_sensor
-        peaks[ws.channel] = ws.settings.sensitivity * float(np.max(truth.wall_force - truth.wall_force[0]))
+        peaks[ws.channel] = ws.settings.sensitivity * float(np.max(truth.wall() - truth.wall()[0]))
     for ch, v in peaks.items():
         extra.append(f"scope.channels.{ch}.volts_per_div={_step_125(v / 5.0)!r}")
     extra.append(f"scope.trigger.level={0.15 * peaks[rig.scope.trigger.source]!r}")
@@ -87,7 +87,7 @@ def reproduce(study: str, out, progress=None) -> dict:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     tick = progress or (lambda *a: None)
-    results = {"table1": [], "scenes": {}, "sweeps": {}, "mass_ratio": []}  # JSON-ready
+    results: dict = {"table1": [], "scenes": {}, "sweeps": {}, "mass_ratio": []}  # JSON-ready
     rigs = {}
     for scene in [c[2] for c in CONFIGS] + OTHER_SCENES:
         rig = rigs[scene] = Rig.from_scene(scene)
@@ -153,7 +153,7 @@ def _counts(rig: Rig, role: str) -> tuple:
     f = g.average_force - g.average_force[0]
     t = np.arange(f.size) * truth.sample_interval
     lead = leading(find_pulses(t, f, PeakRules()))
-    cut = reflection_time(t, {"wall": truth.wall_force - truth.wall_force[0]}, setup, lead, math.nan)
+    cut = reflection_time(t, {"wall": truth.wall() - truth.wall()[0]}, setup, lead, math.nan)
     train = solitary_train(t, f, lead, cut, PeakRules(), refine=True)
     gap = train[1].time - train[0].time if len(train) > 1 else math.nan
     return len(train), gap
@@ -180,7 +180,7 @@ def _summary(results, rigs) -> dict:
 
 
 def _wall_peak(rig: Rig) -> float:
-    w = rig.truth().wall_force
+    w = rig.truth().wall()
     return float(np.max(w) - w[0])
 
 

@@ -56,7 +56,9 @@ def fig3_figures(truths: dict) -> dict:
     g, m = truths[SCENE], truths[MAGNETIC_SCENE]
 
     def of(kind, truth, where=""):
-        return _finite(KINDS[kind].measure(truth, where))
+        measure = KINDS[kind].measure
+        assert measure is not None, f"a {kind} is measured on one truth (not a ratio)"
+        return _finite(measure(truth, where))
 
     peaks = of("peak", m, "upper"), of("peak", g, "upper")
     duration = of("duration", g, "upper")
@@ -82,7 +84,7 @@ def fitted_shots(overrides: list, magnetic=()) -> dict:
     out = {}
     for name, rig in rigs.items():
         t = rig.truth_analysis()
-        w = rig.truth().wall_force
+        w = rig.truth().wall()
         out[name] = {"speed_m_per_s": t.speed_m_per_s, "amplitude_N": t.amplitude_N, "duration_s": t.duration_s,
                      "base_duration_s": t.base_duration_s, "pulses": t.pulses, "wall_peak_N": float(np.max(w) - w[0]),
                      "dissipated_energy_J": rig.solution().stats.dissipated_energy_J,
@@ -99,7 +101,7 @@ def reproduce_fitted(out, progress=None, families=FAMILIES) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     tell = progress or (lambda *a: None)
     pts, obs = table1_points(), fig3_observations()
-    judged = []
+    judged: list = []
     for f in families:
         judged.append(assess(f, pts, obs, tell, judged))
     shots = {}
@@ -110,7 +112,7 @@ def reproduce_fitted(out, progress=None, families=FAMILIES) -> dict:
             tell(f"{a.family.name}: shots")
     best = choose(judged)
     power = next((a for a in judged if a.family.name == POWER_LAW), None)
-    fitted = {"model": None if best is None else best.family.name,
+    fitted: dict = {"model": None if best is None else best.family.name,
               "selection": "lowest held-out chi2: Table 1's linearised leave-one-out plus the magnetic data "
                            "predicted by the fit to the gravity-only data, among the converged joint fits",
               "models": {a.family.name: a.row for a in judged}, "power_law_shots": shots.get(POWER_LAW),

@@ -67,11 +67,11 @@ def targets(fitted: dict) -> list:
                         "value": fig3.get(key), "met": _inside(fig3.get(key), window)})
     g, m = fig3.get("wall_peak_gravity_N"), fig3.get("wall_peak_magnetic_N")
     out.append({"target": "the magnet does not reduce the wall's peak", "value": [g, m],
-                "met": None if None in (g, m) else bool(m >= g)})
-    for key, what, published in STEEL:
+                "met": None if g is None or m is None else bool(m >= g)})
+    for key, what, speed in STEEL:
         v = fitted["steel"].get(key)
-        out.append({"target": f"{what}: {published:g} +- 10%", "value": v,
-                    "met": _inside(v, (0.9 * published, 1.1 * published))})
+        out.append({"target": f"{what}: {speed:g} +- 10%", "value": v,
+                    "met": _inside(v, (0.9 * speed, 1.1 * speed))})
     return out
 
 

@@ -60,7 +60,7 @@ def window(holds, centre: float, lo: float, hi: float, points: int = SCAN_POINTS
     i = grid.index(centre)
     if not res[i][0]:
         return None
-    sides = []
+    sides: list[list] = []
     for step in (-1, 1):
         j = i
         while 0 <= j + step < len(grid) and res[j + step][0]:
@@ -103,7 +103,7 @@ def set_parameters(overrides) -> tuple:
         law = PARAMETERS.get(key.split(".", 1)[1]) if key.startswith("chain.") else None
         if law is not None:
             lo, hi = max(lo, law.lo), min(hi, law.hi)
-        out.append((FitParameter(key, lo, hi, "1" if spec is float else spec), float(v)))
+        out.append((FitParameter(key, lo, hi, "1" if spec is float else str(spec)), float(v)))
     if not out:
         raise invalid("--set", list(overrides), "no numeric key at a value > 0 to take sensitivities to")
     return tuple(out)
@@ -154,8 +154,8 @@ def sensitivities(fig: Figures) -> dict:
             t[k] = x
             thetas.append(t)
     models = fig.at(thetas)
-    sens = {t.name: {} for t in fig3.TARGETS}
-    counts = {t.name: {} for t in fig3.TARGETS if t.figure.kind == "pulses"}
+    sens: dict[str, dict] = {t.name: {} for t in fig3.TARGETS}
+    counts: dict[str, dict] = {t.name: {} for t in fig3.TARGETS if t.figure.kind == "pulses"}
     for k, (p, v) in enumerate(fig.params):
         down, up = steps[p.key]
         f_down, f_up = models[2 * k], models[2 * k + 1]

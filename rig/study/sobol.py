@@ -56,7 +56,7 @@ def sobol_indices(study, X, Y) -> dict:
     pick = lambda key: {n: float(v) for n, v in zip(names, s[key])}  # noqa: E731
     total = pick("ST")
     return {"first_order": pick("S1"), "first_order_conf95": pick("S1_conf"), "total": total,
-            "total_conf95": pick("ST_conf"), "dominant": max(total, key=total.get),
+            "total_conf95": pick("ST_conf"), "dominant": max(total, key=lambda name: total[name]),
             "base_samples": int(X.shape[0] // (len(names) + 2)),
             "note": "the instruments' own noise is not in the design and adds to every index; "
                     "indices are trustworthy where their 95% half-widths are small"}

@@ -195,8 +195,8 @@ class BatchWriter:
 
     def __init__(self, store: Store, stored, backlog: int):
         self.store, self.stored = store, stored
-        self.waiting = queue.Queue(backlog)
-        self.failure = None
+        self.waiting: queue.Queue = queue.Queue(backlog)
+        self.failure: BaseException | None = None
         self.thread = threading.Thread(target=self._run, name="rig-study-store", daemon=True)
         self.thread.start()
 

@@ -166,7 +166,7 @@ class SweepStore:
     @contextlib.contextmanager
     def writer(self, stored=None):
         """The BatchSink of the block; ``stored(point)`` is told each point kept."""
-        entries = []
+        entries: list = []  # the archive entries of the points kept, appended once at the end
         try:
             yield _Collector(self, entries, stored or (lambda point: None))
         finally:

@@ -65,6 +65,7 @@ def chain_frames(rig, n_frames: int) -> Frames:
     problem = ChainProblem.from_chain(rig.chain)
     sol = solve(problem, duration, save=rec, method=rig.solver.method, accuracy=rig.solver.accuracy)
     rig.use_solution(sol)
+    assert sol.frames is not None, "frames were asked for (frame_interval)"
     pos = sol.frames[:n_frames]
     u = pos - frame_origin(rig.chain)  # displacements from the static equilibrium (m)
     off, beads = problem.offset, len(rig.chain.beads)
@@ -232,6 +233,7 @@ def animate(rig, out, frames: int = 100, exaggerate: float | None = None, seed: 
     view = _View(rig, fr, x)
     traces = _Traces(shot.scope, rig.solver.duration)
     still = out.suffix.lower() == ".png"
+    order: list[int] | range
     if still:
         k, still_at = _still_frame(rig, fr)
         order = [k]

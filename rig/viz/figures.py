@@ -1,6 +1,7 @@
 """Figures of the reproduction (matplotlib, Agg backend, PNG; imported only when drawn)."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,8 +20,8 @@ class FigureSpec:
 
 def draw(folder, spec: FigureSpec) -> Path:
     """Draw ``spec`` into folder/spec.filename (PNG)."""
-    kinds = {"speed_vs_force": speed_vs_force, "traces": traces, "beta_curve": beta_curve,
-             "pulse_vs_solitary": pulse_vs_solitary}
+    kinds: dict[str, Callable[..., None]] = {"speed_vs_force": speed_vs_force, "traces": traces,
+                                             "beta_curve": beta_curve, "pulse_vs_solitary": pulse_vs_solitary}
     path = Path(folder) / spec.filename
     kinds[spec.kind](path, *spec.args)
     return path

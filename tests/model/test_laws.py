@@ -64,6 +64,13 @@ def test_chain_takes_every_parameter_as_an_attribute():
     assert tau.max() == pytest.approx(2e-6, rel=1e-15) and not mu.any()
 
 
+def test_chain_declares_every_parameter_for_type_checkers():
+    """Chain's class annotations (what mypy and editors see) name each law parameter the
+    chain sets as an attribute, no more and no fewer."""
+    declared = {name for name, kind in Chain.__annotations__.items() if kind == "float"}
+    assert declared == set(PARAMETERS)
+
+
 def test_fit_bounds_outside_the_law_are_refused_before_solving():
     with pytest.raises(RigError, match=r"chain.contact_exponent = 0.5: a number in \[1, 3\]"):
         parse_parameter("chain.contact_exponent=0.5:2")

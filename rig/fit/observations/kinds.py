@@ -58,7 +58,7 @@ class Observation:
         return (self.shot,) if self.over is None else (self.shot, self.over)
 
 
-def signal(truth, where: str) -> tuple:
+def signal(truth, where: str) -> tuple[np.ndarray, np.ndarray]:
     """(t, f) of a truth at a gauge or the wall: times from the impact (s) and the dynamic
     force (N, less its value before the impact)."""
     f = truth.wall_force if where == WALL else truth.gauges[where].average_force
@@ -95,7 +95,7 @@ class Kind:
 
     unit: str
     at_gauge: bool
-    measure: Callable
+    measure: Callable | None  # None: a ratio, measured by ``measure`` from two shots
     meaning: str
 
 
@@ -130,6 +130,9 @@ def measure(obs: Observation, truths: dict) -> float:
         return math.nan
     if obs.kind == "ratio":
         inner = KINDS[obs.of].measure
+        assert inner is not None, "a ratio is of a measured kind (reading.py refuses a ratio of ratios)"
         num, den = inner(truths[obs.shot], obs.gauge), inner(truths[obs.over], obs.gauge)
         return num / den if den != 0 else math.nan
-    return float(KINDS[obs.kind].measure(truths[obs.shot], obs.gauge))
+    own = KINDS[obs.kind].measure
+    assert own is not None, "only a ratio has no measure of its own"
+    return float(own(truths[obs.shot], obs.gauge))

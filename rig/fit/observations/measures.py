@@ -115,7 +115,7 @@ def pulses_in_train(t: np.ndarray, f: np.ndarray, until: float = math.inf, heigh
     seg = f[i:stop]
     tops = 1 + np.flatnonzero((seg[1:-1] > seg[:-2]) & (seg[1:-1] >= seg[2:]))
     count, last = 1, 0
-    for k in tops:
+    for k in tops.tolist():
         low = float(np.min(seg[last:k]))
         if seg[k] >= height * p.amplitude and low <= dip * min(seg[last], seg[k]):
             count, last = count + 1, k

@@ -52,7 +52,7 @@ class ObservationObjective:
     def rigs_of(self, theta) -> list:
         """The rig of each shot at candidate ``theta`` (None where its scene refuses it)."""
         fitted = [q.override(x) for q, x in zip(self.params, theta)]
-        out = []
+        out: list[Rig | None] = []
         for s in self.shot_list:
             try:
                 out.append(Rig.from_scene(s.scene, self.overrides + fitted + list(s.overrides)))

@@ -81,7 +81,7 @@ def _gauge(entry: dict, shots: tuple, field: str) -> str:
         if gauge not in known:
             raise invalid(f"{field}.gauge", gauge, f"where this kind is taken: one of {', '.join(known)} "
                                                    f"(in {shot.scene})")
-    return gauge
+    return str(gauge)  # one of a scene's gauge names
 
 
 def observation(entry, default_scene: str, folder: Path, field: str) -> Observation:

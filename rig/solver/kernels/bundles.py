@@ -94,6 +94,6 @@ class Checks(NamedTuple):
     counts."""
 
     check_every: int
-    e_ref: float
-    p_ref: float
+    e_ref: float | np.ndarray
+    p_ref: float | np.ndarray
     wall_slot: int
