@@ -32,7 +32,7 @@ class Report:
     noise: dict = field(default_factory=dict)
     reasons: dict = field(default_factory=dict)
 
-    def refuse(self, why: str, figures=FIGURES) -> "Report":
+    def refuse(self, why: str, figures=FIGURES) -> Report:
         """Leave ``figures`` out (None), each with ``why`` unless it has a reason already."""
         for name in figures:
             setattr(self, name, None)

@@ -49,7 +49,7 @@ class GaugeDraw:
     misalignment: float
 
     @classmethod
-    def draw(cls, s: GaugeSettings, rng: np.random.Generator) -> "GaugeDraw":
+    def draw(cls, s: GaugeSettings, rng: np.random.Generator) -> GaugeDraw:
         return cls(1.0 + s.calibration_error * rng.standard_normal(),
                    s.misalignment_sd * rng.standard_normal())
 

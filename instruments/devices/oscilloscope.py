@@ -214,7 +214,7 @@ class Oscilloscope:
                  for c, (ch, s) in enumerate(self.channels.items()) if read is None or read[c]}
         return ScopeRecord(waves, True, None, float(t_cross))
 
-    def front_panel(self, h: float) -> "FrontPanel":
+    def front_panel(self, h: float) -> FrontPanel:
         """The settings of every displayed channel, the trigger and the converter as the
         compiled acquisition takes them, for inputs sampled every h s."""
         chans = list(self.channels.values())

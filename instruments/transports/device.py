@@ -47,7 +47,7 @@ class MessageInstrument(Protocol):
     max_message_bytes: int
     """The largest program message taken; a longer one is refused, not buffered."""
 
-    lock: "InstrumentLock"
+    lock: InstrumentLock
 
     def open_session(self, peer: str) -> Session:
         """A new client (``peer``: its address, for the log)."""

@@ -30,7 +30,7 @@ class TcpService:
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._accept, name=f"{name}-accept", daemon=True)
 
-    def start(self) -> "TcpService":
+    def start(self) -> TcpService:
         self._thread.start()
         return self
 

@@ -73,7 +73,7 @@ class Setting:
     stepping: Stepping
 
     @classmethod
-    def of(cls, study: MonteCarloStudy) -> "Setting":
+    def of(cls, study: MonteCarloStudy) -> Setting:
         nom = nominal(study.scene, ())
         template = nom.template(study.window)
         save = template.save_at(contacts=False, averages=True)

@@ -194,7 +194,7 @@ def positive_seconds(text: str) -> float:
         value = number(text, "value", "a number of seconds > 0")
     except RigError as exc:
         raise refusal(exc, "value") from None
-    if not 0 < value:
+    if not value > 0:
         raise argparse.ArgumentTypeError(f"{text!r}: a number of seconds > 0")
     return value
 

@@ -78,7 +78,7 @@ class Scene:
     overrides: tuple = ()
     values: dict = field(default_factory=dict)
 
-    def with_values(self, values: dict) -> "Scene":
+    def with_values(self, values: dict) -> Scene:
         """The same scene with other values (a study's shot: the same text and overrides)."""
         return Scene(self.name, self.text, self.overrides, values)
 

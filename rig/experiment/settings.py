@@ -56,7 +56,7 @@ class SolverSettings:
             checked_accuracy(self.accuracy, "solver.accuracy")
 
     @classmethod
-    def from_table(cls, table: dict) -> "SolverSettings":
+    def from_table(cls, table: dict) -> SolverSettings:
         duration = table.get("duration")  # None (missing): refused by __post_init__, naming the key
         return cls(table.get("method", "srkn6b"), table.get("accuracy"), duration,  # type: ignore[arg-type]
                    table.get("sample_interval", 1e-7))

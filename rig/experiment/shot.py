@@ -83,7 +83,7 @@ class Rig(Assembly):
         self._truth_report: Report | None = None
 
     @classmethod
-    def from_scene(cls, name_or_path, overrides=()) -> "Rig":
+    def from_scene(cls, name_or_path, overrides=()) -> Rig:
         return cls(scene_io.load(name_or_path, overrides))
 
     def save_at(self, contacts: bool = True, averages: bool = False) -> SaveAt:

@@ -50,7 +50,7 @@ class Points:
         """The distinct configurations, in first-seen order."""
         return list(dict.fromkeys(self.configs))
 
-    def subset(self, rows) -> "Points":
+    def subset(self, rows) -> Points:
         rows = np.asarray(rows)
         return Points(self.force[rows], self.force_sd[rows], self.speed[rows], self.speed_sd[rows],
                       tuple(self.configs[i] for i in rows), self.source)

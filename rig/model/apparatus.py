@@ -140,7 +140,7 @@ class RingMagnet:
         return 0.0 if self.force == 0 else LONG_HOLD
 
     @classmethod
-    def hanging(cls, added_mass: float = 0.0) -> "RingMagnet":
+    def hanging(cls, added_mass: float = 0.0) -> RingMagnet:
         """A ring hanging freely on the bead (plus ``added_mass`` kg): force = weight."""
         return cls(force=(RING_MASS + added_mass) * STANDARD_GRAVITY)
 

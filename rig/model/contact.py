@@ -17,6 +17,7 @@ modulus stay two separate parameters.
 from __future__ import annotations
 
 import math
+
 import numpy as np
 
 from rig.errors import invalid

@@ -138,7 +138,7 @@ class GaugeBead(Bead):
         return PTFE_GAUGE_CAPS_FRACTION * plain_mass
 
     @classmethod
-    def like(cls, bead: Bead, mass: float | None = None) -> "GaugeBead":
+    def like(cls, bead: Bead, mass: float | None = None) -> GaugeBead:
         """The gauge version of a plain bead (same material, diameter): caps cut from its
         mass and the plate, or the whole gauge bead's ``mass`` (kg) when given (the plate
         keeps its mass, the caps take the rest)."""

@@ -43,7 +43,7 @@ class RunEstimate:
         (rig/solver/control.py, WORK_BUDGET) before it spends more."""
         return self.seconds if math.isnan(self.most_seconds) else self.most_seconds
 
-    def times(self, runs: int, kept: int) -> "RunEstimate":
+    def times(self, runs: int, kept: int) -> RunEstimate:
         """``runs`` such solves one after another, ``kept`` of them held in memory at once."""
         return RunEstimate(self.bytes * kept, self.seconds * runs, self.steps, self.bodies, self.samples,
                            self.most_seconds * runs)

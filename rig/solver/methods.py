@@ -37,7 +37,7 @@ class Method:
         return harmonic_stability_limit(self.drifts, self.kicks)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def harmonic_stability_limit(drifts: tuple, kicks: tuple, z_max: float = 20.0) -> float:
     """First z = omega*dt where the one-step matrix of x'' = -omega^2 x has |trace| >= 2."""
     z = np.linspace(1e-6, z_max, 200001)

@@ -90,7 +90,7 @@ class ProblemArrays(_BodyArrays):
     momentum_scale (shots,); ``layout``: a ChainProblem of the layout (its offset, wall
     slot, law and schedule, which every shot shares)."""
 
-    layout: "ChainProblem"
+    layout: ChainProblem
     energy_scale: np.ndarray
     momentum_scale: np.ndarray
 
@@ -103,7 +103,7 @@ class ProblemArrays(_BodyArrays):
         return self.layout.offset
 
     @classmethod
-    def of(cls, problems: list) -> "ProblemArrays":
+    def of(cls, problems: list) -> ProblemArrays:
         """The problems' arrays stacked (one layout)."""
         stack = {k: np.stack([getattr(p, k) for p in problems]) for k in PER_BODY + ("load",)}
         return cls(problems[0], **stack, energy_scale=np.array([p.energy_scale for p in problems]),
@@ -238,7 +238,7 @@ class ChainProblem(_BodyArrays):
     momentum_scale: float
 
     @classmethod
-    def from_chain(cls, chain: Chain) -> "ChainProblem":
+    def from_chain(cls, chain: Chain) -> ChainProblem:
         a = problem_arrays(chain, chain.masses, chain.contact_constants(), chain.initial_top_force)
         off = 1 if chain.striker is not None else 0
         nb = a["mass"].shape[1]

@@ -50,7 +50,7 @@ class KernelReport:
     bodies_stepped: float  # the bodies a step integrated, on average (the front; all of them at most)
 
     @classmethod
-    def of(cls, diag) -> "KernelReport":
+    def of(cls, diag) -> KernelReport:
         """The report in a diagnostics array (a shot's column of a batch's)."""
         steps = int(diag[slot.STEPS])
         return cls(float(diag[slot.ENERGY_ERROR]), float(diag[slot.MOMENTUM_ERROR]), float(diag[slot.WALL_IMPULSE]),

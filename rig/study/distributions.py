@@ -73,7 +73,7 @@ class Distribution:
     params: tuple  # SI
 
     @classmethod
-    def parse(cls, key: str, text: str) -> "Distribution":
+    def parse(cls, key: str, text: str) -> Distribution:
         m = _SPEC.match(text)
         if not m:
             raise invalid(f"--vary {key}", text, "normal(MEAN, SD), truncnormal(MEAN, SD, LO, HI), "

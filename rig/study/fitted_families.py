@@ -62,7 +62,7 @@ class Family:
     fit to the gravity-only data leaves them at the law's defaults, so that its prediction of
     the magnetic data uses nothing of them."""
 
-    def without(self, keys) -> "Family":
+    def without(self, keys) -> Family:
         """The family with ``keys`` no longer fitted."""
         return dataclasses.replace(self, params=tuple(p for p in self.params if p.split("=")[0] not in keys))
 

@@ -52,7 +52,7 @@ class Shots:
     positions: np.ndarray
     fixed: np.ndarray
 
-    def take(self, rows) -> "Shots":
+    def take(self, rows) -> Shots:
         """The shots of ``rows`` (indices) alone."""
         p = self.problems
         arrays = {k: getattr(p, k)[rows] for k in PER_BODY + ("load", "energy_scale", "momentum_scale")}

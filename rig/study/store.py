@@ -66,7 +66,7 @@ class Store:
             with left_as_found(self.folder, Exception, keep=lambda exc: bool(self.done())):  # inside the hold
                 yield self
 
-    def open(self) -> "Store":
+    def open(self) -> Store:
         """Create the folder, or check that it holds this very study (to resume it)."""
         meta = self.folder / "study.json"
         spec = {"digest": self.study.digest(), **self.study.spec()}

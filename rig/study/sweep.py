@@ -32,7 +32,7 @@ class Vary:
     values: tuple
 
     @classmethod
-    def parse(cls, text: str, max_count: int | None = None) -> "Vary":
+    def parse(cls, text: str, max_count: int | None = None) -> Vary:
         """Parse KEY=START:STOP:COUNT; more than ``max_count`` points (if given) is refused
         before any is made."""
         if "=" not in text:

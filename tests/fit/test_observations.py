@@ -64,7 +64,7 @@ def test_tail_of_a_sine_on_a_drift(period):
     mean follows: a / amplitude; without the sine, close to 0."""
     a, start = 0.3, 3.6e-4
     drift = 50.0 * T
-    tail = np.where(T > start, a * np.sin(2 * np.pi * (T - start) / period), 0.0)
+    tail = np.where(start < T, a * np.sin(2 * np.pi * (T - start) / period), 0.0)
     assert measures.tail_excursion(T, gauss() + tail + drift) == pytest.approx(a / 3.0, rel=0.02)
     assert measures.tail_excursion(T, gauss() + drift) < 0.02 * a / 3.0
 

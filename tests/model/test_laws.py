@@ -19,7 +19,7 @@ def chain(**kw):
 
 
 def test_registry_is_what_contact_reexports():
-    assert CONTACT_LAWS == {law.name: law for law in LAWS}
+    assert {law.name: law for law in LAWS} == CONTACT_LAWS
     assert contact_law("Dashpot") is CONTACT_LAWS["dashpot"]
     assert CONTACT_LAWS["hertz"].code == HERTZ and not CONTACT_LAWS["hertz"].dissipative
     kk = CONTACT_LAWS["kuwabara-kono"]

@@ -8,9 +8,9 @@ import pytest
 from rig.cli import main
 from rig.experiment.scene import load
 from rig.experiment.shot import Rig
-from rig.solver.estimate import CONTROL_WORK
 from rig.solver import control
 from rig.solver.control import WORK_BUDGET, AccuracyNotReached, controlled_solve
+from rig.solver.estimate import CONTROL_WORK
 from rig.solver.methods import method
 from rig.solver.problem import ChainProblem
 from rig.solver.run import time_grid
@@ -98,9 +98,10 @@ def test_the_command_line_refuses_it_in_one_line_naming_the_duration_that_reache
 
 def test_the_error_over_time_ends_at_the_whole_records_error_and_cuts_where_it_should():
     # two channels: a pulse at 1 ms, a second one at 2 ms where the solution drifts off
+    import numpy as np
+
     from rig.solver.control import error_over_time
     from rig.solver.solution import relative_error
-    import numpy as np
 
     t = np.arange(3000) * 1e-6
     pulse = lambda t0: np.exp(-(((t - t0) / 5e-5) ** 2))  # noqa: E731

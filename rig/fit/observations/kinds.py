@@ -9,8 +9,8 @@ with its overrides; a ratio is the figure of one shot over the same figure of an
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 

@@ -10,8 +10,8 @@ linear dashpot of gamma kg/s).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from rig.errors import invalid
 from rig.units import number, quantity
