@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from numba.core import ir, types
 from numba.core.compiler import CompilerBase, DefaultPassBuilder
 from numba.core.compiler_machinery import FunctionPass, register_pass
+from numba.core.ir_utils import get_definition, guard
 from numba.core.registry import CPUDispatcher
 from numba.core.types import unliteral
 from numba.core.untyped_passes import IRProcessing
@@ -82,7 +83,7 @@ def _read_type(func_ir, expr, args, arguments):
         return args[expr.index]
     if not (isinstance(expr, ir.Expr) and expr.op == "static_getitem" and isinstance(expr.index, int)):
         return None
-    source = func_ir.get_definition(expr.value)
+    source = guard(get_definition, func_ir, expr.value)  # None where the variable is defined more than once
     whole = source.value if isinstance(source, ir.Expr) and source.op == "exhaust_iter" else expr.value
     ty = arguments.get(getattr(whole, "name", None))
     return ty.types[expr.index] if isinstance(ty, types.BaseTuple) and expr.index < len(ty.types) else None
