@@ -34,15 +34,22 @@ from instruments.jit import has_machine_code
 PER_VALUE = frozenset({"law"})  # the parameters compiled per value (module doc)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Constant:
     """An integer that the kernels it is handed to are compiled for (numba types it as its
-    literal value; a parameter named in PER_VALUE keeps that type in every callee)."""
+    literal value; a parameter named in PER_VALUE keeps that type in every callee). In
+    Python it is its value: equal to it, hashed as it."""
 
     value: int
 
     def __index__(self):
         return int(self.value)
+
+    def __eq__(self, other):
+        return int(self.value) == (int(other.value) if isinstance(other, Constant) else other)
+
+    def __hash__(self):
+        return hash(int(self.value))
 
 
 @typeof_impl.register(Constant)
