@@ -39,7 +39,8 @@ STUDY = {f"{DEVICES}.acquisition.shots": f"(int64, int64, {I1}, {F3}, float64, {
                                          f"Tuple(({I1}, {F1}, {F2}, {F2}, int64, float64, boolean, int64, float64, "
                                          f"{F1}, {F1}, {F1}, {F1}, float64, float64, boolean)), {B1}, int64, {I1}, "
                                          f"{I8}, boolean[:, ::1], {I1}, {F2}, {F3})",
-         f"{ANALYSIS}.batch_analysis.analyse_shots": f"({I8}, {I1}, {F2}, float64, int64, {F1}, {F1}, {F1}, {I1}, "
+         f"{ANALYSIS}.batch_analysis.analyse_range": f"(int64, int64, {I8}, {I1}, {F2}, float64, int64, {F1}, {F1}, "
+                                                   f"{F1}, {I1}, "
                                                    f"{F1}, {F1}, UniTuple(float64, 7), {F2}, {F2}, {B1})"}
 
 

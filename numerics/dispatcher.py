@@ -1,5 +1,6 @@
 """The dispatcher of every kernel (numerics.jit): numba's CPU dispatcher, but a call from
-compiled code is typed by its arguments' plain types, never by a constant's literal type.
+compiled code is typed by its arguments' plain types, never by a constant's literal type,
+except for the parameters compiled per value (``PER_VALUE``).
 
 numba compiles a callee for the types its caller hands it, and a constant argument is of
 a literal type (``Literal[int](0)``): each constant then costs one more copy of the callee
@@ -7,19 +8,117 @@ and of everything it calls (the analysis' ``_leading(..., 0, ...)`` and ``(..., 
 were two, ``index_of`` fourteen), and a flag first typed ``False`` before its loop made it
 ``bool`` a copy that is never run. A callee's arithmetic is the same for a constant and a
 variable (no fastmath: the same bits), so one copy per array layout does.
+
+A parameter named in ``PER_VALUE`` (the contacts' law code of the chain's kernels) is the
+opposite: a ``Constant`` handed to a kernel from Python, alone or as a field of a named
+tuple, is typed by its value, each kernel it reaches is compiled for that value, and the
+compiler takes it as the constant it is (``ConstantArguments``): the branches of the other
+values are dropped before numba types them, so the kernels they call are never compiled (a
+Hertz chain compiles no Thornton code). One copy per value used, the same operations on
+the branch taken (the same bits).
 """
 import time
+from dataclasses import dataclass
 
+from numba.core import ir, types
+from numba.core.compiler import CompilerBase, DefaultPassBuilder
+from numba.core.compiler_machinery import FunctionPass, register_pass
+from numba.core.ir_utils import get_definition, guard
 from numba.core.registry import CPUDispatcher
 from numba.core.types import unliteral
+from numba.core.untyped_passes import IRProcessing
+from numba.extending import typeof_impl
+
+PER_VALUE = frozenset({"law"})  # the parameters compiled per value (module doc)
+
+
+@dataclass(frozen=True, eq=False)
+class Constant:
+    """An integer that the kernels it is handed to are compiled for (numba types it as its
+    literal value; a parameter named in PER_VALUE keeps that type in every callee). In
+    Python it is its value: equal to it, hashed as it."""
+
+    value: int
+
+    def __index__(self):
+        return int(self.value)
+
+    def __eq__(self, other):
+        return int(self.value) == (int(other.value) if isinstance(other, Constant) else other)
+
+    def __hash__(self):
+        return hash(int(self.value))
+
+
+@typeof_impl.register(Constant)
+def _typeof_constant(val, c):
+    return types.IntegerLiteral(int(val.value))
+
+
+@register_pass(mutates_CFG=True, analysis_only=False)
+class ConstantArguments(FunctionPass):
+    """Replace each read of an argument of integer literal type, and of such a field of a
+    tuple argument (``law, con, state = contacts``), with the constant it is, so that
+    numba's dead-branch pruning, which follows, drops the branches of the other values."""
+
+    _name = "constant_arguments"
+
+    def __init__(self):
+        FunctionPass.__init__(self)
+
+    def run_pass(self, state):
+        func_ir, changed = state.func_ir, False
+        arguments = {stmt.target.name: state.args[stmt.value.index]  # {variable: the type of the argument it holds}
+                     for block in func_ir.blocks.values() for stmt in block.body
+                     if isinstance(stmt, ir.Assign) and isinstance(stmt.value, ir.Arg)}
+        for block in func_ir.blocks.values():
+            for stmt in block.body:
+                if isinstance(stmt, ir.Assign):
+                    ty = _read_type(func_ir, stmt.value, state.args, arguments)
+                    if isinstance(ty, types.IntegerLiteral):
+                        stmt.value = ir.Const(ty.literal_value, stmt.value.loc)
+                        changed = True
+        return changed
+
+
+def _read_type(func_ir, expr, args, arguments):
+    """The type of the argument, or of the tuple argument's field, that ``expr`` reads; None
+    for any other expression."""
+    if isinstance(expr, ir.Arg):
+        return args[expr.index]
+    if not (isinstance(expr, ir.Expr) and expr.op == "static_getitem" and isinstance(expr.index, int)):
+        return None
+    source = guard(get_definition, func_ir, expr.value)  # None where the variable is defined more than once
+    whole = source.value if isinstance(source, ir.Expr) and source.op == "exhaust_iter" else expr.value
+    ty = arguments.get(getattr(whole, "name", None))
+    return ty.types[expr.index] if isinstance(ty, types.BaseTuple) and expr.index < len(ty.types) else None
+
+
+class ConstantPipeline(CompilerBase):
+    """numba's nopython pipeline with ConstantArguments before its dead-branch pruning."""
+
+    def define_pipelines(self):
+        passes = DefaultPassBuilder.define_nopython_pipeline(self.state)
+        passes.add_pass_after(ConstantArguments, IRProcessing)
+        passes.finalize()
+        return [passes]
 
 
 class OneTypePerArgument(CPUDispatcher):
-    """A CPU dispatcher that compiles a callee for its arguments' plain types."""
+    """A CPU dispatcher that compiles a callee for its arguments' plain types (a PER_VALUE
+    parameter's literal kept)."""
 
     def get_call_template(self, args, kws):
-        return super().get_call_template(tuple(unliteral(a) for a in args),
-                                         {k: unliteral(v) for k, v in kws.items()})
+        names = self.py_func.__code__.co_varnames[:self.py_func.__code__.co_argcount]
+        return super().get_call_template(tuple(_plain(a, n) for a, n in zip(args, names)) + args[len(names):],
+                                         {k: _plain(v, k) for k, v in kws.items()})
+
+    def typeof_pyval(self, val):
+        """numba's type of ``val``, a named tuple's Constant fields by their value (numba's
+        own typeof makes a named tuple's fields plain)."""
+        if isinstance(val, tuple) and hasattr(val, "_fields") and any(isinstance(x, Constant) for x in val):
+            return types.NamedTuple([self.typeof_pyval(x) for x in val], type(val))
+        return super().typeof_pyval(val)
 
     def compile(self, sig):
         """Compile (or load from numba's cache) the copy for ``sig``, called from Python or
@@ -30,6 +129,12 @@ class OneTypePerArgument(CPUDispatcher):
         while side is not None and side.poll() is None and not has_machine_code(self):
             time.sleep(POLL_S)
         return super().compile(sig)
+
+
+def _plain(ty, name):
+    """``ty`` as a callee's parameter ``name`` is compiled for: its plain type, unless a
+    PER_VALUE parameter's integer literal."""
+    return ty if name in PER_VALUE and isinstance(ty, types.IntegerLiteral) else unliteral(ty)
 
 
 SIDE_COMPILES: dict = {}  # {module.kernel: the side process (subprocess.Popen) compiling it}

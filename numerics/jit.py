@@ -33,7 +33,9 @@ def jit(function=None, **options):
     is loaded here, by the first module that declares a kernel.
 
     A call from another kernel is typed by its arguments' plain types (one compiled copy
-    per array layout, not one per constant argument: numerics/dispatcher.py)."""
+    per array layout, not one per constant argument), but for a ``Constant`` handed to a
+    parameter compiled per value (the contacts' law): one copy per value, the other values'
+    branches never compiled (numerics/dispatcher.py)."""
     if function is None:
         return lambda f: _declare(f, options)
     return _declare(function, {})
@@ -42,10 +44,11 @@ def jit(function=None, **options):
 def _declare(function, options: dict):
     """``function`` as a cached ``OneTypePerArgument`` dispatcher with njit's target
     options and ``options``."""
-    from numerics.dispatcher import OneTypePerArgument
+    from numerics.dispatcher import ConstantPipeline, OneTypePerArgument
 
     targetoptions = {"nopython": True, "boundscheck": None, "fastmath": OPTIONS["fastmath"], **options}
-    dispatcher = OneTypePerArgument(py_func=function, locals={}, targetoptions=targetoptions)
+    dispatcher = OneTypePerArgument(py_func=function, locals={}, targetoptions=targetoptions,
+                                    pipeline_class=ConstantPipeline)
     if OPTIONS["cache"]:
         dispatcher.enable_caching()
     return dispatcher

@@ -6,9 +6,10 @@ Each cold run is a fresh interpreter whose NUMBA_CACHE_DIR is an empty temporary
 (every kernel it needs is compiled, as in a new venv or a CI run); the warm runs reuse
 the folder the cold mc filled. Times are wall seconds and the children's CPU seconds
 (user + system: on several cores the compilation spread over processes makes CPU exceed
-wall). The cold shot also reports where its compilation went: each kernel's compile time,
-exclusive of the kernels it calls (numba's ``numba:compile`` events, seconds), the largest
-first. ``--baseline REV`` measures another revision in turns (one revision after the
+wall). The cold shot and the cold mc also report where their compilation went: each
+kernel's compile time, exclusive of the kernels it calls (numba's ``numba:compile`` events,
+seconds), the largest first, and how many functions numba compiled (numba's own
+implementations included), in the command's own process. ``--baseline REV`` measures another revision in turns (one revision after the
 other in each round), so both see the same machine load.
 """
 from __future__ import annotations
@@ -32,11 +33,12 @@ STUDY = ["--vary", "striker.velocity=normal(0.89 m/s, 0.01 m/s)", "--shots", "64
 # the rig's command line in a child that records each kernel's exclusive compile time into the file $RIG_COMPILE_LOG
 CHILD = """import json, os, sys, time
 from numba.core import event
-stack, spent = [], {}
+stack, spent, count = [], {}, [0]
 class Compiles(event.Listener):
     def on_start(self, ev):
         f = ev.data["dispatcher"].py_func
         stack.append([f"{f.__module__}.{f.__qualname__}", time.perf_counter(), 0.0])
+        count[0] += 1
     def on_end(self, ev):
         name, t0, inner = stack.pop()
         dt = time.perf_counter() - t0
@@ -49,13 +51,14 @@ try:
     code = main(sys.argv[1:])
 finally:
     with open(os.environ["RIG_COMPILE_LOG"], "w") as fh:
-        json.dump(spent, fh)
+        json.dump({"spent": spent, "count": count[0]}, fh)
 sys.exit(code)
 """
 
 
 def _run(tree: Path | None, argv: list, cache: Path, log: Path) -> tuple:
-    """(wall s, CPU s, {kernel: exclusive compile s}) of one rig command with numba's cache in ``cache``."""
+    """(wall s, CPU s, {"spent": {kernel: exclusive compile s}, "count": functions compiled}) of one rig
+    command with numba's cache in ``cache``."""
     path = [str(tree)] if tree else []
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), RIG_COMPILE_LOG=str(log),
                PYTHONPATH=os.pathsep.join(path + [os.environ.get("PYTHONPATH", "")]))
@@ -77,7 +80,8 @@ def measure_revision(tree: Path | None, folder: Path) -> dict:
     rows["warm rig shot"] = _run(tree, shot, cold_mc, log)
     rows["warm rig mc"] = _run(tree, ["mc", SCENE, *STUDY, "--out", str(folder / "mc-warm")], cold_mc, log)
     return {"wall_s": {k: v[0] for k, v in rows.items()}, "cpu_s": {k: v[1] for k, v in rows.items()},
-            "shot_compiles_s": rows["cold rig shot"][2]}
+            "shot_compiles_s": rows["cold rig shot"][2]["spent"], "mc_compiles_s": rows["cold rig mc"][2]["spent"],
+            "compiled": {k: v[2]["count"] for k, v in rows.items() if k.startswith("cold")}}
 
 
 def run(rounds: int = ROUNDS, baseline: str | None = None) -> dict:
@@ -96,13 +100,15 @@ def run(rounds: int = ROUNDS, baseline: str | None = None) -> dict:
               "targets_s": TARGETS, "revisions": {}}
     for name, runs in got.items():
         commands = runs[0]["wall_s"]
-        compiles = {k: statistics.median(r["shot_compiles_s"].get(k, 0.0) for r in runs)
-                    for k in runs[0]["shot_compiles_s"]}
-        result["revisions"][name] = {
+        rev = result["revisions"][name] = {
             "wall_s": {c: statistics.median(r["wall_s"][c] for r in runs) for c in commands},
             "cpu_s": {c: statistics.median(r["cpu_s"][c] for r in runs) for c in commands},
-            "shot_compile_total_s": sum(compiles.values()),
-            "shot_top_compiles_s": dict(sorted(compiles.items(), key=lambda kv: -kv[1])[:12])}
+            "functions_compiled": {c: statistics.median(r["compiled"][c] for r in runs) for c in runs[0]["compiled"]}}
+        for task in ("shot", "mc"):
+            compiles = {k: statistics.median(r[f"{task}_compiles_s"].get(k, 0.0) for r in runs)
+                        for k in runs[0][f"{task}_compiles_s"]}
+            rev[f"{task}_compile_total_s"] = sum(compiles.values())
+            rev[f"{task}_top_compiles_s"] = dict(sorted(compiles.items(), key=lambda kv: -kv[1])[:12])
     if baseline:
         cur = result["revisions"]["current"]
         result["ratio_to_baseline"] = {c: statistics.median(a["wall_s"][c] / b["wall_s"][c]
@@ -123,9 +129,10 @@ def table(r: dict) -> str:
         ratio = f" {r['ratio_to_baseline'][command]:6.2f}" if "ratio_to_baseline" in r else ""
         target = TARGETS.get(command)
         lines.append(f"  {command:16s}{cells}{ratio} {'-' if target is None else f'{target:.1f}':>8s}")
-    for n in names:
+    for n, task in ((n, task) for n in names for task in ("shot", "mc")):
         rev = r["revisions"][n]
-        lines.append(f"  {n}: the cold shot's compile time by kernel (exclusive s; {rev['shot_compile_total_s']:.1f} s "
-                     f"in all, in the shot's own process):")
-        lines += [f"    {k:60s} {v:6.2f}" for k, v in rev["shot_top_compiles_s"].items()]
+        lines.append(f"  {n}: the cold {task}'s compile time by kernel (exclusive s; {rev[f'{task}_compile_total_s']:.1f} s "
+                     f"in all, {rev['functions_compiled'][f'cold rig {task}']:.0f} functions compiled, in its own "
+                     f"process):")
+        lines += [f"    {k:60s} {v:6.2f}" for k, v in rev[f"{task}_top_compiles_s"].items()]
     return "\n".join(lines)

@@ -262,11 +262,11 @@ def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     from instruments.precompile import SHOT, STUDY, start
     from numerics.dispatcher import has_machine_code
     from rig.solver.cold import SIDE
-    from rig.solver.kernels.ensemble import integrate_ensemble
+    from rig.solver.kernels.ensemble import integrate_chunk
     from rig.solver.kernels.integrators import integrate
 
     kernels = {**SIDE, **SHOT, **(STUDY if task == "study" else {})}
-    cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_ensemble)))
+    cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_chunk)))
     aside = start(kernels)
     parts = (["the chain solver"] if cold_solver else []) + (["the instruments"] if aside else [])
     if parts and not quiet and sys.stderr.isatty():

@@ -11,6 +11,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from numerics.dispatcher import Constant
 from rig.errors import RigError, invalid
 from rig.model.laws.thornton import STATE_ROWS
 from rig.solver.kernels import bundles
@@ -98,7 +99,7 @@ def kernel_inputs(problems: ChainProblem | ProblemArrays, take: Callable[[str], 
     ch_slot, ch_weight = save.channels(layout.offset)
     return KernelInputs(
         bundles.ChainArrays(*(take(k) for k in bundles.ChainArrays._fields)),
-        bundles.Contacts(problems.law, rows(CONTACT_ROWS), rows(STATE_ROWS)),
+        bundles.Contacts(Constant(problems.law), rows(CONTACT_ROWS), rows(STATE_ROWS)),
         bundles.Holder(rows(("drag", "friction")), layout.slip_speed, viscous_rate(problems)),
         bundles.Method(np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head,
                        stepping.substeps(step, m.drifts)),

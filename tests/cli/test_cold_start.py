@@ -2,7 +2,8 @@
 compiles, compiles the instruments' kernels and a part of the solver's in a side process
 (instruments/precompile.py) and gives the bits of a warm shot; the side process compiles
 exactly the signatures the shot calls (else the main process would compile them again, and
-the side process be waste)."""
+the side process be waste); a Hertz shot compiles no other law's code (the law reaches the
+kernels as a constant, numerics/dispatcher.py)."""
 import json
 import os
 import subprocess
@@ -17,11 +18,13 @@ SHOT_ARGS = ["shot", "ptfe52_magnetic", "--seed", "1", "--json"]
 
 
 # a cold shot in a fresh process, then the side kernels the main process did not load from numba's cache
-# (it compiled them itself, or compiled another copy: a signature out of step)
+# (it compiled them itself, or compiled another copy: a signature out of step), then the Thornton
+# law's kernels it compiled
 COLD_SHOT = ("import json\nfrom instruments.precompile import SHOT, kernel\nfrom rig.cli import main\n"
-             "from rig.solver.cold import SIDE\ncode = main({argv!r})\n"
+             "from rig.model.laws import thornton\nfrom rig.solver.cold import SIDE\ncode = main({argv!r})\n"
              "print(json.dumps(sorted(n for n in {{**SIDE, **SHOT}} if sum(kernel(n).stats.cache_misses.values())\n"
-             "                        or len(kernel(n).signatures) != 1)))")
+             "                        or len(kernel(n).signatures) != 1)))\n"
+             "print(json.dumps(sorted(n for n, f in vars(thornton).items() if getattr(f, 'signatures', None))))")
 
 
 def test_the_side_process_compiles_the_signatures_a_shot_calls_from_python(capsys):
@@ -38,8 +41,9 @@ def test_a_cold_shot_says_what_it_compiles_once_compiles_nothing_twice_and_has_t
     lines = said.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("rig shot: numba is compiling the chain solver and the "
                                                    "instruments (in two processes)"), said
-    *shot, compiled_twice = cold.stdout.strip().splitlines()
+    *shot, compiled_twice, thornton = cold.stdout.strip().splitlines()
     assert json.loads(compiled_twice) == []
+    assert json.loads(thornton) == []  # the scene's contacts are Hertz's
     assert _bits(json.loads("\n".join(shot))) == _bits(json.loads(warm.stdout))
     again, said = _on_a_terminal([sys.executable, "-m", "rig.cli", *SHOT_ARGS],
                                  dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path)))

@@ -32,7 +32,9 @@ class Contacts(NamedTuple):
     PLASTIC), ``con`` each slot's law parameters (rig.solver.problem.CONTACT_ROWS: exponent,
     damping time s, dashpot coefficient and exponent, yield rate exponent, reference rate
     m/s) and ``state`` each slot's memory (rig.model.laws.thornton.STATE_ROWS), which the
-    kernels renew in place (PLASTIC only)."""
+    kernels renew in place (PLASTIC only). run.kernel_inputs hands the code as an
+    numerics.dispatcher.Constant: every kernel is compiled for the law it runs, the other
+    laws' code never compiled."""
 
     law: int
     con: np.ndarray

@@ -2,7 +2,7 @@
 
 Arrays are (chunks, bodies, width): each chunk is a C-contiguous block whose inner index
 runs over ``width`` shots from 0, so every loop over the shots of a chunk vectorises;
-``integrate_ensemble`` runs the chunks on numba's threads. Every shot
+``integrate_ensemble`` runs the chunks on as many threads as numba's. Every shot
 performs exactly the operations of the single-shot kernel (integrators.integrate) in the
 same order with the same step, so the two agree to the last bit (the multirate head
 runs the same multirate.head_flow in both; the viscous contacts and the holder's drag and
@@ -13,9 +13,10 @@ inline numba's calls, and a call per row cost as much as the row of 64 shots its
 (tests/solver/test_vectorised.py guards this).
 """
 import math
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-from numba import prange
+from numba import get_num_threads
 
 from numerics.jit import jit
 from rig.model.contact import HERTZ, PLASTIC, POWER
@@ -292,7 +293,28 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
         diag[slot.BODIES_STEPPED, s] = stepped
 
 
-@jit(parallel=True)
+@jit(nogil=True)
+def integrate_chunk(k, u, v, chain, contacts, holder, method, record, checks, diag):
+    """Integrate the shots of chunk k of the (chunks, bodies, width) arrays u (m) and v (m/s)
+    in place (integrate_ensemble's arguments), without the GIL: the chunks run on threads."""
+    mass, invm, bias, load, A, d0, d_limit = chain  # each bundle's fields, in their order (bundles.py)
+    law, con, state = contacts
+    onsite, slip, viscous_rate = holder
+    a_coef, b_coef, dt, n_steps, head, sub = method
+    ch_slot, ch_weight, sample_dt, out = record.ch_slot, record.ch_weight, record.sample_dt, record.out
+    check_every, e_ref, p_ref, wall_slot = checks.check_every, checks.e_ref, checks.p_ref, checks.wall_slot
+    n_chunks, nb, W = u.shape
+    n_ch = ch_slot.shape[0]
+    f = np.zeros((nb + 1, W))
+    d_old = np.zeros((n_ch, ch_slot.shape[1], W))
+    r_old = np.zeros((n_ch, ch_slot.shape[1], W))
+    d_new = np.zeros((n_ch, ch_slot.shape[1], W))
+    r_new = np.zeros((n_ch, ch_slot.shape[1], W))
+    _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], law, con[k], state[k], onsite[k], slip,
+           viscous_rate, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, k * W,
+           check_every, d_limit[k], wall_slot, e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)
+
+
 def integrate_ensemble(u, v, chain, contacts, holder, method, record, checks, diag):
     """Integrate every shot of the (chunks, bodies, width) arrays u (m) and v (m/s) in
     place; the bundles are bundles.py's, their arrays with the chunk axis first and the
@@ -302,21 +324,20 @@ def integrate_ensemble(u, v, chain, contacts, holder, method, record, checks, di
     record.out is (shots, channels, samples), each shot's record contiguous, chunk k
     holding shots k width .. (k + 1) width - 1 (fill past the last shot); record.frames is
     not read. diag is (chunks, report.DIAGNOSTICS, width), each shot's column as the
-    single-shot kernel's diag."""
-    mass, invm, bias, load, A, d0, d_limit = chain  # each bundle's fields, in their order (bundles.py)
-    law, con, state = contacts
-    onsite, slip, viscous_rate = holder
-    a_coef, b_coef, dt, n_steps, head, sub = method
-    ch_slot, ch_weight, sample_dt, out = record.ch_slot, record.ch_weight, record.sample_dt, record.out
-    check_every, e_ref, p_ref, wall_slot = checks.check_every, checks.e_ref, checks.p_ref, checks.wall_slot
-    n_chunks, nb, W = u.shape
-    n_ch = ch_slot.shape[0]
-    for k in prange(n_chunks):
-        f = np.zeros((nb + 1, W))
-        d_old = np.zeros((n_ch, ch_slot.shape[1], W))
-        r_old = np.zeros((n_ch, ch_slot.shape[1], W))
-        d_new = np.zeros((n_ch, ch_slot.shape[1], W))
-        r_new = np.zeros((n_ch, ch_slot.shape[1], W))
-        _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], law, con[k], state[k], onsite[k], slip,
-               viscous_rate, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, k * W,
-               check_every, d_limit[k], wall_slot, e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)
+    single-shot kernel's diag.
+
+    The chunks are shared out over as many threads as numba's (numba.get_num_threads), each
+    running integrate_chunk: a numba parallel loop over them compiled the chunk's whole
+    kernel twice more (its gufunc and its caller each link and re-optimise it), the largest
+    part of a cold rig mc's compile time."""
+    def run(k):
+        integrate_chunk(k, u, v, chain, contacts, holder, method, record, checks, diag)
+
+    chunks = range(u.shape[0])
+    threads = min(len(chunks), get_num_threads())
+    if threads <= 1:
+        for k in chunks:
+            run(k)
+        return
+    with ThreadPoolExecutor(threads) as pool:
+        list(pool.map(run, chunks))
