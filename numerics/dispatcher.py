@@ -76,7 +76,7 @@ class ConstantArguments(FunctionPass):
                 if isinstance(stmt, ir.Assign):
                     ty = _read_type(func_ir, stmt.value, state.args, arguments)
                     if isinstance(ty, types.IntegerLiteral):
-                        stmt.value = ir.Const(ty.literal_value, stmt.value.loc)
+                        stmt.value = ir.Const(ty.literal_value, stmt.loc)
                         changed = True
         return changed
 
@@ -91,7 +91,8 @@ def _read_type(func_ir, expr, args, arguments):
     source = guard(get_definition, func_ir, expr.value)  # None where the variable is defined more than once
     whole = source.value if isinstance(source, ir.Expr) and source.op == "exhaust_iter" else expr.value
     ty = arguments.get(getattr(whole, "name", None))
-    return ty.types[expr.index] if isinstance(ty, types.BaseTuple) and expr.index < len(ty.types) else None
+    fields = getattr(ty, "types", ()) if isinstance(ty, types.BaseTuple) else ()  # every numba tuple type's fields
+    return fields[expr.index] if expr.index < len(fields) else None
 
 
 class ConstantPipeline(CompilerBase):

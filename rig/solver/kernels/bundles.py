@@ -7,9 +7,12 @@ Arrays are the single-shot kernel's (integrators.integrate): per body (nb,) or p
 (nb + 1,); the batched kernel's (ensemble.integrate_ensemble) carry a leading chunk axis
 and the chunk's shots innermost, (chunks, ..., width). Built by rig.solver.run.kernel_inputs.
 """
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numerics.dispatcher import Constant
 
 
 class ChainArrays(NamedTuple):
@@ -36,7 +39,7 @@ class Contacts(NamedTuple):
     numerics.dispatcher.Constant: every kernel is compiled for the law it runs, the other
     laws' code never compiled."""
 
-    law: int
+    law: "int | Constant"
     con: np.ndarray
     state: np.ndarray
 
