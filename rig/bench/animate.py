@@ -30,7 +30,7 @@ def run(repeats: int = 3) -> dict:
             rss = {}
             count = [0]
 
-            def progress():
+            def progress(count=count, rss=rss):  # bound: one counter per run
                 count[0] += 1
                 if count[0] in (10, FRAMES):
                     rss[count[0]] = _rss_mib()
