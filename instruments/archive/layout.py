@@ -51,7 +51,8 @@ def write_entry(f: h5py.File, shot_id: int, e: Entry, checked: dict, stored: dic
     dimension of its length in its group: ``time``)."""
     attach = stored is None
     written: dict = {}  # {address: value_digest} of the datasets this call writes (digest.table)
-    put = lambda parent, name, data, **kw: store(parent, name, data, written, **kw)
+    def put(parent, name, data, **kw):
+        return store(parent, name, data, written, **kw)
     where = f"shot {shot_id}"
     facts = facts_json(e, f"{where}: facts") if e.truth is not None else None
     members, linked = scene_group(f, shot_id, e, checked, stored, written)

@@ -97,7 +97,7 @@ def reproduce(study: str, out, progress=None) -> dict:
                                     "experiment": _experiment(rig, seeds_for(1, SEEDS)),
                                     "theory": _theory(rig, F0, F0 + t.amplitude_N)}
         tick(f"scene {scene}")
-    for material, pre, scene in CONFIGS:
+    for _material, _pre, scene in CONFIGS:
         base_v = rigs[scene].striker.velocity
         pts = []
         for k, f in enumerate(VELOCITY_FACTORS):

@@ -62,9 +62,9 @@ class Store:
         """The folder, held by this run for as long as the block runs: another run into it
         (same folder, any study) is refused in one line naming the holder. The OS releases
         the hold when this process ends, killed or not."""
-        with folder_lock(self.folder, "study.lock", "wait for it to end, or give another --out"):
-            with left_as_found(self.folder, Exception, keep=lambda exc: bool(self.done())):  # inside the hold
-                yield self
+        with (folder_lock(self.folder, "study.lock", "wait for it to end, or give another --out"),
+              left_as_found(self.folder, Exception, keep=lambda exc: bool(self.done()))):  # inside the hold
+            yield self
 
     def open(self) -> Store:
         """Create the folder, or check that it holds this very study (to resume it)."""

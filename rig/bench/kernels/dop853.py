@@ -138,10 +138,7 @@ def starting_step(y, k, t_end, rtol, atol, A_hertz, d0, load, invm, f, work, sca
     for i in range(n):
         work[i] = k[1, i] - k[0, i]
     n2 = rms(work, scale) / h0
-    if n1 <= 1e-15 and n2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(n1, n2)) ** (1.0 / 8.0)
+    h1 = max(1e-6, h0 * 1e-3) if n1 <= 1e-15 and n2 <= 1e-15 else (0.01 / max(n1, n2)) ** (1.0 / 8.0)
     return min(100.0 * h0, h1, t_end)
 
 
