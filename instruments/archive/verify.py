@@ -9,7 +9,8 @@ recorded): the attribute ``checksums``, {attribute: SHA-256} of the root's other
 Version 2 adds the attribute ``members``, the names in the root group and in ``/shared`` (the
 two groups that no table of their own covers); its SHA-256 is a row of ``checksums`` like
 any attribute's. A layout-3 master lists its shots as ranges of ids (``"shot_ids": [[1,
-10000]]``, ``compact``), so that the attribute an append rewrites stays small. An archive without ``members`` is checked as version 1; its next append
+10000]]``, ``compact``), so that the attribute an append rewrites stays small. An archive
+without ``members`` is checked as version 1; its next append
 (or ``rig upgrade``) writes version 2. From layout 4 on, the root's table also holds a row
 per attribute of ``/shared`` ("/shared@NX_class")."""
 from __future__ import annotations
@@ -189,7 +190,8 @@ def check(f: h5py.File) -> dict:
         shot_bad.update(ids)
         for p in found:
             bad.append({"shot": None, "shots": ids, "where": _where(p, f"/shared/{key}"),
-                        "reason": f"{p} (shared by shot{'' if len(ids) == 1 else 's'} {', '.join(map(str, ids)) or '-'})"})
+                        "reason": f"{p} (shared by shot{'' if len(ids) == 1 else 's'} "
+                                  f"{', '.join(map(str, ids)) or '-'})"})
     listed = len(names) + sum(1 for p in missing if _shot_id(p) is not None)
     return {"shots": listed, "ok": listed - len(shot_bad), "bad": bad}
 

@@ -72,7 +72,7 @@ def run(scene: str = SCENE, rounds: int = ROUNDS, cycles: int = CYCLES) -> dict:
             base["fire, new velocity"].append(_cpu(lambda fresh=fresh, k=k: Rig.from_scene(scene, fresh).fire(seed=k)))
             sock.write("DATA:SOURCE CH1;:DATA:ENCDG SRIBINARY;:DATA:WIDTH 2;:DATA:START 1;"
                        f":DATA:STOP {CURVE_POINTS}")
-            curve = []
+            curve: list[np.ndarray] = []
             rows["CURVe? 10,000 points 16-bit"].append(_cpu(lambda curve=curve: curve.append(
                 sock.query_binary_values("CURVE?", datatype="h", container=np.array))))
             if curve[0].size != CURVE_POINTS:

@@ -61,7 +61,8 @@ class AnalyzeOptions:
                                            ("--tau", self.tau, False, "s"), ("--beta", self.beta, False, ""),
                                            ("--f0", self.f0, True, "N"), ("--diameter", self.diameter, False, "m")):
             if value is not None and not (math.isfinite(value) and (value >= 0 if zero_ok else value > 0)):
-                raise invalid(flag, value, f"a finite number {'>= 0' if zero_ok else '> 0'}{' ' + unit if unit else ''}")
+                raise invalid(flag, value,
+                              f"a finite number {'>= 0' if zero_ok else '> 0'}{' ' + unit if unit else ''}")
         if self.material is not None:
             lookup(MATERIALS, self.material, "--material", Material)  # an unknown name: one line naming the known
 

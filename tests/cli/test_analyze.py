@@ -136,7 +136,8 @@ def test_bad_flags_are_one_line_and_exit_2(gauge_files, capsys, flag, value, mes
 
 
 def test_beta_one_is_the_default(gauge_files, capsys):
-    assert run(capsys, "analyze", *gauge_files, *GAUGE, "--beta", "1")[1] == run(capsys, "analyze", *gauge_files, *GAUGE)[1]
+    with_beta = run(capsys, "analyze", *gauge_files, *GAUGE, "--beta", "1")[1]
+    assert with_beta == run(capsys, "analyze", *gauge_files, *GAUGE)[1]
 
 
 def test_every_real_file_is_a_clear_refusal(realdata, capsys):

@@ -34,7 +34,8 @@ def test_the_hard_override_ends_within_its_estimate_and_names_the_accuracy():
     assert estimate.seconds < estimate.bound_seconds == pytest.approx(estimate.seconds * WORK_BUDGET / CONTROL_WORK)
     Rig.from_scene("ptfe52_magnetic").solution()  # the kernels compiled or loaded, outside the timing
     t0 = time.process_time()
-    with pytest.raises(AccuracyNotReached, match=r"accuracy = 0\.0001: not reached; over solver\.duration = 0\.003 s the error "
+    with pytest.raises(AccuracyNotReached, match=r"accuracy = 0\.0001: not reached; "
+                       r"over solver\.duration = 0\.003 s the error "
                        r"estimate stayed at 0\.\d+ .*"
                        r"a step 16 times finer, which lowered it by less than 2 times"):
         rig.solution()
