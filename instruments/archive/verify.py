@@ -72,7 +72,8 @@ def member_changes(f: h5py.File) -> tuple:
         added += [prefix + n for n in sorted(after - before)]
         missing += [prefix + n for n in sorted(before - after)]
     parents = set(added) | set(missing)  # a whole /shared added or deleted: its members are not listed again
-    drop = lambda p: p.rsplit("/", 1)[0] in parents  # noqa: E731
+    def drop(p):
+        return p.rsplit("/", 1)[0] in parents
     return [p for p in added if not drop(p)], [p for p in missing if not drop(p)]
 
 
@@ -208,7 +209,8 @@ def named(problems: list, prefix: str) -> list:
             moved[head.rstrip("/")] = "missing" if what == "missing" else "added"
     if not moved:
         return problems
-    inside = lambda item: any(item.startswith((k + "/", k + "@")) for k in moved)  # noqa: E731
+    def inside(item):
+        return any(item.startswith((k + "/", k + "@")) for k in moved)
     parents = {(k.rsplit("/", 1)[0] + "/") if "/" in k else "/" for k in moved}
     out = []
     for p in problems:

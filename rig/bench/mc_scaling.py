@@ -113,7 +113,7 @@ def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
 
     ns = sorted(ns or counts(os.cpu_count() or 1))
     try:
-        import dask.distributed  # noqa: F401
+        import dask.distributed  # noqa: F401 - imported to find whether the dask extra is installed
         modes = list(MODES)
     except ImportError:
         modes = ["workers", "threads"]

@@ -77,7 +77,8 @@ def cmd_sweep(args) -> dict:
 def print_sweep(key: str, points: list):
     """The sweep's table: truth, measured and Eq (1) per point, and under a point that has
     no measured speed, why (the analysis' reasons); a point that gave no record, why."""
-    fmt = lambda v, spec: "-".rjust(int(spec.split(".")[0])) if v is None else format(v, spec)  # noqa: E731
+    def fmt(v, spec):
+        return "-".rjust(int(spec.split(".")[0])) if v is None else format(v, spec)
     print(f"{key:>18s} | {'truth F_d N':>11s} {'V_s m/s':>8s} | {'measured F_d N':>14s} "
           f"{'V_s m/s':>8s} | {'Eq (1) m/s':>10s}")
     clipped = []

@@ -182,7 +182,8 @@ def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
     if len(set(names)) < len(names):
         raise invalid("--channels", options.channels, "a channel named twice (each gauge has its own channel)")
     volts_per_newton = 1.0 if options.sensitivity is None else options.sensitivity
-    g = lambda ch, x: GaugeSetup(ch, x, volts_per_newton, options.tau)  # noqa: E731
+    def g(ch, x):
+        return GaugeSetup(ch, x, volts_per_newton, options.tau)
     wall = g(names[2], math.inf) if len(names) > 2 else None
     return Setup(g(names[0], 0.0), g(names[1], options.gauge_distance), wall, options.diameter,
                  options.beta, options.f0, PeakRules(), force_unit="V" if options.sensitivity is None else "N")

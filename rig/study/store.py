@@ -150,7 +150,8 @@ class Store:
             return StudyResults(np.zeros(0, int), np.zeros((0, len(self.study.keys))), np.zeros(0, np.int64),
                                 {k: np.zeros(0) for k in OUTPUTS})
         order = np.argsort(np.concatenate([q["index"] for q in parts]))
-        cat = lambda key: np.concatenate([q[key] for q in parts])[order]  # noqa: E731
+        def cat(key):
+            return np.concatenate([q[key] for q in parts])[order]
         return StudyResults(cat("index"), cat("inputs"), cat("seeds"),
                             {k: np.concatenate([_output(q, k) for q in parts])[order] for k in OUTPUTS})
 

@@ -345,7 +345,8 @@ def _api_cases():
     from rig.solver.saveat import SaveAt
     from rig.solver.solve import solve
 
-    chain = lambda: Chain([Bead("ptfe", 4.76e-3)] * 5, striker=Striker(), wall=Wall())  # noqa: E731
+    def chain():
+        return Chain([Bead("ptfe", 4.76e-3)] * 5, striker=Striker(), wall=Wall())
     cases = [(lambda a=a: Rig.from_scene(a), "scene") for a in (None, 3, 2.5, "", [S], b"ptfe52_magnetic")]
     cases += [(lambda o=o: Rig.from_scene(S, o), "overrides") for o in (None, "striker.velocity=1", [1], [None])]
     cases += [(lambda s=s: Rig(s), "scene") for s in (None, S, {})]

@@ -105,7 +105,8 @@ def test_the_error_over_time_ends_at_the_whole_records_error_and_cuts_where_it_s
     from rig.solver.solution import relative_error
 
     t = np.arange(3000) * 1e-6
-    pulse = lambda t0: np.exp(-(((t - t0) / 5e-5) ** 2))  # noqa: E731
+    def pulse(t0):
+        return np.exp(-(((t - t0) / 5e-5) ** 2))
     reference = {"a": 2.0 + pulse(1e-3), "b": 1.0 + 3 * pulse(2e-3)}
     forces = {"a": reference["a"] + 1e-7 * pulse(1e-3), "b": reference["b"] + 1e-2 * (t > 2e-3)}
     err = error_over_time(forces, reference)

@@ -41,7 +41,7 @@ import math
 import numpy as np
 
 from numerics.jit import jit
-from rig.bench.kernels.dop853_table import DENSE_STAGES, E3, E5, N_STAGES, N_STAGES_EXTENDED, A, B, C, D  # noqa: F401
+from rig.bench.kernels.dop853_table import E3, E5, N_STAGES, N_STAGES_EXTENDED, A, D
 from rig.solver.kernels.forces import hertz_forces
 
 SAFETY = 0.9            # Hairer's safe
