@@ -41,7 +41,9 @@ import math
 import numpy as np
 
 from numerics.jit import jit
-from rig.bench.kernels.dop853_table import E3, E5, N_STAGES, N_STAGES_EXTENDED, A, D
+
+# B and C, unused here, are re-exported: tests/bench/test_peers.py holds the whole table to scipy's
+from rig.bench.kernels.dop853_table import E3, E5, N_STAGES, N_STAGES_EXTENDED, A, B, C, D  # noqa: F401
 from rig.solver.kernels.forces import hertz_forces
 
 SAFETY = 0.9            # Hairer's safe
