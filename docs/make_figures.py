@@ -14,9 +14,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from rig.experiment.shot import Rig  # noqa: E402
+from rig.experiment.shot import Rig
 
 SCENE, SEED = "ptfe52_magnetic", 1
 DEFAULT_OUT = Path(__file__).resolve().parent / "figures" / "shot_traces.png"

@@ -65,7 +65,8 @@ def rail_of_volts(v: np.ndarray, volts_per_div: float, offset_V: float, position
     v = np.asarray(v, dtype=float)
     if not (v.size and np.isfinite(volts_per_div) and volts_per_div > 0):
         return Rail()
-    div = lambda x: (x - offset_V) / volts_per_div + position_div  # noqa: E731
+    def div(x):
+        return (x - offset_V) / volts_per_div + position_div
     hi, lo = float(np.max(v)), float(np.min(v))
     top = _long_runs(v == hi) if div(hi) >= EDGE_DIV else np.zeros(v.size, bool)
     bottom = _long_runs(v == lo) if div(lo) <= -EDGE_DIV else np.zeros(v.size, bool)

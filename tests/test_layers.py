@@ -222,7 +222,8 @@ def test_the_checker_finds_planted_violations(tmp_path):
         "rig/model/x.py:1: rig.model.x imports rig.solver.solve: model may not import solver",
         "rig/model/lazy.py:3: rig.model.lazy imports rig.viz.figures: model may not import viz",
         "rig/theory/t.py:1: rig.theory.t imports rig.model.x: theory may not import model",
-        "rig/experiment/e.py:1: rig.experiment.e imports instruments._kernels.peaks: _kernels is private to instruments",
+        "rig/experiment/e.py:1: rig.experiment.e imports instruments._kernels.peaks: "
+        "_kernels is private to instruments",
         "rig/experiment/e.py:2: rig.experiment.e imports rig.solver.a: _helper is private to rig.solver.a",
         "rig/experiment/e.py:3: rig.experiment.e imports rig Chain: only __version__ comes from the rig facade",
         "rig/extra/z.py: rig.extra.z is in no layer",

@@ -9,12 +9,12 @@ import math
 import numpy as np
 
 from ._kernels import pulses
-from .pulse import PeakRules, Pulse
+from .pulse import DEFAULT_RULES, PeakRules, Pulse
 from .refine import refined
 from .setup import Setup
 
 
-def find_pulses(t: np.ndarray, f: np.ndarray, rules: PeakRules = PeakRules(),
+def find_pulses(t: np.ndarray, f: np.ndarray, rules: PeakRules = DEFAULT_RULES,
                 floor: float | None = None, refine: bool = True) -> list:
     """Every pulse of f (a dynamic signal, baseline 0), in time order, by find_peaks' rules
     (compiled in _kernels/pulses.py: candidates). ``floor`` replaces the relative height
@@ -34,7 +34,7 @@ def find_pulses(t: np.ndarray, f: np.ndarray, rules: PeakRules = PeakRules(),
     return [refined(t, f, p, rules) for p in coarse] if refine else coarse
 
 
-def leading(pulses: list, rules: PeakRules = PeakRules()):
+def leading(pulses: list, rules: PeakRules = DEFAULT_RULES):
     """The first pulse above ``rules.lead`` of the largest one (None if there is none)."""
     if not pulses:
         return None
@@ -42,7 +42,7 @@ def leading(pulses: list, rules: PeakRules = PeakRules()):
     return next(p for p in pulses if p.amplitude >= rules.lead * big)
 
 
-def solitary_train(t, f, lead, cut: float, rules: PeakRules = PeakRules(), refine: bool = False,
+def solitary_train(t, f, lead, cut: float, rules: PeakRules = DEFAULT_RULES, refine: bool = False,
                    noise: float | None = None) -> list:
     """The solitary waves of a train at one gauge: pulses above 5% of the leading one (and
     ``rules.snr`` times the noise, where known), from the leading one until ``cut`` (s; when

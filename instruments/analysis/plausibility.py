@@ -59,7 +59,8 @@ def speed_doubt(limits: Limits, distance_m: float, flight_s: float, h_s: float, 
         return (f"the time of flight is {flight_s / h_s:.2g} samples, under the {limits.min_flight_samples:g} "
                 f"needed for a speed to 10%: {said} is not measured")
     if speed > limits.max_speed_m_per_s:
-        return f"{said} is faster than {limits.max_speed_m_per_s:.4g} m/s, which no solitary wave of a bead chain reaches"
+        return (f"{said} is faster than {limits.max_speed_m_per_s:.4g} m/s, "
+                "which no solitary wave of a bead chain reaches")
     width = fwhm_s * speed / diameter_m
     lo, hi = limits.width_diameters
     if math.isfinite(width) and not lo <= width <= hi:

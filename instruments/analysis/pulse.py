@@ -42,6 +42,9 @@ class PeakRules:
         check("peaks.width", self.width, lo=0, lo_closed=True, unit="s")
 
 
+# the default rules (a frozen instance, shared by every call that names none)
+DEFAULT_RULES = PeakRules()
+
 
 @dataclass(frozen=True)
 class Pulse:

@@ -9,10 +9,10 @@ from __future__ import annotations
 import numpy as np
 
 from ._kernels import pulses
-from .pulse import PeakRules, Pulse
+from .pulse import DEFAULT_RULES, PeakRules, Pulse
 
 
-def refined(t: np.ndarray, f: np.ndarray, pulse: Pulse, rules: PeakRules = PeakRules()) -> Pulse:
+def refined(t: np.ndarray, f: np.ndarray, pulse: Pulse, rules: PeakRules = DEFAULT_RULES) -> Pulse:
     """The pulse's time and amplitude from its parabola, and its FWHM and 1% base width."""
     i = int(np.rint((pulse.time - t[0]) / (t[1] - t[0])))
     return Pulse(*(float(x) for x in pulses.refine(np.ascontiguousarray(t, dtype=float),

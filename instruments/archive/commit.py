@@ -61,7 +61,8 @@ def commit_parts(path: Path, entries: list, transaction, master=None, ids=None, 
     finally:
         if master is not None:
             master.close()
-    link = lambda f: _link(f, path.name, layout, part, ids, new_shared, members)
+    def link(f):
+        return _link(f, path.name, layout, part, ids, new_shared, members)
     try:
         transaction(link, master is not None)  # a copy of the master, or a new one
     except BaseException:

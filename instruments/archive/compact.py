@@ -8,9 +8,9 @@ NXdata plot itself, read as volts through CF packing attributes (``scale_factor`
 axis as a sample index (uint16, or uint32 past 65,536 points) packed the same way (seconds =
 x_zero + x_increment*n); the shot's scalars, preambles and facts as one JSON attribute of its
 NXentry (``metadata``); one table of checksums, whose rows of what the writer wrote are
-computed from what it wrote, not read back. Codes are chunked with fletcher32 and not compressed (3 x 10,000 int16 codes are
-60 kB; gzip would cost more CPU than the bytes it saves); the index axis is gzipped (a few
-hundred bytes).
+computed from what it wrote, not read back. Codes are chunked with fletcher32 and not
+compressed (3 x 10,000 int16 codes are 60 kB; gzip would cost more CPU than the bytes it
+saves); the index axis is gzipped (a few hundred bytes).
 """
 from __future__ import annotations
 

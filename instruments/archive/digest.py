@@ -149,7 +149,7 @@ def _walk(g, a, prefix: str, t: _Tree):
             _walk(obj, a, path + "/", t)
         else:
             t.where[a] = path
-            t.rows[path] = t.written.get(a) or _guard(lambda: _dataset_digest(obj))
+            t.rows[path] = t.written.get(a) or _guard(functools.partial(_dataset_digest, obj))
             _attrs(obj, a, path, t)
 
 

@@ -89,7 +89,8 @@ def facts_json(e: Entry, where: str) -> str:
     if e.facts is None:
         return "{}"
     if not isinstance(e.facts, ShotFacts):
-        raise InstrumentError(f"{where} = {type(e.facts).__name__}: expected ShotFacts (instruments.archive.facts) or None")
+        raise InstrumentError(f"{where} = {type(e.facts).__name__}: "
+                              "expected ShotFacts (instruments.archive.facts) or None")
     text = json.dumps(e.facts.to_dict(), default=jsonable)
     ShotFacts.from_dict(json.loads(text), where)
     return text

@@ -43,15 +43,17 @@ COMPRESSION = dict(compression="gzip", compression_opts=1, shuffle=True, fletche
 
 def write_entry(f: h5py.File, shot_id: int, e: Entry, checked: dict, stored: dict | None = None):
     """Write one NXentry, then seal its table of checksums; ``checked`` holds the shared
-    groups already compared this transaction ({} at its start; scene_group). ``stored`` (layout 3, a part file; {key: (part
-    file, group)}) names the shared groups an earlier transaction wrote into another part,
+    groups already compared this transaction ({} at its start; scene_group). ``stored``
+    (layout 3, a part file; {key: (part file, group)}) names the shared groups an earlier
+    transaction wrote into another part,
     which the entry links to with HDF5 external links; in a part, the axes are dimension
     scales attached to nothing (h5netcdf reads an attached scale's reference in the file it
     opened, the master, where it does not lie; it gives an unattached variable the
     dimension of its length in its group: ``time``)."""
     attach = stored is None
     written: dict = {}  # {address: value_digest} of the datasets this call writes (digest.table)
-    put = lambda parent, name, data, **kw: store(parent, name, data, written, **kw)
+    def put(parent, name, data, **kw):
+        return store(parent, name, data, written, **kw)
     where = f"shot {shot_id}"
     facts = facts_json(e, f"{where}: facts") if e.truth is not None else None
     members, linked = scene_group(f, shot_id, e, checked, stored, written)

@@ -48,7 +48,8 @@ class OpenParts:
 def returned_by_read(g):
     """Whether a row of the shot ``g``'s table is of what a read returns (a test of the
     row's key): in layout 4 not the time axes and the attributes of the NXdata plot and its
-    datasets (NeXus and CF), which a read computes from the preambles (in ``@metadata``); in layouts 2 and 3, nothing of the plot (``data/``: volts and time
+    datasets (NeXus and CF), which a read computes from the preambles (in ``@metadata``); in
+    layouts 2 and 3, nothing of the plot (``data/``: volts and time
     computed from the codes and preambles, which lie in instrument/)."""
     if g.file.attrs.get("layout_version") == LAYOUT4:
         return lambda key: not key.startswith(("data/time", "data@")) and not (key.startswith("data/") and "@" in key)

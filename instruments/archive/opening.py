@@ -46,7 +46,8 @@ def open_archive(path, current: bool = True) -> h5py.File:
     if current and version not in READ:
         f.close()
         raise InstrumentError(f"{path}: archive layout {version or 1}, this version reads layouts "
-                              f"{', '.join(map(str, READ[:-1]))} and {READ[-1]}: run `rig upgrade {path}` to convert it")
+                              f"{', '.join(map(str, READ[:-1]))} and {READ[-1]}: "
+                              f"run `rig upgrade {path}` to convert it")
     return f
 
 

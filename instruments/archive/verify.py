@@ -9,7 +9,8 @@ recorded): the attribute ``checksums``, {attribute: SHA-256} of the root's other
 Version 2 adds the attribute ``members``, the names in the root group and in ``/shared`` (the
 two groups that no table of their own covers); its SHA-256 is a row of ``checksums`` like
 any attribute's. A layout-3 master lists its shots as ranges of ids (``"shot_ids": [[1,
-10000]]``, ``compact``), so that the attribute an append rewrites stays small. An archive without ``members`` is checked as version 1; its next append
+10000]]``, ``compact``), so that the attribute an append rewrites stays small. An archive
+without ``members`` is checked as version 1; its next append
 (or ``rig upgrade``) writes version 2. From layout 4 on, the root's table also holds a row
 per attribute of ``/shared`` ("/shared@NX_class")."""
 from __future__ import annotations
@@ -71,7 +72,8 @@ def member_changes(f: h5py.File) -> tuple:
         added += [prefix + n for n in sorted(after - before)]
         missing += [prefix + n for n in sorted(before - after)]
     parents = set(added) | set(missing)  # a whole /shared added or deleted: its members are not listed again
-    drop = lambda p: p.rsplit("/", 1)[0] in parents  # noqa: E731
+    def drop(p):
+        return p.rsplit("/", 1)[0] in parents
     return [p for p in added if not drop(p)], [p for p in missing if not drop(p)]
 
 
@@ -189,7 +191,8 @@ def check(f: h5py.File) -> dict:
         shot_bad.update(ids)
         for p in found:
             bad.append({"shot": None, "shots": ids, "where": _where(p, f"/shared/{key}"),
-                        "reason": f"{p} (shared by shot{'' if len(ids) == 1 else 's'} {', '.join(map(str, ids)) or '-'})"})
+                        "reason": f"{p} (shared by shot{'' if len(ids) == 1 else 's'} "
+                                  f"{', '.join(map(str, ids)) or '-'})"})
     listed = len(names) + sum(1 for p in missing if _shot_id(p) is not None)
     return {"shots": listed, "ok": listed - len(shot_bad), "bad": bad}
 
@@ -206,7 +209,8 @@ def named(problems: list, prefix: str) -> list:
             moved[head.rstrip("/")] = "missing" if what == "missing" else "added"
     if not moved:
         return problems
-    inside = lambda item: any(item.startswith((k + "/", k + "@")) for k in moved)  # noqa: E731
+    def inside(item):
+        return any(item.startswith((k + "/", k + "@")) for k in moved)
     parents = {(k.rsplit("/", 1)[0] + "/") if "/" in k else "/" for k in moved}
     out = []
     for p in problems:

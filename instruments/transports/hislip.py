@@ -13,6 +13,7 @@ the session (``Session.overflow``). Headers without the "HS" prologue and broken
 initializations get a FatalError and the connection is closed."""
 from __future__ import annotations
 
+import contextlib
 import itertools
 import socket
 import threading
@@ -148,7 +149,5 @@ class HislipServer:
 
 def _fatal(conn: socket.socket, code: Fatal, text: str) -> None:
     """Send a FatalError; the caller then lets the connection close."""
-    try:
+    with contextlib.suppress(OSError):
         conn.sendall(message(Kind.FATAL_ERROR, code, 0, text.encode("ascii", "replace")))
-    except OSError:
-        pass

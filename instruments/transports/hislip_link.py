@@ -3,6 +3,7 @@ what the synchronous and asynchronous channels share (the reply's delivery, the 
 in progress, the lock it holds)."""
 from __future__ import annotations
 
+import contextlib
 import socket
 import threading
 
@@ -89,7 +90,5 @@ class Link:
         self.session.close()
         for conn in (self.sync, self.asynchronous):
             if conn is not None:
-                try:
+                with contextlib.suppress(OSError):
                     conn.shutdown(socket.SHUT_RDWR)
-                except OSError:
-                    pass

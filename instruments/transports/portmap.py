@@ -8,6 +8,7 @@ already answers on port 111 (a system rpcbind, or another process's), or, where 
 and the caller allows it, starts one here; its ``how`` says which."""
 from __future__ import annotations
 
+import contextlib
 import socket
 import threading
 from dataclasses import dataclass
@@ -120,10 +121,8 @@ class PortMapper:
                 return
             reply = oncrpc.answer(datagram, self._programs)
             if reply is not None:
-                try:
+                with contextlib.suppress(OSError):  # the asker is gone; a UDP caller retries
                     self._udp.sendto(reply, addr)
-                except OSError:
-                    pass  # the asker is gone; a UDP caller retries
 
     def close(self) -> None:
         self._stop.set()
@@ -147,10 +146,8 @@ class Announcement:
             self._started.close()
             self._started = None
             return
-        try:
+        with contextlib.suppress(OSError):  # that portmapper is gone, and the registration with it
             _call_each(self._host, self.port, PMAPPROC_UNSET, self.mappings)
-        except OSError:
-            pass  # that portmapper is gone, and the registration with it
 
 
 def _call_each(host: str, port: int, proc: int, mappings: list[PortMapping]) -> list[bool]:

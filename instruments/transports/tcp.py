@@ -5,6 +5,7 @@ once (one more is accepted and closed at once, so the client sees a clean refusa
 a hang); ``close()`` stops the listener and shuts every open connection down."""
 from __future__ import annotations
 
+import contextlib
 import socket
 import threading
 from collections.abc import Callable
@@ -77,10 +78,8 @@ class TcpService:
         with self._guard:
             clients = list(self._clients)
         for conn in clients:
-            try:
+            with contextlib.suppress(OSError):
                 conn.shutdown(socket.SHUT_RDWR)
-            except OSError:
-                pass
         self._thread.join(timeout=2.0)
 
 

@@ -95,10 +95,9 @@ def register(tree, scope) -> None:
         return scope.settings["scope.sample_interval"] * scope.settings["scope.record_length"]
 
     def set_position(c: Call):
-        if p.name == "tds2000":  # seconds from the trigger to the screen's centre
-            pre = 0.5 - c.number("S") / record_span()
-        else:  # percent of the record before the trigger
-            pre = c.number() / 100
+        # the TDS2000 gives seconds from the trigger to the screen's centre, the others the
+        # percent of the record before the trigger
+        pre = 0.5 - c.number("S") / record_span() if p.name == "tds2000" else c.number() / 100
         scope.change({"scope.trigger.pre_trigger": pre}, code=-222)
 
     def read_position(c: Call) -> str:

@@ -2,7 +2,8 @@
 command group): ``DATa:SOUrce[:AVAILable?]/STARt/STOP/ENCdg/WIDth``, ``DATa INIT``, ``DATa?``,
 the personality's preamble (``WFMPre?`` or ``WFMOutpre?``, whole and per field), ``CURVe?``,
 and ``WAVFrm?`` (preamble;curve). The preamble's BYT_Nr, ENCdg, BN_Fmt and BYT_Or are
-settable too, as the manuals give them: they set DATa:WIDth and DATa:ENCdg. A channel that is off is refused with 2244 "Source
+settable too, as the manuals give them: they set DATa:WIDth and DATa:ENCdg. A channel that
+is off is refused with 2244 "Source
 waveform is not active" by CURVe? (the preamble: see ``preamble`` below); ``CURVe?``
 before the first record is an execution error."""
 from __future__ import annotations
@@ -120,7 +121,8 @@ def register(tree, scope) -> None:
         scope.data = scope.data.encoded("ASCIi" if c.word(("ASCIi", "BINary")) == "ASCIi" else scope.data.binary)
 
     setters = {"BYT_Nr": width, "ENCdg": set_encoding, "BN_Fmt": set_format,
-               "BYT_Or": lambda c: setattr(scope, "data", scope.data.formatted(msb_first=c.word(("MSB", "LSB")) == "MSB"))}
+               "BYT_Or": lambda c: setattr(scope, "data",
+                                           scope.data.formatted(msb_first=c.word(("MSB", "LSB")) == "MSB"))}
     for name in p.preamble_fields:
         tree.add(f"{p.preamble}:{name}", read=preamble_field(name), write=setters.get(name))
     tree.add("CURVe", read=curve)

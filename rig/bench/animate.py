@@ -27,10 +27,10 @@ def run(repeats: int = 3) -> dict:
     times, grow = [], []
     with tempfile.TemporaryDirectory() as tmp:
         for k in range(repeats + 1):  # the first run loads the renderer and compiles
-            rss = {}
+            rss: dict[int, float] = {}  # {frame: resident MiB}
             count = [0]
 
-            def progress():
+            def progress(count=count, rss=rss):  # bound: one counter per run
                 count[0] += 1
                 if count[0] in (10, FRAMES):
                     rss[count[0]] = _rss_mib()
@@ -52,7 +52,8 @@ def run(repeats: int = 3) -> dict:
 def table(r: dict) -> str:
     return "\n".join([
         f"animation of ptfe52_magnetic, {r['frames']} frames to mp4, off-screen (median of {len(r['runs_s'])})",
-        f"  whole animation            {r['median_s']:7.2f} s   ({r['median_s'] / r['frames'] * 1e3:.0f} ms per frame; target < 20 s)",
+        f"  whole animation            {r['median_s']:7.2f} s   "
+        f"({r['median_s'] / r['frames'] * 1e3:.0f} ms per frame; target < 20 s)",
         f"  the same shot, no frames   {r['shot_s']:7.2f} s",
         f"  memory, frame 10 -> 100    {r['memory_growth_10_to_100_MiB']:+7.1f} MiB",
         f"  movie size                 {r['mp4_bytes'] / 1e6:7.2f} MB"])

@@ -56,7 +56,8 @@ def run(shots: int = 400, batch: int = 100, single: int = 60, held: tuple = (10,
             "batched_shots_per_s": batched, "batch": batch,
             "single_shots_per_s": one_by_one, "verify_shots_per_s": verify,
             "read_shots_per_s": read, "bytes_per_shot": size / shots,
-            "held": {**{n: _held(entries, n, batch) for n in held}, **{n: _held(entries, n, batch, True) for n in large}}}
+            "held": {**{n: _held(entries, n, batch) for n in held},
+                     **{n: _held(entries, n, batch, True) for n in large}}}
 
 
 def _held(entries: list, n: int, batch: int, direct: bool = False, repeats: int = 7) -> dict:
@@ -87,6 +88,7 @@ def table(r: dict) -> str:
         f"  verify (fletcher32 + sha256)       {r['verify_shots_per_s']:8.0f} shots/s",
         f"  read back (codes + metadata)       {r['read_shots_per_s']:8.0f} shots/s",
         f"  file size                          {r['bytes_per_shot'] / 1e3:8.1f} kB/shot",
-        *(f"  holding {int(n):>7,} shots: one-shot append {h['append_ms']:6.1f} ms, read one shot {h['read_ms']:5.1f} ms"
+        *(f"  holding {int(n):>7,} shots: one-shot append {h['append_ms']:6.1f} ms, "
+          f"read one shot {h['read_ms']:5.1f} ms"
           for n, h in r.get("held", {}).items()),
         "  (10,000 and 100,000 shots: archives written directly, rig/bench/archive_large.py)"])

@@ -111,8 +111,8 @@ def run(rounds: int = ROUNDS, baseline: str | None = None) -> dict:
             rev[f"{task}_top_compiles_s"] = dict(sorted(compiles.items(), key=lambda kv: -kv[1])[:12])
     if baseline:
         cur = result["revisions"]["current"]
-        result["ratio_to_baseline"] = {c: statistics.median(a["wall_s"][c] / b["wall_s"][c]
-                                                            for a, b in zip(got["current"], got[f"baseline {baseline}"]))
+        pairs = list(zip(got["current"], got[f"baseline {baseline}"]))
+        result["ratio_to_baseline"] = {c: statistics.median(a["wall_s"][c] / b["wall_s"][c] for a, b in pairs)
                                        for c in cur["wall_s"]}
     return result
 
@@ -124,8 +124,8 @@ def table(r: dict) -> str:
              f"  {'command':16s}" + "".join(f" {n[:22]:>22s}" for n in names)
              + (f" {'ratio':>6s}" if "ratio_to_baseline" in r else "") + f" {'target s':>8s}"]
     for command in r["revisions"]["current"]["wall_s"]:
-        cells = "".join(f" {r['revisions'][n]['wall_s'][command]:9.2f} s ({r['revisions'][n]['cpu_s'][command]:5.1f} CPU)"
-                        for n in names)
+        cells = "".join(f" {r['revisions'][n]['wall_s'][command]:9.2f} s "
+                        f"({r['revisions'][n]['cpu_s'][command]:5.1f} CPU)" for n in names)
         ratio = f" {r['ratio_to_baseline'][command]:6.2f}" if "ratio_to_baseline" in r else ""
         target = TARGETS.get(command)
         lines.append(f"  {command:16s}{cells}{ratio} {'-' if target is None else f'{target:.1f}':>8s}")

@@ -124,7 +124,7 @@ def scaling(chain, progress=None) -> dict:
         steps = max(100, int(2e7 / n))
         span = steps * stepping.dt
         solve(p, 2 * stepping.dt, save=save, dt=stepping, estimate=False)
-        _, cpu = median_cpu(lambda: solve(p, span, save=save, dt=stepping, estimate=False), 3)
+        _, cpu = median_cpu(lambda p=p, span=span, save=save: solve(p, span, save=save, dt=stepping, estimate=False), 3)
         rows.append({"beads": n, "cpu_per_simulated_s": cpu / span, "steps": steps})
     log_n = np.log([r["beads"] for r in rows])
     log_c = np.log([r["cpu_per_simulated_s"] for r in rows])

@@ -51,13 +51,13 @@ VARY = ("striker.velocity=normal(0.89 m/s, 0.01 m/s)", "chain.bead_mass=normal(0
 BATCH = DEFAULT_BATCH  # rig mc's
 FIGURES = ("solver_kernel_shots_per_s", "solver_shots_per_s", "pipeline_shots_per_s",
            "pipeline_workers_steady_shots_per_s", "pipeline_workers_total_shots_per_s")
-SNIPPET = """
+SNIPPET = f"""
 import json
 from rig.bench import mc
-mc.BATCH = %d  # a baseline whose default batch differs runs this one's
-kw = {"rounds": 1, "scaling": False}  # what this revision's run takes of them
-print(json.dumps(mc.run(**{k: v for k, v in kw.items() if k in mc.run.__code__.co_varnames})))
-""" % BATCH
+mc.BATCH = {BATCH:d}  # a baseline whose default batch differs runs this one's
+kw = {{"rounds": 1, "scaling": False}}  # what this revision's run takes of them
+print(json.dumps(mc.run(**{{k: v for k, v in kw.items() if k in mc.run.__code__.co_varnames}})))
+"""
 
 
 @dataclass(frozen=True)

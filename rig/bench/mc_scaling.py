@@ -51,7 +51,8 @@ def counts(cores: int) -> list:
 
 
 def _study(vary: tuple, workers: int, batch: int, seed: int) -> MonteCarloStudy:
-    return MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(vary)), PER_WORKER * workers * batch, seed=seed, batch=batch)
+    return MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary(vary)), PER_WORKER * workers * batch,
+                           seed=seed, batch=batch)
 
 
 def _children_cpu() -> float:
@@ -112,7 +113,7 @@ def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
 
     ns = sorted(ns or counts(os.cpu_count() or 1))
     try:
-        import dask.distributed  # noqa: F401
+        import dask.distributed  # noqa: F401 - imported to find whether the dask extra is installed
         modes = list(MODES)
     except ImportError:
         modes = ["workers", "threads"]
@@ -179,7 +180,8 @@ def table(r: dict) -> str:
     lines.append(f"  a batch's result as pickled back to the parent: {r['result_bytes_per_shot']:.0f} bytes per shot")
     if "store_ms_per_batch" in r:
         alone, grouped = (r["store_ms_per_batch"][k] for k in sorted(r["store_ms_per_batch"]))
-        lines.append(f"  the store, per batch: {alone:.1f} ms one at a time, {grouped:.1f} ms in groups of {STORE_GROUP} "
+        lines.append(f"  the store, per batch: {alone:.1f} ms one at a time, "
+                     f"{grouped:.1f} ms in groups of {STORE_GROUP} "
                      f"(its writer keeps up with {1000 / grouped:.0f} batches/s, {1000 / grouped * r['batch']:.0f} "
                      f"shots/s)")
     return "\n".join(lines)

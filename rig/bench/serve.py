@@ -64,16 +64,16 @@ def run(scene: str = SCENE, rounds: int = ROUNDS, cycles: int = CYCLES) -> dict:
         base: dict[str, list] = {"fire": [], "fire, new velocity": [], f"{cycles} fires": []}
         for k in range(rounds):
             for kind, inst in clients.items():
-                rows[f"arm to record ready ({kind})"].append(_cpu(lambda: _arm(inst)))
-            base["fire"].append(_cpu(lambda: rig.fire(seed=k)))
+                rows[f"arm to record ready ({kind})"].append(_cpu(lambda inst=inst: _arm(inst)))
+            base["fire"].append(_cpu(lambda k=k: rig.fire(seed=k)))
             sock.write(f"RIG:STRIKER:VELOCITY {velocities[k]}")
             rows["new striker velocity"].append(_cpu(lambda: _arm(sock)))
             fresh = [*overrides, f"striker.velocity={velocities[k]}"]
-            base["fire, new velocity"].append(_cpu(lambda: Rig.from_scene(scene, fresh).fire(seed=k)))
+            base["fire, new velocity"].append(_cpu(lambda fresh=fresh, k=k: Rig.from_scene(scene, fresh).fire(seed=k)))
             sock.write("DATA:SOURCE CH1;:DATA:ENCDG SRIBINARY;:DATA:WIDTH 2;:DATA:START 1;"
                        f":DATA:STOP {CURVE_POINTS}")
-            curve = []
-            rows["CURVe? 10,000 points 16-bit"].append(_cpu(lambda: curve.append(
+            curve: list[np.ndarray] = []
+            rows["CURVe? 10,000 points 16-bit"].append(_cpu(lambda curve=curve: curve.append(
                 sock.query_binary_values("CURVE?", datatype="h", container=np.array))))
             if curve[0].size != CURVE_POINTS:
                 raise RuntimeError(f"CURVe? gave {curve[0].size} points, not {CURVE_POINTS}")

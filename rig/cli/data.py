@@ -122,7 +122,8 @@ def cmd_analyze(args) -> list:
     results = analyze_paths(options)
     args.exit_code = 0 if any(r["speed_m_per_s"] is not None for r in results) else 1
     if not args.json:
-        fmt = lambda v, spec=".2f": "-" if v is None else format(v, spec)  # noqa: E731
+        def fmt(v, spec=".2f"):
+            return "-" if v is None else format(v, spec)
         if any(r["force_unit"] == "V" for r in results):
             print("note: without --sensitivity a real scope file's forces are its gauges' volts (1 V/N): its "
                   "F_d and F_m,e and noise are in V; give e.g. --sensitivity '0.05 V/N' for newtons")

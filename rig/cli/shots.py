@@ -121,7 +121,8 @@ def print_shot(out: dict, energy: str):
 
 def print_blocks(t, m, th):
     """The truth / measured / theory rows of a shot's summary."""
-    fmt = lambda v, scale=1.0, spec=".1f": "-" if v is None else format(v * scale, spec)  # noqa: E731
+    def fmt(v, scale=1.0, spec=".1f"):
+        return "-" if v is None else format(v * scale, spec)
     print(f"  {'':10s} {'speed m/s':>10s} {'F_d N':>8s} {'F_m,e N':>8s} {'beta':>6s} {'pulses':>6s} {'FWHM us':>8s}")
     for label, r in (("truth", t), ("measured", m)):
         print(f"  {label:10s} {fmt(r['speed_m_per_s']):>10s} {fmt(r['amplitude_N'], 1, '.3f'):>8s} "

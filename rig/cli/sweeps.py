@@ -4,20 +4,23 @@ from __future__ import annotations
 from pathlib import Path
 
 from rig.cli.common import (
+    allow_large,
     check_archive_out,
     check_size,
+    command,
+    count_arg,
     flag_lines,
     folder_shown,
     missing_lines,
     progress_bar,
     scene_overrides,
+    seed_arg,
     writing_to,
 )
 from rig.cli.shots import shot_summary
 from rig.errors import Interrupted, RigError, invalid
 
 MAX_SWEEP_POINTS = 10_000  # more needs --allow-large (each point's shot is kept to the end)
-from rig.cli.common import allow_large, command, count_arg, seed_arg
 
 
 def cmd_sweep(args) -> dict:
@@ -38,19 +41,19 @@ def cmd_sweep(args) -> dict:
     vary = Vary.parse(args.vary[0], None if args.allow_large else MAX_SWEEP_POINTS)
     n = len(vary.values)
     check_size(Rig(scene).estimate().times(n, n), args, f"this sweep of {n} points")  # every point is kept
-    with progress_bar(args.quiet, total=len(vary.values), desc=f"sweep {vary.key}", unit="shot") as bar:
-        with writing_to(args.out or "the sweep"):
-            fired = []
+    with (progress_bar(args.quiet, total=len(vary.values), desc=f"sweep {vary.key}", unit="shot") as bar,
+          writing_to(args.out or "the sweep")):
+        fired = []
 
-            def tick():
-                fired.append(1)
-                bar.update()
+        def tick():
+            fired.append(1)
+            bar.update()
 
-            try:
-                points = run_sweep(args.scene, vary, overrides, args.seed, tick, args.out)
-            except KeyboardInterrupt:
-                kept = f"those points' shots are in {args.out}" if args.out else "nothing is kept (no --out)"
-                raise Interrupted(f"interrupted after {len(fired)} of {n} points: {kept}") from None
+        try:
+            points = run_sweep(args.scene, vary, overrides, args.seed, tick, args.out)
+        except KeyboardInterrupt:
+            kept = f"those points' shots are in {args.out}" if args.out else "nothing is kept (no --out)"
+            raise Interrupted(f"interrupted after {len(fired)} of {n} points: {kept}") from None
     if all(p.shot is None for p in points):  # nothing measured: a failure, not a table of reasons
         raise RigError(f"no point of the sweep gave a record; point 1 of {n} ({vary.key} = {points[0].value:g}): "
                        f"{points[0].reason}")
@@ -74,7 +77,8 @@ def cmd_sweep(args) -> dict:
 def print_sweep(key: str, points: list):
     """The sweep's table: truth, measured and Eq (1) per point, and under a point that has
     no measured speed, why (the analysis' reasons); a point that gave no record, why."""
-    fmt = lambda v, spec: "-".rjust(int(spec.split(".")[0])) if v is None else format(v, spec)  # noqa: E731
+    def fmt(v, spec):
+        return "-".rjust(int(spec.split(".")[0])) if v is None else format(v, spec)
     print(f"{key:>18s} | {'truth F_d N':>11s} {'V_s m/s':>8s} | {'measured F_d N':>14s} "
           f"{'V_s m/s':>8s} | {'Eq (1) m/s':>10s}")
     clipped = []

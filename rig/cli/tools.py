@@ -137,9 +137,11 @@ def add_bench(sub) -> None:
                     help="startup: the first rig shot and rig mc with an empty numba cache (everything compiled), "
                          "beside the warm ones")
     be.add_argument("--baseline", metavar="REV",
-                    help="solver, mc, startup --cold: measure git revision REV of this checkout too, in turns with the current code")
+                    help="solver, mc, startup --cold: measure git revision REV of this checkout too, "
+                         "in turns with the current code")
     be.add_argument("--rounds", type=rounds_arg, metavar="N",
-                    help="solver, mc, startup --cold: rounds, 1 to 100, of the figures that run in turns with --baseline "
+                    help="solver, mc, startup --cold: rounds, 1 to 100, "
+                         "of the figures that run in turns with --baseline "
                          "(solver: its kernel figure only, default 3, 1 with --quick; mc: every figure, default 3; "
                          "startup --cold: default 1); more "
                          "rounds steady the ratios on a machine whose speed swings")

@@ -61,7 +61,8 @@ class AnalyzeOptions:
                                            ("--tau", self.tau, False, "s"), ("--beta", self.beta, False, ""),
                                            ("--f0", self.f0, True, "N"), ("--diameter", self.diameter, False, "m")):
             if value is not None and not (math.isfinite(value) and (value >= 0 if zero_ok else value > 0)):
-                raise invalid(flag, value, f"a finite number {'>= 0' if zero_ok else '> 0'}{' ' + unit if unit else ''}")
+                raise invalid(flag, value,
+                              f"a finite number {'>= 0' if zero_ok else '> 0'}{' ' + unit if unit else ''}")
         if self.material is not None:
             lookup(MATERIALS, self.material, "--material", Material)  # an unknown name: one line naming the known
 
@@ -181,7 +182,8 @@ def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
     if len(set(names)) < len(names):
         raise invalid("--channels", options.channels, "a channel named twice (each gauge has its own channel)")
     volts_per_newton = 1.0 if options.sensitivity is None else options.sensitivity
-    g = lambda ch, x: GaugeSetup(ch, x, volts_per_newton, options.tau)  # noqa: E731
+    def g(ch, x):
+        return GaugeSetup(ch, x, volts_per_newton, options.tau)
     wall = g(names[2], math.inf) if len(names) > 2 else None
     return Setup(g(names[0], 0.0), g(names[1], options.gauge_distance), wall, options.diameter,
                  options.beta, options.f0, PeakRules(), force_unit="V" if options.sensitivity is None else "N")

@@ -114,7 +114,8 @@ def shot_blocks(rig, shot) -> dict:
     measured = measured_report(rig, shot, truth)
     keys = ("speed_m_per_s", "amplitude_N", "averaged_amplitude_N", "beta", "static_force_N",
             "pulses", "duration_s")
-    pick = lambda r: {k: _clean(getattr(r, k)) for k in keys}  # noqa: E731
+    def pick(r):
+        return {k: _clean(getattr(r, k)) for k in keys}
     m = pick(measured)
     m["speed_xcorr_m_per_s"] = _clean(measured.speed_xcorr_m_per_s)
     m["reasons"] = dict(measured.reasons)  # why each missing figure is missing

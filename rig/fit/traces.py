@@ -227,7 +227,7 @@ class TraceObjective:
     def residuals(self, model, eta) -> np.ndarray:
         _, gains, delays = self._split(eta)
         parts = []
-        for k, (c, m) in enumerate(zip(self.channels, self.traces(model, eta))):
+        for c, m in zip(self.channels, self.traces(model, eta)):
             r = np.full(c.t.size, 1e3) if m is None else (m - c.y) / c.sd
             parts.append(np.where(np.isfinite(r), r, 0.0))  # past the model's end: not compared
         priors = [(gains[k] - 1.0) / c.gain_sd for k, c in enumerate(self.channels) if c.gain_sd > 0]

@@ -97,7 +97,7 @@ def reproduce(study: str, out, progress=None) -> dict:
                                     "experiment": _experiment(rig, seeds_for(1, SEEDS)),
                                     "theory": _theory(rig, F0, F0 + t.amplitude_N)}
         tick(f"scene {scene}")
-    for material, pre, scene in CONFIGS:
+    for _material, _pre, scene in CONFIGS:
         base_v = rigs[scene].striker.velocity
         pts = []
         for k, f in enumerate(VELOCITY_FACTORS):
@@ -161,7 +161,8 @@ def _counts(rig: Rig, role: str) -> tuple:
 
 def _summary(results, rigs) -> dict:
     s, sc = {}, results["scenes"]
-    for mat, grav, mag in (("PTFE", "ptfe52_gravity", "ptfe52_magnetic"), ("steel", "steel21_gravity", "steel21_magnetic")):
+    for mat, grav, mag in (("PTFE", "ptfe52_gravity", "ptfe52_magnetic"),
+                           ("steel", "steel21_gravity", "steel21_magnetic")):
         s[f"{mat}_sound_speed_ratio_magnet_over_gravity"] = sc[mag]["theory"]["c0"] / sc[grav]["theory"]["c0"]
         s[f"{mat}_wall_peak_gravity_N"] = _wall_peak(rigs[grav])
         s[f"{mat}_wall_peak_2p38N_N"] = _wall_peak(rigs[mag])
@@ -204,7 +205,8 @@ def _write_tables(out: Path, results):
                      f"{r['Vs_numerics_m_per_s']:.1f} | {r['Vs_eq1_m_per_s']:.1f} | {r['c0_eq2_m_per_s']:.1f} | "
                      f"{r['c0_published_m_per_s']:.1f} |")
     write_text(
-        out / "table1.md", f"Table 1, reproduced: virtual experiment (mean ± sd over {SEEDS} shots), numerics (noise-free truth), "
+        out / "table1.md",
+        f"Table 1, reproduced: virtual experiment (mean ± sd over {SEEDS} shots), numerics (noise-free truth), "
         "long-wave theory at the numerics' F_m.\n\n" + "\n".join(lines) + "\n")
     s = results["summary"]
     body = ["# Summary", ""]

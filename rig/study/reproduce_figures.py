@@ -19,7 +19,8 @@ def figure_specs(results, rigs) -> list:
     """The published study's figures as data: theory curves, virtual and numerical traces,
     beta against F_m/F_0 and the leading pulse against the exact solitary wave."""
     specs = []
-    for mat, scenes in (("PTFE", ("ptfe52_gravity", "ptfe52_magnetic")), ("steel", ("steel21_gravity", "steel21_magnetic"))):
+    for mat, scenes in (("PTFE", ("ptfe52_gravity", "ptfe52_magnetic")),
+                        ("steel", ("steel21_gravity", "steel21_magnetic"))):
         rig = rigs[scenes[0]]
         bead = rig.chain.beads[-1]
         m = bead.material
@@ -31,10 +32,12 @@ def figure_specs(results, rigs) -> list:
             curve = np.full_like(F, np.nan)
             curve[ok] = solitary_wave_speed(m.E, m.nu, m.rho, bead.diameter, F0, F[ok])
             curves.append((f"Eq (1), F_0 = {F0:.3g} N", curve, style + "-"))
-            sound.append((f"c0 Eq (2), F_0 = {F0:.3g} N", float(sound_speed(m.E, m.nu, m.rho, bead.diameter, F0)), style))
+            sound.append((f"c0 Eq (2), F_0 = {F0:.3g} N",
+                          float(sound_speed(m.E, m.nu, m.rho, bead.diameter, F0)), style))
             pts = results["sweeps"][scene]
             pre = "gravity" if "gravity" in scene else "2.38 N"
-            series.append((f"numerics, {pre}", [p["truth_Fm"] for p in pts], [p["truth_speed"] for p in pts], style + "o"))
+            series.append((f"numerics, {pre}", [p["truth_Fm"] for p in pts], [p["truth_speed"] for p in pts],
+                           style + "o"))
             meas = [(p["measured_Fm"], p["measured_speed"]) for p in pts if p["measured_speed"] is not None]
             series.append((f"virtual experiment, {pre}", [x for x, _ in meas], [y for _, y in meas], style + "x"))
         curves.append(("Eq (4), sonic vacuum", sonic_vacuum_speed(m.E, m.nu, m.rho, bead.diameter, F), "k--"))
@@ -60,9 +63,11 @@ def figure_specs(results, rigs) -> list:
                                 (f"{mat}: gauges (top two) and wall, gravity only vs 2.38 N", panels)))
     fr = np.logspace(math.log10(1.06), 3, 40)
     pts = []
-    for scene, style in (("ptfe52_gravity", "C0o"), ("ptfe52_magnetic", "C3o"), ("steel21_gravity", "C0s"), ("steel21_magnetic", "C3s")):
+    for scene, style in (("ptfe52_gravity", "C0o"), ("ptfe52_magnetic", "C3o"),
+                         ("steel21_gravity", "C0s"), ("steel21_magnetic", "C3s")):
         sw = results["sweeps"][scene]
-        pts.append((f"virtual shots, {scene}", [p["truth_Fm"] / p["F0"] for p in sw], [p["truth_beta"] for p in sw], style))
+        pts.append((f"virtual shots, {scene}", [p["truth_Fm"] / p["F0"] for p in sw], [p["truth_beta"] for p in sw],
+                    style))
     specs.append(FigureSpec("beta_curve", "beta.png", (fr, [beta_of(x) for x in fr], pts)))
     for scene in ("ptfe52_gravity", "ptfe52_magnetic"):
         r = rigs[scene]

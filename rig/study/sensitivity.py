@@ -156,7 +156,7 @@ def sensitivities(fig: Figures) -> dict:
     models = fig.at(thetas)
     sens: dict[str, dict] = {t.name: {} for t in fig3.TARGETS}
     counts: dict[str, dict] = {t.name: {} for t in fig3.TARGETS if t.figure.kind == "pulses"}
-    for k, (p, v) in enumerate(fig.params):
+    for k, (p, _v) in enumerate(fig.params):
         down, up = steps[p.key]
         f_down, f_up = models[2 * k], models[2 * k + 1]
         for i, t in enumerate(fig3.TARGETS):

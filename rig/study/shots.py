@@ -72,7 +72,8 @@ def shots_of(template: Rig, values: list, masses: list) -> Shots:
     plain bead's mass, kg, or None) on ``template``'s layout."""
     chain = template.chain
     S = len(values)
-    col = lambda key, default: np.array([x.get(key, default) for x in values], dtype=float)  # noqa: E731
+    def col(key, default):
+        return np.array([x.get(key, default) for x in values], dtype=float)
     bead_mass = np.tile(chain.masses, (S, 1))
     if any(m is not None for m in masses):
         plain = [j for j, b in enumerate(chain.beads) if b.kind != "magnetic"]

@@ -53,7 +53,8 @@ def sobol_indices(study, X, Y) -> dict:
         Y = np.where(np.isfinite(Y), Y, np.nanmean(Y))
     s = sobol.analyze(problem, Y[: X.shape[0]], calc_second_order=False, seed=study.seed)
     names = problem["names"]
-    pick = lambda key: {n: float(v) for n, v in zip(names, s[key])}  # noqa: E731
+    def pick(key):
+        return {n: float(v) for n, v in zip(names, s[key])}
     total = pick("ST")
     return {"first_order": pick("S1"), "first_order_conf95": pick("S1_conf"), "total": total,
             "total_conf95": pick("ST_conf"), "dominant": max(total, key=lambda name: total[name]),

@@ -62,9 +62,9 @@ class Store:
         """The folder, held by this run for as long as the block runs: another run into it
         (same folder, any study) is refused in one line naming the holder. The OS releases
         the hold when this process ends, killed or not."""
-        with folder_lock(self.folder, "study.lock", "wait for it to end, or give another --out"):
-            with left_as_found(self.folder, Exception, keep=lambda exc: bool(self.done())):  # inside the hold
-                yield self
+        with (folder_lock(self.folder, "study.lock", "wait for it to end, or give another --out"),
+              left_as_found(self.folder, Exception, keep=lambda exc: bool(self.done()))):  # inside the hold
+            yield self
 
     def open(self) -> Store:
         """Create the folder, or check that it holds this very study (to resume it)."""
@@ -150,7 +150,8 @@ class Store:
             return StudyResults(np.zeros(0, int), np.zeros((0, len(self.study.keys))), np.zeros(0, np.int64),
                                 {k: np.zeros(0) for k in OUTPUTS})
         order = np.argsort(np.concatenate([q["index"] for q in parts]))
-        cat = lambda key: np.concatenate([q[key] for q in parts])[order]  # noqa: E731
+        def cat(key):
+            return np.concatenate([q[key] for q in parts])[order]
         return StudyResults(cat("index"), cat("inputs"), cat("seeds"),
                             {k: np.concatenate([_output(q, k) for q in parts])[order] for k in OUTPUTS})
 

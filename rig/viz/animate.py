@@ -285,11 +285,11 @@ def require_renderer(out: str | None = None):
     """pyvista and imageio (and imageio-ffmpeg for an ``out`` movie .mp4), or a one-line
     error saying how to get them (the ``animate`` extra)."""
     try:
-        import imageio  # noqa: F401
-        import pyvista  # noqa: F401
+        import imageio  # noqa: F401 - imported to find whether the extra is installed
+        import pyvista  # noqa: F401 - the same
 
         if out is not None and str(out).lower().endswith(".mp4"):
-            import imageio_ffmpeg  # noqa: F401
+            import imageio_ffmpeg  # noqa: F401 - the same
     except ImportError as exc:
         raise RigError(f"rig animate needs the animate extra ({exc.name} is missing): "
                        f"pip install \"sonic-rig[animate]\"") from None

@@ -20,7 +20,8 @@ def gauge_files(tmp_path_factory):
     """An emulated 8-bit two-gauge record, one ISF file per channel: PTFE-like pulses of
     4 N (0.05 V/N) 200 us apart, gauge RC 1 ms, the scope's own noise floor."""
     t = np.arange(30000) * H
-    pulse = lambda t0: 4.0 / np.cosh((t - t0) / 3e-5) ** 2  # noqa: E731
+    def pulse(t0):
+        return 4.0 / np.cosh((t - t0) / 3e-5) ** 2
     scope = Oscilloscope(channels={"CH1": ChannelSettings(0.05, -1.0), "CH2": ChannelSettings(0.05, -1.0)},
                          timebase=Timebase(2e-7, 10000), trigger=Trigger("CH1", 0.03, "rising", 0.1))
     volts = {ch: rc_highpass(0.05 * pulse(t0), H, 1e-3) for ch, t0 in (("CH1", 1e-3), ("CH2", 1.2e-3))}
@@ -136,7 +137,8 @@ def test_bad_flags_are_one_line_and_exit_2(gauge_files, capsys, flag, value, mes
 
 
 def test_beta_one_is_the_default(gauge_files, capsys):
-    assert run(capsys, "analyze", *gauge_files, *GAUGE, "--beta", "1")[1] == run(capsys, "analyze", *gauge_files, *GAUGE)[1]
+    with_beta = run(capsys, "analyze", *gauge_files, *GAUGE, "--beta", "1")[1]
+    assert with_beta == run(capsys, "analyze", *gauge_files, *GAUGE)[1]
 
 
 def test_every_real_file_is_a_clear_refusal(realdata, capsys):
@@ -330,7 +332,8 @@ def test_eq1_without_f0_says_it_assumes_no_precompression(gauge_files, capsys):
 def three_channels(tmp_path_factory):
     """gauge_files' record with a third channel, CH3, a later pulse (the wall sensor's place)."""
     t = np.arange(30000) * H
-    pulse = lambda t0: 4.0 / np.cosh((t - t0) / 3e-5) ** 2  # noqa: E731
+    def pulse(t0):
+        return 4.0 / np.cosh((t - t0) / 3e-5) ** 2
     chans = {ch: ChannelSettings(0.05, -1.0) for ch in ("CH1", "CH2", "CH3")}
     scope = Oscilloscope(channels=chans, timebase=Timebase(2e-7, 10000), trigger=Trigger("CH1", 0.03, "rising", 0.1))
     volts = {ch: rc_highpass(0.05 * pulse(t0), H, 1e-3) for ch, t0 in (("CH1", 1e-3), ("CH2", 1.2e-3),

@@ -135,10 +135,12 @@ def _flag_cases():
                   "striker.velocity", "=normal(1, 1)", "striker.velocity=truncnormal(1 m/s, 1 m/s, 2 m/s, 1 m/s)"]:
         cases.append((["mc", S, "--shots", "8", "--vary", value, "--out", out], "--vary"))
     for value in ["chain.youngs_modulus=0,4 GPa:2 GPa", "chain.youngs_modulus=0.4 GPa:2,0 GPa",
-                  "chain.youngs_modulus=1 200 MPa:2 GPa", "chain.youngs_modulus=0.4:2", "chain.youngs_modulus=2 GPa:1 GPa",
+                  "chain.youngs_modulus=1 200 MPa:2 GPa", "chain.youngs_modulus=0.4:2",
+                  "chain.youngs_modulus=2 GPa:1 GPa",
                   "chain.youngs_modulus=0.4 GPa", "chain.youngs_modulus=0.4 m:2 m", "chain.contact_exponent=1,2:2.4",
                   "chain.contact_exponent=1.2:2,4", "chain.contact_exponent=a:b", "chain.contact_exponent=1.2 m:2",
-                  "chain.material=a:b", "nosuch=1:2", "chain.damping_time=0 s:1 ms", "chain.youngs_modulus=nan GPa:2 GPa"]:
+                  "chain.material=a:b", "nosuch=1:2", "chain.damping_time=0 s:1 ms",
+                  "chain.youngs_modulus=nan GPa:2 GPa"]:
         cases.append((["fit", S, "--param", value, "--points", "p.csv", "--out", out], "--param"))
     for text in NOT_ONE_NUMBER:  # one number in every command, every kind of value
         cases += [(["shot", S, "--set", f"magnet.force={text} N"], "magnet.force"),
@@ -343,12 +345,13 @@ def _api_cases():
     from rig.solver.saveat import SaveAt
     from rig.solver.solve import solve
 
-    chain = lambda: Chain([Bead("ptfe", 4.76e-3)] * 5, striker=Striker(), wall=Wall())  # noqa: E731
+    def chain():
+        return Chain([Bead("ptfe", 4.76e-3)] * 5, striker=Striker(), wall=Wall())
     cases = [(lambda a=a: Rig.from_scene(a), "scene") for a in (None, 3, 2.5, "", [S], b"ptfe52_magnetic")]
     cases += [(lambda o=o: Rig.from_scene(S, o), "overrides") for o in (None, "striker.velocity=1", [1], [None])]
     cases += [(lambda s=s: Rig(s), "scene") for s in (None, S, {})]
-    cases += [(lambda v=v: Striker(velocity=v), "striker.velocity") for v in (0, -1, math.nan, math.inf, 1e-300, "1,2 m/s",
-                                                                          "1 kg", None, True)]
+    cases += [(lambda v=v: Striker(velocity=v), "striker.velocity")
+              for v in (0, -1, math.nan, math.inf, 1e-300, "1,2 m/s", "1 kg", None, True)]
     cases += [(lambda v=v: Striker(mass=v), "striker.mass") for v in (0, -1, math.nan, "0,47 g", "1 m")]
     cases += [(lambda v=v: Bead("ptfe", v), "diameter") for v in (0, -1, math.nan, "4,76 mm", "1 kg", None)]
     cases += [(lambda v=v: Bead(v, 4.76e-3), "material") for v in ("wood", 3, None)]

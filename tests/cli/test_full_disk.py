@@ -57,8 +57,8 @@ CASES = {
 def _run(argv, d: Path, realdata, limit=None):
     argv = [a.replace("{d}", str(d)).replace("{realdata}", str(realdata)) for a in argv]
     code = DISK_FULL if limit else "import sys\nfrom rig.cli import main\nsys.exit(main(sys.argv[2:]))\n"
-    return subprocess.run([sys.executable, "-c", code, str(limit or 0), *argv], check=False, capture_output=True, text=True,
-                          cwd=d, timeout=600)
+    return subprocess.run([sys.executable, "-c", code, str(limit or 0), *argv], check=False, capture_output=True,
+                          text=True, cwd=d, timeout=600)
 
 
 def whole(path: Path):

@@ -88,7 +88,8 @@ def test_a_gauge_distance_the_record_cannot_hold():
 
 
 def test_a_pulse_too_wide_for_a_solitary_wave():
-    rep = analyze_record(record(clean_pair()), Setup(SETUP.upper, SETUP.lower, limits=Limits(width_diameters=(0.5, 1.0))))
+    narrow = Setup(SETUP.upper, SETUP.lower, limits=Limits(width_diameters=(0.5, 1.0)))
+    rep = analyze_record(record(clean_pair()), narrow)
     refused(rep, "the leading pulse's FWHM is 1.48 bead diameters, outside the 0.5 to 1 of a solitary wave",
             SPEED_FIGURES)
 

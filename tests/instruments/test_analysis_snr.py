@@ -20,8 +20,9 @@ def sech2(t0, width=2e-5, amp=1.0):
 
 def record(volts: dict, n_pre: int = N_PRE, fmt: str = "Y", triggered: bool = True) -> ScopeRecord:
     """Channels of volts (no codes, as a CSV file gives them)."""
-    pre = lambda v: Preamble(points=v.size, x_increment=H, x_zero=-n_pre * H, trigger_index=n_pre,  # noqa: E731
-                             y_multiplier=1.0, y_offset=0.0, y_zero=0.0, point_format=fmt)
+    def pre(v):
+        return Preamble(points=v.size, x_increment=H, x_zero=-n_pre * H, trigger_index=n_pre,
+                                 y_multiplier=1.0, y_offset=0.0, y_zero=0.0, point_format=fmt)
     return ScopeRecord({ch: Waveform(ch, pre(v), samples=v) for ch, v in volts.items()}, triggered)
 
 

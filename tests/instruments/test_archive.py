@@ -214,7 +214,8 @@ def test_files_open_with_plain_h5py_and_xarray(tmp_path):
     with h5py.File(path, "r") as f:
         g = f["shot_000001"]
         assert g.attrs["NX_class"] == "NXentry" and g["data"].attrs["signal"] == "CH1"
-        assert json.loads(g.attrs["metadata"])["seed"] == 5 and "volts = scale_factor" in f.attrs["layout"] and f.attrs["layout_version"] == 4
+        assert json.loads(g.attrs["metadata"])["seed"] == 5
+        assert "volts = scale_factor" in f.attrs["layout"] and f.attrs["layout_version"] == 4
         assert g["title"][()].decode() == "synthetic seed 5" and g["start_time"][()].decode().startswith("20")
         for name, obj in _all_datasets(g):
             assert obj.ndim == 0 or (obj.fletcher32 and obj.chunks), name  # arrays carry fletcher32

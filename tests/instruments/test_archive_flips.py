@@ -22,7 +22,8 @@ def tiny_entry(seed: int, truth: bool = True, n: int = 96) -> Entry:
                       1e-5, {"method": "synthetic"})
     forces = {"upper_average_force": np.linspace(0, 1, 48), "wall_force": np.linspace(1, 0, 48)}
     return Entry(ScopeRecord(waves, True), truth, seed if truth else None, "tiny" if truth else "",
-                 "[scene]\nname = 'tiny'\n" if truth else "", {"probe": "tiny"} if truth else {"source_files": ["a.isf"]},
+                 "[scene]\nname = 'tiny'\n" if truth else "",
+                 {"probe": "tiny"} if truth else {"source_files": ["a.isf"]},
                  forces if truth else None, facts if truth else None, "tiny" if truth else None,
                  "2026-01-01T00:00:00+00:00", "0.9")
 

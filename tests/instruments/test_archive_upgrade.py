@@ -24,7 +24,8 @@ def old(tmp_path):
 
 def test_an_old_layout_is_refused_with_the_command_that_converts_it(old):
     for call in (lambda a: a.ids(), lambda a: a.read(1), lambda a: a.summary()):
-        with pytest.raises(InstrumentError, match=r"archive layout 1, this version reads layouts 2, 3 and 4: run `rig upgrade"):
+        with pytest.raises(InstrumentError,
+                           match=r"archive layout 1, this version reads layouts 2, 3 and 4: run `rig upgrade"):
             call(Archive(old))
     assert "rig upgrade" in Archive(old).verify()["bad"][0]["reason"]
 

@@ -16,7 +16,8 @@ from instruments.devices._kernels.resample import at_positions
 
 
 def _same_bits(a, b):
-    return a.shape == b.shape and np.array_equal(np.asarray(a, float).view(np.int64), np.asarray(b, float).view(np.int64))
+    return a.shape == b.shape and np.array_equal(np.asarray(a, float).view(np.int64),
+                                                 np.asarray(b, float).view(np.int64))
 
 
 def _signals():
@@ -145,7 +146,8 @@ def test_one_pole_filters_are_lfilters():
         a = math.exp(-rng.uniform(1e-4, 30))
         g = (1.0 / rng.uniform(1e-3, 10)) * (1.0 - a)
         assert _same_bits(one_pole(x, g, -g, -a, x[0], False), lfilter([g, -g], [1.0, -a], x - x[0]))
-        assert _same_bits(one_pole(x, 1 - g, g - a, -a, x[0], True), lfilter([1 - g, g - a], [1.0, -a], x - x[0]) + x[0])
+        assert _same_bits(one_pole(x, 1 - g, g - a, -a, x[0], True),
+                          lfilter([1 - g, g - a], [1.0, -a], x - x[0]) + x[0])
 
 
 def test_undo_highpass_is_the_trapezoid_inversion():

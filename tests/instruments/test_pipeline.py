@@ -77,7 +77,8 @@ def test_a_quantised_train_counts_each_flat_top_once():
     rng = np.random.default_rng(4)
     a = sech2(0.5e-3, 2e-5)
     train = sech2(0.7e-3, 2e-5) + sech2(0.85e-3, 2e-5, 0.5) + sech2(1.0e-3, 2e-5, 0.2)
-    flicker = lambda f: np.round(f * 40 + rng.uniform(-0.3, 0.3, f.size)) / 40  # noqa: E731
+    def flicker(f):
+        return np.round(f * 40 + rng.uniform(-0.3, 0.3, f.size)) / 40
     quantised = flicker(train)
     assert len(find_pulses(T, quantised, floor=0.05)) > 3  # what the maxima alone say
     setup = Setup(GaugeSetup("A", 0.0), GaugeSetup("B", 0.05))

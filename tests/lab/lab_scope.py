@@ -36,7 +36,8 @@ def parsed(text: str, like):
 
 class PulseSource:
     """ShotSource: the scene's scope with the overrides, acquiring pulse() on CH1 and a
-    larger one on CH2 (both scaled by striker.velocity / 0.9 m/s; magnet keys taken, no effect); ``gate``, where set, holds
+    larger one on CH2 (both scaled by striker.velocity / 0.9 m/s; magnet keys taken, no
+    effect); ``gate``, where set, holds
     each shot until it is set; ``calls`` lists (overrides, seed)."""
 
     def __init__(self, scene):

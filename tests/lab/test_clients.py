@@ -70,7 +70,8 @@ def assert_same_volts(volts, waveform) -> None:
     """The client's volts are the record's, to a thousandth of one code's step."""
     assert np.shape(volts) == waveform.codes.shape
     np.testing.assert_allclose(volts, waveform.volts(), rtol=0, atol=1e-3 * waveform.preamble.y_multiplier)
-    assert np.ptp(waveform.codes.astype(np.int64)) > 25  # a pulse over a division high, not a flat line that matches anything
+    # a pulse over a division high, not a flat line that matches anything
+    assert np.ptp(waveform.codes.astype(np.int64)) > 25
 
 
 @pytest.mark.filterwarnings("ignore:A VISA IO error occurred when attempting to read the status byte")

@@ -59,7 +59,8 @@ def test_the_overrides_change_the_record_and_the_same_call_repeats_its_bits(shot
     assert finer["CH1"].preamble.y_multiplier == pytest.approx(base["CH1"].preamble.y_multiplier / 2.5, rel=1e-9)
     assert np.array_equal(finer["CH2"].codes, base["CH2"].codes)  # CH2 untouched, the same draws
     slower = shots({"striker.velocity": "0.5 m/s"}, 7)
-    peak = lambda r: float(r["CH1"].volts().max())
+    def peak(r):
+        return float(r["CH1"].volts().max())
     assert peak(slower) < 0.8 * peak(base)  # F ~ v^(6/5): 0.5/0.89 gives about half the force
 
 

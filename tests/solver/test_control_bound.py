@@ -34,7 +34,8 @@ def test_the_hard_override_ends_within_its_estimate_and_names_the_accuracy():
     assert estimate.seconds < estimate.bound_seconds == pytest.approx(estimate.seconds * WORK_BUDGET / CONTROL_WORK)
     Rig.from_scene("ptfe52_magnetic").solution()  # the kernels compiled or loaded, outside the timing
     t0 = time.process_time()
-    with pytest.raises(AccuracyNotReached, match=r"accuracy = 0\.0001: not reached; over solver\.duration = 0\.003 s the error "
+    with pytest.raises(AccuracyNotReached, match=r"accuracy = 0\.0001: not reached; "
+                       r"over solver\.duration = 0\.003 s the error "
                        r"estimate stayed at 0\.\d+ .*"
                        r"a step 16 times finer, which lowered it by less than 2 times"):
         rig.solution()
@@ -104,7 +105,8 @@ def test_the_error_over_time_ends_at_the_whole_records_error_and_cuts_where_it_s
     from rig.solver.solution import relative_error
 
     t = np.arange(3000) * 1e-6
-    pulse = lambda t0: np.exp(-(((t - t0) / 5e-5) ** 2))  # noqa: E731
+    def pulse(t0):
+        return np.exp(-(((t - t0) / 5e-5) ** 2))
     reference = {"a": 2.0 + pulse(1e-3), "b": 1.0 + 3 * pulse(2e-3)}
     forces = {"a": reference["a"] + 1e-7 * pulse(1e-3), "b": reference["b"] + 1e-2 * (t > 2e-3)}
     err = error_over_time(forces, reference)

@@ -25,8 +25,9 @@ def _cases():
                                       wall=Wall(), gravity=0, top_force=2.38), 0.4e-3),
         ("gravity, striker in flight", ptfe_rig(n=60, top_force=0.0), 0.6e-3),
         ("magnet schedule", ptfe_rig(n=60, top_force=ForceSchedule((0, 2e-4), (2.38, 3.0))), 0.6e-3),
-        ("compliant wall (a linear rod)", Chain([steel] * 60, striker=Striker("steel316", "0.4501 g", "0.44 m/s"),
-                                                wall=Wall(plate_mass=0.02, rod_stiffness=2e8), gravity=9.80665), 0.3e-3),
+        ("compliant wall (a linear rod)",
+         Chain([steel] * 60, striker=Striker("steel316", "0.4501 g", "0.44 m/s"),
+               wall=Wall(plate_mass=0.02, rod_stiffness=2e8), gravity=9.80665), 0.3e-3),
     ]
 
 

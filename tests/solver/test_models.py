@@ -108,7 +108,8 @@ def _slope(chain, t_end, ratios, contacts=(5, 12, 20), kick=None):
         p.v0[kick] = 0.01  # a small kick: the contacts never open
     tau = contact_time_scale(p)
     save = record_contacts(chain, *contacts)
-    run = lambda r: solve(p, t_end, save=save, dt=stepping_at(p, tau / r), estimate=False).forces  # noqa: E731
+    def run(r):
+        return solve(p, t_end, save=save, dt=stepping_at(p, tau / r), estimate=False).forces
     ref = run(128)
     errs = [_max_rel(run(r), ref) for r in ratios]
     return -np.polyfit(np.log(ratios), np.log(errs), 1)[0], errs

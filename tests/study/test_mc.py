@@ -361,7 +361,8 @@ def test_a_second_run_into_a_held_folder_is_refused_and_a_killed_holder_blocks_n
     holder = subprocess.Popen([sys.executable, "-c", HOLD, str(out), VARY[0]], stdout=subprocess.PIPE, text=True)
     try:
         assert holder.stdout.readline().strip() == "held"
-        argv = ["mc", "ptfe52_magnetic", "--shots", "4", "--batch", "2", "--vary", VARY[0], "--out", str(out), "--quiet"]
+        argv = ["mc", "ptfe52_magnetic", "--shots", "4", "--batch", "2", "--vary", VARY[0], "--out", str(out),
+                "--quiet"]
         assert main(argv) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and err.startswith(f"rig mc: error: {out}: in use by another run (pid {holder.pid} "

@@ -62,7 +62,7 @@ def test_wave_speed_is_free_of_cancellation(n):
         Fm = A * (xi0 * (1 + u) * D) ** n
         u = ((Fm / A) ** (1 / n) / D - xi0) / xi0  # the strain Fm rounds to
         # the bracket 2 int_xi0^xim (s^n - xi0^n) ds by quadrature, over xi0^(n+1) u^2
-        g = 2 / u * quad(lambda t: np.expm1(n * np.log1p(u * t)), 0, 1, epsabs=0, epsrel=2e-14)[0]
+        g = 2 / u * quad(lambda t, u=u: np.expm1(n * np.log1p(u * t)), 0, 1, epsabs=0, epsrel=2e-14)[0]
         exact = math.sqrt(A * D ** (n + 1) / MASS * xi0 ** (n - 1) * g)
         assert power_law_wave_speed(A, n, MASS, D, F0, Fm) == pytest.approx(exact, rel=2e-14)
 

@@ -83,7 +83,8 @@ def test_bad_output_is_refused_before_rendering(tmp_path, capsys, monkeypatch, o
 
 
 def test_the_rig_does_not_import_pyvista():
-    code = "import sys, rig, rig.experiment.shot, rig.solver.solve, rig.study.mc_run, rig.cli; print('pyvista' in sys.modules or 'vtk' in sys.modules)"
+    code = ("import sys, rig, rig.experiment.shot, rig.solver.solve, rig.study.mc_run, rig.cli; "
+            "print('pyvista' in sys.modules or 'vtk' in sys.modules)")
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "False"
 
 

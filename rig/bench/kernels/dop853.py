@@ -41,7 +41,9 @@ import math
 import numpy as np
 
 from numerics.jit import jit
-from rig.bench.kernels.dop853_table import DENSE_STAGES, E3, E5, N_STAGES, N_STAGES_EXTENDED, A, B, C, D  # noqa: F401
+
+# B and C, unused here, are re-exported: tests/bench/test_peers.py holds the whole table to scipy's
+from rig.bench.kernels.dop853_table import E3, E5, N_STAGES, N_STAGES_EXTENDED, A, B, C, D  # noqa: F401
 from rig.solver.kernels.forces import hertz_forces
 
 SAFETY = 0.9            # Hairer's safe
@@ -138,10 +140,7 @@ def starting_step(y, k, t_end, rtol, atol, A_hertz, d0, load, invm, f, work, sca
     for i in range(n):
         work[i] = k[1, i] - k[0, i]
     n2 = rms(work, scale) / h0
-    if n1 <= 1e-15 and n2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(n1, n2)) ** (1.0 / 8.0)
+    h1 = max(1e-6, h0 * 1e-3) if n1 <= 1e-15 and n2 <= 1e-15 else (0.01 / max(n1, n2)) ** (1.0 / 8.0)
     return min(100.0 * h0, h1, t_end)
 
 
