@@ -9,8 +9,9 @@ the folder the cold mc filled. Times are wall seconds and the children's CPU sec
 wall). The cold shot and the cold mc also report where their compilation went: each
 kernel's compile time, exclusive of the kernels it calls (numba's ``numba:compile`` events,
 seconds), the largest first, and how many functions numba compiled (numba's own
-implementations included), in the command's own process. ``--baseline REV`` measures another revision in turns (one revision after the
-other in each round), so both see the same machine load.
+implementations included), in the command's own process. ``--baseline REV`` measures
+another revision in turns (one revision after the other in each round), so both see the
+same machine load.
 """
 from __future__ import annotations
 
@@ -131,7 +132,8 @@ def table(r: dict) -> str:
         lines.append(f"  {command:16s}{cells}{ratio} {'-' if target is None else f'{target:.1f}':>8s}")
     for n, task in ((n, task) for n in names for task in ("shot", "mc")):
         rev = r["revisions"][n]
-        lines.append(f"  {n}: the cold {task}'s compile time by kernel (exclusive s; {rev[f'{task}_compile_total_s']:.1f} s "
+        total = rev[f"{task}_compile_total_s"]
+        lines.append(f"  {n}: the cold {task}'s compile time by kernel (exclusive s; {total:.1f} s "
                      f"in all, {rev['functions_compiled'][f'cold rig {task}']:.0f} functions compiled, in its own "
                      f"process):")
         lines += [f"    {k:60s} {v:6.2f}" for k, v in rev[f"{task}_top_compiles_s"].items()]

@@ -6,8 +6,8 @@ law alone, the other laws' code never compiled."""
 import os
 import subprocess
 import sys
-from typing import NamedTuple
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from numba.core import types
