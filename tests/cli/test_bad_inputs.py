@@ -206,7 +206,7 @@ def _argv(argv, d):
     return [a.replace("{d}", str(d)) for a in argv]
 
 
-def _one_line(err: str) -> str:
+def one_line(err: str) -> str:
     lines = [line for line in err.splitlines() if line.strip()]
     assert len(lines) == 1, f"expected one line on stderr, got {len(lines)}:\n{err}"
     assert "Traceback" not in err
@@ -232,7 +232,7 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path, monkeypatch, capsys, argv, n
     except SystemExit as exc:  # argparse's own errors
         code = exc.code
     out = capsys.readouterr()
-    line = _one_line(out.err)
+    line = one_line(out.err)
     assert code == 2, line
     assert needle in line, line
     assert (tmp_path / "existing.txt").read_text() == "already here\n"  # never overwritten
@@ -248,7 +248,7 @@ def test_the_real_entry_point(tmp_path, argv, needle):
     r = subprocess.run([sys.executable, "-m", "rig.cli", *_argv(argv, tmp_path)], capture_output=True,
                        text=True, cwd=tmp_path, env={**os.environ}, timeout=300)
     assert r.returncode == 2
-    assert needle in _one_line(r.stderr)
+    assert needle in one_line(r.stderr)
 
 
 DISK_FULL = """
@@ -271,7 +271,7 @@ def test_a_full_disk_is_one_line_naming_the_path(tmp_path, limit, argv, folder):
     r = subprocess.run([sys.executable, "-c", DISK_FULL, str(limit), *_argv(argv, tmp_path)],
                        capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert r.returncode == 2, r.stderr
-    line = _one_line(r.stderr)
+    line = one_line(r.stderr)
     assert str(tmp_path / folder) in line and "too large" in line.lower()
     meta = tmp_path / folder / "study.json"
     if meta.exists():

@@ -19,7 +19,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from test_bad_inputs import DISK_FULL, VEL, S, _one_line
+from test_bad_inputs import DISK_FULL, VEL, S, one_line
 
 from instruments.archive import Archive
 from instruments.formats.isf import read_isf
@@ -54,7 +54,7 @@ CASES = {
 }
 
 
-def _run(argv, d: Path, realdata, limit=None):
+def run_case(argv, d: Path, realdata, limit=None):
     argv = [a.replace("{d}", str(d)).replace("{realdata}", str(realdata)) for a in argv]
     code = DISK_FULL if limit else "import sys\nfrom rig.cli import main\nsys.exit(main(sys.argv[2:]))\n"
     return subprocess.run([sys.executable, "-c", code, str(limit or 0), *argv], check=False, capture_output=True,
@@ -86,7 +86,7 @@ def whole(path: Path):
         path.read_text()
 
 
-def _check_left(d: Path, before: set | None = None):
+def check_left(d: Path, before: set | None = None):
     """Every file under ``d`` whole; after a failed run (``before``: the paths there before
     it), nothing new but whole files: no lock file, no empty folder."""
     for p in d.rglob("*"):
@@ -109,64 +109,19 @@ def test_a_full_disk_is_one_line_leaves_nothing_broken_and_a_second_run_succeeds
     if argv[0] == "fit":
         (tmp_path / "points.csv").write_text(POINTS)
         if case != "fit, the cache":  # the cache filled by a first run: this one writes the scene and report first
-            assert _run(FIT, tmp_path, realdata).returncode in (0, 1)
+            assert run_case(FIT, tmp_path, realdata).returncode in (0, 1)
     before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file() and p.suffix != ".lock"}
     there = set(tmp_path.rglob("*"))
-    r = _run(argv, tmp_path, realdata, limit)
+    r = run_case(argv, tmp_path, realdata, limit)
     assert r.returncode == 2, r.stderr
-    line = _one_line(r.stderr)
+    line = one_line(r.stderr)
     assert line.startswith(f"rig {argv[0]}: error: {tmp_path}") and line.endswith(": File too large"), line
-    _check_left(tmp_path, there)
+    check_left(tmp_path, there)
     if argv[0] == "shot" and "--export" in argv:  # several files: all of them or none, and no new empty folder
         assert not list(tmp_path.rglob("*.isf")) and not list(tmp_path.rglob("*.csv"))
     for p in (p for p in before if p.suffix == ".h5"):
         assert p.read_bytes() == before[p], f"{p}: changed by a failed write"
-    again = _run(argv, tmp_path, realdata)
+    again = run_case(argv, tmp_path, realdata)
     assert again.returncode in ((0, 1) if argv[0] == "fit" else (0,)), again.stderr
     assert "Traceback" not in again.stderr
-    _check_left(tmp_path)
-
-
-@pytest.fixture
-def small_disk(tmp_path, request):
-    """A real file system of ``request.param`` (tmpfs, "16k"): writes past it fail with ENOSPC."""
-    disk = tmp_path / "disk"
-    disk.mkdir()
-    r = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={request.param}", "tmpfs", str(disk)],
-                       check=False, capture_output=True, text=True)
-    if r.returncode:
-        pytest.skip(f"cannot mount a tmpfs here ({r.stderr.strip() or 'mount failed'}): the file-size-limit cases "
-                    "above cover the same writes")
-    yield disk
-    subprocess.run(["umount", "-l", str(disk)], check=False, capture_output=True)
-
-
-@pytest.mark.parametrize("case,small_disk", [("shot --export", "16k"), ("shot --export csv, a new folder", "16k"),
-                                             ("shot --out", "64k"), ("mc --out", "64k"), ("mc --traces", "64k"),
-                                             ("import", "16k"), ("fit, the cache", "16k")], indirect=["small_disk"])
-def test_a_real_full_disk_is_one_line_and_the_command_succeeds_once_there_is_room(small_disk, realdata, case):
-    _, argv = CASES[case]
-    if argv[0] == "fit":
-        (small_disk / "points.csv").write_text(POINTS)
-    there = set(small_disk.rglob("*"))
-    r = _run(argv, small_disk, realdata)
-    assert r.returncode == 2, r.stderr
-    line = _one_line(r.stderr)
-    assert line.startswith(f"rig {argv[0]}: error: {small_disk}") and line.endswith(": No space left on device"), line
-    _check_left(small_disk, there)
-    subprocess.run(["mount", "-o", "remount,size=64m", str(small_disk)], check=True)  # room made
-    again = _run(argv, small_disk, realdata)
-    assert again.returncode in ((0, 1) if argv[0] == "fit" else (0,)), again.stderr
-    _check_left(small_disk)
-
-
-@pytest.mark.parametrize("case,small_disk", [("shot --export", "1m"), ("mc --out", "1m"), ("shot --out", "1m")],
-                         indirect=["small_disk"])
-def test_a_read_only_disk_is_one_line(small_disk, realdata, case):
-    _, argv = CASES[case]
-    (small_disk / "study").mkdir()  # a folder that exists, on a disk that takes no write
-    subprocess.run(["mount", "-o", "remount,ro", str(small_disk)], check=True)
-    r = _run(argv, small_disk, realdata)
-    assert r.returncode == 2, r.stderr
-    line = _one_line(r.stderr)
-    assert line.startswith(f"rig {argv[0]}: error: {small_disk}") and "Read-only file system" in line, line
+    check_left(tmp_path)
