@@ -262,11 +262,11 @@ def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     from instruments.precompile import SHOT, STUDY, start
     from numerics.dispatcher import has_machine_code
     from rig.solver.cold import SIDE
-    from rig.solver.kernels.ensemble import integrate_chunk
+    from rig.solver.kernels.ensemble import integrate_chunks
     from rig.solver.kernels.integrators import integrate
 
     kernels = {**SIDE, **SHOT, **(STUDY if task == "study" else {})}
-    cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_chunk)))
+    cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_chunks)))
     aside = start(kernels)
     parts = (["the chain solver"] if cold_solver else []) + (["the instruments"] if aside else [])
     if parts and not quiet and sys.stderr.isatty():

@@ -294,9 +294,11 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
 
 
 @jit(nogil=True)
-def integrate_chunk(k, u, v, chain, contacts, holder, method, record, checks, diag):
-    """Integrate the shots of chunk k of the (chunks, bodies, width) arrays u (m) and v (m/s)
-    in place (integrate_ensemble's arguments), without the GIL: the chunks run on threads."""
+def integrate_chunks(first, last, u, v, chain, contacts, holder, method, record, checks, diag):
+    """Integrate the shots of chunks first .. last - 1 of the (chunks, bodies, width) arrays
+    u (m) and v (m/s) in place (integrate_ensemble's arguments), without the GIL: each
+    thread runs one range of chunks, in one call (a call from Python types its bundles
+    again: one per thread, not one per chunk)."""
     mass, invm, bias, load, A, d0, d_limit = chain  # each bundle's fields, in their order (bundles.py)
     law, con, state = contacts
     onsite, slip, viscous_rate = holder
@@ -305,14 +307,15 @@ def integrate_chunk(k, u, v, chain, contacts, holder, method, record, checks, di
     check_every, e_ref, p_ref, wall_slot = checks.check_every, checks.e_ref, checks.p_ref, checks.wall_slot
     n_chunks, nb, W = u.shape
     n_ch = ch_slot.shape[0]
-    f = np.zeros((nb + 1, W))
-    d_old = np.zeros((n_ch, ch_slot.shape[1], W))
-    r_old = np.zeros((n_ch, ch_slot.shape[1], W))
-    d_new = np.zeros((n_ch, ch_slot.shape[1], W))
-    r_new = np.zeros((n_ch, ch_slot.shape[1], W))
-    _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], law, con[k], state[k], onsite[k], slip,
-           viscous_rate, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, k * W,
-           check_every, d_limit[k], wall_slot, e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)
+    for k in range(first, last):
+        f = np.zeros((nb + 1, W))
+        d_old = np.zeros((n_ch, ch_slot.shape[1], W))
+        r_old = np.zeros((n_ch, ch_slot.shape[1], W))
+        d_new = np.zeros((n_ch, ch_slot.shape[1], W))
+        r_new = np.zeros((n_ch, ch_slot.shape[1], W))
+        _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], law, con[k], state[k], onsite[k], slip,
+               viscous_rate, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, k * W,
+               check_every, d_limit[k], wall_slot, e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)
 
 
 def integrate_ensemble(u, v, chain, contacts, holder, method, record, checks, diag):
@@ -326,18 +329,19 @@ def integrate_ensemble(u, v, chain, contacts, holder, method, record, checks, di
     not read. diag is (chunks, report.DIAGNOSTICS, width), each shot's column as the
     single-shot kernel's diag.
 
-    The chunks are shared out over as many threads as numba's (numba.get_num_threads), each
-    running integrate_chunk: a numba parallel loop over them compiled the chunk's whole
-    kernel twice more (its gufunc and its caller each link and re-optimise it), the largest
-    part of a cold rig mc's compile time."""
-    def run(k):
-        integrate_chunk(k, u, v, chain, contacts, holder, method, record, checks, diag)
+    The chunks are shared out over as many threads as numba's (numba.get_num_threads) in
+    contiguous ranges, each thread running integrate_chunks over its range: a numba parallel
+    loop over them compiled the chunk's whole kernel twice more (its gufunc and its caller
+    each link and re-optimise it), the largest part of a cold rig mc's compile time."""
+    n_chunks = u.shape[0]
+    threads = min(n_chunks, get_num_threads())
+    cuts = [n_chunks * i // max(threads, 1) for i in range(max(threads, 1) + 1)]
 
-    chunks = range(u.shape[0])
-    threads = min(len(chunks), get_num_threads())
+    def run(i):
+        integrate_chunks(cuts[i], cuts[i + 1], u, v, chain, contacts, holder, method, record, checks, diag)
+
     if threads <= 1:
-        for k in chunks:
-            run(k)
+        run(0)
         return
     with ThreadPoolExecutor(threads) as pool:
-        list(pool.map(run, chunks))
+        list(pool.map(run, range(threads)))
