@@ -7,11 +7,11 @@ its own generator, seeded by its seed (pcg64: np.random.default_rng(seed)'s numb
 compiled), in the order a lone shot draws them (acquisition.shot_draws)."""
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
-import numba
 import numpy as np
+
+from numerics.threads import over_threads
 
 from ..records import ScopeRecord
 from ._kernels import acquisition
@@ -126,11 +126,5 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
         acquisition.shots(lo, hi, seeds, forces, float(h), speed, replace, gauges, panel, reads, drawn_rows, rested,
                           codes, over, status, times, drawn)
 
-    threads = min(numba.get_num_threads(), S)
-    if threads > 1:
-        cuts = np.linspace(0, S, threads + 1).astype(int)
-        with ThreadPoolExecutor(threads) as pool:
-            list(pool.map(shots_from, cuts[:-1], cuts[1:]))
-    else:
-        shots_from(0, S)
+    over_threads(S, shots_from)
     return Records(wiring, codes, over, status, times, drawn, n_in, float(h), reads)

@@ -4,14 +4,13 @@ the shots on as many threads as numba's. instruments/analysis/batch.analysed tur
 into Reports. The same functions as a lone record's analysis (pulses.py), so the same bits.
 """
 import math
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-from numba import get_num_threads
 
 from instruments._kernels.filters import undo_highpass_into
 from instruments.devices.batch import OK
 from numerics.jit import jit
+from numerics.threads import over_threads
 
 from .pulses import baseline_mean, leading_pair, noise_level
 
@@ -58,16 +57,8 @@ def analyse_shots(codes, status, times, dx, n_pre, ymult, yoff, yzero, roles, ta
     The shots are shared out in contiguous ranges over as many threads as numba's
     (numba.get_num_threads), each running analyse_range: a numba parallel loop over them
     doubled this analysis' compile time."""
-    n = codes.shape[0]
-    threads = max(1, min(n, get_num_threads()))
-    bounds = [n * k // threads for k in range(threads + 1)]
+    def run(lo, hi):
+        analyse_range(lo, hi, codes, status, times, dx, n_pre, ymult, yoff, yzero, roles, tau, sens, rules, answer,
+                      sigma, finite)
 
-    def run(k):
-        analyse_range(bounds[k], bounds[k + 1], codes, status, times, dx, n_pre, ymult, yoff, yzero, roles, tau, sens,
-                      rules, answer, sigma, finite)
-
-    if threads == 1:
-        run(0)
-        return
-    with ThreadPoolExecutor(threads) as pool:
-        list(pool.map(run, range(threads)))
+    over_threads(codes.shape[0], run)

@@ -13,12 +13,11 @@ inline numba's calls, and a call per row cost as much as the row of 64 shots its
 (tests/solver/test_vectorised.py guards this).
 """
 import math
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-from numba import get_num_threads
 
 from numerics.jit import jit
+from numerics.threads import over_threads
 from rig.model.contact import HERTZ, PLASTIC, POWER
 from rig.model.laws.thornton import AP, DC, DS, SPAN_END, SPAN_FIRST, plastic_force
 from rig.solver.kernels import report as slot
@@ -333,15 +332,7 @@ def integrate_ensemble(u, v, chain, contacts, holder, method, record, checks, di
     contiguous ranges, each thread running integrate_chunks over its range: a numba parallel
     loop over them compiled the chunk's whole kernel twice more (its gufunc and its caller
     each link and re-optimise it), the largest part of a cold rig mc's compile time."""
-    n_chunks = u.shape[0]
-    threads = min(n_chunks, get_num_threads())
-    cuts = [n_chunks * i // max(threads, 1) for i in range(max(threads, 1) + 1)]
+    def run(first, last):
+        integrate_chunks(first, last, u, v, chain, contacts, holder, method, record, checks, diag)
 
-    def run(i):
-        integrate_chunks(cuts[i], cuts[i + 1], u, v, chain, contacts, holder, method, record, checks, diag)
-
-    if threads <= 1:
-        run(0)
-        return
-    with ThreadPoolExecutor(threads) as pool:
-        list(pool.map(run, range(threads)))
+    over_threads(u.shape[0], run)
