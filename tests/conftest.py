@@ -47,3 +47,27 @@ def realdata():
     if os.environ.get("CI", "").lower() in ("1", "true", "yes"):
         pytest.fail(how + " (CI must run the real-data tests)")
     pytest.skip(how)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_sessionstart(session):
+    """Before pytest-xdist starts its workers on a cold numba cache, compile the kernels
+    most test files need once, in as many processes as there will be workers
+    (tests/compile_once.py), rather than once in every worker."""
+    config = session.config
+    workers = getattr(config.option, "numprocesses", None)
+    if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 2:
+        return
+    from compile_once import compile_all
+
+    wall, failed = compile_all(workers)
+    COMPILED.append(f"compiled the shared kernels once in {wall:.0f} s ({workers} processes) before the workers "
+                    "started" + "".join(f"; failed: {f}" for f in failed))
+
+
+COMPILED: list = []  # what pytest_sessionstart compiled, said in the summary
+
+
+def pytest_terminal_summary(terminalreporter):
+    for line in COMPILED:
+        terminalreporter.write_line(line)
