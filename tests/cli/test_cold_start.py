@@ -11,7 +11,7 @@ import sys
 
 from numba.core.sigutils import normalize_signature
 
-from instruments.precompile import SHOT, compile_now, kernel
+from instruments.precompile import SHOT, STUDY, compile_now, kernel
 from rig.cli import main
 
 SHOT_ARGS = ["shot", "ptfe52_magnetic", "--seed", "1", "--json"]
@@ -31,6 +31,14 @@ def test_the_side_process_compiles_the_signatures_a_shot_calls_from_python(capsy
     compile_now(SHOT)
     assert main(SHOT_ARGS) in (0, None)
     for name, signature in SHOT.items():
+        assert kernel(name).signatures == [normalize_signature(signature)[0]], name
+
+
+def test_the_side_process_compiles_the_signatures_a_study_calls_from_python(tmp_path):
+    compile_now(STUDY)
+    assert main(["mc", "ptfe52_magnetic", "--vary", "striker.velocity=normal(0.89 m/s, 0.01 m/s)", "--shots", "4",
+                 "--batch", "4", "--out", str(tmp_path / "study"), "--quiet"]) in (0, None)
+    for name, signature in STUDY.items():
         assert kernel(name).signatures == [normalize_signature(signature)[0]], name
 
 

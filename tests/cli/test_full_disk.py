@@ -99,8 +99,18 @@ def check_left(d: Path, before: set | None = None):
         assert not (p.is_dir() and not any(p.iterdir())), f"{p}: an empty folder left behind by a failed run"
 
 
-@pytest.mark.parametrize("case", CASES)
+# the cases tests/cli/test_full_disk_studies.py runs (the longest: so the suite's workers share them)
+STUDIES = ("reproduce --out", "mc --out, two workers", "mc --traces", "mc --out")
+
+
+@pytest.mark.parametrize("case", [c for c in CASES if c not in STUDIES])
 def test_a_full_disk_is_one_line_leaves_nothing_broken_and_a_second_run_succeeds(tmp_path, realdata, case):
+    check_full_disk(tmp_path, realdata, case)
+
+
+def check_full_disk(tmp_path: Path, realdata, case: str):
+    """Case ``case`` of CASES under its file-size limit: one line naming the path and the
+    cause, exit 2, nothing broken left; then run again with room, it succeeds."""
     limit, argv = CASES[case]
     if argv[0] == "animate":
         pytest.importorskip("pyvista")
