@@ -97,10 +97,13 @@ def kernel_inputs(problems: ChainProblem | ProblemArrays, take: Callable[[str], 
         return np.ascontiguousarray(np.stack([take(k) for k in names], axis=rows_axis))
 
     ch_slot, ch_weight = save.channels(layout.offset)
+    con, onsite = rows(CONTACT_ROWS), rows(("drag", "friction"))
+    damping = np.take(con, [CONTACT_ROWS.index("damping"), CONTACT_ROWS.index("dashpot")], axis=rows_axis)
+    flows = Constant(int(bool(np.any(damping != 0.0) or np.any(onsite != 0.0))))
     return KernelInputs(
         bundles.ChainArrays(*(take(k) for k in bundles.ChainArrays._fields)),
-        bundles.Contacts(Constant(problems.law), rows(CONTACT_ROWS), rows(STATE_ROWS)),
-        bundles.Holder(rows(("drag", "friction")), layout.slip_speed, viscous_rate(problems)),
+        bundles.Contacts(Constant(problems.law), con, rows(STATE_ROWS)),
+        bundles.Holder(onsite, layout.slip_speed, viscous_rate(problems), flows),
         bundles.Method(np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head,
                        stepping.substeps(step, m.drifts)),
         bundles.Schedule(layout.sched_body, layout.sched_t, layout.sched_f),

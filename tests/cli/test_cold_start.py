@@ -3,7 +3,8 @@ compiles, compiles the instruments' kernels and a part of the solver's in a side
 (instruments/precompile.py) and gives the bits of a warm shot; the side process compiles
 exactly the signatures the shot calls (else the main process would compile them again, and
 the side process be waste); a Hertz shot compiles no other law's code (the law reaches the
-kernels as a constant, numerics/dispatcher.py)."""
+kernels as a constant, numerics/dispatcher.py), and a shot without drag, friction or
+viscous contacts no dissipation (bundles.Holder.flows, another such constant)."""
 import json
 import os
 import subprocess
@@ -24,7 +25,9 @@ COLD_SHOT = ("import json\nfrom instruments.precompile import SHOT, kernel\nfrom
              "from rig.model.laws import thornton\nfrom rig.solver.cold import SIDE\ncode = main({argv!r})\n"
              "print(json.dumps(sorted(n for n in {{**SIDE, **SHOT}} if sum(kernel(n).stats.cache_misses.values())\n"
              "                        or len(kernel(n).signatures) != 1)))\n"
-             "print(json.dumps(sorted(n for n, f in vars(thornton).items() if getattr(f, 'signatures', None))))")
+             "print(json.dumps(sorted(n for n, f in vars(thornton).items() if getattr(f, 'signatures', None))))\n"
+             "from rig.solver.kernels import dissipation\n"
+             "print(json.dumps(sorted(n for n, f in vars(dissipation).items() if getattr(f, 'signatures', None))))")
 
 
 def test_the_side_process_compiles_the_signatures_a_shot_calls_from_python(capsys):
@@ -49,9 +52,10 @@ def test_a_cold_shot_says_what_it_compiles_once_compiles_nothing_twice_and_has_t
     lines = said.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("rig shot: numba is compiling the chain solver and the "
                                                    "instruments (in two processes)"), said
-    *shot, compiled_twice, thornton = cold.stdout.strip().splitlines()
+    *shot, compiled_twice, thornton, dissipation = cold.stdout.strip().splitlines()
     assert json.loads(compiled_twice) == []
     assert json.loads(thornton) == []  # the scene's contacts are Hertz's
+    assert "dissipate" not in json.loads(dissipation)  # and without flows (bundles.Holder.flows)
     assert _bits(json.loads("\n".join(shot))) == _bits(json.loads(warm.stdout))
     again, said = _on_a_terminal([sys.executable, "-m", "rig.cli", *SHOT_ARGS],
                                  dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path)))

@@ -48,11 +48,15 @@ class Holder(NamedTuple):
     """The holder and the contacts' viscous flow: ``onsite`` each body's drag rate (1/s)
     and friction deceleration (m/s^2), friction smoothed over ``slip`` (m/s);
     ``viscous_rate`` (1/s) a bound on the contacts' viscous decay rates
-    (dissipation.substeps)."""
+    (dissipation.substeps); ``flows`` 1 where any of these flows acts (a contact's damping
+    time or dashpot coefficient, a body's drag or friction not 0), else 0: handed as a
+    Constant, the kernels of a chain without flows are compiled without the dissipation's
+    code (the same bits: it is never run there)."""
 
     onsite: np.ndarray
     slip: float
     viscous_rate: float
+    flows: "int | Constant"
 
 
 class Method(NamedTuple):

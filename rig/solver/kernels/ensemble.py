@@ -173,8 +173,8 @@ def _record(out, lo, j0, nj, w, x, ch_slot, ch_weight, A, law, con, state, d_old
 
 
 @jit
-def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, viscous_rate, a_coef, b_coef, dt,
-           n_steps,
+def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, viscous_rate, flows, a_coef, b_coef,
+           dt, n_steps,
            head, sub, ch_slot, ch_weight, sample_dt, out, lo, check_every, d_limit, wall_slot,
            e_ref, p_ref, diag, f, d_old, r_old, d_new, r_new):
     nb = u.shape[0]
@@ -187,7 +187,7 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
         for s in range(W):
             viscous = viscous or con[1, i, s] != 0.0 or con[2, i, s] != 0.0
             holder = holder or onsite[0, i, s] != 0.0 or onsite[1, i, s] != 0.0
-    dissipative = viscous or holder
+    dissipative = flows  # a constant (bundles.Holder): a chain without flows compiles no dissipation
     every = other_exponent(A, con)  # PLASTIC: every slot renewed at every stage (memory.plastic_commit)
     work = np.zeros((5, nb + 1, W))  # the dissipation's work arrays
     hold = holder_factors(onsite, 0.5 * dt, viscous)  # E(dt/2)'s holder flows
@@ -300,7 +300,7 @@ def integrate_chunks(first, last, u, v, chain, contacts, holder, method, record,
     again: one per thread, not one per chunk)."""
     mass, invm, bias, load, A, d0, d_limit = chain  # each bundle's fields, in their order (bundles.py)
     law, con, state = contacts
-    onsite, slip, viscous_rate = holder
+    onsite, slip, viscous_rate, flows = holder
     a_coef, b_coef, dt, n_steps, head, sub = method
     ch_slot, ch_weight, sample_dt, out = record.ch_slot, record.ch_weight, record.sample_dt, record.out
     check_every, e_ref, p_ref, wall_slot = checks.check_every, checks.e_ref, checks.p_ref, checks.wall_slot
@@ -313,7 +313,7 @@ def integrate_chunks(first, last, u, v, chain, contacts, holder, method, record,
         d_new = np.zeros((n_ch, ch_slot.shape[1], W))
         r_new = np.zeros((n_ch, ch_slot.shape[1], W))
         _chunk(u[k], v[k], mass[k], invm[k], bias[k], load[k], A[k], d0[k], law, con[k], state[k], onsite[k], slip,
-               viscous_rate, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, k * W,
+               viscous_rate, flows, a_coef, b_coef, dt, n_steps, head, sub, ch_slot, ch_weight, sample_dt, out, k * W,
                check_every, d_limit[k], wall_slot, e_ref[k], p_ref[k], diag[k], f, d_old, r_old, d_new, r_new)
 
 

@@ -106,7 +106,7 @@ def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks
     """
     mass, invm, bias, load, A, d0, d_limit = chain  # each bundle's fields, in their order (bundles.py)
     law, con, state = contacts
-    onsite, slip, viscous_rate = holder
+    onsite, slip, viscous_rate, flows = holder
     a_coef, b_coef, dt, n_steps, head, sub = method
     sched_body, sched_t, sched_f = schedule.body, schedule.t, schedule.f
     ch_slot, ch_weight, sample_dt, out = record.ch_slot, record.ch_weight, record.sample_dt, record.out
@@ -125,7 +125,7 @@ def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks
     for i in range(nb):
         viscous = viscous or con[1, i] != 0.0 or con[2, i] != 0.0
         holder = holder or onsite[0, i] != 0.0 or onsite[1, i] != 0.0
-    dissipative = viscous or holder
+    dissipative = flows  # a constant (bundles.Holder): a chain without flows compiles no dissipation
 
     state3 = state.reshape((state.shape[0], nb, 1))
     expo = con[0]
