@@ -47,7 +47,12 @@ def external(g, name: str) -> str | None:
     import h5py
 
     link = g.get(name, getlink=True)
-    return f"link:{link.path} in {link.filename}" if isinstance(link, h5py.ExternalLink) else None
+    return external_row(link) if isinstance(link, h5py.ExternalLink) else None
+
+
+def external_row(link) -> str:
+    """The row of an HDF5 external link (an h5py.ExternalLink)."""
+    return f"link:{link.path} in {link.filename}"
 
 
 def paths(group: h5py.Group, linked: dict) -> dict:
@@ -126,7 +131,7 @@ def _walk(g, a, prefix: str, t: _Tree):
     import h5py
 
     members = sorted(n for n in g if n != TABLE or g is not t.group)
-    t.rows[prefix or "/"] = sha(json.dumps(members).encode())
+    t.rows[prefix or "/"] = member_row(members)
     _attrs(g, a, prefix.rstrip("/"), t)
     for name in members:
         path = prefix + name
@@ -157,12 +162,24 @@ def seal(group: h5py.Group, linked: dict, written: dict | None = None, attribute
     """Write ``group``'s table and its digest (after everything else in it is written;
     ``written``: as for table()); the table is a dataset, or with ``attribute`` (layout 4:
     one object fewer per shot) an attribute of the group."""
-    text = json.dumps(table(group, linked, written), sort_keys=True, indent=0)
+    seal_rows(group, table(group, linked, written), attribute)
+
+
+def seal_rows(group: h5py.Group, rows: dict, attribute: bool = False):
+    """Write ``rows`` as ``group``'s table, and its digest (seal, for a writer that has
+    made every row of the group itself)."""
+    text = json.dumps(rows, sort_keys=True, indent=0)
     if attribute:
         group.attrs[TABLE] = text
     else:
         group.create_dataset(TABLE, data=text)
     group.attrs[DIGEST] = sha(text.encode())
+
+
+def member_row(names) -> str:
+    """The row of a group's member names (``path/``; the sealed group's own table, a
+    dataset, not among them)."""
+    return sha(json.dumps(sorted(names)).encode())
 
 
 def stored_table(group: h5py.Group) -> str:
