@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from .hashes import attribute_digest, sha, value_digest
+from .values import dataset_value
 
 if TYPE_CHECKING:
     import h5py
@@ -39,6 +40,13 @@ def address(obj) -> tuple:
     import h5py
 
     return os.path.abspath(h5py.h5f.get_name(obj.id).decode()), h5py.h5o.get_info(obj.id).addr
+
+
+def member_address(group, name: str) -> tuple:
+    """address() of ``group[name]``, a hard link, without opening the object."""
+    import h5py
+
+    return os.path.abspath(h5py.h5f.get_name(group.id).decode()), h5py.h5o.get_info(group.id, name.encode()).addr
 
 
 def external(g, name: str) -> str | None:
@@ -184,19 +192,23 @@ def member_row(names) -> str:
 
 def stored_table(group: h5py.Group) -> str:
     """The text of ``group``'s table as stored (an attribute, or a dataset)."""
-    text = group.attrs[TABLE] if TABLE in group.attrs else group[TABLE][()]
+    try:
+        text = group.attrs[TABLE]
+    except KeyError:  # a table before layout 4: a dataset
+        text = group[TABLE][()]
     return text.decode() if isinstance(text, bytes) else str(text)
 
 
-def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None) -> list:
+def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None, text: str | None = None) -> list:
     """What differs between ``group``'s stored table and the file: a list of
     "path: what is wrong" lines, empty when every item matches. ``read`` (a test of a row's
     key, e.g. ``lambda key: not key.startswith("data/")``): only the rows a reader reads are
     computed, item by item, without walking the rest (``known``: {row key: its row} that a
     reader computed from the values it read, not read again); where one differs, the whole
-    table is compared and the lines about those rows given."""
+    table is compared and the lines about those rows given. ``text``: the stored table's
+    text where the caller has read it (stored_table), not read again."""
     try:
-        text = stored_table(group)
+        text = stored_table(group) if text is None else text
         if sha(text.encode()) != str(group.attrs.get(DIGEST, "")):
             return [f"{TABLE}: the table of checksums (or the attribute {DIGEST}) is damaged"]
         stored = json.loads(text)
@@ -257,24 +269,24 @@ def _row(at, key: str, sealed: str, t: _Tree) -> str:
         link = external(at(parent), name)
         if link:
             return link
+        a = member_address(at(parent), name)  # a link to what another table covers: not opened
+        if a in t.linked:
+            return "link:" + t.linked[a]
+        if sealed.startswith("link:./"):
+            return "link:./" + names(t).get(a, "?") if names(t).get(a) != path else "not a link"
+        return _dataset_digest(at(path))
     obj, group = at(path), at("")
     if is_attr:
         return _attr_digest(obj, attr, names(t) if attr in _REFERENCE_ATTRS else {})
-    if key.endswith("/"):  # a group's member names
-        return sha(json.dumps(sorted(n for n in obj if n != TABLE or obj is not group)).encode())
-    a = address(obj)
-    if a in t.linked:
-        return "link:" + t.linked[a]
-    if sealed.startswith("link:./"):
-        return "link:./" + names(t).get(a, "?") if names(t).get(a) != path else "not a link"
-    return _dataset_digest(obj)
+    return member_row(n for n in obj if n != TABLE or obj is not group)  # a group's member names
 
 
-def linked_groups(group: h5py.Group, under: str) -> set:
+def linked_groups(group: h5py.Group, under: str, text: str | None = None) -> set:
     """The groups below ``under`` (e.g. "/shared/") that ``group``'s stored table links to,
-    by name ({"scene_ab12"}); empty when the table is unreadable (its check says why)."""
+    by name ({"scene_ab12"}); empty when the table is unreadable (its check says why).
+    ``text``: the stored table's text, as for damage()."""
     try:
-        rows = json.loads(stored_table(group))
+        rows = json.loads(stored_table(group) if text is None else text)
     except Exception:  # noqa: BLE001
         return set()
     return {v[len("link:") + len(under):].split("/", 1)[0] for v in rows.values()
@@ -282,7 +294,7 @@ def linked_groups(group: h5py.Group, under: str) -> set:
 
 
 def _dataset_digest(d) -> str:
-    return value_digest(d[()])  # fletcher32 is checked chunk by chunk here
+    return value_digest(dataset_value(d.id))  # fletcher32 is checked chunk by chunk here
 
 
 def _attr_digest(obj, key, names) -> str:

@@ -44,6 +44,7 @@ class Entry:
     start_time_source: str = ""
     file_modification_time: str = ""
     title: str = ""
+    raw_sha256: str = ""  # as stored, set when read back from layout 4 (a writer computes its own)
 
 
 def raw_values(w: Waveform) -> np.ndarray:
