@@ -44,7 +44,7 @@ from ..files import cause, folder_lock, hdf5_image
 from ..files import fsync as _fsync  # a name of this module's own: the crash tests stop a writer after it
 from .commit import commit_parts
 from .compact import LAYOUT4, LAYOUT4_TEXT
-from .digest import damage, linked_groups, stored_table
+from .digest import damage, linked_groups, table_text
 from .entry import Entry, raw_digest
 from .layout import LAYOUT as LAYOUT2_TEXT
 from .layout import LAYOUT_VERSION, write_entry
@@ -266,11 +266,11 @@ class Archive:
         ``parts``: the OpenParts the shot was read through."""
         linked: dict = {}
         name, scene = f"{self.path}: shot {int(g.name.rsplit('_', 1)[1])}", None
+        text = table_text(g)
         try:
-            text = stored_table(g)
-            sealed = json.loads(text)
-        except Exception:  # noqa: BLE001 - damage() says what is wrong with it
-            text, sealed = None, {}
+            sealed = json.loads(text or "{}")
+        except ValueError:  # damage() says what is wrong with it
+            sealed = {}
         for key in sorted(linked_groups(g, "/shared/", text)):
             s = parts.group(f["shared"], key)  # its part opened directly, as the shot's is
             held = s.file.filename

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from .hashes import attribute_digest, sha, value_digest
-from .values import dataset_value
+from .values import attribute_names, attribute_value, dataset_value, h5py_object, hdf5_id
 
 if TYPE_CHECKING:
     import h5py
@@ -34,12 +34,14 @@ _REFERENCE_ATTRS = ("DIMENSION_LIST", "REFERENCE_LIST")
 
 
 def address(obj) -> tuple:
-    """The object's file (its absolute path) and address in it: equal for every hard link to
-    it, for the paths that reach it through external links (the part files of layouts 3 and
-    4), and for a part opened directly (instruments/archive/links.py)."""
+    """The object's (an h5py object or its HDF5 identifier) file (its absolute path) and
+    address in it: equal for every hard link to it, for the paths that reach it through
+    external links (the part files of layouts 3 and 4), and for a part opened directly
+    (instruments/archive/links.py)."""
     import h5py
 
-    return os.path.abspath(h5py.h5f.get_name(obj.id).decode()), h5py.h5o.get_info(obj.id).addr
+    oid = hdf5_id(obj)
+    return os.path.abspath(h5py.h5f.get_name(oid).decode()), h5py.h5o.get_info(oid).addr
 
 
 def member_address(group, name: str) -> tuple:
@@ -120,7 +122,7 @@ class _Tree:
 
 
 def _attrs(obj, a, path: str, t: _Tree):
-    for key in sorted(obj.attrs):
+    for key in sorted(attribute_names(obj)):
         if obj is t.group and key in (DIGEST, TABLE):
             continue
         refs = names(t) if key in _REFERENCE_ATTRS else {}
@@ -148,7 +150,7 @@ def _walk(g, a, prefix: str, t: _Tree):
             t.rows[path] = link
             continue
         try:
-            obj = g[name]
+            obj = h5py.h5o.open(g.id, name.encode())  # as g[name] does, without its h5py object
             a = address(obj)
         except Exception as exc:  # noqa: BLE001 - a damaged link or header is a finding
             t.rows[path] = f"unreadable: {_first_line(exc)}"
@@ -157,9 +159,9 @@ def _walk(g, a, prefix: str, t: _Tree):
             t.rows[path] = "link:" + t.linked[a]
         elif a in t.where:
             t.rows[path] = "link:./" + t.where[a]
-        elif isinstance(obj, h5py.Group):
+        elif isinstance(obj, h5py.h5g.GroupID):
             t.where[a] = path
-            _walk(obj, a, path + "/", t)
+            _walk(h5py.Group(obj), a, path + "/", t)
         else:
             t.where[a] = path
             t.rows[path] = t.written.get(a) or _guard(functools.partial(_dataset_digest, obj))
@@ -193,7 +195,7 @@ def member_row(names) -> str:
 def stored_table(group: h5py.Group) -> str:
     """The text of ``group``'s table as stored (an attribute, or a dataset)."""
     try:
-        text = group.attrs[TABLE]
+        text = attribute_value(group, TABLE)
     except KeyError:  # a table before layout 4: a dataset
         text = group[TABLE][()]
     return text.decode() if isinstance(text, bytes) else str(text)
@@ -209,7 +211,7 @@ def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None
     text where the caller has read it (stored_table), not read again."""
     try:
         text = stored_table(group) if text is None else text
-        if sha(text.encode()) != str(group.attrs.get(DIGEST, "")):
+        if sha(text.encode()) != _sealed_digest(group):
             return [f"{TABLE}: the table of checksums (or the attribute {DIGEST}) is damaged"]
         stored = json.loads(text)
     except Exception as exc:  # noqa: BLE001
@@ -222,6 +224,14 @@ def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None
         found = _differences(stored, table(group, linked))
         return [p for p in found if read(p.removeprefix("attribute ").split(": ", 1)[0])] or found
     return _differences(stored, table(group, linked))
+
+
+def _sealed_digest(group) -> str:
+    """The group's attribute ``sha256`` ("" where it has none)."""
+    try:
+        return str(attribute_value(group, DIGEST))
+    except KeyError:
+        return ""
 
 
 def _differences(stored: dict, now: dict) -> list:
@@ -281,6 +291,14 @@ def _row(at, key: str, sealed: str, t: _Tree) -> str:
     return member_row(n for n in obj if n != TABLE or obj is not group)  # a group's member names
 
 
+def table_text(group: h5py.Group) -> str | None:
+    """stored_table(), None where it cannot be read (damage() then says why)."""
+    try:
+        return stored_table(group)
+    except Exception:  # noqa: BLE001
+        return None
+
+
 def linked_groups(group: h5py.Group, under: str, text: str | None = None) -> set:
     """The groups below ``under`` (e.g. "/shared/") that ``group``'s stored table links to,
     by name ({"scene_ab12"}); empty when the table is unreadable (its check says why).
@@ -294,13 +312,13 @@ def linked_groups(group: h5py.Group, under: str, text: str | None = None) -> set
 
 
 def _dataset_digest(d) -> str:
-    return value_digest(dataset_value(d.id))  # fletcher32 is checked chunk by chunk here
+    return value_digest(dataset_value(hdf5_id(d)))  # fletcher32 is checked chunk by chunk here
 
 
 def _attr_digest(obj, key, names) -> str:
     if key in _REFERENCE_ATTRS:
-        return sha(json.dumps(_references(obj, key, names)).encode())
-    return attribute_digest(obj.attrs[key])
+        return sha(json.dumps(_references(h5py_object(obj), key, names)).encode())
+    return attribute_digest(attribute_value(obj, key))
 
 
 def _references(obj, key, names) -> list:

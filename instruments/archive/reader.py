@@ -15,7 +15,7 @@ from .digest import linked_groups
 from .entry import Entry
 from .facts import ShotFacts
 from .hashes import attribute_digest, value_digest
-from .values import dataset_value, member_value
+from .values import attribute_value, dataset_value, member_value
 
 if TYPE_CHECKING:
     import h5py
@@ -42,7 +42,7 @@ def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool
     shot_id = int(g.name.rsplit("_", 1)[1])
     where = f"{path}: shot {shot_id}"
     seen = {} if seen is None else seen
-    text = g.attrs["metadata"]
+    text = attribute_value(g, "metadata")
     seen["@metadata"] = attribute_digest(text)
     meta = json.loads(text)
     data = g["data"]
