@@ -52,6 +52,7 @@ from .links import OpenParts, file_identity, returned_by_read, truth_item
 from .opening import check_archive_path, id_range, open_archive, stored_raw_digest
 from .parts import LAYOUT3, folder
 from .reader import read_entry, read_shot, summary_row
+from .values import attribute_or
 from .verify import addresses, check, root_seal, sealed_members, shot_names
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
@@ -212,6 +213,8 @@ class Archive:
         plot shows: the time axis, the plot's attributes; ``rig verify`` checks those) and
         of what it shares. The shot is read from the part its master's link names, opened
         directly."""
+        import h5py
+
         with self._reader() as (f, parts):
             name = f"shot_{shot_id:06d}"
             try:
@@ -223,7 +226,7 @@ class Archive:
             try:
                 e = None
                 seen: dict = {}
-                layout = g.file.attrs.get("layout_version")
+                layout = attribute_or(h5py.h5o.open(g.id, b"/"), "layout_version")  # of the file that holds it
                 if verify:  # read first: what it read is checked as read, not read again
                     table, linked, scene = self._check_shared(f, parts, g, with_truth)
                     with contextlib.suppress(Exception):  # a damaged shot: the check says what

@@ -9,6 +9,7 @@ from __future__ import annotations
 import os
 
 from .compact import LAYOUT4
+from .digest import external_link
 
 
 def file_identity(path) -> tuple | None:
@@ -44,12 +45,8 @@ class OpenParts:
         """The group ``f[name]`` (``f``: a file or a group): where ``name`` is an external
         link, read from its part opened directly (KeyError where ``f`` has no such member;
         OSError where the part is missing or not HDF5)."""
-        import h5py
-
-        link = f.get(name, getlink=True)
+        link = external_link(f, name)
         if link is None:
-            raise KeyError(name)
-        if not isinstance(link, h5py.ExternalLink):
             return f[name]
         return self.file(os.path.join(os.path.dirname(f.file.filename), link.filename))[link.path]
 

@@ -128,10 +128,9 @@ def _str(value) -> str:
 
 
 def _text(g, name: str, seen: dict | None = None) -> str:
-    try:
-        value = member_value(g, name)
-    except KeyError:
+    if name not in g:
         return ""
+    value = member_value(g, name)
     if seen is not None:
         seen[name] = value_digest(value)
     return _str(value)

@@ -39,13 +39,10 @@ def dataset_value(dataset_id):
 
 def member_value(group, name: str):
     """The value of the dataset ``group[name]`` (dataset_value), opened through HDF5's own
-    call: no h5py object made (KeyError where there is none)."""
+    call, as ``group[name]`` opens it (its errors), but no h5py object made."""
     import h5py
 
-    try:
-        return dataset_value(h5py.h5o.open(group.id, name.encode()))
-    except KeyError:
-        raise KeyError(name) from None
+    return dataset_value(h5py.h5o.open(group.id, name.encode()))
 
 
 @functools.cache
@@ -77,13 +74,11 @@ def attribute_value(obj, name: str):
     """The attribute ``name`` of ``obj`` (an h5py object or its HDF5 identifier) as h5py's
     ``obj.attrs[name]`` reads it, through HDF5's own calls for what a table of checksums
     holds most: a text (str), a list of texts (an array of str), an integer or float scalar;
-    anything else through h5py itself (KeyError where there is no such attribute)."""
+    anything else through h5py itself. It fails as h5py does (KeyError where there is no
+    such attribute, or where HDF5 cannot open it)."""
     import h5py
 
-    try:
-        attribute = h5py.h5a.open(hdf5_id(obj), name.encode())
-    except KeyError:
-        raise KeyError(name) from None
+    attribute = h5py.h5a.open(hdf5_id(obj), name.encode())
     kind = attribute.get_type()
     cls = kind.get_class()
     shape = attribute.shape
@@ -97,6 +92,16 @@ def attribute_value(obj, name: str):
         attribute.read(value)
         return value[()]
     return h5py_object(obj).attrs[name]
+
+
+def attribute_or(obj, name: str, default=None):
+    """attribute_value(), or ``default`` where ``obj`` has no attribute ``name``, as h5py's
+    ``obj.attrs.get`` (which fails where HDF5 cannot tell)."""
+    import h5py
+
+    if not h5py.h5a.exists(hdf5_id(obj), name.encode()):
+        return default
+    return attribute_value(obj, name)
 
 
 def h5py_object(obj):
