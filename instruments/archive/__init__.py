@@ -24,7 +24,9 @@ part no master names (a writer killed between the two renames) is replaced by th
 transaction of the same first shot, and a stale temporary file is removed by the next
 append. Readers open the master and see one complete version: this is what SWMR would give,
 without SWMR's ban on creating groups. A read goes from the master's link straight to the
-part that holds the shot. An I/O failure (a full disk, no permission) or a damaged archive
+part that holds the shot; an Archive keeps the master and the parts it read last open for
+its next read, and opens again a master or part whose file was replaced or removed since
+(instruments/archive/links.py). An I/O failure (a full disk, no permission) or a damaged archive
 ends an append with one InstrumentError naming the archive and the cause; the archive is
 left as it was.
 """
@@ -212,7 +214,8 @@ class Archive:
         the checksums of what it returns first (all of the shot's table but what only its
         plot shows: the time axis, the plot's attributes; ``rig verify`` checks those) and
         of what it shares. The shot is read from the part its master's link names, opened
-        directly."""
+        directly; the master and the parts read last stay open for the next read, while the
+        files at their paths are those they were opened from."""
         import h5py
 
         with self._reader() as (f, parts):
@@ -274,6 +277,7 @@ class Archive:
             sealed = json.loads(text or "{}")
         except ValueError:  # damage() says what is wrong with it
             sealed = {}
+        sealed = sealed if isinstance(sealed, dict) else {}
         for key in sorted(linked_groups(g, "/shared/", text)):
             s = parts.group(f["shared"], key)  # its part opened directly, as the shot's is
             held = s.file.filename

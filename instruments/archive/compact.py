@@ -7,10 +7,12 @@ NXdata plot itself, read as volts through CF packing attributes (``scale_factor`
 ``add_offset`` = YZERO - YOFF*YMULT: xarray and h5netcdf decode them by default); the time
 axis as a sample index (uint16, or uint32 past 65,536 points) packed the same way (seconds =
 x_zero + x_increment*n); the shot's scalars, preambles and facts as one JSON attribute of its
-NXentry (``metadata``); one table of checksums, whose rows of what the writer wrote are
-computed from what it wrote, not read back. Codes are chunked with fletcher32 and not
-compressed (3 x 10,000 int16 codes are 60 kB; gzip would cost more CPU than the bytes it
-saves); the index axis is gzipped (a few hundred bytes).
+NXentry (``metadata``); one table of checksums, whose rows the writer makes from what it
+writes, as it writes it: the shot is neither walked nor read back. Its datasets, groups and
+attributes are made through HDF5's own calls where h5py's cost more (layout.store). Codes
+are chunked with fletcher32 and not compressed (3 x 10,000 int16 codes are 60 kB; gzip
+would cost more CPU than the bytes it saves); the index axis is gzipped (a few hundred
+bytes).
 """
 from __future__ import annotations
 

@@ -57,7 +57,7 @@ def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool
     return Entry(record, bool(meta["simulated"]), meta["seed"], meta["scene"], scene_text,
                  settings, truth, facts, keys[0].removeprefix("scene_") if keys else None,
                  _text(g, "start_time", seen), meta["program_version"], shot_id, meta["start_time_source"],
-                 meta["file_modification_time"], _text(g, "title", seen), meta["raw_sha256"])
+                 meta["file_modification_time"], _text(g, "title", seen), meta.get("raw_sha256", ""))
 
 
 def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False) -> Entry:
