@@ -239,11 +239,12 @@ class Archive:
                     if problems:
                         raise InstrumentError(f"{self.path}: shot {shot_id}: {problems[0]}")
                 e = e or read_shot(g, self.path, with_truth, layout=layout)
+                stored = (e.raw_sha256 or stored_raw_digest(g)) if verify else ""
             except InstrumentError:
                 raise
             except Exception as exc:  # noqa: BLE001 - a damaged file, one line
                 raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({cause(exc)})") from None
-            if verify and raw_digest(e.record) != (e.raw_sha256 or stored_raw_digest(g)):
+            if verify and raw_digest(e.record) != stored:
                 raise InstrumentError(f"{self.path}: shot {shot_id}: raw_sha256 does not match the raw data")
             return e
 
