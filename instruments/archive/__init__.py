@@ -24,16 +24,20 @@ part no master names (a writer killed between the two renames) is replaced by th
 transaction of the same first shot, and a stale temporary file is removed by the next
 append. Readers open the master and see one complete version: this is what SWMR would give,
 without SWMR's ban on creating groups. A read goes from the master's link straight to the
-part that holds the shot. An I/O failure (a full disk, no permission) or a damaged archive
+part that holds the shot; an Archive keeps the master and the parts it read last open for
+its next read, and opens again a master or part whose file was replaced or removed since
+(instruments/archive/links.py). An I/O failure (a full disk, no permission) or a damaged archive
 ends an append with one InstrumentError naming the archive and the cause; the archive is
 left as it was.
 """
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import shutil
 import tempfile
+import threading
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -42,14 +46,15 @@ from ..files import cause, folder_lock, hdf5_image
 from ..files import fsync as _fsync  # a name of this module's own: the crash tests stop a writer after it
 from .commit import commit_parts
 from .compact import LAYOUT4, LAYOUT4_TEXT
-from .digest import damage, linked_groups
+from .digest import damage, linked_groups, table_text
 from .entry import Entry, raw_digest
 from .layout import LAYOUT as LAYOUT2_TEXT
 from .layout import LAYOUT_VERSION, write_entry
-from .links import OpenParts, returned_by_read, truth_item
+from .links import OpenParts, file_identity, returned_by_read, truth_item
 from .opening import check_archive_path, id_range, open_archive, stored_raw_digest
 from .parts import LAYOUT3, folder
 from .reader import read_entry, read_shot, summary_row
+from .values import attribute_or
 from .verify import addresses, check, root_seal, sealed_members, shot_names
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
@@ -57,6 +62,7 @@ if TYPE_CHECKING:  # h5py itself is imported where a file is opened
 
 __all__ = ["Archive", "Entry", "check_archive_path", "raw_digest", "stored_raw_digest"]
 LAYOUT, CURRENT_LAYOUT = LAYOUT4_TEXT, LAYOUT4  # what a new archive is written in
+PARTS_KEPT = 4  # the part files an Archive keeps open between reads (a shot's part, its scene's, ...)
 
 
 class Archive:
@@ -64,7 +70,10 @@ class Archive:
 
     def __init__(self, path):
         self.path = Path(path)
-        self._sound_shared = {}  # {(file, shared group): (the file's identity, its addresses)}, found intact
+        self._sound_shared = {}  # {(file, shared group): (the file's identity, its addresses, its texts)}, intact
+        self._master: tuple | None = None  # (the file's identity, the master open for reading)
+        self._parts = OpenParts(kept=PARTS_KEPT)  # the parts read last, kept open
+        self._reading = threading.Lock()  # one read at a time uses them
 
     # --- writing --------------------------------------------------------------------
     def append(self, entries) -> list:
@@ -205,8 +214,11 @@ class Archive:
         the checksums of what it returns first (all of the shot's table but what only its
         plot shows: the time axis, the plot's attributes; ``rig verify`` checks those) and
         of what it shares. The shot is read from the part its master's link names, opened
-        directly."""
-        with self._open() as f, OpenParts() as parts:
+        directly; the master and the parts read last stay open for the next read, while the
+        files at their paths are those they were opened from."""
+        import h5py
+
+        with self._reader() as (f, parts):
             name = f"shot_{shot_id:06d}"
             try:
                 g = parts.group(f, name)
@@ -217,46 +229,75 @@ class Archive:
             try:
                 e = None
                 seen: dict = {}
+                layout = attribute_or(h5py.h5o.open(g.id, b"/"), "layout_version")  # of the file that holds it
                 if verify:  # read first: what it read is checked as read, not read again
+                    table, linked, scene = self._check_shared(f, parts, g, with_truth)
                     with contextlib.suppress(Exception):  # a damaged shot: the check says what
-                        e = read_shot(g, self.path, with_truth, seen=seen)
-                    self._check_shot(f, g, with_truth, seen if e is not None else {})
-                e = e or read_shot(g, self.path, with_truth)
+                        e = read_shot(g, self.path, with_truth, seen=seen, layout=layout, scene=scene)
+                    problems = damage(g, linked, read=returned_by_read(layout), known=seen if e is not None else {},
+                                      text=table)
+                    if problems:
+                        raise InstrumentError(f"{self.path}: shot {shot_id}: {problems[0]}")
+                e = e or read_shot(g, self.path, with_truth, layout=layout)
+                stored = (e.raw_sha256 or stored_raw_digest(g)) if verify else ""
             except InstrumentError:
                 raise
             except Exception as exc:  # noqa: BLE001 - a damaged file, one line
                 raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({cause(exc)})") from None
-            if verify and raw_digest(e.record) != stored_raw_digest(g):
+            if verify and raw_digest(e.record) != stored:
                 raise InstrumentError(f"{self.path}: shot {shot_id}: raw_sha256 does not match the raw data")
             return e
 
-    def _check_shot(self, f, g, with_truth: bool = True, read_rows: dict | None = None):
-        """The shot's table, and those of the shared groups it links to (scene text and
-        settings, and the truth's forces where ``with_truth``; once per version of the file
-        that holds them: a part, never changed, or a layout-2 archive, replaced whole by each
+    @contextlib.contextmanager
+    def _reader(self):
+        """(the master open for reading, the parts read last): kept open from one read to
+        the next while the file at each path is the one it was opened from (links.OpenParts;
+        an append puts a new master in place, which the next read opens)."""
+        with self._reading:
+            identity = file_identity(self.path)
+            if self._master is not None and (identity is None or self._master[0] != identity):
+                self._master[1].close()
+                self._master = None
+            if self._master is None:
+                self._master = identity, self._open()
+            yield self._master[1], self._parts
+
+    def _check_shared(self, f, parts, g, with_truth: bool = True) -> tuple:
+        """The tables of the shared groups the shot ``g`` links to (scene text and settings,
+        and the truth's forces where ``with_truth``; once per version of the file that holds
+        them: a part, never changed, or a layout-2 archive, replaced whole by each
         transaction): a shot read without its truth is not refused for damaged truth forces,
-        which it does not read; ``read_rows``: the rows the read computed from what it read."""
-        linked, name = {}, f"{self.path}: shot {int(g.name.rsplit('_', 1)[1])}"
-        for key in sorted(linked_groups(g, "/shared/")):
-            s = f["shared"][key]
+        which it does not read. (the shot's stored table as text, None where unreadable;
+        {address: path} of what it shares; the scene's texts ({"scene_text", "settings"}, as
+        stored) of the group that the shot's table links its own to, found intact, else None);
+        ``parts``: the OpenParts the shot was read through."""
+        linked: dict = {}
+        name, scene = f"{self.path}: shot {int(g.name.rsplit('_', 1)[1])}", None
+        text = table_text(g)
+        try:
+            sealed = json.loads(text or "{}")
+        except ValueError:  # damage() says what is wrong with it
+            sealed = {}
+        sealed = sealed if isinstance(sealed, dict) else {}
+        for key in sorted(linked_groups(g, "/shared/", text)):
+            s = parts.group(f["shared"], key)  # its part opened directly, as the shot's is
             held = s.file.filename
-            st = os.stat(held)
-            identity = (st.st_ino, st.st_size, st.st_mtime_ns)
+            identity = file_identity(held)
             known = self._sound_shared.get((held, key))
-            if known and known[0] == identity:
-                linked.update(known[1])
-                continue
-            here = addresses(s)
-            linked.update(here)
-            problems = damage(s, {})
-            read = problems if with_truth else [p for p in problems if not truth_item(p)]
-            if read:
-                raise InstrumentError(f"{name}: shared/{key}/{read[0]}")
-            if not problems:
-                self._sound_shared[(held, key)] = (identity, here)
-        problems = damage(g, linked, read=returned_by_read(g), known=read_rows)
-        if problems:
-            raise InstrumentError(f"{name}: {problems[0]}")
+            if not (known and known[0] == identity):
+                here = addresses(s)
+                problems = damage(s, {})
+                read = problems if with_truth else [p for p in problems if not truth_item(p)]
+                if read:
+                    raise InstrumentError(f"{name}: shared/{key}/{read[0]}")
+                texts = {k: s[k][()].decode() for k in ("scene_text", "settings") if k in s}
+                known = (identity, here, texts)
+                if not problems:
+                    self._sound_shared[(held, key)] = known
+            linked.update(known[1])
+            if str(sealed.get("scene_text", "")).split(" in ")[0] == f"link:/shared/{key}/scene_text":
+                scene = known[2]
+        return text, linked, scene
 
     def verify(self) -> dict:
         """Check the whole archive: {"shots", "ok", "bad"}; each bad row names the shot

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from .hashes import attribute_digest, sha, value_digest
+from .values import attribute_names, attribute_or, attribute_value, dataset_value, h5py_object, hdf5_id
 
 if TYPE_CHECKING:
     import h5py
@@ -33,21 +34,49 @@ _REFERENCE_ATTRS = ("DIMENSION_LIST", "REFERENCE_LIST")
 
 
 def address(obj) -> tuple:
-    """The object's file (its absolute path) and address in it: equal for every hard link to
-    it, for the paths that reach it through external links (the part files of layouts 3 and
-    4), and for a part opened directly (instruments/archive/links.py)."""
+    """The object's (an h5py object or its HDF5 identifier) file (its absolute path) and
+    address in it: equal for every hard link to it, for the paths that reach it through
+    external links (the part files of layouts 3 and 4), and for a part opened directly
+    (instruments/archive/links.py)."""
     import h5py
 
-    return os.path.abspath(h5py.h5f.get_name(obj.id).decode()), h5py.h5o.get_info(obj.id).addr
+    oid = hdf5_id(obj)
+    return os.path.abspath(h5py.h5f.get_name(oid).decode()), h5py.h5o.get_info(oid).addr
+
+
+def member_address(group, name: str) -> tuple:
+    """address() of ``group[name]``, a hard link, without opening the object."""
+    import h5py
+
+    return os.path.abspath(h5py.h5f.get_name(group.id).decode()), h5py.h5o.get_info(group.id, name.encode()).addr
 
 
 def external(g, name: str) -> str | None:
     """The row of ``g[name]`` where it is an HDF5 external link ("link:/shared/k/x in
     part.h5"), else None; the link is not followed."""
+    link = external_link(g, name)
+    return external_row(link) if link is not None else None
+
+
+def external_link(g, name: str):
+    """``g[name]`` as an h5py.ExternalLink where it is one, else None (no such member, or
+    another kind of link): as ``g.get(name, getlink=True)`` gives it, through HDF5's own
+    calls (h5py's costs four times as much)."""
     import h5py
 
-    link = g.get(name, getlink=True)
-    return f"link:{link.path} in {link.filename}" if isinstance(link, h5py.ExternalLink) else None
+    try:
+        info = g.id.links.get_info(name.encode())
+    except KeyError:
+        return None
+    if info.type != h5py.h5l.TYPE_EXTERNAL:
+        return None
+    filename, path = (part.decode("utf8", "surrogateescape") for part in g.id.links.get_val(name.encode()))
+    return h5py.ExternalLink(filename, path)
+
+
+def external_row(link) -> str:
+    """The row of an HDF5 external link (an h5py.ExternalLink)."""
+    return f"link:{link.path} in {link.filename}"
 
 
 def paths(group: h5py.Group, linked: dict) -> dict:
@@ -107,7 +136,7 @@ class _Tree:
 
 
 def _attrs(obj, a, path: str, t: _Tree):
-    for key in sorted(obj.attrs):
+    for key in sorted(attribute_names(obj)):
         if obj is t.group and key in (DIGEST, TABLE):
             continue
         refs = names(t) if key in _REFERENCE_ATTRS else {}
@@ -126,7 +155,7 @@ def _walk(g, a, prefix: str, t: _Tree):
     import h5py
 
     members = sorted(n for n in g if n != TABLE or g is not t.group)
-    t.rows[prefix or "/"] = sha(json.dumps(members).encode())
+    t.rows[prefix or "/"] = member_row(members)
     _attrs(g, a, prefix.rstrip("/"), t)
     for name in members:
         path = prefix + name
@@ -135,7 +164,7 @@ def _walk(g, a, prefix: str, t: _Tree):
             t.rows[path] = link
             continue
         try:
-            obj = g[name]
+            obj = h5py.h5o.open(g.id, name.encode())  # as g[name] does, without its h5py object
             a = address(obj)
         except Exception as exc:  # noqa: BLE001 - a damaged link or header is a finding
             t.rows[path] = f"unreadable: {_first_line(exc)}"
@@ -144,9 +173,9 @@ def _walk(g, a, prefix: str, t: _Tree):
             t.rows[path] = "link:" + t.linked[a]
         elif a in t.where:
             t.rows[path] = "link:./" + t.where[a]
-        elif isinstance(obj, h5py.Group):
+        elif isinstance(obj, h5py.h5g.GroupID):
             t.where[a] = path
-            _walk(obj, a, path + "/", t)
+            _walk(h5py.Group(obj), a, path + "/", t)
         else:
             t.where[a] = path
             t.rows[path] = t.written.get(a) or _guard(functools.partial(_dataset_digest, obj))
@@ -157,7 +186,13 @@ def seal(group: h5py.Group, linked: dict, written: dict | None = None, attribute
     """Write ``group``'s table and its digest (after everything else in it is written;
     ``written``: as for table()); the table is a dataset, or with ``attribute`` (layout 4:
     one object fewer per shot) an attribute of the group."""
-    text = json.dumps(table(group, linked, written), sort_keys=True, indent=0)
+    seal_rows(group, table(group, linked, written), attribute)
+
+
+def seal_rows(group: h5py.Group, rows: dict, attribute: bool = False):
+    """Write ``rows`` as ``group``'s table, and its digest (seal, for a writer that has
+    made every row of the group itself)."""
+    text = json.dumps(rows, sort_keys=True, indent=0)
     if attribute:
         group.attrs[TABLE] = text
     else:
@@ -165,22 +200,31 @@ def seal(group: h5py.Group, linked: dict, written: dict | None = None, attribute
     group.attrs[DIGEST] = sha(text.encode())
 
 
+def member_row(names) -> str:
+    """The row of a group's member names (``path/``; the sealed group's own table, a
+    dataset, not among them)."""
+    return sha(json.dumps(sorted(names)).encode())
+
+
 def stored_table(group: h5py.Group) -> str:
     """The text of ``group``'s table as stored (an attribute, or a dataset)."""
-    text = group.attrs[TABLE] if TABLE in group.attrs else group[TABLE][()]
+    text = attribute_or(group, TABLE)
+    if text is None:  # a table before layout 4: a dataset
+        text = group[TABLE][()]
     return text.decode() if isinstance(text, bytes) else str(text)
 
 
-def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None) -> list:
+def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None, text: str | None = None) -> list:
     """What differs between ``group``'s stored table and the file: a list of
     "path: what is wrong" lines, empty when every item matches. ``read`` (a test of a row's
     key, e.g. ``lambda key: not key.startswith("data/")``): only the rows a reader reads are
     computed, item by item, without walking the rest (``known``: {row key: its row} that a
     reader computed from the values it read, not read again); where one differs, the whole
-    table is compared and the lines about those rows given."""
+    table is compared and the lines about those rows given. ``text``: the stored table's
+    text where the caller has read it (stored_table), not read again."""
     try:
-        text = stored_table(group)
-        if sha(text.encode()) != str(group.attrs.get(DIGEST, "")):
+        text = stored_table(group) if text is None else text
+        if sha(text.encode()) != _sealed_digest(group):
             return [f"{TABLE}: the table of checksums (or the attribute {DIGEST}) is damaged"]
         stored = json.loads(text)
     except Exception as exc:  # noqa: BLE001
@@ -193,6 +237,11 @@ def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None
         found = _differences(stored, table(group, linked))
         return [p for p in found if read(p.removeprefix("attribute ").split(": ", 1)[0])] or found
     return _differences(stored, table(group, linked))
+
+
+def _sealed_digest(group) -> str:
+    """The group's attribute ``sha256`` ("" where it has none)."""
+    return str(attribute_or(group, DIGEST, ""))
 
 
 def _differences(stored: dict, now: dict) -> list:
@@ -214,11 +263,14 @@ def rows(group: h5py.Group, keys: list, linked: dict, stored: dict, known: dict 
     walk over the rest of the group), and those of ``known`` (rows a reader computed) that the
     table holds; ``stored``: the table as sealed, which says where a row is a hard link
     inside the group (only then is the group walked for its paths)."""
+    import h5py
+
     t, objects = _Tree(group, {}, {}, linked, {}, {}), {"": group}
 
     def at(path: str):  # each object looked up once (a path lookup costs as much as a small read)
-        if path not in objects:
-            objects[path] = group[path]
+        if path not in objects:  # opened as group[path] does, without its h5py object for a dataset
+            oid = h5py.h5o.open(group.id, path.encode())
+            objects[path] = h5py.Group(oid) if isinstance(oid, h5py.h5g.GroupID) else oid
         return objects[path]
 
     out = {k: v for k, v in (known or {}).items() if k in stored}
@@ -240,24 +292,32 @@ def _row(at, key: str, sealed: str, t: _Tree) -> str:
         link = external(at(parent), name)
         if link:
             return link
+        a = member_address(at(parent), name)  # a link to what another table covers: not opened
+        if a in t.linked:
+            return "link:" + t.linked[a]
+        if sealed.startswith("link:./"):
+            return "link:./" + names(t).get(a, "?") if names(t).get(a) != path else "not a link"
+        return _dataset_digest(at(path))
     obj, group = at(path), at("")
     if is_attr:
         return _attr_digest(obj, attr, names(t) if attr in _REFERENCE_ATTRS else {})
-    if key.endswith("/"):  # a group's member names
-        return sha(json.dumps(sorted(n for n in obj if n != TABLE or obj is not group)).encode())
-    a = address(obj)
-    if a in t.linked:
-        return "link:" + t.linked[a]
-    if sealed.startswith("link:./"):
-        return "link:./" + names(t).get(a, "?") if names(t).get(a) != path else "not a link"
-    return _dataset_digest(obj)
+    return member_row(n for n in h5py_object(obj) if n != TABLE or obj is not group)  # a group's member names
 
 
-def linked_groups(group: h5py.Group, under: str) -> set:
-    """The groups below ``under`` (e.g. "/shared/") that ``group``'s stored table links to,
-    by name ({"scene_ab12"}); empty when the table is unreadable (its check says why)."""
+def table_text(group: h5py.Group) -> str | None:
+    """stored_table(), None where it cannot be read (damage() then says why)."""
     try:
-        rows = json.loads(stored_table(group))
+        return stored_table(group)
+    except Exception:  # noqa: BLE001
+        return None
+
+
+def linked_groups(group: h5py.Group, under: str, text: str | None = None) -> set:
+    """The groups below ``under`` (e.g. "/shared/") that ``group``'s stored table links to,
+    by name ({"scene_ab12"}); empty when the table is unreadable (its check says why).
+    ``text``: the stored table's text, as for damage()."""
+    try:
+        rows = json.loads(stored_table(group) if text is None else text)
     except Exception:  # noqa: BLE001
         return set()
     return {v[len("link:") + len(under):].split("/", 1)[0] for v in rows.values()
@@ -265,13 +325,13 @@ def linked_groups(group: h5py.Group, under: str) -> set:
 
 
 def _dataset_digest(d) -> str:
-    return value_digest(d[()])  # fletcher32 is checked chunk by chunk here
+    return value_digest(dataset_value(hdf5_id(d)))  # fletcher32 is checked chunk by chunk here
 
 
 def _attr_digest(obj, key, names) -> str:
     if key in _REFERENCE_ATTRS:
-        return sha(json.dumps(_references(obj, key, names)).encode())
-    return attribute_digest(obj.attrs[key])
+        return sha(json.dumps(_references(h5py_object(obj), key, names)).encode())
+    return attribute_digest(attribute_value(obj, key))
 
 
 def _references(obj, key, names) -> list:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import hashlib
 import json
 import re
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -44,6 +44,7 @@ class Entry:
     start_time_source: str = ""
     file_modification_time: str = ""
     title: str = ""
+    raw_sha256: str = ""  # as stored, set when read back from layout 4 (a writer computes its own)
 
 
 def raw_values(w: Waveform) -> np.ndarray:
@@ -79,8 +80,14 @@ def texts(e: Entry) -> dict:
 
 def preamble_json(w: Waveform) -> str:
     """A channel's name, over-range flag and preamble (its scaling: volts and seconds), JSON."""
-    return json.dumps({"channel": w.channel, "overrange": bool(w.overrange), **asdict(w.preamble)},
-                      default=jsonable, sort_keys=True)
+    return json.dumps(preamble_fields(w), default=jsonable, sort_keys=True)
+
+
+def preamble_fields(w: Waveform) -> dict:
+    """What preamble_json writes, as a dict of the preamble's own values (json.dumps with
+    ``default=jsonable`` writes it alike)."""
+    p = w.preamble
+    return {"channel": w.channel, "overrange": bool(w.overrange), **{f.name: getattr(p, f.name) for f in fields(p)}}
 
 
 def facts_json(e: Entry, where: str) -> str:

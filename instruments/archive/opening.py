@@ -12,6 +12,7 @@ from ..files import cause
 from .compact import LAYOUT4
 from .layout import LAYOUT_VERSION
 from .parts import LAYOUT3
+from .values import attribute_or
 from .verify import shot_names
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
@@ -33,7 +34,7 @@ def open_archive(path, current: bool = True) -> h5py.File:
         raise InstrumentError(f"{path}: not an HDF5 file")
     try:
         f = h5py.File(path, "r")
-        creator, version = f.attrs.get("creator"), f.attrs.get("layout_version")
+        creator, version = attribute_or(f, "creator"), attribute_or(f, "layout_version")
     except Exception as exc:  # noqa: BLE001 - any failure of a damaged file
         raise InstrumentError(f"{path}: cannot be opened as HDF5 (truncated or damaged?): {cause(exc)}") from None
     if creator != "sonic-rig":

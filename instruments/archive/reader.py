@@ -15,42 +15,49 @@ from .digest import linked_groups
 from .entry import Entry
 from .facts import ShotFacts
 from .hashes import attribute_digest, value_digest
+from .values import attribute_value, dataset_value, member_value
 
 if TYPE_CHECKING:
     import h5py
 
 
-def read_shot(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False, seen: dict | None = None) -> Entry:
-    """The Entry of an NXentry of any current layout (the file that holds it says which);
-    ``seen`` (layout 4): filled with the rows of the shot's table of what was read."""
-    if g.file.attrs.get("layout_version") == LAYOUT4:
-        return read_compact_entry(g, path, with_truth, keyed, {} if seen is None else seen)
+def read_shot(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False, seen: dict | None = None,
+              layout=None, scene: dict | None = None) -> Entry:
+    """The Entry of an NXentry of any current layout (the file that holds it says which, or
+    ``layout`` where the caller has read it); ``seen`` and ``scene`` (layout 4): as for
+    read_compact_entry."""
+    if (g.file.attrs.get("layout_version") if layout is None else layout) == LAYOUT4:
+        return read_compact_entry(g, path, with_truth, keyed, {} if seen is None else seen, scene)
     return read_entry(g, path, with_truth, keyed)
 
 
 def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False,
-                       seen: dict | None = None) -> Entry:
+                       seen: dict | None = None, scene: dict | None = None) -> Entry:
     """The Entry of an NXentry of layout 4 (its checksums are checked by the caller);
     ``keyed`` as for read_entry; ``seen``: filled with {row key: row} (digest.table) of the
-    metadata, texts and codes read, which the caller's check takes rather than read again."""
+    metadata, texts and codes read, which the caller's check takes rather than read again;
+    ``scene``: the texts of the shared group its scene_text and settings link to
+    ({"scene_text", "settings"}, as stored), where the caller has read them from it: not read
+    again through the shot's links."""
     shot_id = int(g.name.rsplit("_", 1)[1])
     where = f"{path}: shot {shot_id}"
     seen = {} if seen is None else seen
-    text = g.attrs["metadata"]
+    text = attribute_value(g, "metadata")
     seen["@metadata"] = attribute_digest(text)
     meta = json.loads(text)
     data = g["data"]
-    waves = dict(_waveform(data[ch.replace("#", "_")], p, where, seen) for ch, p in meta["preambles"].items())
+    waves = dict(_waveform(_codes(data, ch.replace("#", "_"), seen), p, where) for ch, p in meta["preambles"].items())
     record = ScopeRecord(dict(sorted(waves.items())), bool(meta["triggered"]), meta["no_trigger_reason"] or None)
     facts = ShotFacts.from_dict(meta["facts"], f"{where}: facts") if meta.get("facts") else None
     truth = _forces(g["truth/forces"]) if with_truth and "truth" in g else None
     keys = sorted(k for k in linked_groups(g, "/shared/") if k.startswith("scene_")) if keyed else []
-    scene_text = meta["scene_text"] if "scene_text" in meta else _text(g, "scene_text")
-    settings = meta["settings"] if "settings" in meta else json.loads(_text(g, "settings"))
+    texts = meta if "scene_text" in meta else scene or {k: _text(g, k) for k in ("scene_text", "settings")}
+    scene_text = texts["scene_text"]
+    settings = meta["settings"] if "settings" in meta else json.loads(texts["settings"])
     return Entry(record, bool(meta["simulated"]), meta["seed"], meta["scene"], scene_text,
                  settings, truth, facts, keys[0].removeprefix("scene_") if keys else None,
                  _text(g, "start_time", seen), meta["program_version"], shot_id, meta["start_time_source"],
-                 meta["file_modification_time"], _text(g, "title", seen))
+                 meta["file_modification_time"], _text(g, "title", seen), meta.get("raw_sha256", ""))
 
 
 def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False) -> Entry:
@@ -62,7 +69,7 @@ def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False
     waves = {}
     for d in g["instrument/oscilloscope"].values():
         if "preamble" in d.attrs:  # not the sample axis
-            ch, wave = _waveform(d, json.loads(d.attrs["preamble"]), where)
+            ch, wave = _waveform(dataset_value(d.id), json.loads(d.attrs["preamble"]), where)
             waves[ch] = wave
     reason = _text(g, "no_trigger_reason")
     record = ScopeRecord(dict(sorted(waves.items())), bool(g["triggered"][()]), reason or None)
@@ -89,17 +96,22 @@ def summary_row(e: Entry) -> dict:
             "settings": e.settings.get("striker", {})}
 
 
-def _waveform(d, preamble: dict, where: str, seen: dict | None = None) -> tuple:
-    """(channel, Waveform) of a dataset of raw codes (or volts) and its preamble (with the
+def _codes(data, name: str, seen: dict):
+    """The raw codes (or volts) of the channel ``name`` in a layout-4 shot's ``data``; their
+    row of the shot's table kept in ``seen``."""
+    values = member_value(data, name)
+    seen[f"data/{name}"] = value_digest(values)
+    return values
+
+
+def _waveform(values, preamble: dict, where: str) -> tuple:
+    """(channel, Waveform) of a channel's raw codes (or volts) and its preamble (with the
     channel's name and over-range flag)."""
     meta = dict(preamble)
     ch, overrange = meta.pop("channel"), meta.pop("overrange")
     unknown = set(meta) - {f.name for f in fields(Preamble)}
     if unknown:
         raise InstrumentError(f"{where}: channel {ch}: preamble.{sorted(unknown)[0]}: unknown key")
-    values = d[()]
-    if seen is not None:
-        seen[d.name.split("/", 2)[2]] = value_digest(values)  # "data/CH1", its row in the shot's table
     kind = "samples" if values.dtype.kind == "f" else "codes"  # volts from a file that held volts only
     return ch, Waveform(ch, Preamble(**meta), overrange=overrange, **{kind: values})
 
@@ -118,7 +130,7 @@ def _str(value) -> str:
 def _text(g, name: str, seen: dict | None = None) -> str:
     if name not in g:
         return ""
-    value = g[name][()]
+    value = member_value(g, name)
     if seen is not None:
         seen[name] = value_digest(value)
     return _str(value)

@@ -19,7 +19,7 @@ import json
 import re
 from typing import TYPE_CHECKING
 
-from .digest import TABLE, address, damage, linked_groups, sha
+from .digest import TABLE, address, damage, linked_groups, sha, table_text
 from .links import OpenParts
 from .members import expanded
 
@@ -173,8 +173,9 @@ def check(f: h5py.File) -> dict:
             shot_id = int(name.split("_", 1)[1])
             try:
                 g = parts.group(f, name)
-                found = named(damage(g, linked), f"/{name}")
-                for key in linked_groups(g, "/shared/"):
+                text = table_text(g)
+                found = named(damage(g, linked, text=text), f"/{name}")
+                for key in linked_groups(g, "/shared/", text):
                     users.setdefault(key, []).append(shot_id)
             except Exception as exc:  # noqa: BLE001
                 found = [f"unreadable ({_line(exc)})"]

@@ -132,3 +132,31 @@ def test_layout_3_grows_in_layout_3_until_upgraded_to_4(tmp_path):
         for ch, w in e.record.waveforms.items():
             assert np.array_equal(back.record[ch].codes, w.codes) and back.record[ch].preamble == w.preamble
     assert a.append([tiny_entry(10)]) == [6] and a.read(6).seed == 10
+
+
+def test_the_table_a_writer_seals_is_the_one_the_file_reads(tmp_path):
+    """Layout 4's writer makes a shot's table from what it writes, never walking the shot:
+    each row must be the one digest.table computes from the file (a hard-linked scene and
+    time axis, a scene stored by an earlier part, a shot alone, two time bases, volts)."""
+    import json
+
+    from instruments.archive.digest import stored_table, table
+    from instruments.archive.links import OpenParts
+    from instruments.archive.verify import addresses
+    from instruments.records import Preamble, ScopeRecord, Waveform
+
+    two_bases = tiny_entry(7)
+    slow = Preamble(points=50, x_increment=2e-6, x_zero=0.0, trigger_index=5, y_multiplier=1.0, y_offset=0.0,
+                    y_zero=0.0, y_unit="V")
+    waves = {**two_bases.record.waveforms, "CH3": Waveform("CH3", slow, samples=np.linspace(-1, 1, 50))}
+    two_bases.record = ScopeRecord(waves, True)
+    path = tmp_path / "a.h5"
+    a = Archive(path)
+    a.append([tiny_entry(1), tiny_entry(2), tiny_entry(3, truth=False), two_bases])
+    a.append([tiny_entry(5), tiny_entry(6, truth=False)])  # shot 5: its scene in the first part
+    with h5py.File(path, "r") as f, OpenParts() as parts:
+        linked = addresses(f["shared/scene_tiny"])
+        for n in sorted(k for k in f if k.startswith("shot_")):
+            g = parts.group(f, n)
+            assert json.loads(stored_table(g)) == table(g, linked), n
+    assert a.verify()["bad"] == [] and a.verify()["ok"] == 6
