@@ -18,19 +18,21 @@ import sys
 
 ANALYSIS, DEVICES = "instruments.analysis._kernels", "instruments.devices._kernels"  # the wings' kernel packages
 F1, F2 = "float64[::1]", "float64[:, ::1]"
-# the instruments' kernels a shot calls from Python: {module.kernel: its argument types}; the
-# analysis first (most of the compile time: numba compiles what a kernel calls with it)
-SHOT = {f"{ANALYSIS}.pulses.leading_pair": f"({F1}, {F1}, {F1}, float64, float64, UniTuple(float64, 7), {F1})",
-        f"{DEVICES}.acquisition.scope_shot": f"({F2}, float64, int64, float64, boolean, float64, int64, float64, "
-                                             f"{F1}, {F1}, {F1}, {F1}, {F2}, float64, float64, int8[:, ::1], "
-                                             f"boolean[::1], boolean[::1])",
-        f"{DEVICES}.acquisition.gauge_signal": f"({F1}, float64, float64, float64, float64, float64, float64, "
-                                               f"float64, {F1})",
-        f"{DEVICES}.acquisition.condition": f"({F1}, float64, {F1}, {F1})",
-        f"{DEVICES}.acquisition.samples_before_input": "(int64, float64, float64, float64)",
-        f"{ANALYSIS}.pulses.conditioned": f"({F1}, int64, float64, float64, float64)",
-        f"{ANALYSIS}.pulses.noise_level": f"({F1}, int64, float64)",
-        f"{ANALYSIS}.pulses.first_peak": f"({F1},)"}
+# the instruments' kernel a shot compiles aside: {module.kernel: its argument types}; its analysis (about
+# 10 s CPU on one core here: numba compiles what a kernel calls with it)
+SHOT = {f"{ANALYSIS}.pulses.leading_pair": f"({F1}, {F1}, {F1}, float64, float64, UniTuple(float64, 7), {F1})"}
+# the others a shot calls from Python, small (about 2.6 s in all): the command compiles them itself, after the
+# solver, while the side process is still at the analysis (listed for tests/compile_once.py)
+SHOT_SMALL = {f"{DEVICES}.acquisition.scope_shot": f"({F2}, float64, int64, float64, boolean, float64, int64, float64, "
+                                                   f"{F1}, {F1}, {F1}, {F1}, {F2}, float64, float64, int8[:, ::1], "
+                                                   f"boolean[::1], boolean[::1])",
+              f"{DEVICES}.acquisition.gauge_signal": f"({F1}, float64, float64, float64, float64, float64, float64, "
+                                                     f"float64, {F1})",
+              f"{DEVICES}.acquisition.condition": f"({F1}, float64, {F1}, {F1})",
+              f"{DEVICES}.acquisition.samples_before_input": "(int64, float64, float64, float64)",
+              f"{ANALYSIS}.pulses.conditioned": f"({F1}, int64, float64, float64, float64)",
+              f"{ANALYSIS}.pulses.noise_level": f"({F1}, int64, float64)",
+              f"{ANALYSIS}.pulses.first_peak": f"({F1},)"}
 B1, I1, I8 = "boolean[::1]", "int64[::1]", "int8[:, :, ::1]"
 F3 = "float64[:, :, ::1]"
 # and those a study's batches call (its nominal shot calls SHOT's): the acquisition and the analysis of many shots
@@ -41,9 +43,10 @@ STUDY = {f"{DEVICES}.acquisition.shots": f"(int64, int64, {I1}, {F3}, float64, {
                                          f"{I8}, boolean[:, ::1], {I1}, {F2}, {F3})",
          f"{ANALYSIS}.batch_analysis.analyse_range": f"(int64, int64, {I8}, {I1}, {F2}, float64, int64, {F1}, {F1}, "
                                                    f"{F1}, {I1}, "
-                                                   f"{F1}, {F1}, UniTuple(float64, 7), {F2}, {F2}, {B1})",
-         # the shots' drawn values (instruments/streams.spawned_draws)
-         "instruments._kernels.pcg64.spawned_draws": f"(uint64[::1], int64, {B1}, {I1}, {F2}, uint64[::1])"}
+                                                   f"{F1}, {F1}, UniTuple(float64, 7), {F2}, {F2}, {B1})"}
+# and the shots' drawn values, small: a study draws them first thing, so it compiles them itself (aside, it
+# would wait for them behind the solver's and the analysis' kernels)
+STUDY_SMALL = {"instruments._kernels.pcg64.spawned_draws": f"(uint64[::1], int64, {B1}, {I1}, {F2}, uint64[::1])"}
 
 
 def needs_compiling(kernels: dict) -> bool:

@@ -30,10 +30,10 @@ JOBS = ["instruments", "hertz", "thornton", "power", "kuwabara-kono"]
 def run_job(name: str) -> None:
     """Compile what job ``name`` stands for (module doc), in this process."""
     if name == "instruments":
-        from instruments.precompile import SHOT, STUDY, compile_now
+        from instruments.precompile import SHOT, SHOT_SMALL, STUDY, STUDY_SMALL, compile_now
         from rig.solver.cold import SIDE
 
-        compile_now({**SIDE, **SHOT, **STUDY})
+        compile_now({**SIDE, **SHOT, **SHOT_SMALL, **STUDY, **STUDY_SMALL})
         return
     from conftest import PTFE
 

@@ -255,8 +255,8 @@ def flag_lines(flags: dict) -> list:
 
 def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     """On a cold numba cache (a new install, a changed kernel): start compiling the
-    instruments' kernels of ``task`` ("shot" or "study") and a part of the solver's in a side
-    process while this one compiles the rest, and say so in one line on stderr when it is a
+    instruments' kernels of ``task`` ("shot" or "study"; a shot's with a part of the solver's)
+    in a side process while this one compiles the rest, and say so in one line on stderr when it is a
     terminal (a log or a test keeps a failure's one error line alone) and not ``quiet``.
     Nothing on a warm cache."""
     from instruments.precompile import SHOT, STUDY, start
@@ -265,7 +265,9 @@ def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     from rig.solver.kernels.ensemble import integrate_chunks
     from rig.solver.kernels.integrators import integrate
 
-    kernels = {**SIDE, **SHOT, **(STUDY if task == "study" else {})}
+    # a study compiles the batched solver too: the multirate head's flow is then this process's (the side
+    # process has the batches' acquisition and analysis), a shot's is the side process's
+    kernels = {**SHOT, **STUDY} if task == "study" else {**SIDE, **SHOT}
     cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_chunks)))
     aside = start(kernels)
     parts = (["the chain solver"] if cold_solver else []) + (["the instruments"] if aside else [])
