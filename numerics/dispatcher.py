@@ -17,6 +17,7 @@ values are dropped before numba types them, so the kernels they call are never c
 Hertz chain compiles no Thornton code). One copy per value used, the same operations on
 the branch taken (the same bits).
 """
+import os
 import time
 from dataclasses import dataclass
 
@@ -145,6 +146,11 @@ POLL_S = 0.05  # how often a kernel waiting for a side process looks into numba'
 def has_machine_code(dispatcher) -> bool:
     """Whether numba's on-disk cache holds machine code of ``dispatcher`` (a ``jit``
     kernel) for this machine and its current source, for any signature. True where numba
-    keeps no such cache (nothing to compile ahead then: a command compiles as it goes)."""
-    load_index = getattr(getattr(getattr(dispatcher, "_cache", None), "_cache_file", None), "_load_index", None)
-    return load_index is None or bool(load_index())
+    keeps no such cache (nothing to compile ahead then: a command compiles as it goes).
+    numba writes a new entry's index before its data file (each replaced whole), so an
+    entry counts once its data file is there too: a kernel that another process is saving
+    is not loaded (a miss, compiled again) in between."""
+    cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
+    if cache_file is None:
+        return True
+    return any(os.path.exists(cache_file._data_path(name)) for name in cache_file._load_index().values())
