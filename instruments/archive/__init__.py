@@ -75,6 +75,21 @@ class Archive:
         self._parts = OpenParts(kept=PARTS_KEPT)  # the parts read last, kept open
         self._reading = threading.Lock()  # one read at a time uses them
 
+    def close(self) -> None:
+        """Close the files kept open for reads (the master and the parts read last); the
+        next read opens them again. ``with Archive(path) as a:`` closes them at the end."""
+        with self._reading:
+            if self._master is not None:
+                self._master[1].close()
+                self._master = None
+            self._parts.close()
+
+    def __enter__(self) -> Archive:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
     # --- writing --------------------------------------------------------------------
     def append(self, entries) -> list:
         """Append shots in one transaction; returns their ids. All or nothing. An archive of

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from test_archive_flips import tiny_entry
 
-from instruments.archive import Archive
+from instruments.archive import Archive, raw_digest
 from instruments.archive.hashes import attribute_digest, value_digest
 from instruments.archive.values import attribute_names, attribute_value, dataset_value
 from instruments.errors import InstrumentError
@@ -80,3 +80,24 @@ def test_an_archive_read_again_sees_a_new_master_and_a_part_replaced_or_removed(
     with pytest.raises(InstrumentError, match="shot 1: .*data/CH1: damaged"):
         reader.read(1)
     assert reader.read(2).seed == 2
+
+
+def _open_under(folder: Path) -> list:
+    """The HDF5 files this process holds open under ``folder``."""
+    ids = h5py.h5f.get_obj_ids(h5py.h5f.OBJ_ALL, h5py.h5f.OBJ_FILE)
+    return [i.name for i in ids if Path(i.name.decode()).is_relative_to(folder)]
+
+
+def test_close_closes_the_files_a_read_kept_open_and_a_later_read_opens_them_again(tmp_path):
+    path = tmp_path / "a.h5"
+    with Archive(path) as a:
+        a.append([tiny_entry(1), tiny_entry(2)])
+        a.append([tiny_entry(3)])
+        first = a.read(1)
+        a.read(3)
+        assert len(_open_under(tmp_path)) >= 2  # the master and the parts of shots 1 and 3, kept for the next read
+    assert _open_under(tmp_path) == []
+    again = a.read(1)  # closed, then read: opened again
+    assert raw_digest(again.record) == raw_digest(first.record)
+    a.close()
+    assert _open_under(tmp_path) == []
