@@ -24,7 +24,8 @@ import numpy as np
 
 from ..errors import InstrumentError
 from ..records import ScopeRecord
-from .digest import attribute_digest, external_row, member_row, seal_rows
+from .addresses import external_row
+from .digest import attribute_digest, member_row, seal_rows
 from .entry import NAME, Entry, facts_json, jsonable, preamble_fields, raw_digest, raw_values
 from .layout import new_group, scene_group, store
 

@@ -18,7 +18,8 @@ import numpy as np
 
 from ..errors import InstrumentError
 from ..records import Preamble, ScopeRecord
-from .digest import address, seal, value_digest
+from .addresses import address
+from .digest import seal, value_digest
 from .entry import NAME, Entry, facts_json, preamble_json, raw_digest, raw_values, shared_name, texts
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened: Entry alone does not need it

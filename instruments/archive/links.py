@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import os
 
+from .addresses import external_link
 from .compact import LAYOUT4
-from .digest import external_link
 
 
 def file_identity(path) -> tuple | None:

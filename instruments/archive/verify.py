@@ -19,7 +19,8 @@ import json
 import re
 from typing import TYPE_CHECKING
 
-from .digest import TABLE, address, damage, linked_groups, sha, table_text
+from .addresses import address
+from .digest import TABLE, damage, linked_groups, sha, table_text
 from .links import OpenParts
 from .members import expanded
 
