@@ -12,6 +12,7 @@ then compiles that kernel itself); tests/cli/test_cold_start.py keeps them in st
 """
 from __future__ import annotations
 
+import atexit
 import importlib
 import subprocess
 import sys
@@ -56,20 +57,36 @@ def needs_compiling(kernels: dict) -> bool:
     return not all(has_machine_code(kernel(name)) for name in kernels)
 
 
-def start(kernels: dict) -> bool:
+def start(kernels: dict, then: dict | None = None) -> bool:
     """Start a side process compiling ``kernels`` ({module.kernel: argument types}, in this
-    order) when numba's cache lacks any; True when started (the caller may say so)."""
+    order) when numba's cache lacks any; True when started (the caller may say so). The
+    command waits for these when it needs them; ``then``, compiled after them, it does not
+    (it compiles them itself where it gets there first): kernels that it calls soon, small,
+    which a later command needs (a study's leaves the cache holding all a shot needs)."""
     from numerics.dispatcher import SIDE_COMPILES
 
     if not needs_compiling(kernels):
         return False
     side = subprocess.Popen([sys.executable, "-c", "import sys; from instruments.precompile import compile_now; "
                                                    "compile_now(dict(zip(sys.argv[1::2], sys.argv[2::2])))",
-                             *[x for item in kernels.items() for x in item]],
+                             *[x for item in {**kernels, **(then or {})}.items() for x in item]],
                             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     for name in kernels:
         SIDE_COMPILES[name] = side
+    atexit.register(finish, side)
     return True
+
+
+def finish(side: subprocess.Popen, wait_s: float = 30.0) -> None:
+    """At the command's exit: let the side process end its compiles (``then``'s may outlast
+    the command) for up to ``wait_s`` seconds, then stop it, so none outlives the command (a
+    stopped compile leaves numba's cache whole: each of its files is replaced whole, and
+    has_machine_code counts an entry once its data is there)."""
+    try:
+        side.wait(timeout=wait_s)
+    except subprocess.TimeoutExpired:
+        side.kill()
+        side.wait()
 
 
 def compile_now(kernels: dict) -> None:

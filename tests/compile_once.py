@@ -20,11 +20,12 @@ ROOT = Path(__file__).resolve().parents[1]
 # {job: the contact-law keywords of its chain}; "instruments" takes none
 LAWS = {"hertz": {}, "power": {"contact_exponent": 1.75},
         "kuwabara-kono": {"contact_law": "kuwabara-kono", "damping_time": 2e-6},
-        "thornton": {"contact_law": "thornton", "yield_force": 0.5}}
+        "thornton": {"contact_law": "thornton", "yield_force": 0.5},
+        "hertz, drag": {"drag": 0.05}}  # a Hertz chain with a dissipative flow: another copy (bundles.Holder.flows)
 # the jobs, the costliest first (they are dealt out in this order); a job compiles the
 # single-shot and the batched solver of its law, "instruments" a shot's and a study's
 # acquisition and analysis
-JOBS = ["instruments", "hertz", "thornton", "power", "kuwabara-kono"]
+JOBS = ["instruments", "hertz", "thornton", "power", "kuwabara-kono", "hertz, drag"]
 
 
 def run_job(name: str) -> None:

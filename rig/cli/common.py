@@ -259,7 +259,7 @@ def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     in a side process while this one compiles the rest, and say so in one line on stderr when it is a
     terminal (a log or a test keeps a failure's one error line alone) and not ``quiet``.
     Nothing on a warm cache."""
-    from instruments.precompile import SHOT, STUDY, start
+    from instruments.precompile import SHOT, SHOT_SMALL, STUDY, start
     from numerics.dispatcher import has_machine_code
     from rig.solver.cold import SIDE
     from rig.solver.kernels.ensemble import integrate_chunks
@@ -269,7 +269,7 @@ def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     # process has the batches' acquisition and analysis), a shot's is the side process's
     kernels = {**SHOT, **STUDY} if task == "study" else {**SIDE, **SHOT}
     cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_chunks)))
-    aside = start(kernels)
+    aside = start(kernels, then=SHOT_SMALL if task == "study" else None)  # so a shot after it compiles nothing
     parts = (["the chain solver"] if cold_solver else []) + (["the instruments"] if aside else [])
     if parts and not quiet and sys.stderr.isatty():
         print(f"rig {command}: numba is compiling {' and '.join(parts)}{' (in two processes)' if aside else ''}, "

@@ -87,3 +87,16 @@ def _bits(out):
     if isinstance(out, dict):
         return {k: _bits(v) for k, v in out.items() if k != "wall_s"}
     return [_bits(v) for v in out] if isinstance(out, list) else out
+
+
+def test_a_side_process_never_outlives_its_command():
+    """finish(), registered at exit by precompile.start: a side process that ends within the
+    wait is waited for (its compiles kept), one that does not is stopped."""
+    from instruments.precompile import finish
+
+    quick = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(0.2)"])
+    finish(quick, wait_s=30.0)
+    assert quick.returncode == 0
+    slow = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    finish(slow, wait_s=0.5)
+    assert slow.returncode is not None and slow.returncode != 0
