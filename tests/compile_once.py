@@ -34,7 +34,8 @@ def run_job(name: str) -> None:
         from instruments.precompile import SHOT, SHOT_SMALL, STUDY, STUDY_SMALL, compile_now
         from rig.solver.cold import SIDE
 
-        compile_now({**SIDE, **SHOT, **SHOT_SMALL, **STUDY, **STUDY_SMALL})
+        # the multirate head last: the other process's first law compiles it meanwhile, and this one loads it
+        compile_now({**SHOT, **SHOT_SMALL, **STUDY, **STUDY_SMALL, **SIDE})
         return
     from conftest import PTFE
 
