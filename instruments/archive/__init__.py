@@ -71,7 +71,7 @@ class Archive:
     def __init__(self, path):
         self.path = Path(path)
         self._sound_shared = {}  # {(file, shared group): (the file's identity, its addresses, its texts)}, intact
-        self._master: tuple | None = None  # (the file's identity, the master open for reading)
+        self._master = OpenParts(kept=1)  # the master open for reading, while it is the file at its path
         self._parts = OpenParts(kept=PARTS_KEPT)  # the parts read last, kept open
         self._reading = threading.Lock()  # one read at a time uses them
 
@@ -79,9 +79,7 @@ class Archive:
         """Close the files kept open for reads (the master and the parts read last); the
         next read opens them again. ``with Archive(path) as a:`` closes them at the end."""
         with self._reading:
-            if self._master is not None:
-                self._master[1].close()
-                self._master = None
+            self._master.close()
             self._parts.close()
 
     def __enter__(self) -> Archive:
@@ -269,13 +267,7 @@ class Archive:
         the next while the file at each path is the one it was opened from (links.OpenParts;
         an append puts a new master in place, which the next read opens)."""
         with self._reading:
-            identity = file_identity(self.path)
-            if self._master is not None and (identity is None or self._master[0] != identity):
-                self._master[1].close()
-                self._master = None
-            if self._master is None:
-                self._master = identity, self._open()
-            yield self._master[1], self._parts
+            yield self._master.file(str(self.path), self._open), self._parts
 
     def _check_shared(self, f, parts, g, with_truth: bool = True) -> tuple:
         """The tables of the shared groups the shot ``g`` links to (scene text and settings,

@@ -23,8 +23,9 @@ def file_identity(path) -> tuple | None:
 
 
 class OpenParts:
-    """The part files opened directly: the ``kept`` last used, each with the identity of the
-    file it was opened from; a context manager that closes them."""
+    """The part files opened directly (or an archive's master, Archive: one kept): the
+    ``kept`` last used, each with the identity of the file it was opened from; a context
+    manager that closes them."""
 
     def __init__(self, kept: int = 1):
         self.kept = kept
@@ -50,9 +51,9 @@ class OpenParts:
             return f[name]
         return self.file(os.path.join(os.path.dirname(f.file.filename), link.filename))[link.path]
 
-    def file(self, path: str):
+    def file(self, path: str, opener=None):
         """The part at ``path``, open (opened again where the file there is not the one it
-        was opened from)."""
+        was opened from); ``opener(path)`` opens it (default: h5py, read-only)."""
         import h5py
 
         identity = file_identity(path)
@@ -61,7 +62,7 @@ class OpenParts:
             held[1].close()
             held = None
         if held is None:
-            held = identity, h5py.File(path, "r")
+            held = identity, (opener or (lambda p: h5py.File(p, "r")))(path)
         self.files[path] = held
         while len(self.files) > self.kept:
             self.files.pop(next(iter(self.files)))[1].close()
