@@ -34,7 +34,8 @@ def checked_shot(g: h5py.Group, path, where: str, layout, shared: Shared | None,
     InstrumentError (``where`` first) naming the first damage."""
     if shared is None:
         return read_shot(g, path, with_truth, layout=layout)
-    e, seen = None, {}
+    e: Entry | None = None
+    seen: dict = {}  # the rows of what read_shot read, not read again by the check
     with contextlib.suppress(Exception):  # a damaged shot: the check says what
         e = read_shot(g, path, with_truth, seen=seen, layout=layout, scene=shared.scene, truth=shared.truth)
     problems = damage(g, shared.linked, read=returned_by_read(layout), known=seen if e is not None else {},
