@@ -114,8 +114,7 @@ class SharedGroups:
 
 def truth_forces(forces) -> dict:
     """{name: array in N} of a truth's ``forces`` group (NXdata; its time axis left out),
-    each array read-only: the reads of one scene's shots share them
-    (instruments/archive/shared.py)."""
+    each array read-only: the reads of one scene's shots share them (SharedGroups)."""
     axis = forces.attrs["axes"][0]
     out = {k: v[()] for k, v in forces.items() if k != axis}
     for values in out.values():
