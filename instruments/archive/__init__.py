@@ -33,7 +33,6 @@ left as it was.
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 import shutil
 import tempfile
@@ -46,16 +45,16 @@ from ..files import cause, folder_lock, hdf5_image
 from ..files import fsync as _fsync  # a name of this module's own: the crash tests stop a writer after it
 from .commit import commit_parts
 from .compact import LAYOUT4, LAYOUT4_TEXT
-from .digest import damage, linked_groups, table_text
 from .entry import Entry, raw_digest
 from .layout import LAYOUT as LAYOUT2_TEXT
 from .layout import LAYOUT_VERSION, write_entry
-from .links import OpenParts, file_identity, returned_by_read, truth_item
+from .links import OpenParts
 from .opening import check_archive_path, id_range, open_archive, stored_raw_digest
 from .parts import LAYOUT3, folder
-from .reader import read_entry, read_shot, summary_row
+from .reader import checked_shot, read_entry, read_shot, summary_row
+from .shared import SharedGroups
 from .values import attribute_or
-from .verify import addresses, check, root_seal, sealed_members, shot_names
+from .verify import check, root_seal, sealed_members, shot_names
 
 if TYPE_CHECKING:  # h5py itself is imported where a file is opened
     import h5py
@@ -70,7 +69,7 @@ class Archive:
 
     def __init__(self, path):
         self.path = Path(path)
-        self._sound_shared = {}  # {(file, shared group): (the file's identity, its addresses, its texts)}, intact
+        self._shared = SharedGroups()  # the shared groups found intact, by version of their file (shared.py)
         self._master = OpenParts(kept=1)  # the master open for reading, while it is the file at its path
         self._parts = OpenParts(kept=PARTS_KEPT)  # the parts read last, kept open
         self._reading = threading.Lock()  # one read at a time uses them
@@ -226,9 +225,11 @@ class Archive:
         """The stored shot as the same record objects the scope produces; with ``verify``,
         the checksums of what it returns first (all of the shot's table but what only its
         plot shows: the time axis, the plot's attributes; ``rig verify`` checks those) and
-        of what it shares. The shot is read from the part its master's link names, opened
-        directly; the master and the parts read last stay open for the next read, while the
-        files at their paths are those they were opened from."""
+        of what it shares (once per version of its file, instruments/archive/shared.py: the
+        truth's forces, read-only, shared by the reads of a scene's shots). The shot is read
+        from the part its master's link names, opened directly; the master and the parts read
+        last stay open for the next read, while the files at their paths are those they were
+        opened from."""
         import h5py
 
         with self._reader() as (f, parts):
@@ -240,26 +241,14 @@ class Archive:
             except Exception as exc:  # noqa: BLE001 - a missing or damaged part, one line
                 raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({cause(exc)})") from None
             try:
-                e = None
-                seen: dict = {}
                 layout = attribute_or(h5py.h5o.open(g.id, b"/"), "layout_version")  # of the file that holds it
-                if verify:  # read first: what it read is checked as read, not read again
-                    table, linked, scene = self._check_shared(f, parts, g, with_truth)
-                    with contextlib.suppress(Exception):  # a damaged shot: the check says what
-                        e = read_shot(g, self.path, with_truth, seen=seen, layout=layout, scene=scene)
-                    problems = damage(g, linked, read=returned_by_read(layout), known=seen if e is not None else {},
-                                      text=table)
-                    if problems:
-                        raise InstrumentError(f"{self.path}: shot {shot_id}: {problems[0]}")
-                e = e or read_shot(g, self.path, with_truth, layout=layout)
-                stored = (e.raw_sha256 or stored_raw_digest(g)) if verify else ""
+                where = f"{self.path}: shot {shot_id}"
+                shared = self._shared.check(f, parts, g, where, with_truth) if verify else None
+                return checked_shot(g, self.path, where, layout, shared, with_truth)
             except InstrumentError:
                 raise
             except Exception as exc:  # noqa: BLE001 - a damaged file, one line
                 raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({cause(exc)})") from None
-            if verify and raw_digest(e.record) != stored:
-                raise InstrumentError(f"{self.path}: shot {shot_id}: raw_sha256 does not match the raw data")
-            return e
 
     @contextlib.contextmanager
     def _reader(self):
@@ -268,43 +257,6 @@ class Archive:
         an append puts a new master in place, which the next read opens)."""
         with self._reading:
             yield self._master.file(str(self.path), self._open), self._parts
-
-    def _check_shared(self, f, parts, g, with_truth: bool = True) -> tuple:
-        """The tables of the shared groups the shot ``g`` links to (scene text and settings,
-        and the truth's forces where ``with_truth``; once per version of the file that holds
-        them: a part, never changed, or a layout-2 archive, replaced whole by each
-        transaction): a shot read without its truth is not refused for damaged truth forces,
-        which it does not read. (the shot's stored table as text, None where unreadable;
-        {address: path} of what it shares; the scene's texts ({"scene_text", "settings"}, as
-        stored) of the group that the shot's table links its own to, found intact, else None);
-        ``parts``: the OpenParts the shot was read through."""
-        linked: dict = {}
-        name, scene = f"{self.path}: shot {int(g.name.rsplit('_', 1)[1])}", None
-        text = table_text(g)
-        try:
-            sealed = json.loads(text or "{}")
-        except ValueError:  # damage() says what is wrong with it
-            sealed = {}
-        sealed = sealed if isinstance(sealed, dict) else {}
-        for key in sorted(linked_groups(g, "/shared/", text)):
-            s = parts.group(f["shared"], key)  # its part opened directly, as the shot's is
-            held = s.file.filename
-            identity = file_identity(held)
-            known = self._sound_shared.get((held, key))
-            if not (known and known[0] == identity):
-                here = addresses(s)
-                problems = damage(s, {})
-                read = problems if with_truth else [p for p in problems if not truth_item(p)]
-                if read:
-                    raise InstrumentError(f"{name}: shared/{key}/{read[0]}")
-                texts = {k: s[k][()].decode() for k in ("scene_text", "settings") if k in s}
-                known = (identity, here, texts)
-                if not problems:
-                    self._sound_shared[(held, key)] = known
-            linked.update(known[1])
-            if str(sealed.get("scene_text", "")).split(" in ")[0] == f"link:/shared/{key}/scene_text":
-                scene = known[2]
-        return text, linked, scene
 
     def verify(self) -> dict:
         """Check the whole archive: {"shots", "ok", "bad"}; each bad row names the shot

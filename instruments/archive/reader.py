@@ -1,9 +1,11 @@
 """Reading one NXentry of layout 2 or 3 (instruments/archive/layout.py) or of layout 4
 (instruments/archive/compact.py) back into the Entry it was written from: the same scope
-records (codes, preamble with its point format, channel names), facts and truth. The
-checksums are checked by the caller (instruments/archive/__init__.py)."""
+records (codes, preamble with its point format, channel names), facts and truth; and
+checked against its table of checksums and its raw data's SHA-256 (checked_shot), the shared
+groups it links to checked by the caller (instruments/archive/shared.py)."""
 from __future__ import annotations
 
+import contextlib
 import json
 from dataclasses import fields
 from typing import TYPE_CHECKING
@@ -11,34 +13,59 @@ from typing import TYPE_CHECKING
 from ..errors import InstrumentError
 from ..records import Preamble, ScopeRecord, Waveform
 from .compact import LAYOUT4
-from .digest import linked_groups
-from .entry import Entry
+from .digest import damage, linked_groups
+from .entry import Entry, raw_digest
 from .facts import ShotFacts
 from .hashes import attribute_digest, value_digest
+from .links import returned_by_read
+from .opening import stored_raw_digest
+from .shared import Shared, truth_forces
 from .values import attribute_value, dataset_value, member_value
 
 if TYPE_CHECKING:
     import h5py
 
 
+def checked_shot(g: h5py.Group, path, where: str, layout, shared: Shared | None, with_truth: bool = True) -> Entry:
+    """The Entry of the shot ``g`` (read_shot; ``layout``: of the file that holds it), and
+    where ``shared`` (what it links to, checked: shared.SharedGroups.check) is given, checked
+    first: the rows of its table that a read returns (links.returned_by_read), those of what
+    it read computed from the values read, not read again, and its raw data's SHA-256;
+    InstrumentError (``where`` first) naming the first damage."""
+    if shared is None:
+        return read_shot(g, path, with_truth, layout=layout)
+    e: Entry | None = None
+    seen: dict = {}  # the rows of what read_shot read, not read again by the check
+    with contextlib.suppress(Exception):  # a damaged shot: the check says what
+        e = read_shot(g, path, with_truth, seen=seen, layout=layout, scene=shared.scene, truth=shared.truth)
+    problems = damage(g, shared.linked, read=returned_by_read(layout), known=seen if e is not None else {},
+                      text=shared.table)
+    if problems:
+        raise InstrumentError(f"{where}: {problems[0]}")
+    e = e or read_shot(g, path, with_truth, layout=layout)
+    if raw_digest(e.record) != (e.raw_sha256 or stored_raw_digest(g)):
+        raise InstrumentError(f"{where}: raw_sha256 does not match the raw data")
+    return e
+
+
 def read_shot(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False, seen: dict | None = None,
-              layout=None, scene: dict | None = None) -> Entry:
+              layout=None, scene: dict | None = None, truth: dict | None = None) -> Entry:
     """The Entry of an NXentry of any current layout (the file that holds it says which, or
     ``layout`` where the caller has read it); ``seen`` and ``scene`` (layout 4): as for
-    read_compact_entry."""
+    read_compact_entry; ``truth``: as for read_entry."""
     if (g.file.attrs.get("layout_version") if layout is None else layout) == LAYOUT4:
-        return read_compact_entry(g, path, with_truth, keyed, {} if seen is None else seen, scene)
-    return read_entry(g, path, with_truth, keyed)
+        return read_compact_entry(g, path, with_truth, keyed, {} if seen is None else seen, scene, truth)
+    return read_entry(g, path, with_truth, keyed, truth)
 
 
 def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False,
-                       seen: dict | None = None, scene: dict | None = None) -> Entry:
+                       seen: dict | None = None, scene: dict | None = None, truth: dict | None = None) -> Entry:
     """The Entry of an NXentry of layout 4 (its checksums are checked by the caller);
     ``keyed`` as for read_entry; ``seen``: filled with {row key: row} (digest.table) of the
     metadata, texts and codes read, which the caller's check takes rather than read again;
     ``scene``: the texts of the shared group its scene_text and settings link to
     ({"scene_text", "settings"}, as stored), where the caller has read them from it: not read
-    again through the shot's links."""
+    again through the shot's links; ``truth``: as for read_entry."""
     shot_id = int(g.name.rsplit("_", 1)[1])
     where = f"{path}: shot {shot_id}"
     seen = {} if seen is None else seen
@@ -49,7 +76,7 @@ def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool
     waves = dict(_waveform(_codes(data, ch.replace("#", "_"), seen), p, where) for ch, p in meta["preambles"].items())
     record = ScopeRecord(dict(sorted(waves.items())), bool(meta["triggered"]), meta["no_trigger_reason"] or None)
     facts = ShotFacts.from_dict(meta["facts"], f"{where}: facts") if meta.get("facts") else None
-    truth = _forces(g["truth/forces"]) if with_truth and "truth" in g else None
+    truth = (truth or truth_forces(g["truth/forces"])) if with_truth and "truth" in g else None
     keys = sorted(k for k in linked_groups(g, "/shared/") if k.startswith("scene_")) if keyed else []
     texts = meta if "scene_text" in meta else scene or {k: _text(g, k) for k in ("scene_text", "settings")}
     scene_text = texts["scene_text"]
@@ -60,10 +87,11 @@ def read_compact_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool
                  meta["file_modification_time"], _text(g, "title", seen), meta.get("raw_sha256", ""))
 
 
-def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False) -> Entry:
+def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False, truth: dict | None = None) -> Entry:
     """The Entry of an NXentry of layout 2 (its checksums are checked by the caller); with
     ``keyed``, its truth_key that of the scene's shared group it links to (``rig upgrade``
-    keeps the shots of one scene sharing one group)."""
+    keeps the shots of one scene sharing one group); ``truth``: the forces of the shared
+    group its truth links to, where the caller has them (truth_forces): not read again."""
     shot_id = int(g.name.rsplit("_", 1)[1])
     where = f"{path}: shot {shot_id}"
     waves = {}
@@ -73,12 +101,11 @@ def read_entry(g: h5py.Group, path, with_truth: bool = True, keyed: bool = False
             waves[ch] = wave
     reason = _text(g, "no_trigger_reason")
     record = ScopeRecord(dict(sorted(waves.items())), bool(g["triggered"][()]), reason or None)
-    truth, facts = None, None
+    facts = None
     if "truth" in g:
         stored = json.loads(_text(g["truth"], "facts"))
         facts = ShotFacts.from_dict(stored, f"{where}: facts") if stored else None
-        if with_truth:
-            truth = _forces(g["truth/forces"])
+    truth = (truth or truth_forces(g["truth/forces"])) if with_truth and "truth" in g else None
     keys = sorted(k for k in linked_groups(g, "/shared/") if k.startswith("scene_")) if keyed else []
     return Entry(record, bool(g["simulated"][()]), int(g["seed"][()]) if "seed" in g else None,
                  _text(g, "scene"), _text(g, "scene_text"), json.loads(_text(g, "settings")), truth, facts,
@@ -114,11 +141,6 @@ def _waveform(values, preamble: dict, where: str) -> tuple:
         raise InstrumentError(f"{where}: channel {ch}: preamble.{sorted(unknown)[0]}: unknown key")
     kind = "samples" if values.dtype.kind == "f" else "codes"  # volts from a file that held volts only
     return ch, Waveform(ch, Preamble(**meta), overrange=overrange, **{kind: values})
-
-
-def _forces(forces) -> dict:
-    axis = forces.attrs["axes"][0]
-    return {k: v[()] for k, v in forces.items() if k != axis}
 
 
 def _str(value) -> str:

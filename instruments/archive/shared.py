@@ -1,0 +1,128 @@
+"""The shared groups a shot links to (``/shared/<key>``: its scene's text and settings, its
+truth's forces), checked once per version of the file that holds them.
+
+A scene's shared group lies in a part file, written once and never changed (layouts 3 and 4),
+or in a layout-2 archive, replaced whole by each transaction. A version of that file is told
+from another by links.file_identity (inode, size, modification time): the first read of a
+shot that links to a group checks the group's whole table of checksums; the next reads of
+the same version take what that read found (its objects' addresses, its scene texts and,
+for the truth, its forces) and read nothing of it again. A file replaced or damaged on disk
+(a new identity) is read and checked again before anything of it is returned.
+
+The forces are the bulk (a published scene's: 7 arrays of 30,001 float64, 1.7 MB, stored
+gzipped): those of the last ``FORCES_KEPT`` groups read are kept, read-only, and every read
+of one of them returns the same arrays in a dict of its own.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+
+from ..errors import InstrumentError
+from .digest import damage, linked_groups, table_text
+from .links import file_identity, truth_item
+from .verify import addresses
+
+FORCES_KEPT = 4  # the shared groups whose truth forces are kept (a published scene's: 1.7 MB each)
+
+
+@dataclass(frozen=True)
+class SoundGroup:
+    """A shared group found intact: the identity of the file it was checked in
+    (links.file_identity), {address: path} of its objects, its scene texts ({"scene_text",
+    "settings"}, as stored)."""
+
+    identity: tuple | None
+    addresses: dict
+    texts: dict
+
+
+@dataclass(frozen=True)
+class Shared:
+    """What a shot links to, checked: its stored table (text; None where unreadable),
+    {address: path} of the shared objects it links to, the scene texts of the group its own
+    scene_text links to (None where none, or not intact) and the truth's forces of the group
+    its truth links to ({name: read-only array in N}; None where not asked for or none)."""
+
+    table: str | None
+    linked: dict
+    scene: dict | None
+    truth: dict | None
+
+
+class SharedGroups:
+    """The shared groups an Archive's reads have checked, by (file, key): each checked once
+    per version of its file; the truth forces of the last ``kept`` read."""
+
+    def __init__(self, kept: int = FORCES_KEPT):
+        self.kept = kept
+        self.sound: dict = {}  # {(file, key): SoundGroup}
+        self.forces: dict = {}  # {(file, key): (the file's identity, {name: array})}, the last used last
+
+    def check(self, f, parts, g, where: str, with_truth: bool = True) -> Shared:
+        """The shared groups the shot ``g`` links to, each checked where its file is not the
+        version found intact before: a shot read without its truth is not refused for
+        damaged truth forces, which it does not read (InstrumentError, ``where`` first, for
+        the rest). ``f``: the archive's master (or layout-2 file); ``parts``: the
+        links.OpenParts the shot was read through."""
+        linked: dict = {}
+        scene, truth = None, None
+        text = table_text(g)
+        try:
+            sealed = json.loads(text or "{}")
+        except ValueError:  # damage() says what is wrong with it
+            sealed = {}
+        sealed = sealed if isinstance(sealed, dict) else {}
+        for key in sorted(linked_groups(g, "/shared/", text)):
+            s = parts.group(f["shared"], key)  # its part opened directly, as the shot's is
+            held = s.file.filename
+            sound = self._sound(s, (held, key), f"{where}: shared/{key}/", with_truth)
+            linked.update(sound.addresses)
+            if _links_to(sealed, "scene_text", key, "scene_text"):
+                scene = sound.texts
+            if with_truth and _links_to(sealed, "truth/forces", key, "forces"):
+                truth = self._forces(s, (held, key), sound.identity)
+        return Shared(text, linked, scene, truth)
+
+    def _sound(self, s, at: tuple, where: str, with_truth: bool) -> SoundGroup:
+        """The group ``s`` (at (file, key)), checked where its file is not the version found
+        intact before."""
+        identity = file_identity(at[0])
+        known = self.sound.get(at)
+        if known and known.identity == identity:
+            return known
+        problems = damage(s, {})
+        refused = problems if with_truth else [p for p in problems if not truth_item(p)]
+        if refused:
+            raise InstrumentError(f"{where}{refused[0]}")
+        known = SoundGroup(identity, addresses(s), {k: s[k][()].decode() for k in ("scene_text", "settings") if k in s})
+        if not problems:
+            self.sound[at] = known
+        return known
+
+    def _forces(self, s, at: tuple, identity) -> dict:
+        """The truth forces of the group ``s`` (at (file, key); the file's ``identity`` when it
+        was checked): read once per version of its file, the last ``kept`` groups' kept."""
+        held = self.forces.pop(at, None)
+        if held is None or held[0] is None or held[0] != identity:
+            held = identity, truth_forces(s["forces"])
+        self.forces[at] = held
+        while len(self.forces) > self.kept:
+            self.forces.pop(next(iter(self.forces)))
+        return dict(held[1])
+
+
+def truth_forces(forces) -> dict:
+    """{name: array in N} of a truth's ``forces`` group (NXdata; its time axis left out),
+    each array read-only: the reads of one scene's shots share them (SharedGroups)."""
+    axis = forces.attrs["axes"][0]
+    out = {k: v[()] for k, v in forces.items() if k != axis}
+    for values in out.values():
+        values.setflags(write=False)
+    return out
+
+
+def _links_to(sealed: dict, row: str, key: str, name: str) -> bool:
+    """Whether the shot's sealed table says its ``row`` is a link to ``/shared/<key>/<name>``
+    (in this file or, layouts 3 and 4, in another part)."""
+    return str(sealed.get(row, "")).split(" in ")[0] == f"link:/shared/{key}/{name}"
