@@ -2,9 +2,9 @@
 
 numba compiles a kernel on its first call, one kernel after the other in one process: a
 cold ``rig shot`` compiled the solver, then the gauges, the scope and the analysis. Much of
-that is independent, so on a cold cache a command starts a side process that compiles some
-of the kernels it needs (the instruments' below, a part of the solver's that rig.solver
-names) into numba's on-disk cache while the main process compiles the rest. When the main
+that is independent, so on a cold cache a command starts a side process that compiles the
+instruments' kernels it needs (below) into numba's on-disk cache while the main process
+compiles the chain solver. When the main
 process needs one of those kernels, called from Python or from a kernel it compiles, it
 waits until the cache holds it (numerics/dispatcher.py) and loads it from there. A
 signature that no longer matches what the command calls costs time only (the main process
@@ -22,8 +22,8 @@ F1, F2 = "float64[::1]", "float64[:, ::1]"
 # the instruments' kernel a shot compiles aside: {module.kernel: its argument types}; its analysis (about
 # 10 s CPU on one core here: numba compiles what a kernel calls with it)
 SHOT = {f"{ANALYSIS}.pulses.leading_pair": f"({F1}, {F1}, {F1}, float64, float64, UniTuple(float64, 7), {F1})"}
-# the others a shot calls from Python, small (about 2.6 s in all): the command compiles them itself, after the
-# solver, while the side process is still at the analysis (listed for tests/compile_once.py)
+# the others a shot calls from Python, small (about 2.6 s in all), compiled aside after the analysis: the
+# solver's compile (about 14 s) outlasts both
 SHOT_SMALL = {f"{DEVICES}.acquisition.scope_shot": f"({F2}, float64, int64, float64, boolean, float64, int64, float64, "
                                                    f"{F1}, {F1}, {F1}, {F1}, {F2}, float64, float64, int8[:, ::1], "
                                                    f"boolean[::1], boolean[::1])",

@@ -32,10 +32,8 @@ def run_job(name: str) -> None:
     """Compile what job ``name`` stands for (module doc), in this process."""
     if name == "instruments":
         from instruments.precompile import SHOT, SHOT_SMALL, STUDY, STUDY_SMALL, compile_now
-        from rig.solver.cold import SIDE
 
-        # the multirate head last: the other process's first law compiles it meanwhile, and this one loads it
-        compile_now({**SHOT, **SHOT_SMALL, **STUDY, **STUDY_SMALL, **SIDE})
+        compile_now({**SHOT, **SHOT_SMALL, **STUDY, **STUDY_SMALL})
         return
     from conftest import PTFE
 

@@ -255,19 +255,19 @@ def flag_lines(flags: dict) -> list:
 
 def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     """On a cold numba cache (a new install, a changed kernel): start compiling the
-    instruments' kernels of ``task`` ("shot" or "study"; a shot's with a part of the solver's)
-    in a side process while this one compiles the rest, and say so in one line on stderr when it is a
+    instruments' kernels of ``task`` ("shot" or "study") in a side process while this one
+    compiles the chain solver, and say so in one line on stderr when it is a
     terminal (a log or a test keeps a failure's one error line alone) and not ``quiet``.
     Nothing on a warm cache."""
     from instruments.precompile import SHOT, SHOT_SMALL, STUDY, start
     from numerics.dispatcher import has_machine_code
-    from rig.solver.cold import SIDE
     from rig.solver.kernels.ensemble import integrate_chunks
     from rig.solver.kernels.integrators import integrate
 
-    # a study compiles the batched solver too: the multirate head's flow is then this process's (the side
-    # process has the batches' acquisition and analysis), a shot's is the side process's
-    kernels = {**SHOT, **STUDY} if task == "study" else {**SIDE, **SHOT}
+    # this process: the chain solver (a shot's single-shot kernel, a study's batched one; about 14 s CPU on one
+    # core here); the side process: the analysis (10 s), then a shot's small kernels (2.6 s), or a study's
+    # batches' acquisition and analysis (13 s), then (not waited for) a shot's small kernels
+    kernels = {**SHOT, **STUDY} if task == "study" else {**SHOT, **SHOT_SMALL}
     cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_chunks)))
     aside = start(kernels, then=SHOT_SMALL if task == "study" else None)  # so a shot after it compiles nothing
     parts = (["the chain solver"] if cold_solver else []) + (["the instruments"] if aside else [])

@@ -54,9 +54,10 @@ from dataclasses import replace
 import numpy as np
 
 from rig.errors import RigError
+from rig.solver.ensemble import integrate_one
 from rig.solver.methods import Method
 from rig.solver.problem import ChainProblem
-from rig.solver.run import Unstable, integrate_at, time_grid
+from rig.solver.run import Unstable, time_grid
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import STATIC, Solution, Status, relative_error
 from rig.solver.stepsize import COARSEST_ACCURACY, Stepping, default_step, largest_step
@@ -91,7 +92,7 @@ def companion_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method
     if not save.names:
         return None, "nothing recorded"
     companion = Stepping(sol.stats.dt_s / COMPANION, stepping.head, stepping.inner_dt / COMPANION)
-    comp = integrate_at(problem, t_end, SaveAt(save.probes, save.sample_interval), m, companion)
+    comp = integrate_one(problem, t_end, SaveAt(save.probes, save.sample_interval), m, companion)
     return (comp, "companion at dt/2") if comp.success else (None, "the companion at dt/2 was unstable")
 
 
@@ -122,7 +123,7 @@ def estimated_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Method
                     estimate: bool = True) -> Solution:
     """One solve at ``stepping``, with its companion estimate unless ``estimate`` is False."""
     t0 = time.process_time()
-    sol = Unstable.check(integrate_at(problem, t_end, save, m, stepping), stepping)
+    sol = Unstable.check(integrate_one(problem, t_end, save, m, stepping), stepping)
     est, basis = companion_estimate(problem, t_end, save, m, stepping, sol) if estimate else (None, "not asked")
     return with_estimate(sol, est, basis, 1, time.process_time() - t0)
 
@@ -144,7 +145,7 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
     tried = []  # (solution, estimate, basis)
     for _ in range(MAX_ATTEMPTS):
         stepping = Stepping(dt, first.head, first.inner_dt * dt / first.dt)
-        sol = integrate_at(problem, t_end, save, m, stepping, accuracy)
+        sol = integrate_one(problem, t_end, save, m, stepping, accuracy)
         if not sol.success:
             spent += time_grid(t_end, dt, t_end)[0]
             dt *= 0.5

@@ -7,8 +7,10 @@ same numbers to the last bit.
 """
 from __future__ import annotations
 
+import contextlib
 import functools
 import time
+from contextvars import ContextVar
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,13 +18,18 @@ import numpy as np
 from rig.errors import RigError, invalid
 from rig.solver.kernels.ensemble import integrate_ensemble
 from rig.solver.kernels.report import DIAGNOSTICS, ENERGY_ERROR, STATUS
-from rig.solver.methods import DEFAULT_METHOD
+from rig.solver.methods import DEFAULT_METHOD, Method
 from rig.solver.methods import method as get_method
-from rig.solver.problem import ProblemArrays
-from rig.solver.run import check_record, kernel_inputs, time_grid
+from rig.solver.problem import ChainProblem, ProblemArrays
+from rig.solver.run import check_record, integrate_at, kernel_inputs, time_grid
 from rig.solver.saveat import SaveAt
-from rig.solver.solution import KernelReport, SolverStats, Status
+from rig.solver.solution import KernelReport, Solution, SolverStats, Status
 from rig.solver.stepsize import Stepping
+
+ONE_SHOT_KERNEL: ContextVar[str] = ContextVar("one_shot_kernel", default="single")
+"""The kernel that integrates one shot in this thread (``integrate_one``): "single"
+(kernels/integrators.py) or "batched" (kernels/ensemble.py, as a batch of one; set by
+``solved_as_batches``)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,6 +92,54 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
     (default: the batch shared out over numba's threads, 8 to 128: wider chunks spread each
     row's loop overhead over more shots, and 128 shots of a 53-body chain still fit the
     core's L2 cache). A shot that blows up is reported so (its report's status), not raised."""
+    return _integrated(problems, t_end, save, dt, method, width)[0]
+
+
+def integrate_one(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, stepping: Stepping,
+                  accuracy: float | None = None) -> Solution:
+    """``run.integrate_at``'s Solution, from the kernel this thread's solves of one shot take
+    (ONE_SHOT_KERNEL): the batched kernel as a batch of one where it can take the shot (no
+    frames, no force schedule), else the single-shot kernel. The same bits either way."""
+    if ONE_SHOT_KERNEL.get() == "batched" and save.frame_interval is None and not problem.sched_t.size:
+        return batch_of_one(problem, t_end, save, m, stepping, accuracy)
+    return integrate_at(problem, t_end, save, m, stepping, accuracy)
+
+
+def batch_of_one(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, stepping: Stepping,
+                 accuracy: float | None = None) -> Solution:
+    """``run.integrate_at``'s Solution of ``problem`` from the batched kernel, as a batch of
+    one shot (a chunk of width 1; no frames, no force schedule): the same records and final
+    state to the last bit (module doc); one that blows up returned so (its status), as
+    integrate_at's. What a study's solves of one shot use (``solved_as_batches``)."""
+    sol, u, v = _integrated([problem], t_end, save, stepping, m.name, 1)
+    report = sol.reports[0]
+    detail = "" if report.status is Status.SUCCESS else \
+        f" (near t = {report.end_time_s:.4g} s, dt = {sol.dt:.4g} s, method {m.name})"
+    stats = SolverStats(m.name, sol.dt, sol.steps, sol.steps * m.force_evaluations, sol.wall_s,
+                        report.energy_error, report.momentum_error, report.wall_impulse_Ns, accuracy,
+                        dissipated_energy_J=report.dissipated_energy_J, bodies_stepped=report.bodies_stepped)
+    moving = slice(0, problem.n_bodies - (1 if problem.wall_slot else 0))
+    return Solution(dict(zip(save.names, sol.records[0])), save.sample_interval, None, None,
+                    u[0, moving, 0].copy(), v[0, moving, 0].copy(), stats, problem, report.status, detail)
+
+
+@contextlib.contextmanager
+def solved_as_batches():
+    """Within it, this thread's solves of one shot that the batched kernel can take (no
+    frames, no force schedule) run through it as a batch of one (``batch_of_one``; the same
+    bits): a study, which compiles the batched kernel for its shots, then compiles (or
+    loads) no single-shot kernel for its nominal solves."""
+    token = ONE_SHOT_KERNEL.set("batched")
+    try:
+        yield
+    finally:
+        ONE_SHOT_KERNEL.reset(token)
+
+
+def _integrated(problems, t_end: float, save: SaveAt, dt: float | Stepping, method: str,
+                width: int | None) -> tuple:
+    """(EnsembleSolution, u, v): solve_ensemble's, and the final displacements (m) and
+    velocities (m/s) as (chunks, bodies, width)."""
     if not isinstance(problems, ProblemArrays):
         if not problems:
             raise invalid("problems", [], "at least one shot")
@@ -124,4 +179,4 @@ def solve_ensemble(problems, t_end: float, *, save: SaveAt, dt: float | Stepping
     integrate_ensemble(u, v, k.chain, k.contacts, k.holder, k.method, k.record, k.checks, diag)
     wall = time.perf_counter() - t0
     diag = np.ascontiguousarray(np.moveaxis(diag, 0, -2).reshape(DIAGNOSTICS, n_chunks * width)[:, :n])
-    return EnsembleSolution(out, save.sample_interval, step, n_steps, wall, m.name, diag, save.names)
+    return EnsembleSolution(out, save.sample_interval, step, n_steps, wall, m.name, diag, save.names), u, v

@@ -5,7 +5,9 @@ and the template rig whose parts the shots take over.
 One cache (``nominal``) keeps these per (scene, overrides) in a process; the values are
 computed on first use, from the nominal scene's noise-free solution and from its nominal
 shot (``nominal_trigger_time``: the one shot a study fires outside its design, with the
-instrument draws of NOMINAL_SEED).
+instrument draws of NOMINAL_SEED). Each of these solves runs through the batched kernel
+that the study's shots take, as a batch of one (rig.solver.ensemble.solved_as_batches; the
+same bits as the single-shot kernel): a study compiles and loads one chain kernel.
 """
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from dataclasses import dataclass
 from rig.experiment import scene as scene_io
 from rig.experiment.measure import leading_end, midway_static_force
 from rig.experiment.shot import Rig
+from rig.solver.ensemble import solved_as_batches
 
 NOMINAL_SEED = 0
 """The seed of the nominal shot's instrument draws (gains, misalignments, noise, the scope's
@@ -44,7 +47,8 @@ class Nominal:
     def calibration(self) -> tuple:
         """(beta, F_0 in N) of the nominal numerics: what an experimenter applies to every
         shot (each shot's own truth is unknown to the analysis)."""
-        return self.rig.truth_analysis().beta, midway_static_force(self.rig)
+        with solved_as_batches():
+            return self.rig.truth_analysis().beta, midway_static_force(self.rig)
 
     @property
     def record_window(self) -> Window:
@@ -63,8 +67,9 @@ class Nominal:
         the record's end) or no trigger."""
         rig = self.rig
         tb, pre = rig.scope.timebase, rig.scope.trigger.pre_trigger
-        end = leading_end(rig.truth_analysis())
-        trigger = nominal_trigger_time(rig)
+        with solved_as_batches():
+            end = leading_end(rig.truth_analysis())
+            trigger = nominal_trigger_time(rig)
         if end is None or trigger is None:
             return self.record_window
         duration = min(rig.solver.duration, end)
@@ -89,8 +94,9 @@ class Nominal:
             from rig.solver.solve import solve
 
             rig = self.template(kind)
-            self._pilots[key] = solve(ChainProblem.from_chain(rig.chain), rig.solver.duration, save=save,
-                                      method=rig.solver.method, accuracy=accuracy or rig.solver.accuracy)
+            with solved_as_batches():
+                self._pilots[key] = solve(ChainProblem.from_chain(rig.chain), rig.solver.duration, save=save,
+                                          method=rig.solver.method, accuracy=accuracy or rig.solver.accuracy)
         return self._pilots[key]
 
     def template(self, kind: str) -> Rig:

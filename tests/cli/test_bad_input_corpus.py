@@ -275,7 +275,7 @@ def no_solve(monkeypatch):
     def trap(*args, **kwargs):
         raise AssertionError("solved: a bad input must be refused before any solve")
 
-    monkeypatch.setattr(rig.solver.control, "integrate_at", trap)
+    monkeypatch.setattr(rig.solver.control, "integrate_one", trap)
     for module in (rig.fit.evaluate, rig.study.batch):
         monkeypatch.setattr(module, "solve_ensemble", trap)
 

@@ -244,7 +244,7 @@ def test_an_archive_or_export_path_of_the_wrong_kind_is_named_before_the_shot(tm
     def trap(*a, **k):
         raise AssertionError("solved before refusing the output path")
 
-    monkeypatch.setattr(rig.solver.control, "integrate_at", trap)
+    monkeypatch.setattr(rig.solver.control, "integrate_one", trap)
     a_file = tmp_path / "notes.txt"
     a_file.write_text("x")
     for argv, words in ((["shot", "ptfe52_magnetic", "--out", str(tmp_path)], "--out"),

@@ -1,5 +1,5 @@
 """A cold start: the first `rig shot` with an empty numba cache says in one line what it
-compiles, compiles the instruments' kernels and a part of the solver's in a side process
+compiles, compiles the instruments' kernels in a side process
 (instruments/precompile.py) and gives the bits of a warm shot; the side process compiles
 exactly the signatures the shot calls (else the main process would compile them again, and
 the side process be waste); a Hertz shot compiles no other law's code (the law reaches the
@@ -21,10 +21,10 @@ SHOT_ARGS = ["shot", "ptfe52_magnetic", "--seed", "1", "--json"]
 # a cold shot in a fresh process, then the side kernels the main process did not load from numba's cache
 # (it compiled them itself, or compiled another copy: a signature out of step), then the Thornton
 # law's kernels it compiled
-COLD_SHOT = ("import json\nfrom instruments.precompile import SHOT, kernel\nfrom rig.cli import main\n"
-             "from rig.model.laws import thornton\nfrom rig.solver.cold import SIDE\ncode = main({argv!r})\n"
-             "print(json.dumps(sorted(n for n in {{**SIDE, **SHOT}} if sum(kernel(n).stats.cache_misses.values())\n"
-             "                        or len(kernel(n).signatures) != 1)))\n"
+COLD_SHOT = ("import json\nfrom instruments.precompile import SHOT, SHOT_SMALL, kernel\nfrom rig.cli import main\n"
+             "from rig.model.laws import thornton\ncode = main({argv!r})\n"
+             "print(json.dumps(sorted(n for n in {{**SHOT, **SHOT_SMALL}}\n"
+             "    if sum(kernel(n).stats.cache_misses.values()) or len(kernel(n).signatures) != 1)))\n"
              "print(json.dumps(sorted(n for n, f in vars(thornton).items() if getattr(f, 'signatures', None))))\n"
              "from rig.solver.kernels import dissipation\n"
              "print(json.dumps(sorted(n for n, f in vars(dissipation).items() if getattr(f, 'signatures', None))))")
@@ -37,10 +37,17 @@ def test_the_side_process_compiles_the_signatures_a_shot_calls_from_python(capsy
         assert kernel(name).signatures == [normalize_signature(signature)[0]], name
 
 
-def test_the_side_process_compiles_the_signatures_a_study_calls_from_python(tmp_path):
+def test_the_side_process_compiles_the_signatures_a_study_calls_from_python(tmp_path, monkeypatch):
+    """And a study calls no single-shot kernel: its nominal solves run through the batched
+    kernel (rig.solver.ensemble.solved_as_batches), so a cold study compiles one chain kernel."""
+    from rig.solver import run
+
+    single = []
+    monkeypatch.setattr(run, "integrate", lambda *args: single.append(args))
     compile_now({**STUDY, **STUDY_SMALL})
     assert main(["mc", "ptfe52_magnetic", "--vary", "striker.velocity=normal(0.89 m/s, 0.01 m/s)", "--shots", "4",
                  "--batch", "4", "--out", str(tmp_path / "study"), "--quiet"]) in (0, None)
+    assert single == []
     for name, signature in {**STUDY, **STUDY_SMALL}.items():
         assert kernel(name).signatures == [normalize_signature(signature)[0]], name
 

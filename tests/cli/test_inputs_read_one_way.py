@@ -86,7 +86,7 @@ def test_a_sweep_of_a_gauge_bead_fires_each_point_and_says_why_a_point_has_no_fi
 def test_a_setting_that_can_give_no_record_names_itself_before_anything_is_solved(capsys, monkeypatch, item, line):
     import rig.solver.control
 
-    monkeypatch.setattr(rig.solver.control, "integrate_at", lambda *a, **k: pytest.fail("solved"))
+    monkeypatch.setattr(rig.solver.control, "integrate_one", lambda *a, **k: pytest.fail("solved"))
     assert main(["shot", S, "--set", item]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and line in err, err

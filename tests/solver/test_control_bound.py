@@ -62,7 +62,7 @@ def test_the_control_spends_at_most_its_work_budget(monkeypatch):
                                             "chain.contact_damping=0.4", "solver.accuracy=1e-6"])
     p, m, s = ChainProblem.from_chain(rig.chain), method(rig.solver.method), rig.solver
     steps = []
-    solve_at = control.integrate_at
+    solve_at = control.integrate_one
 
     def counted(*args, **kw):
         sol = solve_at(*args, **kw)
@@ -70,7 +70,7 @@ def test_the_control_spends_at_most_its_work_budget(monkeypatch):
         return sol
 
     monkeypatch.setattr(control, "WORK_BUDGET", 64.0)
-    monkeypatch.setattr(control, "integrate_at", counted)
+    monkeypatch.setattr(control, "integrate_one", counted)
     with pytest.raises(AccuracyNotReached, match=r"accuracy = 1e-06: not reached; .*its work budget \(64 solves"):
         control.controlled_solve(p, s.duration, rig.save_at(), m, s.accuracy)
     first = time_grid(s.duration, default_step(p, m, s.accuracy, s.duration).dt, s.duration)[0]

@@ -42,3 +42,34 @@ def test_ensemble_refuses_mixed_topologies_and_schedules():
     sched = ptfe_rig(n=20, top_force=ForceSchedule((0, 1e-4), (2.38, 3.0)))
     with pytest.raises(RigError, match="constant loads only"):
         solve_ensemble([ChainProblem.from_chain(sched)], 1e-4, save=SAVE, dt=1e-7)
+
+
+def test_a_solve_within_solved_as_batches_is_the_single_shot_solve_to_the_last_bit():
+    """A study's solves of one shot (rig/study/nominal.py) run through the batched kernel as a
+    batch of one: the accuracy control's choice, the records, the final state and the report
+    as the single-shot kernel's; a solve it cannot take (frames) stays the single kernel's."""
+    from rig.solver import ensemble
+
+    p = _problems(1)[0]
+    single = solve(p, 0.8e-3, save=SAVE)
+    calls = []
+    batched = ensemble.batch_of_one
+
+    def counted(*args, **kw):
+        calls.append(args[0])
+        return batched(*args, **kw)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(ensemble, "batch_of_one", counted)
+        with ensemble.solved_as_batches():
+            as_batch = solve(p, 0.8e-3, save=SAVE)
+            assert len(calls) == as_batch.stats.attempts * 2  # each try of the accuracy control and its companion
+            framed = solve(p, 0.2e-3, save=record_contacts(ptfe_rig(n=20), 5, frame_interval=1e-5))
+            assert ensemble.ONE_SHOT_KERNEL.get() == "batched" and framed.frames is not None
+        assert ensemble.ONE_SHOT_KERNEL.get() == "single"
+    assert as_batch.stats.dt_s == single.stats.dt_s and as_batch.stats.error_estimate == single.stats.error_estimate
+    for name, f in single.forces.items():
+        assert np.array_equal(as_batch.forces[name], f), name
+    assert np.array_equal(as_batch.final_u, single.final_u) and np.array_equal(as_batch.final_v, single.final_v)
+    assert as_batch.stats.energy_error == single.stats.energy_error
+    assert as_batch.stats.bodies_stepped == single.stats.bodies_stepped
