@@ -170,7 +170,8 @@ def spawned_draws(run_entropy, first, uniform, counts, raw, heads):
     four (uint64 array), i < 2^32."""
     n = run_entropy.shape[0]
     entropy = np.empty(n + 1, np.uint64)
-    entropy[:n] = run_entropy
+    for i in range(n):  # element by element: numba's array slice assignment compiles its error message
+        entropy[i] = run_entropy[i]
     for s in range(raw.shape[0]):
         entropy[n] = U(first + s)
         st, heads[s] = seeded_by(entropy)

@@ -122,7 +122,8 @@ def at_rest_before(v, rest_sd, z_rest):
     out = np.empty(n_pad + v.shape[0])
     for k in range(n_pad):
         out[k] = rest_sd * z_rest[k] if rest_sd > 0.0 else v[0]
-    out[n_pad:] = v
+    for k in range(v.shape[0]):  # element by element: numba's array slice assignment compiles its error message
+        out[n_pad + k] = v[k]
     return out
 
 
@@ -152,7 +153,9 @@ def one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wi
                 v = at_rest_before(v, noise_sd[g], z_rest[g])
         else:
             v = np.zeros(n)
-        analog[c] = condition(v, probe[c], ac[c], lowpass[c])
+        conditioned = condition(v, probe[c], ac[c], lowpass[c])
+        for k in range(conditioned.shape[0]):  # element by element: numba's row assignment compiles its error message
+            analog[c, k] = conditioned[k]
     st, t_cross, x_zero = scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult, yoff, sd,
                                      z_scope, lo, hi, codes, over, read)
     return st, t_cross - n_pad * h, x_zero

@@ -270,8 +270,11 @@ def _chunk(u, v, mass, invm, bias, load, A, d0, law, con, state, onsite, slip, v
         if law == PLASTIC:  # the contacts' memory renewed at the step's end, after its records
             plastic_commit(u, v, invm, f, A, d0, con, state, pending, head, -1, 0.0, dt, reach, every)
         j_out = j_end
-        d_old[:, :, :] = d_new
-        r_old[:, :, :] = r_new
+        for c in range(d_old.shape[0]):  # element by element: numba's array slice assignment compiles its error message
+            for q in range(d_old.shape[1]):
+                for s in range(W):
+                    d_old[c, q, s] = d_new[c, q, s]
+                    r_old[c, q, s] = r_new[c, q, s]
         if check:
             state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, state, e, pn, worst)
             for s in range(u.shape[1]):

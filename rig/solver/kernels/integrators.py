@@ -172,7 +172,8 @@ def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks
     u_old = np.empty(nb if n_frames > 0 else 0)
     v_old = np.empty(nb if n_frames > 0 else 0)
     if n_frames > 0:
-        frames[0, :] = u
+        for i in range(nb):  # element by element: numba's array slice assignment compiles its error message
+            frames[0, i] = u[i]
     j_frame = 1
 
     e_err = 0.0
@@ -184,8 +185,9 @@ def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks
     for n in range(n_steps):
         t = n * dt
         if n_frames > 0:
-            u_old[:] = u
-            v_old[:] = v
+            for i in range(nb):
+                u_old[i] = u[i]
+                v_old[i] = v[i]
         us_old = 0.0
         fe_old = 0.0
         if has_sched:

@@ -159,12 +159,14 @@ def _resolved_substeps(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, n, s
         if not _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, busy, changed, closed,
                         saved[0]):
             continue
-        fine[:] = changed
+        for s in range(W):  # element by element: numba's array slice assignment compiles its error message
+            fine[s] = changed[s]
         for _ in range(REFINE):
             if not _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k / REFINE, pending, fine, changed,
                             closed, saved[1]):
                 continue
-            finest[:] = changed
+            for s in range(W):
+                finest[s] = changed[s]
             kk = k / REFINE / REFINE
             for _ in range(REFINE):
                 _lane_substep(u, v, invm, f, A, d0, load, head, a_coef, b_coef, kk, pending, finest, changed, closed)
