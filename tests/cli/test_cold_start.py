@@ -20,14 +20,23 @@ SHOT_ARGS = ["shot", "ptfe52_magnetic", "--seed", "1", "--json"]
 
 # a cold shot in a fresh process, then the side kernels the main process did not load from numba's cache
 # (it compiled them itself, or compiled another copy: a signature out of step), then the Thornton
-# law's kernels it compiled
+# law's kernels it compiled, the dissipation's, and the numba functions it compiled that format text
 COLD_SHOT = ("import json\nfrom instruments.precompile import SHOT, SHOT_SMALL, kernel\nfrom rig.cli import main\n"
+             "from numba.core import event\ncompiled = set()\n"
+             "class Compiled(event.Listener):\n"
+             "    def on_start(self, ev):\n"
+             "        f = ev.data['dispatcher'].py_func\n"
+             "        compiled.add(f'{{f.__module__}}.{{f.__qualname__}}')\n"
+             "    def on_end(self, ev):\n"
+             "        pass\n"
+             "event.register('numba:compile', Compiled())\n"
              "from rig.model.laws import thornton\ncode = main({argv!r})\n"
              "print(json.dumps(sorted(n for n in {{**SHOT, **SHOT_SMALL}}\n"
              "    if sum(kernel(n).stats.cache_misses.values()) or len(kernel(n).signatures) != 1)))\n"
              "print(json.dumps(sorted(n for n, f in vars(thornton).items() if getattr(f, 'signatures', None))))\n"
              "from rig.solver.kernels import dissipation\n"
-             "print(json.dumps(sorted(n for n, f in vars(dissipation).items() if getattr(f, 'signatures', None))))")
+             "print(json.dumps(sorted(n for n, f in vars(dissipation).items() if getattr(f, 'signatures', None))))\n"
+             "print(json.dumps(sorted(n for n in compiled if 'unicode' in n or 'shape_context' in n)))")
 
 
 def test_the_side_process_compiles_the_signatures_a_shot_calls_from_python(capsys):
@@ -59,10 +68,12 @@ def test_a_cold_shot_says_what_it_compiles_once_compiles_nothing_twice_and_has_t
     lines = said.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("rig shot: numba is compiling the chain solver and the "
                                                    "instruments (in two processes)"), said
-    *shot, compiled_twice, thornton, dissipation = cold.stdout.strip().splitlines()
+    *shot, compiled_twice, thornton, dissipation, text = cold.stdout.strip().splitlines()
     assert json.loads(compiled_twice) == []
     assert json.loads(thornton) == []  # the scene's contacts are Hertz's
     assert "dissipate" not in json.loads(dissipation)  # and without flows (bundles.Holder.flows)
+    # no array assigned to a slice: numba would compile the shape-mismatch message's formatting (about 1.5 s)
+    assert json.loads(text) == []
     assert _bits(json.loads("\n".join(shot))) == _bits(json.loads(warm.stdout))
     again, said = _on_a_terminal([sys.executable, "-m", "rig.cli", *SHOT_ARGS],
                                  dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path)))
