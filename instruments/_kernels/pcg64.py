@@ -91,10 +91,10 @@ def standard_normal(st):
 
 @jit(nogil=True)
 def normals(st, out):
-    """Fill out (float64, any shape, contiguous) with standard normals from state st."""
-    flat = out.reshape(-1)
-    for i in range(flat.shape[0]):
-        flat[i] = standard_normal(st)
+    """Fill out (float64[::1]; an array of more axes as its flat view, reshape(-1): one
+    compiled copy, about 0.8 s each) with standard normals from state st."""
+    for i in range(out.shape[0]):
+        out[i] = standard_normal(st)
 
 
 @jit(inline="always")

@@ -191,7 +191,7 @@ def shot_draws(st, calibration_error, misalignment_sd, noisy, draws, z_gauge, ph
             pcg64.normals(st, z_gauge[k])
     phase = 0.0 + phase_span * pcg64.next_double(st)  # Generator.uniform(0, span): low + span x random
     if scope_noisy:
-        pcg64.normals(st, z_scope)
+        pcg64.normals(st, z_scope.reshape(-1))
     return phase
 
 
