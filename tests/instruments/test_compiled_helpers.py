@@ -11,6 +11,7 @@ from instruments._kernels.filters import one_pole, undo_highpass
 from instruments.analysis._kernels.parabola import parabola
 from instruments.analysis._kernels.peaks import local_maxima, thin_by_distance, widths_at
 from instruments.analysis._kernels.prominence import prominence_bases, prominent
+from instruments.analysis._kernels.select import kept, stable_order, taken
 from instruments.devices._kernels.quantiser import quantise
 from instruments.devices._kernels.resample import at_positions
 
@@ -246,3 +247,20 @@ def test_front_end_is_its_filters_one_after_another(probe):
         if not math.isnan(lp[2]):
             x = lfilter(lp[:2], [1.0, lp[2]], x - x[0]) + x[0]
         assert _same_bits(condition(v, probe, a, lp), x * probe)
+
+
+def test_the_selection_loops_are_numpys_indexing_and_stable_argsort():
+    """kept, taken and stable_order (the analysis' selections as loops) against a[keep],
+    a[idx] and np.argsort(kind="stable"), with ties (plateaus of equal heights, -0.0 beside
+    0.0) and the empty and one-element cases."""
+    rng = np.random.default_rng(11)
+    for n in [0, 1, 2, 3, 7, 8, 9, 64, 257]:
+        for values in (rng.standard_normal(n), rng.integers(0, 4, n).astype(float),
+                       rng.choice([-0.0, 0.0, 1.0], n)):
+            order = stable_order(values)
+            assert order.dtype == np.int64 and np.array_equal(order, np.argsort(values, kind="stable")), (n, values)
+            keep = rng.random(n) < 0.4
+            idx = rng.integers(0, max(n, 1), n // 2) if n else np.empty(0, np.int64)
+            assert _same_bits(kept(values, keep), values[keep])
+            assert np.array_equal(kept(np.arange(n), keep), np.arange(n)[keep])
+            assert _same_bits(taken(values, idx), values[idx])

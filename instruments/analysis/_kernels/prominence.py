@@ -21,6 +21,8 @@ import numpy as np
 
 from numerics.jit import jit
 
+from .select import kept, taken
+
 
 @jit
 def _left_bases(x, floor, base):
@@ -122,14 +124,16 @@ def prominent(x, peaks, min_prominence, floor=-np.inf):
             prom[j] = top - max(lmin, rmin)
             keep[j] = prom[j] >= min_prominence
             left[j], right[j] = lbase, rbase
-    return peaks[keep], prom[keep], left[keep], right[keep]
+    return kept(peaks, keep), kept(prom, keep), kept(left, keep), kept(right, keep)
 
 
 @jit
 def _prominent_in_one_pass(x, peaks, min_prominence, floor):
     """prominent's answer from every sample's bases (prominence_bases)."""
     lb, rb = prominence_bases(x, floor)
-    left, right = lb[peaks], rb[peaks]
-    prom = x[peaks] - np.maximum(x[left], x[right])
-    keep = prom >= min_prominence
-    return peaks[keep], prom[keep], left[keep], right[keep]
+    k = peaks.shape[0]
+    prom, keep = np.empty(k), np.empty(k, np.bool_)
+    for j in range(k):
+        prom[j] = x[peaks[j]] - np.maximum(x[lb[peaks[j]]], x[rb[peaks[j]]])
+        keep[j] = prom[j] >= min_prominence
+    return kept(peaks, keep), kept(prom, keep), kept(taken(lb, peaks), keep), kept(taken(rb, peaks), keep)

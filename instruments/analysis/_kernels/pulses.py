@@ -15,6 +15,7 @@ from .crossings import level_bracket
 from .parabola import parabola
 from .peaks import local_maxima, thin_by_distance, widths_at
 from .prominence import prominent
+from .select import kept, stable_order, taken
 
 MIN_BASELINE = 16  # pre-trigger samples needed to measure the noise (the MAD to about 1/3)
 MAD_TO_SD = 1.4826  # the standard deviation of Gaussian noise over its median absolute deviation
@@ -145,10 +146,14 @@ def candidates(f, height, min_prominence, spacing, min_width):
         return np.empty(0, np.int64)
     idx = local_maxima(f, height)
     if spacing > 1 and idx.shape[0]:
-        idx = idx[thin_by_distance(idx, np.argsort(f[idx], kind="mergesort"), float(spacing))]
+        idx = kept(idx, thin_by_distance(idx, stable_order(taken(f, idx)), float(spacing)))
     idx, prominence, left, right = prominent(f, idx, min_prominence, height)
     if min_width > 0.0 and idx.shape[0]:
-        idx = idx[widths_at(f, idx, 0.5, prominence, left, right) >= min_width]
+        widths = widths_at(f, idx, 0.5, prominence, left, right)
+        wide = np.empty(widths.shape[0], np.bool_)
+        for k in range(widths.shape[0]):
+            wide[k] = widths[k] >= min_width
+        idx = kept(idx, wide)
     return idx
 
 
