@@ -4,7 +4,10 @@ of a kernel package consistent with its sources.
 Every compiled kernel (the chain integrators in rig/solver/kernels/, the instruments'
 and the analysis' loops in the instruments' kernel packages) is declared with ``@jit`` (or
 ``@jit(parallel=True)``): numba's ``njit`` with ``cache=True`` (compiled once per machine,
-kept on disk) and ``fastmath=False`` (IEEE arithmetic: results bit-identical to numpy's).
+kept on disk), ``fastmath=False`` (IEEE arithmetic: results bit-identical to numpy's) and
+no C-callable wrapper (``no_cfunc_wrapper``: numba builds one for every function by
+default, for a function passed as a value, which no kernel does; 4% of the solver's
+compile time).
 A loop that divides and must vectorise takes ``error_model="numpy"`` (a division by zero
 gives inf, as in numpy; numba's default checks every divisor, a branch per element).
 A kernel package calls ``drop_stale_cache(__name__)`` in its ``__init__``.
@@ -46,7 +49,8 @@ def _declare(function, options: dict):
     options and ``options``."""
     from numerics.dispatcher import ConstantPipeline, OneTypePerArgument
 
-    targetoptions = {"nopython": True, "boundscheck": None, "fastmath": OPTIONS["fastmath"], **options}
+    targetoptions = {"nopython": True, "boundscheck": None, "fastmath": OPTIONS["fastmath"], "no_cfunc_wrapper": True,
+                     **options}
     dispatcher = OneTypePerArgument(py_func=function, locals={}, targetoptions=targetoptions,
                                     pipeline_class=ConstantPipeline)
     if OPTIONS["cache"]:

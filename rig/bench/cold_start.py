@@ -3,8 +3,10 @@ first ``rig mc`` of a fresh install, where numba has compiled nothing yet, besid
 commands once its cache is warm.
 
 Each cold run is a fresh interpreter whose NUMBA_CACHE_DIR is an empty temporary folder
-(every kernel it needs is compiled, as in a new venv or a CI run); the warm runs reuse
-the folder the cold mc filled. Times are wall seconds and the children's CPU seconds
+(every kernel it needs is compiled, as in a new venv or a CI run); each warm run reuses
+the folder its cold run filled. A last row runs a shot in the folder the cold mc filled: a
+study compiles the batched chain kernel only, so a shot after it compiles the single-shot
+one (once). Times are wall seconds and the children's CPU seconds
 (user + system: on several cores the compilation spread over processes makes CPU exceed
 wall). The cold shot and the cold mc also report where their compilation went: each
 kernel's compile time, exclusive of the kernels it calls (numba's ``numba:compile`` events,
@@ -72,14 +74,16 @@ def _run(tree: Path | None, argv: list, cache: Path, log: Path) -> tuple:
 
 def measure_revision(tree: Path | None, folder: Path) -> dict:
     """One round of one revision (``tree``: its checkout; None: this code): cold shot, cold
-    mc, then the warm shot and mc. Seconds, and the cold shot's compile times by kernel."""
+    mc, then the warm shot and mc, then a shot after the cold mc. Seconds, and the cold
+    commands' compile times by kernel."""
     shot = ["shot", SCENE, "--seed", "1"]
     cold_shot, cold_mc, log = folder / "cache-shot", folder / "cache-mc", folder / "compiles.json"
     rows = {}
     rows["cold rig shot"] = _run(tree, shot, cold_shot, log)
     rows["cold rig mc"] = _run(tree, ["mc", SCENE, *STUDY, "--out", str(folder / "mc-cold")], cold_mc, log)
-    rows["warm rig shot"] = _run(tree, shot, cold_mc, log)
+    rows["warm rig shot"] = _run(tree, shot, cold_shot, log)
     rows["warm rig mc"] = _run(tree, ["mc", SCENE, *STUDY, "--out", str(folder / "mc-warm")], cold_mc, log)
+    rows["rig shot after a cold mc"] = _run(tree, shot, cold_mc, log)
     return {"wall_s": {k: v[0] for k, v in rows.items()}, "cpu_s": {k: v[1] for k, v in rows.items()},
             "shot_compiles_s": rows["cold rig shot"][2]["spent"], "mc_compiles_s": rows["cold rig mc"][2]["spent"],
             "compiled": {k: v[2]["count"] for k, v in rows.items() if k.startswith("cold")}}
@@ -122,14 +126,14 @@ def table(r: dict) -> str:
     names = list(r["revisions"])
     lines = [f"cold start: an empty numba cache in a fresh interpreter ({SCENE}; mc: {r['study']}); "
              f"medians of {r['rounds']} round(s), {r['cores']} cores",
-             f"  {'command':16s}" + "".join(f" {n[:22]:>22s}" for n in names)
+             f"  {'command':24s}" + "".join(f" {n[:22]:>22s}" for n in names)
              + (f" {'ratio':>6s}" if "ratio_to_baseline" in r else "") + f" {'target s':>8s}"]
     for command in r["revisions"]["current"]["wall_s"]:
         cells = "".join(f" {r['revisions'][n]['wall_s'][command]:9.2f} s "
                         f"({r['revisions'][n]['cpu_s'][command]:5.1f} CPU)" for n in names)
         ratio = f" {r['ratio_to_baseline'][command]:6.2f}" if "ratio_to_baseline" in r else ""
         target = TARGETS.get(command)
-        lines.append(f"  {command:16s}{cells}{ratio} {'-' if target is None else f'{target:.1f}':>8s}")
+        lines.append(f"  {command:24s}{cells}{ratio} {'-' if target is None else f'{target:.1f}':>8s}")
     for n, task in ((n, task) for n in names for task in ("shot", "mc")):
         rev = r["revisions"][n]
         total = rev[f"{task}_compile_total_s"]
