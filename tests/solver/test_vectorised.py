@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rig.model.contact import HERTZ, KUWABARA_KONO, PLASTIC, POWER
-from rig.solver.kernels import dissipation, ensemble, forces, multirate, record, step
+from rig.solver.kernels import dissipation, ensemble_passes, forces, multirate, record, step
 from rig.solver.problem import CONTACT_ROWS, STATE_ROWS
 
 
@@ -49,7 +49,7 @@ def test_the_closing_kick_is_vectorised():
 def test_the_batched_kernel_vectorises_over_shots():
     nb, W = 16, 32
     u = np.zeros((nb, W))
-    ir = _llvm(ensemble._contact_row, u, np.ones((nb, W)), np.full((nb, W), 1e-7), np.zeros((nb + 1, W)),
+    ir = _llvm(ensemble_passes.contact_row, u, np.ones((nb, W)), np.full((nb, W), 1e-7), np.zeros((nb + 1, W)),
                np.zeros((nb + 1, W)), 3)
     assert re.search(r"llvm\.sqrt\.v\d+f64", ir), "the batched force row is scalar"
 
@@ -62,8 +62,9 @@ def test_the_batched_pass_runs_its_rows_inline():
     nb, W = 16, 32
     m = method("srkn6b")
     z = np.zeros((nb, W))
-    ir = _llvm(ensemble._kick_drift_forces, z, z.copy(), np.ones((nb, W)), np.zeros((nb + 1, W)), np.ones((nb, W)),
-               np.full((nb, W), 1e-7), np.zeros((nb + 1, W)), 1e-9, 1e-9, 0, np.array(m.drifts), np.array(m.kicks),
+    ir = _llvm(ensemble_passes.kick_drift_forces, z, z.copy(), np.ones((nb, W)), np.zeros((nb + 1, W)),
+               np.ones((nb, W)), np.full((nb, W), 1e-7), np.zeros((nb + 1, W)), 1e-9, 1e-9, 0, np.array(m.drifts),
+               np.array(m.kicks),
                1, np.zeros((2, 3, 1, W)), np.zeros((5, W)), HERTZ, np.full((len(CONTACT_ROWS), nb, W), 1.5),
                np.zeros((len(STATE_ROWS), nb, W)), nb)
     called = set(re.findall(r"call [^@]*@\"?([\w.$]+)", ir))
