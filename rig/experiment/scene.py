@@ -64,7 +64,8 @@ def find_scene(name_or_path) -> Path:
     hits = sorted(PUBLISHED_SCENES.rglob(f"{p.name}.toml"))
     if not hits:
         known = sorted(q.stem for q in PUBLISHED_SCENES.rglob("*.toml"))
-        raise invalid("scene", str(name_or_path), f"not a file; known scenes: {', '.join(known)}")
+        raise invalid("scene", str(name_or_path), f"neither a scene file nor a published scene; known scenes: "
+                                                  f"{', '.join(known)}")
     return hits[0]
 
 
@@ -147,15 +148,28 @@ def key_spec(key: str):
     return _spec_for(key.split("."))
 
 
+def unknown_key(key: str, extra: tuple = ()) -> str:
+    """Why the dotted ``key`` is not a scene key: "unknown key; known in TABLE: ..." (the
+    keys of the table where the schema stops knowing it, and those of ``extra``, dotted
+    keys known elsewhere, that lie in the same table)."""
+    parts = key.split(".")
+    try:
+        schema_node(key)
+        return "unknown key"
+    except KeyError as exc:
+        where = ".".join(parts[:exc.args[0]])
+    parent = schema_node(where) if where else SCHEMA
+    known = [k for k in parent if k != "*"] if isinstance(parent, dict) else []
+    known += [k.removeprefix(f"{where}.") for k in extra if k.rpartition(".")[0] == where]
+    return f"unknown key; known in {where or 'the scene'}: {', '.join(dict.fromkeys(known)) or 'none'}"
+
+
 def _spec_for(parts):
     key = ".".join(parts)
     try:
         node = schema_node(key)
-    except KeyError as exc:
-        where = ".".join(parts[:exc.args[0]])
-        parent = schema_node(where) if where else SCHEMA
-        known = ", ".join(k for k in parent if k != "*") if isinstance(parent, dict) else "none"
-        raise invalid("scene key", key, f"unknown key; known in {where or 'the scene'}: {known}") from None
+    except KeyError:
+        raise invalid("scene key", key, unknown_key(key)) from None
     if isinstance(node, dict):
         raise invalid("scene key", key, "is a table; set one of its keys")
     return node

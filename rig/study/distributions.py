@@ -20,7 +20,7 @@ import numpy as np
 from scipy import stats
 
 from rig.errors import invalid
-from rig.experiment.scene import schema_node
+from rig.experiment.scene import schema_node, unknown_key
 from rig.units import check_digits, number, quantity
 
 EXTRA_KEYS = {"chain.bead_mass": "kg", "chain.youngs_modulus": "Pa", "chain.poisson_ratio": float}
@@ -41,7 +41,7 @@ def key_unit(key: str):
     try:
         node = schema_node(key)
     except KeyError:
-        raise invalid("--vary", key, "unknown key") from None
+        raise invalid("--vary", key, unknown_key(key, tuple(EXTRA_KEYS))) from None
     if node is int:
         raise invalid("--vary", key, "a whole-number key (a count or an index) cannot take a continuous "
                                      "distribution; run one study per value, or rig sweep")

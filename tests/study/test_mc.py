@@ -31,6 +31,8 @@ def _outputs(folder):
     ("striker.velocity=normal(0.89 m/s, -0.01 m/s)", "standard deviation must be > 0"),
     ("magnet.force=uniform(3 N, 2 N)", "LO < HI"),
     ("striker.colour=normal(1, 2)", "unknown key"),
+    ("striker.speed=normal(1 m/s, 0.1 m/s)", "unknown key; known in striker: material, mass, velocity"),
+    ("chain.bead_mas=normal(1 g, 0.1 g)", "magnetic_poisson_ratio, bead_mass\n"),  # and the study's own, once each
     ("striker.mass=normal(0.47 g, 0.3 g)", "outside the allowed range"),
     ("chain.bead_mass=normal(0.1226 g, 0.1 g)", "outside the allowed range (0, inf) kg (the values in SI units)"),
     ("gauges.middle.gain=normal(1, 0.05)", "no gauge 'middle'"),
