@@ -34,6 +34,10 @@ loops vectorise, and each shot still gets the operations of its own sequence of
 substeps. The shots of a batch strike at about the same instant, so the masks are mostly
 full; taken one shot at a time through scalar calls, the head cost a batched shot of
 ptfe52_magnetic about as much as its force passes.
+
+_busy and _resolved_substeps, each called once, by head_flow, are inlined into it: numba
+links a callee's machine code into each caller's module and optimises it again, so each
+level of calls costs its whole subtree's compile once more (0.7 s CPU for these two).
 """
 import math
 
@@ -50,7 +54,7 @@ def _open_acceleration(j, invm, load, head, s):
     return (above - below) * invm[j, s]
 
 
-@jit
+@jit(inline="always")
 def _busy(u, v, invm, d0, load, head, a_coef, b_coef, h, busy):
     """busy[s]: 1 where a head contact of shot s is closed or may close during a drift of h
     seconds, 0 where all are open and provably stay open (bound in the module doc); no
@@ -141,7 +145,7 @@ def _attempt(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, pending, activ
     return True
 
 
-@jit
+@jit(inline="always")
 def _resolved_substeps(u, v, invm, f, A, d0, load, head, a_coef, b_coef, k, n, saved, lanes):
     """n substeps of k seconds on the head of every busy shot (lanes[0] != 0), each substep
     across a change of contact state taken again as REFINE, and the piece across it as
