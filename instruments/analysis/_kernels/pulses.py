@@ -3,6 +3,11 @@ its pulses, the leading pulse's parabola and widths, the cross-correlation delay
 pipeline (instruments/analysis/pipeline.py) calls these for one record, and the batched analysis
 (instruments/analysis/batch.py) for every shot of a study in one compiled loop: the same code, so
 the same bits.
+
+candidates, refine and xcorr_lag, each called from one place, are inlined there: numba
+links a callee's machine code into each caller's module and optimises it again, so a
+level of calls of its own cost their subtree's compile once more (1.3 s CPU of a shot's
+analysis).
 """
 import math
 
@@ -136,7 +141,7 @@ def conditioned(volts, n_pre, h, tau, sensitivity):
     return out
 
 
-@jit
+@jit(inline="always")
 def candidates(f, height, min_prominence, spacing, min_width):
     """Indices of f's pulses by find_peaks' rules, in time order: local maxima at least
     ``height`` high, thinned to ``spacing`` samples from the highest down (equal heights:
@@ -190,7 +195,7 @@ def crossings(t, f, i, level):
     return tl, tr
 
 
-@jit
+@jit(inline="always")
 def refine(t, f, i, top):
     """(time, amplitude, FWHM, 1% width, rise from 1%) of the pulse at sample i."""
     time, amp = _vertex(t, f, i, top)
@@ -226,7 +231,7 @@ def correlate(a, b, c):
         j += 1
 
 
-@jit
+@jit(inline="always")
 def xcorr_lag(t, fa, time_a, fwhm_a, fb, time_b):
     """Delay (s) of pulse b after pulse a: a's window one FWHM either side of its maximum,
     searched in b's window twice as wide, a parabola through the correlation peak."""
