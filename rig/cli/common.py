@@ -264,9 +264,9 @@ def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     from rig.solver.kernels.ensemble import integrate_chunks
     from rig.solver.kernels.integrators import integrate
 
-    # this process: the chain solver (a shot's single-shot kernel, a study's batched one; about 14 s CPU on one
-    # core here); the side process: the analysis (10 s), then a shot's small kernels (2.6 s), or a study's
-    # batches' acquisition and analysis (13 s), then (not waited for) a shot's small kernels
+    # this process: the chain solver (a shot's single-shot kernel, a study's batched one; about 11 s CPU on one
+    # core here); the side process: the analysis (8 s), then a shot's small kernels (2.6 s), or a study's
+    # batches' acquisition and analysis (9 s), then (not waited for) a shot's small kernels
     kernels = {**SHOT, **STUDY} if task == "study" else {**SHOT, **SHOT_SMALL}
     cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_chunks)))
     aside = start(kernels, then=SHOT_SMALL if task == "study" else None)  # so a shot after it compiles nothing
