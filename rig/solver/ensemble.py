@@ -21,7 +21,7 @@ from rig.solver.kernels.report import DIAGNOSTICS, ENERGY_ERROR, STATUS
 from rig.solver.methods import DEFAULT_METHOD, Method
 from rig.solver.methods import method as get_method
 from rig.solver.problem import ChainProblem, ProblemArrays
-from rig.solver.run import check_record, integrate_at, kernel_inputs, time_grid
+from rig.solver.run import check_record, integrate_at, kernel_inputs, solution_of, time_grid
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import KernelReport, Solution, SolverStats, Status
 from rig.solver.stepsize import Stepping
@@ -112,15 +112,8 @@ def batch_of_one(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     state to the last bit (module doc); one that blows up returned so (its status), as
     integrate_at's. What a study's solves of one shot use (``solved_as_batches``)."""
     sol, u, v = _integrated([problem], t_end, save, stepping, m.name, 1)
-    report = sol.reports[0]
-    detail = "" if report.status is Status.SUCCESS else \
-        f" (near t = {report.end_time_s:.4g} s, dt = {sol.dt:.4g} s, method {m.name})"
-    stats = SolverStats(m.name, sol.dt, sol.steps, sol.steps * m.force_evaluations, sol.wall_s,
-                        report.energy_error, report.momentum_error, report.wall_impulse_Ns, accuracy,
-                        dissipated_energy_J=report.dissipated_energy_J, bodies_stepped=report.bodies_stepped)
-    moving = slice(0, problem.n_bodies - (1 if problem.wall_slot else 0))
-    return Solution(dict(zip(save.names, sol.records[0])), save.sample_interval, None, None,
-                    u[0, moving, 0].copy(), v[0, moving, 0].copy(), stats, problem, report.status, detail)
+    return solution_of(problem, save, sol.records[0], None, u[0, :, 0], v[0, :, 0], sol.reports[0], m, sol.dt,
+                       sol.steps, sol.wall_s, accuracy)
 
 
 @contextlib.contextmanager

@@ -157,15 +157,24 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     t0 = time.perf_counter()
     integrate(u, v, f, *k, diag, front)
     wall = time.perf_counter() - t0
-    report = KernelReport.of(diag)
+    shown = slice(0, problem.offset + problem.chain.n_beads)  # the striker and the beads (not a wall's plate)
+    frames_abs = frames[:, shown] + frame_origin(problem.chain) if n_frames else None
+    return solution_of(problem, save, out, frames_abs, u, v, KernelReport.of(diag), m, step, n_steps, wall, accuracy)
+
+
+def solution_of(problem: ChainProblem, save: SaveAt, out: np.ndarray, frames: np.ndarray | None, u: np.ndarray,
+                v: np.ndarray, report: KernelReport, m: Method, step: float, n_steps: int, wall: float,
+                accuracy: float | None) -> Solution:
+    """The Solution of one integration of ``problem``: its records ``out`` (channels,
+    samples; N) of ``save``, its frames (m; None: none), the final displacements ``u`` (m)
+    and velocities ``v`` (m/s) of every body, and the kernel's report of ``n_steps`` steps of
+    ``step`` (s) of method ``m``, which took ``wall`` s."""
     detail = "" if report.status is Status.SUCCESS else \
         f" (near t = {report.end_time_s:.4g} s, dt = {step:.4g} s, method {m.name})"
     stats = SolverStats(m.name, step, n_steps, n_steps * m.force_evaluations, wall,
                         report.energy_error, report.momentum_error, report.wall_impulse_Ns, accuracy,
                         dissipated_energy_J=report.dissipated_energy_J, bodies_stepped=report.bodies_stepped)
     moving = slice(0, problem.n_bodies - (1 if problem.wall_slot else 0))
-    shown = slice(0, problem.offset + problem.chain.n_beads)  # the striker and the beads (not a wall's plate)
-    frames_abs = frames[:, shown] + frame_origin(problem.chain) if n_frames else None
-    return Solution(dict(zip(save.names, out)), save.sample_interval, frames_abs,
-                    save.frame_interval, u[moving].copy(), v[moving].copy(), stats, problem,
-                    report.status, detail)
+    return Solution(dict(zip(save.names, out)), save.sample_interval, frames,
+                    save.frame_interval if frames is not None else None, u[moving].copy(), v[moving].copy(), stats,
+                    problem, report.status, detail)
