@@ -33,8 +33,8 @@ SHOT_SMALL = {f"{DEVICES}.acquisition.scope_shot": f"({F2}, float64, int64, floa
                                                      f"float64, {F1})",
               f"{DEVICES}.acquisition.condition": f"({F1}, float64, {F1}, {F1})",
               f"{DEVICES}.acquisition.samples_before_input": "(int64, float64, float64, float64)",
-              f"{ANALYSIS}.pulses.conditioned": f"({F1}, int64, float64, float64, float64)",
-              f"{ANALYSIS}.pulses.noise_level": f"({F1}, int64, float64)",
+              f"{ANALYSIS}.baseline.conditioned": f"({F1}, int64, float64, float64, float64)",
+              f"{ANALYSIS}.baseline.noise_level": f"({F1}, int64, float64)",
               f"{ANALYSIS}.pulses.first_peak": f"({F1},)"}
 B1, I1, I8 = "boolean[::1]", "int64[::1]", "int8[:, :, ::1]"
 F3 = "float64[:, :, ::1]"

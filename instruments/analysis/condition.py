@@ -2,7 +2,7 @@
 baseline is the mean of the pre-trigger samples; the one-pole RC high-pass is undone,
 x = y + (1/tau) * integral of y dt (trapezoid rule); volts become force through each
 gauge's sensitivity (V/N). The noise comes from the pre-trigger samples too (noise_level).
-The loops are compiled in _kernels/pulses.py (conditioned, noise_level)."""
+The loops are compiled in _kernels/baseline.py (conditioned, noise_level)."""
 from __future__ import annotations
 
 import math
@@ -12,10 +12,10 @@ import numpy as np
 from .._kernels.filters import undo_highpass
 from ..errors import InstrumentError
 from ..records import ScopeRecord, Waveform, time_base_mismatch
-from ._kernels import pulses
+from ._kernels import baseline
 from .setup import Setup
 
-MIN_BASELINE = pulses.MIN_BASELINE  # pre-trigger samples needed to measure the noise
+MIN_BASELINE = baseline.MIN_BASELINE  # pre-trigger samples needed to measure the noise
 
 
 def record_forces(record: ScopeRecord, setup: Setup):
@@ -37,7 +37,7 @@ def record_forces(record: ScopeRecord, setup: Setup):
             raise InstrumentError(mismatch)
         if t is None:
             t, first = w.time(), w
-        out[role] = pulses.conditioned(np.ascontiguousarray(w.volts(), dtype=float), int(w.preamble.trigger_index),
+        out[role] = baseline.conditioned(np.ascontiguousarray(w.volts(), dtype=float), int(w.preamble.trigger_index),
                                        float(h), float(g.tau_s or 0.0), float(g.sensitivity_V_per_N))
     return t, out
 
@@ -70,7 +70,7 @@ def noise_level(y: np.ndarray, n_pre: int, step: float = 0.0) -> float | None:
     does not inflate it as it does the standard deviation), never below the quantisation
     floor step / sqrt(12) (a flat 8-bit baseline has a MAD of 0, yet a code step hides
     that much). None with fewer than MIN_BASELINE samples: the noise cannot be measured."""
-    sigma = pulses.noise_level(np.ascontiguousarray(y, dtype=float), int(n_pre), float(step))
+    sigma = baseline.noise_level(np.ascontiguousarray(y, dtype=float), int(n_pre), float(step))
     return None if math.isnan(sigma) else float(sigma)
 
 

@@ -187,7 +187,7 @@ def test_quantiser_is_the_numpy_expression(sd):
 
 @pytest.mark.parametrize("n", [1, 2, 7, 16, 1250, 1251])
 def test_median_is_numpys(n):
-    from instruments.analysis._kernels.pulses import median
+    from instruments.analysis._kernels.baseline import median
 
     rng = np.random.default_rng(n)
     for x in (rng.standard_normal(n), rng.integers(0, 4, n).astype(float)):  # ties as on 8-bit records
@@ -215,7 +215,7 @@ def test_correlation_adds_each_lag_in_order():
 def test_median_of_many_records_is_numpys():
     # sorted, tied and noisy inputs of every length parity: the selection's pivots and
     # buffers give numpy's value exactly; a nan gives nan, as np.median does
-    from instruments.analysis._kernels.pulses import median
+    from instruments.analysis._kernels.baseline import median
 
     rng = np.random.default_rng(21)
     for t in range(600):

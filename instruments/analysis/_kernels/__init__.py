@@ -1,7 +1,8 @@
 """The analysis' compiled loops (numba, see numerics/jit.py), beneath the pipeline: the
 peak rules of scipy.signal.find_peaks (peaks.py, prominence.py), the parabola through a
-pulse's top (parabola.py), level crossings (crossings.py), a record's conditioning, noise,
-pulses and delay (pulses.py) and a batch's records through them (batch_analysis.py). The
+pulse's top (parabola.py), level crossings (crossings.py), numpy's selections as loops
+(select.py), a channel's baseline, noise and force (baseline.py), a record's pulses and
+delay (pulses.py) and a batch's records through them (batch_analysis.py). The
 shared inverse filter they inline and the acquisition status a batch reads join the cache's
 digest."""
 from numerics.jit import drop_stale_cache

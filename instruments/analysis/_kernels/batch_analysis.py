@@ -1,7 +1,7 @@
 """The leading-pulse analysis of a batch of scope records, compiled (numba): each shot's
 channels from their 8-bit codes to forces, their noise and leading_pair's answer, over
 the shots on as many threads as numba's. instruments/analysis/batch.analysed turns the numbers
-into Reports. The same functions as a lone record's analysis (pulses.py), so the same bits.
+into Reports. The same functions as a lone record's analysis (baseline.py, pulses.py), so the same bits.
 """
 import math
 
@@ -12,7 +12,8 @@ from instruments.devices.batch import OK
 from numerics.jit import jit
 from numerics.threads import over_threads
 
-from .pulses import baseline_mean, leading_pair, noise_level
+from .baseline import baseline_mean, noise_level
+from .pulses import leading_pair
 
 
 @jit
