@@ -35,58 +35,23 @@ from instruments.transports.device import MessageInstrument
 from instruments.transports.portmap import PMAP_PORT, Announcement, announce
 from instruments.transports.tcp import TcpService
 from instruments.transports.vxi11_codec import (
-    ABORT,
-    CHANNEL_NOT_ESTABLISHED,
-    CREATE_INTR_CHAN,
     CREATE_LINK,
-    DESTROY_INTR_CHAN,
     DESTROY_LINK,
     DEVICE_ABORT,
     DEVICE_ASYNC_PROG,
-    DEVICE_CLEAR,
     DEVICE_CORE_PROG,
-    DEVICE_DOCMD,
-    DEVICE_ENABLE_SRQ,
-    DEVICE_LOCAL,
-    DEVICE_LOCK,
     DEVICE_LOCKED,
     DEVICE_NOT_ACCESSIBLE,
-    DEVICE_READ,
-    DEVICE_READSTB,
-    DEVICE_REMOTE,
-    DEVICE_TRIGGER,
-    DEVICE_UNLOCK,
-    DEVICE_WRITE,
-    FLAG_END,
-    FLAG_TERMCHAR,
-    FLAG_WAIT_LOCK,
     INVALID_LINK,
-    IO_ERROR,
-    IO_TIMEOUT,
-    MAV,
     NO_ERROR,
-    NO_LOCK_HELD,
-    OPERATION_NOT_SUPPORTED,
     OUT_OF_RESOURCES,
-    PARAMETER_ERROR,
-    REASON_CHR,
-    REASON_END,
-    REASON_REQCNT,
     VERSION,
     reply,
 )
-from instruments.transports.vxi11_link import POLL_S, Link
-from instruments.transports.vxi11_procedures import MAX_READ_BYTES, LinkProcedures
+from instruments.transports.vxi11_link import Link
+from instruments.transports.vxi11_procedures import LinkProcedures
 
-__all__ = ["ABORT", "CHANNEL_NOT_ESTABLISHED", "CREATE_INTR_CHAN", "CREATE_LINK", "DESTROY_INTR_CHAN", "DESTROY_LINK",
-           "DEVICE_ABORT", "DEVICE_ASYNC_PROG", "DEVICE_CLEAR", "DEVICE_CORE_PROG", "DEVICE_DOCMD", "DEVICE_ENABLE_SRQ",
-           "DEVICE_LOCAL", "DEVICE_LOCK", "DEVICE_LOCKED", "DEVICE_NAMES", "DEVICE_NOT_ACCESSIBLE", "DEVICE_READ",
-           "DEVICE_READSTB", "DEVICE_REMOTE", "DEVICE_TRIGGER", "DEVICE_UNLOCK", "DEVICE_WRITE", "FLAG_END",
-           "FLAG_TERMCHAR", "FLAG_WAIT_LOCK", "INVALID_LINK", "IO_ERROR", "IO_TIMEOUT", "MAV", "MAX_READ_BYTES",
-           "NO_ERROR", "NO_LOCK_HELD", "OPERATION_NOT_SUPPORTED", "OUT_OF_RESOURCES", "PARAMETER_ERROR", "POLL_S",
-           "REASON_CHR", "REASON_END", "REASON_REQCNT", "VERSION", "Vxi11Server"]
-"""The server, and the numbers this module has always exported (vxi11_codec's, the read
-limit and the poll interval), re-exported here."""
+__all__ = ["DEVICE_NAMES", "Vxi11Server"]
 
 DEVICE_NAMES = ("inst0",)
 

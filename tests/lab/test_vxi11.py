@@ -19,7 +19,8 @@ from pyvisa_py.tcpip import Vxi11CoreClient
 
 from instruments.errors import InstrumentError
 from instruments.transports import oncrpc, portmap
-from instruments.transports.vxi11 import DEVICE_CORE_PROG, Vxi11Server
+from instruments.transports.vxi11 import Vxi11Server
+from instruments.transports.vxi11_codec import DEVICE_CORE_PROG
 from lab.vxi11_instrument import IDN, EchoInstrument, block
 
 MAX_MESSAGE = 4096
