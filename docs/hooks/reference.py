@@ -21,11 +21,10 @@ from mkdocs.structure.files import File
 from reference_api import api
 from reference_archive import archive
 from reference_commands import commands
-from reference_scene_keys import EXAMPLE_SCENE, MEANINGS, WILDCARDS, scene_keys
+from reference_scene_keys import scene_keys
 from reference_text import ROOT
 
-__all__ = ["EXAMPLE_SCENE", "MEANINGS", "PAGES", "ROOT", "WILDCARDS", "api", "archive", "commands", "on_files",
-           "scene_keys"]
+__all__ = ["PAGES", "on_files"]
 
 PAGES = {"reference/scene-keys.md": scene_keys, "reference/commands.md": commands,
          "reference/api.md": api, "reference/archive.md": archive}
