@@ -225,11 +225,10 @@ class Archive:
         """The stored shot as the same record objects the scope produces; with ``verify``,
         the checksums of what it returns first (all of the shot's table but what only its
         plot shows: the time axis, the plot's attributes; ``rig verify`` checks those) and
-        of what it shares (once per version of its file, instruments/archive/shared.py: the
-        truth's forces, read-only, shared by the reads of a scene's shots). The shot is read
-        from the part its master's link names, opened directly; the master and the parts read
-        last stay open for the next read, while the files at their paths are those they were
-        opened from."""
+        of what it shares (once per version of its file, shared.py: the truth's forces,
+        read-only, shared by the reads of a scene's shots, with or without ``verify``). The
+        shot is read from the part its master's link names, opened directly; the master and
+        the parts read last stay open while the files at their paths are those opened."""
         import h5py
 
         with self._reader() as (f, parts):
@@ -242,9 +241,12 @@ class Archive:
                 raise InstrumentError(f"{self.path}: shot {shot_id}: unreadable ({cause(exc)})") from None
             try:
                 layout = attribute_or(h5py.h5o.open(g.id, b"/"), "layout_version")  # of the file that holds it
+                if not verify:
+                    return read_shot(g, self.path, with_truth, layout=layout,
+                                     truth=self._shared.unchecked_truth(f, parts, g) if with_truth else None)
                 where = f"{self.path}: shot {shot_id}"
-                shared = self._shared.check(f, parts, g, where, with_truth) if verify else None
-                return checked_shot(g, self.path, where, layout, shared, with_truth)
+                return checked_shot(g, self.path, where, layout, self._shared.check(f, parts, g, where, with_truth),
+                                    with_truth)
             except InstrumentError:
                 raise
             except Exception as exc:  # noqa: BLE001 - a damaged file, one line

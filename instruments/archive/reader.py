@@ -26,14 +26,12 @@ if TYPE_CHECKING:
     import h5py
 
 
-def checked_shot(g: h5py.Group, path, where: str, layout, shared: Shared | None, with_truth: bool = True) -> Entry:
-    """The Entry of the shot ``g`` (read_shot; ``layout``: of the file that holds it), and
-    where ``shared`` (what it links to, checked: shared.SharedGroups.check) is given, checked
-    first: the rows of its table that a read returns (links.returned_by_read), those of what
-    it read computed from the values read, not read again, and its raw data's SHA-256;
-    InstrumentError (``where`` first) naming the first damage."""
-    if shared is None:
-        return read_shot(g, path, with_truth, layout=layout)
+def checked_shot(g: h5py.Group, path, where: str, layout, shared: Shared, with_truth: bool = True) -> Entry:
+    """The Entry of the shot ``g`` (read_shot; ``layout``: of the file that holds it),
+    checked with ``shared`` (what it links to, checked: shared.SharedGroups.check): the rows
+    of its table that a read returns (links.returned_by_read), those of what it read computed
+    from the values read, not read again, and its raw data's SHA-256; InstrumentError
+    (``where`` first) naming the first damage."""
     e: Entry | None = None
     seen: dict = {}  # the rows of what read_shot read, not read again by the check
     with contextlib.suppress(Exception):  # a damaged shot: the check says what

@@ -11,16 +11,22 @@ for the truth, its forces) and read nothing of it again. A file replaced or dama
 
 The forces are the bulk (a published scene's: 7 arrays of 30,001 float64, 1.7 MB, stored
 gzipped): those of the last ``FORCES_KEPT`` groups read are kept, read-only, and every read
-of one of them returns the same arrays in a dict of its own.
+of one of them returns the same arrays in a dict of its own. The first read of a version
+reads them once: its check takes their rows of the table from the values read. A read that
+skips the checksums (``Archive.read(verify=False)``) takes the forces kept for that version
+of the file too, or reads them and keeps them as unchecked, which a checked read never takes.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 from dataclasses import dataclass
 
 from ..errors import InstrumentError
 from .digest import damage, linked_groups, table_text
+from .hashes import value_digest
 from .links import file_identity, truth_item
+from .values import member_value
 from .verify import addresses
 
 FORCES_KEPT = 4  # the shared groups whose truth forces are kept (a published scene's: 1.7 MB each)
@@ -57,7 +63,8 @@ class SharedGroups:
     def __init__(self, kept: int = FORCES_KEPT):
         self.kept = kept
         self.sound: dict = {}  # {(file, key): SoundGroup}
-        self.forces: dict = {}  # {(file, key): (the file's identity, {name: array})}, the last used last
+        # {(file, key): (the file's identity, {name: array}, whether checked)}, the last used last
+        self.forces: dict = {}
 
     def check(self, f, parts, g, where: str, with_truth: bool = True) -> Shared:
         """The shared groups the shot ``g`` links to, each checked where its file is not the
@@ -68,58 +75,98 @@ class SharedGroups:
         linked: dict = {}
         scene, truth = None, None
         text = table_text(g)
-        try:
-            sealed = json.loads(text or "{}")
-        except ValueError:  # damage() says what is wrong with it
-            sealed = {}
-        sealed = sealed if isinstance(sealed, dict) else {}
+        sealed = _sealed(text)
         for key in sorted(linked_groups(g, "/shared/", text)):
             s = parts.group(f["shared"], key)  # its part opened directly, as the shot's is
-            held = s.file.filename
-            sound = self._sound(s, (held, key), f"{where}: shared/{key}/", with_truth)
+            at = (s.file.filename, key)
+            truth_here = with_truth and _links_to(sealed, "truth/forces", key, "forces")
+            sound = self._sound(s, at, f"{where}: shared/{key}/", with_truth, truth_here)
             linked.update(sound.addresses)
             if _links_to(sealed, "scene_text", key, "scene_text"):
                 scene = sound.texts
-            if with_truth and _links_to(sealed, "truth/forces", key, "forces"):
-                truth = self._forces(s, (held, key), sound.identity)
+            if truth_here:
+                truth = self._forces(s, at, sound.identity, checked=True)
         return Shared(text, linked, scene, truth)
 
-    def _sound(self, s, at: tuple, where: str, with_truth: bool) -> SoundGroup:
+    def unchecked_truth(self, f, parts, g) -> dict | None:
+        """The truth forces the shot ``g`` links to, for a read that skips the checksums:
+        those kept for the version of their file that is there now, else read from it and
+        kept as unchecked; None where its table names no shared truth (the caller reads the
+        shot's own)."""
+        text = table_text(g)
+        sealed = _sealed(text)
+        for key in linked_groups(g, "/shared/", text):
+            if _links_to(sealed, "truth/forces", key, "forces"):
+                s = parts.group(f["shared"], key)
+                return self._forces(s, (s.file.filename, key), file_identity(s.file.filename), checked=False)
+        return None
+
+    def _sound(self, s, at: tuple, where: str, with_truth: bool, truth_here: bool) -> SoundGroup:
         """The group ``s`` (at (file, key)), checked where its file is not the version found
-        intact before."""
+        intact before; ``truth_here``: its forces are the shot's truth, read first (kept,
+        where the group is intact) and their rows of the table taken from the values read."""
         identity = file_identity(at[0])
         known = self.sound.get(at)
         if known and known.identity == identity:
             return known
-        problems = damage(s, {})
+        forces: dict = {}
+        if truth_here:
+            with contextlib.suppress(Exception):  # damaged: the check below says what
+                forces = truth_forces(s["forces"])
+        rows = {f"forces/{name}": value_digest(values) for name, values in forces.items()}
+        problems = damage(s, {}, read=_every_row, known=rows)
         refused = problems if with_truth else [p for p in problems if not truth_item(p)]
         if refused:
             raise InstrumentError(f"{where}{refused[0]}")
         known = SoundGroup(identity, addresses(s), {k: s[k][()].decode() for k in ("scene_text", "settings") if k in s})
         if not problems:
             self.sound[at] = known
+            if forces:
+                self._keep(at, (identity, forces, True))
         return known
 
-    def _forces(self, s, at: tuple, identity) -> dict:
+    def _forces(self, s, at: tuple, identity, checked: bool) -> dict:
         """The truth forces of the group ``s`` (at (file, key); the file's ``identity`` when it
-        was checked): read once per version of its file, the last ``kept`` groups' kept."""
+        was checked, or now): read once per version of its file, the last ``kept`` groups'
+        kept; a ``checked`` read takes only those its check read."""
         held = self.forces.pop(at, None)
-        if held is None or held[0] is None or held[0] != identity:
-            held = identity, truth_forces(s["forces"])
+        if held is None or held[0] is None or held[0] != identity or (checked and not held[2]):
+            held = identity, truth_forces(s["forces"]), checked
+        self._keep(at, held)
+        return dict(held[1])
+
+    def _keep(self, at: tuple, held: tuple):
+        """Keep ``held`` as the forces of ``at``, the last used: those of the last ``kept`` groups."""
+        self.forces.pop(at, None)
         self.forces[at] = held
         while len(self.forces) > self.kept:
             self.forces.pop(next(iter(self.forces)))
-        return dict(held[1])
 
 
 def truth_forces(forces) -> dict:
     """{name: array in N} of a truth's ``forces`` group (NXdata; its time axis left out),
-    each array read-only: the reads of one scene's shots share them (SharedGroups)."""
+    each array read-only: the reads of one scene's shots share them (SharedGroups). Each is
+    read as the table of checksums reads it (values.member_value), so its row there is the
+    digest of the value returned."""
     axis = forces.attrs["axes"][0]
-    out = {k: v[()] for k, v in forces.items() if k != axis}
+    out = {k: member_value(forces, k) for k in forces if k != axis}
     for values in out.values():
         values.setflags(write=False)
     return out
+
+
+def _every_row(key: str) -> bool:
+    """damage()'s ``read``: every row of a shared group's table, each computed alone."""
+    return True
+
+
+def _sealed(text: str | None) -> dict:
+    """A shot's stored table ({row key: row}); empty where unreadable (damage() says why)."""
+    try:
+        sealed = json.loads(text or "{}")
+    except ValueError:
+        return {}
+    return sealed if isinstance(sealed, dict) else {}
 
 
 def _links_to(sealed: dict, row: str, key: str, name: str) -> bool:

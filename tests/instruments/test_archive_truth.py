@@ -2,7 +2,9 @@
 group under /shared, in the part file that first stored it). An Archive reads and checks them
 once per version of that file (instruments/archive/shared.py): a later read of any shot of
 the scene takes them from the first, read-only; a file replaced on disk is read and checked
-again; the forces of the last FORCES_KEPT groups only are kept.
+again; the forces of the last FORCES_KEPT groups only are kept. Its first read of a version
+reads each of them once (its check takes their rows from the values read); a read that skips
+the checksums takes them from the reads before it too.
 
 The tests prove "not read again" by damaging the stored bytes of a truth dataset in place,
 keeping the file's identity (inode, size, modification time): a read that went to the file
@@ -17,7 +19,7 @@ import numpy as np
 import pytest
 from test_archive_flips import tiny_entry
 
-from instruments.archive import Archive
+from instruments.archive import Archive, digest, values
 from instruments.archive.links import file_identity
 from instruments.archive.shared import FORCES_KEPT
 from instruments.errors import InstrumentError
@@ -126,3 +128,48 @@ def test_layout_2_reads_its_truth_once_per_version_of_the_file(tmp_path):
     Archive(path).append([tiny_entry(5, truth=False)])  # layout 2: the whole file copied, a new version
     with pytest.raises(InstrumentError, match="shot 1: shared/scene_tiny/forces/.*: damaged"):
         a.read(1)
+
+
+def test_the_first_read_of_a_version_reads_each_truth_force_once(tmp_path, monkeypatch):
+    path = tmp_path / "a.h5"
+    Archive(path).append([tiny_entry(1)])
+    Archive(path).append([tiny_entry(2)])
+    reads: list = []
+    read_value = values.dataset_value
+
+    def counted(dataset_id):
+        reads.append(h5py.h5i.get_name(dataset_id).decode())
+        return read_value(dataset_id)
+
+    def counted_item(dataset, key):
+        reads.append(dataset.name)
+        return get_item(dataset, key)
+
+    get_item = h5py.Dataset.__getitem__
+    monkeypatch.setattr(values, "dataset_value", counted)  # how the reader reads a value
+    monkeypatch.setattr(digest, "dataset_value", counted)  # how the check reads one
+    monkeypatch.setattr(h5py.Dataset, "__getitem__", counted_item)  # and any read through h5py's own objects
+    a = Archive(path)
+    truth = a.read(2).truth
+    forces = sorted(r for r in reads if "/forces/" in r and not r.endswith("/time"))
+    assert forces == sorted(f"/shared/scene_tiny/forces/{k}" for k in truth)  # each once, not twice
+    reads.clear()
+    a.read(1)
+    assert not [r for r in reads if "/forces/" in r]  # the same version: kept
+
+
+def test_a_read_that_skips_the_checksums_takes_the_truth_kept(tmp_path):
+    path = tmp_path / "a.h5"
+    Archive(path).append([tiny_entry(1)])
+    Archive(path).append([tiny_entry(2)])
+    a = Archive(path)
+    a.read(1)
+    _flip_in_place(_part(path), "shared/scene_tiny/forces/wall_force")
+    for shot in (2, 1):  # the forces the checked read kept: the damaged chunk never met
+        assert np.array_equal(a.read(shot, verify=False).truth["wall_force"], tiny_entry(1).truth["wall_force"])
+    with pytest.raises(InstrumentError, match="shot 2: unreadable"):
+        Archive(path).read(2, verify=False)  # a new reader reads them from the file
+    b = Archive(path)
+    assert b.read(2, verify=False, with_truth=False).truth is None
+    with pytest.raises(InstrumentError, match="shot 2: shared/scene_tiny/forces/wall_force: damaged"):
+        b.read(2)  # the checked read finds the damage the unchecked one did not read
