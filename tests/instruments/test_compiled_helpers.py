@@ -11,7 +11,7 @@ from instruments._kernels.filters import one_pole, undo_highpass
 from instruments.analysis._kernels.parabola import parabola
 from instruments.analysis._kernels.peaks import local_maxima, thin_by_distance, widths_at
 from instruments.analysis._kernels.prominence import prominence_bases, prominent
-from instruments.analysis._kernels.select import kept, stable_order, taken
+from instruments.analysis._kernels.select import first_largest, kept, largest, left_index, stable_order, taken
 from instruments.devices._kernels.quantiser import quantise
 from instruments.devices._kernels.resample import at_positions
 
@@ -264,3 +264,31 @@ def test_the_selection_loops_are_numpys_indexing_and_stable_argsort():
             assert _same_bits(kept(values, keep), values[keep])
             assert np.array_equal(kept(np.arange(n), keep), np.arange(n)[keep])
             assert _same_bits(taken(values, idx), values[idx])
+
+
+def test_the_search_loops_are_numpys_max_argmax_and_searchsorted():
+    """largest, first_largest and left_index (the analysis' np.max, np.argmax and
+    np.searchsorted as loops) against numpy: ties (the first largest, bit for bit: of 0.0
+    and -0.0 the first, as numba's np.max, where numpy's may give either), nan anywhere (nan,
+    np.argmax the first nan, searchsorted's nan after every number), values off both ends
+    and on the samples."""
+    rng = np.random.default_rng(5)
+    for n in [1, 2, 3, 8, 9, 257]:
+        for values in (rng.standard_normal(n), rng.integers(0, 4, n).astype(float), rng.choice([-0.0, 0.0], n)):
+            cases = [values]
+            for k in {0, n // 2, n - 1}:
+                with_nan = values.copy()
+                with_nan[k] = np.nan
+                cases.append(with_nan)
+            if n > 2:
+                two = cases[-1].copy()
+                two[1] = np.nan
+                cases.append(two)
+            for a in cases:
+                assert _same_bits(np.array([largest(a)]), a[[np.argmax(a)]]), a
+                assert largest(a) == np.max(a) or np.isnan(np.max(a)) and np.isnan(largest(a)), a
+                assert first_largest(a) == np.argmax(a), a
+            grid = np.sort(values)
+            probes = np.concatenate([grid, grid + 1e-9, grid - 1e-9, [-np.inf, np.inf, np.nan, -1e9, 1e9]])
+            for v in probes:
+                assert left_index(grid, v) == np.searchsorted(grid, v), (grid, v)

@@ -20,7 +20,7 @@ from .crossings import level_bracket
 from .parabola import parabola
 from .peaks import local_maxima, thin_by_distance, widths_at
 from .prominence import prominent
-from .select import kept, stable_order, taken
+from .select import first_largest, kept, largest, left_index, stable_order, taken
 
 # the layout of leading_pair's answer
 OK, SAME_RECORD, NO_PULSE, SWAPPED = 0, 1, 2, 3
@@ -59,7 +59,7 @@ def candidates(f, height, min_prominence, spacing, min_width):
     ``height`` high, thinned to ``spacing`` samples from the highest down (equal heights:
     the later first), with at least ``min_prominence`` of prominence and ``min_width``
     samples of width at half prominence. Nothing if f never rises above 0."""
-    if f.shape[0] == 0 or np.max(f) <= 0.0:
+    if f.shape[0] == 0 or largest(f) <= 0.0:
         return np.empty(0, np.int64)
     idx = local_maxima(f, height)
     if spacing > 1 and idx.shape[0]:
@@ -87,7 +87,9 @@ def _vertex(t, f, i, top):
     lo, hi = min(lo, i - 1), max(hi, i + 1)
     if lo < 0 or hi >= f.shape[0]:
         return t[i], f[i]
-    x = np.arange(lo - i, hi - i + 1).astype(np.float64)
+    x = np.empty(hi - lo + 1)  # the samples' offsets from i
+    for k in range(x.shape[0]):
+        x[k] = lo - i + k
     a, b, c = parabola(x, f[lo:hi + 1])
     if not a < 0.0:
         return t[i], f[i]
@@ -151,14 +153,14 @@ def xcorr_lag(t, fa, time_a, fwhm_a, fb, time_b):
     half = fwhm_a
     if not (math.isfinite(half) and half > 0.0):
         return math.nan
-    ia0, ia1 = np.searchsorted(t, time_a - half), np.searchsorted(t, time_a + half)
-    ib0, ib1 = np.searchsorted(t, time_b - 2.0 * half), np.searchsorted(t, time_b + 2.0 * half)
+    ia0, ia1 = left_index(t, time_a - half), left_index(t, time_a + half)
+    ib0, ib1 = left_index(t, time_b - 2.0 * half), left_index(t, time_b + 2.0 * half)
     m, nb = ia1 - ia0, ib1 - ib0
     if m < 3 or nb <= m:
         return math.nan
     c = np.zeros(nb - m + 1)
     correlate(fa[ia0:ia1], fb[ib0:ib1], c)
-    k = int(np.argmax(c))
+    k = first_largest(c)
     shift = 0.0
     if 0 < k < c.shape[0] - 1:
         den = c[k - 1] - 2.0 * c[k] + c[k + 1]
@@ -171,14 +173,14 @@ def _leading(t, f, sigma, rules, r, out):
     """Role r's leading pulse into out (leading_pair's layout); True where found."""
     height_frac, prominence_frac, top, lead, snr, distance, width = rules
     h = t[1] - t[0]
-    peak = np.max(f) if f.shape[0] else 0.0
+    peak = largest(f) if f.shape[0] else 0.0
     floor = height_frac * peak if math.isnan(sigma) else max(height_frac * peak, snr * sigma)
     out[index_of(r, PEAK)] = peak
     idx = candidates(f, floor, prominence_frac * peak, int(np.rint(max(distance, 0.5 * width) / h)), width / h)
     out[index_of(r, FOUND)] = 0.0
     if idx.shape[0] == 0:
         return False
-    big = np.max(f[idx])
+    big = largest(taken(f, idx))
     first = idx[0]
     for i in idx:
         if f[i] >= lead * big:
@@ -193,6 +195,17 @@ def _leading(t, f, sigma, rules, r, out):
 
 
 @jit
+def _same(a, b):
+    """np.array_equal(a, b) of 1-D float arrays (nan equal to nothing)."""
+    if a.shape[0] != b.shape[0]:
+        return False
+    for k in range(a.shape[0]):  # noqa: SIM110 - numba compiles no generator for all()
+        if a[k] != b[k]:
+            return False
+    return True
+
+
+@jit
 def leading_pair(t, up, low, sigma_up, sigma_low, rules, out):
     """The leading pulses of the upper and lower gauges' forces (time t, s) and their delay
     by cross-correlation, into out (ANSWER floats: STATUS, each role's PEAK, FOUND, TIME,
@@ -201,7 +214,7 @@ def leading_pair(t, up, low, sigma_up, sigma_low, rules, out):
     distance, width) as a tuple of floats. STATUS: OK, SAME_RECORD,
     NO_PULSE (FOUND says which), SWAPPED (the lower pulse first)."""
     out[:] = math.nan
-    if up.shape[0] == low.shape[0] and np.all(up == low):
+    if _same(up, low):
         out[STATUS] = SAME_RECORD
         return
     found_up = _leading(t, up, sigma_up, rules, 0, out)

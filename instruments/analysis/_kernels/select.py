@@ -1,8 +1,10 @@
-"""numpy's array selections as plain loops (numba): ``a[keep]`` for a boolean mask and
-``a[idx]`` for an index array. numba lowers each selection written with numpy's indexing
-into its caller, a large block of code for every one (candidates' six took 1.9 s of its
-compile); as calls of these, each element type compiles once. The same elements, in the
-same order."""
+"""numpy's array selections and searches as plain loops (numba): ``a[keep]`` for a boolean
+mask, ``a[idx]`` for an index array, np.max, np.argmax, np.searchsorted and a stable
+argsort. numba lowers each selection written with numpy's indexing into its caller, a large
+block of code for every one (candidates' six took 1.9 s of its compile), and compiles its own
+np.max, np.argmax and np.searchsorted in every process for every caller's types (about 0.6 s
+of a cold shot), never cached; as calls of these, each element type compiles once. The same
+elements, in the same order, numpy's results (NaN included)."""
 import numpy as np
 
 from numerics.jit import jit
@@ -60,3 +62,39 @@ def stable_order(values):
         order, merged = merged, order
         width *= 2
     return order
+
+
+@jit
+def largest(a):
+    """np.max(a) of a non-empty 1-D float array as numba's own computes it: the first of the
+    largest elements (of 0.0 and -0.0, the first), the first nan where any is nan."""
+    top = a[0]
+    for k in range(1, a.shape[0]):
+        if a[k] > top or a[k] != a[k]:  # a nan is kept: nothing is greater than it
+            top = a[k]
+    return top
+
+
+@jit
+def first_largest(a):
+    """np.argmax(a) of a non-empty 1-D float array: the first largest element's index, the
+    first nan's where any is nan."""
+    best = 0
+    for k in range(1, a.shape[0]):
+        if a[best] == a[best] and (a[k] > a[best] or a[k] != a[k]):
+            best = k
+    return best
+
+
+@jit
+def left_index(a, value):
+    """np.searchsorted(a, value) of an ascending 1-D float array: the first index k with
+    a[k] >= value (len(a) where none), a nan sorted after every number as numpy sorts it."""
+    lo, hi = 0, a.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if a[mid] < value or (value != value and a[mid] == a[mid]):
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo

@@ -230,7 +230,7 @@ def balance_at_rest(load, A, d0, expo, invm, tolerance, nudges):
         q = np.spacing(top)
         for i in range(nb):
             if d0[s, i] <= 0.0 and load[s, i] != 0.0:
-                load[s, i] = np.round(load[s, i] / q) * q
+                load[s, i] = np.rint(load[s, i] / q) * q  # np.round(x): numba compiles its decimals branch too
         target = rest_elastic(A[s, 0], d0[s, 0], expo[s, 0]) - load[s, 0]
         for i in range(nb - 1):
             el = rest_elastic(A[s, i + 1], d0[s, i + 1], expo[s, i + 1])

@@ -192,7 +192,10 @@ def head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, h, n, work, lane
     (_resolved_substeps)."""
     busy = lanes[0]
     _busy(u, v, invm, d0, load, head, a_coef, b_coef, h, busy)
-    if busy.sum() > 0.0:
+    resolved = False
+    for s in range(busy.shape[0]):
+        resolved = resolved or busy[s] != 0.0
+    if resolved:
         _resolved_substeps(u, v, invm, f, A, d0, load, head, a_coef, b_coef, h / n, n, work, lanes)
     for i in range(head + 1):
         for s in range(u.shape[1]):
