@@ -20,10 +20,11 @@ import sys
 ANALYSIS, DEVICES = "instruments.analysis._kernels", "instruments.devices._kernels"  # the wings' kernel packages
 F1, F2 = "float64[::1]", "float64[:, ::1]"
 # the instruments' kernels a shot compiles aside: {module.kernel: its argument types}; its analysis (about
-# 8 s CPU on one core here: numba compiles what a kernel calls with it), and the pulse train's candidates
-# (inlined in the leading pair's, so compiled on their own for the train's call from Python)
-SHOT = {f"{ANALYSIS}.pulses.leading_pair": f"({F1}, {F1}, {F1}, float64, float64, UniTuple(float64, 7), {F1})",
-        f"{ANALYSIS}.pulses.candidates": f"({F1}, float64, float64, int64, float64)"}
+# 6.4 s CPU on one core here: numba compiles what a kernel calls with it), and the pulse train's candidates
+# (0.7 s: inlined in the leading pair's, so compiled on their own for the train's call from Python; a study
+# compiles those itself, while it waits for its batches' kernels)
+LEADING = {f"{ANALYSIS}.pulses.leading_pair": f"({F1}, {F1}, {F1}, float64, float64, UniTuple(float64, 7), {F1})"}
+SHOT = {**LEADING, f"{ANALYSIS}.pulses.candidates": f"({F1}, float64, float64, int64, float64)"}
 # the others a shot calls from Python, small (about 2.6 s in all), compiled aside after the analysis: the
 # solver's compile (about 11 s) outlasts both
 SHOT_SMALL = {f"{DEVICES}.acquisition.scope_shot": f"({F2}, float64, int64, float64, boolean, float64, int64, float64, "

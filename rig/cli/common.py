@@ -259,15 +259,16 @@ def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     compiles the chain solver, and say so in one line on stderr when it is a
     terminal (a log or a test keeps a failure's one error line alone) and not ``quiet``.
     Nothing on a warm cache."""
-    from instruments.precompile import SHOT, SHOT_SMALL, STUDY, start
+    from instruments.precompile import LEADING, SHOT, SHOT_SMALL, STUDY, start
     from numerics.dispatcher import has_machine_code
     from rig.solver.kernels.ensemble import integrate_chunks
     from rig.solver.kernels.integrators import integrate
 
     # this process: the chain solver (a shot's single-shot kernel, a study's batched one; about 11 s CPU on one
-    # core here); the side process: the analysis (8 s), then a shot's small kernels (2.6 s), or a study's
-    # batches' acquisition and analysis (9 s), then (not waited for) a shot's small kernels
-    kernels = {**SHOT, **STUDY} if task == "study" else {**SHOT, **SHOT_SMALL}
+    # core here); the side process: the analysis (7 s), then a shot's small kernels (2.3 s), or a study's
+    # leading pair (6.4 s), its batches' acquisition and analysis (9 s), then (not waited for) a shot's small
+    # kernels
+    kernels = {**LEADING, **STUDY} if task == "study" else {**SHOT, **SHOT_SMALL}
     cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_chunks)))
     aside = start(kernels, then=SHOT_SMALL if task == "study" else None)  # so a shot after it compiles nothing
     parts = (["the chain solver"] if cold_solver else []) + (["the instruments"] if aside else [])
