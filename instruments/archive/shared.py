@@ -14,7 +14,8 @@ gzipped): those of the last ``FORCES_KEPT`` groups read are kept, read-only, and
 of one of them returns the same arrays in a dict of its own. The first read of a version
 reads them once: its check takes their rows of the table from the values read. A read that
 skips the checksums (``Archive.read(verify=False)``) takes the forces kept for that version
-of the file too, or reads them and keeps them as unchecked, which a checked read never takes.
+of the file too, or reads them and keeps them as unchecked, which a checked read never takes:
+it reads them again and checks them against the group's table.
 """
 from __future__ import annotations
 
@@ -85,7 +86,7 @@ class SharedGroups:
             if _links_to(sealed, "scene_text", key, "scene_text"):
                 scene = sound.texts
             if truth_here:
-                truth = self._forces(s, at, sound.identity, checked=True)
+                truth = self._forces(s, at, sound.identity, f"{where}: shared/{key}/")
         return Shared(text, linked, scene, truth)
 
     def unchecked_truth(self, f, parts, g) -> dict | None:
@@ -98,7 +99,7 @@ class SharedGroups:
         for key in linked_groups(g, "/shared/", text):
             if _links_to(sealed, "truth/forces", key, "forces"):
                 s = parts.group(f["shared"], key)
-                return self._forces(s, (s.file.filename, key), file_identity(s.file.filename), checked=False)
+                return self._forces(s, (s.file.filename, key), file_identity(s.file.filename))
         return None
 
     def _sound(self, s, at: tuple, where: str, with_truth: bool, truth_here: bool) -> SoundGroup:
@@ -113,8 +114,7 @@ class SharedGroups:
         if truth_here:
             with contextlib.suppress(Exception):  # damaged: the check below says what
                 forces = truth_forces(s["forces"])
-        rows = {f"forces/{name}": value_digest(values) for name, values in forces.items()}
-        problems = damage(s, {}, read=_every_row, known=rows)
+        problems = damage(s, {}, read=_every_row, known=_rows(forces))
         refused = problems if with_truth else [p for p in problems if not truth_item(p)]
         if refused:
             raise InstrumentError(f"{where}{refused[0]}")
@@ -125,13 +125,20 @@ class SharedGroups:
                 self._keep(at, (identity, forces, True))
         return known
 
-    def _forces(self, s, at: tuple, identity, checked: bool) -> dict:
+    def _forces(self, s, at: tuple, identity, checked: str | None = None) -> dict:
         """The truth forces of the group ``s`` (at (file, key); the file's ``identity`` when it
         was checked, or now): read once per version of its file, the last ``kept`` groups'
-        kept; a ``checked`` read takes only those its check read."""
+        kept. A checked read (``checked``: where, for its error) takes only forces that were
+        checked, and checks those it reads against the group's table (InstrumentError)."""
         held = self.forces.pop(at, None)
         if held is None or held[0] is None or held[0] != identity or (checked and not held[2]):
-            held = identity, truth_forces(s["forces"]), checked
+            forces = truth_forces(s["forces"])
+            if checked:
+                rows = _rows(forces)
+                problems = damage(s, {}, read=rows.__contains__, known=rows)
+                if problems:
+                    raise InstrumentError(f"{checked}{problems[0]}")
+            held = identity, forces, bool(checked)
         self._keep(at, held)
         return dict(held[1])
 
@@ -153,6 +160,12 @@ def truth_forces(forces) -> dict:
     for values in out.values():
         values.setflags(write=False)
     return out
+
+
+def _rows(forces: dict) -> dict:
+    """The rows of a shared group's table ({"forces/<name>": SHA-256}) of ``forces`` as read
+    (truth_forces)."""
+    return {f"forces/{name}": value_digest(values) for name, values in forces.items()}
 
 
 def _every_row(key: str) -> bool:

@@ -173,3 +173,15 @@ def test_a_read_that_skips_the_checksums_takes_the_truth_kept(tmp_path):
     assert b.read(2, verify=False, with_truth=False).truth is None
     with pytest.raises(InstrumentError, match="shot 2: shared/scene_tiny/forces/wall_force: damaged"):
         b.read(2)  # the checked read finds the damage the unchecked one did not read
+
+
+def test_a_checked_read_checks_the_forces_an_unchecked_read_kept(tmp_path):
+    path = tmp_path / "a.h5"
+    Archive(path).append([tiny_entry(1)])
+    Archive(path).append([tiny_entry(2)])
+    a = Archive(path)
+    a.read(2, with_truth=False)  # the group checked (its forces not read)
+    a.read(2, verify=False)  # the forces read unchecked, and kept
+    _flip_in_place(_part(path), "shared/scene_tiny/forces/wall_force")
+    with pytest.raises(InstrumentError, match="shot 2: unreadable"):
+        a.read(2)  # not given the unchecked forces: it reads the file and meets the damage

@@ -284,6 +284,9 @@ def test_the_search_loops_are_numpys_max_argmax_and_searchsorted():
                 two = cases[-1].copy()
                 two[1] = np.nan
                 cases.append(two)
+                signs = values.copy()  # nans of other signs and payloads: the first one's bits
+                signs[[1, n - 1]] = -np.nan, np.array(0x7FF8000000000001).view(np.float64)
+                cases.append(signs)
             for a in cases:
                 assert _same_bits(np.array([largest(a)]), a[[np.argmax(a)]]), a
                 assert largest(a) == np.max(a) or np.isnan(np.max(a)) and np.isnan(largest(a)), a

@@ -69,8 +69,10 @@ def largest(a):
     """np.max(a) of a non-empty 1-D float array as numba's own computes it: the first of the
     largest elements (of 0.0 and -0.0, the first), the first nan where any is nan."""
     top = a[0]
-    for k in range(1, a.shape[0]):
-        if a[k] > top or a[k] != a[k]:  # a nan is kept: nothing is greater than it
+    for k in range(a.shape[0]):
+        if a[k] != a[k]:
+            return a[k]
+        if a[k] > top:
             top = a[k]
     return top
 
