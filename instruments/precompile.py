@@ -25,7 +25,7 @@ F1, F2 = "float64[::1]", "float64[:, ::1]"
 # compiles those itself, while it waits for its batches' kernels)
 LEADING = {f"{ANALYSIS}.pulses.leading_pair": f"({F1}, {F1}, {F1}, float64, float64, UniTuple(float64, 7), {F1})"}
 SHOT = {**LEADING, f"{ANALYSIS}.pulses.candidates": f"({F1}, float64, float64, int64, float64)"}
-# the others a shot calls from Python, small (about 2.6 s in all), compiled aside after the analysis: the
+# the others a shot calls from Python, small (about 2.3 s in all), compiled aside after the analysis: the
 # solver's compile (about 11 s) outlasts both
 SHOT_SMALL = {f"{DEVICES}.acquisition.scope_shot": f"({F2}, float64, int64, float64, boolean, float64, int64, float64, "
                                                    f"{F1}, {F1}, {F1}, {F1}, {F2}, float64, float64, int8[:, ::1], "

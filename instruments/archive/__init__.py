@@ -223,12 +223,11 @@ class Archive:
 
     def read(self, shot_id: int, verify: bool = True, with_truth: bool = True) -> Entry:
         """The stored shot as the same record objects the scope produces; with ``verify``,
-        the checksums of what it returns first (all of the shot's table but what only its
-        plot shows: the time axis, the plot's attributes; ``rig verify`` checks those) and
-        of what it shares (once per version of its file, shared.py: the truth's forces,
-        read-only, shared by the reads of a scene's shots, with or without ``verify``). The
-        shot is read from the part its master's link names, opened directly; the master and
-        the parts read last stay open while the files at their paths are those opened."""
+        the checksums of what it returns first (its table's rows but its plot's: the time
+        axis and attributes, which ``rig verify`` checks) and of what it shares (shared.py:
+        once per version of its file; the truth's read-only forces shared by a scene's shots,
+        with or without ``verify``). The shot is read from the part its master's link names;
+        the master and the parts read last stay open while the files there are those opened."""
         import h5py
 
         with self._reader() as (f, parts):

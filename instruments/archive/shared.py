@@ -125,11 +125,12 @@ class SharedGroups:
                 self._keep(at, (identity, forces, True))
         return known
 
-    def _forces(self, s, at: tuple, identity, checked: str | None = None) -> dict:
+    def _forces(self, s, at: tuple, identity, where: str | None = None) -> dict:
         """The truth forces of the group ``s`` (at (file, key); the file's ``identity`` when it
         was checked, or now): read once per version of its file, the last ``kept`` groups'
-        kept. A checked read (``checked``: where, for its error) takes only forces that were
+        kept. A checked read (``where`` given, its error's start) takes only forces that were
         checked, and checks those it reads against the group's table (InstrumentError)."""
+        checked = where is not None
         held = self.forces.pop(at, None)
         if held is None or held[0] is None or held[0] != identity or (checked and not held[2]):
             forces = truth_forces(s["forces"])
@@ -137,8 +138,8 @@ class SharedGroups:
                 rows = _rows(forces)
                 problems = damage(s, {}, read=rows.__contains__, known=rows)
                 if problems:
-                    raise InstrumentError(f"{checked}{problems[0]}")
-            held = identity, forces, bool(checked)
+                    raise InstrumentError(f"{where}{problems[0]}")
+            held = identity, forces, checked
         self._keep(at, held)
         return dict(held[1])
 
