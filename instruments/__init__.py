@@ -23,6 +23,7 @@ if TYPE_CHECKING:  # the names above, for type checkers and editors (tests/test_
     from .analysis.condition import record_forces as record_forces
     from .analysis.find import find_pulses as find_pulses
     from .analysis.find import first_peak_time as first_peak_time
+    from .analysis.find import first_peak_times as first_peak_times
     from .analysis.find import leading as leading
     from .analysis.find import reflection_time as reflection_time
     from .analysis.find import solitary_train as solitary_train

@@ -24,7 +24,7 @@ PUBLIC = {  # {module: its public names}
     "setup": ("GaugeSetup", "Setup"),
     "pulse": ("PeakRules", "Pulse"),
     "condition": ("MIN_BASELINE", "invert_rc", "noise_level", "record_forces"),
-    "find": ("find_pulses", "first_peak_time", "leading", "reflection_time", "solitary_train"),
+    "find": ("find_pulses", "first_peak_time", "first_peak_times", "leading", "reflection_time", "solitary_train"),
     "refine": ("refined", "xcorr_delay"),
     "plausibility": ("Limits",),
     "report": ("FIGURES", "SPEED_FIGURES", "Report"),
@@ -42,6 +42,7 @@ if TYPE_CHECKING:  # the names above, for type checkers and editors (tests/test_
     from .condition import record_forces as record_forces
     from .find import find_pulses as find_pulses
     from .find import first_peak_time as first_peak_time
+    from .find import first_peak_times as first_peak_times
     from .find import leading as leading
     from .find import reflection_time as reflection_time
     from .find import solitary_train as solitary_train

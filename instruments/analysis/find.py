@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 
+from numerics.threads import over_threads
+
 from ._kernels import pulses
 from .pulse import DEFAULT_RULES, PeakRules, Pulse
 from .refine import refined
@@ -86,5 +88,16 @@ def _snr_floor(rules: PeakRules, peak: float, sigma: float | None) -> float | No
 def first_peak_time(f: np.ndarray, h: float) -> float | None:
     """Time (s) of the first local maximum of f - f[0] above half its peak (samples every h
     s): where the pulse first crests; None where f never rises above f[0]."""
-    i = pulses.first_peak(np.ascontiguousarray(f, dtype=float))
-    return None if i < 0 else i * h
+    t = first_peak_times(np.reshape(f, (1, 1, -1)), [0], h)[0, 0]
+    return None if math.isnan(t) else float(t)
+
+
+def first_peak_times(f: np.ndarray, rows, h: float) -> np.ndarray:
+    """first_peak_time of rows ``rows`` of every shot of f (shots, rows, samples; samples
+    every h s), on numba's threads: (shots, len(rows)) s, nan where a signal never rises
+    above its first sample."""
+    f = np.ascontiguousarray(f, dtype=float)
+    rows = np.asarray(rows, np.int64)
+    i = np.empty((f.shape[0], rows.shape[0]), np.int64)
+    over_threads(f.shape[0], lambda lo, hi: pulses.first_peaks(f, rows, lo, hi, i))
+    return np.where(i >= 0, i * h, np.nan)

@@ -16,7 +16,10 @@ small part of it.
 Where the time goes, per batch: the parent's CPU in the steady part (handing batches out,
 taking results in, storing them; on Dask the LocalCluster's scheduler runs in the parent
 too), the workers' CPU (reaped children, so start-up included; none for one worker, which
-runs in this process), and the bytes of one batch's result as it is pickled back."""
+runs in this process), and the bytes of one batch's result as it is pickled back; in one
+process, a batch's time outside its compiled ranges over the shots (numerics/threads.py:
+what runs on one thread whatever N is) and the efficiency that share allows at 4, 8 and 16
+threads (Amdahl)."""
 from __future__ import annotations
 
 import dataclasses
@@ -27,6 +30,7 @@ import statistics
 import tempfile
 import time
 
+from numerics.threads import time_in_ranges
 from rig.study.batch import run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
@@ -86,8 +90,10 @@ def steady_run(study: MonteCarloStudy, workers: int, scheduler: str | None = Non
             "worker_cpu_ms_per_batch": children / study.n_batches * 1e3}
 
 
-def thread_rate(study: MonteCarloStudy, threads: int) -> float:
-    """Shots/s of the batch path in this process on ``threads`` numba threads (median batch)."""
+def thread_rate(study: MonteCarloStudy, threads: int) -> dict:
+    """The batch path in this process on ``threads`` numba threads: shots/s (median batch),
+    and the median batch's time outside the compiled ranges over the shots (ms: its Python,
+    numpy and kernels called alone, which run on one thread whatever ``threads`` is)."""
     import numba
 
     was = numba.get_num_threads()
@@ -95,14 +101,24 @@ def thread_rate(study: MonteCarloStudy, threads: int) -> float:
     try:
         for b in range(WARM_UP):
             run_batch(study, b)
-        wall = []
+        wall, outside = [], []
         for b in range(WARM_UP, WARM_UP + THREAD_BATCHES):
-            t0 = time.perf_counter()
+            t0, r0 = time.perf_counter(), time_in_ranges()
             run_batch(study, b)
             wall.append(time.perf_counter() - t0)
+            outside.append(wall[-1] - (time_in_ranges() - r0))
     finally:
         numba.set_num_threads(was)
-    return study.batch / statistics.median(wall)
+    return {"shots_per_s": study.batch / statistics.median(wall),
+            "outside_ranges_ms_per_batch": statistics.median(outside) * 1e3,
+            "batch_ms": statistics.median(wall) * 1e3}
+
+
+def amdahl_efficiency(serial: float, n: int, base: int = 2) -> float:
+    """The most parallel efficiency vs ``base`` (rate_n / (n/base x rate_base)) one batch on n
+    threads can have when a share ``serial`` of its time on one thread runs on one thread
+    whatever n is: (serial + (1 - serial) / base) / (serial + (1 - serial) / n) / (n / base)."""
+    return (serial + (1 - serial) / base) / (serial + (1 - serial) / n) / (n / base)
 
 
 def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
@@ -124,7 +140,7 @@ def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
             rows["dask"][n] = steady_run(_study(vary, n, batch, seed=2), n, scheduler="local")
         # numba.config sets its options at import: a checker does not see them
         if n <= numba.config.NUMBA_NUM_THREADS:  # type: ignore[attr-defined]
-            rows["threads"][n] = {"shots_per_s": thread_rate(_study(vary, 1, batch, seed=3), n)}
+            rows["threads"][n] = thread_rate(_study(vary, 1, batch, seed=3), n)
     for by_n in rows.values():
         for n, row in by_n.items():
             row["efficiency_vs_2"] = _efficiency(by_n, n, 2)
@@ -177,6 +193,15 @@ def table(r: dict) -> str:
             lines.append(f"  per batch, {mode}: parent CPU ms (steady) / workers' CPU ms (start-up included): "
                          + ", ".join(f"N = {n}: {row['parent_cpu_ms_per_batch']:.1f} / "
                                      f"{row['worker_cpu_ms_per_batch']:.0f}" for n, row in by_n.items()))
+    threads = r["modes"].get("threads", {})
+    if 1 in threads:
+        one = threads[1]
+        serial = one["outside_ranges_ms_per_batch"] / one["batch_ms"]
+        lines.append("  per batch, threads: outside the compiled ranges (one thread whatever N), ms: "
+                     + ", ".join(f"N = {n}: {row['outside_ranges_ms_per_batch']:.1f} of {row['batch_ms']:.1f}"
+                                 for n, row in threads.items())
+                     + f"; {serial:.0%} on one thread bounds N threads' efficiency vs 2 (Amdahl) at "
+                     + ", ".join(f"{amdahl_efficiency(serial, n):.0%} at N = {n}" for n in (4, 8, 16)))
     lines.append(f"  a batch's result as pickled back to the parent: {r['result_bytes_per_shot']:.0f} bytes per shot")
     if "store_ms_per_batch" in r:
         alone, grouped = (r["store_ms_per_batch"][k] for k in sorted(r["store_ms_per_batch"]))

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from instruments.analysis import first_peak_time
+from instruments.analysis import first_peak_times
 from rig.errors import RigError
 
 
@@ -61,14 +61,17 @@ def wave_speed(gauges: dict, h: float) -> float | None:
     if len(gauges) < 2:
         return None
     g = sorted(gauges.values(), key=lambda t: t.position_m)
-    return speed_between(g[0].position_m, g[0].average_force, g[-1].position_m, g[-1].average_force, h)
+    v = speeds_between(np.array([g[0].position_m]), np.array([g[-1].position_m]),
+                       np.stack([g[0].average_force, g[-1].average_force])[None], 0, 1, h)[0]
+    return None if np.isnan(v) else float(v)
 
 
-def speed_between(x_top: float, f_top: np.ndarray, x_bottom: float, f_bottom: np.ndarray, h: float) -> float | None:
-    """Leading-pulse speed (m/s) between two beads at x_top and x_bottom (m) from the first
-    peaks of their forces (N, every h s); None where either has none or they come in the
-    wrong order."""
-    t_top, t_bottom = first_peak_time(f_top, h), first_peak_time(f_bottom, h)
-    if t_top is None or t_bottom is None or t_bottom <= t_top:
-        return None
-    return (x_bottom - x_top) / (t_bottom - t_top)
+def speeds_between(x_top: np.ndarray, x_bottom: np.ndarray, forces: np.ndarray, top: int, bottom: int,
+                   h: float) -> np.ndarray:
+    """Each shot's leading-pulse speed (m/s) between two beads at x_top and x_bottom (m, one
+    per shot), from the first peaks of their forces, rows ``top`` and ``bottom`` of forces
+    (shots, rows, samples; N, every h s): (x_bottom - x_top) / (t_bottom - t_top); nan where
+    either has no peak or they come in the wrong order."""
+    t = first_peak_times(forces, [top, bottom], h)
+    later = t[:, 1] > t[:, 0]  # False where either is nan
+    return np.where(later, (x_bottom - x_top) / np.where(later, t[:, 1] - t[:, 0], 1.0), np.nan)

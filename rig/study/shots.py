@@ -14,7 +14,7 @@ import numpy as np
 
 from instruments.devices.batch import Wiring
 from rig.experiment.shot import Rig
-from rig.experiment.truth import speed_between
+from rig.experiment.truth import speeds_between
 from rig.model.parts import GaugeBead
 from rig.model.statics import contact_constants_of, equilibrium_positions_of, static_forces_of, static_overlaps_of
 from rig.solver.problem import PER_BODY, ChainProblem, ProblemArrays, problem_arrays
@@ -114,8 +114,4 @@ def wave_speeds(template: Rig, shots: Shots, forces: np.ndarray, h: float) -> np
     first, every h s): the speed that turns a position error into a delay (Truth)."""
     order = np.argsort([g.bead for g in template.gauges], kind="stable")
     top, bottom = order[0], order[-1]
-    out = np.full(forces.shape[0], np.nan)
-    for s in range(forces.shape[0]):
-        v = speed_between(shots.positions[s, top], forces[s, top], shots.positions[s, bottom], forces[s, bottom], h)
-        out[s] = np.nan if v is None else v
-    return out
+    return speeds_between(shots.positions[:, top], shots.positions[:, bottom], forces, int(top), int(bottom), h)

@@ -79,7 +79,12 @@ def test_the_mc_scaling_table_runs_at_one_and_two_workers(monkeypatch):
     pool = r["modes"]["workers"]
     assert pool[2]["parent_cpu_ms_per_batch"] > 0 and pool[2]["worker_cpu_ms_per_batch"] > 0
     assert set(r["store_ms_per_batch"]) == {1, mc_scaling.STORE_GROUP} and min(r["store_ms_per_batch"].values()) > 0
+    for row in r["modes"]["threads"].values():  # a batch's time outside its compiled ranges, measured
+        assert 0 < row["outside_ranges_ms_per_batch"] < row["batch_ms"]
+    assert mc_scaling.amdahl_efficiency(0.0, 16) == 1 and mc_scaling.amdahl_efficiency(1.0, 16) == 2 / 16
+    assert abs(mc_scaling.amdahl_efficiency(0.1, 16) - (0.55 / 0.15625) / 8) < 1e-12
     text = mc_scaling.table(r)
+    assert "outside the compiled ranges" in text and "at N = 16" in text
     for mode, label in mc_scaling.MODES.items():
         if mode in r["modes"]:
             assert label in text and f"{r['modes'][mode][2]['shots_per_s']:7.0f} (100%)" in text

@@ -295,3 +295,43 @@ def test_the_search_loops_are_numpys_max_argmax_and_searchsorted():
             probes = np.concatenate([grid, grid + 1e-9, grid - 1e-9, [-np.inf, np.inf, np.nan, -1e9, 1e9]])
             for v in probes:
                 assert left_index(grid, v) == np.searchsorted(grid, v), (grid, v)
+
+
+def _first_crest(f):
+    """The definition, sample by sample: the first sample above half of max(f - f[0]), then
+    on while the next does not fall; None where f never rises above f[0]."""
+    rise = [x - f[0] for x in f]
+    top = max(rise, default=0.0)
+    if top <= 0:
+        return None
+    i = next(k for k, r in enumerate(rise) if r > 0.5 * top)
+    while i + 1 < len(rise) and not rise[i + 1] < rise[i]:
+        i += 1
+    return i
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_first_crests_of_many_shots_are_each_shots_own(threads):
+    import numba
+
+    from instruments.analysis.find import first_peak_time, first_peak_times
+
+    rng = np.random.default_rng(5)
+    f = np.round(rng.standard_normal((37, 3, 200)).cumsum(axis=2))  # plateaus: ties at the crest
+    f[4, 1] = f[4, 1, 0] - np.abs(f[4, 1] - f[4, 1, 0])  # never above its first sample: no crest
+    f[5, 2] = 7.0  # flat
+    h = 2.5e-7
+    was = numba.get_num_threads()
+    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    try:
+        t = first_peak_times(f, [2, 0], h)
+    finally:
+        numba.set_num_threads(was)
+    assert t.shape == (37, 2)
+    for s in range(37):
+        for k, row in enumerate((2, 0)):
+            i = _first_crest(list(f[s, row]))
+            assert (math.isnan(t[s, k]) if i is None else t[s, k] == i * h)
+            single = first_peak_time(f[s, row], h)
+            assert single == (None if i is None else i * h)
+    assert np.isnan(t[5, 0]) and np.isnan(first_peak_times(f, [1], h)[4, 0])

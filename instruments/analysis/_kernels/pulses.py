@@ -36,10 +36,12 @@ def index_of(r, field):
     return 1 + ROLE * r + field
 
 
-@jit
+@jit(inline="always")
 def first_peak(f):
     """Index of the first local maximum of f - f[0] above half its peak (-1: f never rises
-    above f[0]): the sample where the climb from the first one above half stops."""
+    above f[0]): the sample where the climb from the first one above half stops. Called
+    from first_peaks alone, inlined there (a library of its own is compiled, linked and
+    optimised once more)."""
     top = 0.0
     for k in range(f.shape[0]):
         top = max(top, f[k] - f[0])
@@ -51,6 +53,15 @@ def first_peak(f):
     while i + 1 < f.shape[0] and not (f[i + 1] - f[0] < f[i] - f[0]):
         i += 1
     return i
+
+
+@jit(nogil=True)
+def first_peaks(f, rows, lo, hi, out):
+    """out[s, k] = first_peak(f[s, rows[k]]) for shots s in lo..hi-1 of f (shots, rows,
+    samples): the first crests of many shots' signals, a range of shots per thread."""
+    for s in range(lo, hi):
+        for k in range(rows.shape[0]):
+            out[s, k] = first_peak(f[s, rows[k]])
 
 
 @jit(inline="always")
