@@ -1,11 +1,15 @@
 """numerics.threads: a compiled loop's ranges on numba's threads, the helper threads kept."""
+import os
 import threading
 
 import numba
 import numpy as np
 import pytest
 
-from numerics.threads import over_threads
+from numerics.threads import HELPERS, over_threads, time_in_ranges
+
+MANY = numba.config.NUMBA_NUM_THREADS >= 2
+needs_two = pytest.mark.skipif(not MANY, reason="one core: every range runs in the caller")
 
 
 def _with_threads(n, call):
@@ -15,6 +19,14 @@ def _with_threads(n, call):
         return call()
     finally:
         numba.set_num_threads(was)
+
+
+def _in_time(target, seconds=20.0):
+    """Run ``target`` on a thread; False where it has not ended after ``seconds`` (a hang)."""
+    t = threading.Thread(target=target, daemon=True)
+    t.start()
+    t.join(seconds)
+    return not t.is_alive()
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 17])
@@ -30,22 +42,21 @@ def test_every_item_is_in_exactly_one_range(n):
     assert (seen == 1).all()
 
 
-def test_the_helper_threads_are_started_once_and_the_caller_takes_a_range():
-    if numba.config.NUMBA_NUM_THREADS < 2:
-        pytest.skip("one core: every range runs in the caller")
+@needs_two
+def test_the_helper_threads_are_kept_and_the_caller_takes_a_range():
     used = []
 
     def run(lo, hi):
         used.append(threading.current_thread())
 
     _with_threads(2, lambda: over_threads(10, run))
-    alive = set(threading.enumerate())
+    pool = HELPERS.pool
     for _ in range(4):
         _with_threads(2, lambda: over_threads(10, run))
+    assert HELPERS.pool is pool  # the same pool for every call: no thread started and joined per call
     assert used.count(threading.current_thread()) == 5  # the caller runs the first range of each call
     helpers = set(used) - {threading.current_thread()}
-    assert helpers and helpers <= alive  # no thread started after the first call
-    assert all(t.is_alive() for t in helpers)  # kept between calls
+    assert helpers and all(t.name.startswith("numba-range") and t.is_alive() for t in helpers)
 
 
 def test_an_error_in_a_range_comes_after_every_range_has_run():
@@ -59,33 +70,87 @@ def test_an_error_in_a_range_comes_after_every_range_has_run():
 
     with pytest.raises(ValueError, match="first range"):
         _with_threads(2, lambda: over_threads(4, run))
-    if numba.config.NUMBA_NUM_THREADS >= 2:
+    if MANY:
         assert done == [2]  # the other range had finished when the error came
 
 
-def test_callers_on_several_threads_share_the_helpers():
-    totals = {}
+def test_callers_on_several_threads_share_the_helpers_while_the_pool_grows():
+    # numba's thread count is per thread: callers asking for more helpers than the pool has
+    # replace it with a bigger one while others hand ranges over, and no range may fail
+    # (handed to a pool shut down) or be lost
+    from concurrent.futures import wait
+
+    failures, totals = [], {}
 
     def caller(k):
-        out = np.zeros(100)
+        out = np.zeros(64)
 
         def run(lo, hi):
             out[lo:hi] = np.arange(lo, hi) * k
 
-        _with_threads(2, lambda: over_threads(100, run))
-        totals[k] = out.sum()
+        try:
+            for trial in range(30):
+                helpers = 1 + (k + trial) % 8
+                cuts = [64 * j // (helpers + 1) for j in range(helpers + 2)]
+                futures = HELPERS.submit(run, list(zip(cuts[1:-1], cuts[2:])))
+                run(cuts[0], cuts[1])
+                wait(futures)
+                for f in futures:
+                    f.result()
+            totals[k] = out.sum()
+        except BaseException as exc:  # noqa: BLE001 - the test reports any failure below
+            failures.append(exc)
 
-    threads = [threading.Thread(target=caller, args=(k,)) for k in range(1, 5)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    assert totals == {k: k * 4950.0 for k in range(1, 5)}
+    for _ in range(5):
+        HELPERS.reset()  # a fresh pool, grown by the callers as they come
+        threads = [threading.Thread(target=caller, args=(k,)) for k in range(8)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        assert failures == []
+        assert totals == {k: k * 2016.0 for k in range(8)}
+    _with_threads(2, lambda: over_threads(8, lambda lo, hi: None))  # and over_threads goes on with it
+
+
+def test_a_range_that_runs_over_threads_again_does_not_hang():
+    seen = np.zeros(16, int)
+    lock = threading.Lock()
+
+    def inner(lo, hi):
+        with lock:
+            seen[lo:hi] += 1
+
+    def outer(lo, hi):
+        over_threads(16, inner)  # runs in the range's own thread
+
+    assert _in_time(lambda: _with_threads(2, lambda: over_threads(4, outer)))
+    assert (seen == min(4, numba.config.NUMBA_NUM_THREADS)).all()
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork on this system")
+@needs_two
+def test_a_forked_child_starts_helpers_of_its_own():
+    _with_threads(2, lambda: over_threads(4, lambda lo, hi: None))  # the parent's pool exists
+    pid = os.fork()
+    if pid == 0:  # the child: its ranges must run (the parent's threads are not there)
+        code = 1
+        try:
+            out = np.zeros(4)
+
+            def run(lo, hi):
+                out[lo:hi] = 1.0
+
+            _with_threads(2, lambda: over_threads(4, run))
+            code = 0 if out.sum() == 4.0 else 1
+        finally:
+            os._exit(code)
+    waited = []
+    assert _in_time(lambda: waited.append(os.waitpid(pid, 0)))
+    assert os.waitstatus_to_exitcode(waited[0][1]) == 0
 
 
 def test_the_time_in_ranges_is_counted_for_the_calling_thread():
-    from numerics.threads import time_in_ranges
-
     before = time_in_ranges()
     _with_threads(2, lambda: over_threads(2, lambda lo, hi: threading.Event().wait(0.05)))
     spent = time_in_ranges() - before

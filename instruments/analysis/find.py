@@ -5,11 +5,13 @@ first crest of a signal. Each pulse found is refined (refine.py) unless asked no
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
 from numerics.threads import over_threads
 
+from ..errors import InstrumentError
 from ._kernels import pulses
 from .pulse import DEFAULT_RULES, PeakRules, Pulse
 from .refine import refined
@@ -88,16 +90,23 @@ def _snr_floor(rules: PeakRules, peak: float, sigma: float | None) -> float | No
 def first_peak_time(f: np.ndarray, h: float) -> float | None:
     """Time (s) of the first local maximum of f - f[0] above half its peak (samples every h
     s): where the pulse first crests; None where f never rises above f[0]."""
-    t = first_peak_times(np.reshape(f, (1, 1, -1)), [0], h)[0, 0]
+    f = np.asarray(f, dtype=float)
+    if f.ndim != 1:
+        raise InstrumentError(f"signal of shape {f.shape}: allowed one dimension (samples)")
+    t = first_peak_times(f.reshape(1, 1, -1), [0], h)[0, 0]
     return None if math.isnan(t) else float(t)
 
 
-def first_peak_times(f: np.ndarray, rows, h: float) -> np.ndarray:
+def first_peak_times(f: np.ndarray, rows: Sequence[int] | np.ndarray, h: float) -> np.ndarray:
     """first_peak_time of rows ``rows`` of every shot of f (shots, rows, samples; samples
     every h s), on numba's threads: (shots, len(rows)) s, nan where a signal never rises
     above its first sample."""
     f = np.ascontiguousarray(f, dtype=float)
-    rows = np.asarray(rows, np.int64)
+    rows = np.asarray(rows, np.int64).reshape(-1)
+    if f.ndim != 3:
+        raise InstrumentError(f"signals of shape {f.shape}: allowed (shots, rows, samples)")
+    if rows.size and not (rows.min() >= 0 and rows.max() < f.shape[1]):
+        raise InstrumentError(f"rows = {rows.tolist()}: allowed 0 .. {f.shape[1] - 1} (the signals' rows)")
     i = np.empty((f.shape[0], rows.shape[0]), np.int64)
     over_threads(f.shape[0], lambda lo, hi: pulses.first_peaks(f, rows, lo, hi, i))
     return np.where(i >= 0, i * h, np.nan)

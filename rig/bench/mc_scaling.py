@@ -91,9 +91,10 @@ def steady_run(study: MonteCarloStudy, workers: int, scheduler: str | None = Non
 
 
 def thread_rate(study: MonteCarloStudy, threads: int) -> dict:
-    """The batch path in this process on ``threads`` numba threads: shots/s (median batch),
-    and the median batch's time outside the compiled ranges over the shots (ms: its Python,
-    numpy and kernels called alone, which run on one thread whatever ``threads`` is)."""
+    """The batch path in this process on ``threads`` numba threads, medians over the timed
+    batches: shots/s, a batch's wall time (ms) and its time outside the compiled ranges over
+    the shots (ms: its Python, numpy and kernels called alone, which run on one thread
+    whatever ``threads`` is)."""
     import numba
 
     was = numba.get_num_threads()

@@ -315,6 +315,7 @@ def test_first_crests_of_many_shots_are_each_shots_own(threads):
     import numba
 
     from instruments.analysis.find import first_peak_time, first_peak_times
+    from instruments.errors import InstrumentError
 
     rng = np.random.default_rng(5)
     f = np.round(rng.standard_normal((37, 3, 200)).cumsum(axis=2))  # plateaus: ties at the crest
@@ -335,3 +336,9 @@ def test_first_crests_of_many_shots_are_each_shots_own(threads):
             single = first_peak_time(f[s, row], h)
             assert single == (None if i is None else i * h)
     assert np.isnan(t[5, 0]) and np.isnan(first_peak_times(f, [1], h)[4, 0])
+    for call, message in ((lambda: first_peak_times(f, [3], h), r"rows = \[3\]: allowed 0 .. 2"),
+                          (lambda: first_peak_times(f, [-1], h), r"rows = \[-1\]"),
+                          (lambda: first_peak_times(f[0], [0], h), r"shape \(3, 200\): allowed \(shots, rows"),
+                          (lambda: first_peak_time(f[0], h), r"shape \(3, 200\): allowed one dimension")):
+        with pytest.raises(InstrumentError, match=message):
+            call()
