@@ -37,11 +37,13 @@ def analysed(records: Records, setup: Setup) -> list:
     read = records.codes[:, roles]
     lo, hi = code_rails(read)
     touches = np.any((read <= lo) | (read >= hi), axis=2)  # (shots, 2): which channels reach a rail at all
+    flagged = np.any(touches | records.over[:, roles], axis=1)  # a channel at a rail or over range: a Clip to make
     out = []
     for s in range(S):
         rep = Report(beta=setup.beta, static_force_N=setup.static_force_N)
-        if records.outcome(s) is not OK:
-            out.append(rep.refuse(records.outcome(s).message))
+        outcome = records.outcome(s)
+        if outcome is not OK:
+            out.append(rep.refuse(outcome.message))
         elif not finite[s]:
             out.append(rep.refuse("samples that are not finite numbers"))
         else:
@@ -50,6 +52,6 @@ def analysed(records: Records, setup: Setup) -> list:
                      for k, r in enumerate(("upper", "lower"))}
             clipped = tuple(filter(None, (clipping(channels[c], rail_of_codes(records.codes[s, c]) if touches[s, k]
                                                    else Rail(), dx, bool(records.over[s, c]))
-                                          for k, c in enumerate(roles))))
+                                          for k, c in enumerate(roles)))) if flagged[s] else ()
             out.append(report_of(answer[s], t, {}, setup, False, noise, clipped, limits))
     return out

@@ -181,16 +181,17 @@ def _fire_arrays(study: MonteCarloSpec, nom, template: Rig, drawn: list, out: di
     reports = analysed(records, setup)
     roles = [records.wiring.channels.index(setup.upper.channel), records.wiring.channels.index(setup.lower.channel)]
     succeeded, energy_errors = ens.succeeded, ens.energy_errors
+    clipped = records.over[:, roles].any(axis=1)  # a channel the analysis reads ran off the scope's range
     for e, j in enumerate(keep):
         if not succeeded[e]:
             out["failure"][j] = Failure.UNSTABLE
             continue
-        if records.outcome(e) is AcquisitionStatus.PAST_INPUT:  # the scope's record ends after the simulated window
+        outcome = records.outcome(e)
+        if outcome is AcquisitionStatus.PAST_INPUT:  # the scope's record ends after the simulated window
             out["failure"][j] = Failure.SHORT_WINDOW
             continue
-        triggered = records.outcome(e) is AcquisitionStatus.OK
-        _outputs(out, int(j), reports[e], None, float(energy_errors[e]), ens.dt, triggered,
-                 bool(records.over[e, roles].any()))
+        _outputs(out, int(j), reports[e], None, float(energy_errors[e]), ens.dt, outcome is AcquisitionStatus.OK,
+                 bool(clipped[e]))
 
 
 def _outputs(out: dict, j: int, m, t, energy_error: float, dt: float, triggered: bool, clipped: bool):
