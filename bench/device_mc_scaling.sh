@@ -6,14 +6,14 @@
 # COUNTS, with each one's parallel efficiency against 2 (rig/bench/mc_scaling.py), once for
 # each batch size of BATCHES (a smaller batch tells whether memory traffic caps the workers).
 #
-#   bench/device_mc_scaling.sh                    # N = 2 4 8 16
+#   bench/device_mc_scaling.sh                    # N = 1 2 4 8 16
 #   COUNTS="1 2" BATCHES=256 bench/device_mc_scaling.sh   # a small machine
 #
 # PYTHON: the interpreter to use (default python3); WHEELS: a folder of wheels to install
 # from without an index; OUT: a folder for mc_scaling.json and the log (default: a temporary one).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-COUNTS=${COUNTS:-"2 4 8 16"}
+COUNTS=${COUNTS:-"1 2 4 8 16"}  # 1: the serial share of a batch in one process (the Amdahl line)
 BATCHES=${BATCHES:-"256 64"}  # rig mc's default batch, and a batch whose arrays stay in a core's share of cache
 OUT=${OUT:-$(mktemp -d)}
 PYTHON=${PYTHON:-python3}
