@@ -181,7 +181,7 @@ def _fire_arrays(study: MonteCarloSpec, nom, template: Rig, drawn: list, out: di
     reports = analysed(records, setup)
     roles = [records.wiring.channels.index(setup.upper.channel), records.wiring.channels.index(setup.lower.channel)]
     succeeded, energy_errors = ens.succeeded, ens.energy_errors
-    clipped = records.over[:, roles].any(axis=1)  # a channel the analysis reads ran off the scope's range
+    clipped = np.any(records.over[:, roles], axis=1)  # a channel the analysis reads ran off the scope's range
     for e, j in enumerate(keep):
         if not succeeded[e]:
             out["failure"][j] = Failure.UNSTABLE
