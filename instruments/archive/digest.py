@@ -23,12 +23,12 @@ from typing import TYPE_CHECKING
 
 from .addresses import address, external, member_address
 from .hashes import attribute_digest, sha, value_digest
+from .stored import TABLE, stored_table
 from .values import attribute_names, attribute_or, attribute_value, dataset_value, h5py_object, hdf5_id
 
 if TYPE_CHECKING:
     import h5py
 
-TABLE = "checksums"  # the dataset (layout 4: the attribute) that holds a group's table
 DIGEST = "sha256"  # the group attribute that holds the table's own SHA-256
 _REFERENCE_ATTRS = ("DIMENSION_LIST", "REFERENCE_LIST")
 
@@ -160,14 +160,6 @@ def member_row(names) -> str:
     return sha(json.dumps(sorted(names)).encode())
 
 
-def stored_table(group: h5py.Group) -> str:
-    """The text of ``group``'s table as stored (an attribute, or a dataset)."""
-    text = attribute_or(group, TABLE)
-    if text is None:  # a table before layout 4: a dataset
-        text = group[TABLE][()]
-    return text.decode() if isinstance(text, bytes) else str(text)
-
-
 def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None, text: str | None = None) -> list:
     """What differs between ``group``'s stored table and the file: a list of
     "path: what is wrong" lines, empty when every item matches. ``read`` (a test of a row's
@@ -256,26 +248,6 @@ def _row(at, key: str, sealed: str, t: _Tree) -> str:
     if is_attr:
         return _attr_digest(obj, attr, names(t) if attr in _REFERENCE_ATTRS else {})
     return member_row(n for n in h5py_object(obj) if n != TABLE or obj is not group)  # a group's member names
-
-
-def table_text(group: h5py.Group) -> str | None:
-    """stored_table(), None where it cannot be read (damage() then says why)."""
-    try:
-        return stored_table(group)
-    except Exception:  # noqa: BLE001
-        return None
-
-
-def linked_groups(group: h5py.Group, under: str, text: str | None = None) -> set:
-    """The groups below ``under`` (e.g. "/shared/") that ``group``'s stored table links to,
-    by name ({"scene_ab12"}); empty when the table is unreadable (its check says why).
-    ``text``: the stored table's text, as for damage()."""
-    try:
-        rows = json.loads(stored_table(group) if text is None else text)
-    except Exception:  # noqa: BLE001
-        return set()
-    return {v[len("link:") + len(under):].split("/", 1)[0] for v in rows.values()
-            if isinstance(v, str) and v.startswith("link:" + under)}
 
 
 def _dataset_digest(d) -> str:

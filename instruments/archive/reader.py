@@ -13,13 +13,14 @@ from typing import TYPE_CHECKING
 from ..errors import InstrumentError
 from ..records import Preamble, ScopeRecord, Waveform
 from .compact import LAYOUT4
-from .digest import damage, linked_groups
+from .digest import damage
 from .entry import Entry, raw_digest
 from .facts import ShotFacts
 from .hashes import attribute_digest, value_digest
 from .links import returned_by_read
 from .opening import stored_raw_digest
 from .shared import Shared, truth_forces
+from .stored import linked_groups
 from .values import attribute_value, dataset_value, member_value
 
 if TYPE_CHECKING:

@@ -20,13 +20,13 @@ it reads them again and checks them against the group's table.
 from __future__ import annotations
 
 import contextlib
-import json
 from dataclasses import dataclass
 
 from ..errors import InstrumentError
-from .digest import damage, linked_groups, table_text
+from .digest import damage
 from .hashes import value_digest
 from .links import file_identity, truth_item
+from .stored import links_below, stored_rows, table_text
 from .values import member_value
 from .verify import addresses
 
@@ -76,8 +76,8 @@ class SharedGroups:
         linked: dict = {}
         scene, truth = None, None
         text = table_text(g)
-        sealed = _sealed(text)
-        for key in sorted(linked_groups(g, "/shared/", text)):
+        sealed = stored_rows(text)
+        for key in sorted(links_below(sealed, "/shared/")):
             s = parts.group(f["shared"], key)  # its part opened directly, as the shot's is
             at = (s.file.filename, key)
             truth_here = with_truth and _links_to(sealed, "truth/forces", key, "forces")
@@ -94,9 +94,8 @@ class SharedGroups:
         those kept for the version of their file that is there now, else read from it and
         kept as unchecked; None where its table names no shared truth (the caller reads the
         shot's own)."""
-        text = table_text(g)
-        sealed = _sealed(text)
-        for key in linked_groups(g, "/shared/", text):
+        sealed = stored_rows(table_text(g))
+        for key in links_below(sealed, "/shared/"):
             if _links_to(sealed, "truth/forces", key, "forces"):
                 s = parts.group(f["shared"], key)
                 return self._forces(s, (s.file.filename, key), file_identity(s.file.filename))
@@ -172,15 +171,6 @@ def _rows(forces: dict) -> dict:
 def _every_row(key: str) -> bool:
     """damage()'s ``read``: every row of a shared group's table, each computed alone."""
     return True
-
-
-def _sealed(text: str | None) -> dict:
-    """A shot's stored table ({row key: row}); empty where unreadable (damage() says why)."""
-    try:
-        sealed = json.loads(text or "{}")
-    except ValueError:
-        return {}
-    return sealed if isinstance(sealed, dict) else {}
 
 
 def _links_to(sealed: dict, row: str, key: str, name: str) -> bool:

@@ -20,9 +20,10 @@ import re
 from typing import TYPE_CHECKING
 
 from .addresses import address
-from .digest import TABLE, damage, linked_groups, sha, table_text
+from .digest import damage, sha
 from .links import OpenParts
 from .members import expanded
+from .stored import TABLE, linked_groups, table_text
 
 if TYPE_CHECKING:
     import h5py

@@ -140,8 +140,9 @@ def test_the_table_a_writer_seals_is_the_one_the_file_reads(tmp_path):
     time axis, a scene stored by an earlier part, a shot alone, two time bases, volts)."""
     import json
 
-    from instruments.archive.digest import stored_table, table
+    from instruments.archive.digest import table
     from instruments.archive.links import OpenParts
+    from instruments.archive.stored import stored_table
     from instruments.archive.verify import addresses
     from instruments.records import Preamble, ScopeRecord, Waveform
 
