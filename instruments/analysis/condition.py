@@ -38,7 +38,7 @@ def record_forces(record: ScopeRecord, setup: Setup):
         if t is None:
             t, first = w.time(), w
         out[role] = baseline.conditioned(np.ascontiguousarray(w.volts(), dtype=float), int(w.preamble.trigger_index),
-                                       float(h), float(g.tau_s or 0.0), float(g.sensitivity_V_per_N))
+                                         float(h), float(g.tau_s or 0.0), float(g.sensitivity_V_per_N))
     return t, out
 
 

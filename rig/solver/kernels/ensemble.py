@@ -87,14 +87,13 @@ def integrate_chunks(first, last, u3, v3, chain, contacts, holder, method, recor
         u, v, mass, invm, bias, load, A, d0 = u3[k], v3[k], mass3[k], invm3[k], bias3[k], load3[k], A3[k], d03[k]
         con, state, onsite, d_limit = con3[k], state3[k], onsite3[k], d_limit3[k]
         e_ref, p_ref, diag = e_ref3[k], p_ref3[k], diag3[k]
-        lo = k * u.shape[1]
-        f = np.zeros((u.shape[0] + 1, u.shape[1]))
-        d_old = np.zeros((n_ch, ch_slot.shape[1], u.shape[1]))
-        r_old = np.zeros((n_ch, ch_slot.shape[1], u.shape[1]))
-        d_new = np.zeros((n_ch, ch_slot.shape[1], u.shape[1]))
-        r_new = np.zeros((n_ch, ch_slot.shape[1], u.shape[1]))
-        nb = u.shape[0]
-        W = u.shape[1]
+        nb, W = u.shape
+        lo = k * W
+        f = np.zeros((nb + 1, W))
+        d_old = np.zeros((n_ch, ch_slot.shape[1], W))
+        r_old = np.zeros((n_ch, ch_slot.shape[1], W))
+        d_new = np.zeros((n_ch, ch_slot.shape[1], W))
+        r_new = np.zeros((n_ch, ch_slot.shape[1], W))
         n_drift = a_coef.shape[0]
         n_out = out.shape[2]
         viscous = False
@@ -110,7 +109,7 @@ def integrate_chunks(first, last, u3, v3, chain, contacts, holder, method, recor
         lost = np.zeros(W)  # the energy dissipation took (J), its impulse on the wall and the holder's (N s)
         j_visc = np.zeros(W)
         j_holder = np.zeros(W)
-        for s in range(u.shape[1]):
+        for s in range(W):
             f[0, s] = 0.0
             f[nb, s] = -load[nb, s]
         shot_forces(u, A, d0, load, f, law, con, state)
@@ -125,7 +124,7 @@ def integrate_chunks(first, last, u3, v3, chain, contacts, holder, method, recor
         x = np.empty(w.shape[1])  # their fractions of the step
         h_work, h_busy = np.empty((2, 3, head + 1, W)), np.empty((5 + head, W))  # the head flow's work arrays
         state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, state, e0, p0, worst)
-        for s in range(u.shape[1]):
+        for s in range(W):
             net[s] = load[nb, s] - (load[wall_slot, s] if wall_slot > 0 else 0.0)
         probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, 0.0, head, -1, 0.0, d_old, r_old)
         u_rest = u.copy()
@@ -147,14 +146,13 @@ def integrate_chunks(first, last, u3, v3, chain, contacts, holder, method, recor
             stepped += reach
             if dissipative:  # E(dt/2) S(dt) E(dt/2) (integrators.integrate)
                 dissipate(u, v, mass, invm, A, d0, con, law, state, hold, slip, viscous, holder, viscous_rate, 0.5 * dt,
-                          wall_slot,
-                          work, lost, j_visc, j_holder)
+                          wall_slot, work, lost, j_visc, j_holder)
             for st in range(n_drift):
                 hb = b_coef[st] * dt
                 if st == 0:
                     hb += pending
                 if wall_slot > 0:
-                    for s in range(u.shape[1]):
+                    for s in range(W):
                         j_wall[s] += hb * f[wall_slot, s]
                 h = a_coef[st] * dt
                 kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_work, h_busy,
@@ -164,7 +162,7 @@ def integrate_chunks(first, last, u3, v3, chain, contacts, holder, method, recor
             check = (n + 1) % check_every == 0 or n == n_steps - 1
             if check or dissipative:
                 if wall_slot > 0:
-                    for s in range(u.shape[1]):
+                    for s in range(W):
                         j_wall[s] += pending * f[wall_slot, s]
                 kick_drift(u, v, invm, f, pending, 0.0, head, reach)
                 pending = 0.0
@@ -172,8 +170,7 @@ def integrate_chunks(first, last, u3, v3, chain, contacts, holder, method, recor
                 still = still_from(u, v, u_rest, still, reach)
             if dissipative:
                 dissipate(u, v, mass, invm, A, d0, con, law, state, hold, slip, viscous, holder, viscous_rate, 0.5 * dt,
-                          wall_slot,
-                          work, lost, j_visc, j_holder)
+                          wall_slot, work, lost, j_visc, j_holder)
             probe_overlaps(u, v, invm, f, d0, ch_slot, ch_weight, pending, head, -1, 0.0, d_new, r_new)
             j_end = j_out
             while j_end < n_out and j_end * sample_dt <= t_new * (1.0 + 1e-12):
@@ -193,14 +190,14 @@ def integrate_chunks(first, last, u3, v3, chain, contacts, holder, method, recor
                         r_old[c, q, s] = r_new[c, q, s]
             if check:
                 state_sums(u, v, mass, bias, A, con[0], d0, d_limit, law, state, e, pn, worst)
-                for s in range(u.shape[1]):
+                for s in range(W):
                     err = abs(e[s] + lost[s] - e0[s]) / e_ref[s]
                     pe = abs(pn[s] - p0[s] - (t_new * net[s] - (j_wall[s] + j_visc[s]) + j_holder[s])) / p_ref[s]
                     if not (err < 1e300) or not (worst[s] <= 1.0):
                         diag[slot.STATUS, s] = 1.0
                     diag[slot.ENERGY_ERROR, s] = max(diag[slot.ENERGY_ERROR, s], err)
                     diag[slot.MOMENTUM_ERROR, s] = max(diag[slot.MOMENTUM_ERROR, s], pe)
-        for s in range(u.shape[1]):
+        for s in range(W):
             wall_load = load[wall_slot, s] if wall_slot > 0 else 0.0
             diag[slot.WALL_IMPULSE, s] = j_wall[s] + j_visc[s] + wall_load * n_steps * dt
             diag[slot.STEPS, s] = n_steps
