@@ -34,8 +34,8 @@ def with_clipping(rep: Report, clipped: tuple) -> Report:
             rep.reasons[name] = f"{cut}; {rep.reasons[name]}" if name in rep.reasons else cut
         return rep
     flight = rep.leading["lower"]["time"] - rep.leading["upper"]["time"]
-    doubt = 0.5 * sum(c.flat_top_s for c in clipped)
-    if doubt <= CLIPPED_SPEED * flight:
+    doubt = flat_top_doubt(clipped)
+    if speed_survives(doubt, flight):
         for name in CLIPPED_FIGURES:
             setattr(rep, name, None)
             rep.reasons[name] = cut
@@ -49,6 +49,18 @@ def with_clipping(rep: Report, clipped: tuple) -> Report:
     return rep
 
 
+def flat_top_doubt(clipped: tuple) -> float:
+    """How uncertain clipped channels (rails.Clip) leave the time of flight (s): half of
+    each one's flat top, summed (nan where a flag comes without its samples)."""
+    return 0.5 * sum(c.flat_top_s for c in clipped)
+
+
+def speed_survives(doubt_s: float, flight_s: float) -> bool:
+    """Whether the speed figures stand a flat-top uncertainty of ``doubt_s`` (s) on a time of
+    flight ``flight_s`` (s): at most CLIPPED_SPEED of it."""
+    return doubt_s <= CLIPPED_SPEED * flight_s
+
+
 RISE_PER_BANDWIDTH = 0.35  # a one-pole filter's 10-90% rise time x its -3 dB bandwidth
 # The most rise time per pulse FWHM: a Gaussian pulse through a one-pole filter whose rise
 # time is 1/3 of its FWHM comes out 5% lower and 5% wider, its peak 0.14 FWHM late; at 1/2
@@ -57,18 +69,24 @@ RISE_PER_BANDWIDTH = 0.35  # a one-pole filter's 10-90% rise time x its -3 dB ba
 SLOW_FRACTION = 1 / 3
 
 
+def slow(bandwidth_Hz, fwhm):
+    """Whether a bandwidth limit ``bandwidth_Hz`` (Hz; 0: none known) distorts a pulse of
+    FWHM ``fwhm`` (s; nan: none measured): its rise time RISE_PER_BANDWIDTH / bandwidth
+    beyond SLOW_FRACTION of the FWHM. Arrays (or floats) broadcast together."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rise = RISE_PER_BANDWIDTH / np.asarray(bandwidth_Hz, dtype=float)
+        return (np.asarray(bandwidth_Hz) != 0) & np.isfinite(fwhm) & ~(rise <= SLOW_FRACTION * np.asarray(fwhm))
+
+
 def too_slow(channel: str, bandwidth_Hz: float | None, fwhm: float) -> str:
-    """Why a channel's bandwidth limit distorts its pulse of FWHM ``fwhm`` (s): its rise
-    time RISE_PER_BANDWIDTH / bandwidth beyond SLOW_FRACTION of the FWHM; '' otherwise
-    (no limit known, or no FWHM measured)."""
-    if not bandwidth_Hz or not math.isfinite(fwhm):
+    """Why a channel's bandwidth limit distorts its pulse of FWHM ``fwhm`` (s; slow); ''
+    otherwise (no limit known, or no FWHM measured)."""
+    if bandwidth_Hz is None or not slow(bandwidth_Hz, fwhm):
         return ""
-    rise = RISE_PER_BANDWIDTH / bandwidth_Hz
-    if rise <= SLOW_FRACTION * fwhm:
-        return ""
-    return (f"{channel}: its bandwidth limit of {bandwidth_Hz:.6g} Hz rises in 0.35/B = {rise:.3g} s, more than "
-            f"1/3 of the measured pulse's FWHM ({fwhm:.3g} s): the filter lowers, widens and delays the pulse "
-            f"(5% at 1/3); a wider bandwidth (scope.channels.{channel}.bandwidth) or none")
+    return (f"{channel}: its bandwidth limit of {bandwidth_Hz:.6g} Hz rises in 0.35/B = "
+            f"{RISE_PER_BANDWIDTH / bandwidth_Hz:.3g} s, more than 1/3 of the measured pulse's FWHM ({fwhm:.3g} s): "
+            f"the filter lowers, widens and delays the pulse (5% at 1/3); a wider bandwidth "
+            f"(scope.channels.{channel}.bandwidth) or none")
 
 
 END_SAMPLES = 3  # the last samples that show a pulse still rising at the record's end

@@ -18,6 +18,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..errors import InstrumentError, check
 
 
@@ -40,30 +42,44 @@ class Limits:
             raise InstrumentError(f"limits.width_diameters = {self.width_diameters!r}: allowed 0 <= least < most")
 
 
-def record_doubt(limits: Limits, distance_m: float, span_s: float) -> str | None:
-    """Why a record of ``span_s`` (s) cannot hold a pulse crossing ``distance_m`` (m), or None."""
-    need = distance_m / limits.max_speed_m_per_s
-    if need > span_s:
+# why a speed is not a chain's (doubts), in the order the checks run
+NO_DOUBT, SHORT_RECORD, FEW_SAMPLES, TOO_FAST, WRONG_WIDTH = range(5)
+
+
+def doubts(limits: Limits, distance_m: float, span_s, flight_s, h_s, fwhm_s, diameter_m: float) -> np.ndarray:
+    """The first check each speed distance / flight fails (arrays, one entry per shot),
+    NO_DOUBT where it passes them all: SHORT_RECORD, a record of ``span_s`` (s) too short
+    for a pulse crossing ``distance_m`` (m) even at the speed bound; FEW_SAMPLES, a time of
+    flight under ``min_flight_samples`` sample intervals ``h_s`` (s); TOO_FAST, a speed over
+    the bound; WRONG_WIDTH, the leading pulse's FWHM ``fwhm_s`` (s; nan: not checked) times
+    the speed outside ``width_diameters`` bead diameters ``diameter_m`` (m)."""
+    lo, hi = limits.width_diameters
+    with np.errstate(divide="ignore", invalid="ignore"):
+        speed = distance_m / np.asarray(flight_s, dtype=float)
+        width = fwhm_s * speed / diameter_m
+        return np.select([distance_m / limits.max_speed_m_per_s > np.asarray(span_s),
+                          flight_s < limits.min_flight_samples * np.asarray(h_s), speed > limits.max_speed_m_per_s,
+                          np.isfinite(width) & ~((lo <= width) & (width <= hi))],
+                         [SHORT_RECORD, FEW_SAMPLES, TOO_FAST, WRONG_WIDTH], NO_DOUBT)
+
+
+def doubt_text(doubt: int, limits: Limits, distance_m: float, span_s: float, flight_s: float, h_s: float,
+               fwhm_s: float, diameter_m: float) -> str:
+    """What doubt ``doubt`` (doubts' code) says of one speed, with its numbers ('' for NO_DOUBT)."""
+    speed = distance_m / flight_s if flight_s != 0 else math.inf
+    said = f"{speed:.4g} m/s ({distance_m * 1e3:.4g} mm in {flight_s * 1e6:.4g} us)"
+    if doubt == SHORT_RECORD:
+        need = distance_m / limits.max_speed_m_per_s
         return (f"the gauges are {distance_m:.4g} m apart: even at {limits.max_speed_m_per_s:.4g} m/s a pulse "
                 f"needs {need:.3g} s between them, but the record spans {span_s:.3g} s (is the gauge distance right?)")
-    return None
-
-
-def speed_doubt(limits: Limits, distance_m: float, flight_s: float, h_s: float, fwhm_s: float,
-                diameter_m: float) -> str | None:
-    """Why the speed distance / flight is not a chain's (each check above), or None.
-    h_s: sample interval (s); fwhm_s: the leading pulse's FWHM (s; nan: not checked)."""
-    speed = distance_m / flight_s
-    said = f"{speed:.4g} m/s ({distance_m * 1e3:.4g} mm in {flight_s * 1e6:.4g} us)"
-    if flight_s < limits.min_flight_samples * h_s:
+    if doubt == FEW_SAMPLES:
         return (f"the time of flight is {flight_s / h_s:.2g} samples, under the {limits.min_flight_samples:g} "
                 f"needed for a speed to 10%: {said} is not measured")
-    if speed > limits.max_speed_m_per_s:
+    if doubt == TOO_FAST:
         return (f"{said} is faster than {limits.max_speed_m_per_s:.4g} m/s, "
                 "which no solitary wave of a bead chain reaches")
-    width = fwhm_s * speed / diameter_m
-    lo, hi = limits.width_diameters
-    if math.isfinite(width) and not lo <= width <= hi:
-        return (f"at {said} the leading pulse's FWHM is {width:.3g} bead diameters, outside the "
-                f"{lo:g} to {hi:g} of a solitary wave")
-    return None
+    if doubt == WRONG_WIDTH:
+        lo, hi = limits.width_diameters
+        return (f"at {said} the leading pulse's FWHM is {fwhm_s * speed / diameter_m:.3g} bead diameters, outside "
+                f"the {lo:g} to {hi:g} of a solitary wave")
+    return ""

@@ -30,7 +30,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 
-from instruments.analysis.batch import analysed
+from instruments.analysis.batch import analysed_figures
 from instruments.devices import batch as instrument_batch
 from rig.experiment.measure import setup_for
 from rig.experiment.shot import Rig
@@ -38,7 +38,7 @@ from rig.solver.ensemble import solve_ensemble
 from rig.solver.saveat import SaveAt
 from rig.solver.solution import Solution
 from rig.solver.stepsize import Stepping, stepping_at
-from rig.study.batch import batch_inputs, collector_paused, run_batch
+from rig.study.batch import batch_inputs, collector_paused, input_table, run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
 from rig.study.mc_spec import DEFAULT_BATCH
@@ -84,7 +84,8 @@ class Setting:
         """(shots lo..hi-1 as the solver's arrays (rig/study/shots.py), their instruments' seeds)."""
         beads = self.nominal.rig.values["chain"]["beads"]
         drawn = batch_inputs(study, lo, hi, beads)
-        return shots_of(self.template, [x for x, *_ in drawn], [m for _, m, _ in drawn]), [s for *_, s in drawn]
+        values = dict(zip(study.keys, input_table(study.keys, drawn).T))
+        return shots_of(self.template, self.pilot.problem, values, [m for _, m, _ in drawn]), [s for *_, s in drawn]
 
 
 def _solver(study: MonteCarloStudy, shots: int) -> dict:
@@ -165,7 +166,7 @@ def _stage_times(study: MonteCarloStudy, setting: Setting, template: Rig, wiring
     records = instrument_batch.acquire(ens.records, ens.sample_interval, wiring, seeds, shots.fixed, speeds,
                                        read=(setup.upper.channel, setup.lower.channel))
     t.append(time.perf_counter())
-    analysed(records, setup)
+    analysed_figures(records, setup)
     t.append(time.perf_counter())
     return t
 

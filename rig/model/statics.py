@@ -43,13 +43,9 @@ def follows_law(chain: Layout) -> np.ndarray:
     contact law (its exponent and dissipation): those that touch a bead of the chain's
     material (not the magnetic bead). The others (a striker on the magnetic bead, the rod)
     keep their own: Hertz, and linear for the rod."""
-    b = chain.beads
-    chain_bead = [x.kind != "magnetic" for x in b]
+    chain_bead = np.array([x.kind != "magnetic" for x in chain.beads], dtype=bool)
     out = np.zeros(chain.n_contacts, dtype=bool)
-    for k in range(chain.n_beads + 1):
-        above = chain_bead[k - 1] if k > 0 else False
-        below = chain_bead[k] if k < chain.n_beads else False
-        out[k] = above or below
+    out[:chain_bead.size + 1] = np.append(False, chain_bead) | np.append(chain_bead, False)  # the bead above, below
     return out
 
 

@@ -161,8 +161,9 @@ def _integrated(problems, t_end: float, save: SaveAt, dt: float | Stepping, meth
     fill = np.concatenate((np.arange(n), np.full(n_chunks * width - n, n - 1)))  # the last chunk filled up
 
     def stack(name):  # (shots, ...) -> (chunks, ..., width), each chunk C-contiguous
-        a = np.moveaxis(getattr(problems, name)[fill], 0, -1)
-        return np.ascontiguousarray(np.moveaxis(a.reshape(a.shape[:-1] + (n_chunks, width)), -2, 0))
+        a = getattr(problems, name)
+        a = (a[fill] if fill.size > n else a).reshape((n_chunks, width) + a.shape[1:])
+        return np.ascontiguousarray(a.transpose(0, *range(2, a.ndim), 1))
 
     out = np.empty((n, len(save.names), n_out))  # the kernel writes every sample of every shot
     diag = np.zeros((n_chunks, DIAGNOSTICS, width))

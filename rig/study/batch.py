@@ -14,7 +14,8 @@ import numpy as np
 
 from instruments import streams
 from instruments.analysis import analyze_record
-from instruments.analysis.batch import analysed
+from instruments.analysis.batch import analysed_figures
+from instruments.analysis.verdicts import ARRAY_FIGURES
 from instruments.devices import batch as instrument_batch
 from instruments.devices.oscilloscope import AcquisitionStatus
 from rig.errors import RigError, invalid
@@ -81,6 +82,11 @@ def batch_inputs(study: MonteCarloSpec, lo: int, hi: int, n_plain: int, design=N
     return out
 
 
+def input_table(keys, drawn: list) -> np.ndarray:
+    """(shots, keys) the inputs of batch_inputs' shots ``drawn``, in the order of ``keys``."""
+    return np.array([[x[k] for k in keys] for x, *_ in drawn], dtype=float).reshape(len(drawn), len(keys))
+
+
 def shot_rig(study: MonteCarloSpec, x: dict, masses) -> tuple:
     """Shot inputs x (and bead masses) -> (the shot's rig, its instrument draws)."""
     template = nominal(study.scene, tuple(study.overrides)).template(study.window)
@@ -134,7 +140,7 @@ def _batch(study: MonteCarloSpec, b: int) -> BatchResult:
     out["failure"][:] = Failure.NONE
     drawn = batch_inputs(study, lo, hi, base.values["chain"]["beads"], design)
     seeds = [seed for *_, seed in drawn]
-    xs = np.array([[x[k] for k in study.keys] for x, *_ in drawn], dtype=float).reshape(hi - lo, len(study.keys))
+    xs = input_table(study.keys, drawn)
     template = nom.template(study.window)
     traces: list = []
     if study.truth or study.traces or not array_keys(study.keys, template):
@@ -147,28 +153,28 @@ def _batch(study: MonteCarloSpec, b: int) -> BatchResult:
         if rigs:
             _fire_rigs(study, nom, rigs, draws, seeds, out, traces, lo)
     else:
-        _fire_arrays(study, nom, template, drawn, out)
+        _fire_arrays(study, nom, template, drawn, xs, out)
     return BatchResult(b, np.arange(lo, hi), xs, np.array(seeds, dtype=np.int64), out, tuple(traces))
 
 
 def _pilot(study: MonteCarloSpec, nom, template: Rig):
-    """(the stepping every shot takes, the pilot's stats): the step is calibrated once, on
+    """(the stepping every shot takes, the pilot's Solution): the step is calibrated once, on
     what every study measures (the gauges' averages, the wall), so that recording the
     contacts too (--truth, --traces) changes no result."""
     pilot = nom.pilot(study.window, template.save_at(contacts=False, averages=True), study.accuracy)
-    return stepping_at(pilot.problem, pilot.stats.dt_s), pilot.stats
+    return stepping_at(pilot.problem, pilot.stats.dt_s), pilot
 
 
-def _fire_arrays(study: MonteCarloSpec, nom, template: Rig, drawn: list, out: dict):
+def _fire_arrays(study: MonteCarloSpec, nom, template: Rig, drawn: list, xs: np.ndarray, out: dict):
     """The batch with no rig built per shot (rig/study/shots.py): one batched solve, one
     batched acquisition and one batched analysis of the leading pulse."""
-    shots = shots_of(template, [x for x, *_ in drawn], [m for _, m, _ in drawn])
+    dt, pilot = _pilot(study, nom, template)
+    shots = shots_of(template, pilot.problem, dict(zip(study.keys, xs.T)), [m for _, m, _ in drawn])
     out["failure"][~shots.possible] = Failure.IMPOSSIBLE
     keep = np.flatnonzero(shots.possible)
     if not keep.size:
         return
     sub = shots.take(keep)
-    dt, _ = _pilot(study, nom, template)
     save = template.save_at(contacts=False, averages=True)
     ens = solve_ensemble(sub.problems, template.solver.duration, save=save, dt=dt, method=template.solver.method)
     wiring = wiring_of(template)
@@ -178,34 +184,38 @@ def _fire_arrays(study: MonteCarloSpec, nom, template: Rig, drawn: list, out: di
     setup = setup_for(template, *nom.calibration)
     records = instrument_batch.acquire(forces, h, wiring, [drawn[j][2] for j in keep], sub.fixed, speeds,
                                        read=(setup.upper.channel, setup.lower.channel))  # what the analysis reads
-    reports = analysed(records, setup)
+    figures = analysed_figures(records, setup)
     roles = [records.wiring.channels.index(setup.upper.channel), records.wiring.channels.index(setup.lower.channel)]
-    succeeded, energy_errors = ens.succeeded, ens.energy_errors
     clipped = np.any(records.over[:, roles], axis=1)  # a channel the analysis reads ran off the scope's range
-    for e, j in enumerate(keep):
-        if not succeeded[e]:
-            out["failure"][j] = Failure.UNSTABLE
-            continue
-        outcome = records.outcome(e)
-        if outcome is AcquisitionStatus.PAST_INPUT:  # the scope's record ends after the simulated window
-            out["failure"][j] = Failure.SHORT_WINDOW
-            continue
-        _outputs(out, int(j), reports[e], None, float(energy_errors[e]), ens.dt, outcome is AcquisitionStatus.OK,
-                 bool(clipped[e]))
+    unstable = ~ens.succeeded
+    short = ~unstable & (records.status == int(AcquisitionStatus.PAST_INPUT))  # the record ends after the window
+    out["failure"][keep[unstable]] = Failure.UNSTABLE
+    out["failure"][keep[short]] = Failure.SHORT_WINDOW
+    done = ~(unstable | short)
+    _outputs(out, keep[done], {name: x[done] for name, x in figures.items()}, None, ens.energy_errors[done], ens.dt,
+             records.status[done] == int(AcquisitionStatus.OK), clipped[done])
 
 
-def _outputs(out: dict, j: int, m, t, energy_error: float, dt: float, triggered: bool, clipped: bool):
-    """Shot j's outputs from its measured Report m (and truth Report t, or None), and its
-    failure, if any (``clipped``: a gauge channel the analysis reads ran off the scope's range)."""
-    for key, val in (("speed_m_per_s", m.speed_m_per_s), ("speed_xcorr_m_per_s", m.speed_xcorr_m_per_s),
-                     ("amplitude_N", m.amplitude_N), ("averaged_amplitude_N", m.averaged_amplitude_N),
-                     ("truth_speed_m_per_s", t and t.speed_m_per_s), ("truth_amplitude_N", t and t.amplitude_N),
-                     ("energy_error", energy_error), ("dt_s", dt)):
-        out[key][j] = np.nan if val is None else val
-    if not triggered:
-        out["failure"][j] = Failure.NO_TRIGGER
-    elif not (np.isfinite(out["speed_m_per_s"][j]) and np.isfinite(out["amplitude_N"][j])):
-        out["failure"][j] = Failure.CLIPPED if clipped else Failure.NON_FINITE
+def _figures(rep) -> dict:
+    """A Report's figures as analysed_figures gives a batch's: name -> (1,), nan for None."""
+    return {name: np.array([np.nan if getattr(rep, name) is None else getattr(rep, name)], dtype=float)
+            for name in ARRAY_FIGURES}
+
+
+def _outputs(out: dict, rows: np.ndarray, m: dict, t: dict | None, energy_error: np.ndarray, dt: float,
+             triggered: np.ndarray, clipped: np.ndarray):
+    """The outputs of shots ``rows`` from their measured figures m (and truth figures t, or
+    None; name -> (rows,), nan where not given, as analysed_figures gives them), and their
+    failures, if any (``clipped``: a gauge channel the analysis reads ran off the scope's
+    range)."""
+    for key in ("speed_m_per_s", "speed_xcorr_m_per_s", "amplitude_N", "averaged_amplitude_N"):
+        out[key][rows] = m[key]
+    if t is not None:
+        out["truth_speed_m_per_s"][rows], out["truth_amplitude_N"][rows] = t["speed_m_per_s"], t["amplitude_N"]
+    out["energy_error"][rows], out["dt_s"][rows] = energy_error, dt
+    measured = np.isfinite(m["speed_m_per_s"]) & np.isfinite(m["amplitude_N"])
+    out["failure"][rows] = np.select([~triggered, ~measured & clipped, ~measured],
+                                     [Failure.NO_TRIGGER, Failure.CLIPPED, Failure.NON_FINITE], Failure.NONE)
 
 
 def _fire_rigs(study: MonteCarloSpec, nom, rigs: dict, draws: dict, seeds: list, out: dict, traces: list, lo: int):
@@ -223,7 +233,7 @@ def _fire_rigs(study: MonteCarloSpec, nom, rigs: dict, draws: dict, seeds: list,
         if not ens.succeeded[e]:
             out["failure"][j] = Failure.UNSTABLE
             continue
-        stats = ens.stats(e, pilot.accuracy, pilot.error_estimate)
+        stats = ens.stats(e, pilot.stats.accuracy, pilot.stats.error_estimate)
         forces = {name: a[e] for name, a in ens.forces.items()}
         rig.use_solution(Solution(forces, ens.sample_interval, None, None, np.empty(0), np.empty(0), stats, p))
         try:
@@ -242,8 +252,9 @@ def _fire_rigs(study: MonteCarloSpec, nom, rigs: dict, draws: dict, seeds: list,
         m = analyze_record(shot.scope, setup, train=False)  # leading pulse only
         waves = shot.scope.waveforms
         clipped = any(waves[ch].overrange for ch in (setup.upper.channel, setup.lower.channel) if ch in waves)
-        _outputs(out, j, m, rig.truth_analysis() if study.truth else None, stats.energy_error, ens.dt,
-                 shot.scope.triggered, clipped)
+        _outputs(out, np.array([j]), _figures(m),
+                 _figures(rig.truth_analysis()) if study.truth else None, np.array([stats.energy_error]),
+                 ens.dt, np.array([shot.scope.triggered]), np.array([clipped]))
 
 
 def refire(study: MonteCarloSpec, i: int) -> dict:

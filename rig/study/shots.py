@@ -67,13 +67,13 @@ def wiring_of(rig: Rig) -> Wiring:
     return Wiring(tuple(gauges), rig.scope)
 
 
-def shots_of(template: Rig, values: list, masses: list) -> Shots:
-    """The Shots of ``values`` ({key: SI value} per shot) and ``masses`` (per shot: each
-    plain bead's mass, kg, or None) on ``template``'s layout."""
+def shots_of(template: Rig, layout: ChainProblem, values: dict, masses: list) -> Shots:
+    """The Shots of ``values`` ({key: (shots,) SI values}) and ``masses`` (per shot: each
+    plain bead's mass, kg, or None) on ``template``'s ``layout`` (its ChainProblem)."""
     chain = template.chain
-    S = len(values)
+    S = len(masses)
     def col(key, default):
-        return np.array([x.get(key, default) for x in values], dtype=float)
+        return np.asarray(values[key], dtype=float) if key in values else np.full(S, default, dtype=float)
     bead_mass = np.tile(chain.masses, (S, 1))
     if any(m is not None for m in masses):
         plain = [j for j, b in enumerate(chain.beads) if b.kind != "magnetic"]
@@ -91,7 +91,7 @@ def shots_of(template: Rig, values: list, masses: list) -> Shots:
                 & np.isfinite(top) & (top >= 0))
     if striker is not None:
         possible &= (velocity > 0) & (striker_mass > 0) & np.isfinite(velocity) & np.isfinite(striker_mass)
-    varied = "chain.youngs_modulus" in values[0] or "chain.poisson_ratio" in values[0]
+    varied = "chain.youngs_modulus" in values or "chain.poisson_ratio" in values
     A = contact_constants_of(chain, E, nu) if varied else np.tile(chain.contact_constants(), (S, 1))
     arrays = problem_arrays(chain, bead_mass, A, top, striker_mass if striker else None,
                             velocity if striker else None)
@@ -104,7 +104,6 @@ def shots_of(template: Rig, values: list, masses: list) -> Shots:
     for k, g in enumerate(template.gauges):
         for f, field in enumerate(DRAW_FIELDS):
             fixed[:, k, f] = col(f"gauges.{g.name}.{field}", math.nan)
-    layout = ChainProblem.from_chain(chain)
     return Shots(ProblemArrays(layout, **arrays), possible, x[:, beads], fixed)
 
 

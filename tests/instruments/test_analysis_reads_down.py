@@ -7,16 +7,16 @@ from pathlib import Path
 import instruments.analysis
 
 HERE = Path(instruments.analysis.__file__).parent
-DOWN = ("batch", "pipeline", "judge", "distortion", "find", "refine", "condition", "setup", "plausibility", "pulse",
-        "report")
+DOWN = ("batch", "pipeline", "judge", "verdicts", "distortion", "find", "refine", "condition", "setup",
+        "plausibility", "pulse", "report")
 
 
 def _siblings(module: str) -> set:
     """The modules of instruments/analysis/ (not _kernels) that ``module`` imports."""
     out = set()
     for node in ast.walk(ast.parse((HERE / f"{module}.py").read_text())):
-        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module:
-            out.add(node.module.split(".")[0])
+        if isinstance(node, ast.ImportFrom) and node.level == 1:  # from .m import x, or from . import m
+            out.update([node.module.split(".")[0]] if node.module else [a.name for a in node.names])
     return out - {"_kernels"}
 
 

@@ -154,3 +154,50 @@ def test_a_clipped_gauge_channel_gives_no_figure_alone_or_in_a_batch():
     assert re.match(r"CH2: clipped: \d+ samples at the ADC's top, a flat top of \d+ samples .*: the signal ran off "
                     r"the scope's range", alone.reasons["amplitude_N"])
     assert reports[1].speed_m_per_s is not None and set(reports[1].reasons) == {"pulses"}  # leading pulse only
+
+
+@pytest.mark.parametrize("bandwidth", [20e6, 20e3])
+def test_the_figures_of_a_batch_are_its_reports_figures_whatever_refuses_them(bandwidth):
+    # a study takes a batch's figures as arrays, judged by the rules over the whole batch
+    # (verdicts.py), with no Report built: for shots that every rule refuses in turn they
+    # are the figures of the Reports analysed words, which are the lone records' Reports
+    from instruments.analysis.batch import analysed_figures
+
+    wiring = _wiring()
+    channels = {c: ChannelSettings(volts_per_div=0.05, bandwidth=bandwidth) for c in ("CH1", "CH2", "CH3")}
+    wiring = batch.Wiring(wiring.gauges, Oscilloscope(channels=channels, timebase=wiring.scope.timebase,
+                                                      trigger=wiring.scope.trigger, noise_floor=2e-4))
+    pairs = [(1.0e-4, 1.6e-4, 3.0, 3.0),  # measured
+             (1.6e-4, 1.0e-4, 3.0, 3.0),  # the lower pulse first
+             (1.0e-4, 1.005e-4, 3.0, 3.0),  # 2.5 samples of flight
+             (1.0e-4, 1.6e-4, 0.0, 3.0),  # no upper pulse
+             (1.0e-4, 1.6e-4, 5.12, 3.0),  # at the rail for a few samples: the speed stands it, the amplitude not
+             (1.0e-4, 1.6e-4, 6.0, 3.0),  # at the rail for 40 samples: no figure
+             (1.0e-4, 1.6e-4, 3.0, 1e-4),  # no trigger
+             (5.9e-4, 5.8e-4, 3.0, 3.0)]  # the record runs past the input
+    forces = np.stack([np.stack([_pulse(a, amp_a, 10e-6), _pulse(b, amp_b, 10e-6), _pulse(4e-4, 3.0)])
+                       for a, b, amp_a, amp_b in pairs])
+    fixed = np.full((len(pairs), 3, 2), np.nan)
+    fixed[:, :, 0] = 1.0  # no gain drawn: the rail cuts the tops the cases say
+    records = batch.acquire(forces, H, wiring, list(range(1, len(pairs) + 1)), fixed)
+    setup = Setup(GaugeSetup("CH2", 0.0, 0.05, 1e-3), GaugeSetup("CH1", 0.0043, 0.05, 1e-3), None, 1e-3)
+    figures = analysed_figures(records, setup)
+    reports = analysed(records, setup)
+    for s, rep in enumerate(reports):
+        if records.outcome(s) is AcquisitionStatus.OK:
+            assert rep.as_dict() == analyze_record(records.record(s), setup, train=False).as_dict(), s
+        for name, x in figures.items():
+            want = getattr(rep, name)
+            assert (np.isnan(x[s]) if want is None else x[s] == want), (s, name)
+    if bandwidth < 1e6:  # the channel's rise time 0.35/B = 17.5 us, over a third of the pulses' 17.6 us FWHM
+        assert all("bandwidth limit" in r.reasons["speed_m_per_s"] for r in (reports[0], reports[2]))
+    else:
+        assert reports[0].speed_m_per_s is not None and reports[0].amplitude_N is not None
+        assert "comes before or with" in reports[1].reasons["speed_m_per_s"]
+        assert f"under the {setup.limits.min_flight_samples:g}" in reports[2].reasons["speed_m_per_s"]
+        assert reports[2].amplitude_N is not None  # an implausible speed keeps the amplitudes
+        assert "CH2: no pulse" in reports[3].reasons["speed_m_per_s"]
+        assert reports[4].speed_m_per_s is not None and "ran off the scope's range" in reports[4].reasons["amplitude_N"]
+        assert reports[5].speed_m_per_s is None and "ran off the scope's range" in reports[5].reasons["speed_m_per_s"]
+    assert "did not trigger" in reports[6].reasons["speed_m_per_s"]
+    assert "runs past the input" in reports[7].reasons["speed_m_per_s"]
