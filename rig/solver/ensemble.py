@@ -160,15 +160,25 @@ def _integrated(problems, t_end: float, save: SaveAt, dt: float | Stepping, meth
     n_chunks = -(-n // width)
     fill = np.concatenate((np.arange(n), np.full(n_chunks * width - n, n - 1)))  # the last chunk filled up
 
-    def stack(name):  # (shots, ...) -> (chunks, ..., width), each chunk C-contiguous
+    def chunked(name):  # (shots, ...) -> a view (chunks, ..., width)
         a = getattr(problems, name)
         a = (a[fill] if fill.size > n else a).reshape((n_chunks, width) + a.shape[1:])
-        return np.ascontiguousarray(a.transpose(0, *range(2, a.ndim), 1))
+        return a.transpose(0, *range(2, a.ndim), 1)
+
+    def stack(name):  # each chunk C-contiguous
+        return np.ascontiguousarray(chunked(name))
+
+    def rows(names):  # (chunks, rows, ..., width), in one copy
+        parts = [chunked(k) for k in names]
+        out = np.empty((n_chunks, len(parts)) + parts[0].shape[1:])
+        for r, part in enumerate(parts):
+            out[:, r] = part
+        return out
 
     out = np.empty((n, len(save.names), n_out))  # the kernel writes every sample of every shot
     diag = np.zeros((n_chunks, DIAGNOSTICS, width))
     u, v = stack("u0"), stack("v0")
-    k = kernel_inputs(problems, stack, 1, m, stepping, step, n_steps, save, out, np.zeros((0, p0.n_bodies)), 1.0)
+    k = kernel_inputs(problems, stack, rows, m, stepping, step, n_steps, save, out, np.zeros((0, p0.n_bodies)), 1.0)
     t0 = time.perf_counter()
     integrate_ensemble(u, v, k.chain, k.contacts, k.holder, k.method, k.record, k.checks, diag)
     wall = time.perf_counter() - t0

@@ -153,16 +153,17 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
     near = np.append(near, math.inf) if plate else near  # the rod: no overlap limit of its own
     slot = np.arange(chain.n_contacts) + off
     live = np.isfinite(chain.contact_constants()) & (slot > 0) & (slot < nb)
-    A[:, slot[live]], d0[:, slot[live]], f0[:, slot[live]] = A_c[:, live], d_c[:, live], F_c[:, live]
-    expo[:, slot[live]] = expo_c[live]
+    to, at = _span(slot[live]), _span(np.flatnonzero(live))  # each live contact's slot, and the contact
+    A[:, to], d0[:, to], f0[:, to] = A_c[:, at], d_c[:, at], F_c[:, at]
+    expo[:, to] = expo_c[at]
     tau_c, gamma_c, alpha_c = chain.contact_dissipation()
-    damping[:, slot[live]], dashpot[:, slot[live]] = tau_c[live], gamma_c[live]
-    dashpot_exponent[:, slot[live]] = alpha_c[live]
-    state[:, :, slot[live]] = state_c[:, :, live]
+    damping[:, to], dashpot[:, to] = tau_c[at], gamma_c[at]
+    dashpot_exponent[:, to] = alpha_c[at]
+    state[:, :, to] = state_c[:, :, at]
     m_c, r_c = chain.contact_yield_rates()
     yield_rate_exponent, yield_reference_rate = np.zeros((S, nb)), np.ones((S, nb))
-    yield_rate_exponent[:, slot[live]], yield_reference_rate[:, slot[live]] = m_c[live], r_c[live]
-    d_limit[:, slot[live]] = 0.5 * near[live]
+    yield_rate_exponent[:, to], yield_reference_rate[:, to] = m_c[at], r_c[at]
+    d_limit[:, to] = 0.5 * near[at]
     if chain.striker is not None:
         d0[:, 1] = -chain.striker.gap
     balance_at_rest(load, A, d0, expo, invm)  # before d_limit, f0, e_scale read d0
@@ -183,6 +184,12 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
                 dashpot=dashpot, dashpot_exponent=dashpot_exponent, yield_rate_exponent=yield_rate_exponent,
                 yield_reference_rate=yield_reference_rate, **dict(zip(STATE_ROWS, state)), d_limit=d_limit,
                 drag=drag, friction=friction, u0=u0, v0=v0, energy_scale=e_scale, momentum_scale=p_scale)
+
+
+def _span(index: np.ndarray):
+    """``index`` (ascending) as a slice where it is a run of consecutive indices (numpy
+    reads and writes a slice faster than an index array), else as it is."""
+    return slice(int(index[0]), int(index[-1]) + 1) if index.size and np.all(np.diff(index) == 1) else index
 
 
 def _rows_alike(a: np.ndarray) -> bool:

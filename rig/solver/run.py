@@ -82,24 +82,27 @@ class KernelInputs(NamedTuple):
     checks: bundles.Checks
 
 
-def kernel_inputs(problems: ChainProblem | ProblemArrays, take: Callable[[str], np.ndarray], rows_axis: int,
-                  m: Method, stepping: Stepping, step: float, n_steps: int, save: SaveAt, out: np.ndarray,
-                  frames: np.ndarray, frame_dt: float) -> KernelInputs:
+def stacked(take: Callable[[str], np.ndarray], axis: int) -> Callable[[tuple], np.ndarray]:
+    """kernel_inputs' ``rows`` from its ``take``: the fields' arrays stacked on ``axis``."""
+    def rows(names):
+        return np.ascontiguousarray(np.stack([take(k) for k in names], axis=axis))
+    return rows
+
+
+def kernel_inputs(problems: ChainProblem | ProblemArrays, take: Callable[[str], np.ndarray],
+                  rows: Callable[[tuple], np.ndarray], m: Method, stepping: Stepping, step: float, n_steps: int,
+                  save: SaveAt, out: np.ndarray, frames: np.ndarray, frame_dt: float) -> KernelInputs:
     """The bundles of one kernel call, for one shot (``integrate_at``) or a batch
     (rig.solver.ensemble): ``take(name)`` gives the kernel's array of the ChainProblem
     field ``name`` (a shot's as placed by layout.working_arrays; a batch's (chunks, ...,
-    width)), whose per-body rows (con, state, onsite) are stacked on ``rows_axis``; n_steps
+    width)), ``rows(names)`` the per-body rows of several fields stacked (con, state,
+    onsite: a shot's (rows, bodies), a batch's (chunks, rows, bodies, width)); n_steps
     steps of ``step`` (s) of method ``m`` with ``stepping``'s head; ``out`` and ``frames``
     (every frame_dt s) receive the record of ``save``."""
     layout = problems.layout if isinstance(problems, ProblemArrays) else problems
-
-    def rows(names):
-        return np.ascontiguousarray(np.stack([take(k) for k in names], axis=rows_axis))
-
     ch_slot, ch_weight = save.channels(layout.offset)
     con, onsite = rows(CONTACT_ROWS), rows(("drag", "friction"))
-    damping = np.take(con, [CONTACT_ROWS.index("damping"), CONTACT_ROWS.index("dashpot")], axis=rows_axis)
-    flows = Constant(int(bool(np.any(damping != 0.0) or np.any(onsite != 0.0))))
+    flows = Constant(int(any(np.any(getattr(problems, k) != 0.0) for k in ("damping", "dashpot", "drag", "friction"))))
     return KernelInputs(
         bundles.ChainArrays(*(take(k) for k in bundles.ChainArrays._fields)),
         bundles.Contacts(Constant(problems.law), con, rows(STATE_ROWS)),
@@ -151,7 +154,7 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     def take(name):
         return placed[name] if name in placed else getattr(problem, name)
 
-    k = kernel_inputs(problem, take, 0, m, stepping, step, n_steps, save, out, frames, frame_dt)
+    k = kernel_inputs(problem, take, stacked(take, 0), m, stepping, step, n_steps, save, out, frames, frame_dt)
     warm = k._replace(contacts=k.contacts._replace(state=problem.memory()), method=k.method._replace(n_steps=0))
     integrate(u.copy(), v.copy(), f, *warm, diag, front)  # load the compiled kernel
     t0 = time.perf_counter()

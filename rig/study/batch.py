@@ -69,17 +69,16 @@ def batch_inputs(study: MonteCarloSpec, lo: int, hi: int, n_plain: int, design=N
     raw, heads = streams.spawned_draws(study.seed, lo, hi - lo, [d.standard for d in study.dists], sizes)
     edges = np.cumsum([0, *sizes])
     values = [d.from_standard(raw[:, a:b]) for d, a, b in zip(study.dists, edges, edges[1:])]
-    out = []
-    for s, i in enumerate(range(lo, hi)):
-        x, masses = {}, None
-        for k, (d, v) in enumerate(zip(study.dists, values)):
-            if d.key == "chain.bead_mass":
-                masses = v[s].copy()
-                x[d.key] = float(np.mean(masses))
-            else:
-                x[d.key] = float(v[s, 0]) if design is None else float(design[i, k])
-        out.append((x, masses, int(heads[s] >> np.uint64(1))))
-    return out
+    columns, masses = [], [None] * (hi - lo)
+    for k, (d, v) in enumerate(zip(study.dists, values)):
+        if d.key == "chain.bead_mass":
+            masses = list(v.copy())  # each shot's row; its input the row's mean
+            columns.append(v.mean(axis=1).tolist())
+        else:
+            columns.append((v[:, 0] if design is None else design[lo:hi, k]).tolist())
+    rows = zip(*columns) if columns else [()] * (hi - lo)
+    seeds = (heads >> np.uint64(1)).tolist()
+    return [(dict(zip(study.keys, row)), m, seed) for row, m, seed in zip(rows, masses, seeds)]
 
 
 def input_table(keys, drawn: list) -> np.ndarray:
@@ -174,7 +173,7 @@ def _fire_arrays(study: MonteCarloSpec, nom, template: Rig, drawn: list, xs: np.
     keep = np.flatnonzero(shots.possible)
     if not keep.size:
         return
-    sub = shots.take(keep)
+    sub = shots if keep.size == len(drawn) else shots.take(keep)  # most batches: every shot possible
     save = template.save_at(contacts=False, averages=True)
     ens = solve_ensemble(sub.problems, template.solver.duration, save=save, dt=dt, method=template.solver.method)
     wiring = wiring_of(template)

@@ -75,7 +75,8 @@ def shots_of(template: Rig, layout: ChainProblem, values: dict, masses: list) ->
     def col(key, default):
         return np.asarray(values[key], dtype=float) if key in values else np.full(S, default, dtype=float)
     bead_mass = np.tile(chain.masses, (S, 1))
-    if any(m is not None for m in masses):
+    masses_drawn = any(m is not None for m in masses)
+    if masses_drawn:
         plain = [j for j, b in enumerate(chain.beads) if b.kind != "magnetic"]
         bead_mass[:, plain] = np.array(masses, dtype=float)
         for g in template.gauges:  # a gauge bead: caps cut from its plain bead, and the plate (GaugeBead)
@@ -95,16 +96,20 @@ def shots_of(template: Rig, layout: ChainProblem, values: dict, masses: list) ->
     A = contact_constants_of(chain, E, nu) if varied else np.tile(chain.contact_constants(), (S, 1))
     arrays = problem_arrays(chain, bead_mass, A, top, striker_mass if striker else None,
                             velocity if striker else None)
-    bodies = np.append(bead_mass, np.full((S, len(chain.body_masses) - bead_mass.shape[1]),
-                                          chain.body_masses[-1]), axis=1)  # a compliant wall's plate
-    d0 = static_overlaps_of(A, static_forces_of(bodies, chain.gravity, top), chain.contact_exponents())
+    # where the study varies no mass, contact or top force, every shot rests where the first does
+    rest = slice(0, 1) if not (masses_drawn or varied or "magnet.force" in values) else slice(None)
+    resting = bead_mass[rest]
+    bodies = np.append(resting, np.full((resting.shape[0], len(chain.body_masses) - resting.shape[1]),
+                                        chain.body_masses[-1]), axis=1)  # a compliant wall's plate
+    d0 = static_overlaps_of(A[rest], static_forces_of(bodies, chain.gravity, top[rest]), chain.contact_exponents())
     x = equilibrium_positions_of([b.radius for b in chain.beads], d0[:, :chain.n_beads + 1])
     beads = [g.bead for g in template.gauges]
+    positions = np.repeat(x[:, beads], S // x.shape[0], axis=0)
     fixed = np.full((S, len(wiring_of(template).gauges), 2), np.nan)
     for k, g in enumerate(template.gauges):
         for f, field in enumerate(DRAW_FIELDS):
             fixed[:, k, f] = col(f"gauges.{g.name}.{field}", math.nan)
-    return Shots(ProblemArrays(layout, **arrays), possible, x[:, beads], fixed)
+    return Shots(ProblemArrays(layout, **arrays), possible, positions, fixed)
 
 
 def wave_speeds(template: Rig, shots: Shots, forces: np.ndarray, h: float) -> np.ndarray:

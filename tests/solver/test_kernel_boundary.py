@@ -12,7 +12,7 @@ from rig.model.laws.thornton import STATE_ROWS
 from rig.solver.kernels import report
 from rig.solver.methods import method
 from rig.solver.problem import CONTACT_ROWS
-from rig.solver.run import kernel_inputs
+from rig.solver.run import kernel_inputs, stacked
 from rig.solver.solution import KernelReport, Status
 from rig.solver.stepsize import Stepping
 
@@ -49,7 +49,10 @@ def test_bundles_carry_the_problem_arrays_of_their_names():
     save = record_contacts(chain, 3, 9)
     m = method("srkn6b")
     out, frames = np.zeros((2, 11)), np.zeros((0, p.n_bodies))
-    k = kernel_inputs(p, lambda name: getattr(p, name), 0, m, Stepping(1e-6), 1e-6, 10, save, out, frames, 1.0)
+    def take(name):
+        return getattr(p, name)
+
+    k = kernel_inputs(p, take, stacked(take, 0), m, Stepping(1e-6), 1e-6, 10, save, out, frames, 1.0)
     for name, x in k.chain._asdict().items():
         assert x is getattr(p, name), name
     for rows, names in ((k.contacts.con, CONTACT_ROWS), (k.contacts.state, STATE_ROWS),
