@@ -200,6 +200,11 @@ class Chain:
         carries nothing; a contact flattened by a static hold rests deeper (contact_memory)."""
         return self._cached("d0", lambda: self.contact_memory(self.contact_constants(), self.static_forces())[1])
 
+    def rest_state(self) -> np.ndarray:
+        """The kernels' memory of the chain's contacts at rest (contact_memory's state of its
+        constants and static forces)."""
+        return self._cached("state", lambda: self.contact_memory(self.contact_constants(), self.static_forces())[0])
+
     def contact_memory(self, A, F) -> tuple:
         """(state, d0, hold_work) of contacts of constants A (N/m^n) carrying static forces F
         (N) (arrays (..., contacts)): the kernels' memory of each contact

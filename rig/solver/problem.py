@@ -139,9 +139,14 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
 
     expo_c = chain.contact_exponents()
     F_c = static_forces_of(bodies, chain.gravity, top)
-    # the contacts' memory, of one row where every shot has the same contacts (a study that varies the striker)
-    alike = S > 1 and _rows_alike(A_c) and _rows_alike(F_c)
-    state_c, d_c, _ = chain.contact_memory(A_c[:1], F_c[:1]) if alike else chain.contact_memory(A_c, F_c)
+    # the contacts' memory: where every shot has the same contacts (a study that varies the striker) one row's,
+    # the chain's own where they are the chain's
+    alike = _rows_alike(A_c) and _rows_alike(F_c)
+    if alike and np.array_equal(A_c[0], chain.contact_constants(), equal_nan=True) and np.array_equal(
+            F_c[0], chain.static_forces()):
+        state_c, d_c = chain.rest_state()[:, None], chain.static_overlaps()[None]
+    else:
+        state_c, d_c, _ = chain.contact_memory(A_c[:1], F_c[:1]) if alike else chain.contact_memory(A_c, F_c)
     state = np.zeros((len(STATE_ROWS), S, nb))
     state[STATE_ROWS.index("elastic_limit")] = np.inf  # a slot of no contact never yields
     A, d0, f0 = np.zeros((S, nb)), np.zeros((S, nb)), np.zeros((S, nb))
