@@ -133,7 +133,7 @@ STAGES = {"inputs": "each shot's inputs drawn, the shots' arrays built",
           "solver": "batched solver (the whole call) and the pulse speeds",
           "acquisition": "the instruments' random draws (19,000 normals), the read channels' gauges, front ends, "
                          "trigger and 8-bit codes",
-          "analysis": "leading pulses, delays, each shot's Report"}
+          "analysis": "leading pulses, delays, the judge's rules over the batch (its figures)"}
 
 
 def _stages(study: MonteCarloStudy, batches: int = 4) -> dict:

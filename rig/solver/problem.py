@@ -110,13 +110,29 @@ class ProblemArrays(_BodyArrays):
                    momentum_scale=np.array([p.momentum_scale for p in problems]))
 
 
-def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velocity=None) -> dict:
+def contacts_at_rest(chain: Chain, A_c: np.ndarray, F_c: np.ndarray) -> tuple:
+    """(state, d0): Chain.contact_memory of shots' contacts of constants A_c (N/m^n) carrying
+    static forces F_c (N) ((shots, contacts) each): the kernels' memory of each contact
+    (STATE_ROWS first) and the static overlaps (m) a static hold left. Where every shot
+    has the same contacts (a study that varies the striker) of one row (shots axis 1),
+    the chain's own (computed once) where they are the chain's."""
+    if not (_rows_alike(A_c) and _rows_alike(F_c)):
+        return chain.contact_memory(A_c, F_c)[:2]
+    if np.array_equal(A_c[0], chain.contact_constants(), equal_nan=True) and np.array_equal(F_c[0],
+                                                                                            chain.static_forces()):
+        return chain.rest_state()[:, None], chain.static_overlaps()[None]
+    return chain.contact_memory(A_c[:1], F_c[:1])[:2]
+
+
+def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velocity=None,
+                   at_rest: tuple | None = None) -> dict:
     """The kernels' arrays of shots of ``chain``'s layout that differ in their bead masses
     (kg, (shots, beads)), contact constants (N/m^n, (shots, contacts), nan where no
     partner), initial top force (N, (shots,)), and striker mass (kg) and velocity (m/s)
     ((shots,); None: the chain's): {name: array, shots first} (ChainProblem's fields).
     The contacts' exponents and dissipation, the holder's drag and friction and a
-    compliant wall's plate are the chain's."""
+    compliant wall's plate are the chain's. at_rest: contacts_at_rest of these shots,
+    where the caller has it."""
     masses, A_c = np.atleast_2d(masses), np.atleast_2d(A_c)
     top = np.asarray(top_force, dtype=float).reshape(-1)
     S, n = masses.shape
@@ -139,14 +155,7 @@ def problem_arrays(chain: Chain, masses, A_c, top_force, striker_mass=None, velo
 
     expo_c = chain.contact_exponents()
     F_c = static_forces_of(bodies, chain.gravity, top)
-    # the contacts' memory: where every shot has the same contacts (a study that varies the striker) one row's,
-    # the chain's own where they are the chain's
-    alike = _rows_alike(A_c) and _rows_alike(F_c)
-    if alike and np.array_equal(A_c[0], chain.contact_constants(), equal_nan=True) and np.array_equal(
-            F_c[0], chain.static_forces()):
-        state_c, d_c = chain.rest_state()[:, None], chain.static_overlaps()[None]
-    else:
-        state_c, d_c, _ = chain.contact_memory(A_c[:1], F_c[:1]) if alike else chain.contact_memory(A_c, F_c)
+    state_c, d_c = contacts_at_rest(chain, A_c, F_c) if at_rest is None else at_rest
     state = np.zeros((len(STATE_ROWS), S, nb))
     state[STATE_ROWS.index("elastic_limit")] = np.inf  # a slot of no contact never yields
     A, d0, f0 = np.zeros((S, nb)), np.zeros((S, nb)), np.zeros((S, nb))

@@ -16,8 +16,8 @@ from instruments.devices.batch import Wiring
 from rig.experiment.shot import Rig
 from rig.experiment.truth import speeds_between
 from rig.model.parts import GaugeBead
-from rig.model.statics import contact_constants_of, equilibrium_positions_of, static_forces_of, static_overlaps_of
-from rig.solver.problem import PER_BODY, ChainProblem, ProblemArrays, problem_arrays
+from rig.model.statics import contact_constants_of, equilibrium_positions_of, static_forces_of
+from rig.solver.problem import PER_BODY, ChainProblem, ProblemArrays, contacts_at_rest, problem_arrays
 
 ARRAY_KEYS = ("striker.velocity", "striker.mass", "chain.bead_mass", "chain.youngs_modulus", "chain.poisson_ratio",
               "magnet.force")
@@ -75,8 +75,7 @@ def shots_of(template: Rig, layout: ChainProblem, values: dict, masses: list) ->
     def col(key, default):
         return np.asarray(values[key], dtype=float) if key in values else np.full(S, default, dtype=float)
     bead_mass = np.tile(chain.masses, (S, 1))
-    masses_drawn = any(m is not None for m in masses)
-    if masses_drawn:
+    if any(m is not None for m in masses):
         plain = [j for j, b in enumerate(chain.beads) if b.kind != "magnetic"]
         bead_mass[:, plain] = np.array(masses, dtype=float)
         for g in template.gauges:  # a gauge bead: caps cut from its plain bead, and the plate (GaugeBead)
@@ -94,15 +93,13 @@ def shots_of(template: Rig, layout: ChainProblem, values: dict, masses: list) ->
         possible &= (velocity > 0) & (striker_mass > 0) & np.isfinite(velocity) & np.isfinite(striker_mass)
     varied = "chain.youngs_modulus" in values or "chain.poisson_ratio" in values
     A = contact_constants_of(chain, E, nu) if varied else np.tile(chain.contact_constants(), (S, 1))
+    bodies = np.append(bead_mass, np.full((S, len(chain.body_masses) - bead_mass.shape[1]),
+                                          chain.body_masses[-1]), axis=1)  # a compliant wall's plate
+    at_rest = contacts_at_rest(chain, A, static_forces_of(bodies, chain.gravity, top))  # one row where all alike
     arrays = problem_arrays(chain, bead_mass, A, top, striker_mass if striker else None,
-                            velocity if striker else None)
-    # where the study varies no mass, contact or top force, every shot rests where the first does
-    rest = slice(0, 1) if not (masses_drawn or varied or "magnet.force" in values) else slice(None)
-    resting = bead_mass[rest]
-    bodies = np.append(resting, np.full((resting.shape[0], len(chain.body_masses) - resting.shape[1]),
-                                        chain.body_masses[-1]), axis=1)  # a compliant wall's plate
-    d0 = static_overlaps_of(A[rest], static_forces_of(bodies, chain.gravity, top[rest]), chain.contact_exponents())
-    x = equilibrium_positions_of([b.radius for b in chain.beads], d0[:, :chain.n_beads + 1])
+                            velocity if striker else None, at_rest)
+    # the beads rest where a lone shot's do (Chain.equilibrium_positions): on the overlaps a static hold left
+    x = equilibrium_positions_of([b.radius for b in chain.beads], at_rest[1][:, :chain.n_beads + 1])
     beads = [g.bead for g in template.gauges]
     positions = np.repeat(x[:, beads], S // x.shape[0], axis=0)
     fixed = np.full((S, len(wiring_of(template).gauges), 2), np.nan)
