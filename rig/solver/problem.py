@@ -230,9 +230,10 @@ def balance_at_rest(load, A, d0, expo, invm):
     for chains under 1e4 beads), so that the slots below can carry it exactly. The change
     is otherwise a few parts in 1e16; the kernels integrate the bodies ahead of a pulse
     only where they are at rest bit for bit (rig/solver/kernels/integrators.py)."""
+    from numerics.threads import over_threads
     from rig.solver.kernels.forces import balance_at_rest as balance  # numba: loaded when a problem is built
 
-    balance(load, A, d0, expo, invm, REST_TOLERANCE, NUDGES)
+    over_threads(A.shape[0], lambda lo, hi: balance(lo, hi, load, A, d0, expo, invm, REST_TOLERANCE, NUDGES))
 
 
 @dataclass(frozen=True, eq=False)

@@ -284,7 +284,8 @@ def initial_state(A, n, F_static, d_static, terms: YieldTerms, hold: float = 0.0
     state[DC] = np.where(dy > 0, dy, np.inf)
     work = np.zeros(A.shape)
     dys = dy * (terms.static_ratio**2 if hold > 0 else 1.0)
-    flat = (dys > 0) & (A * dys**n < F)
+    flat = dys > 0
+    flat[flat] = A[flat] * dys[flat] ** n[flat] < F[flat]  # past the yield (the power only where one is)
     for k in zip(*np.nonzero(flat)):  # the contacts loaded past their yield, by the kernels' own functions
         a, m, f, y = A[k], n[k], F[k], dys[k]
         fy = a * elastic_power(y, m)

@@ -216,14 +216,15 @@ def _ulps(x, k):
     return x
 
 
-@jit
-def balance_at_rest(load, A, d0, expo, invm, tolerance, nudges):
-    """rig.solver.problem.balance_at_rest's rounding, shot by shot (arrays (shots, ...)):
-    the open slots' loads rounded to multiples of the ulp of the shot's largest load, then,
-    down the chain, each body meant to rest given a lower slot whose force at rest is its
-    upper slot's bit for bit, d0 and load moved by at most ``nudges`` ulps each."""
+@jit(nogil=True)
+def balance_at_rest(first, last, load, A, d0, expo, invm, tolerance, nudges):
+    """rig.solver.problem.balance_at_rest's rounding, shot by shot (arrays (shots, ...)),
+    of shots first..last-1 (without the GIL: the ranges run on threads): the open slots'
+    loads rounded to multiples of the ulp of the shot's largest load, then, down the chain,
+    each body meant to rest given a lower slot whose force at rest is its upper slot's bit
+    for bit, d0 and load moved by at most ``nudges`` ulps each."""
     nb = A.shape[1]
-    for s in range(A.shape[0]):
+    for s in range(first, last):
         top = 0.0
         for i in range(nb + 1):
             top = max(top, abs(load[s, i]))
