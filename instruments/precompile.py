@@ -46,8 +46,9 @@ STUDY = {f"{DEVICES}.acquisition.shots": f"(int64, int64, {I1}, {F3}, float64, {
                                          f"{F1}, {F1}, {F1}, {F1}, float64, float64, boolean)), {B1}, int64, {I1}, "
                                          f"{I8}, boolean[:, ::1], {I1}, {F2}, {F3})",
          f"{ANALYSIS}.batch_analysis.analyse_range": f"(int64, int64, {I8}, {I1}, {F2}, float64, int64, {F1}, {F1}, "
-                                                   f"{F1}, {I1}, "
-                                                   f"{F1}, {F1}, UniTuple(float64, 7), {F2}, {F2}, {B1})"}
+                                                   f"{F1}, {I1}, {I1}, "
+                                                   f"{F1}, {F1}, UniTuple(float64, 7), {F2}, {F2}, {B1}, "
+                                                   f"boolean[:, ::1])"}
 # and the shots' drawn values, small: a study draws them first thing, so it compiles them itself (aside, it
 # would wait for them behind the solver's and the analysis' kernels)
 STUDY_SMALL = {"instruments._kernels.pcg64.spawned_draws": f"(uint64[::1], int64, {B1}, {I1}, {F2}, uint64[::1])"}

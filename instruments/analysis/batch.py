@@ -91,27 +91,21 @@ def _judged(records: Records, setup: Setup) -> Judged:
     answers = np.empty((S, pulses.ANSWER))
     sigma = np.empty((S, 2))
     finite = np.empty(S, np.bool_)
+    touches = np.empty((S, 2), np.bool_)  # (shots, 2): a gauge channel reaches a rail of its converter at all
     dx = scope.timebase.sample_interval
     batch_analysis.analyse_shots(records.codes, records.status, records.times, dx, front.n_pre, front.ymult,
-                                 front.yoff, front.offset, roles, np.array([g.tau_s or 0.0 for g in gauges]),
+                                 front.yoff, front.offset, roles, np.array(code_rails(records.codes), np.int64),
+                                 np.array([g.tau_s or 0.0 for g in gauges]),
                                  np.array([g.sensitivity_V_per_N for g in gauges]), setup.rules.as_tuple(), answers,
-                                 sigma, finite)
+                                 sigma, finite, touches)
     bandwidth = {ch: scope.channels[ch].bandwidth for ch in (setup.upper.channel, setup.lower.channel)}
     ticks = dx * np.arange(records.codes.shape[2])  # each record's sample times from its first
     first = records.times[:, 1] + ticks[0]  # t[0], t[1] and t[-1] of each record as the pipeline has them
     span = (records.times[:, 1] + ticks[-1]) - first
     h = (records.times[:, 1] + ticks[min(1, ticks.size - 1)]) - first
     v = verdicts.judge(answers, span, h, sigma, setup, bandwidths(setup, bandwidth))
-    touches = np.stack([_at_rail(records.codes[:, c]) for c in roles], axis=1)  # (shots, 2): a channel reaches a rail
     flagged = np.any(touches | records.over[:, roles], axis=1)  # a channel at a rail or over range: a Clip to make
     return Judged(answers, sigma, finite, v, roles, touches, flagged, ticks, bandwidth)
-
-
-def _at_rail(codes: np.ndarray) -> np.ndarray:
-    """(shots,) whether each shot's record of one channel (codes (shots, samples)) reaches a
-    rail of its converter (rails.code_rails)."""
-    lo, hi = code_rails(codes)
-    return (codes.min(axis=1) <= lo) | (codes.max(axis=1) >= hi)
 
 
 def _clips(records: Records, judged: Judged, s: int) -> tuple:
