@@ -39,12 +39,13 @@ def report_of(answer: np.ndarray, t: np.ndarray, forces: dict, setup: Setup, tra
     channel whose record ran off the scope's range (with_clipping). ``bandwidth``: channel
     -> its bandwidth limit (Hz; None or absent: none known), whose rise time must stay
     within SLOW_FRACTION of the leading pulse's FWHM (too_slow)."""
-    sigma = None if noise is None else np.array([[math.nan if noise.get(r) is None else noise[r] for r in ROLES]])
-    ends = np.array([[record_ends_in_pulse(forces.get(r), None if noise is None else noise.get(r), setup.rules)
-                      for r in ROLES]])
+    given = {} if noise is None else noise
+    sigma = None if noise is None else np.array([[math.nan if given.get(r) is None else given[r] for r in ROLES]])
+    ends = np.array([[record_ends_in_pulse(forces.get(r), given.get(r), setup.rules) for r in ROLES]])
     lower = forces.get("lower")
     v = verdicts.judge(answer[None], np.array([t[-1] - t[0]]), np.array([t[1] - t[0]]), sigma, setup,
-                 bandwidths(setup, bandwidth), ends, np.array([math.nan if lower is None else float(lower[-1])]))
+                       bandwidths(setup, bandwidth), ends, np.array([math.nan if lower is None else float(lower[-1])]),
+                       np.array([[given.get(r) is None for r in ROLES]]))
     return with_clipping(report_at(v, 0, answer, t, forces, setup, train, noise, bandwidth), clipped)
 
 
@@ -61,7 +62,7 @@ def report_at(v: Verdicts, s: int, answer: np.ndarray, t: np.ndarray, forces: di
     rules, rep = setup.rules, Report(beta=setup.beta, static_force_N=setup.static_force_N)
     ch = {r: getattr(setup, r).channel for r in ROLES}
     refused = v.refused[s]
-    if refused == verdicts.SAME_RECORD:
+    if refused == verdicts.SAME_RECORDS:
         return rep.refuse(f"{ch['upper']} and {ch['lower']} hold the same record (the same file twice?)")
     fields = np.stack([role_field(answer[None], f)[0] for f in (TIME, AMPLITUDE, FWHM, BASE_WIDTH, RISE, PEAK)])
     pulse = {r: Pulse(*(float(x) for x in fields[:-1, k])) for k, r in enumerate(ROLES)}
@@ -85,13 +86,13 @@ def report_at(v: Verdicts, s: int, answer: np.ndarray, t: np.ndarray, forces: di
             problems.append(f"{ch[r]}: no pulse passes the peak rules (height, prominence, width)")
         elif sigma is not None and sigma > 0:
             rep.snr[ch[r]] = pulse[r].amplitude / sigma
-    if refused == verdicts.GAUGE:
+    if refused == verdicts.MISSING_PULSE:
         return rep.refuse("; ".join(problems))
-    if refused == verdicts.SLOW:
-        return rep.refuse("; ".join(filter(None, (too_slow(ch[r], (bandwidth or {}).get(ch[r]), pulse[r].fwhm)
-                                                  for r in ROLES))))
+    if refused == verdicts.NARROW_BAND:
+        return rep.refuse("; ".join(too_slow(ch[r], (bandwidth or {}).get(ch[r]), pulse[r].fwhm)
+                                    for k, r in enumerate(ROLES) if v.slow[s, k]))
     up, low = pulse["upper"], pulse["lower"]
-    if refused == verdicts.SWAPPED:
+    if refused == verdicts.LOWER_FIRST:
         return rep.refuse(f"the lower gauge's pulse ({ch['lower']}, {low.time * 1e6:.4g} us) comes before or with "
                           f"the upper gauge's ({ch['upper']}, {up.time * 1e6:.4g} us): channels swapped?")
     figures = {name: float(x[s]) for name, x in v.figures.items()}

@@ -6,10 +6,10 @@ the figures as they are, so that a shot has the same numbers whether it was judg
 or with thousands of others, and a batch pays a few array operations, not a Report per
 shot.
 
-The rules, in the order they refuse: the two gauges hold the same record (SAME_RECORD);
-a gauge has no leading pulse (GAUGE: ``gauges`` says why, per gauge); a channel's
-bandwidth distorts its pulse (SLOW, distortion.slow); the lower pulse comes first
-(SWAPPED). A shot they all pass gives its amplitudes and widths; its speed figures
+The rules, in the order they refuse: the two gauges hold the same record (SAME_RECORDS);
+a gauge has no leading pulse (MISSING_PULSE: ``gauges`` says why, per gauge); a channel's
+bandwidth distorts its pulse (NARROW_BAND, distortion.slow); the lower pulse comes first
+(LOWER_FIRST). A shot they all pass gives its amplitudes and widths; its speed figures
 further need a plausible speed (``doubt``, plausibility.doubts) and the cross-correlation
 a lower record that runs past its pulse's fall (``cut``)."""
 from __future__ import annotations
@@ -25,7 +25,7 @@ from .plausibility import NO_DOUBT, doubts
 from .setup import Setup
 
 # the first rule that refused every figure of a shot (Verdicts.refused)
-GIVEN, SAME_RECORD, GAUGE, SLOW, SWAPPED = range(5)
+GIVEN, SAME_RECORDS, MISSING_PULSE, NARROW_BAND, LOWER_FIRST = range(5)
 # what a gauge's leading pulse lacks (Verdicts.gauges): none (PULSE), a measurable noise,
 # a record that goes on past it, a height over the noise, a peak that passes the rules
 PULSE, NO_NOISE, ENDS_IN_PULSE, BELOW_NOISE, NO_PEAK = range(5)
@@ -64,25 +64,29 @@ class Verdicts:
 
 
 def judge(answers: np.ndarray, span_s: np.ndarray, h_s: np.ndarray, sigma: np.ndarray | None, setup: Setup,
-             bandwidth_Hz: np.ndarray, ends: np.ndarray | None = None,
-             lower_last: np.ndarray | None = None) -> Verdicts:
+          bandwidth_Hz: np.ndarray, ends: np.ndarray | None = None, lower_last: np.ndarray | None = None,
+          unmeasured: np.ndarray | None = None) -> Verdicts:
     """The rules on S shots' answers (S, ANSWER). span_s, h_s (S,): each record's span and
-    sample interval (s); sigma (S, 2): each gauge's noise (nan: not measurable, and no pulse
-    is accepted), None for noise-free signals (no SNR rule); bandwidth_Hz (2,): each gauge
-    channel's bandwidth limit (0: none known); ends (S, 2): a gauge's record ends inside its
-    largest pulse (distortion.record_ends_in_pulse; None: not known); lower_last (S,): the
-    lower gauge's last force sample (nan or None: not known)."""
+    sample interval (s); sigma (S, 2): each gauge's noise (where ``unmeasured``, by default
+    where nan: not measurable, and no pulse is accepted), None for noise-free signals (no
+    SNR rule); bandwidth_Hz (2,): each gauge channel's bandwidth limit (0: none known); ends
+    (S, 2): a gauge's record ends inside its largest pulse (distortion.record_ends_in_pulse;
+    None: not known); lower_last (S,): the lower gauge's last force sample (nan or None:
+    not known)."""
     S = answers.shape[0]
     status, peak, found = answers[:, STATUS], role_field(answers, PEAK), role_field(answers, FOUND) == 1.0
     time, amp, fwhm = role_field(answers, TIME), role_field(answers, AMPLITUDE), role_field(answers, FWHM)
     rules = setup.rules
-    unmeasured = np.isnan(sigma) if sigma is not None else np.zeros((S, 2), bool)
-    below = peak < rules.snr * sigma if sigma is not None else np.zeros((S, 2), bool)
+    if sigma is None:
+        unmeasured = below = np.zeros((S, 2), bool)
+    else:
+        unmeasured = np.isnan(sigma) if unmeasured is None else unmeasured
+        below = peak < rules.snr * sigma
     gauges = np.select([unmeasured, found, np.zeros((S, 2), bool) if ends is None else ends, below],
                        [NO_NOISE, PULSE, ENDS_IN_PULSE, BELOW_NOISE], NO_PEAK)
-    too_slow = slow(np.asarray(bandwidth_Hz, dtype=float)[None, :], fwhm)
-    refused = np.select([status == pulses.SAME_RECORD, np.any(gauges != PULSE, axis=1), np.any(too_slow, axis=1),
-                         status == pulses.SWAPPED], [SAME_RECORD, GAUGE, SLOW, SWAPPED], GIVEN)
+    slowed = slow(np.asarray(bandwidth_Hz, dtype=float)[None, :], fwhm)
+    refused = np.select([status == pulses.SAME_RECORD, np.any(gauges != PULSE, axis=1), np.any(slowed, axis=1),
+                         status == pulses.SWAPPED], [SAME_RECORDS, MISSING_PULSE, NARROW_BAND, LOWER_FIRST], GIVEN)
     given = refused == GIVEN
     distance, flight = setup.lower.position_m - setup.upper.position_m, time[:, 1] - time[:, 0]
     doubt = np.where(given, doubts(setup.limits, distance, span_s, flight, h_s, fwhm[:, 0], setup.bead_diameter_m),
@@ -104,4 +108,4 @@ def judge(answers: np.ndarray, span_s: np.ndarray, h_s: np.ndarray, sigma: np.nd
     figures = {name: np.where(kept, value, np.nan) for name, (kept, value) in values.items()}
     for name in ("speed_xcorr_m_per_s", "duration_s", "base_duration_s", "width_diameters"):  # given if finite
         figures[name][~np.isfinite(figures[name])] = np.nan
-    return Verdicts(refused, gauges, too_slow, doubt, cut, flight, figures)
+    return Verdicts(refused, gauges, slowed, doubt, cut, flight, figures)

@@ -8,6 +8,7 @@ The chain starts in static equilibrium, nothing moving before the impact (static
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -198,12 +199,20 @@ class Chain:
     def static_overlaps(self) -> np.ndarray:
         """Static overlaps (m), d0 = (F/A)^(1/n) ((F/A)^(2/3): Hertz); 0 where a contact
         carries nothing; a contact flattened by a static hold rests deeper (contact_memory)."""
-        return self._cached("d0", lambda: self.contact_memory(self.contact_constants(), self.static_forces())[1])
+        return self._at_rest[1]
 
     def rest_state(self) -> np.ndarray:
         """The kernels' memory of the chain's contacts at rest (contact_memory's state of its
         constants and static forces)."""
-        return self._cached("state", lambda: self.contact_memory(self.contact_constants(), self.static_forces())[0])
+        return self._at_rest[0]
+
+    @functools.cached_property
+    def _at_rest(self) -> tuple:
+        """(rest_state, static_overlaps), computed once, read-only."""
+        state, d0, _ = self.contact_memory(self.contact_constants(), self.static_forces())
+        for a in (state, d0):
+            a.setflags(write=False)
+        return state, d0
 
     def contact_memory(self, A, F) -> tuple:
         """(state, d0, hold_work) of contacts of constants A (N/m^n) carrying static forces F

@@ -165,8 +165,8 @@ def _integrated(problems, t_end: float, save: SaveAt, dt: float | Stepping, meth
         a = (a[fill] if fill.size > n else a).reshape((n_chunks, width) + a.shape[1:])
         return a.transpose(0, *range(2, a.ndim), 1)
 
-    def stack(name):  # each chunk C-contiguous
-        return np.ascontiguousarray(chunked(name))
+    def stack(name):  # each chunk C-contiguous, a copy (the kernel integrates u and v in place)
+        return np.array(chunked(name), order="C")
 
     def rows(names):  # (chunks, rows, ..., width), in one copy
         parts = [chunked(k) for k in names]

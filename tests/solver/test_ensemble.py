@@ -32,6 +32,22 @@ def test_batched_kernel_agrees_with_single_shots(width):
         assert ens.reports[k].momentum_error <= 1e-10
 
 
+@pytest.mark.parametrize("width", [1, 4])
+def test_an_ensemble_leaves_the_shots_it_solves_as_they_were(width):
+    # the kernel integrates its chunks' displacements and velocities in place: the shots'
+    # own arrays must reach it as copies, at any width (a chunk of one shot is contiguous
+    # already), so that solving the same shots again gives the same records
+    from rig.solver.problem import ProblemArrays
+
+    shots = ProblemArrays.of(_problems(4))
+    u0, v0 = shots.u0.copy(), shots.v0.copy()
+    dt = stepping_at(shots.layout, 2e-6)
+    first = solve_ensemble(shots, 0.2e-3, save=SAVE, dt=dt, width=width)
+    assert np.array_equal(shots.u0, u0) and np.array_equal(shots.v0, v0)
+    again = solve_ensemble(shots, 0.2e-3, save=SAVE, dt=dt, width=width)
+    assert all(np.array_equal(again.forces[name], f) for name, f in first.forces.items())
+
+
 def test_ensemble_refuses_mixed_topologies_and_schedules():
     from rig import ForceSchedule
     a = _problems(1)[0]
