@@ -66,9 +66,10 @@ def analysed_figures(records: Records, setup: Setup) -> dict:
 class Judged:
     """A batch's compiled analysis and the rules' verdicts on it: answers (shots, ANSWER),
     sigma (shots, 2: each gauge's noise, nan: not measurable), finite (shots,), verdicts,
-    roles (2,: the gauge channels' rows in the records), touches (shots, 2: the channel reaches a
-    rail; False where the acquisition did not end OK), flagged (shots,: a gauge channel at a rail or over range), ticks (samples,: a
-    record's sample times from its first), bandwidth (channel -> its limit, Hz)."""
+    roles (2,: the gauge channels' rows in the records), touches (shots, 2: the channel
+    reaches a rail; False where the acquisition did not end OK), flagged (shots,: a gauge
+    channel at a rail or over range), ticks (samples,: a record's sample times from its
+    first), bandwidth (channel -> its limit, Hz)."""
 
     answers: np.ndarray
     sigma: np.ndarray
