@@ -8,12 +8,15 @@
 #
 #   bench/device_mc_scaling.sh                    # N = 1 2 4 8 16
 #   COUNTS="1 2" BATCHES=256 bench/device_mc_scaling.sh   # a small machine
+#   VARY="striker.velocity=normal(0.89 m/s, 0.01 m/s)" bench/device_mc_scaling.sh  # another study
 #
-# PYTHON: the interpreter to use (default python3); WHEELS: a folder of wheels to install
+# VARY: the study's --vary expressions, separated by ';' (default: rig bench mc's, striker speed and
+# every bead's mass); PYTHON: the interpreter to use (default python3); WHEELS: a folder of wheels to install
 # from without an index; OUT: a folder for mc_scaling.json and the log (default: a temporary one).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 COUNTS=${COUNTS:-"1 2 4 8 16"}  # 1: the serial share of a batch in one process (the Amdahl line)
+VARY=${VARY:-}  # empty: rig bench mc's study
 BATCHES=${BATCHES:-"256 64"}  # rig mc's default batch, and a batch whose arrays stay in a core's share of cache
 OUT=${OUT:-$(mktemp -d)}
 PYTHON=${PYTHON:-python3}
@@ -43,12 +46,14 @@ from rig.bench.baseline import machine
 
 if __name__ == "__main__":  # Dask's and the pool's worker processes import this file again
     print(f"machine: {machine()}")
+    vary = tuple(v.strip() for v in os.environ["VARY"].split(";") if v.strip()) or mc.VARY
+    print(f"study: ptfe52_magnetic, varied: {'; '.join(vary)}")
     tables = {}
     for batch in [int(b) for b in os.environ["BATCHES"].split()]:
-        tables[batch] = mc_scaling.run(mc.VARY, batch, [int(n) for n in os.environ["COUNTS"].split()])
+        tables[batch] = mc_scaling.run(vary, batch, [int(n) for n in os.environ["COUNTS"].split()])
         print(mc_scaling.table(tables[batch]), flush=True)
     with open(os.path.join(os.environ["OUT"], "mc_scaling.json"), "w") as fh:
-        json.dump({"machine": machine(), "tables": tables}, fh, indent=1)
+        json.dump({"machine": machine(), "vary": vary, "tables": tables}, fh, indent=1)
 PY
-COUNTS="$COUNTS" BATCHES="$BATCHES" OUT="$OUT" timeout 360 "$PYTHON" "$OUT/scaling.py" 2>&1 | tee -a "$OUT/log.txt"
+VARY="$VARY" COUNTS="$COUNTS" BATCHES="$BATCHES" OUT="$OUT" timeout 360 "$PYTHON" "$OUT/scaling.py" 2>&1 | tee -a "$OUT/log.txt"
 log "done: $OUT/mc_scaling.json"
