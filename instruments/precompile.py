@@ -36,7 +36,7 @@ SHOT_SMALL = {f"{DEVICES}.acquisition.scope_shot": f"({F2}, float64, int64, floa
               f"{DEVICES}.acquisition.samples_before_input": "(int64, float64, float64, float64)",
               f"{ANALYSIS}.baseline.conditioned": f"({F1}, int64, float64, float64, float64)",
               f"{ANALYSIS}.baseline.noise_level": f"({F1}, int64, float64)",
-              f"{ANALYSIS}.pulses.first_peaks": "(float64[:, :, ::1], int64[::1], int64, int64, int64[:, ::1])"}
+              f"{ANALYSIS}.pulses.first_peaks": "(int64, int64, float64[:, :, ::1], int64[::1], int64[:, ::1])"}
 B1, I1, I8 = "boolean[::1]", "int64[::1]", "int8[:, :, ::1]"
 F3 = "float64[:, :, ::1]"
 # and those a study's batches call (its nominal shot calls SHOT's): the acquisition and the analysis of many shots

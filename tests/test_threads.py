@@ -6,7 +6,7 @@ import numba
 import numpy as np
 import pytest
 
-from numerics.threads import HELPERS, over_threads, time_in_ranges
+from numerics.threads import HELPERS, PIECES, compiled, over_threads, time_in_ranges
 
 MANY = numba.config.NUMBA_NUM_THREADS >= 2
 needs_two = pytest.mark.skipif(not MANY, reason="one core: every range runs in the caller")
@@ -43,35 +43,90 @@ def test_every_item_is_in_exactly_one_range(n):
 
 
 @needs_two
-def test_the_helper_threads_are_kept_and_the_caller_takes_a_range():
-    used = []
+def test_the_helper_threads_are_kept_and_the_caller_takes_the_first_piece():
+    firsts, used = [], []
 
     def run(lo, hi):
         used.append(threading.current_thread())
+        if lo == 0:
+            firsts.append(threading.current_thread())
 
     _with_threads(2, lambda: over_threads(10, run))
     pool = HELPERS.pool
     for _ in range(4):
         _with_threads(2, lambda: over_threads(10, run))
     assert HELPERS.pool is pool  # the same pool for every call: no thread started and joined per call
-    assert used.count(threading.current_thread()) == 5  # the caller runs the first range of each call
+    assert firsts == [threading.current_thread()] * 5  # the caller runs the first piece of each call
     helpers = set(used) - {threading.current_thread()}
-    assert helpers and all(t.name.startswith("numba-range") and t.is_alive() for t in helpers)
+    assert all(t.name.startswith("numba-range") and t.is_alive() for t in helpers)
 
 
-def test_an_error_in_a_range_comes_after_every_range_has_run():
-    done = []
+def test_the_items_are_cut_into_pieces_that_the_threads_take_in_turn():
+    # up to PIECES pieces per thread, contiguous, in order of lo, each taken once
+    pieces = []
+    lock = threading.Lock()
+
+    def run(lo, hi):
+        with lock:
+            pieces.append((lo, hi))
+
+    _with_threads(2, lambda: over_threads(100, run))
+    threads = min(2, numba.config.NUMBA_NUM_THREADS)
+    pieces.sort()
+    assert len(pieces) == (PIECES * threads if threads > 1 else 1)
+    assert [lo for lo, _ in pieces[1:]] == [hi for _, hi in pieces[:-1]] and pieces[0][0] == 0 and pieces[-1][1] == 100
+
+
+@needs_two
+def test_a_slow_thread_takes_fewer_pieces():
+    # the caller's first piece is slow: the helper takes every other piece meanwhile
+    by = {}
+    lock = threading.Lock()
 
     def run(lo, hi):
         if lo == 0:
-            raise ValueError("first range")
+            threading.Event().wait(0.3)
+        with lock:
+            by.setdefault(threading.current_thread().name, []).append(lo)
+
+    _with_threads(2, lambda: over_threads(8, run))
+    assert by[threading.current_thread().name] == [0]
+    assert sorted(sum(by.values(), [])) == list(range(8))
+
+
+def test_an_error_in_a_piece_comes_after_every_piece_begun_has_run():
+    begun, done = [], []
+
+    def run(lo, hi):
+        begun.append(lo)
+        if lo == 0:
+            threading.Event().wait(0.05)
+            raise ValueError("first piece")
         threading.Event().wait(0.05)
         done.append(lo)
 
-    with pytest.raises(ValueError, match="first range"):
+    with pytest.raises(ValueError, match="first piece"):
         _with_threads(2, lambda: over_threads(4, run))
+    assert sorted(done) == sorted(lo for lo in begun if lo != 0)  # none left running when the error came
     if MANY:
-        assert done == [2]  # the other range had finished when the error came
+        assert done  # the helper ran pieces meanwhile
+
+
+@numba.njit(nogil=True)
+def _scaled(lo, hi, x, k, out):
+    for i in range(lo, hi):
+        out[i] = k * x[i]
+
+
+def test_a_compiled_kernel_is_typed_once_and_its_entry_point_gives_the_same_bits():
+    x = np.random.default_rng(1).random(1000)
+    out = np.full(1000, np.nan)
+    _with_threads(2, lambda: over_threads(1000, _scaled, x, 3.0, out))
+    assert np.array_equal(out, 3.0 * x)
+    entry = compiled(_scaled, (x, 3.0, out))
+    assert entry is _scaled.get_overload(_scaled.signatures[0])  # one signature: its entry point
+    _scaled(0, 1, x.astype(np.float32), 3.0, out.astype(np.float32))  # a second signature
+    assert compiled(_scaled, (x, 3.0, out)) is _scaled  # which one the dispatcher took is not told: itself
 
 
 def test_callers_on_several_threads_share_the_helpers_while_the_pool_grows():
@@ -125,7 +180,8 @@ def test_a_range_that_runs_over_threads_again_does_not_hang():
         over_threads(16, inner)  # runs in the range's own thread
 
     assert _in_time(lambda: _with_threads(2, lambda: over_threads(4, outer)))
-    assert (seen == min(4, numba.config.NUMBA_NUM_THREADS)).all()
+    threads = min(2, numba.config.NUMBA_NUM_THREADS)
+    assert (seen == (min(4, PIECES * threads) if threads > 1 else 1)).all()  # one inner loop per piece of outer
 
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork on this system")

@@ -108,5 +108,5 @@ def first_peak_times(f: np.ndarray, rows: Sequence[int] | np.ndarray, h: float) 
     if rows.size and not (rows.min() >= 0 and rows.max() < f.shape[1]):
         raise InstrumentError(f"rows = {rows.tolist()}: allowed 0 .. {f.shape[1] - 1} (the signals' rows)")
     i = np.empty((f.shape[0], rows.shape[0]), np.int64)
-    over_threads(f.shape[0], lambda lo, hi: pulses.first_peaks(f, rows, lo, hi, i))
+    over_threads(f.shape[0], pulses.first_peaks, f, rows, i)
     return np.where(i >= 0, i * h, np.nan)

@@ -121,10 +121,6 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
     panel = (wired, front.probe, front.ac, front.lowpass, front.source, front.level, front.rising, front.n_pre, dx,
              front.offset, front.ymult, front.yoff, front.sd, float(CODE_MIN), float(CODE_MAX), bool(scope.noise_floor))
     seeds = np.asarray(seeds, np.int64)
-
-    def shots_from(lo: int, hi: int) -> None:
-        acquisition.shots(lo, hi, seeds, forces, float(h), speed, replace, gauges, panel, reads, drawn_rows, rested,
-                          codes, over, status, times, drawn)
-
-    over_threads(S, shots_from)
+    over_threads(S, acquisition.shots, seeds, forces, float(h), speed, replace, gauges, panel, reads, drawn_rows,
+                 rested, codes, over, status, times, drawn)
     return Records(wiring, codes, over, status, times, drawn, n_in, float(h), reads)

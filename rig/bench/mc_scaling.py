@@ -4,7 +4,9 @@ at 1, 2, 4, ... up to the machine's cores, run three ways:
 - ``workers``: ``rig mc --workers N``, N local worker processes on one numba thread each;
 - ``dask``: a Dask LocalCluster of N single-threaded workers (``--scheduler local``), where
   Dask is installed;
-- ``threads``: one process, the batch path on N numba threads.
+- ``threads``: one process, the batch path on N numba threads;
+- ``threads_batch``: the same at the batch ``rig mc`` takes in one process on N threads
+  (rig.study.mc_spec.default_batch: 128 shots per thread, 256 at least).
 
 The rate of the first two is the steady one (shots stored after each worker's first
 batch, over the time since: worker start-up and numba's cache loads left out); of the
@@ -34,12 +36,14 @@ from numerics.threads import time_in_ranges
 from rig.study.batch import run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
+from rig.study.mc_spec import default_batch
 from rig.study.montecarlo import MonteCarloStudy
 from rig.study.store import Store
 
 MODES = {"workers": "rig mc --workers N (processes, 1 numba thread each), steady",
          "dask": "Dask LocalCluster, N single-threaded workers, steady",
-         "threads": "one process, N numba threads (batch path)"}
+         "threads": "one process, N numba threads (batch path)",
+         "threads_batch": "the same, rig mc's batch for N threads (128 per thread)"}
 PER_WORKER = 8  # batches per worker in each study
 THREAD_BATCHES = 4  # timed batches per thread count (after WARM_UP)
 STORE_GROUP = 8  # batches stored at once in the store's timing
@@ -133,7 +137,7 @@ def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
         import dask.distributed  # noqa: F401 - imported to find whether the dask extra is installed
         modes = list(MODES)
     except ImportError:
-        modes = ["workers", "threads"]
+        modes = ["workers", "threads", "threads_batch"]
     rows: dict[str, dict] = {m: {} for m in modes}
     for n in ns:
         rows["workers"][n] = steady_run(_study(vary, n, batch, seed=1), n)
@@ -142,6 +146,7 @@ def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
         # numba.config sets its options at import: a checker does not see them
         if n <= numba.config.NUMBA_NUM_THREADS:  # type: ignore[attr-defined]
             rows["threads"][n] = thread_rate(_study(vary, 1, batch, seed=3), n)
+            rows["threads_batch"][n] = thread_rate(_study(vary, 1, default_batch(n), seed=3), n)
     for by_n in rows.values():
         for n, row in by_n.items():
             row["efficiency_vs_2"] = _efficiency(by_n, n, 2)

@@ -32,11 +32,15 @@ def cmd_mc(args) -> dict:
         raise invalid("--workers", args.workers, f"the workers of --scheduler {args.scheduler} are the cluster's; "
                                                  "--workers sizes a local run or --scheduler local")
     load(args.scene, scene_overrides(args))  # a bad scene stops here, before numba is loaded
+    import numba
+
     from rig.study.executors import DEFAULT_WORKER_TIMEOUT
     from rig.study.mc_run import described, run_to
 
+    here = not args.scheduler and (args.workers or 1) == 1  # the batches run in this process, on numba's threads
     study = described(args.scene, args.vary or [], args.shots, args.out, args.seed, tuple(args.set or ()), args.batch,
-                      args.accuracy, args.sobol, args.truth, args.window, args.traces)
+                      args.accuracy, args.sobol, args.truth, args.window, args.traces,
+                      numba.get_num_threads() if here else 1)
 
     def admit(cost):  # the folder held, before anything is solved
         if study.shots != args.shots and not args.json:
@@ -96,8 +100,9 @@ def add_mc(sub) -> None:
                          'gauges.NAME.gain, gauges.NAME.misalignment')
     mc.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides")
     mc.add_argument("--seed", type=seed_arg, default=0, help="the study's seed (default 0)")
-    mc.add_argument("--batch", type=count_arg, help="shots per batch (default 256; resuming a study in --out: "
-                                                    "its own)")
+    mc.add_argument("--batch", type=count_arg, help="shots per batch (default 256, or 128 per numba thread up to "
+                                                    "4096 where the study runs in this process on more than 2; "
+                                                    "resuming a study in --out: its own)")
     mc.add_argument("--accuracy", type=plain(float), help="solver accuracy (default: the scene's)")
     mc.add_argument("--workers", type=count_arg,
                     help="local worker processes, or with --scheduler local the cluster's (default 1)")

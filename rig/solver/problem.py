@@ -233,7 +233,7 @@ def balance_at_rest(load, A, d0, expo, invm):
     from numerics.threads import over_threads
     from rig.solver.kernels.forces import balance_at_rest as balance  # numba: loaded when a problem is built
 
-    over_threads(A.shape[0], lambda lo, hi: balance(lo, hi, load, A, d0, expo, invm, REST_TOLERANCE, NUDGES))
+    over_threads(A.shape[0], balance, load, A, d0, expo, invm, REST_TOLERANCE, NUDGES)
 
 
 @dataclass(frozen=True, eq=False)

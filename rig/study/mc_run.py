@@ -15,7 +15,7 @@ from rig.errors import Interrupted, RigError
 from rig.experiment.measure import midway_static_force
 from rig.study.distributions import parse_vary
 from rig.study.executors import DEFAULT_WORKER_TIMEOUT, run_study
-from rig.study.mc_spec import DEFAULT_BATCH, Failure
+from rig.study.mc_spec import Failure, default_batch
 from rig.study.montecarlo import MonteCarloStudy
 from rig.study.nominal import nominal
 from rig.study.report import failures, figures, jcgm101
@@ -49,15 +49,16 @@ class StudyRun:
 
 def described(scene, vary: list, shots: int, folder, seed: int = 0, overrides: tuple = (), batch: int | None = None,
               accuracy: float | None = None, sobol: bool = False, truth: bool = False, window: str = "leading",
-              traces: bool = False) -> MonteCarloStudy:
+              traces: bool = False, threads: int = 1) -> MonteCarloStudy:
     """The study `rig mc` describes: ``vary`` its --vary texts (KEY=DIST); a Sobol design's
     shots (``sobol``: ``shots`` base samples' worth, rig.study.sobol); the batch size
     ``batch``, else the one of the study already in ``folder`` (a study resumed keeps its
-    batches), else DEFAULT_BATCH."""
+    batches), else default_batch(``threads``): ``threads`` the numba threads of a study run
+    in this process, 1 for one run by worker processes."""
     dists = tuple(parse_vary(vary))
     return MonteCarloStudy(scene, dists, sobol_shots(shots, len(dists)) if sobol else shots, seed, tuple(overrides),
-                           batch or Store.stored_batch(folder) or DEFAULT_BATCH, accuracy, sobol, truth, window,
-                           traces)
+                           batch or Store.stored_batch(folder) or default_batch(threads), accuracy, sobol, truth,
+                           window, traces)
 
 
 def cost(study: MonteCarloStudy):

@@ -128,6 +128,18 @@ def test_a_resumed_study_keeps_its_batch_size(tmp_path, capsys):
         capsys.readouterr().err
 
 
+def test_a_study_in_one_process_on_many_threads_takes_128_shots_per_thread_a_batch(tmp_path, monkeypatch, capsys):
+    """`rig mc` without --batch, its batches run here on 16 numba threads: 2048 shots a batch
+    (rig.study.mc_spec.default_batch), the solver's widest chunk per thread."""
+    import numba
+
+    monkeypatch.setattr(numba, "get_num_threads", lambda: 16)  # rig mc asks; the ranges' own count is unchanged
+    out = tmp_path / "s"
+    assert main(["mc", "ptfe52_magnetic", "--shots", "3", "--vary", VARY[0], "--out", str(out), "--quiet",
+                 "--json"]) == 0
+    assert json.loads((out / "study.json").read_text())["batch"] == 2048
+
+
 def test_interrupted_study_keeps_finished_shots_and_resumes(tmp_path):
     study = _study(shots=96)  # 6 batches
     store = Store(tmp_path / "s", study).open()

@@ -89,5 +89,9 @@ def test_the_study_rig_mc_describes_keeps_a_resumed_study_s_batches_and_sizes_a_
     (tmp_path / "old" / "study.json").write_text(json.dumps({"batch": 7}))
     assert described("ptfe52_magnetic", vary, 40, tmp_path / "old").batch == 7  # resumed: its own batches
     assert described("ptfe52_magnetic", vary, 40, tmp_path / "old", batch=5).batch == 5  # --batch says otherwise
+    # in one process on many threads: 128 shots per thread, 256 at least, 4096 at most; a resumed study its own
+    assert [described("ptfe52_magnetic", vary, 40, tmp_path / "new", threads=n).batch
+            for n in (1, 2, 3, 16, 64)] == [256, 256, 384, 2048, 4096]
+    assert described("ptfe52_magnetic", vary, 40, tmp_path / "old", threads=16).batch == 7
     sobol = described("ptfe52_magnetic", vary, 40, tmp_path / "new", sobol=True)
     assert sobol.shots == sobol_shots(40, 2) == 32 and sobol.sobol  # whole base samples of 2 + 2 shots

@@ -65,8 +65,5 @@ def analyse_shots(codes, status, times, dx, n_pre, ymult, yoff, yzero, roles, ra
     The shots are shared out in contiguous ranges over as many threads as numba's
     (numba.get_num_threads), each running analyse_range: a numba parallel loop over them
     doubled this analysis' compile time."""
-    def run(lo, hi):
-        analyse_range(lo, hi, codes, status, times, dx, n_pre, ymult, yoff, yzero, roles, rails, tau, sens, rules,
-                      answer, sigma, finite, touches)
-
-    over_threads(codes.shape[0], run)
+    over_threads(codes.shape[0], analyse_range, codes, status, times, dx, n_pre, ymult, yoff, yzero, roles, rails, tau,
+                 sens, rules, answer, sigma, finite, touches)

@@ -56,7 +56,7 @@ def first_peak(f):
 
 
 @jit(nogil=True)
-def first_peaks(f, rows, lo, hi, out):
+def first_peaks(lo, hi, f, rows, out):
     """out[s, k] = first_peak(f[s, rows[k]]) for shots s in lo..hi-1 of f (shots, rows,
     samples): the first crests of many shots' signals, a range of shots per thread."""
     for s in range(lo, hi):

@@ -223,7 +223,4 @@ def integrate_ensemble(u, v, chain, contacts, holder, method, record, checks, di
     contiguous ranges, each thread running integrate_chunks over its range: a numba parallel
     loop over them compiled the chunk's whole kernel twice more (its gufunc and its caller
     each link and re-optimise it), the largest part of a cold rig mc's compile time."""
-    def run(first, last):
-        integrate_chunks(first, last, u, v, chain, contacts, holder, method, record, checks, diag)
-
-    over_threads(u.shape[0], run)
+    over_threads(u.shape[0], integrate_chunks, u, v, chain, contacts, holder, method, record, checks, diag)
