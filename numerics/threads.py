@@ -99,7 +99,8 @@ def over_threads(n: int, kernel: Callable[..., None], *args) -> None:
     on as many threads as numba's (at most n): the first piece in this thread, the others
     taken in turn by this thread and the helpers; all in this thread where one suffices, or
     where this thread is a piece's already. ``kernel`` is a numba function compiled
-    ``nogil`` (its arguments typed once, ``compiled``) or any callable. Returns when every
+    ``nogil`` (its arguments typed once, ``compiled``: ``kernel(0, 0, *args)`` must do
+    nothing) or any callable. Returns when every
     piece has run; the first error of a piece is raised then. Every item is in exactly one
     piece, so a kernel whose items are independent gives the same bits however many threads
     run it."""
