@@ -100,10 +100,10 @@ def over_threads(n: int, kernel: Callable[..., None], *args) -> None:
     taken in turn by this thread and the helpers; all in this thread where one suffices, or
     where this thread is a piece's already. ``kernel`` is a numba function compiled
     ``nogil`` (its arguments typed once, ``compiled``: ``kernel(0, 0, *args)`` must do
-    nothing) or any callable. Returns when every
-    piece has run; the first error of a piece is raised then. Every item is in exactly one
-    piece, so a kernel whose items are independent gives the same bits however many threads
-    run it."""
+    nothing) or any callable. Returns when every piece has run; where a piece fails, the
+    threads take no more pieces and the first error is raised once those running have
+    ended. Every item is in exactly one piece, so a kernel whose items are independent gives
+    the same bits however many threads run it."""
     if getattr(LOCAL, "inside", False):
         kernel(0, n, *args)
         return
@@ -139,20 +139,25 @@ def _run_pieces(n: int, kernel: Callable[..., None], args: tuple) -> None:
     pieces = min(n, PIECES * threads)
     cuts = [n * k // pieces for k in range(pieces + 1)]
     taken = itertools.count()  # next() on it is atomic: each piece goes to one thread
-    failed: list[BaseException] = []
+    failed: list[BaseException] = []  # in the order they came: the first is raised
 
-    def take(_lo: int = 0, _hi: int = 0) -> None:
-        while not failed and (k := next(taken)) < pieces:
+    def run_from(k: int) -> None:
+        """Piece k, then the next not taken, until none is left or a piece failed."""
+        while not failed and k < pieces:
             try:
                 call(cuts[k], cuts[k + 1], *args)
-            except BaseException as exc:
-                failed.append(exc)  # the other threads take no more pieces
-                raise
+            except BaseException as exc:  # noqa: BLE001 - raised in the caller once every thread has stopped
+                failed.append(exc)
+                return
+            k = next(taken)
 
-    others = HELPERS.submit(take, [(0, 0)] * (threads - 1))
+    first = next(taken)  # the caller's, taken before a helper (one started by this very call) could
+    others = HELPERS.submit(lambda _lo, _hi: run_from(next(taken)), [(0, 0)] * (threads - 1))
     try:
-        take()
+        run_from(first)
     finally:
         wait(others)  # the pieces write into the caller's arrays: none outlives this call
     for future in others:
-        future.result()
+        future.result()  # an error of the helpers' own (none expected: run_from keeps them)
+    if failed:
+        raise failed[0]

@@ -50,7 +50,9 @@ def test_the_helper_threads_are_kept_and_the_caller_takes_the_first_piece():
         used.append(threading.current_thread())
         if lo == 0:
             firsts.append(threading.current_thread())
+        threading.Event().wait(0.002)  # long enough for a helper to wake and take pieces too
 
+    HELPERS.reset()  # a pool started by the first call: its new thread must not take the caller's piece
     _with_threads(2, lambda: over_threads(10, run))
     pool = HELPERS.pool
     for _ in range(4):
@@ -58,7 +60,7 @@ def test_the_helper_threads_are_kept_and_the_caller_takes_the_first_piece():
     assert HELPERS.pool is pool  # the same pool for every call: no thread started and joined per call
     assert firsts == [threading.current_thread()] * 5  # the caller runs the first piece of each call
     helpers = set(used) - {threading.current_thread()}
-    assert all(t.name.startswith("numba-range") and t.is_alive() for t in helpers)
+    assert helpers and all(t.name.startswith("numba-range") and t.is_alive() for t in helpers)
 
 
 def test_the_items_are_cut_into_pieces_that_the_threads_take_in_turn():
@@ -89,12 +91,13 @@ def test_a_slow_thread_takes_fewer_pieces():
         with lock:
             by.setdefault(threading.current_thread().name, []).append(lo)
 
+    HELPERS.reset()
     _with_threads(2, lambda: over_threads(8, run))
     assert by[threading.current_thread().name] == [0]
     assert sorted(sum(by.values(), [])) == list(range(8))
 
 
-def test_an_error_in_a_piece_comes_after_every_piece_begun_has_run():
+def test_an_error_in_a_piece_comes_after_every_piece_begun_has_run_and_stops_the_rest():
     begun, done = [], []
 
     def run(lo, hi):
@@ -102,14 +105,25 @@ def test_an_error_in_a_piece_comes_after_every_piece_begun_has_run():
         if lo == 0:
             threading.Event().wait(0.05)
             raise ValueError("first piece")
-        threading.Event().wait(0.05)
+        threading.Event().wait(0.04)
         done.append(lo)
 
     with pytest.raises(ValueError, match="first piece"):
-        _with_threads(2, lambda: over_threads(4, run))
+        _with_threads(2, lambda: over_threads(100, run))  # 8 pieces on 2 threads
     assert sorted(done) == sorted(lo for lo in begun if lo != 0)  # none left running when the error came
     if MANY:
-        assert done  # the helper ran pieces meanwhile
+        assert 1 <= len(done) <= 3  # the helper ran pieces meanwhile, and took none of the other 4 after the error
+
+
+def test_the_first_error_is_raised_whichever_thread_it_came_on():
+    def run(lo, hi):
+        if lo == 0:
+            threading.Event().wait(0.2)
+            raise ValueError("the caller's, later")
+        raise KeyError("a helper's, first")
+
+    with pytest.raises(KeyError if MANY else ValueError):
+        _with_threads(2, lambda: over_threads(2, run))
 
 
 @numba.njit(nogil=True)
@@ -118,13 +132,29 @@ def _scaled(lo, hi, x, k, out):
         out[i] = k * x[i]
 
 
-def test_a_compiled_kernel_is_typed_once_and_its_entry_point_gives_the_same_bits():
+def test_a_compiled_kernel_is_typed_once_and_its_pieces_call_its_entry_point(monkeypatch):
+    import numerics.threads as threads
+
     x = np.random.default_rng(1).random(1000)
     out = np.full(1000, np.nan)
-    _with_threads(2, lambda: over_threads(1000, _scaled, x, 3.0, out))
-    assert np.array_equal(out, 3.0 * x)
     entry = compiled(_scaled, (x, 3.0, out))
     assert entry is _scaled.get_overload(_scaled.signatures[0])  # one signature: its entry point
+    pieces = []
+
+    def spied(kernel, args):  # the pieces must call what compiled gives, not the dispatcher
+        chosen = compiled(kernel, args)
+        assert chosen is entry
+
+        def call(lo, hi, *rest):
+            pieces.append(lo)
+            chosen(lo, hi, *rest)
+        return call
+
+    monkeypatch.setattr(threads, "compiled", spied)
+    _with_threads(2, lambda: over_threads(1000, _scaled, x, 3.0, out))
+    assert np.array_equal(out, 3.0 * x)
+    if MANY:
+        assert sorted(pieces) == [1000 * k // len(pieces) for k in range(len(pieces))] and len(pieces) == PIECES * 2
     _scaled(0, 1, x.astype(np.float32), 3.0, out.astype(np.float32))  # a second signature
     assert compiled(_scaled, (x, 3.0, out)) is _scaled  # which one the dispatcher took is not told: itself
 

@@ -1,16 +1,17 @@
 """How ``rig mc`` scales with cores (the scaling table of ``rig bench mc``): the same study
-at 1, 2, 4, ... up to the machine's cores, run three ways:
+at 1, 2, 4, ... up to the machine's cores, run four ways:
 
 - ``workers``: ``rig mc --workers N``, N local worker processes on one numba thread each;
 - ``dask``: a Dask LocalCluster of N single-threaded workers (``--scheduler local``), where
   Dask is installed;
 - ``threads``: one process, the batch path on N numba threads;
 - ``threads_batch``: the same at the batch ``rig mc`` takes in one process on N threads
-  (rig.study.mc_spec.default_batch: 128 shots per thread, 256 at least).
+  (rig.study.mc_spec.default_batch: 128 shots per thread, 256 at least, within the memory
+  limit), in the table of rig mc's default batch only.
 
 The rate of the first two is the steady one (shots stored after each worker's first
 batch, over the time since: worker start-up and numba's cache loads left out); of the
-third the median batch after warm-up batches. Parallel efficiency is against 2 of the
+last two the median batch after warm-up batches. Parallel efficiency is against 2 of the
 same: rate_N / (N/2 x rate_2) (1 at N = 2), and against 1 for the single worker. Each
 study runs ``PER_WORKER`` batches per worker, so that the last round's batches are a
 small part of it.
@@ -36,7 +37,8 @@ from numerics.threads import time_in_ranges
 from rig.study.batch import run_batch
 from rig.study.distributions import parse_vary
 from rig.study.executors import run_study
-from rig.study.mc_spec import default_batch
+from rig.study.mc_run import held_per_shot
+from rig.study.mc_spec import DEFAULT_BATCH, default_batch
 from rig.study.montecarlo import MonteCarloStudy
 from rig.study.store import Store
 
@@ -135,10 +137,17 @@ def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
     ns = sorted(ns or counts(os.cpu_count() or 1))
     try:
         import dask.distributed  # noqa: F401 - imported to find whether the dask extra is installed
-        modes = list(MODES)
+        modes = ["workers", "dask", "threads"]
     except ImportError:
-        modes = ["workers", "threads", "threads_batch"]
+        modes = ["workers", "threads"]
+    if batch == DEFAULT_BATCH:  # beside rig mc's default batch only
+        modes.append("threads_batch")
     rows: dict[str, dict] = {m: {} for m in modes}
+    held = held_per_shot(_study(vary, 1, batch, seed=3)).bytes
+
+    def auto(n: int) -> int:  # rig mc's batch in one process on n threads
+        return default_batch(n, held)
+
     for n in ns:
         rows["workers"][n] = steady_run(_study(vary, n, batch, seed=1), n)
         if "dask" in rows:
@@ -146,7 +155,8 @@ def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
         # numba.config sets its options at import: a checker does not see them
         if n <= numba.config.NUMBA_NUM_THREADS:  # type: ignore[attr-defined]
             rows["threads"][n] = thread_rate(_study(vary, 1, batch, seed=3), n)
-            rows["threads_batch"][n] = thread_rate(_study(vary, 1, default_batch(n), seed=3), n)
+            if "threads_batch" in rows:
+                rows["threads_batch"][n] = dict(thread_rate(_study(vary, 1, auto(n), seed=3), n), batch=auto(n))
     for by_n in rows.values():
         for n, row in by_n.items():
             row["efficiency_vs_2"] = _efficiency(by_n, n, 2)
@@ -193,6 +203,10 @@ def table(r: dict) -> str:
             cells.append(f" {'-':>14s}" if row is None else
                          f" {row['shots_per_s']:7.0f}" + (f" ({eff:4.0%})" if eff is not None else " " * 7))
         lines.append(f"  {MODES[mode]:58s}" + "".join(cells))
+    auto = r["modes"].get("threads_batch", {})
+    if auto:
+        lines.append("  rig mc's batch in one process: "
+                     + ", ".join(f"N = {n}: {row['batch']}" for n, row in auto.items()))
     for mode in ("workers", "dask"):
         by_n = r["modes"].get(mode, {})
         if by_n:

@@ -101,7 +101,8 @@ def add_mc(sub) -> None:
     mc.add_argument("--set", action="append", metavar="KEY=VALUE", help="fixed overrides")
     mc.add_argument("--seed", type=seed_arg, default=0, help="the study's seed (default 0)")
     mc.add_argument("--batch", type=count_arg, help="shots per batch (default 256, or 128 per numba thread up to "
-                                                    "4096 where the study runs in this process on more than 2; "
+                                                    "4096 where the study runs in this process on more than 2 numba "
+                                                    "threads, within the memory limit; "
                                                     "resuming a study in --out: its own)")
     mc.add_argument("--accuracy", type=plain(float), help="solver accuracy (default: the scene's)")
     mc.add_argument("--workers", type=count_arg,

@@ -3,6 +3,7 @@ run the batches not yet stored (progress per batch), collect every shot and writ
 report (JCGM 101 summaries, Sobol indices, figures, study.h5, report.json)."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from dataclasses import dataclass
@@ -56,18 +57,50 @@ def described(scene, vary: list, shots: int, folder, seed: int = 0, overrides: t
     batches), else default_batch(``threads``): ``threads`` the numba threads of a study run
     in this process, 1 for one run by worker processes."""
     dists = tuple(parse_vary(vary))
-    return MonteCarloStudy(scene, dists, sobol_shots(shots, len(dists)) if sobol else shots, seed, tuple(overrides),
-                           batch or Store.stored_batch(folder) or default_batch(threads), accuracy, sobol, truth,
-                           window, traces)
+    given = batch or Store.stored_batch(folder)
+    study = MonteCarloStudy(scene, dists, sobol_shots(shots, len(dists)) if sobol else shots, seed, tuple(overrides),
+                            given or default_batch(1), accuracy, sobol, truth, window, traces)
+    if given or default_batch(threads) == study.batch:
+        return study
+    return dataclasses.replace(study, batch=default_batch(threads, held_per_shot(study).bytes))
+
+
+BATCH_COPIES = 2  # a batch of arrays holds its shots' recorded channels about twice (measured: 1.2 to 1.4 times)
+
+
+def held_per_shot(study: MonteCarloStudy):
+    """One shot of ``study`` as its batches hold it (rig.solver.estimate's RunEstimate of one
+    run). A batch of rigs (--truth, --traces, or a key the arrays do not take) holds each
+    shot's whole solution: the rig's own estimate. A batch of arrays (rig/study/shots.py)
+    holds each shot's recorded channels (its gauges' averages and the wall, at the scope's
+    sampling: the study's template) BATCH_COPIES times over the scene's whole record (a
+    leading window is shorter), and its scope codes (one byte a sample). ptfe52_magnetic:
+    estimated 640 kB a shot; measured (peak resident memory of a batch of 256 and of 1024)
+    410 kB over the whole record, 130 kB in the leading window."""
+    from rig.solver.estimate import estimate_solve
+    from rig.solver.problem import ChainProblem
+    from rig.study.shots import array_keys
+
+    nom = nominal(study.scene, tuple(study.overrides))
+    rig = nom.rig
+    rig.check_record()
+    one = rig.estimate(controlled=False)
+    if study.truth or study.traces or not array_keys(study.keys, rig):
+        return one
+    shot = nom.template("record")  # what the shots record, over the scene's window
+    channels = len(shot.save_at(contacts=False, averages=True).names)
+    s = shot.solver
+    recorded = estimate_solve(ChainProblem.from_chain(shot.chain), s.duration, channels, s.sample_interval, s.method,
+                              s.accuracy, controlled=False)
+    codes = len(shot.scope.channels) * shot.scope.timebase.record_length
+    return dataclasses.replace(one, bytes=8.0 * recorded.samples * channels * BATCH_COPIES + codes)
 
 
 def cost(study: MonteCarloStudy):
     """The whole study's estimated memory and CPU time (rig.solver.estimate, batches of
-    ``study.batch`` shots held at once), after refusing settings that can give no record
-    (or a made-up one) before any solve."""
-    rig = nominal(study.scene, study.overrides).rig
-    rig.check_record()
-    return rig.estimate(controlled=False).times(study.shots, min(study.batch, study.shots))
+    ``study.batch`` shots held at once, each shot as ``held_per_shot``), after refusing
+    settings that can give no record (or a made-up one) before any solve."""
+    return held_per_shot(study).times(study.shots, min(study.batch, study.shots))
 
 
 def run_to(folder, study: MonteCarloStudy, workers: int = 1, scheduler: str | None = None, progress=None,

@@ -47,19 +47,26 @@ FAILURES = ("none", "impossible inputs (the rig refuses them)", "solver unstable
 
 DEFAULT_BATCH = 256  # shots per batch: a batch's fixed costs (threads, arrays) spread over more shots
 SHOTS_PER_THREAD = 128  # in one process on many threads: the solver's widest chunk (rig/solver/ensemble.py) each
-MAX_BATCH = 4096  # about 150 kB a shot held while a batch runs: 0.6 GB
+MAX_BATCH = 4096
 
 
-def default_batch(threads: int = 1) -> int:
+def default_batch(threads: int = 1, bytes_per_shot: float = 0.0) -> int:
     """Shots per batch where none is given, for a study run in one process on ``threads``
     numba threads (1: a worker process of many): DEFAULT_BATCH, or SHOTS_PER_THREAD shots
-    per thread where that is more (at most MAX_BATCH). The solver integrates a batch's
+    per thread where that is more, at most MAX_BATCH and as many as the memory limit of a
+    run takes (rig.solver.estimate.LIMIT_BYTES) at ``bytes_per_shot`` held a shot (the
+    study's estimate: rig.study.mc_run.held_per_shot). The solver integrates a batch's
     shots in chunks of up to 128 shots, one or more per thread; a narrower chunk costs
     more per shot (16 shots: 1.6 times the CPU of 128, from the work each step does per
     chunk), and a batch's fixed costs weigh less. On 16 cores, 2048 shots a batch ran
     about 1.5 to 2 times as many shots/s as 256 (rig bench mc's scaling table). The shots'
     values do not depend on the batch size."""
-    return max(DEFAULT_BATCH, min(MAX_BATCH, SHOTS_PER_THREAD * threads))
+    from rig.solver.estimate import LIMIT_BYTES
+
+    batch = min(MAX_BATCH, SHOTS_PER_THREAD * threads)
+    if bytes_per_shot > 0:
+        batch = min(batch, int(LIMIT_BYTES // bytes_per_shot))
+    return max(DEFAULT_BATCH, batch)
 
 
 @dataclass(frozen=True)

@@ -69,8 +69,10 @@ def test_the_mc_scaling_table_runs_at_one_and_two_workers(monkeypatch):
     monkeypatch.setattr(mc_scaling, "PER_WORKER", 3)
     monkeypatch.setattr(mc_scaling, "WARM_UP", 1)
     monkeypatch.setattr(mc_scaling, "THREAD_BATCHES", 1)
+    monkeypatch.setattr(mc_scaling, "DEFAULT_BATCH", 8)  # rig mc's batch in one process on N threads beside it
     r = mc_scaling.run(mc.VARY, 8, [2, 1])
     assert r["counts"] == [1, 2] and r["batch"] == 8 and 60 < r["result_bytes_per_shot"] < 200
+    assert {n: row["batch"] for n, row in r["modes"]["threads_batch"].items()} == {1: 256, 2: 256}
     for mode, by_n in r["modes"].items():
         one, two = by_n[1], by_n[2]
         assert one["shots_per_s"] > 0 and two["shots_per_s"] > 0, mode

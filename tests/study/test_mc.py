@@ -1,6 +1,7 @@
 """Monte Carlo studies: inputs, seeds, executors, resume, report, Sobol."""
 import dataclasses
 import json
+import sys
 
 import h5py
 import numpy as np
@@ -130,14 +131,44 @@ def test_a_resumed_study_keeps_its_batch_size(tmp_path, capsys):
 
 def test_a_study_in_one_process_on_many_threads_takes_128_shots_per_thread_a_batch(tmp_path, monkeypatch, capsys):
     """`rig mc` without --batch, its batches run here on 16 numba threads: 2048 shots a batch
-    (rig.study.mc_spec.default_batch), the solver's widest chunk per thread."""
+    (rig.study.mc_spec.default_batch), the solver's widest chunk per thread; admitted
+    without --allow-large (the estimate of the memory a batch holds is under the limit)."""
     import numba
 
-    monkeypatch.setattr(numba, "get_num_threads", lambda: 16)  # rig mc asks; the ranges' own count is unchanged
+    # rig mc asks numba (so does the solver's chunk width, which changes no result); the ranges run on 2
+    monkeypatch.setattr(numba, "get_num_threads", lambda: 16)
     out = tmp_path / "s"
-    assert main(["mc", "ptfe52_magnetic", "--shots", "3", "--vary", VARY[0], "--out", str(out), "--quiet",
+    assert main(["mc", "ptfe52_magnetic", "--shots", "2100", "--vary", VARY[0], "--out", str(out), "--quiet",
                  "--json"]) == 0
     assert json.loads((out / "study.json").read_text())["batch"] == 2048
+    assert json.loads(capsys.readouterr().out)["shots"] == 2100
+
+
+HELD = """
+import dataclasses, json, sys, tracemalloc
+from rig.study.batch import run_batch
+from rig.study.distributions import parse_vary
+from rig.study.mc_run import held_per_shot
+from rig.study.montecarlo import MonteCarloStudy
+study = MonteCarloStudy("ptfe52_magnetic", tuple(parse_vary([sys.argv[1]])), 512, seed=2, batch=256, window="record")
+run_batch(dataclasses.replace(study, batch=4), 0)  # the nominal shot, the pilot, the kernels: before the count
+tracemalloc.start()  # numpy's arrays are traced (the kernels' own scratch is not: a few per thread)
+run_batch(study, 1)
+peak = tracemalloc.get_traced_memory()[1]
+print(json.dumps({"held": peak / 256, "estimate": held_per_shot(study).bytes}))
+"""
+
+
+def test_the_estimate_of_a_shot_held_in_a_batch_bounds_what_a_batch_holds():
+    """The memory a batch of arrays holds at its peak (tracemalloc: numpy's arrays), per shot,
+    over the scene's whole record (the longest window), is under the estimate that sizes rig
+    mc's batches and admits a study (rig.study.mc_run.held_per_shot), and not far under it."""
+    import subprocess
+
+    run = subprocess.run([sys.executable, "-c", HELD, VARY[0]], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    r = json.loads(run.stdout)
+    assert 0.25 * r["estimate"] < r["held"] <= r["estimate"]
 
 
 def test_interrupted_study_keeps_finished_shots_and_resumes(tmp_path):

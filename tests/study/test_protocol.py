@@ -89,9 +89,18 @@ def test_the_study_rig_mc_describes_keeps_a_resumed_study_s_batches_and_sizes_a_
     (tmp_path / "old" / "study.json").write_text(json.dumps({"batch": 7}))
     assert described("ptfe52_magnetic", vary, 40, tmp_path / "old").batch == 7  # resumed: its own batches
     assert described("ptfe52_magnetic", vary, 40, tmp_path / "old", batch=5).batch == 5  # --batch says otherwise
-    # in one process on many threads: 128 shots per thread, 256 at least, 4096 at most; a resumed study its own
+    # in one process on many threads: 128 shots per thread, 256 at least, 4096 at most, and no more than the
+    # memory limit takes at the study's estimate of a shot held (so that the default is never refused); a
+    # resumed study its own
+    from rig.solver.estimate import LIMIT_BYTES
+    from rig.study.mc_run import cost, held_per_shot
+
     assert [described("ptfe52_magnetic", vary, 40, tmp_path / "new", threads=n).batch
-            for n in (1, 2, 3, 16, 64)] == [256, 256, 384, 2048, 4096]
+            for n in (1, 2, 3, 16)] == [256, 256, 384, 2048]
+    for truth in (False, True):  # --truth: each shot's whole solution held (a batch of rigs)
+        many = described("ptfe52_magnetic", vary, 10**6, tmp_path / "new", threads=64, truth=truth)
+        assert many.batch == max(256, min(4096, int(LIMIT_BYTES // held_per_shot(many).bytes)))
+        assert 256 <= many.batch < 4096 and cost(many).bytes <= LIMIT_BYTES
     assert described("ptfe52_magnetic", vary, 40, tmp_path / "old", threads=16).batch == 7
     sobol = described("ptfe52_magnetic", vary, 40, tmp_path / "new", sobol=True)
     assert sobol.shots == sobol_shots(40, 2) == 32 and sobol.sobol  # whole base samples of 2 + 2 shots
