@@ -106,7 +106,10 @@ def add_mc(sub) -> None:
                                                     "resuming a study in --out: its own)")
     mc.add_argument("--accuracy", type=plain(float), help="solver accuracy (default: the scene's)")
     mc.add_argument("--workers", type=count_arg,
-                    help="local worker processes, or with --scheduler local the cluster's (default 1)")
+                    help="local worker processes, or with --scheduler local the cluster's (default 1: this "
+                         "process, on every core through numba's threads; each worker starts an interpreter of its "
+                         "own, about 2 s: workers run faster than one process's threads only on many cores and in "
+                         "long studies)")
     mc.add_argument("--scheduler", help="Dask scheduler: tcp://HOST:PORT, or 'local' for a LocalCluster")
     mc.add_argument("--sobol", action="store_true", help="Sobol design and indices (needs SALib)")
     mc.add_argument("--truth", action="store_true", help="also analyse each shot's noise-free truth (slower)")
