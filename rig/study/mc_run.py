@@ -65,7 +65,7 @@ def described(scene, vary: list, shots: int, folder, seed: int = 0, overrides: t
     return dataclasses.replace(study, batch=default_batch(threads, held_per_shot(study).bytes))
 
 
-BATCH_COPIES = 2  # a batch of arrays holds its shots' recorded channels about twice (measured: 1.2 to 1.4 times)
+BATCH_COPIES = 2  # copies of a batch's recorded channels counted (measured: 1.1 with everything else a batch holds)
 
 
 def held_per_shot(study: MonteCarloStudy):
@@ -75,8 +75,9 @@ def held_per_shot(study: MonteCarloStudy):
     holds each shot's recorded channels (its gauges' averages and the wall, at the scope's
     sampling: the study's template) BATCH_COPIES times over the scene's whole record (a
     leading window is shorter), and its scope codes (one byte a sample). ptfe52_magnetic:
-    estimated 640 kB a shot; measured (peak resident memory of a batch of 256 and of 1024)
-    410 kB over the whole record, 130 kB in the leading window."""
+    estimated 760 kB a shot; measured 420 kB over the whole record (a batch of 256 at its
+    peak, tracemalloc; a test holds the estimate above it) and 130 kB in the leading window
+    (resident memory, a batch of 1024)."""
     from rig.solver.estimate import estimate_solve
     from rig.solver.problem import ChainProblem
     from rig.study.shots import array_keys
