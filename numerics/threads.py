@@ -6,15 +6,15 @@ the same at run time, but links and re-optimises the kernel it calls once more a
 The calling thread takes the first piece; helper threads, started once per process and kept
 (``Helpers``), join in. A batch of a study calls this five times (the shots' rest, solver,
 pulse speeds, acquisition, analysis): a pool started and joined for each call cost 16 thread
-starts per call on 16 cores, serial time of the order of the ranges' own. A range that calls
+starts per call on 16 cores, serial time of the order of the pieces' own. A piece that calls
 ``over_threads`` again runs its items in its own thread (the helpers may all be waiting on it).
 
-Two costs that grow with the threads are kept off the pieces (measured on 16 cores, rig mc's
-batch of 256 shots):
+Two costs that grow with the threads are kept off the pieces (measured on 16 cores, batches
+of 256 shots):
 
 - **Choosing the compiled kernel.** numba's dispatcher types every argument on each call,
   holding Python's lock: 40-330 us for these kernels (a solver's bundles of arrays), so 15
-  helpers started one after another, the last 4.9 ms into a 8.6 ms solver pass. The caller
+  helpers started one after another, the last 4.9 ms into an 8.6 ms solver pass. The caller
   now asks the dispatcher once (an empty piece) and every piece calls the compiled entry
   point it chose, which types nothing (``compiled``).
 - **Uneven threads.** Pieces of equal size took from 2.8 to 4.9 ms on the threads of one
@@ -36,7 +36,7 @@ from concurrent.futures import Future, ThreadPoolExecutor, wait
 from numba import get_num_threads
 from numba.core.dispatcher import Dispatcher
 
-PIECES = 4  # pieces per thread: a thread slower by a quarter of a piece's time holds the others up at most that
+PIECES = 4  # pieces per thread: the threads end within about a piece (a quarter of a share) of each other
 LOCAL = threading.local()  # .spent: seconds this thread has spent in over_threads; .inside: in it now, or a helper
 
 
