@@ -143,7 +143,7 @@ def run(vary: tuple, batch: int, ns: list | None = None) -> dict:
     if batch == DEFAULT_BATCH:  # beside rig mc's default batch only
         modes.append("threads_batch")
     rows: dict[str, dict] = {m: {} for m in modes}
-    held = held_per_shot(_study(vary, 1, batch, seed=3)).bytes
+    held = held_per_shot(_study(vary, 1, batch, seed=3)).bytes if "threads_batch" in rows else 0.0
 
     def auto(n: int) -> int:  # rig mc's batch in one process on n threads
         return default_batch(n, held)

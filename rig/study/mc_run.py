@@ -78,8 +78,6 @@ def held_per_shot(study: MonteCarloStudy):
     estimated 760 kB a shot; measured 420 kB over the whole record (a batch of 256 at its
     peak, tracemalloc; a test holds the estimate above it) and 130 kB in the leading window
     (resident memory, a batch of 1024)."""
-    from rig.solver.estimate import estimate_solve
-    from rig.solver.problem import ChainProblem
     from rig.study.shots import array_keys
 
     nom = nominal(study.scene, tuple(study.overrides))
@@ -90,11 +88,9 @@ def held_per_shot(study: MonteCarloStudy):
         return one
     shot = nom.template("record")  # what the shots record, over the scene's window
     channels = len(shot.save_at(contacts=False, averages=True).names)
-    s = shot.solver
-    recorded = estimate_solve(ChainProblem.from_chain(shot.chain), s.duration, channels, s.sample_interval, s.method,
-                              s.accuracy, controlled=False)
+    samples = shot.estimate(controlled=False).samples  # per channel
     codes = len(shot.scope.channels) * shot.scope.timebase.record_length
-    return dataclasses.replace(one, bytes=8.0 * recorded.samples * channels * BATCH_COPIES + codes)
+    return dataclasses.replace(one, bytes=8.0 * samples * channels * BATCH_COPIES + codes)
 
 
 def cost(study: MonteCarloStudy):
