@@ -53,7 +53,9 @@ def autoscaled(scene: str, overrides=()) -> Rig:
     for ch, v in peaks.items():
         extra.append(f"scope.channels.{ch}.volts_per_div={_step_125(v / 5.0)!r}")
     extra.append(f"scope.trigger.level={0.15 * peaks[rig.scope.trigger.source]!r}")
-    return Rig.from_scene(scene, list(overrides) + extra)
+    scaled = Rig.from_scene(scene, list(overrides) + extra)
+    scaled.use_solution(rig.solution())  # the scope's settings alone differ: the same chain, the same solve
+    return scaled
 
 
 def _step_125(x: float) -> float:

@@ -179,3 +179,28 @@ def test_without_a_kept_family_every_target_says_it_has_no_value():
     md = markdown(f)
     assert "**none**" in md and "No fitted scene written: no family's joint fit converged" in md
     assert "skipped: no such law" in md
+
+
+def test_an_autoscaled_rig_takes_the_solve_it_was_scaled_from_and_fires_as_if_solved_itself(monkeypatch):
+    """reproduce's sweep points set the scope from a first rig's truth: the scaled rig differs
+    in the scope's settings only, so it takes that rig's solve (one solve a point, not two),
+    and its shot is the shot of the same scene solved on its own, bit for bit."""
+    import numpy as np
+
+    from rig.experiment import shot as shot_module
+    from rig.experiment.shot import Rig
+    from rig.study.reproduce import autoscaled
+
+    solves = []
+    real_solve = shot_module.solve
+    monkeypatch.setattr(shot_module, "solve", lambda *a, **k: solves.append(1) or real_solve(*a, **k))
+    scaled = autoscaled("ptfe20_gravity", ["striker.velocity=0.5"])
+    shot = scaled.fire(seed=3)
+    assert len(solves) == 1
+    assert any(o.startswith("scope.channels.") for o in scaled.scene.overrides)  # the scope was set
+    alone = Rig.from_scene("ptfe20_gravity", scaled.scene.overrides).fire(seed=3)
+    assert len(solves) == 2
+    assert shot.scope.waveforms.keys() == alone.scope.waveforms.keys()
+    for ch, w in shot.scope.waveforms.items():
+        assert np.array_equal(w.codes, alone.scope[ch].codes)
+    assert shot.analysis_truth == alone.analysis_truth and shot.analysis_truth is not None
