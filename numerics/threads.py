@@ -55,22 +55,21 @@ class Helpers:
         """No pool yet (a forked child's state: the parent's threads are not in it)."""
         self.lock, self.pool, self.size = threading.Lock(), None, 0
 
-    def submit(self, run_range: Callable[[int, int], None], ranges: list) -> list:
-        """``run_range(lo, hi)`` of each (lo, hi) of ``ranges`` on a helper thread: their
-        Futures. The pool is grown (a new one; the old one's threads end after what was given
-        them) and the ranges handed over under one lock, so that callers on several threads
-        never hand ranges to a pool another has just replaced; their ranges queue in turn."""
+    def submit(self, task: Callable[[], None], count: int) -> list:
+        """``task()`` on ``count`` helper threads: their Futures. The pool is grown (a new
+        one; the old one's threads end after what was given them) and the tasks handed over
+        under one lock, so that callers on several threads never hand tasks to a pool another
+        has just replaced; their tasks queue in turn."""
         with self.lock:
-            if self.pool is None or self.size < len(ranges):
+            if self.pool is None or self.size < count:
                 if self.pool is not None:
                     self.pool.shutdown(wait=False)
-                self.pool = ThreadPoolExecutor(len(ranges), thread_name_prefix="numba-range",
-                                               initializer=_mark_helper)
-                self.size = len(ranges)
+                self.pool = ThreadPoolExecutor(count, thread_name_prefix="numba-range", initializer=_mark_helper)
+                self.size = count
             futures: list[Future] = []
             try:
-                for lo, hi in ranges:
-                    futures.append(self.pool.submit(run_range, lo, hi))
+                for _ in range(count):
+                    futures.append(self.pool.submit(task))
             except BaseException:
                 wait(futures)  # none outlives the call that failed to hand over the rest
                 raise
@@ -87,7 +86,7 @@ if hasattr(os, "register_at_fork"):  # POSIX: a forked child has none of the par
 
 
 def time_in_ranges() -> float:
-    """Seconds the calling thread has spent in ``over_threads`` since it began (its ranges
+    """Seconds the calling thread has spent in ``over_threads`` since it began (its pieces
     running, on every thread): a batch's time in its compiled loops over the shots. The
     rest of a batch's time (its Python, numpy, kernels called alone) runs on one thread
     however many numba has, which bounds what N threads can give (Amdahl)."""
@@ -152,7 +151,7 @@ def _run_pieces(n: int, kernel: Callable[..., None], args: tuple) -> None:
             k = next(taken)
 
     first = next(taken)  # the caller's, taken before a helper (one started by this very call) could
-    others = HELPERS.submit(lambda _lo, _hi: run_from(next(taken)), [(0, 0)] * (threads - 1))
+    others = HELPERS.submit(lambda: run_from(next(taken)), threads - 1)
     try:
         run_from(first)
     finally:

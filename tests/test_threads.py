@@ -177,7 +177,8 @@ def test_callers_on_several_threads_share_the_helpers_while_the_pool_grows():
             for trial in range(30):
                 helpers = 1 + (k + trial) % 8
                 cuts = [64 * j // (helpers + 1) for j in range(helpers + 2)]
-                futures = HELPERS.submit(run, list(zip(cuts[1:-1], cuts[2:])))
+                ranges = iter(list(zip(cuts[1:-1], cuts[2:])))  # one a helper: next() hands each out once
+                futures = HELPERS.submit(lambda r=ranges: run(*next(r)), helpers)
                 run(cuts[0], cuts[1])
                 wait(futures)
                 for f in futures:
