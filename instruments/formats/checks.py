@@ -32,6 +32,19 @@ def channel_name(text: str) -> str:
     return f"CH_{name}" if name[0].isdigit() or name[0] == "#" else name
 
 
+def printed_quantum(cell) -> float:
+    """The unit in the last digit a file prints of a number (its rounding is at most half
+    of it): ``6.109e-05`` -> 1e-8, ``-8.000e-01`` -> 1e-4, ``0.0008`` -> 1e-4,
+    ``1.00E-09`` -> 1e-11, ``24999.16015625`` -> 1e-8, ``2000`` -> 1. What a file prints
+    is all it promises: a shortest form (``0.0008``) is taken to its last digit too."""
+    mantissa, _, exponent = str(cell).strip().lower().partition("e")
+    try:
+        power = int(exponent) if exponent else 0
+    except ValueError:
+        return 0.0  # no printed number: no rounding to allow for (the caller reads the value)
+    return 10.0 ** (power - len(mantissa.partition(".")[2]))
+
+
 def bandwidth(text) -> dict:
     """{"bandwidth_Hz": B} from a header's filter frequency (ISF FILTERF, CSV "Filter
     Frequency"), as the preamble's extra keeps a channel's bandwidth limit; {} where the

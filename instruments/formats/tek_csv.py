@@ -24,7 +24,7 @@ from ..errors import InstrumentError
 from ..files import atomic_writes
 from ..rails import flagged
 from ..records import Preamble, Waveform
-from .checks import bandwidth, channel_name, time_axis
+from .checks import bandwidth, channel_name, printed_quantum, time_axis
 
 TDS_BLOCK = 6  # columns per channel in the TDS1000/2000 layout
 _UNITS = {"volts": "V", "volt": "V", "v": "V"}
@@ -113,8 +113,9 @@ def _read_dpo(path, rows, start) -> list:
     names = [c.strip() for c in rows[start][1:] if c.strip()]
     if not names:
         raise InstrumentError(f"{path}: the TIME row names no channel")
-    data = [_floats(path, r[:1 + len(names)], start + 1 + i)
-            for i, r in enumerate(rows[start + 1:]) if any(c.strip() for c in r)]
+    kept = [(start + 1 + i, r) for i, r in enumerate(rows[start + 1:]) if any(c.strip() for c in r)]
+    data = [_floats(path, r[:1 + len(names)], i) for i, r in kept]
+    printed = [r[0] for _, r in kept]
     if len(data) < 2:
         raise InstrumentError(f"{path}: fewer than two data rows")
     if any(len(r) != 1 + len(names) for r in data):
@@ -124,9 +125,10 @@ def _read_dpo(path, rows, start) -> list:
     units = header.get("Vertical Units", [])
     interval = header.get("Sample Interval", [None])[0]
     fmt = header.get("Point Format", [None])[0]
-    return [_waveform(path, name.upper(), table[:, 0], table[:, 1 + k], zero, units[k] if k < len(units) else "V",
-                      interval, fmt, _screen(*(_cell(header, key, k) for key in
-                                               ("Vertical Scale", "Vertical Offset", "Vertical Position")))
+    return [_waveform(path, name.upper(), table[:, 0], printed, table[:, 1 + k], zero,
+                      units[k] if k < len(units) else "V", interval, fmt,
+                      _screen(*(_cell(header, key, k) for key in ("Vertical Scale", "Vertical Offset",
+                                                                    "Vertical Position")))
                       | bandwidth(_cell(header, "Filter Frequency", k)), zero_index=True)
             for k, name in enumerate(names)]
 
@@ -147,16 +149,31 @@ def _screen(scale, offset, position) -> dict:
             "position_div": float(position or 0)}
 
 
-TIME_TOLERANCE = 0.1  # samples: the most the TIME column may differ from the header's time base
+TIME_TOLERANCE = 0.1  # samples: the scope's own disagreement allowed beyond what its printing rounds
 
 
-def _time_base(path, t, interval, zero) -> tuple:
+def _time_base(path, t, interval, zero, printed) -> tuple:
     """(first sample's time s, sample interval s) of a record whose TIME column is ``t``:
     the header's Sample Interval (the column's median step where it gives none) from the
     column's first time, or from -Zero Index x Sample Interval where the header has a
     Zero Index (4/5/6 Series: the column prints nine digits, the fractional Zero Index
-    more). Every layout alike: InstrumentError in one line where that time base and the
-    column differ by more than TIME_TOLERANCE of a sample anywhere in the record."""
+    more).
+
+    The check, every layout alike: sample i of that time base and the TIME column may
+    differ by at most what the file's printing rounds, plus TIME_TOLERANCE of a sample,
+
+        |x0 + dt i - t_i| <= 0.1 dt + q(t_i)/2 + [q(t_0)/2 or q(z) dt/2]
+
+    with q(x) the unit in the last digit the file prints of x (checks.printed_quantum:
+    ``6.109e-05`` -> 1e-8 s, ``-8.000e-01`` -> 1e-4 s) and the last term the rounding of
+    the time base's start (the column's first time, or the printed Zero Index z). The
+    Sample Interval is the scope's time-base setting, which every layout prints in full
+    (shortest form, ``0.0008``, ``4e-08``; a TDS's ``1.00E-09``): taken as exact, so a
+    header interval off by one unit in its last digit is refused over a long record. A
+    TBS1000C prints its times to four digits, which round a time by up to 0.16 of a
+    sample at 4 us/div, a 4/5/6 Series nine. Beyond that bound the header and the column
+    describe two time bases: InstrumentError in one line.
+    ``printed``: the TIME column's cells as the file prints them."""
     if interval in (None, ""):
         dt = float(np.median(np.diff(t)))
     elif _is_float(interval):
@@ -166,13 +183,20 @@ def _time_base(path, t, interval, zero) -> tuple:
     if not (np.isfinite(dt) and dt > 0):
         raise InstrumentError(f"{path}: Sample Interval = {interval!r}: must be a finite number > 0 s")
     with_zero = zero not in (None, "") and _is_float(zero) and interval not in (None, "")
+    if with_zero and not np.isfinite(float(zero)):
+        raise InstrumentError(f"{path}: Zero Index = {zero!r}: must be a finite number of samples")
     x0 = -float(zero) * dt if with_zero else float(t[0])
-    grid = x0 + dt * np.arange(t.size)
-    if np.max(np.abs(grid - t)) > TIME_TOLERANCE * dt:
+    index = np.arange(t.size)
+    grid = x0 + dt * index
+    q_t = np.array([printed_quantum(c) for c in printed])
+    start = printed_quantum(zero) * dt / 2 if with_zero else q_t[0] / 2
+    bound = TIME_TOLERANCE * dt + q_t / 2 + start
+    if np.any(np.abs(grid - t) > bound):
         said = f"Zero Index = {zero} and Sample Interval = {interval}" if with_zero else f"Sample Interval = {interval}"
         raise InstrumentError(f"{path}: {said} put the first sample at {grid[0]:.9g} s and the last at "
                               f"{grid[-1]:.9g} s, the TIME column at {t[0]:.9g} s and {t[-1]:.9g} s: they must "
-                              f"agree within {TIME_TOLERANCE:g} of a sample")
+                              f"agree within {TIME_TOLERANCE:g} of a sample beyond the rounding of the digits "
+                              f"printed")
     return x0, dt
 
 
@@ -190,7 +214,7 @@ def _read_tds(path, rows) -> list:
 
 
 def _read_tds_block(path, rows, b: int) -> Waveform:
-    header, t, v = {}, [], []
+    header, t, v, printed = {}, [], [], []
     for i, row in enumerate(rows):
         r = row[b:b + 5]
         if len(r) < 5:
@@ -202,6 +226,7 @@ def _read_tds_block(path, rows, b: int) -> Waveform:
         tv = _floats(path, [r[3], r[4]], i)
         t.append(tv[0])
         v.append(tv[1])
+        printed.append(r[3])
     where = f"column {b + 1}" if b else "TDS layout"
     for key in ("Record Length", "Sample Interval"):
         if key not in header:
@@ -211,7 +236,7 @@ def _read_tds_block(path, rows, b: int) -> Waveform:
     if n != len(t):
         raise InstrumentError(f"{path}: Record Length says {n} points but the file holds {len(t)} ({where})")
     name = header.get("Source", Path(path).stem).upper()
-    return _waveform(path, name, np.array(t), np.array(v), header.get("Trigger Point"),
+    return _waveform(path, name, np.array(t), printed, np.array(v), header.get("Trigger Point"),
                      header.get("Vertical Units", "V"), header["Sample Interval"], header.get("Pt Fmt"),
                      _screen(header.get("Vertical Scale"), _negated(header.get("Vertical Offset")), "0"))
 
@@ -223,10 +248,11 @@ def _negated(cell):
     return f"{-float(cell)!r}" if cell not in (None, "") and _is_float(cell) else cell
 
 
-def _waveform(path, name, t, v, trigger, unit, interval=None, point_format=None, screen=None,
+def _waveform(path, name, t, printed, v, trigger, unit, interval=None, point_format=None, screen=None,
               zero_index=False) -> Waveform:
     """A volts-only Waveform on the time base _time_base checks against the TIME column
-    (``trigger``: the Zero Index where ``zero_index``, else the trigger's sample); an
+    (``trigger``: the Zero Index where ``zero_index``, else the trigger's sample;
+    ``printed``: the TIME column's cells as printed, whose digits bound its rounding); an
     envelope where the header's point format says ENV or PEAK (detect); the screen
     (``screen``, _screen) kept in extra and the over-range flag set where samples sit at
     its edge (instruments.rails). The channel is called after its source (or the file),
@@ -235,7 +261,7 @@ def _waveform(path, name, t, v, trigger, unit, interval=None, point_format=None,
         raise InstrumentError(f"{path}: the time column does not increase")
     if trigger not in (None, "") and not _is_float(trigger):
         raise InstrumentError(f"{path}: trigger position = {trigger!r} is not a number")
-    x0, dt = _time_base(path, t, interval, trigger if zero_index else None)
+    x0, dt = _time_base(path, t, interval, trigger if zero_index else None, printed)
     idx = (int(round(float(trigger))) if trigger not in (None, "") and not zero_index
            else int(np.clip(round(-x0 / dt), 0, t.size - 1)))
     unit = _UNITS.get((unit or "V").strip().lower(), (unit or "V").strip())

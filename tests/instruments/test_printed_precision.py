@@ -1,0 +1,83 @@
+"""A CSV reader's time check is as tight as the file's printing allows, no tighter: a
+TBS1000C prints its TIME column to four significant digits (``6.109e-05``), which round a
+time by up to half a unit in its last digit, 0.16 of a sample at 3.2e-8 s. Files built to
+that layout at every decade of the sample interval read on the header's time base; a time
+moved past the bound the printed digits allow is refused, one moved to just within it
+is not."""
+import math
+
+import numpy as np
+import pytest
+
+from instruments.errors import InstrumentError
+from instruments.formats import read_waveforms
+from instruments.formats.checks import printed_quantum
+from instruments.formats.tek_csv import TIME_TOLERANCE
+
+POINTS = 2000
+DECADES = range(-11, 0)  # sample intervals 3.2e-11 s ... 3.2e-1 s
+
+
+def _tbs1000c(path, dt: float, times: list) -> None:
+    """A TBS1102C's CSV: Model/Firmware rows, no Zero Index, TIME,CH1 in four digits."""
+    head = ["Model,TBS1102C", "Firmware Version,v1.38", "", "Point Format,Y", "Horizontal Units,S",
+            f"Horizontal Scale,{dt * POINTS / 16:g}", f"Sample Interval,{dt:g}", "Filter Frequency,2e+07",
+            f"Record Length,{POINTS}", "Gating,0.0% to 100.0%", "Probe Attenuation,1", "Vertical Units,V",
+            "Vertical Offset,0", "Vertical Scale,0.5", "Label,", "TIME,CH1"]
+    volts = 0.02 * np.round(50 * np.sin(np.arange(POINTS) / 40.0)) / 50
+    path.write_text("\n".join(head + [f"{t},{v:g}" for t, v in zip(times, volts)]) + "\n")
+
+
+def _grid(dt: float) -> np.ndarray:
+    """The scope's sample times: a trigger 40% into the record, off the printed grid."""
+    return dt * (np.arange(POINTS) - 0.4 * POINTS + 0.37)
+
+
+def _four_digits(t: float) -> str:
+    return f"{t:.3e}"
+
+
+@pytest.mark.parametrize("decade", DECADES)
+def test_a_four_digit_time_column_reads_on_the_headers_time_base_at_every_decade(tmp_path, decade):
+    dt = 3.2 * 10.0 ** decade
+    printed = [_four_digits(t) for t in _grid(dt)]
+    rounding = np.max(np.abs(np.array(printed, dtype=float) - (float(printed[0]) + dt * np.arange(POINTS))))
+    assert rounding > TIME_TOLERANCE * dt  # the printing alone is past the old bound of 0.1 of a sample
+    path = tmp_path / "TEK0000.CSV"
+    _tbs1000c(path, dt, printed)
+    (w,) = read_waveforms(path)
+    assert w.preamble.x_increment == float(f"{dt:g}")
+    np.testing.assert_allclose(w.time(), float(printed[0]) + w.preamble.x_increment * np.arange(POINTS),
+                               rtol=0, atol=1e-9 * dt)
+
+
+@pytest.mark.parametrize("decade", DECADES)
+def test_a_time_past_what_the_printed_digits_allow_is_refused_and_one_within_is_not(tmp_path, decade):
+    dt = float(f"{3.2 * 10.0 ** decade:g}")
+    printed = [_four_digits(t) for t in _grid(dt)]
+    x0 = float(printed[0])
+    j = POINTS - 1  # the last time: the furthest from the first, moved later (the column still increases)
+    q, q0 = printed_quantum(printed[j]), printed_quantum(printed[0])
+    on_grid = x0 + dt * j
+    bound = TIME_TOLERANCE * dt + q / 2 + q0 / 2  # the reader's bound there (tek_csv._time_base)
+    # one unit of the last digit at a time: the furthest within the bound, then the nearest past it
+    within = on_grid + q * math.floor((bound - q / 2) / q)
+    past = on_grid + q * (math.floor(bound / q) + 2)
+    for shifted, reads in ((within, True), (past, False)):
+        cells = list(printed)
+        cells[j] = _four_digits(shifted)
+        assert abs(float(cells[j]) - on_grid) <= bound if reads else abs(float(cells[j]) - on_grid) > bound
+        path = tmp_path / f"shifted_{reads}.csv"
+        _tbs1000c(path, dt, cells)
+        if reads:
+            read_waveforms(path)
+        else:
+            with pytest.raises(InstrumentError, match="beyond the rounding of the digits printed"):
+                read_waveforms(path)
+
+
+@pytest.mark.parametrize("cell,quantum", [
+    ("6.109e-05", 1e-8), ("-8.000e-01", 1e-4), ("0.0008", 1e-4), ("1.00E-09", 1e-11),
+    ("24999.16015625", 1e-8), ("2000", 1.0), ("4e-08", 1e-8), ("-2.5000000000E-04", 1e-14)])
+def test_the_unit_in_the_last_printed_digit(cell, quantum):
+    assert printed_quantum(cell) == pytest.approx(quantum, rel=1e-12)
