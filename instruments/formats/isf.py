@@ -23,7 +23,7 @@ from ..errors import InstrumentError
 from ..files import atomic_writes
 from ..rails import flagged
 from ..records import Preamble, Waveform
-from .checks import bandwidth, channel_name, time_axis
+from .checks import analog_only, bandwidth, channel_name, screen, time_axis
 
 # every spelling real scopes use, long and short, to one canonical key
 _ALIASES = {"BYT_NR": "BYT_NR", "BYT_N": "BYT_NR", "BIT_NR": "BIT_NR", "BIT_N": "BIT_NR",
@@ -34,7 +34,12 @@ _ALIASES = {"BYT_NR": "BYT_NR", "BYT_N": "BYT_NR", "BIT_NR": "BIT_NR", "BIT_N": 
             "XZERO": "XZERO", "XZE": "XZERO", "PT_OFF": "PT_OFF", "PT_O": "PT_OFF",
             "YUNIT": "YUNIT", "YUN": "YUNIT", "YMULT": "YMULT", "YMU": "YMULT",
             "YOFF": "YOFF", "YOF": "YOFF", "YZERO": "YZERO", "YZE": "YZERO",
-            "FILTERF": "FILTERF", "FILTERFREQ": "FILTERF"}  # the channel's filter (bandwidth) frequency, Hz
+            "FILTERF": "FILTERF", "FILTERFREQ": "FILTERF",  # the channel's filter (bandwidth) frequency, Hz
+            # what the record is (DPO/MDO/4/5/6 Series): TIME or FREQUENCY; ANALOG, DIGITAL, RF_TD, RF_FD;
+            # the frames of a FastFrame set; the screen (V/div, divisions)
+            "DOMAIN": "DOMAIN", "DOM": "DOMAIN", "WFMTYPE": "WFMTYPE", "WFMTYP": "WFMTYPE",
+            "NR_FR": "NR_FR", "VSCALE": "VSCALE", "VSCA": "VSCALE", "VPOS": "VPOS", "VOFFSET": "VOFFSET",
+            "VOFFS": "VOFFSET"}
 _REQUIRED = ("BYT_NR", "NR_PT", "XINCR", "XZERO", "YMULT", "YOFF", "YZERO")
 _CURVE = re.compile(rb":CURV(?:E)?\s+")
 # the end of an ASCII curve: the line's end, or the next record's header
@@ -96,6 +101,10 @@ def read_isf(path) -> list:
         if m is None:
             raise InstrumentError(f"{path}: no :CURVE block after byte {pos} (not an ISF file?)")
         header = _parse_header(data[pos:m.start()], path)
+        analog_only(path, waveform_type=header.get("WFMTYPE", ""), domain=header.get("DOMAIN", ""),
+                    source=header.get("WFID", ""), number_format=header.get("BN_FMT", ""),
+                    frames=header.get("NR_FR", ""))
+        time_axis(path, "XUNIT", header.get("XUNIT", "s"))
         ascii_header = header.get("ENCDG", "BIN").upper().startswith("ASC")
         binary_block = data[m.end():m.end() + 1] == b"#"
         if ascii_header == binary_block:
@@ -127,7 +136,11 @@ def _parse_header(raw: bytes, path) -> dict:
         key, _, value = item.partition(" ")
         canon = _ALIASES.get(key.upper())
         if canon:
-            fields[canon] = value.strip().strip('"')
+            value = value.strip().strip('"')
+            if canon in fields and fields[canon] != value:
+                raise InstrumentError(f"{path}: header field {canon} given twice ({fields[canon]!r} and {value!r}): "
+                                      f"the header contradicts itself")
+            fields[canon] = value
     missing = [k for k in _REQUIRED if k not in fields]
     if missing:
         raise InstrumentError(f"{path}: header field(s) missing: {', '.join(missing)}")
@@ -135,10 +148,15 @@ def _parse_header(raw: bytes, path) -> dict:
 
 
 def _number(header, key, path, kind=float):
+    """A header field's value: a finite number (a whole one where ``kind`` is int)."""
     try:
-        return kind(float(header[key])) if kind is int else float(header[key])
+        value = float(header[key])
     except ValueError:
         raise InstrumentError(f"{path}: header field {key} = {header[key]!r} is not a number") from None
+    if not np.isfinite(value) or (kind is int and not value.is_integer()):
+        raise InstrumentError(f"{path}: {key} = {value!r}: the header field must be a finite "
+                              f"{'whole ' if kind is int else ''}number")
+    return int(value) if kind is int else value
 
 
 def _read_curve(data: bytes, at: int, header: dict, path):
@@ -163,8 +181,10 @@ def _read_curve(data: bytes, at: int, header: dict, path):
     if len(data) - start < count:
         raise InstrumentError(f"{path}: truncated curve block: {len(data) - start} of {count} bytes present")
     order = ">" if header.get("BYT_OR", "MSB").upper() == "MSB" else "<"
-    signed = header.get("BN_FMT", "RI").upper() == "RI"
-    dtype = np.dtype(f"{order}{'i' if signed else 'u'}{nbytes}")
+    fmt = header.get("BN_FMT", "RI").upper()
+    if fmt not in ("RI", "RP"):
+        raise InstrumentError(f"{path}: BN_FMT = {fmt}: binary codes are RI (signed) or RP (unsigned)")
+    dtype = np.dtype(f"{order}{'i' if fmt == 'RI' else 'u'}{nbytes}")
     codes = np.frombuffer(data, dtype=dtype, count=points, offset=start).astype(dtype.newbyteorder("="))
     return codes, start + count
 
@@ -187,13 +207,41 @@ def _read_ascii_curve(data: bytes, at: int, header: dict, path):
         raise InstrumentError(f"{path}: the ASCII curve holds {len(cells)} codes but the header says NR_PT = {points}")
     if points < 2:
         raise InstrumentError(f"{path}: NR_PT = {points}: a record needs at least 2 points (one has no time base)")
-    dtype = np.int8 if nbytes == 1 else np.int16
+    unsigned = header.get("BN_FMT", "RI").upper() == "RP"
+    dtype = np.dtype(f"{'u' if unsigned else 'i'}{nbytes}")
     codes = np.array([int(c) for c in cells], dtype=np.int64)
     info = np.iinfo(dtype)
     if codes.min() < info.min or codes.max() > info.max:
         raise InstrumentError(f"{path}: an ASCII code of {codes.min() if codes.min() < info.min else codes.max()} "
-                              f"does not fit BYT_NR = {nbytes} ({info.min} to {info.max})")
+                              f"does not fit BYT_NR = {nbytes}{', BN_FMT RP' if unsigned else ''} "
+                              f"({info.min} to {info.max})")
     return codes.astype(dtype), stop
+
+
+def _signed(codes: np.ndarray, y_offset: float) -> tuple:
+    """(signed codes, YOFF) of the same volts: BN_FMT RP's unsigned codes c (0 .. 2^(8n) - 1)
+    become c - 2^(8n-1) with YOFF moved by as much, volts = YZERO + YMULT (code - YOFF)
+    unchanged, so every record holds int8 or int16 codes as a scope's RI records do."""
+    if codes.dtype.kind != "u":
+        return codes, y_offset
+    half = 1 << (8 * codes.dtype.itemsize - 1)
+    signed = np.dtype(f"i{codes.dtype.itemsize}")
+    return (codes.astype(np.int32) - half).astype(signed), y_offset - half
+
+
+_VOLTS_PER_DIV = re.compile(r"([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)\s*(m|u|\u00b5|n)?V/div", re.IGNORECASE)
+_PREFIX = {None: 1.0, "m": 1e-3, "u": 1e-6, "\u00b5": 1e-6, "n": 1e-9}
+
+
+def _screen_of(h: dict) -> dict:
+    """The screen the header gives, as the CSV reader keeps it (checks.screen): VSCALE,
+    VOFFSET and VPOS of a DPO/MSO header, else the V/div its WFID names ("50.00mV/div")."""
+    if "VSCALE" in h:
+        return screen(h["VSCALE"], h.get("VOFFSET"), h.get("VPOS"))
+    m = _VOLTS_PER_DIV.search(h.get("WFID", ""))
+    if m is None:
+        return {}
+    return screen(float(m.group(1)) * _PREFIX[m.group(2) and m.group(2).lower()], 0, 0)
 
 
 def _waveform(h: dict, codes, path, index) -> Waveform:
@@ -204,6 +252,11 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
     ymult = _number(h, "YMULT", path)
     if not (np.isfinite(ymult) and ymult != 0):
         raise InstrumentError(f"{path}: YMULT = {ymult!r}: the volts per code must be a finite number other than 0")
+    nbytes = codes.dtype.itemsize
+    codes, y_offset = _signed(codes, _number(h, "YOFF", path))
+    if abs(y_offset) > 1 << (8 * nbytes):
+        raise InstrumentError(f"{path}: YOFF = {h['YOFF']}: a code offset beyond the converter's range "
+                              f"(+-{1 << (8 * nbytes)} for {nbytes} byte(s) a point): not this record's header")
     x0 = _number(h, "XZERO", path)
     pt_off = _number(h, "PT_OFF", path, int) if "PT_OFF" in h else 0
     first = x0 - dx * pt_off  # t = XZERO + XINCR (n - PT_OFF)
@@ -217,10 +270,10 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
         name = f"{name}#{index + 1}"
     name = channel_name(name)
     pre = Preamble(points=codes.size, x_increment=dx, x_zero=first, trigger_index=trigger,
-                   y_multiplier=ymult, y_offset=_number(h, "YOFF", path),
+                   y_multiplier=ymult, y_offset=y_offset,
                    y_zero=_number(h, "YZERO", path), byte_count=codes.dtype.itemsize,
                    x_unit=x_unit, y_unit=h.get("YUNIT", "V"), waveform_id=wfid,
                    point_format="ENV" if envelope else "Y",
                    extra={"source": str(path), "record": index + 1, "name_in_file": name_in_file,
-                          **bandwidth(h.get("FILTERF"))})
+                          **bandwidth(h.get("FILTERF")), **_screen_of(h)})
     return flagged(Waveform(name, pre, codes=codes))

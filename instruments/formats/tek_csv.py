@@ -8,13 +8,17 @@
   the block's first two (three, with a units column) beside time and volts in its fourth
   and fifth.
 
-A spectrum (MATH FFT: Horizontal Units Hz) is refused by name, never read as a time record.
+A spectrum (MATH FFT: Horizontal Units Hz), a digital record (Waveform Type DIGITAL, a
+Digital Type row, D0 or CH1_D0 columns), an IQ record (Waveform Type IQ, IQ_centerFrequency
+rows) and a FastFrame set are refused by name from the header (checks.analog_only), never
+read as a time record of volts.
 The export is the 4/5/6 Series layout, one file per channel, with the fractional Zero Index
 (the trigger's place in samples) those scopes write, so that Tektronix's own reader
 (tm_data_types) puts every sample where this reader does.
 """
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -24,7 +28,7 @@ from ..errors import InstrumentError
 from ..files import atomic_writes
 from ..rails import flagged
 from ..records import Preamble, Waveform
-from .checks import bandwidth, channel_name, printed_quantum, time_axis
+from .checks import analog_only, bandwidth, channel_name, printed_quanta, printed_quantum, screen, time_axis
 
 TDS_BLOCK = 6  # columns per channel in the TDS1000/2000 layout
 _UNITS = {"volts": "V", "volt": "V", "v": "V"}
@@ -109,8 +113,12 @@ def _is_float(c):
 
 def _read_dpo(path, rows, start) -> list:
     header = {r[0].strip(): [c.strip() for c in r[1:]] for r in rows[:start] if r and r[0].strip()}
-    time_axis(path, "Horizontal Units", (header.get("Horizontal Units") or ["s"])[0])
     names = [c.strip() for c in rows[start][1:] if c.strip()]
+    analog_only(path, waveform_type=_first(header, "Waveform Type"), digital_type=_first(header, "Digital Type"),
+                source=next((n for n in names if _DIGITAL_COLUMN.match(n)), ""),
+                iq_keys=any(k.upper().startswith("IQ_") for k in header),
+                frames=next((_first(header, k) for k in header if "FRAME" in k.upper() and "COUNT" in k.upper()), ""))
+    time_axis(path, "Horizontal Units", (header.get("Horizontal Units") or ["s"])[0])
     if not names:
         raise InstrumentError(f"{path}: the TIME row names no channel")
     kept = [(start + 1 + i, r) for i, r in enumerate(rows[start + 1:]) if any(c.strip() for c in r)]
@@ -120,6 +128,7 @@ def _read_dpo(path, rows, start) -> list:
         raise InstrumentError(f"{path}: fewer than two data rows")
     if any(len(r) != 1 + len(names) for r in data):
         raise InstrumentError(f"{path}: a data row has fewer columns than the TIME row")
+    _record_length(path, _first(header, "Record Length"), _first(header, "Gating"), len(data))
     table = np.array(data)
     zero = header.get("Zero Index", [None])[0]
     units = header.get("Vertical Units", [])
@@ -127,10 +136,48 @@ def _read_dpo(path, rows, start) -> list:
     fmt = header.get("Point Format", [None])[0]
     return [_waveform(path, name.upper(), table[:, 0], printed, table[:, 1 + k], zero,
                       units[k] if k < len(units) else "V", interval, fmt,
-                      _screen(*(_cell(header, key, k) for key in ("Vertical Scale", "Vertical Offset",
+                      screen(*(_cell(header, key, k) for key in ("Vertical Scale", "Vertical Offset",
                                                                     "Vertical Position")))
                       | bandwidth(_cell(header, "Filter Frequency", k)), zero_index=True)
             for k, name in enumerate(names)]
+
+
+_GATE = re.compile(r"^\s*([\d.]+)\s*%\s*to\s*([\d.]+)\s*%\s*$")
+
+
+def _record_length(path, length: str, gating: str, rows: int) -> None:
+    """InstrumentError in one line unless the data rows are as many as the header's Record
+    Length, times the gated fraction where the header gates part of the record ("25.0% to
+    75.0%": half of it, to a row either way): a file cut short, at a line boundary or not,
+    or a header that lies, is refused rather than read as a shorter record."""
+    if not length:
+        return
+    n = _whole_number(length)
+    if n is None or n < 2:
+        raise InstrumentError(f"{path}: Record Length = {length!r}: must be a whole number of points >= 2")
+    gate = _GATE.match(gating or "")
+    lo, hi = (float(gate.group(1)), float(gate.group(2))) if gate else (0.0, 100.0)
+    expected = n * (hi - lo) / 100
+    if abs(rows - expected) > (1 if gate and (lo, hi) != (0.0, 100.0) else 0):
+        said = f" gated {gating.strip()}, about {expected:.0f}" if gate and (lo, hi) != (0.0, 100.0) else ""
+        raise InstrumentError(f"{path}: Record Length says {n} points{said} but the file holds {rows} data rows "
+                              f"(a file cut short, or a header that is not this record's)")
+
+
+def _whole_number(text: str) -> int | None:
+    try:
+        value = float(text)
+    except ValueError:
+        return None
+    return int(value) if value.is_integer() else None
+
+
+def _first(header: dict, key: str) -> str:
+    """A header row's first value ('' where the row is missing or empty)."""
+    return (header.get(key) or [""])[0]
+
+
+_DIGITAL_COLUMN = re.compile(r"^(D\d+|CH\d+_D\d+)$", re.IGNORECASE)  # a 4/5/6 Series digital column
 
 
 def _cell(header: dict, key: str, k: int) -> str:
@@ -138,15 +185,6 @@ def _cell(header: dict, key: str, k: int) -> str:
     last one given before it (an MSO3012 writes "Vertical Scale,0.05," for two channels)."""
     given = [v for v in (header.get(key) or [])[:k + 1] if v]
     return given[-1] if given else ""
-
-
-def _screen(scale, offset, position) -> dict:
-    """The screen a header gives (V/div, offset V, position div), as the preamble's extra
-    keeps it for instruments.rails; {} where the scale is missing or not a number."""
-    if not _is_float(scale or "") or not all(_is_float(x) for x in (offset or "0", position or "0")):
-        return {}
-    return {"volts_per_div": float(scale), "vertical_offset_V": float(offset or 0),
-            "position_div": float(position or 0)}
 
 
 TIME_TOLERANCE = 0.1  # samples: the scope's own disagreement allowed beyond what its printing rounds
@@ -164,9 +202,10 @@ def _time_base(path, t, interval, zero, printed) -> tuple:
 
         |x0 + dt i - t_i| <= 0.1 dt + q(t_i)/2 + [q(t_0)/2 or q(z) dt/2]
 
-    with q(x) the unit in the last digit the file prints of x (checks.printed_quantum:
-    ``6.109e-05`` -> 1e-8 s, ``-8.000e-01`` -> 1e-4 s) and the last term the rounding of
-    the time base's start (the column's first time, or the printed Zero Index z). The
+    with q(x) the unit in the last digit the file prints x to (checks.printed_quanta, from
+    the digits of the whole column: ``6.109e-05`` -> 1e-8 s, ``-8.000e-01`` -> 1e-4 s; a
+    zero is exact) and the last term the rounding of the time base's start (the column's
+    first time, or the printed Zero Index z, checks.printed_quantum). The
     Sample Interval is the scope's time-base setting, which every layout prints in full
     (shortest form, ``0.0008``, ``4e-08``; a TDS's ``1.00E-09``): taken as exact, so a
     header interval off by one unit in its last digit is refused over a long record. A
@@ -188,7 +227,7 @@ def _time_base(path, t, interval, zero, printed) -> tuple:
     x0 = -float(zero) * dt if with_zero else float(t[0])
     index = np.arange(t.size)
     grid = x0 + dt * index
-    q_t = np.array([printed_quantum(c) for c in printed])
+    q_t = printed_quanta(printed)
     start = printed_quantum(zero) * dt / 2 if with_zero else q_t[0] / 2
     bound = TIME_TOLERANCE * dt + q_t / 2 + start
     if np.any(np.abs(grid - t) > bound):
@@ -231,6 +270,7 @@ def _read_tds_block(path, rows, b: int) -> Waveform:
     for key in ("Record Length", "Sample Interval"):
         if key not in header:
             raise InstrumentError(f"{path}: header field {key!r} missing ({where})")
+    analog_only(path, source=header.get("Source", ""))
     time_axis(path, "Horizontal Units", header.get("Horizontal Units", "s"))
     n = int(float(header["Record Length"]))
     if n != len(t):
@@ -238,7 +278,7 @@ def _read_tds_block(path, rows, b: int) -> Waveform:
     name = header.get("Source", Path(path).stem).upper()
     return _waveform(path, name, np.array(t), printed, np.array(v), header.get("Trigger Point"),
                      header.get("Vertical Units", "V"), header["Sample Interval"], header.get("Pt Fmt"),
-                     _screen(header.get("Vertical Scale"), _negated(header.get("Vertical Offset")), "0"))
+                     screen(header.get("Vertical Scale"), _negated(header.get("Vertical Offset")), "0"))
 
 
 def _negated(cell):

@@ -18,7 +18,8 @@ Waveform File Format" (the same in WFM#001, #002 and #003) say what the file hol
 what is not one analog record is refused by name: a digital waveform (data type 6), an IQ
 record (interleaved I and Q samples, told by the IQ_ keys of its trailing tekmeta block),
 a FastFrame set (set type 1, or more than one frame), any other data type than a vector,
-and a record whose horizontal (implicit dimension) unit is not seconds.
+and a record whose horizontal (implicit dimension) unit is not seconds (a spectrum), each
+before the bytes per point, so that a refusal names what the record is.
 """
 from __future__ import annotations
 
@@ -55,9 +56,6 @@ def check_header(path, data: bytes) -> None:
     if data[2:10] not in VERSIONS:
         raise InstrumentError(f"{path}: WFM version string = {data[2:10]!r}: the rig reads "
                               f"{', '.join(v.decode() for v in VERSIONS)}")
-    if data[BYTES_PER_POINT] not in (1, 2):
-        raise InstrumentError(f"{path}: WFM bytes per point = {data[BYTES_PER_POINT]}: the rig reads integer codes "
-                              f"of 1 or 2 bytes (4 or 8 bytes: int32 or floating-point values)")
     (frames,) = struct.unpack_from(f"{order}I", data, FAST_FRAMES_MINUS_ONE)
     (set_type,) = struct.unpack_from(f"{order}i", data, SET_TYPE)
     (data_type,) = struct.unpack_from(f"{order}i", data, DATA_TYPE)
@@ -72,6 +70,10 @@ def check_header(path, data: bytes) -> None:
     if set_type == FASTFRAME or frames > 0:
         raise InstrumentError(f"{path}: a FastFrame waveform set ({frames + 1} frames, set type = {set_type}); "
                               f"the rig reads single-record files (save one frame)")
+    time_axis(path, "WFM implicit dimension units", _horizontal_unit(data))
+    if data[BYTES_PER_POINT] not in (1, 2):
+        raise InstrumentError(f"{path}: WFM bytes per point = {data[BYTES_PER_POINT]}: the rig reads integer codes "
+                              f"of 1 or 2 bytes (4 or 8 bytes: int32 or floating-point values)")
 
 
 def read_wfm(path) -> list:
@@ -94,7 +96,6 @@ def read_wfm(path) -> list:
     dx = float(times[1] - times[0])
     if not (np.isfinite(dx) and dx > 0):
         raise InstrumentError(f"{path}: sample interval {dx!r}: must be a finite number > 0 s")
-    time_axis(path, "WFM implicit dimension units", _horizontal_unit(data))
     codes = np.rint((volts - offset) / scale)
     width = data[BYTES_PER_POINT]
     dtype = np.int8 if width == 1 else np.int16
@@ -133,5 +134,8 @@ def _horizontal_unit(data: bytes) -> str:
                (False, True): tektronix_wfm_002_le_wfm.TektronixWfm002LeWfm,
                (False, False): tektronix_wfm_002_be_wfm.TektronixWfm002BeWfm}
     layout = layouts[(data[3:10] == b"WFM#001", data[:2] == b"\x0f\x0f")]
-    units = layout.from_bytes(data).wfm_header.imp_dim1.units
+    try:
+        units = layout.from_bytes(data).wfm_header.imp_dim1.units
+    except Exception:  # noqa: BLE001 - a header the description cannot parse: the reader's own parse names it
+        return "s"
     return units.split(b"\0")[0].decode("ascii", "replace")

@@ -261,6 +261,18 @@ SCOPE_FILES = {
     "asc_over_bin.isf": _isf().replace(b"ENCDG BIN", b"ENCDG ASC"),
     "bin_over_asc.isf": _isf().split(b"#14")[0] + b"1,2,3,4\n",
     "ascii_curve_short.isf": _isf().replace(b"ENCDG BIN", b"ENCDG ASC").split(b"#14")[0] + b"1,2,3\n",
+    # a header with a field that is no number, given twice, or off the converter's range
+    "xzero_nan.isf": _isf().replace(b"XZERO 0;", b"XZERO NAN;"),
+    "ymult_twice.isf": _isf(header_extra="YMULT 2E-3;"),
+    "yoff_huge.isf": _isf().replace(b"YOFF 0;", b"YOFF 1e300;"),
+    "bn_fmt_fp.isf": _isf().replace(b"BN_FMT RI", b"BN_FMT FP"),
+    # a CSV cut short at a line boundary, or whose Record Length lies
+    "cut_dpo.csv": b"Record Length,12\nSample Interval,1e-06\nTIME,CH1\n0,0.1\n1e-06,0.2\n2e-06,0.3\n3e-06,0.4\n",
+    "record_length_lies.csv": (b"Record Length,99999999\nSample Interval,1e-06\nTIME,CH1\n0,0.1\n1e-06,0.2\n"
+                               b"2e-06,0.3\n3e-06,0.4\n"),
+    # records that are no analog volts, as CSV (the .wfm and .isf forms: tests/instruments/test_record_kinds.py)
+    "digital.csv": b"Waveform Type,DIGITAL\nSample Interval,1e-06\nRecord Length,2\nTIME,CH1_D0,CH1_D1\n0,0,1\n1e-06,1,1\n",
+    "iq.csv": b"Waveform Type,IQ\nIQ_centerFrequency,1e9\nIQ_span,1e6\nSample Interval,1e-06\nTIME,CH1\n0,1\n1e-06,2\n",
 }
 FILE_CASES = [(cmd, name) for name in SCOPE_FILES for cmd in ("analyze", "import")]
 

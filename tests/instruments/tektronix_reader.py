@@ -37,6 +37,18 @@ tm.write_file(sys.argv[1], w)
 """
 
 
+_WRITE_DIGITAL = """
+import sys
+import numpy as np
+import tm_data_types as tm
+w = tm.DigitalWaveform()
+w.y_axis_byte_values = (np.arange(400) % 7).astype(np.uint8)
+w.x_axis_spacing, w.trigger_index = 1e-6, 40.0
+for path in sys.argv[1:]:
+    tm.write_file(path, w)
+"""
+
+
 def _run(script: str, *args) -> str:
     python = os.environ.get("RIG_TMDT_PYTHON")
     if not python or not os.path.exists(python):
@@ -54,6 +66,12 @@ def read_with_tm_data_types(paths) -> list:
     (numpy arrays for the last four but spacing)."""
     out = json.loads(_run(_SCRIPT, *paths))
     return [{**w, **{k: np.asarray(w[k]) for k in ("codes", "t", "v")}} for w in out]
+
+
+def write_digital(*paths) -> None:
+    """A digital record (eight bits a sample) as Tektronix's own writer makes it, in each
+    path's format (.csv: Waveform Type DIGITAL, CH1_D0..CH1_D7 columns; .wfm)."""
+    _run(_WRITE_DIGITAL, *paths)
 
 
 def write_iq_wfm(path) -> None:

@@ -11,7 +11,7 @@ import pytest
 
 from instruments.errors import InstrumentError
 from instruments.formats import read_waveforms
-from instruments.formats.checks import printed_quantum
+from instruments.formats.checks import printed_quanta, printed_quantum
 from instruments.formats.tek_csv import TIME_TOLERANCE
 
 POINTS = 2000
@@ -81,3 +81,13 @@ def test_a_time_past_what_the_printed_digits_allow_is_refused_and_one_within_is_
     ("24999.16015625", 1e-8), ("2000", 1.0), ("4e-08", 1e-8), ("-2.5000000000E-04", 1e-14)])
 def test_the_unit_in_the_last_printed_digit(cell, quantum):
     assert printed_quantum(cell) == pytest.approx(quantum, rel=1e-12)
+
+
+@pytest.mark.parametrize("column,quanta", [
+    (["-8.000e-01", "0.000e+00", "6.109e-05"], [1e-4, 0.0, 1e-8]),  # a fixed form: every cell its digits
+    (["-0.00000033", "-0.000000329", "0.00000067", "0.0000033"], [1e-9, 1e-9, 1e-9, 1e-8]),  # TDS2001C
+    (["0", "1e-06", "2e-06", "1.5e-06"], [0.0, 1e-7, 1e-7, 1e-7]),  # shortest form: 1.5e-06 shows two digits
+    (["-880.000006873E-6", "-1.0000091E-6"], [1e-15, 1e-17]),  # engineering form, twelve digits
+])
+def test_a_columns_rounding_comes_from_its_most_digits(column, quanta):
+    np.testing.assert_allclose(printed_quanta(column), quanta, rtol=1e-12, atol=0)
