@@ -271,8 +271,10 @@ SCOPE_FILES = {
     "record_length_lies.csv": (b"Record Length,99999999\nSample Interval,1e-06\nTIME,CH1\n0,0.1\n1e-06,0.2\n"
                                b"2e-06,0.3\n3e-06,0.4\n"),
     # records that are no analog volts, as CSV (the .wfm and .isf forms: tests/instruments/test_record_kinds.py)
-    "digital.csv": b"Waveform Type,DIGITAL\nSample Interval,1e-06\nRecord Length,2\nTIME,CH1_D0,CH1_D1\n0,0,1\n1e-06,1,1\n",
-    "iq.csv": b"Waveform Type,IQ\nIQ_centerFrequency,1e9\nIQ_span,1e6\nSample Interval,1e-06\nTIME,CH1\n0,1\n1e-06,2\n",
+    "digital.csv": (b"Waveform Type,DIGITAL\nSample Interval,1e-06\nRecord Length,2\nTIME,CH1_D0,CH1_D1\n"
+                    b"0,0,1\n1e-06,1,1\n"),
+    "iq.csv": (b"Waveform Type,IQ\nIQ_centerFrequency,1e9\nIQ_span,1e6\nSample Interval,1e-06\nTIME,CH1\n"
+               b"0,1\n1e-06,2\n"),
 }
 FILE_CASES = [(cmd, name) for name in SCOPE_FILES for cmd in ("analyze", "import")]
 
