@@ -141,8 +141,8 @@ def cmd_analyze(args) -> list:
             src = ", ".join(Path(part).name for part in r["source"].split(", "))  # the files' names (JSON: paths)
             src = src if len(src) <= 40 else src[:37] + "..."
             print(f"{src:40s} {fmt(r['speed_m_per_s'], '.1f'):>8s} "
-                  f"{fmt(r['speed_xcorr_m_per_s'], '.1f'):>8s} {fmt(r['amplitude_N'], '.3f'):>8s} "
-                  f"{fmt(r['averaged_amplitude_N'], '.3f'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
+                  f"{fmt(r['speed_xcorr_m_per_s'], '.1f'):>8s} {fmt(_force(r, 'amplitude'), '.3f'):>8s} "
+                  f"{fmt(_force(r, 'averaged_amplitude'), '.3f'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
                   f"{fmt(fwhm, '.1f'):>8s} {fmt(r['theory_speed_m_per_s'], '.1f'):>8s}")
             if r["snr"]:
                 noise = r["noise"]
@@ -162,6 +162,12 @@ def cmd_analyze(args) -> list:
             for line in missing_lines(r["reasons"]):
                 print(f"  {line}")
     return results
+
+
+def _force(row: dict, figure: str):
+    """A row's force figure in its own unit: FIGURE_N (newtons) or FIGURE_V (a real record's
+    gauge volts without --sensitivity)."""
+    return row.get(f"{figure}_N", row.get(f"{figure}_V"))
 
 
 def cmd_ls(args) -> list:

@@ -199,6 +199,20 @@ def _refused(source: str, why: str, simulated: bool | None = None) -> dict:
     return out
 
 
+IN_VOLTS = {"amplitude_N": "amplitude_V", "averaged_amplitude_N": "averaged_amplitude_V",
+            "total_force_N": "total_force_V"}
+"""The force figures of a real record analysed without --sensitivity, which the gauges'
+volts give: each under a key that names its unit (a key's unit is in its name)."""
+
+
+def _in_volts(out: dict) -> dict:
+    """``out`` with its force figures, and their reasons, under the _V keys of IN_VOLTS
+    (no F_0 is added to them: --f0 needs --sensitivity)."""
+    out = {IN_VOLTS.get(k, k): v for k, v in out.items()}
+    out["reasons"] = {IN_VOLTS.get(k, k): v for k, v in out["reasons"].items()}
+    return out
+
+
 def _limits(name: str | None) -> Limits:
     """The speed bound: the bar speed sqrt(E / rho) of the bead material, or of the
     fastest material in the table when it is not known."""
@@ -207,6 +221,13 @@ def _limits(name: str | None) -> Limits:
 
 
 def _result(source, record, setup: Setup, options: AnalyzeOptions, entry=None) -> dict:
+    """One source's row: the figures, their reasons and the theory beside them; a real
+    record's forces without --sensitivity under _V keys (IN_VOLTS)."""
+    out = _figures(source, record, setup, options, entry)
+    return _in_volts(out) if setup.force_unit == "V" else out
+
+
+def _figures(source, record, setup: Setup, options: AnalyzeOptions, entry=None) -> dict:
     virtual = entry is not None and entry.simulated
     mat = entry.settings["chain"]["material"] if virtual else options.material
     setup = replace(setup, limits=_limits(mat))

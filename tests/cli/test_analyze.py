@@ -11,6 +11,7 @@ from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Time
 from instruments.formats import read_record
 from instruments.formats.isf import write_isf
 from rig.cli import main
+from rig.experiment.analyze import IN_VOLTS
 
 H = 1e-7
 
@@ -41,7 +42,8 @@ def run(capsys, *argv):
 
 def refused(result, text):
     assert result["speed_m_per_s"] is None
-    assert {f for f in FIGURES if result[f] is None} <= set(result["reasons"])
+    figures = [f if f in result else IN_VOLTS[f] for f in FIGURES]  # a real record's in volts: _V keys
+    assert {f for f in figures if result[f] is None} <= set(result["reasons"])
     assert any(text in why for why in result["reasons"].values()), result["reasons"]
 
 
@@ -77,6 +79,40 @@ def test_text_output_says_when_its_forces_are_volts(gauge_files, capsys):
                                                                                     *GAUGE)
     assert (v["force_unit"], n["force_unit"], v["simulated"]) == ("V", "N", False)
     assert v["noise"]["CH1"] == pytest.approx(0.05 * n["noise"]["CH1"], rel=1e-12)
+
+
+def _keys(node, path=""):
+    """Every key of a JSON document, with where it stands."""
+    if isinstance(node, dict):
+        for k, v in node.items():
+            yield f"{path}.{k}", k
+            yield from _keys(v, f"{path}.{k}")
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            yield from _keys(v, f"{path}[{i}]")
+
+
+def test_a_figure_in_volts_is_never_under_a_newton_key(gauge_files, realdata, capsys):
+    """Without --sensitivity a real record's forces are its gauges' volts: every force
+    figure goes under a _V key, the _N keys appear only where a sensitivity makes newtons,
+    and the volts are the newtons times the sensitivity. Every JSON row rig analyze writes
+    for a real record: the gauge pair, and each real file that gives a row."""
+    _, (v,), _ = run(capsys, "analyze", *gauge_files, "--gauge-distance", "40 mm", "--tau", "1 ms")
+    _, (n,), _ = run(capsys, "analyze", *gauge_files, *GAUGE)
+    assert (v["force_unit"], n["force_unit"]) == ("V", "N")
+    for name, key in IN_VOLTS.items():
+        assert name not in v and name not in v["reasons"] and key in v and key not in n
+    assert v["amplitude_V"] == pytest.approx(0.05 * n["amplitude_N"], rel=1e-9)
+    assert v["averaged_amplitude_V"] == pytest.approx(0.05 * n["averaged_amplitude_N"], rel=1e-9)
+    assert v["total_force_V"] == pytest.approx(0.05 * n["total_force_N"], rel=1e-9)  # F_0 = 0: --f0 needs N
+    rows = [v]
+    for path in sorted(p for p in realdata.iterdir() if p.suffix.lower() in (".csv", ".isf", ".wfm")):
+        code, out, _ = run(capsys, "analyze", str(path), str(path), "--gauge-distance", "43 mm")
+        rows += out if code != 2 else []
+    assert len(rows) > 5
+    for row in rows:
+        newton_keys = [where for where, key in _keys(row) if key.endswith("_N")]
+        assert newton_keys == [".static_force_N"] and row["static_force_N"] == 0, newton_keys  # no --f0: 0 N
 
 
 def test_19_km_between_the_gauges_is_refused(gauge_files, capsys):
