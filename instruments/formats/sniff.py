@@ -5,9 +5,10 @@ one-line refusal, so that a user who hands over a LeCroy or Rigol file learns wh
 and what the rig reads, instead of a parse error from deep inside a reader. The
 signatures are those the makers' own programmer manuals give (and RigolWFM's detector
 uses): LeCroy's WAVEDESC block, Tektronix's byte-order word and ":WFM#00n" version string,
-Keysight's "AG" cookie and Infiniium HDF5 groups, Rigol's 0xA5A5 / 0xA1A5 / "RG0n" magics
-and CSV title rows, Siglent's channel-on flags and volt/div records, PicoScope's zip
-container and CSV title/units rows, Yokogawa's ASCII keys, R&S's XML header (its eRS_
+Keysight's "AG" cookie and Infiniium HDF5 groups, Tektronix DPO5000/7000 HDF5 datasets,
+Rigol's 0xA5A5 / 0xA1A5 / "RG0n" magics, DHO zlib blocks and CSV title rows, Siglent's
+channel-on flags, volt/div records and "Analog:" tags, PicoScope's zip container and CSV
+title/units rows, Yokogawa's ASCII keys, R&S's XML header (its eRS_
 enumerations) and .Wfm.bin payload header (format code and record length that match the
 file's size).
 """
@@ -28,6 +29,7 @@ _FOREIGN = (
     ("a Keysight/Agilent .bin waveform", lambda h: h[:2] == b"AG" and h[2:4].isdigit()),
     ("a Rigol .bin waveform", lambda h: h[:4] in (b"RG01", b"RG02", b"RG03")),
     ("a Rigol .wfm waveform", lambda h: h[:2] in (b"\xa5\xa5", b"\xa1\xa5", b"\x01\xff")),
+    ("a Rigol DHO800/DHO1000 .wfm waveform (zlib-compressed blocks)", lambda h: _rigol_dho_wfm(h)),  # below
     ("a Yokogawa .wfm/.wvf waveform", lambda h: b"$PublicInfo" in h or all(
         k in h for k in (b"NR_PT:", b"XIN:", b"YMU:"))),
     # the .bin metadata of an R&S .bin / .Wfm.bin pair: XML with the eRS_ enumerations
@@ -36,13 +38,18 @@ _FOREIGN = (
     ("a Siglent SDS .bin waveform", lambda h: _siglent_bin(h)),  # defined below
     ("a zip archive (PicoScope .psdata / .pssettings files are zip archives)", lambda h: h[:4] == b"PK\x03\x04"),
     # DS1000Z/DS2000/DS4000: "X,CH1,...,Start,Increment," or, without the X column,
-    # "CH1,CH2,Start,Increment,"; DS1000E/D: "X,CH1," then "Second,Volt,"
+    # "CH1,CH2,Start,Increment,"; DS1000B/D/E: "X,CH1,CH2," or "Time,X(CH1),X(CH2)," then the
+    # units row "Second,Volt,Volt,"
     ("a Rigol CSV export", lambda h: re.match(
         rb"\s*(X,)?(CH\d,|D\d+,|MATH\d?,)+\s*Start,Increment", h) is not None or re.match(
-        rb"\s*X,(CH\d,?)+\s*\r?\n\s*Second,", h) is not None),
+        rb"\s*(X|Time),((CH\d|X\(CH\d\)),?)+\s*\r?\n\s*Second,", h) is not None),
     ("a Keysight/Agilent CSV export", lambda h: re.match(rb"\s*x-axis,\d", h) is not None),
     # Siglent SDS: "Record Length,Analog:1400,", ..., then "Second,Volt,"
     ("a Siglent CSV export", lambda h: _siglent_csv(h)),  # defined below
+    # a "Second,Volt" units row under a title row that names no maker: Rigol's DS1000B/D/E and
+    # Siglent's SDS exports both write one
+    ("a CSV export with a 'Second,Volt' units row (a Rigol DS1000B/D/E or Siglent SDS layout)",
+     lambda h: re.search(rb"^\s*Second,\s*Volt", h, re.M) is not None),
     # LeCroy WaveStudio / X-Stream: "LECROYWS...", "Segments,1,SegmentSize,...", then "Time,Ampl"
     ("a LeCroy CSV export", lambda h: h.lstrip().upper().startswith(b"LECROY") or re.search(
         rb"^\s*Segments,.*\r?\n(.*\r?\n){0,4}\s*Time,\s*Ampl", h, re.M) is not None),
@@ -55,9 +62,23 @@ _FOREIGN = (
 
 
 def _siglent_csv(head: bytes) -> bool:
-    """Siglent's CSV header: values tagged "Analog:" or the "Second,Volt" units row."""
-    return re.search(rb"^\s*Record Length,\s*Analog:", head, re.M) is not None or re.search(
-        rb"^\s*Second,\s*Volt", head, re.M) is not None
+    """Siglent's CSV header: its values tagged "Analog:" (a "Second,Volt" units row alone
+    is no maker's: Rigol's DS1000B/D/E write one too)."""
+    return re.search(rb"^\s*(Record Length|Sample Interval),\s*Analog:", head, re.M) is not None
+
+
+# Rigol DHO800/DHO1000 .wfm (RigolWFM's description of the layout): a 24-byte file header,
+# then blocks of a 12-byte header (id, type, decompressed size, compressed size, content
+# length: uint16 each, and a reserved one) and their content, zlib-compressed
+_DHO_BLOCK, _DHO_CONTENT = 24, 36
+
+
+def _rigol_dho_wfm(head: bytes) -> bool:
+    if len(head) < _DHO_CONTENT + 2:
+        return False
+    _, _, _, compressed, length, _ = struct.unpack_from("<6H", head, _DHO_BLOCK)
+    cmf, flg = head[_DHO_CONTENT], head[_DHO_CONTENT + 1]
+    return 0 < compressed == length and cmf == 0x78 and (cmf * 256 + flg) % 31 == 0  # RFC 1950's header check
 
 
 def _decimal_comma_csv(head: bytes) -> bool:
@@ -98,13 +119,17 @@ def _rs_payload(head: bytes, size: int) -> bool:
 
 def _hdf5_kind(path: Path) -> str:
     """What an HDF5 file is: a Keysight Infiniium waveform ('Waveforms' or 'Frame' group),
-    or another HDF5 file (a rig archive is read by the archive commands, not as a scope file)."""
+    a Tektronix DPO5000/7000 one (root datasets Data, Spacing, StartTime), or another HDF5
+    file (a rig archive is read by the archive commands, not as a scope file)."""
     import h5py
 
     try:
         with h5py.File(path, "r") as f:
             if "Waveforms" in f or "Frame" in f:
                 return "a Keysight Infiniium HDF5 waveform"
+            if all(isinstance(f.get(k), h5py.Dataset) for k in ("Data", "Spacing", "StartTime")):
+                return ("a Tektronix DPO5000/DPO7000 HDF5 waveform (float volts: Data, Spacing, StartTime; save "
+                        "it from the scope as .isf or .csv)")
     except OSError:
         pass
     return "an HDF5 file (a rig archive? use rig analyze/verify/ls on .h5 files)"
@@ -134,8 +159,8 @@ def _tek_csv(head: bytes) -> bool:
         text = head.decode("ascii")
     except UnicodeDecodeError:
         return False
-    if _siglent_csv(head):
-        return False  # Siglent's header rows have Tektronix's names
+    if _siglent_csv(head) or re.search(rb"^\s*Second,\s*Volt", head, re.M):
+        return False  # Siglent's header rows have Tektronix's names; a units row is no Tektronix layout
     first = [line.split(",")[0].strip() for line in text.splitlines()[:40]]
     known = {"Model", "Firmware Version", "Record Length", "Sample Interval", "Point Format", "Waveform Type",
              "Horizontal Units", "Trigger Point", "Source", "Vertical Units", "Label", "TIME"}
