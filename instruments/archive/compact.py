@@ -67,7 +67,8 @@ def write_compact_entry(f, shot_id: int, e: Entry, checked: dict, stored: dict, 
             "start_time_source": e.start_time_source or "when the shot was archived",
             "file_modification_time": e.file_modification_time,
             "facts": json.loads(facts_json(e, f"{where}: facts")) if e.truth is not None else None,
-            "preambles": {ch: preamble_fields(w) for ch, w in sorted(e.record.waveforms.items())}}
+            "preambles": {ch: preamble_fields(w) for ch, w in sorted(e.record.waveforms.items())},
+            "channel_order": list(e.record.waveforms)}  # the record's own order (the JSON sorts its keys)
     shares = e.truth_key is not None or e.truth is not None  # a scene's shots share its group
     if shares:
         members = scene_group(f, shot_id, e, checked, stored, written)[0]

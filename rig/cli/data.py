@@ -84,6 +84,8 @@ def cmd_import(args) -> dict:
                     seen[w.channel] = f
         if args.together:
             check_one_time_base(record)  # the analysis of one shot needs one time base: refuse now, not then
+        if not args.keep_paths:
+            record = _names_only(record)
         entries.append(Entry(record, False, scene="",
                              settings={"source_files": [str(Path(f).resolve().name) for f in files]},
                              start_time=mtime, file_modification_time=mtime,
@@ -106,6 +108,20 @@ def cmd_import(args) -> dict:
     if not args.json:
         print(f"imported {len(args.files)} file(s) into {args.into} as shot(s) {', '.join(map(str, ids))}")
     return out
+
+
+def _names_only(record):
+    """``record`` with each channel's source file named by its name alone (the readers keep
+    the path they were given, which an archive would carry to every machine it goes to)."""
+    from dataclasses import replace
+    from pathlib import Path
+
+    def named(w):
+        extra = w.preamble.extra
+        if "source" not in extra:
+            return w
+        return replace(w, preamble=replace(w.preamble, extra={**extra, "source": Path(str(extra["source"])).name}))
+    return replace(record, waveforms={ch: named(w) for ch, w in record.waveforms.items()})
 
 
 def cmd_analyze(args) -> list:
@@ -211,6 +227,9 @@ def add_import_(sub) -> None:
     im.add_argument("files", nargs="+", metavar="FILE")
     im.add_argument("--into", required=True, metavar="ARCHIVE.h5")
     im.add_argument("--together", action="store_true", help="the files are the channels of one shot")
+    im.add_argument("--keep-paths", action="store_true",
+                    help="keep each file's full path in the archive (default: its name and the data's digest only, "
+                         "nothing of this machine)")
 
 
 def add_analyze(sub) -> None:

@@ -1,11 +1,13 @@
 """`rig analyze`: a clear result or a clear refusal, with the reason, for every file; the
 SNR of each channel; every flag checked; exit 0 with a speed, 1 without, 2 for a mistake."""
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from instruments.analysis.report import FIGURES
+from instruments.archive import Archive
 from instruments.devices.frontend import rc_highpass
 from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
 from instruments.formats import read_record
@@ -400,3 +402,27 @@ def test_wall_flags_that_disagree_are_refused_and_a_named_wall_needs_no_note(thr
     assert "without --wall" not in out and "not read" not in out
     assert main(["analyze", *files, *GAUGE, "--channels", "CH1,CH2"]) == 0
     assert "  not read: CH3" in capsys.readouterr().out.splitlines()  # named, without a hint to pass --channels
+
+
+def test_an_archive_keeps_its_files_channel_order_and_nothing_of_this_machine(gauge_files, tmp_path, capsys):
+    """rig import keeps the channels in the order of the files, so that an archive and the
+    files it came from analyse alike by default (the first channel the upper gauge); and it
+    stores each file's name, not where it lay on the importing machine (unless asked)."""
+    lower_first = list(reversed(gauge_files))  # CH2 first: the gauges as the user ordered them
+    archive = tmp_path / "order.h5"
+    assert main(["import", *lower_first, "--together", "--into", str(archive)]) == 0
+    capsys.readouterr()
+    _, (files,), _ = run(capsys, "analyze", *lower_first, *GAUGE)
+    _, (stored,), _ = run(capsys, "analyze", str(archive), *GAUGE)
+    assert files["channels"] == stored["channels"] == ["CH2", "CH1"]
+    assert files["reasons"] == stored["reasons"]
+    entry = Archive(archive).read(1)
+    assert list(entry.record.waveforms) == ["CH2", "CH1"]
+    assert {w.preamble.extra["source"] for w in entry.record.waveforms.values()} == {"shot_CH1.isf", "shot_CH2.isf"}
+    folder = str(Path(gauge_files[0]).parent).encode()
+    stored_bytes = b"".join(p.read_bytes() for p in tmp_path.rglob("*")
+                            if p.is_file() and str(p.relative_to(tmp_path)).startswith("order"))
+    assert folder not in stored_bytes
+    kept = tmp_path / "kept.h5"
+    assert main(["import", *lower_first, "--together", "--keep-paths", "--into", str(kept)]) == 0
+    assert Archive(kept).read(1).record["CH1"].preamble.extra["source"] == gauge_files[0]

@@ -315,8 +315,8 @@ def test_a_two_channel_tds_csv_imports_lists_and_analyses_both_channels(tmp_path
     (result,) = json.loads(capsys.readouterr().out)
     # both channels analysed, not "the record holds CH1"; CH1 sits at 3.46 V, 6.9 divisions up at 0.5 V/div,
     # for its last 1121 samples without the one-code flicker of its baseline: the ADC's rail
-    assert result["reasons"]["amplitude_N"].startswith("CH1: clipped: 1124 samples at the ADC's top")
-    assert "CH2" not in result["reasons"]["amplitude_N"]
+    assert result["reasons"]["amplitude_V"].startswith("CH1: clipped: 1124 samples at the ADC's top")
+    assert "CH2" not in result["reasons"]["amplitude_V"]
     assert not back["CH2"].overrange and back["CH1"].overrange
 
 
