@@ -105,7 +105,17 @@ class Trigger:
         check("scope.trigger.pre_trigger", self.pre_trigger, lo=0, hi=1, lo_closed=True, hi_closed=False)
 
 
+def per_division(x: float, unit: str, digits: int = 4) -> str:
+    """A V/div or s/div figure as a scope's WFID prints it, with an SI prefix and ``digits``
+    significant digits (4 on the DPO/MDO/MSO, 3 on the TDS): 0.05 V -> ``50.00mV``, 2.5e-4 s
+    -> ``250.0us``, 1 V -> ``1.000V``."""
+    prefixes = {-12: "p", -9: "n", -6: "u", -3: "m", 0: "", 3: "k"}
+    exp = min(max(3 * math.floor(math.log10(abs(x)) / 3), -12), 3) if x else 0
+    return f"{x / 10 ** exp:#.{digits}g}".rstrip(".") + prefixes[exp] + unit
+
+
 @dataclass(frozen=True)
+
 class Oscilloscope:
     """The scope's front panel; ``acquire`` turns analog inputs into a ScopeRecord.
 
@@ -239,8 +249,9 @@ class Oscilloscope:
         pre = Preamble(points=codes.size, x_increment=self.timebase.sample_interval, x_zero=x_zero,
                        trigger_index=n_pre, y_multiplier=s.y_multiplier, y_offset=s.position * CODES_PER_DIV,
                        y_zero=s.offset, byte_count=1,
-                       waveform_id=(f"{ch}, {s.coupling} coupling, {s.volts_per_div:g}V/div, "
-                                    f"{self.timebase.sample_interval * codes.size / 10:.4g}s/div, {codes.size} points, "
+                       waveform_id=(f"{ch}, {s.coupling} coupling, {per_division(s.volts_per_div, 'V')}/div, "
+                                    f"{per_division(self.timebase.sample_interval * codes.size / 10, 's')}/div, "
+                                    f"{codes.size} points, "
                                     f"{'Sample' if self.mode == 'sample' else f'Average {self.averages}'} mode"),
                        extra={"volts_per_div": s.volts_per_div, "position_div": s.position,
                               "coupling": s.coupling, "bandwidth_Hz": s.bandwidth, "probe": s.probe,

@@ -19,6 +19,7 @@ import math
 from dataclasses import dataclass
 from decimal import Decimal
 
+from ..devices.oscilloscope import per_division
 from ..errors import InstrumentError
 
 WFMPRE_16 = ("BYT_Nr", "BIT_Nr", "ENCdg", "BN_Fmt", "BYT_Or", "NR_Pt", "WFId", "PT_Fmt", "XINcr", "PT_Off",
@@ -66,10 +67,7 @@ class Personality:
 
     def per_div(self, x: float, unit: str) -> str:
         """A V/div or s/div figure as WFID prints it: ``50.0mV``, ``10.0us``, ``1.000V``."""
-        prefixes = {-12: "p", -9: "n", -6: "u", -3: "m", 0: "", 3: "k"}
-        exp = min(max(3 * math.floor(math.log10(abs(x)) / 3), -12), 3) if x else 0
-        text = f"{x / 10 ** exp:#.{self.wfid_digits}g}".rstrip(".")
-        return f"{text}{prefixes[exp]}{unit}"
+        return per_division(x, unit, self.wfid_digits)
 
 
 PERSONALITIES = {

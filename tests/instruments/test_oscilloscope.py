@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
+from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger, per_division
 from instruments.errors import InstrumentError
 
 H = 1e-7
@@ -87,3 +87,15 @@ def test_same_seed_same_bits():
 def test_bad_settings_name_the_field(make, field):
     with pytest.raises(InstrumentError, match=field):
         make()
+
+
+def test_the_wfid_prints_v_per_div_and_s_per_div_as_a_scope_does():
+    """'50.00mV/div, 250.0us/div', as a DPO/MSO's WFID (and the exports that carry it)
+    prints them, not '0.05V/div, 0.00025s/div'."""
+    assert [per_division(0.05, "V"), per_division(2.5e-4, "s"), per_division(1.0, "V"), per_division(0.2, "V", 3)] \
+        == ["50.00mV", "250.0us", "1.000V", "200mV"]
+    scope = Oscilloscope(channels={"CH1": ChannelSettings(0.05, 0.0)}, timebase=Timebase(2.5e-7, 10000),
+                         trigger=Trigger("CH1", 0.01, "rising", 0.1))
+    t = np.arange(20000) * 2.5e-7
+    rec = scope.acquire({"CH1": 0.1 * np.exp(-(((t - 2e-3) / 1e-4) ** 2))}, 2.5e-7, np.random.default_rng(0))
+    assert "50.00mV/div, 250.0us/div, 10000 points" in rec["CH1"].preamble.waveform_id
