@@ -33,6 +33,7 @@ left as it was.
 from __future__ import annotations
 
 import contextlib
+import numbers
 import os
 import shutil
 import tempfile
@@ -230,6 +231,8 @@ class Archive:
         the master and the parts read last stay open while the files there are those opened."""
         import h5py
 
+        if isinstance(shot_id, bool) or not isinstance(shot_id, numbers.Integral) or shot_id < 1:
+            raise InstrumentError(f"shot_id = {shot_id!r}: a shot's number, a whole number >= 1 (an int)")
         with self._reader() as (f, parts):
             name = f"shot_{shot_id:06d}"
             try:

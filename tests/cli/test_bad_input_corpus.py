@@ -378,6 +378,8 @@ def _api_cases():
               for h in (0, -1, math.nan, math.inf, "1 us", None)]
     cases += [(lambda p=p: SaveAt(p), "probes") for p in (None, 3, "c", {"c": 3})]
     cases += [(lambda x=x: Chain([Bead("ptfe", 4.76e-3)] * 5, striker=x), "striker") for x in ("fast", 3)]
+    from instruments.archive import Archive
+    cases += [(lambda x=x: Archive("shots.h5").read(x), "shot_id") for x in ("1", 1.0, 0, True, None)]
     return cases
 
 

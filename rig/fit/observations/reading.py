@@ -35,6 +35,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
+SD_FLOOR = 1e-9  # the smallest sd an observation may have, relative to its value
 FIELDS = ("kind", "value", "sd", "unit", "scene", "set", "gauge", "of", "over_scene", "over_set")
 
 
@@ -97,6 +98,9 @@ def observation(entry, default_scene: str, folder: Path, field: str) -> Observat
     value, sd = _figure(entry, "value", kind, f"{field}.value"), _figure(entry, "sd", kind, f"{field}.sd")
     if not sd > 0:
         raise invalid(f"{field}.sd", entry["sd"], "> 0: a standard uncertainty (an exact figure cannot be fitted)")
+    if sd < SD_FLOOR * abs(value) or sd < 1e-100:
+        raise invalid(f"{field}.sd", entry["sd"], f">= {SD_FLOOR:g} of the value ({value:.6g} {kind.unit}): no "
+                                                 f"measurement is finer, and the fit's weight 1/sd^2 would overflow")
     shot = _shot(entry, "", default_scene, folder, field)
     of, over = "", None
     if name == "ratio":
