@@ -128,7 +128,7 @@ def _parse_header(raw: bytes, path) -> dict:
         text = raw.decode("ascii")
     except UnicodeDecodeError:
         raise InstrumentError(f"{path}: the header is not ASCII text (not an ISF file?)") from None
-    fields = {}
+    fields: dict[str, str] = {}
     for item in text.split(";"):
         item = re.sub(r"^(:?[A-Z]+:)+", "", item.strip())  # drop :WFMPRE: / :WFMP:
         if not item:
