@@ -6,6 +6,7 @@ memory, flushed and renamed into place) are the Archive's ``_transaction``, hand
 from __future__ import annotations
 
 import contextlib
+import json
 from collections.abc import Callable
 from pathlib import Path
 
@@ -13,6 +14,7 @@ from ..errors import InstrumentError
 from ..files import cause
 from .compact import LAYOUT4, LAYOUT4_TEXT, write_compact_entry
 from .layout import LAYOUT, write_entry
+from .part_digests import PART_DIGESTS, linked_folder, part_digest, part_tables, recorded_digests
 from .parts import LAYOUT3, PARTS_TEXT, add_shots, folder, link_into, next_id, part_name, recorded_ranges, stored_shared
 from .verify import root_seal
 
@@ -33,8 +35,15 @@ def commit_parts(path: Path, entries: list, transaction, master=None, ids=None, 
     try:
         members = recorded_ranges(master) if master is not None else {"/": [], "/shared": [], "shot_ids": []}
         stored = stored_shared(master) if master is not None else {}
+        linked = linked_folder(master) if master is not None and part == "" else None
     except Exception as exc:  # noqa: BLE001 - a damaged master: one line, nothing written
         raise InstrumentError(f"{path}: cannot append: {cause(exc)}") from None
+    if linked is not None and linked != folder(path).name:
+        master.close()
+        raise InstrumentError(f"{path}: cannot append: its shots are links into {linked}, the folder of another "
+                              f"archive's master (a master copied without its folder?); its new shots would go to "
+                              f"{folder(path).name}: copy a master together with its folder, under the same name, "
+                              f"or append to the archive that folder belongs to")
     start = next_id(members)
     ids = ids or [start + i for i in range(len(entries))]
     part = part or (part_name(ids[0]) if ids else part_name(start))
@@ -48,11 +57,11 @@ def commit_parts(path: Path, entries: list, transaction, master=None, ids=None, 
         for shot_id, e in zip(ids, entries):
             WRITERS[layout](f, shot_id, e, checked, stored, *extra)
         f.attrs.update({"NX_class": "NXroot", "layout_version": layout, "part_of": path.name})
-        return sorted(f["shared"]) if "shared" in f else []
+        return (sorted(f["shared"]) if "shared" in f else []), part_digest(part_tables(f))
 
     try:
         where.mkdir(exist_ok=True)
-        new_shared = transaction(fill, False, where / part)
+        new_shared, digest = transaction(fill, False, where / part)
     except BaseException:
         if made:
             with contextlib.suppress(OSError):
@@ -62,7 +71,7 @@ def commit_parts(path: Path, entries: list, transaction, master=None, ids=None, 
         if master is not None:
             master.close()
     def link(f):
-        return _link(f, path.name, layout, part, ids, new_shared, members)
+        return _link(f, path.name, layout, part, ids, new_shared, members, digest)
     try:
         transaction(link, master is not None)  # a copy of the master, or a new one
     except BaseException:
@@ -74,10 +83,10 @@ def commit_parts(path: Path, entries: list, transaction, master=None, ids=None, 
     return ids
 
 
-def _link(f, master: str, layout: int, part: str, ids: list, new_shared: list, members: dict) -> list:
-    """The master's links to a new part's shots and shared groups, and its root sealed
-    (``members``: its member lists before, shots as ranges of ids, to which the new names
-    are added)."""
+def _link(f, master: str, layout: int, part: str, ids: list, new_shared: list, members: dict, digest: str) -> list:
+    """The master's links to a new part's shots and shared groups, the part's digest
+    (parts.PART_DIGESTS) and its root sealed (``members``: its member lists before, shots
+    as ranges of ids, to which the new names are added)."""
     for shot_id in ids:
         name = f"shot_{shot_id:06d}"
         f[name] = link_into(master, part, f"/{name}")
@@ -89,5 +98,6 @@ def _link(f, master: str, layout: int, part: str, ids: list, new_shared: list, m
     f.attrs.update({"NX_class": "NXroot", "creator": "sonic-rig", "layout_version": layout,
                     "layout": TEXTS[layout], "file_name": master})
     f.attrs["default"] = f"shot_{max(ids):06d}" if ids else f.attrs.get("default", "")
+    f.attrs[PART_DIGESTS] = json.dumps({**recorded_digests(f), part: digest}, sort_keys=True)
     root_seal(f, add_shots(members, ids, new_shared))
     return ids

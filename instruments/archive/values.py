@@ -75,10 +75,14 @@ def attribute_value(obj, name: str):
     ``obj.attrs[name]`` reads it, through HDF5's own calls for what a table of checksums
     holds most: a text (str), a list of texts (an array of str), an integer or float scalar;
     anything else through h5py itself. It fails as h5py does (KeyError where there is no
-    such attribute, or where HDF5 cannot open it)."""
+    such attribute, or where HDF5 cannot open it), naming the attribute (HDF5's own words
+    name it only where the object keeps its attributes compact, up to 8 of them)."""
     import h5py
 
-    attribute = h5py.h5a.open(hdf5_id(obj), name.encode())
+    try:
+        attribute = h5py.h5a.open(hdf5_id(obj), name.encode())
+    except KeyError as exc:
+        raise KeyError(f"attribute {name!r}: {exc.args[0] if exc.args else 'cannot be opened'}") from None
     kind = attribute.get_type()
     cls = kind.get_class()
     shape = attribute.shape
