@@ -53,6 +53,25 @@ class _Part:
                 raise invalid(f"{prefix}.{name}", value, f"must be > 0 {_UNITS[name]}")
 
 
+MASS_FACTOR = 2.0
+"""How far a bead's mass may lie from its solid sphere's, density x pi d^3 / 6: real beads
+differ from it by a few percent (the published PTFE 0.1226 g against 0.1243 g, a gauge bead
+0.116 g), a mass in grams given as kilograms by a factor 1000."""
+
+
+def solid_sphere_check(field: str, mass: float, of: Material | str, diameter: float) -> None:
+    """RigError in one line unless ``mass`` (kg) lies within MASS_FACTOR of a solid sphere of
+    the material ``of`` and ``diameter`` (m), naming the field, the mass, the sphere's mass
+    and the density it comes from."""
+    m = material(of)
+    sphere = m.rho * math.pi * diameter**3 / 6.0
+    if not sphere / MASS_FACTOR <= mass <= sphere * MASS_FACTOR:
+        raise invalid(field, mass, f"a {m.name} sphere of {diameter * 1e3:.4g} mm weighs "
+                                  f"{sphere * 1e3:.4g} g (density {m.rho:g} kg/m^3); a bead's mass must lie "
+                                  f"within a factor {MASS_FACTOR:g} of it (grams meant? give the unit, "
+                                  f"'{mass:g} g')")
+
+
 @dataclass(frozen=True)
 class Bead(_Part):
     """A sphere of ``material``; ``mass`` defaults to density x volume (kg)."""
@@ -70,6 +89,7 @@ class Bead(_Part):
         if self.mass is None:
             object.__setattr__(self, "mass", material(self.material).rho * math.pi * self.diameter**3 / 6.0)
         self._positive("bead", "mass")
+        solid_sphere_check("bead.mass", self.mass, self.material, self.diameter)
 
     @property
     def radius(self) -> float:
@@ -146,6 +166,7 @@ class GaugeBead(Bead):
             return cls(bead.material, bead.diameter, mass=bead.mass)
         if not mass > PZT_PLATE_MASS:
             raise invalid("gauges.mass", mass, f"a gauge bead weighs more than its plate ({PZT_PLATE_MASS} kg)")
+        solid_sphere_check("gauges.mass", mass, bead.material, bead.diameter)
         return cls(bead.material, bead.diameter, caps_mass=mass - PZT_PLATE_MASS)
 
 

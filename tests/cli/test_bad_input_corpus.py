@@ -201,6 +201,10 @@ def _flag_cases():
         (["fit", S, "--param", "chain.damping_time=0.1 ms:1 ms", "--set", "chain.contact_law=hertz", "--points",
           "p.csv", "--out", out], "switches chain.contact_law to kuwabara-kono"),
     ]
+    # a mass in grams given as kilograms: a bead 1000 times its sphere's mass (it had fired with NO TRIGGER, exit 0)
+    cases += [(["shot", S, "--set", "chain.mass=0.1226"], "chain.mass = 0.1226: a ptfe sphere of 4.76 mm weighs"),
+              (["shot", S, "--set", "gauges.upper.mass=0.116"], "gauges.upper.mass = 0.116: a ptfe sphere"),
+              (["shot", S, "--set", "chain.mass=0.1226 mg"], "chain.mass = 1.226e-07")]
     twice = ["--set", "striker.velocity=1", "--set", "striker.velocity = 2 m/s"]
     cases += [(["shot", S, *twice], "set twice"),
               (["sweep", S, "--vary", "chain.beads=20:30:3", *twice], "set twice"),
@@ -369,6 +373,7 @@ def _api_cases():
     cases += [(lambda v=v: Striker(mass=v), "striker.mass") for v in (0, -1, math.nan, "0,47 g", "1 m")]
     cases += [(lambda v=v: Bead("ptfe", v), "diameter") for v in (0, -1, math.nan, "4,76 mm", "1 kg", None)]
     cases += [(lambda v=v: Bead(v, 4.76e-3), "material") for v in ("wood", 3, None)]
+    cases += [(lambda v=v: Bead("ptfe", 4.76e-3, v), "bead.mass = ") for v in (0.1226, 1e-7, "0.1226 kg")]
     cases += [(lambda b=b: Chain(b), "beads") for b in ([], None, 3, ["ptfe"])]
     cases += [(lambda t=t: solve(chain(), t), "t_end") for t in (0, -1, math.nan, math.inf, "1 ms", None)]
     cases += [(lambda m=m: solve(chain(), 1e-4, method=m), "method") for m in ("euler", 3)]
