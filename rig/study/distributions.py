@@ -25,6 +25,9 @@ from rig.units import check_digits, number, quantity
 
 EXTRA_KEYS = {"chain.bead_mass": "kg", "chain.youngs_modulus": "Pa", "chain.poisson_ratio": float}
 GAUGE_KEYS = {"gain": float, "misalignment": "m"}
+_BEAD_MASS = "each plain bead's mass: chain.bead_mass a draw per bead, chain.mass one draw for all"
+ONE_QUANTITY = {"chain.mass": {"chain.bead_mass": _BEAD_MASS}, "chain.bead_mass": {"chain.mass": _BEAD_MASS}}
+"""Keys that name one quantity two ways: a study varies one of them."""
 _SIGNED = ("offset", "position", "misalignment", "level")
 _NON_NEGATIVE = ("noise", "noise_floor", "calibration_error", "gap", "misalignment_sd")
 _SPEC = re.compile(r"^\s*(normal|truncnormal|uniform|lognormal)\s*\((.*)\)\s*$", re.IGNORECASE)
@@ -191,6 +194,10 @@ def parse_vary(items) -> list:
         if key.split(".")[0] == "solver":
             raise invalid("--vary", key, "a key of the scene's parts or gauges: every shot of a study takes the "
                                          "study's own solver settings (--accuracy, --window)")
+        alias = next((a for a in ONE_QUANTITY.get(key, ()) if a in seen), None)
+        if alias is not None:
+            raise invalid("--vary", key, f"names the quantity {alias} names too ({ONE_QUANTITY[key][alias]}): the "
+                                         f"one varied later would override the other's draws; vary one of them")
         seen.add(key)
         out.append(Distribution.parse(key, spec))
     return out

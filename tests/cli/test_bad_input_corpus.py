@@ -205,6 +205,9 @@ def _flag_cases():
     cases += [(["shot", S, "--set", "chain.mass=0.1226"], "chain.mass = 0.1226: a ptfe sphere of 4.76 mm weighs"),
               (["shot", S, "--set", "gauges.upper.mass=0.116"], "gauges.upper.mass = 0.116: a ptfe sphere"),
               (["shot", S, "--set", "chain.mass=0.1226 mg"], "chain.mass = 1.226e-07")]
+    mass = "chain.mass=normal(0.1226 g, 0.001 g)"
+    cases += [(["mc", S, "--shots", "8", "--vary", mass, "--vary", "chain.bead_mass=normal(0.1226 g, 0.001 g)",
+                "--out", out], "--vary = 'chain.bead_mass': names the quantity chain.mass names too")]
     twice = ["--set", "striker.velocity=1", "--set", "striker.velocity = 2 m/s"]
     cases += [(["shot", S, *twice], "set twice"),
               (["sweep", S, "--vary", "chain.beads=20:30:3", *twice], "set twice"),
