@@ -117,6 +117,9 @@ def unusable(result) -> str:
         why.append(_misfit(result))
     if result.undetermined:
         why.append(f"the data do not determine {', '.join(result.undetermined)}")
+    if result.at_bound:
+        why.append(f"{', '.join(result.at_bound)} ended at a bound of --param (the best value may lie beyond it): "
+                   f"widen the bounds")
     return "; ".join(why)
 
 

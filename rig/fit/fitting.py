@@ -84,8 +84,9 @@ class FitResult:
     @property
     def usable(self) -> bool:
         """Whether the result stands for the scene: converged, plausible (or nothing to judge
-        it by) and every parameter determined. Only then is a fitted scene written."""
-        return self.converged and self.plausible is not False and not self.undetermined
+        it by), every parameter determined and none at a bound of its range. Only then is a
+        fitted scene written."""
+        return self.converged and self.plausible is not False and not self.undetermined and not self.at_bound
 
     @property
     def interval_scale(self) -> float:

@@ -152,6 +152,9 @@ def test_a_value_at_its_bound_is_flagged_naming_the_bound(tmp_path, capsys, curv
     block = json.loads((out / "fit.json").read_text())
     assert block["at_bound"] == ["chain.youngs_modulus"]
     assert "chain.youngs_modulus = 1.5e+09 Pa is at its lower bound 1.5e+09 Pa" in " ".join(block["warnings"])
+    # as the fitting tutorial says: such a fit writes no fitted scene and exits 1 (it had written one, exit 0)
+    assert code == 1 and "chain.youngs_modulus ended at a bound of --param" in err
+    assert block["fitted_scene"] is None and not (out / "fitted.toml").exists()
 
 
 def test_real_records_that_are_no_impact_are_refused_or_flagged(tmp_path, capsys, realdata):

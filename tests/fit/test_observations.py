@@ -163,6 +163,7 @@ GOOD = {"kind": "speed", "value": "129 m/s", "sd": "13 m/s"}
     ({**GOOD, "value": "129 N"}, ["observation 1.value", "129 N"]),
     ({**GOOD, "sd": "0 m/s"}, ["observation 1.sd", "> 0"]),
     ({**GOOD, "sd": "1e-300 m/s"}, ["observation 1.sd", "1e-300 m/s", ">= 1e-09 of the value"]),  # had overflowed
+    (dict(GOOD), ["observation 1 = ", "repeats observation", "counted twice"]),  # had narrowed the intervals
     ({**GOOD, "colour": "red"}, ["observation 1.colour", "not a field"]),
     ({"kind": "fwhm", "value": "60 us", "sd": "5 us"}, ["observation 1.gauge", "upper, wall"]),
     ({"kind": "fwhm", "value": "60 us", "sd": "5 us", "gauge": "middle"}, ["observation 1.gauge", "middle"]),

@@ -23,6 +23,7 @@ its value and what is allowed.
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from rig.errors import RigError, invalid, lookup
@@ -145,5 +146,12 @@ def read_observations(path, default_scene: str) -> tuple:
     entries = raw.get("observation")
     if not isinstance(entries, list) or not entries:
         raise invalid("--observations", str(path), "no [[observation]] table in it")
-    return tuple(observation(e, default_scene, path.parent, f"{path.name}: observation {i + 1}")
-                 for i, e in enumerate(entries))
+    out = tuple(observation(e, default_scene, path.parent, f"{path.name}: observation {i + 1}")
+                for i, e in enumerate(entries))
+    for i, o in enumerate(out):
+        same = next((j for j in range(i) if replace(out[j], label="") == replace(o, label="")), None)
+        if same is not None:
+            raise invalid(f"{path.name}: observation {i + 1}", f"{o.kind} = {entries[i].get('value')!r}",
+                          f"repeats observation {same + 1} (the same figure of the same shot, value and sd): an "
+                          f"observation counted twice would narrow the intervals without a new measurement")
+    return out
