@@ -12,8 +12,9 @@ if TYPE_CHECKING:
 from rig.cli.common import command, count_arg, seed_arg
 
 
-def _records(args) -> list:
-    """The scope records to fit: one shot's files (--records), or an archive's shots."""
+def _records(args, overrides: list, fitted: dict) -> list:
+    """The scope records to fit: one shot's files (--records), or an archive's shots, each
+    virtual one fired with the set-up the fit models (rig.fit.checks.check_archived_setup)."""
     from instruments.formats import read_record
 
     if args.records:
@@ -23,9 +24,14 @@ def _records(args) -> list:
         return [read_record(args.records)]
     from instruments.archive import Archive
 
+    from rig.experiment.shot import Rig
+    from rig.fit.checks import check_archived_setup
+
     arch = Archive(args.archive)
     ids = arch.ids() if args.shot is None else [args.shot]
-    return [arch.read(i, with_truth=False).record for i in ids]
+    entries = [arch.read(i, with_truth=False) for i in ids]
+    check_archived_setup(args.archive, Rig.from_scene(args.scene, overrides).values, set(fitted), entries)
+    return [e.record for e in entries]
 
 
 def cmd_fit(args) -> dict:
@@ -86,7 +92,7 @@ def cmd_fit(args) -> dict:
     else:
         from rig.fit.traces import TraceObjective
 
-        objective = TraceObjective(args.scene, params, _records(args), overrides)
+        objective = TraceObjective(args.scene, params, _records(args, overrides, fitted), overrides)
     progress = None if args.quiet else stderr_progress
     with writing_to(args.out):
         block = run_fit(args.scene, objective, args.out, progress, args.max_evaluations, args.posterior,

@@ -144,3 +144,45 @@ def result_warnings(result, params: tuple) -> list:
             out.append(f"{p.key} = {p.shown(e)} is at its {side} bound {p.shown(bound)}: the best value may "
                        f"lie beyond it, and its interval is cut there")
     return out
+
+
+def check_archived_setup(archive: str, model: dict, fitted: set, entries: list) -> None:
+    """Refuse archived virtual shots fired with another set-up than the fit's model (the
+    scene's values, ``model``, with --set): the traces' fit models every record with one
+    rig, so a sweep's shots (each at its own striker velocity, say) would all be modelled at
+    the scene's. The keys the fit fits (``fitted``) may differ; imported real files, which
+    carry no settings, are not judged."""
+    want = dict(_flat(model))
+    for e in entries:
+        if not e.simulated:
+            continue
+        have = dict(_flat({k: v for k, v in e.settings.items() if k != "overrides"}))
+        differ = sorted(k for k in set(want) | set(have) if k not in fitted and k != "scene"
+                        and not _same(want.get(k), have.get(k)))
+        if have.get("scene", want.get("scene")) != want.get("scene"):
+            differ.insert(0, "scene")
+        if differ:
+            k = differ[0]
+            raise invalid("--archive", archive, f"shot {e.shot_id} was fired with {k} = {have.get(k)!r} where the "
+                                                f"fit's model has {want.get(k)!r}"
+                                                f"{f' (and {len(differ) - 1} more keys)' if len(differ) > 1 else ''}"
+                                                f": the fit models every record with one set-up; fit the shots of one "
+                                                f"set-up (--shot N), with --set for its keys")
+
+
+def _flat(node, prefix: str = ""):
+    """(dotted key, value) of a nested settings dict."""
+    for k, v in node.items():
+        if isinstance(v, dict):
+            yield from _flat(v, f"{prefix}{k}.")
+        else:
+            yield f"{prefix}{k}", v
+
+
+def _same(a, b) -> bool:
+    """Two settings' values alike (numbers to a relative 1e-12: an archive's JSON round trip)."""
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)) and not isinstance(a, bool):
+        return math.isclose(float(a), float(b), rel_tol=1e-12, abs_tol=0.0)
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    return a == b

@@ -213,3 +213,22 @@ def test_a_key_the_points_set_row_by_row_is_not_also_set_or_fitted(tmp_path, cap
     assert code == 2
     _one_line(err, *words)
     _refused(out)
+
+
+def test_an_archives_shots_of_another_setup_are_refused_not_modelled_at_the_scenes(tmp_path, capsys):
+    """A sweep's archive (each shot at its own striker velocity): the traces' fit models
+    every record with one rig, so a shot fired at 1.2 m/s had been modelled at the scene's
+    0.89 m/s. It is refused, naming the shot, the key and both values, before any solve."""
+    from instruments.archive import Archive
+    from rig.experiment.entry import shot_entry
+    from rig.experiment.shot import Rig
+
+    archive = Archive(tmp_path / "sweep.h5")
+    archive.append([shot_entry(Rig.from_scene("ptfe52_magnetic", [f"striker.velocity={v}"]).fire(seed=1))
+                    for v in (0.89, 1.2)])
+    code = main(["fit", "ptfe52_magnetic", "--archive", str(archive.path), "--param", E, "--out",
+                 str(tmp_path / "fit")])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert "shot 2 was fired with striker.velocity = 1.2 where the fit's model has 0.89" in err
+    assert not (tmp_path / "fit").exists()
