@@ -23,7 +23,6 @@ def _records(args, overrides: list, fitted: dict) -> list:
         check_distinct_files("--records", args.records)
         return [read_record(args.records)]
     from instruments.archive import Archive
-
     from rig.experiment.shot import Rig
     from rig.fit.checks import check_archived_setup
 
