@@ -4,11 +4,15 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from instruments.files import atomic_write, left_as_found, write_text
+from instruments.errors import InstrumentError
+from instruments.files import atomic_write, folder_lock, left_as_found, write_text
 from rig.errors import Interrupted, RigError
 from rig.experiment import scene as scene_io
 from rig.fit import report
 from rig.fit.fitting import fit
+
+
+LOCK = "fit.lock"  # held in the --out folder while a fit writes it: a second fit into it is refused
 
 
 def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 400, posterior_steps: int = 0,
@@ -23,9 +27,12 @@ def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 40
     interruption keeps what was cached before it (evaluations, the posterior's chain) and
     removes only the folders it left empty. posterior_steps > 0: a converged fit's posterior
     is then sampled (rig.fit.posterior: ``walkers``, default 4 per parameter and at least
-    8, drawn from ``seed``) into the block's "posterior" and out/posterior.png."""
+    8, drawn from ``seed``) into the block's "posterior" and out/posterior.png. The folder
+    is held (LOCK) while the fit runs: a second fit into it is refused in one line, naming
+    the run that holds it, rather than the two overwriting each other."""
     kept = (OSError, Interrupted)  # a full disk, Ctrl-C: what was cached stays, for the same command to resume from
-    with left_as_found(out, (RigError, OSError), keep=lambda exc: isinstance(exc, kept)):
+    with left_as_found(out, (RigError, OSError, InstrumentError), keep=lambda exc: isinstance(exc, kept)), \
+            folder_lock(out, LOCK, "wait for it to end, or give another --out", keep=lambda: False):
         return _fit_into(scene, objective, Path(out), progress, max_evaluations, posterior_steps, walkers, seed)
 
 

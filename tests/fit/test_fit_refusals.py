@@ -232,3 +232,18 @@ def test_an_archives_shots_of_another_setup_are_refused_not_modelled_at_the_scen
     assert code == 2 and len(err.strip().splitlines()) == 1
     assert "shot 2 was fired with striker.velocity = 1.2 where the fit's model has 0.89" in err
     assert not (tmp_path / "fit").exists()
+
+
+def test_a_second_fit_into_a_folder_in_use_is_refused(tmp_path, capsys, curve):
+    """Two rig fit into one --out had overwritten each other's files: the folder is held
+    while a fit writes it, and a second is refused in one line naming the holder."""
+    from instruments.files import folder_lock
+    from rig.fit.run import LOCK
+
+    pts = _points(tmp_path, zip(curve.force, curve.speed))
+    out = tmp_path / "fit"
+    with folder_lock(out, LOCK, "another fit"):  # a fit of another process writing there now
+        code = main(["fit", "ptfe52_gravity", "--points", str(pts), "--param", E, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "in use by another run (pid" in err, err
+    assert not (out / "fit.json").exists()
