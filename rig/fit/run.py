@@ -11,7 +11,6 @@ from rig.experiment import scene as scene_io
 from rig.fit import report
 from rig.fit.fitting import fit
 
-
 LOCK = "fit.lock"  # held in the --out folder while a fit writes it: a second fit into it is refused
 
 
