@@ -99,3 +99,23 @@ def test_the_wfid_prints_v_per_div_and_s_per_div_as_a_scope_does():
     t = np.arange(20000) * 2.5e-7
     rec = scope.acquire({"CH1": 0.1 * np.exp(-(((t - 2e-3) / 1e-4) ** 2))}, 2.5e-7, np.random.default_rng(0))
     assert "50.00mV/div, 250.0us/div, 10000 points" in rec["CH1"].preamble.waveform_id
+
+
+@pytest.mark.parametrize("slope", ["rising", "falling"])
+def test_an_edge_trigger_has_a_noise_band_and_fires_on_its_own_flank(slope):
+    """A pulse of 0.2 V whose flanks carry a +-3 mV ripple (1.5 codes at 50 mV/div) through
+    the 0.1 V level: the ripple crosses the level downwards on the rising flank too, where a
+    falling trigger without hysteresis had fired. With the band (0.2 div) each slope fires
+    on its own flank, at the crossing of the level the comparator's turn belongs to."""
+    h = 1e-7
+    t = np.arange(40000) * h
+    pulse = 0.2 * np.exp(-0.5 * ((t - 2e-3) / 2e-4) ** 2)
+    x = pulse + 0.003 * np.sin(2 * np.pi * np.arange(t.size) / 4.0)
+    rise, fall = 2e-3 - 2e-4 * np.sqrt(2 * np.log(2)), 2e-3 + 2e-4 * np.sqrt(2 * np.log(2))  # pulse = 0.1 V
+    scope = Oscilloscope(channels={"CH1": ChannelSettings(0.05, 0.0)}, timebase=Timebase(1e-6, 2000),
+                         trigger=Trigger("CH1", 0.1, slope, 0.5))
+    rec = scope.acquire({"CH1": x}, h, np.random.default_rng(0))
+    assert rec.triggered
+    expected = rise if slope == "rising" else fall
+    # the ripple moves a crossing by up to 3 mV over the flank's 590 V/s, 5 us; the other flank is 471 us away
+    assert abs(rec.trigger_time - expected) < 10e-6, (rec.trigger_time, expected)

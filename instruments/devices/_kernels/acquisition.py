@@ -64,13 +64,34 @@ def condition(v, probe, ac, lowpass):
     return out
 
 
+TRIGGER_BAND_CODES = 5.0
+"""The edge trigger's hysteresis (noise band), in codes of its source channel: 0.2 of a
+division at 25 codes a division, the order of a Tektronix scope's trigger sensitivity."""
+
+
 @jit
-def first_crossing(x, h, level, rising):
-    """Time (s) of the first crossing of ``level``, rising or falling, linearly
-    interpolated; nan where there is none."""
+def first_crossing(x, h, level, rising, band):
+    """Time (s) of the edge trigger on ``x`` (samples every h s): a comparator with
+    hysteresis, as a scope's trigger is, whose state turns high where x reaches
+    level + band/2 and low where x falls to level - band/2 (its state at the start: high
+    where x[0] >= level). A rising trigger fires where the state turns high, a falling one
+    where it turns low; the time is that of the crossing of ``level`` the turn belongs to
+    (the last one before it), linearly interpolated; nan where there is none. Noise
+    smaller than the band on the other flank (a falling trigger's rising flank) no longer
+    fires it; on a clean edge it is the first crossing of the level, as without a band."""
+    high = x[0] >= level
+    last = -1  # the latest crossing of level in the trigger's direction
     for i in range(x.shape[0] - 1):
         if (x[i] < level and x[i + 1] >= level) if rising else (x[i] > level and x[i + 1] <= level):
-            return (i + (level - x[i]) / (x[i + 1] - x[i])) * h
+            last = i
+        if not high and x[i + 1] >= level + 0.5 * band:
+            high = True
+            if rising and last >= 0:
+                return (last + (level - x[last]) / (x[last + 1] - x[last])) * h
+        elif high and x[i + 1] <= level - 0.5 * band:
+            high = False
+            if not rising and last >= 0:
+                return (last + (level - x[last]) / (x[last + 1] - x[last])) * h
     return math.nan
 
 
@@ -84,7 +105,7 @@ def scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult
     (z[c] empty: none). Fills codes (channels, samples) and over of the channels ``read``
     (the others: codes 0, not over); returns (status, time of the trigger crossing s, time
     of the first sample after the trigger s)."""
-    t_cross = first_crossing(analog[source], h, level, rising)
+    t_cross = first_crossing(analog[source], h, level, rising, TRIGGER_BAND_CODES * abs(ymult[source]))
     if math.isnan(t_cross):
         return NO_TRIGGER, t_cross, math.nan
     x_zero = phase - n_pre * dt
