@@ -81,6 +81,16 @@ def _whole(text) -> int | None:
     return int(value) if math.isfinite(value) else None
 
 
+_VOLTS = {"volts": "V", "volt": "V", "v": "V"}
+
+
+def vertical_unit(text) -> str:
+    """A record's vertical unit as the archive and the analysis name it: "V" for every way
+    a scope writes volts ("V", "Volts", "volt"), any other unit ("A", "dB", "W") as given."""
+    unit = (text or "V").strip().strip('"') or "V"
+    return _VOLTS.get(unit.lower(), unit)
+
+
 def channel_name(text: str) -> str:
     """A channel name the archive stores (letters, digits, '_' and '#', not starting with a
     digit), made from ``text``: every other character becomes '_', and a leading digit

@@ -23,7 +23,7 @@ from ..errors import InstrumentError
 from ..files import atomic_writes
 from ..rails import flagged
 from ..records import Preamble, Waveform
-from .checks import analog_only, bandwidth, channel_name, screen, time_axis
+from .checks import analog_only, bandwidth, channel_name, screen, time_axis, vertical_unit
 
 # every spelling real scopes use, long and short, to one canonical key
 _ALIASES = {"BYT_NR": "BYT_NR", "BYT_N": "BYT_NR", "BIT_NR": "BIT_NR", "BIT_N": "BIT_NR",
@@ -272,7 +272,7 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
     pre = Preamble(points=codes.size, x_increment=dx, x_zero=first, trigger_index=trigger,
                    y_multiplier=ymult, y_offset=y_offset,
                    y_zero=_number(h, "YZERO", path), byte_count=codes.dtype.itemsize,
-                   x_unit=x_unit, y_unit=h.get("YUNIT", "V"), waveform_id=wfid,
+                   x_unit=x_unit, y_unit=vertical_unit(h.get("YUNIT")), waveform_id=wfid,
                    point_format="ENV" if envelope else "Y",
                    extra={"source": str(path), "record": index + 1, "name_in_file": name_in_file,
                           **bandwidth(h.get("FILTERF")), **_screen_of(h)})

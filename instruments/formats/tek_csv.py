@@ -28,10 +28,18 @@ from ..errors import InstrumentError
 from ..files import atomic_writes
 from ..rails import flagged
 from ..records import Preamble, Waveform
-from .checks import analog_only, bandwidth, channel_name, printed_quanta, printed_quantum, screen, time_axis
+from .checks import (
+    analog_only,
+    bandwidth,
+    channel_name,
+    printed_quanta,
+    printed_quantum,
+    screen,
+    time_axis,
+    vertical_unit,
+)
 
 TDS_BLOCK = 6  # columns per channel in the TDS1000/2000 layout
-_UNITS = {"volts": "V", "volt": "V", "v": "V"}
 
 
 def write_csv(waveforms: dict, directory, stem: str) -> list:
@@ -304,7 +312,7 @@ def _waveform(path, name, t, printed, v, trigger, unit, interval=None, point_for
     x0, dt = _time_base(path, t, interval, trigger if zero_index else None, printed)
     idx = (int(round(float(trigger))) if trigger not in (None, "") and not zero_index
            else int(np.clip(round(-x0 / dt), 0, t.size - 1)))
-    unit = _UNITS.get((unit or "V").strip().lower(), (unit or "V").strip())
+    unit = vertical_unit(unit)
     pre = Preamble(points=t.size, x_increment=dt, x_zero=x0, trigger_index=idx,
                    y_multiplier=1.0, y_offset=0.0, y_zero=0.0, byte_count=0, y_unit=unit,
                    point_format="ENV" if (point_format or "Y").strip().upper().startswith(("ENV", "PEAK")) else "Y",

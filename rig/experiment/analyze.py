@@ -179,6 +179,11 @@ def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
     for n in names:
         if n not in record.waveforms:
             raise invalid("--channels", options.channels, f"{n!r} is not in the files (channels: {held})")
+        unit = record.waveforms[n].preamble.y_unit
+        if unit != "V":
+            source = record.waveforms[n].preamble.extra.get("source", "the record")
+            raise RigError(f"{source}: channel {n} is in {unit} (its vertical unit), not V: the analysis reads the "
+                           f"gauges' voltages (a current probe's or a math channel's record is no gauge's)")
     if len(set(names)) < len(names):
         raise invalid("--channels", options.channels, "a channel named twice (each gauge has its own channel)")
     volts_per_newton = 1.0 if options.sensitivity is None else options.sensitivity

@@ -89,6 +89,7 @@ class Bead(_Part):
         if self.mass is None:
             object.__setattr__(self, "mass", material(self.material).rho * math.pi * self.diameter**3 / 6.0)
         self._positive("bead", "mass")
+        assert self.mass is not None, "just checked > 0"
         solid_sphere_check("bead.mass", self.mass, self.material, self.diameter)
 
     @property

@@ -426,3 +426,18 @@ def test_an_archive_keeps_its_files_channel_order_and_nothing_of_this_machine(ga
     kept = tmp_path / "kept.h5"
     assert main(["import", *lower_first, "--together", "--keep-paths", "--into", str(kept)]) == 0
     assert Archive(kept).read(1).record["CH1"].preamble.extra["source"] == gauge_files[0]
+
+
+def test_a_record_in_amperes_is_not_analysed_as_gauge_volts(gauge_files, tmp_path, capsys):
+    """YUNIT "A" (a current probe) had been read as volts; "Volts", as TDS scopes write it,
+    is volts."""
+    amps, volts = tmp_path / "amps_CH1.isf", tmp_path / "volts_CH1.isf"
+    data = Path(gauge_files[0]).read_bytes()
+    assert b'YUNIT "V"' in data
+    amps.write_bytes(data.replace(b'YUNIT "V"', b'YUNIT "A"'))
+    volts.write_bytes(data.replace(b'YUNIT "V"', b'YUNIT "Volts"'))
+    code, _, err = run(capsys, "analyze", str(amps), gauge_files[1], *GAUGE)
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert f"{amps}: channel CH1 is in A (its vertical unit), not V" in err
+    code, (r,), _ = run(capsys, "analyze", str(volts), gauge_files[1], *GAUGE)
+    assert code == 0 and r["speed_m_per_s"] == pytest.approx(200.0, rel=5e-3)
