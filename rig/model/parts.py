@@ -53,10 +53,11 @@ class _Part:
                 raise invalid(f"{prefix}.{name}", value, f"must be > 0 {_UNITS[name]}")
 
 
-MASS_FACTOR = 2.0
+MASS_FACTOR = 10.0
 """How far a bead's mass may lie from its solid sphere's, density x pi d^3 / 6: real beads
-differ from it by a few percent (the published PTFE 0.1226 g against 0.1243 g, a gauge bead
-0.116 g), a mass in grams given as kilograms by a factor 1000."""
+differ from it by a few percent (the published PTFE 0.1226 g against 0.1242 g, a gauge bead
+0.116 g), a hollow or composite one (or a test's light steel bead) by a few times, a mass
+in grams given as kilograms (or milligrams as grams) by a factor 1000."""
 
 
 def solid_sphere_check(field: str, mass: float, of: Material | str, diameter: float) -> None:

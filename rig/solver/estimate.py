@@ -12,9 +12,10 @@ from rig.solver.control import WORK_BUDGET
 from rig.solver.methods import method as get_method
 from rig.solver.problem import ChainProblem
 from rig.solver.run import time_grid
-from rig.solver.stepsize import checked_accuracy, default_step
+from rig.solver.stepsize import checked_accuracy, default_step, viscous_rate
 
 NS_PER_BODY_STEP = 7.0  # srkn6b's whole step, one core: 6 force evaluations of about 1.2 ns per body
+NS_PER_BODY_SUBSTEP = 10.0  # a substep of the viscous flow, a body (8 to 23 ns measured, Kuwabara-Kono, 54 bodies)
 NS_PER_STEP = 2000.0  # a step's own cost whatever the chain: the head's substeps, recording, the checks
 # (1.4 to 2.7 us a step beside the bodies' on ptfe52_gravity, ptfe52_magnetic and steel21_gravity; the
 # bodies' 7 ns alone had their solves 4 to 18 times dearer than estimated)
@@ -36,6 +37,7 @@ class RunEstimate:
     bodies: int
     samples: int
     most_seconds: float = math.nan  # the bound: the accuracy control's work budget spent (nan: seconds)
+    substeps: int = 0  # the viscous flow's substeps a step (stepsize.viscous_rate; 0: no viscous contacts)
 
     @property
     def bound_seconds(self) -> float:
@@ -46,7 +48,7 @@ class RunEstimate:
     def times(self, runs: int, kept: int) -> RunEstimate:
         """``runs`` such solves one after another, ``kept`` of them held in memory at once."""
         return RunEstimate(self.bytes * kept, self.seconds * runs, self.steps, self.bodies, self.samples,
-                           self.most_seconds * runs)
+                           self.most_seconds * runs, self.substeps)
 
     @property
     def large(self) -> bool:
@@ -54,8 +56,9 @@ class RunEstimate:
 
     def describe(self) -> str:
         bound = f", at most {self.bound_seconds:.3g} s" if self.bound_seconds > self.seconds else ""
+        flow = f" and {self.substeps} substeps of the viscous flow each" if self.substeps > 2 else ""
         return (f"about {self.bytes / 1e9:.3g} GB and {self.seconds:.3g} s of solving{bound} "
-                f"({self.steps} steps x {self.bodies} bodies, {self.samples} samples per channel)")
+                f"({self.steps} steps x {self.bodies} bodies{flow}, {self.samples} samples per channel)")
 
     def refuse_unless(self, allowed: bool, what: str):
         """RigError naming the estimate and the confirming flag, if large and not allowed."""
@@ -75,7 +78,11 @@ def estimate_solve(problem: ChainProblem, t_end: float, channels: int, sample_in
     most its WORK_BUDGET; one solve where ``controlled`` is False: a study's shots reuse
     its pilot's step)."""
     stepping = default_step(problem, get_method(method), checked_accuracy(accuracy), t_end)
-    steps, _, samples = time_grid(t_end, min(stepping.dt, t_end), sample_interval)  # the grid solve takes
-    one = steps * (problem.moving_bodies * NS_PER_BODY_STEP + NS_PER_STEP) * 1e-9  # s
+    dt = min(stepping.dt, t_end)
+    steps, _, samples = time_grid(t_end, dt, sample_interval)  # the grid solve takes
+    rate = viscous_rate(problem)  # the viscous flow: two half steps a step, each of ceil(dt/2 x rate) substeps
+    flow = 2 * max(1, math.ceil(0.5 * dt * rate)) if rate > 0 else 0
+    per_body = NS_PER_BODY_STEP + flow * NS_PER_BODY_SUBSTEP
+    one = steps * (problem.moving_bodies * per_body + NS_PER_STEP) * 1e-9  # s
     return RunEstimate(8.0 * samples * max(channels, 1) * COPIES, one * (CONTROL_WORK if controlled else 1.0),
-                       steps, problem.moving_bodies, samples, one * WORK_BUDGET if controlled else math.nan)
+                       steps, problem.moving_bodies, samples, one * WORK_BUDGET if controlled else math.nan, flow)

@@ -205,6 +205,9 @@ def _flag_cases():
     cases += [(["shot", S, "--set", "chain.mass=0.1226"], "chain.mass = 0.1226: a ptfe sphere of 4.76 mm weighs"),
               (["shot", S, "--set", "gauges.upper.mass=0.116"], "gauges.upper.mass = 0.116: a ptfe sphere"),
               (["shot", S, "--set", "chain.mass=0.1226 mg"], "chain.mass = 1.226e-07")]
+    # a Kuwabara-Kono damping time of 1 s: the viscous flow's substeps (256846 a step) had run 86 s unannounced
+    cases += [(["shot", S, "--set", "chain.contact_law=kuwabara-kono", "--set", "chain.damping_time=1 s"],
+               "substeps of the viscous flow each")]
     mass = "chain.mass=normal(0.1226 g, 0.001 g)"
     cases += [(["mc", S, "--shots", "8", "--vary", mass, "--vary", "chain.bead_mass=normal(0.1226 g, 0.001 g)",
                 "--out", out], "--vary = 'chain.bead_mass': names the quantity chain.mass names too")]
