@@ -140,8 +140,12 @@ def print_blocks(t, m, th):
 
 def cmd_animate(args) -> dict:
     """Render a virtual shot to a movie or a still, off-screen (pyvista)."""
+    import os
+    from dataclasses import replace
+
+    from rig.errors import RigError
     from rig.experiment.scene import load
-    from rig.viz.animate import check_output, require_renderer
+    from rig.viz.animate import check_output, movie_cost, require_renderer
 
     check_output(args.out)  # before anything is computed
     scene = load(args.scene, scene_overrides(args))
@@ -151,7 +155,14 @@ def cmd_animate(args) -> dict:
 
     rig = Rig(scene)
     rig.check_record()  # the movie's traces are the shot's scope record
-    check_size(rig.estimate(), args, "this movie")
+    solve = rig.estimate()
+    held, seconds = movie_cost(args.frames, args.out)
+    memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    if held > memory:
+        raise RigError(f"--frames {args.frames}: a .gif holds every frame until it is written, about "
+                       f"{held / 1e9:.3g} GB, beyond this machine's {memory / 1e9:.3g} GB; write a .mp4 (its "
+                       f"frames are streamed) or fewer frames")
+    check_size(replace(solve, bytes=solve.bytes + held, seconds=solve.seconds + seconds), args, "this movie")
     still = args.out.lower().endswith(".png")
     with progress_bar(args.quiet or still, total=None if still else args.frames, desc="animate",
                       unit="frame") as bar:

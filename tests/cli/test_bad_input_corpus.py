@@ -208,6 +208,9 @@ def _flag_cases():
     # a Kuwabara-Kono damping time of 1 s: the viscous flow's substeps (256846 a step) had run 86 s unannounced
     cases += [(["shot", S, "--set", "chain.contact_law=kuwabara-kono", "--set", "chain.damping_time=1 s"],
                "substeps of the viscous flow each")]
+    # 10,000 frames: a .gif's frames held in memory (45 GB) had died out of memory; a .mp4's render time announced
+    cases += [(["animate", S, "--frames", "10000", "--out", "{d}/m.gif"], "a .gif holds every frame until it is"),
+              (["animate", S, "--frames", "10000", "--out", "{d}/m.mp4"], "beyond the limit of 120 s; add --allow")]
     mass = "chain.mass=normal(0.1226 g, 0.001 g)"
     cases += [(["mc", S, "--shots", "8", "--vary", mass, "--vary", "chain.bead_mass=normal(0.1226 g, 0.001 g)",
                 "--out", out], "--vary = 'chain.bead_mass': names the quantity chain.mass names too")]
