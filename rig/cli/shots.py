@@ -145,9 +145,10 @@ def cmd_animate(args) -> dict:
 
     from rig.errors import RigError
     from rig.experiment.scene import load
-    from rig.viz.animate import check_output, movie_cost, require_renderer
+    from rig.viz.animate import check_options, check_output, movie_cost, require_renderer
 
     check_output(args.out)  # before anything is computed
+    check_options(args.frames, args.exaggerate)
     scene = load(args.scene, scene_overrides(args))
     require_renderer(args.out)
     from rig.experiment.shot import Rig

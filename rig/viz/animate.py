@@ -217,6 +217,15 @@ GIF_BYTES_PER_FRAME = 4.5e6  # a .gif's writer holds every frame until it closes
 SECONDS_PER_FRAME = 0.16  # rendering and encoding a frame, one core (measured: 0.10 .mp4, 0.16 .gif)
 
 
+def check_options(frames, exaggerate) -> None:
+    """RigError in one line for --frames outside 2..10000 or an --exaggerate that is no
+    factor > 0 (before anything is estimated or solved)."""
+    if not isinstance(frames, int) or not 2 <= frames <= 10000:
+        raise invalid("--frames", frames, "a whole number of frames from 2 to 10000")
+    if exaggerate is not None and not (np.isfinite(exaggerate) and exaggerate > 0):
+        raise invalid("--exaggerate", exaggerate, "a factor > 0")
+
+
 def movie_cost(frames: int, out) -> tuple:
     """(bytes held, seconds) of rendering ``frames`` frames to ``out`` beyond the shot's
     solve: a .gif holds every frame until it is written, a .mp4 streams them to its encoder,
@@ -234,10 +243,7 @@ def animate(rig, out, frames: int = 100, exaggerate: float | None = None, seed: 
     the shot was recorded at, and for a still its time "still_time_s" and why that one
     ("still_at")."""
     out = check_output(out)
-    if not isinstance(frames, int) or not 2 <= frames <= 10000:
-        raise invalid("--frames", frames, "a whole number of frames from 2 to 10000")
-    if exaggerate is not None and not (np.isfinite(exaggerate) and exaggerate > 0):
-        raise invalid("--exaggerate", exaggerate, "a factor > 0")
+    check_options(frames, exaggerate)
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     t_start = time.perf_counter()
     fr = chain_frames(rig, frames)
