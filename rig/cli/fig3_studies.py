@@ -45,6 +45,24 @@ def questions(args, overrides: tuple) -> tuple:
     return tuple(out)
 
 
+SECONDS_PER_FIT = 5.7  # an identifiability fit, one core (the default 5 keys x 20 draws: 9-10 min)
+MOST_SECONDS = 86400.0  # beyond a day's estimate a study waits for --allow-large
+
+
+def _announce(fits: int, draws: int, allowed: bool) -> None:
+    """Say what the identifiability study will take before it starts (stderr); refuse past
+    MOST_SECONDS without --allow-large."""
+    import sys
+
+    seconds = fits * SECONDS_PER_FIT
+    span = f"{seconds / 3600:.3g} h" if seconds >= 3600 else f"{seconds / 60:.3g} min"
+    said = f"{fits} fits at about {SECONDS_PER_FIT:g} s each: about {span}"
+    if seconds > MOST_SECONDS and not allowed:
+        raise invalid("--draws", draws, f"the identifiability study would take {said} ({seconds / 86400:.3g} days), "
+                                        f"beyond a day; give fewer --draws, or add --allow-large")
+    print(f"identifiability: {said}", file=sys.stderr, flush=True)
+
+
 def run_fig3_studies(args) -> dict:
     if not (args.identifiability or args.sensitivity):
         flag = "--set" if args.set else "--param" if args.param else "--truth"
@@ -67,6 +85,7 @@ def run_fig3_studies(args) -> dict:
             from rig.study import identifiability as study
 
             total = len(plan) * args.draws
+            _announce(total, args.draws, args.allow_large)
             with progress_bar(args.quiet, total=total, desc="identifiability", unit="fit") as bar:
                 def progress(what, bar=bar):
                     bar.set_postfix_str(what[:60])

@@ -106,6 +106,11 @@ def print_sweep(key: str, points: list):
 
 
 def cmd_reproduce(args) -> dict:
+    for flag, value in (("--draws", args.draws), ("--seed", args.seed), ("--allow-large", args.allow_large or None)):
+        if value is not None and not args.identifiability:
+            raise invalid(flag, value, "only with --identifiability (the published study draws no noise)")
+    args.draws = 20 if args.draws is None else args.draws
+    args.seed = 0 if args.seed is None else args.seed
     if args.family and not args.fitted:
         raise invalid("--family", args.family[0], "chooses the families of --fitted; give --fitted too")
     if args.fitted:
@@ -181,7 +186,9 @@ def add_reproduce(sub) -> None:
                     help="with --identifiability: a key to find again (with --truth), instead of the five new ones")
     rp.add_argument("--truth", action="append", metavar="VALUE",
                     help="with --param: its truth, a quantity in the key's unit (one per --param, in order)")
-    rp.add_argument("--draws", type=count_arg, default=20,
+    rp.add_argument("--draws", type=count_arg,
                     help="with --identifiability: data sets per key (default 20)")
-    rp.add_argument("--seed", type=seed_arg, default=0, help="with --identifiability: the noise's seed (default 0)")
+    rp.add_argument("--seed", type=seed_arg, help="with --identifiability: the noise's seed (default 0)")
+    rp.add_argument("--allow-large", action="store_true",
+                    help="with --identifiability: run even when its estimate passes a day")
     rp.add_argument("--quiet", action="store_true", help="no progress bar")

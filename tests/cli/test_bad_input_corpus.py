@@ -211,6 +211,11 @@ def _flag_cases():
     # 10,000 frames: a .gif's frames held in memory (45 GB) had died out of memory; a .mp4's render time announced
     cases += [(["animate", S, "--frames", "10000", "--out", "{d}/m.gif"], "a .gif holds every frame until it is"),
               (["animate", S, "--frames", "10000", "--out", "{d}/m.mp4"], "beyond the limit of 120 s; add --allow")]
+    # rig reproduce: a noise seed or draws without the study that draws noise; a study of 330 days unannounced
+    cases += [(["reproduce", "daraio2006", "--out", out, "--seed", "3"], "--seed = 3: only with --identifiability"),
+              (["reproduce", "daraio2006", "--out", out, "--draws", "5"], "--draws = 5: only with --identifiability"),
+              (["reproduce", "daraio2006", "--out", out, "--identifiability", "--draws", "1000000"],
+               "--draws = 1000000: the identifiability study would take 5000000 fits")]
     mass = "chain.mass=normal(0.1226 g, 0.001 g)"
     cases += [(["mc", S, "--shots", "8", "--vary", mass, "--vary", "chain.bead_mass=normal(0.1226 g, 0.001 g)",
                 "--out", out], "--vary = 'chain.bead_mass': names the quantity chain.mass names too")]
