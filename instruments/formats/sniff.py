@@ -171,6 +171,9 @@ def identify(path) -> str:
     """'isf', 'wfm' or 'csv' for a Tektronix file; otherwise InstrumentError in one line
     naming what the file is (another maker's format, or not a scope file at all)."""
     path = Path(path)
+    if path.exists() and not path.is_file():  # a folder, a named pipe, a device: opening one may block
+        what = "a folder" if path.is_dir() else "not a regular file (a named pipe, a socket or a device)"
+        raise InstrumentError(f"{path}: {what}, not a scope file; {READABLE}")
     with open(path, "rb") as fh:
         head = fh.read(HEAD_BYTES)
     if not head.strip():

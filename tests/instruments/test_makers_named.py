@@ -59,3 +59,28 @@ def test_a_tektronix_dpo5000_hdf5_file_is_named_as_one(tmp_path):
     with pytest.raises(InstrumentError, match="a Tektronix DPO5000/DPO7000 HDF5 waveform") as err:
         identify(path)
     assert "rig archive" not in str(err.value)
+
+
+def test_a_named_pipe_or_a_folder_is_refused_without_being_opened(tmp_path):
+    """A named pipe given as a scope file had blocked the import forever (opening it waits
+    for a writer); it is refused in one line, as a folder is. An alarm fails the test rather
+    than hanging the suite, should it block again."""
+    import os
+    import signal
+
+    pipe = tmp_path / "scope.isf"
+    os.mkfifo(pipe)
+
+    def blocked(signum, frame):
+        raise AssertionError("reading a named pipe blocked")
+
+    old = signal.signal(signal.SIGALRM, blocked)
+    signal.alarm(20)
+    try:
+        for path, what in ((pipe, "not a regular file (a named pipe"), (tmp_path, "a folder, not a scope file")):
+            with pytest.raises(InstrumentError, match=what.replace("(", r"\(")) as err:
+                read_waveforms(path)
+            assert str(err.value).startswith(str(path))
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
