@@ -41,6 +41,7 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+PATH_FLAGS = ("out", "export", "into", "log", "observations", "points", "archive")  # flags that name a path
 SIGPIPE_EXIT = 141  # 128 + SIGPIPE: what a shell reports for a command whose reader went away
 
 
@@ -64,6 +65,10 @@ def _run(argv) -> int:
     command = f"{args.command} {args.what}" if args.command == "serve" else args.command  # as argparse names it
     if extra:  # named by the command's parser, not the top one's ("rig: error:")
         return _fail(command, f"unrecognized arguments: {' '.join(extra)} (see rig {command} --help)")
+    for name in PATH_FLAGS:  # '' had meant the current folder (rig mc) or nothing at all (rig shot, exit 0)
+        value = getattr(args, name, None)
+        if isinstance(value, str) and not value.strip():
+            return _fail(command, f"--{name.replace('_', '-')} = {value!r}: an empty path; give a file or folder name")
     try:
         out = args.func(args)
     except BrokenPipeError:

@@ -216,6 +216,11 @@ def _flag_cases():
               (["reproduce", "daraio2006", "--out", out, "--draws", "5"], "--draws = 5: only with --identifiability"),
               (["reproduce", "daraio2006", "--out", out, "--identifiability", "--draws", "1000000"],
                "--draws = 1000000: the identifiability study would take 5000000 fits")]
+    # an empty path: rig mc had written into the current folder, rig shot had archived nothing with exit 0
+    cases += [(["shot", S, "--out", ""], "--out = '': an empty path"),
+              (["shot", S, "--export", " "], "--export = ' ': an empty path"),
+              (["mc", S, "--shots", "8", "--vary", VEL, "--out", ""], "--out = '': an empty path"),
+              (["import", "a.isf", "--into", ""], "--into = '': an empty path")]
     mass = "chain.mass=normal(0.1226 g, 0.001 g)"
     cases += [(["mc", S, "--shots", "8", "--vary", mass, "--vary", "chain.bead_mass=normal(0.1226 g, 0.001 g)",
                 "--out", out], "--vary = 'chain.bead_mass': names the quantity chain.mass names too")]
