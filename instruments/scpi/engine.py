@@ -56,6 +56,7 @@ class Call:
     suffixes: tuple
     header: str
     context: object = None
+    taken: list = field(default_factory=lambda: [0], compare=False)  # how many arguments the handler read
 
     @property
     def suffix(self) -> int:
@@ -65,7 +66,12 @@ class Call:
     def arg(self, i: int = 0) -> Argument:
         if i >= len(self.args):
             raise ScpiError(-109, f"{self.header} needs {i + 1} argument(s)")
+        self.taken[0] = max(self.taken[0], i + 1)
         return self.args[i]
+
+    def unread(self) -> tuple:
+        """The arguments the handler did not read (a setting given one value too many)."""
+        return self.args[self.taken[0]:]
 
     def only(self, count: int) -> None:
         if len(self.args) > count:
@@ -132,14 +138,19 @@ class Engine:
             if found is None or handler is None:
                 self.status.post(-113, unit.header[:60])
                 continue
+            call = Call(unit.args, found.suffixes, unit.header, context)
             try:
-                value = handler(Call(unit.args, found.suffixes, unit.header, context))
+                value = handler(call)
             except ScpiError as e:
                 self.status.post(e.code, f"{e.detail}" if e.detail else unit.header[:60])
                 continue
             except Exception as e:  # noqa: BLE001 - a handler's fault must not drop the client
                 self.status.post(-200, f"{INTERNAL} in {unit.header[:60]}: {type(e).__name__}: {e}")
                 continue
+            extra = call.unread()
+            if extra and not unit.query:  # IEEE 488.2: -108 Parameter not allowed (the value read was set)
+                self.status.post(-108, f"{unit.header[:60]} takes {call.taken[0]} argument(s); "
+                                       f"{', '.join(a.text[:20] for a in extra)} not allowed")
             if unit.query:
                 replies.append(self.reply(value, found))
         return b";".join(replies) + b"\n" if replies else b""

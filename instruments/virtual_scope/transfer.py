@@ -53,9 +53,12 @@ class DataSelection:
         return self.encoding in ("RPBinary", "SRPbinary")
 
     def span(self, points: int) -> tuple:
-        """(first index, end index) of the points sent from a record of ``points``."""
-        first = min(max(self.start, 1), points) - 1
-        return first, max(min(self.stop, points), first + 1)
+        """(first index, end index) of the points sent from a record of ``points``: points
+        DATa:STARt to DATa:STOP, the two taken in order where STARt is the larger (the
+        manuals: the scope swaps them), clamped to the record."""
+        lo, hi = sorted((self.start, self.stop))
+        first = min(max(lo, 1), points) - 1
+        return first, max(min(hi, points), first + 1)
 
 
 def sent_codes(codes: np.ndarray, sel: DataSelection) -> np.ndarray:

@@ -183,3 +183,23 @@ def test_a_scene_scope_no_model_can_take_is_refused():
 def test_a_first_seed_that_is_no_seed_is_refused(seed):
     with pytest.raises(InstrumentError, match="seed"):
         VirtualScope(scene_scope(), lambda o, s: None, seed=seed)
+
+
+def test_a_setting_given_one_value_too_many_queues_parameter_not_allowed(make_scope):
+    """CH1:SCAle 0.1,0.2 had set 0.1 and said nothing of the 0.2: IEEE 488.2's -108
+    (Parameter not allowed) is queued, naming what was not taken."""
+    _scope, s, _ = make_scope("mdo3000")
+    assert s.handle(b"CH1:SCALE 0.1,0.2") == b""
+    assert ask(s, "EVENT?") == "-108"
+    s.handle(b"*CLS")
+    s.handle(b"CH1:SCALE 0.1")
+    assert ask(s, "EVENT?") == "0" and ask(s, "CH1:SCALE?") == "100.0000E-3"
+
+
+def test_data_start_after_stop_sends_the_points_between_as_the_scopes_swap_them(make_scope):
+    _scope, s, _ = make_scope("mdo3000")
+    fire(s)
+    s.handle(b"DATA:SOURCE CH1;:DATA:ENC RIB;WIDTH 1;:DAT:START 500;STOP 100")
+    block = s.handle(b"CURVE?")
+    digits = int(block[1:2])
+    assert int(block[2:2 + digits]) == 401  # points 100 to 500, not the one point 500 alone
