@@ -3,7 +3,8 @@ the immediate one, ``MEASUrement:IMMed:TYPe/SOUrce/VALue?/UNIts?``, and the numb
 ``MEASUrement:MEAS<n>:TYPe/SOUrce/STATE/VALue?/UNIts?`` (n = 1..8). Period-free types
 only: AMPlitude and PK2pk (max - min: the min-max method of HIGH and LOW), MAXimum,
 MINimum, HIGH, LOW, MEAN, RMS, in volts. Without a record the value is 9.91E37 with event
-2225, as the scopes answer; a source that is off is 2244."""
+2225, as the scopes answer; a source that is off is 2244; a source at the converter's rail
+gives its value with the clipping warning (547, 548 or 549)."""
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -11,12 +12,16 @@ from typing import Any
 
 import numpy as np
 
+from ..devices.oscilloscope import CODE_MAX, CODE_MIN
 from ..scpi.engine import Call, Word
 from ..scpi.status import ScpiError
 from .commands import CHANNEL_WORDS
 from .waveform_commands import source_waveform
 
 NO_VALUE = 9.91e37  # what a Tek scope answers for a measurement it cannot make
+# the warnings of a measurement on a clipped source (the manuals' event codes): 547 clipping
+# positive/negative, 548 clipping positive, 549 clipping negative
+CLIPPING = {(True, True): 547, (True, False): 548, (False, True): 549}
 SLOTS = 8
 MEASUREMENTS: dict[str, Callable[[np.ndarray], Any]] = {
     "AMPlitude": lambda v: v.max() - v.min(), "PK2pk": lambda v: v.max() - v.min(),
@@ -53,6 +58,9 @@ def register(tree, scope) -> None:
             scope.status.post(2225, c.header)
             return p.number(NO_VALUE)
         v = pre.y_zero + pre.y_multiplier * (codes.astype(np.float64) - pre.y_offset)
+        top, bottom = bool(np.any(codes >= CODE_MAX)), bool(np.any(codes <= CODE_MIN))
+        if top or bottom:  # the value stands, with the warning the scopes give for a clipped source
+            scope.status.post(CLIPPING[top, bottom], c.header)
         return p.number(float(MEASUREMENTS[m["type"]](v)))
 
     def set_state(c: Call):

@@ -203,3 +203,15 @@ def test_data_start_after_stop_sends_the_points_between_as_the_scopes_swap_them(
     block = s.handle(b"CURVE?")
     digits = int(block[1:2])
     assert int(block[2:2 + digits]) == 401  # points 100 to 500, not the one point 500 alone
+
+
+def test_a_measurement_of_a_clipped_source_gives_its_value_with_the_clipping_warning(make_scope):
+    """A 0.2 V pulse at 10 mV/div runs off the 8-bit converter's top: the value (the rail)
+    comes with event 548, Measurement warning, clipping positive, as the scopes give it."""
+    scope, s, _ = make_scope("mdo3000")
+    s.handle(b"CH1:SCALE 0.01;:MEASU:IMM:SOU1 CH1;TYP MAX")
+    fire(s)
+    assert scope.acq.last.record["CH1"].codes.max() == 127
+    value = float(ask(s, "MEASU:IMM:VAL?"))
+    assert value == pytest.approx(scope.acq.last.record["CH1"].volts().max(), rel=1e-12)
+    assert ask(s, "EVENT?") == "548"
