@@ -256,9 +256,9 @@ def flag_lines(flags: dict) -> list:
 def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     """On a cold numba cache (a new install, a changed kernel): start compiling the
     instruments' kernels of ``task`` ("shot" or "study") in a side process while this one
-    compiles the chain solver, and say so in one line on stderr when it is a
-    terminal (a log or a test keeps a failure's one error line alone) and not ``quiet``.
-    Nothing on a warm cache."""
+    compiles the chain solver, and say so in one line on stderr unless ``quiet``, a
+    terminal or not (a log or a pipe had sat silent for the whole compile, tens of
+    seconds). Nothing on a warm cache."""
     from instruments.precompile import LEADING, SHOT, SHOT_SMALL, STUDY, start
     from numerics.dispatcher import has_machine_code
     from rig.solver.kernels.ensemble import integrate_chunks
@@ -272,6 +272,6 @@ def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_chunks)))
     aside = start(kernels, then=SHOT_SMALL if task == "study" else None)  # so a shot after it compiles nothing
     parts = (["the chain solver"] if cold_solver else []) + (["the instruments"] if aside else [])
-    if parts and not quiet and sys.stderr.isatty():
+    if parts and not quiet:
         print(f"rig {command}: numba is compiling {' and '.join(parts)}{' (in two processes)' if aside else ''}, "
               f"once: later runs load the machine code from its cache", file=sys.stderr, flush=True)

@@ -118,3 +118,20 @@ def test_a_side_process_never_outlives_its_command():
     slow = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
     finish(slow, wait_s=0.5)
     assert slow.returncode is not None and slow.returncode != 0
+
+
+def test_a_cold_start_says_so_in_a_log_too(monkeypatch, capsys):
+    """Output that is no terminal (a log, a pipe, CI) had sat silent for the whole compile:
+    the one line is said there too, and not with --quiet (rig mc)."""
+    import instruments.precompile
+    import numerics.dispatcher
+    from rig.cli.common import compile_cold
+
+    monkeypatch.setattr(numerics.dispatcher, "has_machine_code", lambda kernel: False)  # a cold cache
+    monkeypatch.setattr(instruments.precompile, "start", lambda kernels, then=None: None)  # no side process
+    compile_cold("shot", "shot")
+    err = capsys.readouterr().err
+    assert err == ("rig shot: numba is compiling the chain solver, once: later runs load the machine code from "
+                   "its cache\n"), err
+    compile_cold("mc", "study", quiet=True)
+    assert capsys.readouterr().err == ""
