@@ -12,25 +12,24 @@ if TYPE_CHECKING:
 from rig.cli.common import command, count_arg, seed_arg
 
 
-def _records(args, overrides: list, fitted: dict) -> list:
-    """The scope records to fit: one shot's files (--records), or an archive's shots, each
-    virtual one fired with the set-up the fit models (rig.fit.checks.check_archived_setup)."""
+def _records(args, overrides: list, fitted: dict) -> tuple:
+    """(the scope records to fit, each one's set-up or None): one shot's files (--records),
+    or an archive's shots, each virtual one modelled with its own overrides
+    (rig.fit.checks.archived_setups)."""
     from instruments.formats import read_record
 
     if args.records:
         from rig.fit.checks import check_distinct_files
 
         check_distinct_files("--records", args.records)
-        return [read_record(args.records)]
+        return [read_record(args.records)], None
     from instruments.archive import Archive
-    from rig.experiment.shot import Rig
-    from rig.fit.checks import check_archived_setup
+    from rig.fit.checks import archived_setups
 
     arch = Archive(args.archive)
     ids = arch.ids() if args.shot is None else [args.shot]
     entries = [arch.read(i, with_truth=False) for i in ids]
-    check_archived_setup(args.archive, Rig.from_scene(args.scene, overrides).values, set(fitted), entries)
-    return [e.record for e in entries]
+    return [e.record for e in entries], archived_setups(args.archive, args.scene, overrides, set(fitted), entries)
 
 
 def cmd_fit(args) -> dict:
@@ -91,7 +90,8 @@ def cmd_fit(args) -> dict:
     else:
         from rig.fit.traces import TraceObjective
 
-        objective = TraceObjective(args.scene, params, _records(args, overrides, fitted), overrides)
+        records, setups = _records(args, overrides, fitted)
+        objective = TraceObjective(args.scene, params, records, overrides, setups)
     progress = None if args.quiet else stderr_progress
     with writing_to(args.out):
         block = run_fit(args.scene, objective, args.out, progress, args.max_evaluations, args.posterior,

@@ -146,28 +146,33 @@ def result_warnings(result, params: tuple) -> list:
     return out
 
 
-def check_archived_setup(archive: str, model: dict, fitted: set, entries: list) -> None:
-    """Refuse archived virtual shots fired with another set-up than the fit's model (the
-    scene's values, ``model``, with --set): the traces' fit models every record with one
-    rig, so a sweep's shots (each at its own striker velocity, say) would all be modelled at
-    the scene's. The keys the fit fits (``fitted``) may differ; imported real files, which
-    carry no settings, are not judged."""
-    want = dict(_flat(model))
+def archived_setups(archive: str, scene: str, overrides: list, fitted: set, entries: list) -> list:
+    """Each archived shot's set-up as the traces' fit models it: a virtual shot's own
+    overrides (a sweep's striker velocity, say; the fitted keys are the fit's), an imported
+    real record's none (it carries no settings: the scene and --set describe it). Refused in
+    one line where a virtual shot is of another scene, or was fired with a setting its
+    overrides on this scene and --set do not give (its scene text edited since, say): the
+    model would not be the shot's."""
+    out, models = [], {}
     for e in entries:
         if not e.simulated:
+            out.append(())
             continue
+        own = tuple(e.settings.get("overrides", ()))
+        if own not in models:
+            models[own] = dict(_flat(Rig.from_scene(scene, list(overrides) + list(own)).values))
+        want = models[own]
         have = dict(_flat({k: v for k, v in e.settings.items() if k != "overrides"}))
-        differ = sorted(k for k in set(want) | set(have) if k not in fitted and k != "scene"
-                        and not _same(want.get(k), have.get(k)))
-        if have.get("scene", want.get("scene")) != want.get("scene"):
-            differ.insert(0, "scene")
+        differ = sorted(k for k in set(want) | set(have) if k not in fitted and not k.startswith("solver.")
+                        and not _same(want.get(k), have.get(k)))  # the solver's settings: the fit's own numerics
         if differ:
             k = differ[0]
             raise invalid("--archive", archive, f"shot {e.shot_id} was fired with {k} = {have.get(k)!r} where the "
-                                                f"fit's model has {want.get(k)!r}"
+                                                f"fit's model of it has {want.get(k)!r}"
                                                 f"{f' (and {len(differ) - 1} more keys)' if len(differ) > 1 else ''}"
-                                                f": the fit models every record with one set-up; fit the shots of one "
-                                                f"set-up (--shot N), with --set for its keys")
+                                                f": give the scene it was fired from, and --set only keys it shares")
+        out.append(own)
+    return out
 
 
 def _flat(node, prefix: str = ""):

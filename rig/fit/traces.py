@@ -122,34 +122,53 @@ class TraceObjective:
     on ptfe52_gravity a forward difference's secant made the intervals of n and E 15%
     narrow and stopped the fit 0.3-0.5 sd short of the optimum (rig.fit.fitting.FD_STEP)."""
 
-    def __init__(self, scene: str, params: tuple, records: list, overrides=()):
+    def __init__(self, scene: str, params: tuple, records: list, overrides=(), setups=None):
+        """``setups``: per record, the overrides it was fired with beyond ``overrides`` (an
+        archive's virtual shots: each shot's own, a sweep's striker velocity say), its keys
+        the fit fits left out; None: every record of the one set-up ``overrides`` give.
+        Records of one set-up share its model; each set-up is solved per candidate."""
         self.scene, self.params = scene, tuple(params)
         self.overrides = list(overrides) + law_overrides(params, overrides)
+        fitted = {q.key for q in self.params}
+        per_record = [tuple(o for o in (setups[i] if setups else ()) if o.split("=", 1)[0].strip() not in fitted)
+                      for i in range(len(records))]
+        self.setups = sorted(set(per_record), key=per_record.index)  # in the order the records first give them
+        self.setup_of = [self.setups.index(o) for o in per_record]  # record index -> set-up index
         self._start = start_values(scene, self.overrides, params)
         check_bounds(scene, self.overrides, self.params, self._start)
-        rig = self.rig_of(self._start)
+        rigs = [self.rig_of(self._start, g) for g in range(len(self.setups))]
         start = at_values(self.params, self._start)
         try:
-            self.pilot: Pilot = calibrate([rig])  # the fit's numerics, calibrated on its start (rig.fit.evaluate)
+            self.pilot: Pilot = calibrate(rigs)  # the fit's numerics, calibrated on its start (rig.fit.evaluate)
         except RigError as exc:
             raise RigError(f"at the fit's start values ({start}): {exc}") from None
-        if not solve_rigs([rig], self.pilot)[0]:
-            raise RigError(f"the scene's own shot blew up at the fit's start values ({start}); check the scene "
-                           "before fitting it")
-        self.channels = channels_of(rig, records)
+        for g, good in enumerate(solve_rigs(rigs, self.pilot)):
+            if not good:
+                said = f" with {', '.join(self.setups[g])}" if self.setups[g] else ""
+                raise RigError(f"the scene's own shot{said} blew up at the fit's start values ({start}); check the "
+                               "scene before fitting it")
+        self.channels = [replace(c, record=i) for i, rec in enumerate(records)
+                         for c in channels_of(rigs[self.setup_of[i]], [rec])]
         check_distinct_channels(self.channels)
         self.records = sorted({c.record for c in self.channels})
         self.gauges = [k for k, c in enumerate(self.channels) if c.delay_sd > 0]
-        self.trigger = rig.scope.trigger
+        self.trigger = rigs[0].scope.trigger
 
-    def rig_of(self, theta) -> Rig:
-        return Rig.from_scene(self.scene, self.overrides + [q.override(x) for q, x in zip(self.params, theta)])
+    def rig_of(self, theta, setup: int = 0) -> Rig:
+        """The rig of candidate ``theta`` in set-up ``setup`` (an index into self.setups)."""
+        return Rig.from_scene(self.scene, self.overrides + list(self.setups[setup])
+                              + [q.override(x) for q, x in zip(self.params, theta)])
 
-    def trigger_time(self, model) -> float:
+    def _key(self, name: str, setup: int) -> str:
+        """A model's key for a channel (or "h") of set-up ``setup``: the name alone where
+        the records share one set-up (as every fit of one shot's records)."""
+        return name if len(self.setups) == 1 else f"{name}@{setup}"
+
+    def trigger_time(self, model, setup: int = 0) -> float:
         """Where the model's trigger channel first crosses the scene's trigger level (s from
         the impact, interpolated between samples; 0 if it never does): a record's time 0."""
-        v = model.get(self.trigger.source)
-        h = float(model["h"][0])
+        v = model.get(self._key(self.trigger.source, setup))
+        h = float(model[self._key("h", setup)][0])
         if v is None or not math.isfinite(h):
             return 0.0
         sign = 1.0 if self.trigger.slope == "rising" else -1.0
@@ -161,14 +180,18 @@ class TraceObjective:
         return float((k + x[k] / (x[k] - x[k + 1])) * h)
 
     def spec(self) -> dict:
-        return {"kind": "traces", "scene": self.scene, "overrides": self.overrides,
-                "params": [(q.key, q.lo, q.hi) for q in self.params],
-                "data": [[c.record, c.name, c.sd, hashlib.sha256(c.t.tobytes() + c.y.tobytes()).hexdigest()]
-                         for c in self.channels], "pilot": self.pilot.spec()}
+        out = {"kind": "traces", "scene": self.scene, "overrides": self.overrides,
+               "params": [(q.key, q.lo, q.hi) for q in self.params],
+               "data": [[c.record, c.name, c.sd, hashlib.sha256(c.t.tobytes() + c.y.tobytes()).hexdigest()]
+                        for c in self.channels], "pilot": self.pilot.spec()}
+        if len(self.setups) > 1:
+            out["setups"] = [list(o) for o in self.setups]
+            out["setup_of"] = self.setup_of
+        return out
 
     def numerics(self, theta) -> dict:
         """The fit's numerics at ``theta`` (its result), rig.fit.evaluate.numerics."""
-        return numerics(self.pilot, [self.rig_of(theta)])
+        return numerics(self.pilot, [self.rig_of(theta, g) for g in range(len(self.setups))])
 
     def start(self) -> np.ndarray:
         return self._start
@@ -181,9 +204,18 @@ class TraceObjective:
     data_name = "the records"
 
     def evaluate(self, thetas: list) -> list:
-        rigs = [self.rig_of(t) for t in thetas]
+        G = len(self.setups)
+        rigs = [self.rig_of(t, g) for t in thetas for g in range(G)]
         ok = solve_rigs(rigs, self.pilot)
-        return [model_traces(r) if good else {"h": np.array([math.nan])} for r, good in zip(rigs, ok)]
+        out = []
+        for k in range(len(thetas)):
+            model = {}
+            for g in range(G):
+                rig, good = rigs[k * G + g], ok[k * G + g]
+                traces = model_traces(rig) if good else {"h": np.array([math.nan])}
+                model.update({self._key(name, g): v for name, v in traces.items()})
+            out.append(model)
+        return out
 
     @staticmethod
     def pack(model) -> dict:
@@ -212,15 +244,17 @@ class TraceObjective:
     def traces(self, model, eta) -> list:
         """The model's value at each channel's samples (V), or None where it has none."""
         t0, gains, delays = self._split(eta)
-        h = float(model["h"][0])
-        t0 = t0 + self.trigger_time(model) / US
+        G = len(self.setups)
+        hs = [float(model[self._key("h", g)][0]) for g in range(G)]
+        starts = [self.trigger_time(model, g) / US for g in range(G)]
         out: list[np.ndarray | None] = []
         for k, c in enumerate(self.channels):
-            m = model.get(c.name)
+            g = self.setup_of[c.record]
+            m, h = model.get(self._key(c.name, g)), hs[g]
             if m is None or not math.isfinite(h):
                 out.append(None)
                 continue
-            tm = c.t + (t0[self.records.index(c.record)] + delays[k]) * US
+            tm = c.t + (t0[self.records.index(c.record)] + starts[g] + delays[k]) * US
             out.append(gains[k] * np.interp(tm, np.arange(m.size) * h, m, left=0.0, right=np.nan))
         return out
 
