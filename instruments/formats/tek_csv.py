@@ -10,8 +10,8 @@
 
 A spectrum (MATH FFT: Horizontal Units Hz), a digital record (Waveform Type DIGITAL, a
 Digital Type row, D0 or CH1_D0 columns), an IQ record (Waveform Type IQ, IQ_centerFrequency
-rows) and a FastFrame set are refused by name from the header (checks.analog_only), never
-read as a time record of volts.
+rows) are refused by name from the header (checks.analog_only), never read as a time
+record of volts.
 The export is the 4/5/6 Series layout, one file per channel, with the fractional Zero Index
 (the trigger's place in samples) those scopes write, so that Tektronix's own reader
 (tm_data_types) puts every sample where this reader does.
@@ -124,8 +124,7 @@ def _read_dpo(path, rows, start) -> list:
     names = [c.strip() for c in rows[start][1:] if c.strip()]
     analog_only(path, waveform_type=_first(header, "Waveform Type"), digital_type=_first(header, "Digital Type"),
                 source=next((n for n in names if _DIGITAL_COLUMN.match(n)), ""),
-                iq_keys=any(k.upper().startswith("IQ_") for k in header),
-                frames=next((_first(header, k) for k in header if "FRAME" in k.upper() and "COUNT" in k.upper()), ""))
+                iq_keys=any(k.upper().startswith("IQ_") for k in header))
     time_axis(path, "Horizontal Units", (header.get("Horizontal Units") or ["s"])[0])
     if not names:
         raise InstrumentError(f"{path}: the TIME row names no channel")
