@@ -24,6 +24,7 @@ from instruments.analysis.report import SPEED_FIGURES, Report
 from instruments.archive import Archive, Entry
 from instruments.errors import InstrumentError
 from instruments.formats import read_record
+from instruments.formats.checks import vertical_unit
 from instruments.records import ScopeRecord
 from rig.errors import RigError, invalid, lookup
 from rig.model.materials import MATERIALS, Material, material
@@ -180,7 +181,7 @@ def _setup_from_flags(options: AnalyzeOptions, record: ScopeRecord) -> Setup:
         if n not in record.waveforms:
             raise invalid("--channels", options.channels, f"{n!r} is not in the files (channels: {held})")
         unit = record.waveforms[n].preamble.y_unit
-        if unit != "V":
+        if vertical_unit(unit) != "V":  # an archive imported before the readers named volts V holds "Volts"
             source = record.waveforms[n].preamble.extra.get("source", "the record")
             raise RigError(f"{source}: channel {n} is in {unit} (its vertical unit), not V: the analysis reads the "
                            f"gauges' voltages (a current probe's or a math channel's record is no gauge's)")

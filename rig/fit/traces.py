@@ -71,29 +71,32 @@ def volts_step(v: np.ndarray) -> float:
     return float(gaps.min()) if gaps.size else 0.0
 
 
-def channels_of(rig: Rig, records: list) -> list:
-    """The records' channels that the scene's instruments read (RigError when none is)."""
+def read_channels(rig: Rig) -> dict:
+    """{channel: (its instrument's settings, whether a gauge reads it)} of the scene."""
     settings = {g.channel: (g.settings, True) for g in rig.gauges}
     if rig.wall_sensor is not None:
         settings[rig.wall_sensor.channel] = (rig.wall_sensor.settings, False)
-    truth = rig.truth()
-    speed = truth.wave_speed_m_per_s or math.nan
+    return settings
+
+
+def record_channels(rig: Rig, i: int, rec) -> list:
+    """Record ``rec``'s (the i-th) channels that the scene's instruments read, as fitted
+    (none for a record without them: an untriggered shot holds no channel)."""
+    settings = read_channels(rig)
+    speed = rig.truth().wave_speed_m_per_s or math.nan
     out = []
-    for i, rec in enumerate(records):
-        for name, w in rec.waveforms.items():
-            if name not in settings:
-                continue
-            s, gauge = settings[name]
-            t, v = w.time(), w.volts().astype(float)
-            step = max(1, -(-t.size // MAX_SAMPLES))
-            pre = v[t < 0]
-            base = float(np.median(pre)) if pre.size >= 10 else 0.0
-            lsb = abs(w.preamble.y_multiplier) if w.codes is not None else volts_step(v)
-            sd = max(math.hypot(noise_sd(t, v), lsb / math.sqrt(12)), 1e-9)  # 8-bit rounding beside the noise
-            delay_sd = s.misalignment_sd / speed if gauge and math.isfinite(speed) else 0.0
-            out.append(Channel(i, name, t[::step], v[::step] - base, sd, s.calibration_error, delay_sd))
-    if not out:
-        raise RigError(f"the records have none of the scene's channels ({', '.join(settings)})")
+    for name, w in rec.waveforms.items():
+        if name not in settings:
+            continue
+        s, gauge = settings[name]
+        t, v = w.time(), w.volts().astype(float)
+        step = max(1, -(-t.size // MAX_SAMPLES))
+        pre = v[t < 0]
+        base = float(np.median(pre)) if pre.size >= 10 else 0.0
+        lsb = abs(w.preamble.y_multiplier) if w.codes is not None else volts_step(v)
+        sd = max(math.hypot(noise_sd(t, v), lsb / math.sqrt(12)), 1e-9)  # 8-bit rounding beside the noise
+        delay_sd = s.misalignment_sd / speed if gauge and math.isfinite(speed) else 0.0
+        out.append(Channel(i, name, t[::step], v[::step] - base, sd, s.calibration_error, delay_sd))
     return out
 
 
@@ -147,8 +150,9 @@ class TraceObjective:
                 said = f" with {', '.join(self.setups[g])}" if self.setups[g] else ""
                 raise RigError(f"the scene's own shot{said} blew up at the fit's start values ({start}); check the "
                                "scene before fitting it")
-        self.channels = [replace(c, record=i) for i, rec in enumerate(records)
-                         for c in channels_of(rigs[self.setup_of[i]], [rec])]
+        self.channels = [c for i, rec in enumerate(records) for c in record_channels(rigs[self.setup_of[i]], i, rec)]
+        if not self.channels:
+            raise RigError(f"the records have none of the scene's channels ({', '.join(read_channels(rigs[0]))})")
         check_distinct_channels(self.channels)
         self.records = sorted({c.record for c in self.channels})
         self.gauges = [k for k, c in enumerate(self.channels) if c.delay_sd > 0]

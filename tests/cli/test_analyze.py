@@ -441,3 +441,20 @@ def test_a_record_in_amperes_is_not_analysed_as_gauge_volts(gauge_files, tmp_pat
     assert f"{amps}: channel CH1 is in A (its vertical unit), not V" in err
     code, (r,), _ = run(capsys, "analyze", str(volts), gauge_files[1], *GAUGE)
     assert code == 0 and r["speed_m_per_s"] == pytest.approx(200.0, rel=5e-3)
+
+
+def test_an_archive_imported_with_volts_spelled_out_still_analyses(gauge_files, tmp_path, capsys):
+    """Archives imported before the readers named volts V hold YUNIT as the scope wrote it
+    ("Volts", as TDS scopes do): analysed as volts, not refused as another unit."""
+    from dataclasses import replace
+
+    from instruments.archive import Entry
+    from instruments.records import ScopeRecord
+
+    record = read_record(gauge_files)
+    old = ScopeRecord({ch: replace(w, preamble=replace(w.preamble, y_unit="Volts"))
+                       for ch, w in record.waveforms.items()}, True)
+    archive = Archive(tmp_path / "old.h5")
+    archive.append([Entry(old, False, scene="", settings={"source_files": ["shot_CH1.isf", "shot_CH2.isf"]})])
+    code, (r,), _ = run(capsys, "analyze", str(archive.path), *GAUGE)
+    assert code == 0 and r["speed_m_per_s"] == pytest.approx(200.0, rel=5e-3)

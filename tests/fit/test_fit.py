@@ -358,3 +358,16 @@ def test_a_chain_file_that_cannot_be_read_is_dropped_and_sampled_again(tmp_path,
     captured = capsys.readouterr()
     assert captured.err.startswith(f"{chain}: unreadable (") and "dropped, the chain starts again" in captured.err
     assert json.loads(captured.out)["posterior"] == first  # the same seed: the same chain, sampled again
+
+
+def test_an_untriggered_shot_among_the_records_is_left_out_not_a_refusal():
+    """An archive's untriggered shot holds no channel: the records that have the scene's
+    channels are fitted (each record's channels had been required of every record)."""
+    from instruments.records import ScopeRecord
+
+    shot = Rig.from_scene(SCENE).fire(seed=3)
+    params = parse_parameters(["chain.youngs_modulus=0.5 GPa:3 GPa"])
+    obj = TraceObjective(SCENE, params, [ScopeRecord({}, False, "no trigger"), shot.scope])
+    assert {c.record for c in obj.channels} == {1} and [c.name for c in obj.channels] == list(shot.scope.waveforms)
+    with pytest.raises(RigError, match="the records have none of the scene's channels"):
+        TraceObjective(SCENE, params, [ScopeRecord({}, False, "no trigger")])
