@@ -46,12 +46,19 @@ def part_tables(f) -> dict:
 
 
 def linked_parts(f) -> dict:
-    """{part file name: its path as the master's links name it, relative to the master's
-    folder ("shots.h5.d/shots_000001.h5")} of every part a master of layout 3 or 4 links to."""
-    targets = [_target(f, name) for name in f if name.startswith("shot_")]
-    if "shared" in f:
-        targets += [_target(f["shared"], key) for key in f["shared"]]
-    return {t.name: t for t in targets if t is not None}
+    """{part file name: (its path as the master's links name it, relative to the master's
+    folder ("shots.h5.d/shots_000001.h5"), the ids of the master's shots that link into it)}
+    of every part a master of layout 3 or 4 links to."""
+    out: dict = {}
+    for name in f:
+        target = _target(f, name) if name.startswith("shot_") else None
+        if target is not None:
+            out.setdefault(target.name, (target, []))[1].append(int(name.split("_", 1)[1]))
+    for key in f.get("shared", ()):
+        target = _target(f["shared"], key)
+        if target is not None:
+            out.setdefault(target.name, (target, []))
+    return {name: (target, sorted(ids)) for name, (target, ids) in out.items()}
 
 
 def linked_folder(f) -> str | None:

@@ -210,11 +210,11 @@ def check(f: h5py.File) -> dict:
 
 
 def _swapped_parts(f, bad: set) -> list:
-    """[(part file name, its shots' ids)] of the parts whose groups' tables, read from the
-    part itself, do not give the digest the master records for it (part_digests). Judged
-    only where the master records the part's digest (one written before them: not judged),
-    the part opens, and none of its shots is among those ``bad`` already (a damaged part has
-    its rows)."""
+    """[(part file name, the master's shots linked into it)] of the parts whose groups'
+    tables, read from the part itself, do not give the digest the master records for it
+    (part_digests). Judged only where the master records the part's digest (one written
+    before them: not judged), the part opens, and none of the master's shots in it is among
+    those ``bad`` already (a damaged part has its rows)."""
     import h5py
 
     recorded = recorded_digests(f)
@@ -226,16 +226,15 @@ def _swapped_parts(f, bad: set) -> list:
     except Exception:  # noqa: BLE001 - an unreadable root: its own rows say so
         return []
     base = Path(f.filename).parent
-    for name, relative in sorted(parts.items()):
-        if name not in recorded:
+    for name, (relative, ids) in sorted(parts.items()):  # ids: the master's shots linked into the part
+        if name not in recorded or bad.intersection(ids):
             continue
         try:
             with h5py.File(base / relative, "r") as part:
                 tables = part_tables(part)
         except Exception:  # noqa: BLE001 - a missing or unreadable part: its shots' rows say so
             continue
-        ids = sorted(i for i in map(_shot_id, tables) if i is not None)
-        if not bad.intersection(ids) and part_digest(tables) != recorded[name]:
+        if part_digest(tables) != recorded[name]:
             out.append((name, ids))
     return out
 

@@ -42,3 +42,17 @@ def test_a_master_copied_without_its_folder_is_refused_an_append(tmp_path):
         Archive(copy).append([tiny_entry(4)])
     assert not (tmp_path / "copy.h5.d").exists()
     assert Archive(original.path).append([tiny_entry(4)]) == [3]  # the archive that folder belongs to grows
+
+
+def test_a_swapped_part_names_only_the_shots_this_archive_keeps_in_it(tmp_path):
+    """The other archive's part holds shots 5 and 6 under the name of our part of shot 2:
+    the row names our shot 2, the one our master links into it; shot 3, in our own intact
+    part, stays ok."""
+    ours = _two_parts(tmp_path / "ours.h5", (1, 2, 3))
+    theirs = Archive(tmp_path / "theirs.h5")
+    theirs.append([tiny_entry(1)])
+    theirs.append([tiny_entry(5), tiny_entry(6)])  # shots 2 and 3 of theirs, in its shots_000002.h5
+    shutil.copyfile(tmp_path / "theirs.h5.d" / "shots_000002.h5", tmp_path / "ours.h5.d" / "shots_000002.h5")
+    report = Archive(ours.path).verify()
+    assert [(b["where"], b["shots"]) for b in report["bad"]] == [("shots_000002.h5", [2])], report["bad"]
+    assert (report["shots"], report["ok"]) == (3, 2)
