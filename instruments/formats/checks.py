@@ -104,6 +104,10 @@ def printed_quantum(cell) -> float:
     of it): ``24999.16015625`` -> 1e-8, ``-8.000e-01`` -> 1e-4, ``2000`` -> 1; 0 where the
     cell is no number."""
     parsed = _NUMBER.match(str(cell))
+    try:
+        float(str(cell))
+    except ValueError:
+        parsed = None  # no printed number ('', '.', 'e5')
     if parsed is None:
         return 0.0
     _, fraction, exponent = parsed.groups()

@@ -155,8 +155,9 @@ _GATE = re.compile(r"^\s*([\d.]+)\s*%\s*to\s*([\d.]+)\s*%\s*$")
 def _record_length(path, length: str, gating: str, rows: int) -> None:
     """InstrumentError in one line unless the data rows are as many as the header's Record
     Length, times the gated fraction where the header gates part of the record ("25.0% to
-    75.0%": half of it, to a row either way): a file cut short, at a line boundary or not,
-    or a header that lies, is refused rather than read as a shorter record."""
+    75.0%": half of it, to a row and the rounding of the printed percentages): a file cut
+    short, at a line boundary or not, or a header that lies, is refused rather than read as
+    a shorter record."""
     if not length:
         return
     n = _whole_number(length)
@@ -165,8 +166,11 @@ def _record_length(path, length: str, gating: str, rows: int) -> None:
     gate = _GATE.match(gating or "")
     lo, hi = (float(gate.group(1)), float(gate.group(2))) if gate else (0.0, 100.0)
     expected = n * (hi - lo) / 100
-    if abs(rows - expected) > (1 if gate and (lo, hi) != (0.0, 100.0) else 0):
-        said = f" gated {gating.strip()}, about {expected:.0f}" if gate and (lo, hi) != (0.0, 100.0) else ""
+    gated = gate is not None and (lo, hi) != (0.0, 100.0)
+    # a gated part: the percentages round the gate's ends by half a unit in their last digit each
+    slack = 1 + n * (printed_quantum(gate.group(1)) + printed_quantum(gate.group(2))) / 200 if gated else 0
+    if abs(rows - expected) > slack:
+        said = f" gated {gating.strip()}, about {expected:.0f}" if gated else ""
         raise InstrumentError(f"{path}: Record Length says {n} points{said} but the file holds {rows} data rows "
                               f"(a file cut short, or a header that is not this record's)")
 
@@ -228,7 +232,10 @@ def _time_base(path, t, interval, zero, printed) -> tuple:
         raise InstrumentError(f"{path}: Sample Interval = {interval!r} is not a number")
     if not (np.isfinite(dt) and dt > 0):
         raise InstrumentError(f"{path}: Sample Interval = {interval!r}: must be a finite number > 0 s")
-    with_zero = zero not in (None, "") and _is_float(zero) and interval not in (None, "")
+    # the Zero Index sets the time base where it is printed to a sample or finer (4/5/6 Series:
+    # 24999.16015625); one printed coarser (2.5e+04) leaves it to the TIME column's first time
+    with_zero = zero not in (None, "") and _is_float(zero) and interval not in (None, "") and \
+        printed_quantum(zero) <= 1
     if with_zero and not np.isfinite(float(zero)):
         raise InstrumentError(f"{path}: Zero Index = {zero!r}: must be a finite number of samples")
     x0 = -float(zero) * dt if with_zero else float(t[0])

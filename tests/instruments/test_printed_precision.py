@@ -91,3 +91,37 @@ def test_the_unit_in_the_last_printed_digit(cell, quantum):
 ])
 def test_a_columns_rounding_comes_from_its_most_digits(column, quanta):
     np.testing.assert_allclose(printed_quanta(column), quanta, rtol=1e-12, atol=0)
+
+
+def test_a_zero_index_printed_coarser_than_a_sample_leaves_the_time_base_to_the_column(tmp_path):
+    """'Zero Index,2.5e+04' is 25000 to within 500 samples as printed: the time base is then
+    the TIME column's (whose cells are exact here), not a start 500 samples loose."""
+    dt = 4e-8
+    times = [f"{(k - 24999.4) * dt:.8e}" for k in range(POINTS)]
+    path = tmp_path / "coarse_zero.csv"
+    path.write_text("\n".join(["Model,MSO54", "Waveform Type,ANALOG", "Zero Index,2.5e+04", "Sample Interval,4e-08",
+                               f"Record Length,{POINTS}", "Horizontal Units,s", "TIME,CH1"]
+                              + [f"{t},0.01" for t in times]) + "\n")
+    (w,) = read_waveforms(path)
+    assert w.preamble.x_zero == float(times[0])
+
+
+@pytest.mark.parametrize("cell", ["", ".", "  ", "e5", "+"])
+def test_a_cell_with_no_digit_prints_no_rounding(cell):
+    assert printed_quantum(cell) == 0.0
+
+
+@pytest.mark.parametrize("rows,reads", [(5000, True), (5011, True), (4989, True), (5013, False), (2983, False)])
+def test_a_gated_records_rows_are_held_to_its_printed_gate(tmp_path, rows, reads):
+    """Gating 25.0% to 75.0% of 10000 points: 5000 rows, give or take the rounding of the
+    two printed percentages (0.05% of 10000 each) and a row; a file cut short is refused."""
+    path = tmp_path / "gated.csv"
+    path.write_text("\n".join(["Model,MSO54", "Sample Interval,1e-06", "Record Length,10000",
+                               "Gating,25.0% to 75.0%", "Horizontal Units,s", "TIME,CH1"]
+                              + [f"{k * 1e-6:.8e},0.01" for k in range(rows)]) + "\n")
+    if reads:
+        (w,) = read_waveforms(path)
+        assert w.preamble.points == rows
+    else:
+        with pytest.raises(InstrumentError, match="Record Length says 10000 points gated 25.0% to 75.0%"):
+            read_waveforms(path)
