@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import InstrumentError, check
 from ..records import Preamble, ScopeRecord, Waveform
 from ._kernels import acquisition
-from ._kernels.acquisition import at_rest_before, condition, samples_before_input, scope_shot
+from ._kernels.acquisition import TRIGGER_BAND_CODES, at_rest_before, condition, samples_before_input, scope_shot
 from .frontend import highpass_coefficients, lowpass_coefficients
 
 CHANNELS = ("CH1", "CH2", "CH3", "CH4")
@@ -212,8 +212,11 @@ class Oscilloscope:
         tb, tr = self.timebase, self.trigger
         status = AcquisitionStatus(status)
         if status is AcquisitionStatus.NO_TRIGGER:
+            band = TRIGGER_BAND_CODES * self.channels[tr.source].y_multiplier
             return ScopeRecord({}, False,
-                               f"no {tr.slope} crossing of {tr.level:g} V on {tr.source} in {n_in * h:.4g} s")
+                               f"no {tr.slope} crossing of {tr.level:g} V on {tr.source} in {n_in * h:.4g} s "
+                               f"(past the trigger's noise band of {band:.3g} V: it fires where the signal goes "
+                               f"{band / 2:.3g} V beyond the level)")
         if status is AcquisitionStatus.PAST_INPUT:
             last = t_cross + x_zero + tb.sample_interval * (int(tb.record_length) - 1)
             raise InstrumentError(

@@ -233,15 +233,18 @@ _VOLTS_PER_DIV = re.compile(r"([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)\s*(m|u|\u00b
 _PREFIX = {None: 1.0, "m": 1e-3, "u": 1e-6, "\u00b5": 1e-6, "n": 1e-9}
 
 
-def _screen_of(h: dict) -> dict:
+def _screen_of(h: dict, y_multiplier: float, y_offset: float, y_zero: float) -> dict:
     """The screen the header gives, as the CSV reader keeps it (checks.screen): VSCALE,
-    VOFFSET and VPOS of a DPO/MSO header, else the V/div its WFID names ("50.00mV/div")."""
+    VOFFSET and VPOS of a DPO/MSO header, else the V/div its WFID names ("50.00mV/div")
+    with the offset and position the scaling implies: code 0 at the screen's centre, so the
+    offset is YZERO and the position YOFF codes of V/div / YMULT codes a division."""
     if "VSCALE" in h:
         return screen(h["VSCALE"], h.get("VOFFSET"), h.get("VPOS"))
     m = _VOLTS_PER_DIV.search(h.get("WFID", ""))
     if m is None:
         return {}
-    return screen(float(m.group(1)) * _PREFIX[m.group(2) and m.group(2).lower()], 0, 0)
+    volts_per_div = float(m.group(1)) * _PREFIX[m.group(2) and m.group(2).lower()]
+    return screen(volts_per_div, y_zero, y_offset * y_multiplier / volts_per_div if volts_per_div else 0)
 
 
 def _waveform(h: dict, codes, path, index) -> Waveform:
@@ -257,6 +260,7 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
     if abs(y_offset) > 1 << (8 * nbytes):
         raise InstrumentError(f"{path}: YOFF = {h['YOFF']}: a code offset beyond the converter's range "
                               f"(+-{1 << (8 * nbytes)} for {nbytes} byte(s) a point): not this record's header")
+    y_zero = _number(h, "YZERO", path)
     x0 = _number(h, "XZERO", path)
     pt_off = _number(h, "PT_OFF", path, int) if "PT_OFF" in h else 0
     first = x0 - dx * pt_off  # t = XZERO + XINCR (n - PT_OFF)
@@ -271,9 +275,9 @@ def _waveform(h: dict, codes, path, index) -> Waveform:
     name = channel_name(name)
     pre = Preamble(points=codes.size, x_increment=dx, x_zero=first, trigger_index=trigger,
                    y_multiplier=ymult, y_offset=y_offset,
-                   y_zero=_number(h, "YZERO", path), byte_count=codes.dtype.itemsize,
+                   y_zero=y_zero, byte_count=codes.dtype.itemsize,
                    x_unit=x_unit, y_unit=vertical_unit(h.get("YUNIT")), waveform_id=wfid,
                    point_format="ENV" if envelope else "Y",
                    extra={"source": str(path), "record": index + 1, "name_in_file": name_in_file,
-                          **bandwidth(h.get("FILTERF")), **_screen_of(h)})
+                          **bandwidth(h.get("FILTERF")), **_screen_of(h, ymult, y_offset, y_zero)})
     return flagged(Waveform(name, pre, codes=codes))

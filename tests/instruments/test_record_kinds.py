@@ -112,3 +112,14 @@ def test_a_wfm_spectrum_of_four_byte_values_is_named_before_its_width(realdata, 
     p.write_bytes(bytes(data))
     with pytest.raises(InstrumentError, match="a digital waveform"):
         read_waveforms(p)
+
+
+def test_an_isf_screen_from_its_wfid_takes_the_position_its_scaling_implies(tmp_path):
+    """A TDS header names V/div in its WFID only: the position is YOFF codes of the
+    25 codes a division (code 0 at the screen's centre) and the offset YZERO, as the CSV
+    export writes them, so that a volts record's rail check sees the screen the scope had."""
+    path = _isf(tmp_path, "tds.isf", 'WFID "Ch1, DC coupling, 50.00mV/div, 1.000ms/div, 100 points, Sample mode";'
+                                    'YMULT 2.0E-3;YOFF 25;YZERO 1.0E-2')
+    (w,) = read_waveforms(path)
+    e = w.preamble.extra
+    assert (e["volts_per_div"], e["vertical_offset_V"], e["position_div"]) == (0.05, 0.01, pytest.approx(1.0))

@@ -78,7 +78,9 @@ def first_crossing(x, h, level, rising, band):
     where it turns low; the time is that of the crossing of ``level`` the turn belongs to
     (the last one before it), linearly interpolated; nan where there is none. Noise
     smaller than the band on the other flank (a falling trigger's rising flank) no longer
-    fires it; on a clean edge it is the first crossing of the level, as without a band."""
+    fires it; on a clean edge that goes band/2 beyond the level it is the first crossing of
+    the level, as without a band; a pulse that peaks less than band/2 past the level no
+    longer fires it (nor does a scope's trigger)."""
     high = x[0] >= level
     last = -1  # the latest crossing of level in the trigger's direction
     for i in range(x.shape[0] - 1):
