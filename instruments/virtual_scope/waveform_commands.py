@@ -1,8 +1,8 @@
 """Waveform transfer (programmer manuals, "Waveform Transfer"
 command group): ``DATa:SOUrce[:AVAILable?]/STARt/STOP/ENCdg/WIDth``, ``DATa INIT``, ``DATa?``,
 the personality's preamble (``WFMPre?`` or ``WFMOutpre?``, whole and per field), ``CURVe?``,
-and ``WAVFrm?`` (preamble;curve). The preamble's BYT_Nr, ENCdg, BN_Fmt and BYT_Or are
-settable too, as the manuals give them: they set DATa:WIDth and DATa:ENCdg. A channel that
+and ``WAVFrm?`` (preamble;curve). The preamble's BYT_Nr, BIT_Nr, ENCdg, BN_Fmt and BYT_Or
+are settable too, as the manuals give them: they set DATa:WIDth and DATa:ENCdg. A channel that
 is off is refused with 2244 "Source
 waveform is not active" by CURVe? (the preamble: see ``preamble`` below); ``CURVe?``
 before the first record is an execution error."""
@@ -120,7 +120,15 @@ def register(tree, scope) -> None:
     def set_encoding(c: Call):
         scope.data = scope.data.encoded("ASCIi" if c.word(("ASCIi", "BINary")) == "ASCIi" else scope.data.binary)
 
-    setters = {"BYT_Nr": width, "ENCdg": set_encoding, "BN_Fmt": set_format,
+    def bits(c: Call):
+        """BIT_Nr 8 or 16: the bits a point is sent in, with BYT_Nr (the 4/5/6 Series way to
+        ask for 2 bytes a point; it had been refused, the client reading 1-byte codes as 2)."""
+        b = c.number()
+        if b not in (8, 16):
+            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed 8 or 16 bits per point")
+        data(width=int(b) // 8)
+
+    setters = {"BYT_Nr": width, "BIT_Nr": bits, "ENCdg": set_encoding, "BN_Fmt": set_format,
                "BYT_Or": lambda c: setattr(scope, "data",
                                            scope.data.formatted(msb_first=c.word(("MSB", "LSB")) == "MSB"))}
     for name in p.preamble_fields:

@@ -215,3 +215,20 @@ def test_a_measurement_of_a_clipped_source_gives_its_value_with_the_clipping_war
     value = float(ask(s, "MEASU:IMM:VAL?"))
     assert value == pytest.approx(scope.acq.last.record["CH1"].volts().max(), rel=1e-12)
     assert ask(s, "EVENT?") == "548"
+
+
+@pytest.mark.parametrize("personality", ["tds2000", "mdo3000", "mso4"])
+def test_bit_nr_sets_the_bytes_a_point_is_sent_in(make_scope, personality):
+    """WFMOutpre:BIT_Nr 16 (the 4/5/6 Series way to ask for 2 bytes a point) had been
+    refused while the client went on reading 1-byte codes as 2-byte words: half the points,
+    the volts off by about 170 times. It sets BYT_Nr with it, as the manuals couple them."""
+    scope, s, _ = make_scope(personality)
+    fire(s)
+    pre = scope.personality.preamble
+    s.handle(b"DATA:SOURCE CH1;:DATA:ENC RIB;:DATA:START 1;STOP 100")
+    s.handle(f"{pre}:BIT_NR 16".encode())
+    assert ask(s, f"{pre}:BYT_NR?;BIT_NR?") == "2;16" and ask(s, "EVENT?") == "0"
+    block = s.handle(b"CURVE?")
+    assert int(block[2:2 + int(block[1:2])]) == 200  # 100 points of 2 bytes
+    s.handle(f"{pre}:BIT_NR 12".encode())
+    assert ask(s, "EVENT?") == "-222" and ask(s, f"{pre}:BYT_NR?") == "2"
