@@ -164,11 +164,12 @@ def _record_length(path, length: str, gating: str, rows: int) -> None:
     if n is None or n < 2:
         raise InstrumentError(f"{path}: Record Length = {length!r}: must be a whole number of points >= 2")
     gate = _GATE.match(gating or "")
-    lo, hi = (float(gate.group(1)), float(gate.group(2))) if gate else (0.0, 100.0)
+    ends = (gate.group(1), gate.group(2)) if gate else ("0", "100")
+    lo, hi = float(ends[0]), float(ends[1])
     expected = n * (hi - lo) / 100
-    gated = gate is not None and (lo, hi) != (0.0, 100.0)
+    gated = (lo, hi) != (0.0, 100.0)
     # a gated part: the percentages round the gate's ends by half a unit in their last digit each
-    slack = 1 + n * (printed_quantum(gate.group(1)) + printed_quantum(gate.group(2))) / 200 if gated else 0
+    slack = 1 + n * (printed_quantum(ends[0]) + printed_quantum(ends[1])) / 200 if gated else 0
     if abs(rows - expected) > slack:
         said = f" gated {gating.strip()}, about {expected:.0f}" if gated else ""
         raise InstrumentError(f"{path}: Record Length says {n} points{said} but the file holds {rows} data rows "
