@@ -125,9 +125,34 @@ def register(tree, scope) -> None:
 
     tree.add("TRIGger", write=force)
     tree.add("TRIGger:STATE", read=lambda c: Word("READy" if scope.acq.acquiring else "SAVe"))
+    def set_source(c: Call):
+        """The edge trigger's source; the level follows the channel's own where a client set
+        one (TRIGger:A:LEVel:CH<x>), as each channel keeps its level on the scopes."""
+        ch = c.word(CHANNEL_WORDS)
+        own = scope.trigger_levels.get(ch)
+        scope.change({"scope.trigger.source": ch, **({} if own is None else {"scope.trigger.level": own})})
+
+    def set_level(c: Call):
+        """TRIGger:A:LEVel (the source's) or TRIGger:A:LEVel:CH<x> (channel x's; the
+        trigger's own where x is its source), V."""
+        ch = f"CH{c.suffix}" if c.suffixes and c.suffixes[-1] is not None else scope.settings["scope.trigger.source"]
+        if ch not in CHANNEL_WORDS:
+            raise ScpiError(-113, f"{c.header}: channels CH1 to CH4")
+        level = c.number("V")
+        if ch == scope.settings["scope.trigger.source"]:
+            scope.change({"scope.trigger.level": level}, code=-222)
+        elif not abs(level) <= 1000:
+            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed -1000 V to 1000 V")
+        scope.trigger_levels[ch] = level
+
+    def level(c: Call):
+        ch = f"CH{c.suffix}" if c.suffixes and c.suffixes[-1] is not None else scope.settings["scope.trigger.source"]
+        if ch == scope.settings["scope.trigger.source"]:
+            return num("scope.trigger.level")(c)
+        return p.number(scope.trigger_levels.get(ch, 0.0))
+
     for head in ("TRIGger:A", "TRIGger:MAIn"):
-        tree.add(f"{head}:EDGE:SOUrce", write=lambda c: scope.change({"scope.trigger.source": c.word(CHANNEL_WORDS)}),
-                 read=lambda c: Word(scope.settings["scope.trigger.source"]))
+        tree.add(f"{head}:EDGE:SOUrce", write=set_source, read=lambda c: Word(scope.settings["scope.trigger.source"]))
         tree.add(f"{head}:EDGE:SLOpe", read=lambda c: Word("RISe" if scope.settings["scope.trigger.slope"] == "rising"
                                                            else "FALL"),
                  write=lambda c: scope.change({"scope.trigger.slope": {"RISe": "rising", "FALL": "falling"}[
@@ -135,8 +160,8 @@ def register(tree, scope) -> None:
         tree.add(f"{head}:EDGE:COUPling", write=refuse_but("DC"), read=lambda c: Word("DC"))
         tree.add(f"{head}:TYPe", write=refuse_but("EDGe"), read=lambda c: Word("EDGe"))
         tree.add(f"{head}:READy", read=lambda c: "1" if scope.acq.acquiring else "0")
-        tree.add(f"{head}:LEVel", write=lambda c: scope.change({"scope.trigger.level": c.number("V")}, code=-222),
-                 read=num("scope.trigger.level"))
+        tree.add(f"{head}:LEVel", write=set_level, read=level)
+        tree.add(f"{head}:LEVel:CH<n>", write=set_level, read=level)
 
     # --- acquisition -----------------------------------------------------------------
     def set_state(c: Call):
@@ -182,6 +207,10 @@ def register(tree, scope) -> None:
     tree.add("SELect", read=lambda c: Fields(tuple((ch, "1" if ch in scope.shown else "0") for ch in CHANNEL_WORDS)))
     tree.add("DISplay:GLObal:CH<n>:STATE", write=show, read=shown)
     tree.add("DISplay:WAVEView<n>:CH<n>:STATE", write=show, read=shown)  # 4/5/6 Series MSO form
+    # DISplay:WAVEform (MSO/DPO4000, MDO3000 manuals): the waveforms drawn on the screen or not; the
+    # acquisition goes on either way (programs turn it off to transfer faster)
+    tree.add("DISplay:WAVEform", write=lambda c: setattr(scope, "display_waveform", c.boolean()),
+             read=lambda c: "1" if scope.display_waveform else "0")
     tree.add("CONFIGuration:ANALOg:NUMCHANnels", read=lambda c: str(len(CHANNEL_WORDS)))
     tree.add("AUTOSet", write=lambda c: c.word(("EXECute", "UNDo")) and None)
 

@@ -101,6 +101,8 @@ class VirtualScope:
         self.horizontal_mode = "MANual"
         self.measurements = default_slots(next(iter(self.scene.channels)))
         self.numavg = self.scene.averages if self.scene.mode == "average" else 16
+        self.trigger_levels: dict = {}  # TRIGger:A:LEVel:CH<x>: each channel's own level (V), set by a client
+        self.display_waveform = True  # DISplay:WAVEform: the screen only, the records are the same
         self.acq.stop_after, self.acq.pending = "RUNSTop", 0
         self.acq.run(False)
 

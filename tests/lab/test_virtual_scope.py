@@ -232,3 +232,27 @@ def test_bit_nr_sets_the_bytes_a_point_is_sent_in(make_scope, personality):
     assert int(block[2:2 + int(block[1:2])]) == 200  # 100 points of 2 bytes
     s.handle(f"{pre}:BIT_NR 12".encode())
     assert ask(s, "EVENT?") == "-222" and ask(s, f"{pre}:BYT_NR?") == "2"
+
+
+def test_each_channel_keeps_its_own_trigger_level(make_scope):
+    """TRIGger:A:LEVel:CH<x> (MSO/DPO4000, MDO3000, 4/5/6 Series manuals): each channel's
+    own level, the trigger's where the channel is its source; switching the source takes
+    that channel's level. It had been an undefined header (two public drivers use it)."""
+    scope, s, _ = make_scope("mso4")
+    s.handle(b"TRIG:A:EDGE:SOU CH1;:TRIG:A:LEV 0.03;:TRIG:A:LEV:CH2 0.1")
+    assert ask(s, "EVENT?") == "0"
+    assert ask(s, "TRIG:A:LEV?;LEV:CH1?;:TRIG:A:LEV:CH2?") == "30.0000E-3;30.0000E-3;100.0000E-3"
+    s.handle(b"TRIG:A:EDGE:SOURCE CH2")
+    assert ask(s, "TRIG:A:LEV?") == "100.0000E-3" and scope.overrides()["scope.trigger.level"] == "0.1 V"
+    s.handle(b"TRIG:A:LEV:CH2 -0.02")
+    assert scope.overrides()["scope.trigger.level"] == "-0.02 V"
+
+
+def test_display_waveform_off_leaves_the_records_as_they_are(make_scope):
+    scope, s, _ = make_scope("mdo3000")
+    s.handle(b"DISPLAY:WAVEFORM OFF")
+    assert ask(s, "DIS:WAVE?") == "0" and ask(s, "EVENT?") == "0"
+    fire(s)
+    assert scope.acq.last.record.triggered
+    s.handle(b"*RST")
+    assert ask(s, "DISPLAY:WAVEFORM?") == "1"
