@@ -133,8 +133,10 @@ def _read_dpo(path, rows, start) -> list:
     printed = [r[0] for _, r in kept]
     if len(data) < 2:
         raise InstrumentError(f"{path}: fewer than two data rows")
-    if any(len(r) != 1 + len(names) for r in data):
-        raise InstrumentError(f"{path}: a data row has fewer columns than the TIME row")
+    short = next((i for (i, _), r in zip(kept, data) if len(r) != 1 + len(names)), None)
+    if short is not None:
+        raise InstrumentError(f"{path}: row {short + 1} has fewer columns than the TIME row names "
+                              f"({1 + len(names)}): a file cut short?")
     _record_length(path, _first(header, "Record Length"), _first(header, "Gating"), len(data))
     table = np.array(data)
     zero = header.get("Zero Index", [None])[0]
@@ -204,7 +206,7 @@ TIME_TOLERANCE = 0.1  # samples: the scope's own disagreement allowed beyond wha
 
 def _time_base(path, t, interval, zero, printed) -> tuple:
     """(first sample's time s, sample interval s) of a record whose TIME column is ``t``:
-    the header's Sample Interval (the column's median step where it gives none) from the
+    the header's Sample Interval (the column's mean step where it gives none) from the
     column's first time, or from -Zero Index x Sample Interval where the header has a
     Zero Index (4/5/6 Series: the column prints nine digits, the fractional Zero Index
     more).
@@ -217,7 +219,9 @@ def _time_base(path, t, interval, zero, printed) -> tuple:
     with q(x) the unit in the last digit the file prints x to (checks.printed_quanta, from
     the digits of the whole column: ``6.109e-05`` -> 1e-8 s, ``-8.000e-01`` -> 1e-4 s; a
     zero is exact) and the last term the rounding of the time base's start (the column's
-    first time, or the printed Zero Index z, checks.printed_quantum). The
+    first time, or the printed Zero Index z, checks.printed_quantum); without a Sample
+    Interval the step is the column's span over its samples, and the rounding of its two
+    ends, (q(t_0) + q(t_last)) i / (2 (n - 1)), joins the bound. The
     Sample Interval is the scope's time-base setting, which every layout prints in full
     (shortest form, ``0.0008``, ``4e-08``; a TDS's ``1.00E-09``): taken as exact, so a
     header interval off by one unit in its last digit is refused over a long record. A
@@ -225,8 +229,14 @@ def _time_base(path, t, interval, zero, printed) -> tuple:
     sample at 4 us/div, a 4/5/6 Series nine. Beyond that bound the header and the column
     describe two time bases: InstrumentError in one line.
     ``printed``: the TIME column's cells as the file prints them."""
+    q_t = printed_quanta(printed)
+    back = np.flatnonzero(np.diff(t) < -(q_t[:-1] + q_t[1:]) / 2)  # equal stamps: a rounding coarser than a sample
+    if back.size or not t[-1] > t[0]:
+        k = int(back[0]) if back.size else t.size - 2
+        raise InstrumentError(f"{path}: the TIME column does not increase (data row {k + 2}: {printed[k + 1].strip()} "
+                              f"after {printed[k].strip()}, beyond the rounding of its printed digits)")
     if interval in (None, ""):
-        dt = float(np.median(np.diff(t)))
+        dt = float((t[-1] - t[0]) / (t.size - 1))  # the span: its ends' rounding spread over the record
     elif _is_float(interval):
         dt = float(interval)
     else:
@@ -242,11 +252,14 @@ def _time_base(path, t, interval, zero, printed) -> tuple:
     x0 = -float(zero) * dt if with_zero else float(t[0])
     index = np.arange(t.size)
     grid = x0 + dt * index
-    q_t = printed_quanta(printed)
     start = printed_quantum(zero) * dt / 2 if with_zero else q_t[0] / 2
     bound = TIME_TOLERANCE * dt + q_t / 2 + start
+    if interval in (None, ""):  # the step from the column's ends: their rounding tilts the grid
+        bound = bound + index / (t.size - 1) * (q_t[0] + q_t[-1]) / 2
     if np.any(np.abs(grid - t) > bound):
-        said = f"Zero Index = {zero} and Sample Interval = {interval}" if with_zero else f"Sample Interval = {interval}"
+        said = (f"Zero Index = {zero} and Sample Interval = {interval}" if with_zero else
+                f"Sample Interval = {interval}" if interval not in (None, "") else
+                f"the TIME column's mean step ({dt:.9g} s, no Sample Interval in the header)")
         raise InstrumentError(f"{path}: {said} put the first sample at {grid[0]:.9g} s and the last at "
                               f"{grid[-1]:.9g} s, the TIME column at {t[0]:.9g} s and {t[-1]:.9g} s: they must "
                               f"agree within {TIME_TOLERANCE:g} of a sample beyond the rounding of the digits "
@@ -312,8 +325,6 @@ def _waveform(path, name, t, printed, v, trigger, unit, interval=None, point_for
     (``screen``, _screen) kept in extra and the over-range flag set where samples sit at
     its edge (instruments.rails). The channel is called after its source (or the file),
     made a name the archive stores; the name as the file gives it is kept in extra."""
-    if not np.all(np.diff(t) > 0):
-        raise InstrumentError(f"{path}: the time column does not increase")
     if trigger not in (None, "") and not _is_float(trigger):
         raise InstrumentError(f"{path}: trigger position = {trigger!r} is not a number")
     x0, dt = _time_base(path, t, interval, trigger if zero_index else None, printed)

@@ -125,3 +125,21 @@ def test_a_gated_records_rows_are_held_to_its_printed_gate(tmp_path, rows, reads
     else:
         with pytest.raises(InstrumentError, match="Record Length says 10000 points gated 25.0% to 75.0%"):
             read_waveforms(path)
+
+
+@pytest.mark.parametrize("with_interval", [True, False])
+def test_stamps_that_the_printing_repeats_read_on_the_records_time_base(tmp_path, with_interval):
+    """Past 1e-4 s, four digits step by 1e-7 s, three samples of 3.2e-8 s: the column
+    repeats stamps (1.000e-04 after 1.000e-04). Such a file had been refused as a column
+    that "does not increase"; without a Sample Interval its step is the column's span over
+    its samples (the first rounded step, 3.0e-8 s, had been taken and the file refused)."""
+    dt = 3.2e-8
+    times = [f"{6.1e-5 + k * dt:.3e}" for k in range(POINTS)]
+    assert len(set(times)) < POINTS  # stamps repeat
+    rows = ["Model,TBS1102C", "Horizontal Units,S", *(["Sample Interval,3.2e-08"] if with_interval else []),
+            f"Record Length,{POINTS}", "Vertical Units,V", "TIME,CH1"]
+    path = tmp_path / "repeats.csv"
+    path.write_text("\n".join(rows + [f"{t},0.01" for t in times]) + "\n")
+    (w,) = read_waveforms(path)
+    assert w.preamble.x_increment == pytest.approx(dt, rel=1e-3 if not with_interval else 1e-15)
+    assert w.preamble.x_zero == pytest.approx(6.1e-5, abs=1e-12)
