@@ -104,7 +104,7 @@ def link(g, name: str, target) -> str:
 
 def _write_channels(g, record: ScopeRecord, rows: dict, axes: dict):
     """data/: each channel's raw codes (CF-packed volts) and one time axis per time base."""
-    chans = sorted(record.waveforms)
+    chans = list(record.waveforms)  # the record's order: the NXdata signal is its first channel
     names = [ch.replace("#", "_") for ch in chans]  # "CH1#2", the second record of CH1 in a file: CH1_2
     for ch, name in zip(chans, names):
         if not NAME.match(name):

@@ -119,7 +119,7 @@ def summary_row(e: Entry) -> dict:
     scene, seed, triggered, channels, source files, the striker's settings."""
     return {"shot": e.shot_id, "title": e.title, "start_time": e.start_time, "start_time_source": e.start_time_source,
             "simulated": e.simulated, "scene": e.scene, "seed": e.seed, "triggered": e.record.triggered,
-            "channels": sorted(e.record.waveforms), "sources": e.settings.get("source_files", []),
+            "channels": list(e.record.waveforms), "sources": e.settings.get("source_files", []),
             "settings": e.settings.get("striker", {})}
 
 

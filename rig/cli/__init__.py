@@ -68,7 +68,11 @@ def _run(argv) -> int:
     for name in PATH_FLAGS:  # '' had meant the current folder (rig mc) or nothing at all (rig shot, exit 0)
         value = getattr(args, name, None)
         if isinstance(value, str) and not value.strip():
-            return _fail(command, f"--{name.replace('_', '-')} = {value!r}: an empty path; give a file or folder name")
+            return _fail(command, f"--{name.replace('_', '-')} = {value!r}: an empty path; give the path it names "
+                                  f"(rig {command} --help)")
+    for value in getattr(args, "files", None) or ():  # '' had been read as the current folder, '.'
+        if isinstance(value, str) and not value.strip():
+            return _fail(command, f"FILE = {value!r}: an empty path; give a scope file or an archive")
     try:
         out = args.func(args)
     except BrokenPipeError:

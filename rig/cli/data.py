@@ -149,7 +149,12 @@ def cmd_analyze(args) -> list:
                   f"the virtual shots use their own set-up")
         wall_read = args.wall or (args.channels is not None and len(args.channels.split(",")) == 3)
         units = {r["force_unit"] for r in results} - {None}
-        unit = units.pop() if len(units) == 1 else "N|V"  # mixed: each row's unit as the note says
+        unit = units.pop() if len(units) == 1 else "N|V"  # mixed: each row's figures carry their unit
+
+        def force(r, figure):
+            """A force figure as the table prints it: with its row's unit where the rows mix N and V."""
+            value = _force(r, figure)
+            return fmt(value, ".3f") + (f" {r['force_unit']}" if unit == "N|V" and value is not None else "")
         print(f"{'source':40s} {'V_s m/s':>8s} {'xcorr':>8s} {'F_d ' + unit:>8s} {'F_m,e ' + unit:>8s} "
               f"{'pulses':>6s} {'FWHM us':>8s} {'Eq1 m/s':>8s}")
         for r in results:
@@ -157,8 +162,8 @@ def cmd_analyze(args) -> list:
             src = ", ".join(Path(part).name for part in r["source"].split(", "))  # the files' names (JSON: paths)
             src = src if len(src) <= 40 else src[:37] + "..."
             print(f"{src:40s} {fmt(r['speed_m_per_s'], '.1f'):>8s} "
-                  f"{fmt(r['speed_xcorr_m_per_s'], '.1f'):>8s} {fmt(_force(r, 'amplitude'), '.3f'):>8s} "
-                  f"{fmt(_force(r, 'averaged_amplitude'), '.3f'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
+                  f"{fmt(r['speed_xcorr_m_per_s'], '.1f'):>8s} {force(r, 'amplitude'):>8s} "
+                  f"{force(r, 'averaged_amplitude'):>8s} {fmt(r['pulses'], '.0f'):>6s} "
                   f"{fmt(fwhm, '.1f'):>8s} {fmt(r['theory_speed_m_per_s'], '.1f'):>8s}")
             if r["snr"]:
                 noise = r["noise"]

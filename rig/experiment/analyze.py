@@ -212,9 +212,9 @@ volts give: each under a key that names its unit (a key's unit is in its name)."
 
 
 def _in_volts(out: dict) -> dict:
-    """``out`` with its force figures, and their reasons, under the _V keys of IN_VOLTS
-    (no F_0 is added to them: --f0 needs --sensitivity)."""
-    out = {IN_VOLTS.get(k, k): v for k, v in out.items()}
+    """``out`` with its force figures, and their reasons, under the _V keys of IN_VOLTS,
+    and no static_force_N (F_0 in N: --f0 needs --sensitivity, so there is none to add)."""
+    out = {IN_VOLTS.get(k, k): v for k, v in out.items() if k != "static_force_N"}
     out["reasons"] = {IN_VOLTS.get(k, k): v for k, v in out["reasons"].items()}
     return out
 

@@ -97,8 +97,9 @@ def _keys(node, path=""):
 def test_a_figure_in_volts_is_never_under_a_newton_key(gauge_files, realdata, capsys):
     """Without --sensitivity a real record's forces are its gauges' volts: every force
     figure goes under a _V key, the _N keys appear only where a sensitivity makes newtons,
-    and the volts are the newtons times the sensitivity. Every JSON row rig analyze writes
-    for a real record: the gauge pair, and each real file that gives a row."""
+    and the volts are the newtons times the sensitivity; no _N key at all in a row in volts
+    (static_force_N, F_0, needs --sensitivity too). Every JSON row rig analyze writes for a
+    real record: the gauge pair, and each real file that gives a row."""
     _, (v,), _ = run(capsys, "analyze", *gauge_files, "--gauge-distance", "40 mm", "--tau", "1 ms")
     _, (n,), _ = run(capsys, "analyze", *gauge_files, *GAUGE)
     assert (v["force_unit"], n["force_unit"]) == ("V", "N")
@@ -114,7 +115,7 @@ def test_a_figure_in_volts_is_never_under_a_newton_key(gauge_files, realdata, ca
     assert len(rows) > 5
     for row in rows:
         newton_keys = [where for where, key in _keys(row) if key.endswith("_N")]
-        assert newton_keys == [".static_force_N"] and row["static_force_N"] == 0, newton_keys  # no --f0: 0 N
+        assert newton_keys == [], newton_keys  # F_0 too: --f0 (N) needs --sensitivity
 
 
 def test_19_km_between_the_gauges_is_refused(gauge_files, capsys):
@@ -418,6 +419,11 @@ def test_an_archive_keeps_its_files_channel_order_and_nothing_of_this_machine(ga
     assert files["reasons"] == stored["reasons"]
     entry = Archive(archive).read(1)
     assert list(entry.record.waveforms) == ["CH2", "CH1"]
+    assert main(["ls", str(archive), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)[0]["channels"] == ["CH2", "CH1"]  # rig ls had listed them sorted
+    import h5py
+    with h5py.File(archive, "r") as f:  # the NeXus plot's signal is the record's first channel
+        assert f["shot_000001/data"].attrs["signal"] == "CH2"
     assert {w.preamble.extra["source"] for w in entry.record.waveforms.values()} == {"shot_CH1.isf", "shot_CH2.isf"}
     folder = str(Path(gauge_files[0]).parent).encode()
     stored_bytes = b"".join(p.read_bytes() for p in tmp_path.rglob("*")
@@ -458,3 +464,18 @@ def test_an_archive_imported_with_volts_spelled_out_still_analyses(gauge_files, 
     archive.append([Entry(old, False, scene="", settings={"source_files": ["shot_CH1.isf", "shot_CH2.isf"]})])
     code, (r,), _ = run(capsys, "analyze", str(archive.path), *GAUGE)
     assert code == 0 and r["speed_m_per_s"] == pytest.approx(200.0, rel=5e-3)
+
+
+def test_a_table_mixing_newtons_and_volts_says_each_rows_unit(gauge_files, tmp_path, capsys):
+    """A virtual shot (N) beside a real record without --sensitivity (V): the header says
+    N|V and each force figure carries its row's unit (it had been left to guess)."""
+    archive = str(tmp_path / "mixed.h5")
+    assert main(["shot", "ptfe52_magnetic", "--seed", "1", "--out", archive]) == 0
+    assert main(["import", *gauge_files, "--together", "--into", archive]) == 0
+    capsys.readouterr()
+    main(["analyze", archive, "--gauge-distance", "40 mm", "--tau", "1 ms"])
+    out = capsys.readouterr().out.splitlines()
+    header = next(line for line in out if line.startswith("source"))
+    rows = [line for line in out if line.startswith(("mixed.h5#1", "mixed.h5#2"))]
+    assert "F_d N|V" in header and len(rows) == 2, out
+    assert " N " in rows[0] and " V " in rows[1], rows

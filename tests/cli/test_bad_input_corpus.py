@@ -220,7 +220,9 @@ def _flag_cases():
     cases += [(["shot", S, "--out", ""], "--out = '': an empty path"),
               (["shot", S, "--export", " "], "--export = ' ': an empty path"),
               (["mc", S, "--shots", "8", "--vary", VEL, "--out", ""], "--out = '': an empty path"),
-              (["import", "a.isf", "--into", ""], "--into = '': an empty path")]
+              (["import", "a.isf", "--into", ""], "--into = '': an empty path"),
+              (["analyze", "", "--gauge-distance", "43 mm"], "FILE = '': an empty path"),
+              (["import", "", "--into", "a.h5"], "FILE = '': an empty path")]
     mass = "chain.mass=normal(0.1226 g, 0.001 g)"
     cases += [(["mc", S, "--shots", "8", "--vary", mass, "--vary", "chain.bead_mass=normal(0.1226 g, 0.001 g)",
                 "--out", out], "--vary = 'chain.bead_mass': names the quantity chain.mass names too")]
