@@ -10,11 +10,34 @@ import json
 import os
 import sys
 
-from instruments.errors import InstrumentError
 from rig import __version__
 from rig.cli import data, fitting, lab, shots, study, sweeps, tools
 from rig.cli.common import OneLineParser, command, os_error_line
 from rig.errors import Interrupted, RigError
+
+
+def _own_instruments() -> None:
+    """Exit with one line (2) where the import name ``instruments`` is another
+    distribution's (InstrumentKit installs a package of that name): the rig's own
+    instruments package cannot load beside it, and every command would fail with a
+    ModuleNotFoundError deep in an import."""
+    import importlib.util
+
+    try:
+        ours = importlib.util.find_spec("instruments.rails") is not None
+    except ImportError:  # the other package's own imports failed
+        ours = False
+    if ours:
+        return
+    from importlib.metadata import packages_distributions
+
+    spec = importlib.util.find_spec("instruments")
+    where = [] if spec is None else [str(w) for w in spec.submodule_search_locations or ()] or [str(spec.origin)]
+    others = [d for d in packages_distributions().get("instruments", []) if d.lower() != "sonic-rig"]
+    print(f"rig: error: the import name 'instruments' is {' and '.join(others) or 'another package'}'s here "
+          f"({', '.join(where) or 'not found'}): the rig's own 'instruments' package cannot load beside "
+          f"it; give the rig a virtual environment of its own", file=sys.stderr)
+    raise SystemExit(2)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -61,6 +84,9 @@ def main(argv=None) -> int:
 
 
 def _run(argv) -> int:
+    _own_instruments()  # before any command imports the rig's instruments
+    from instruments.errors import InstrumentError
+
     args, extra = build_parser().parse_known_args(argv)
     command = f"{args.command} {args.what}" if args.command == "serve" else args.command  # as argparse names it
     if extra:  # named by the command's parser, not the top one's ("rig: error:")

@@ -48,3 +48,26 @@ def test_other_commands_check_the_scene_first(argv):
 def test_python_m_rig_cli_is_the_command():
     out = subprocess.run([sys.executable, "-m", "rig.cli", "--version"], capture_output=True, text=True)
     assert out.returncode == 0 and out.stdout.startswith("rig ")
+
+
+def test_another_distributions_instruments_package_is_named_in_one_line(tmp_path):
+    """InstrumentKit installs a package called 'instruments' too: where that one is the
+    package Python finds and the rig's modules are not found under it, every command had
+    failed deep in an import. The command says so in one line, exit 2, naming where the
+    other package lies (a process whose path finds a stand-in first, without site-packages)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    other = tmp_path / "instruments"
+    other.mkdir()
+    (other / "__init__.py").write_text('"""Another distribution\'s instruments package."""\n')
+    root = Path(__file__).resolve().parents[2]
+    run = subprocess.run([sys.executable, "-S", "-c", "import sys; from rig.cli import main; "
+                                                      "sys.exit(main(['--version']))"],
+                         capture_output=True, text=True, timeout=60, cwd=tmp_path,
+                         env={"PYTHONPATH": f"{tmp_path}:{root}", "PATH": "/usr/bin:/bin"})
+    assert run.returncode == 2 and run.stdout == "", run
+    (line,) = run.stderr.strip().splitlines()
+    assert line.startswith("rig: error: the import name 'instruments' is") and str(other) in line, line
+    assert "a virtual environment of its own" in line
