@@ -61,6 +61,36 @@ def linked_parts(f) -> dict:
     return {name: (target, sorted(ids)) for name, (target, ids) in out.items()}
 
 
+def swapped_parts(f, bad: set) -> list:
+    """[(part file name, the master's shots linked into it)] of the parts whose groups'
+    tables, read from the part itself, do not give the digest the master ``f`` records for
+    it. Judged only where the master records the part's digest (one written before them:
+    not judged), the part opens, and none of the master's shots in it is among those
+    ``bad`` already (a damaged part has its rows)."""
+    import h5py
+
+    recorded = recorded_digests(f)
+    if not recorded:
+        return []
+    try:
+        parts = linked_parts(f)
+    except Exception:  # noqa: BLE001 - an unreadable root: its own rows say so
+        return []
+    out = []
+    base = Path(f.filename).parent
+    for name, (relative, ids) in sorted(parts.items()):
+        if name not in recorded or bad.intersection(ids):
+            continue
+        try:
+            with h5py.File(base / relative, "r") as part:
+                tables = part_tables(part)
+        except Exception:  # noqa: BLE001 - a missing or unreadable part: its shots' rows say so
+            continue
+        if part_digest(tables) != recorded[name]:
+            out.append((name, ids))
+    return out
+
+
 def linked_folder(f) -> str | None:
     """The folder the master's links point into (``shots.h5.d``), from its first link; None
     where it links to nothing."""

@@ -17,14 +17,13 @@ from __future__ import annotations
 
 import json
 import re
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .addresses import address
 from .digest import damage, sha
 from .links import OpenParts
 from .members import expanded
-from .part_digests import linked_parts, part_digest, part_tables, recorded_digests
+from .part_digests import swapped_parts
 from .stored import TABLE, linked_groups, table_text
 
 if TYPE_CHECKING:
@@ -198,7 +197,7 @@ def check(f: h5py.File) -> dict:
             bad.append({"shot": None, "shots": ids, "where": _where(p, f"/shared/{key}"),
                         "reason": f"{p} (shared by shot{'' if len(ids) == 1 else 's'} "
                                   f"{', '.join(map(str, ids)) or '-'})"})
-    for part, ids in _swapped_parts(f, shot_bad | {i for b in bad for i in b["shots"]}):
+    for part, ids in swapped_parts(f, shot_bad):
         shot_bad.update(ids)
         bad.append({"shot": None, "shots": ids, "where": part,
                     "reason": f"part {part} is not the one this archive wrote: its groups' tables differ from the "
@@ -207,36 +206,6 @@ def check(f: h5py.File) -> dict:
                               f"{', '.join(map(str, ids)) or '-'})"})
     listed = len(names) + sum(1 for p in missing if _shot_id(p) is not None)
     return {"shots": listed, "ok": listed - len(shot_bad), "bad": bad}
-
-
-def _swapped_parts(f, bad: set) -> list:
-    """[(part file name, the master's shots linked into it)] of the parts whose groups'
-    tables, read from the part itself, do not give the digest the master records for it
-    (part_digests). Judged only where the master records the part's digest (one written
-    before them: not judged), the part opens, and none of the master's shots in it is among
-    those ``bad`` already (a damaged part has its rows)."""
-    import h5py
-
-    recorded = recorded_digests(f)
-    if not recorded:
-        return []
-    out = []
-    try:
-        parts = linked_parts(f)
-    except Exception:  # noqa: BLE001 - an unreadable root: its own rows say so
-        return []
-    base = Path(f.filename).parent
-    for name, (relative, ids) in sorted(parts.items()):  # ids: the master's shots linked into the part
-        if name not in recorded or bad.intersection(ids):
-            continue
-        try:
-            with h5py.File(base / relative, "r") as part:
-                tables = part_tables(part)
-        except Exception:  # noqa: BLE001 - a missing or unreadable part: its shots' rows say so
-            continue
-        if part_digest(tables) != recorded[name]:
-            out.append((name, ids))
-    return out
 
 
 def named(problems: list, prefix: str) -> list:
