@@ -99,15 +99,21 @@ def channel_name(text: str) -> str:
     return f"CH_{name}" if name[0].isdigit() or name[0] == "#" else name
 
 
+def is_number(text) -> bool:
+    """Whether ``text`` reads as one float (nan and inf included: the callers say why each
+    is refused)."""
+    try:
+        float(text)
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
 def printed_quantum(cell) -> float:
     """The unit in the last digit a file prints of one number (its rounding is at most half
     of it): ``24999.16015625`` -> 1e-8, ``-8.000e-01`` -> 1e-4, ``2000`` -> 1; 0 where the
     cell is no number."""
-    parsed = _NUMBER.match(str(cell))
-    try:
-        float(str(cell))
-    except ValueError:
-        parsed = None  # no printed number ('', '.', 'e5')
+    parsed = _NUMBER.match(str(cell)) if is_number(str(cell)) else None  # no printed number: '', '.', 'e5'
     if parsed is None:
         return 0.0
     _, fraction, exponent = parsed.groups()

@@ -12,7 +12,7 @@ import pytest
 from instruments.errors import InstrumentError
 from instruments.formats import read_waveforms
 from instruments.formats.checks import printed_quanta, printed_quantum
-from instruments.formats.tek_csv import TIME_TOLERANCE
+from instruments.formats.csv_columns import TIME_TOLERANCE
 
 POINTS = 2000
 DECADES = range(-11, 0)  # sample intervals 3.2e-11 s ... 3.2e-1 s
@@ -59,7 +59,7 @@ def test_a_time_past_what_the_printed_digits_allow_is_refused_and_one_within_is_
     j = POINTS - 1  # the last time: the furthest from the first, moved later (the column still increases)
     q, q0 = printed_quantum(printed[j]), printed_quantum(printed[0])
     on_grid = x0 + dt * j
-    bound = TIME_TOLERANCE * dt + q / 2 + q0 / 2  # the reader's bound there (tek_csv._time_base)
+    bound = TIME_TOLERANCE * dt + q / 2 + q0 / 2  # the reader's bound there (csv_columns.time_base)
     # one unit of the last digit at a time: the furthest within the bound, then the nearest past it
     within = on_grid + q * math.floor((bound - q / 2) / q)
     past = on_grid + q * (math.floor(bound / q) + 2)
