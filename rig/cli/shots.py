@@ -140,12 +140,9 @@ def print_blocks(t, m, th):
 
 def cmd_animate(args) -> dict:
     """Render a virtual shot to a movie or a still, off-screen (pyvista)."""
-    import os
-    from dataclasses import replace
-
-    from rig.errors import RigError
     from rig.experiment.scene import load
-    from rig.viz.animate import check_options, check_output, movie_cost, require_renderer
+    from rig.viz.animate import check_output, require_renderer
+    from rig.viz.movie_cost import check_options, movie_estimate
 
     check_output(args.out)  # before anything is computed
     check_options(args.frames, args.exaggerate)
@@ -156,14 +153,7 @@ def cmd_animate(args) -> dict:
 
     rig = Rig(scene)
     rig.check_record()  # the movie's traces are the shot's scope record
-    solve = rig.estimate()
-    held, seconds = movie_cost(args.frames, args.out)
-    memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    if held > memory:
-        raise RigError(f"--frames {args.frames}: a .gif holds every frame until it is written, about "
-                       f"{held / 1e9:.3g} GB, beyond this machine's {memory / 1e9:.3g} GB; write a .mp4 (its "
-                       f"frames are streamed) or fewer frames")
-    check_size(replace(solve, bytes=solve.bytes + held, seconds=solve.seconds + seconds), args, "this movie")
+    check_size(movie_estimate(rig.estimate(), args.frames, args.out), args, "this movie")
     still = args.out.lower().endswith(".png")
     with progress_bar(args.quiet or still, total=None if still else args.frames, desc="animate",
                       unit="frame") as bar:

@@ -50,6 +50,11 @@ def frame_origin(chain) -> np.ndarray:
     return np.concatenate(([-top], x_eq))
 
 
+def physical_memory() -> int:
+    """This machine's memory (bytes): the most a run may hold."""
+    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+
+
 def check_record(problem: ChainProblem, save: SaveAt, n_out: int, n_frames: int) -> None:
     """Refuse, naming the field, a probe of a contact this chain does not have (its slot
     would be read outside the kernels' arrays) and a record larger than this machine's
@@ -60,7 +65,7 @@ def check_record(problem: ChainProblem, save: SaveAt, n_out: int, n_frames: int)
             if w != 0.0 and not lo <= k <= hi:
                 raise invalid(f"save[{name!r}]", f"contact {k}", f"contacts {lo}..{hi} of this chain")
     need = 8.0 * (len(save.names) * n_out + n_frames * problem.n_bodies)
-    have = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    have = physical_memory()
     if need > have:
         raise RigError(f"the record would take {need / 1e9:.3g} GB ({n_out} samples per channel, {n_frames} "
                        f"frames), more than this machine's {have / 1e9:.3g} GB: give save a longer "

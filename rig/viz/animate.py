@@ -23,6 +23,7 @@ import numpy as np
 
 from instruments.files import atomic_write
 from rig.errors import RigError, invalid
+from rig.viz.movie_cost import check_options
 
 FORMATS = (".mp4", ".gif", ".png")
 WIDTH, VIEW_HEIGHT, PANEL_HEIGHT = 1280, 420, 300
@@ -211,28 +212,6 @@ def default_exaggeration(frames: Frames, rig) -> float:
     """A factor that moves the most displaced bead by a third of a diameter (at least 1)."""
     top = float(np.max(np.abs(frames.displacement[:, int(rig.chain.striker is not None):])))
     return max(1.0, (rig.chain.beads[0].diameter / 3.0) / top) if top > 0 else 1.0
-
-
-GIF_BYTES_PER_FRAME = 4.5e6  # a .gif's writer holds every frame until it closes (measured: 40 -> 120 frames, +360 MB)
-SECONDS_PER_FRAME = 0.16  # rendering and encoding a frame, one core (measured: 0.10 .mp4, 0.16 .gif)
-
-
-def check_options(frames, exaggerate) -> None:
-    """RigError in one line for --frames outside 2..10000 or an --exaggerate that is no
-    factor > 0 (before anything is estimated or solved)."""
-    if not isinstance(frames, int) or not 2 <= frames <= 10000:
-        raise invalid("--frames", frames, "a whole number of frames from 2 to 10000")
-    if exaggerate is not None and not (np.isfinite(exaggerate) and exaggerate > 0):
-        raise invalid("--exaggerate", exaggerate, "a factor > 0")
-
-
-def movie_cost(frames: int, out) -> tuple:
-    """(bytes held, seconds) of rendering ``frames`` frames to ``out`` beyond the shot's
-    solve: a .gif holds every frame until it is written, a .mp4 streams them to its encoder,
-    a .png renders one."""
-    kind = Path(out).suffix.lower()
-    count = 1 if kind == ".png" else frames
-    return (GIF_BYTES_PER_FRAME * count if kind == ".gif" else 0.0), SECONDS_PER_FRAME * count
 
 
 def animate(rig, out, frames: int = 100, exaggerate: float | None = None, seed: int | None = None,
