@@ -23,6 +23,7 @@ from ._kernels.acquisition import TRIGGER_BAND_CODES, at_rest_before, condition,
 from .frontend import highpass_coefficients, lowpass_coefficients
 
 CHANNELS = ("CH1", "CH2", "CH3", "CH4")
+LEVEL_LIMIT_V = 1000.0  # the largest trigger level either way (V)
 CODES_PER_DIV = 25.0
 CODE_MIN, CODE_MAX = -128, 127
 AC_CORNER_HZ = 10.0  # AC coupling's high-pass corner
@@ -100,7 +101,7 @@ class Trigger:
 
     def __post_init__(self):
         check("scope.trigger.source", self.source, choices=CHANNELS)
-        check("scope.trigger.level", self.level, lo=-1000, hi=1000, unit="V")
+        check("scope.trigger.level", self.level, lo=-LEVEL_LIMIT_V, hi=LEVEL_LIMIT_V, unit="V")
         check("scope.trigger.slope", self.slope, choices=("rising", "falling"))
         check("scope.trigger.pre_trigger", self.pre_trigger, lo=0, hi=1, lo_closed=True, hi_closed=False)
 

@@ -33,8 +33,8 @@ _DIGITAL_SOURCE = re.compile(r"^\s*(D\d+|CH\d+_D\d+|DALL|DIGITAL)\b", re.IGNOREC
 ANALOG = "the rig reads analog voltage records in time"
 
 
-def analog_only(path, *, waveform_type: str = "", domain: str = "", x_unit: str = "", source: str = "",
-                number_format: str = "", frames: str = "", iq_keys: bool = False, digital_type: str = "") -> None:
+def analog_only(path, *, waveform_type: str = "", domain: str = "", source: str = "", number_format: str = "",
+                frames: str = "", iq_keys: bool = False, digital_type: str = "") -> None:
     """InstrumentError in one line unless the header fields a reader found describe one
     analog voltage record in time; every reader of every format family (CSV, ISF, WFM)
     hands over what its header says, under these names, before it reads a sample, so that
@@ -44,8 +44,8 @@ def analog_only(path, *, waveform_type: str = "", domain: str = "", x_unit: str 
       RF_TD, RF_FD, DIGITAL); ``digital_type``: CSV "Digital Type"; ``source``: the source
       or column named (D0, CH1_D3, DAll are digital); ``iq_keys``: the IQ_centerFrequency,
       IQ_span ... rows or tekmeta keys of an IQ record;
-    - ``domain``: ISF DOMAIN (TIME, FREQUENCY); ``x_unit``: the horizontal unit (Hz: a
-      spectrum; anything but seconds: not a time record);
+    - ``domain``: ISF DOMAIN (TIME, FREQUENCY) (the horizontal unit is time_axis's:
+      each reader names its own field);
     - ``number_format``: ISF BN_FMT (FP: floating-point values, which a math or RF record
       holds; the rig reads integer codes); ``frames``: the count of a FastFrame set."""
     kind = waveform_type.strip().strip('"').upper()
@@ -56,10 +56,8 @@ def analog_only(path, *, waveform_type: str = "", domain: str = "", x_unit: str 
     if iq_keys or kind in ("IQ", "RF_BB_IQ"):
         said = "IQ_ keys in the header" if iq_keys else f"Waveform Type = {waveform_type.strip()}"
         raise InstrumentError(f"{path}: an IQ waveform (interleaved I and Q samples, {said}); {ANALOG}")
-    unit = (x_unit or "").strip().strip('"').lower()
-    if domain.strip().upper().startswith("FREQ") or kind in ("RF_FD", "SPECTRUM", "FFT") or unit in ("hz", "hertz"):
-        said = ", ".join(f"{k} = {v.strip()}" for k, v in (("DOMAIN", domain), ("type", waveform_type),
-                                                           ("horizontal unit", x_unit)) if v and v.strip())
+    if domain.strip().upper().startswith("FREQ") or kind in ("RF_FD", "SPECTRUM", "FFT"):
+        said = ", ".join(f"{k} = {v.strip()}" for k, v in (("DOMAIN", domain), ("type", waveform_type)) if v.strip())
         raise InstrumentError(f"{path}: a frequency-domain record (a spectrum: FFT/MATH or RF; {said}); {ANALOG}")
     if kind.startswith("RF"):
         raise InstrumentError(f"{path}: an RF trace (type = {waveform_type.strip()}: amplitude, phase or frequency "

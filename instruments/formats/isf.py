@@ -248,12 +248,12 @@ def _screen_of(h: dict, y_multiplier: float, y_offset: float, y_zero: float) -> 
 
 
 def _waveform(h: dict, codes, path, index) -> Waveform:
-    dx = _number(h, "XINCR", path)
-    if not (np.isfinite(dx) and dx > 0):
+    dx = _number(h, "XINCR", path)  # finite: _number refuses nan and inf
+    if not dx > 0:
         raise InstrumentError(f"{path}: XINCR = {dx!r}: the sample interval must be a finite number > 0 s")
     x_unit = time_axis(path, "XUNIT", h.get("XUNIT", "s"))
     ymult = _number(h, "YMULT", path)
-    if not (np.isfinite(ymult) and ymult != 0):
+    if ymult == 0:
         raise InstrumentError(f"{path}: YMULT = {ymult!r}: the volts per code must be a finite number other than 0")
     nbytes = codes.dtype.itemsize
     codes, y_offset = _signed(codes, _number(h, "YOFF", path))

@@ -21,6 +21,7 @@ from pathlib import Path
 from ..errors import InstrumentError
 
 READABLE = "the rig reads Tektronix ISF, CSV and WFM files"
+_UNITS_ROW = re.compile(rb"^\s*Second,\s*Volt", re.M)  # Rigol's DS1000B/D/E and Siglent's SDS CSV units row
 HEAD_BYTES = 4096
 
 # (name of the format, test on the first bytes); the first match wins
@@ -49,7 +50,7 @@ _FOREIGN = (
     # a "Second,Volt" units row under a title row that names no maker: Rigol's DS1000B/D/E and
     # Siglent's SDS exports both write one
     ("a CSV export with a 'Second,Volt' units row (a Rigol DS1000B/D/E or Siglent SDS layout)",
-     lambda h: re.search(rb"^\s*Second,\s*Volt", h, re.M) is not None),
+     lambda h: _UNITS_ROW.search(h) is not None),
     # LeCroy WaveStudio / X-Stream: "LECROYWS...", "Segments,1,SegmentSize,...", then "Time,Ampl"
     ("a LeCroy CSV export", lambda h: h.lstrip().upper().startswith(b"LECROY") or re.search(
         rb"^\s*Segments,.*\r?\n(.*\r?\n){0,4}\s*Time,\s*Ampl", h, re.M) is not None),
@@ -159,7 +160,7 @@ def _tek_csv(head: bytes) -> bool:
         text = head.decode("ascii")
     except UnicodeDecodeError:
         return False
-    if _siglent_csv(head) or re.search(rb"^\s*Second,\s*Volt", head, re.M):
+    if _siglent_csv(head) or _UNITS_ROW.search(head):
         return False  # Siglent's header rows have Tektronix's names; a units row is no Tektronix layout
     first = [line.split(",")[0].strip() for line in text.splitlines()[:40]]
     known = {"Model", "Firmware Version", "Record Length", "Sample Interval", "Point Format", "Waveform Type",

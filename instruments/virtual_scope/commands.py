@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 
+from ..devices.oscilloscope import LEVEL_LIMIT_V
 from ..scpi.engine import Call, Fields, Word
 from ..scpi.status import ScpiError
 from .personalities import snap_record_length, snap_to_steps
@@ -132,21 +133,25 @@ def register(tree, scope) -> None:
         own = scope.trigger_levels.get(ch)
         scope.change({"scope.trigger.source": ch, **({} if own is None else {"scope.trigger.level": own})})
 
-    def set_level(c: Call):
-        """TRIGger:A:LEVel (the source's) or TRIGger:A:LEVel:CH<x> (channel x's; the
-        trigger's own where x is its source), V."""
+    def level_channel(c: Call) -> str:
+        """The channel a TRIGger:A:LEVel header is about: CH<x>'s, or the trigger's source."""
         ch = f"CH{c.suffix}" if c.suffixes and c.suffixes[-1] is not None else scope.settings["scope.trigger.source"]
         if ch not in CHANNEL_WORDS:
             raise ScpiError(-113, f"{c.header}: channels CH1 to CH4")
-        level = c.number("V")
+        return ch
+
+    def set_level(c: Call):
+        """TRIGger:A:LEVel (the source's) or TRIGger:A:LEVel:CH<x> (channel x's; the
+        trigger's own where x is its source), V."""
+        ch, level = level_channel(c), c.number("V")
         if ch == scope.settings["scope.trigger.source"]:
             scope.change({"scope.trigger.level": level}, code=-222)
-        elif not abs(level) <= 1000:
-            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed -1000 V to 1000 V")
+        elif not abs(level) <= LEVEL_LIMIT_V:
+            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed -{LEVEL_LIMIT_V:g} V to {LEVEL_LIMIT_V:g} V")
         scope.trigger_levels[ch] = level
 
     def level(c: Call):
-        ch = f"CH{c.suffix}" if c.suffixes and c.suffixes[-1] is not None else scope.settings["scope.trigger.source"]
+        ch = level_channel(c)
         if ch == scope.settings["scope.trigger.source"]:
             return num("scope.trigger.level")(c)
         return p.number(scope.trigger_levels.get(ch, 0.0))

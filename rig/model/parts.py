@@ -60,12 +60,17 @@ differ from it by a few percent (the published PTFE 0.1226 g against 0.1242 g, a
 in grams given as kilograms (or milligrams as grams) by a factor 1000."""
 
 
+def sphere_mass(of: Material | str, diameter: float) -> float:
+    """The mass (kg) of a solid sphere of the material ``of`` and ``diameter`` (m): rho pi d^3 / 6."""
+    return material(of).rho * math.pi * diameter**3 / 6.0
+
+
 def solid_sphere_check(field: str, mass: float, of: Material | str, diameter: float) -> None:
     """RigError in one line unless ``mass`` (kg) lies within MASS_FACTOR of a solid sphere of
     the material ``of`` and ``diameter`` (m), naming the field, the mass, the sphere's mass
     and the density it comes from."""
     m = material(of)
-    sphere = m.rho * math.pi * diameter**3 / 6.0
+    sphere = sphere_mass(m, diameter)
     if not sphere / MASS_FACTOR <= mass <= sphere * MASS_FACTOR:
         raise invalid(field, mass, f"a {m.name} sphere of {diameter * 1e3:.4g} mm weighs "
                                   f"{sphere * 1e3:.4g} g (density {m.rho:g} kg/m^3); a bead's mass must lie "
@@ -88,7 +93,7 @@ class Bead(_Part):
         self._convert("bead")
         self._positive("bead", "diameter")
         if self.mass is None:
-            object.__setattr__(self, "mass", material(self.material).rho * math.pi * self.diameter**3 / 6.0)
+            object.__setattr__(self, "mass", sphere_mass(self.material, self.diameter))
         self._positive("bead", "mass")
         assert self.mass is not None, "just checked > 0"
         solid_sphere_check("bead.mass", self.mass, self.material, self.diameter)
@@ -146,8 +151,7 @@ class GaugeBead(Bead):
         self._convert("gauge_bead")
         self._positive("gauge_bead", "diameter", "plate_mass")
         if self.caps_mass is None:
-            plain = self.mass if self.mass is not None else (
-                material(self.material).rho * math.pi * self.diameter**3 / 6.0)
+            plain = self.mass if self.mass is not None else sphere_mass(self.material, self.diameter)
             object.__setattr__(self, "caps_mass", self.caps_of(plain))
         self._positive("gauge_bead", "caps_mass")
         caps, plate = self.caps_mass, self.plate_mass

@@ -86,13 +86,10 @@ def first_crossing(x, h, level, rising, band):
     for i in range(x.shape[0] - 1):
         if (x[i] < level and x[i + 1] >= level) if rising else (x[i] > level and x[i + 1] <= level):
             last = i
-        if not high and x[i + 1] >= level + 0.5 * band:
-            high = True
-            if rising and last >= 0:
-                return (last + (level - x[last]) / (x[last + 1] - x[last])) * h
-        elif high and x[i + 1] <= level - 0.5 * band:
-            high = False
-            if not rising and last >= 0:
+        turned = x[i + 1] <= level - 0.5 * band if high else x[i + 1] >= level + 0.5 * band
+        if turned:
+            high = not high
+            if high == rising and last >= 0:
                 return (last + (level - x[last]) / (x[last + 1] - x[last])) * h
     return math.nan
 
