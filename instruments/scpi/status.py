@@ -4,8 +4,10 @@ Standard event status register (IEEE 488.2 11.5.1): OPC (bit 0), RQC, QYE, DDE, 
 URQ, PON (bit 7); the status byte (11.2): MAV (bit 4, a reply waits), ESB (bit 5, ESR & ESE),
 MSS (bit 6, STB & SRE). Events carry the codes and messages of the Tektronix programmer
 manuals (e.g. TDS200/TDS1000/TDS2000 Programmer Manual 071-1075, "Status and Events"):
-negative SCPI codes, and Tek's own four-digit execution codes (2244 "Source waveform is not
-active"). When the queue is full its last entry becomes -350 "Queue overflow"."""
+the SCPI events (kept with SCPI's negative codes, which ``SYSTem:ERRor?`` answers; Tek's
+event queries give them unsigned, see ``Event.tek_code``), and Tek's own four-digit
+execution codes (2244 "Source waveform is not active"). When the queue is full its last
+entry becomes -350 "Queue overflow"."""
 from __future__ import annotations
 
 from collections import deque
@@ -61,10 +63,18 @@ class Event:
     code: int
     detail: str = ""
 
-    def text(self) -> str:
-        """The Tek form: ``<code>,"<message>; <detail>"`` (quotes in the detail doubled)."""
+    @property
+    def tek_code(self) -> int:
+        """The code as ``EVENT?``, ``EVMsg?`` and ``ALLEv?`` give it: Tek's event tables
+        number the SCPI events without their sign (113 "Undefined header", 222 "Data out of
+        range", 350 "Queue overflow"); ``SYSTem:ERRor?`` gives SCPI's negative code."""
+        return abs(self.code)
+
+    def text(self, scpi: bool = False) -> str:
+        """``<code>,"<message>; <detail>"`` (quotes in the detail doubled): the code as Tek's
+        event queries give it (``tek_code``), or with ``scpi`` as SYSTem:ERRor? does."""
         said = MESSAGES.get(self.code, "Error") + (f"; {self.detail}" if self.detail else "")
-        return f'{self.code},"{said.replace(chr(34), chr(34) * 2)}"'
+        return f'{self.code if scpi else self.tek_code},"{said.replace(chr(34), chr(34) * 2)}"'
 
 
 class StatusModel:

@@ -87,10 +87,17 @@ def register(tree, scope) -> None:
 
     def set_length(c: Call):
         n = snap_record_length(_positive(c, c.number()), p.record_lengths)
-        if n is None or n > scope.max_record_length:
-            raise ScpiError(-200, f"{c.header} {c.arg().text}: the {p.name} takes "
-                                  f"{', '.join(str(x) for x in p.record_lengths if x <= scope.max_record_length)}")
+        if n is None:
+            raise ScpiError(-222, f"{c.header} {c.arg().text}: the {p.name} takes "
+                                  f"{', '.join(str(x) for x in p.record_lengths)}")
+        if n > scope.max_record_length:
+            raise ScpiError(-221, f"{c.header} {c.arg().text}: this virtual scope keeps records of at most "
+                                  f"{scope.max_record_length} points (max_record_length)")
         scope.change({"scope.record_length": n, "scope.sample_interval": s_div() * 10 / n}, code=-222)
+
+    def sample_rate() -> float:
+        """S/s, to 12 digits (1 / 5e-10 s is 2 GS/s, not 1.9999999999999998E+9)."""
+        return float(f"{1.0 / scope.settings['scope.sample_interval']:.12g}")
 
     def record_span() -> float:
         return scope.settings["scope.sample_interval"] * scope.settings["scope.record_length"]
@@ -114,7 +121,7 @@ def register(tree, scope) -> None:
         tree.add(f"{head}:POSition", write=set_position, read=read_position)
     for head in ("HORizontal", "HORizontal:MODE"):
         tree.add(f"{head}:RECOrdlength", write=set_length, read=lambda c: str(scope.settings["scope.record_length"]))
-        tree.add(f"{head}:SAMPLERate", read=lambda c: p.number(1.0 / scope.settings["scope.sample_interval"]))
+        tree.add(f"{head}:SAMPLERate", read=lambda c: p.number(sample_rate()))
     tree.add("HORizontal:MODE", write=set_mode, read=lambda c: Word(scope.horizontal_mode))
     tree.add("HORizontal:MAIn:UNIts", read=lambda c: '"s"')
     tree.add("HORizontal:ROLL", write=refuse_but("OFF"), read=lambda c: Word("OFF"))

@@ -2,7 +2,9 @@
 (TDS2000 and MDO3000 programmer manuals, "Status and Events", "Miscellaneous"):
 ``*IDN? *RST *CLS *OPC[?] *WAI *ESR? *ESE *SRE *STB? *TRG *TST?``, ``ALLEv? EVENT? EVMsg?
 EVQty? SYSTem:ERRor? BUSY? HEADer VERBose``. Every queue read takes the event off the queue;
-``ALLEv?`` takes them all (``0,"No events to report - queue empty"`` when none)."""
+``ALLEv?`` takes them all (``0,"No events to report - queue empty"`` when none). The event
+queries give Tek's unsigned codes (113 "Undefined header"), ``SYSTem:ERRor?`` SCPI's
+(-113)."""
 from __future__ import annotations
 
 from ..scpi.engine import Call
@@ -43,7 +45,7 @@ def register(tree, scope) -> None:
     tree.add("*TRG", write=lambda c: acq.force())
     tree.add("*TST", read=lambda c: "0", bare=True)
     tree.add("ALLEv", read=lambda c: ",".join(_drain(status)))
-    tree.add("EVENT", read=lambda c: str(status.next_event().code))
+    tree.add("EVENT", read=lambda c: str(status.next_event().tek_code))
     tree.add("EVQty", read=lambda c: str(len(status.events)))
     tree.add("EVMsg", read=lambda c: status.next_event().text())
     tree.add("SYSTem:ERRor", read=lambda c: _scpi_error(status.next_event()))
@@ -59,4 +61,4 @@ def _drain(status) -> list:
 
 def _scpi_error(event) -> str:
     """SYSTem:ERRor?'s form: ``0,"No error"`` when the queue is empty."""
-    return '0,"No error"' if event.code == 0 else event.text()
+    return '0,"No error"' if event.code == 0 else event.text(scpi=True)

@@ -31,6 +31,11 @@ from .transfer import DataSelection
 
 Validate = Callable[[str, str], "str | None"]
 """(scene key, value text) -> None when the rig takes it, else its one-line refusal."""
+RecordCost = Callable[[dict], "str | None"]
+"""(overrides of a shot) -> None when its record is within the shot source's limits, else
+the one-line refusal naming its cost."""
+HORIZONTAL = ("scope.sample_interval", "scope.record_length", "scope.trigger.pre_trigger")
+"""The settings that decide how long and how fine a record is."""
 
 
 class VirtualScope:
@@ -38,26 +43,29 @@ class VirtualScope:
     personality: tds2000 | mdo3000 | mso4 (``idn`` overrides its *IDN?); seed: the first
     shot's; validate: checks RIG: values; on_shot(Shot): called after each shot; bounds:
     max_message_bytes (program message), max_reply_bytes (one message's replies),
-    max_record_length (points); opc_timeout_s: the longest *OPC? wait; fire_period_s /
+    max_record_length (points; None: the model's longest record); opc_timeout_s: the longest *OPC? wait; fire_period_s /
     on_command: how an armed scope gets shots (acquisition.py): every so many seconds, or
     only from TRIGger FORCe, *TRG and RIG:FIRE; neither: at once. rig_scene: the scene's
     values of the RIG: settings as text ({"striker.velocity": "0.89 m/s", ...}), what their
-    queries answer until a client sets them."""
+    queries answer until a client sets them. record_cost: asked when a horizontal setting
+    changes (HORIZONTAL); a record past the shot source's limits is refused there (-221)."""
 
     def __init__(self, scope: Oscilloscope, shot_source: ShotSource, *, personality_name: str = "tds2000",
                  idn: str | None = None, seed: int = 0, validate: Validate | None = None, on_shot=None,
                  scene_name: str = "", max_message_bytes: int = 1 << 20, max_reply_bytes: int = 64 << 20,
-                 max_record_length: int = 1_000_000, opc_timeout_s: float = 600.0,
+                 max_record_length: int | None = None, opc_timeout_s: float = 600.0,
                  fire_period_s: float | None = None, on_command: bool = False,
-                 rig_scene: dict | None = None) -> None:
+                 rig_scene: dict | None = None, record_cost: RecordCost | None = None) -> None:
         if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 63:
             raise InstrumentError(f"seed = {seed!r}: a whole number from 0 to 2^63 - 1")
         self.scene, self.scene_name = scope, scene_name
         self.personality = personality(personality_name, idn)
         self.validate = validate or (lambda key, text: None)
+        self.record_cost = record_cost or (lambda overrides: None)
         self.rig_scene = dict(rig_scene or {})
         self.max_message_bytes, self.max_reply_bytes = max_message_bytes, max_reply_bytes
-        self.max_record_length, self.opc_timeout_s = max_record_length, opc_timeout_s
+        self.max_record_length = max_record_length or self.personality.record_lengths[-1]
+        self.opc_timeout_s = opc_timeout_s
         self.lock = InstrumentLock()
         self.cond = threading.Condition()
         self.status = StatusModel()
@@ -120,6 +128,11 @@ class VirtualScope:
             scope_of(settings, acquired(self.scene, shown), self.scene)
         except InstrumentError as e:
             raise ScpiError(code, str(e)) from None
+        if any(settings[k] != self.settings[k] for k in HORIZONTAL):
+            channels = acquired(self.scene, shown)
+            refusal = self.record_cost({**overrides(self.scene, settings, channels), **self.rig_values})
+            if refusal is not None:
+                raise ScpiError(-221, refusal)
         self.settings, self.shown = settings, set(shown)
 
     def overrides_locked(self) -> dict:

@@ -3,12 +3,15 @@ command group): ``DATa:SOUrce[:AVAILable?]/STARt/STOP/ENCdg/WIDth``, ``DATa INIT
 the personality's preamble (``WFMPre?`` or ``WFMOutpre?``, whole and per field), ``CURVe?``,
 and ``WAVFrm?`` (preamble;curve). The preamble's BYT_Nr, BIT_Nr, ENCdg, BN_Fmt and BYT_Or
 are settable too, as the manuals give them: they set DATa:WIDth and DATa:ENCdg. A channel that
-is off is refused with 2244 "Source
-waveform is not active" by CURVe? (the preamble: see ``preamble`` below); ``CURVe?``
-before the first record is an execution error."""
+is off is 2244 "Source waveform is not active" for CURVe? (the preamble: see ``preamble``
+below); ``CURVe?`` before the first record or after a failed shot is an execution error
+(-200). Either way CURVe? answers at once with an empty block (``#10``), the event in the
+queue, so that a client reads the error instead of waiting out its timeout."""
 from __future__ import annotations
 
 from dataclasses import replace
+
+import numpy as np
 
 from ..records import Preamble
 from ..scpi.engine import Call, Fields, Word
@@ -78,13 +81,19 @@ def register(tree, scope) -> None:
         return read
 
     def curve(c: Call) -> bytes:
-        codes, _, _ = source_waveform(scope, scope.data.source, c.header)
-        if codes is None and scope.acq.failure:
-            raise ScpiError(-200, f"{scope.data.source} has no record: the last shot failed ({scope.acq.failure}); "
-                                  f"{c.header}")
+        """The record's codes; where there is none (no shot yet, the last one failed, the
+        source is off) an empty answer at once (``#10``, or an empty line in ASCIi) with the reason in the
+        queue, so that a client reads the error instead of waiting out its timeout."""
+        try:
+            codes, _, _ = source_waveform(scope, scope.data.source, c.header)
+        except ScpiError as off:  # 2244: the source is off
+            scope.status.post(off.code, off.detail)
+            return curve_bytes(np.zeros(0, np.int8), scope.data)
         if codes is None:
-            raise ScpiError(-200, f"{scope.data.source} has no record yet; fire a shot (ACQuire:STATE ON, "
-                                  f"TRIGger FORCe or RIG:FIRE); {c.header}")
+            why = (f"the last shot failed ({scope.acq.failure})" if scope.acq.failure else
+                   "no record yet; fire a shot (ACQuire:STATE ON, TRIGger FORCe or RIG:FIRE)")
+            scope.status.post(-200, f"{scope.data.source} has no record: {why}; {c.header}")
+            return curve_bytes(np.zeros(0, np.int8), scope.data)
         return curve_bytes(codes, scope.data)
 
     def wavfrm(c: Call) -> bytes:

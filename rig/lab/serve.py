@@ -97,6 +97,7 @@ class ScopeServer:
         try:
             self.scope = VirtualScope(self.shots.rig().scope, self.shots, personality_name=s.personality,
                                       idn=s.idn, seed=self.seed, validate=self.shots.validate,
+                                      record_cost=self.shots.record_cost,
                                       scene_name=str(s.scene), fire_period_s=period,
                                       on_command=s.fire == "on-command", rig_scene=rig_scene(self.shots))
         except InstrumentError as e:  # it names the setting (the personality, its record, --idn)

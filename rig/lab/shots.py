@@ -10,7 +10,16 @@ command does (``rig.experiment.scene.load`` of the "key=value" items).
 
 The rigs built are kept per distinct set of overrides (a small LRU), so repeated shots cost
 one fire each; a rig whose settings differ from a kept one only in ``scope.*`` keys takes
-that rig's solved chain (the scope does not change what the chain does). A refusal of the
+that rig's solved chain (the scope does not change what the chain does).
+
+Every record the scope's settings describe is given (``record_solver``): where a record
+lasts longer after its trigger than the scene's solve, the chain is solved for longer (past
+its pulses it rings down and settles under the magnet and gravity, the striker bouncing off
+and falling back as the model has it), and where the scope samples finer than the solver
+records, the solver records at the scope's interval (its dense output: the cubic Hermite
+interpolant of each step, never a held value). Those solver settings are items of the shot
+like any other (``solver.duration=... s``, ``solver.sample_interval=... s``), so the record
+is still that of ``rig shot`` with the same items. A refusal of the
 rig (``RigError``) is raised as ``instruments.errors.InstrumentError`` with the same one
 line, the form the instrument side puts in its error queue.
 """
@@ -25,11 +34,45 @@ from instruments.records import ScopeRecord
 from rig.errors import RigError, invalid
 from rig.experiment.scene import load
 from rig.experiment.shot import Rig, ShotRecord
+from rig.solver.estimate import LIMIT_BYTES, LIMIT_SECONDS
 
 RIG_KEYS = ("striker.velocity", "magnet.force", "magnet.position")
 """The settings of the rig itself (not of the scope) that a lab client may change."""
 
 SCOPE_PREFIX = "scope."  # settings of the scope only: the chain's solve does not depend on them
+
+
+def after_trigger(rig: Rig) -> float:
+    """Seconds the rig's scope records after its trigger: (1 - pre_trigger) x the record's span."""
+    tb = rig.scope.timebase
+    return (1.0 - rig.scope.trigger.pre_trigger) * tb.record_length * tb.sample_interval
+
+
+RECORD_BYTES_PER_POINT = 32
+"""Bytes a scope record holds at once per point and channel while it is acquired: the noise
+draw and the sampled input (float64 each), the codes, the reply's 2-byte words, with room."""
+
+
+def record_bytes(rig: Rig) -> float:
+    """Bytes the scope side of a shot holds at once (RECORD_BYTES_PER_POINT per point and
+    recorded channel)."""
+    return float(RECORD_BYTES_PER_POINT * rig.scope.timebase.record_length * len(rig.scope.channels))
+
+
+def record_solver(rig: Rig, trigger_by: float) -> tuple:
+    """The solver items ("key=value") the rig's scope record needs beyond its solver settings:
+    a solve lasting ``trigger_by`` (s, when the scene's own record triggers at the latest:
+    its solver.duration less what its scope records after the trigger) plus what this scope
+    records after its trigger, and recorded at the scope's sample interval where that is
+    finer. () when the rig's solver already gives the record."""
+    s, dt = rig.solver, rig.scope.timebase.sample_interval
+    items = []
+    needed = trigger_by + after_trigger(rig)
+    if needed > s.duration * (1 + 1e-12):
+        items.append(f"solver.duration={needed!r} s")
+    if s.sample_interval > dt * (1 + 1e-9):
+        items.append(f"solver.sample_interval={float(dt)!r} s")
+    return tuple(items)
 
 
 def key_of(item: str) -> str:
@@ -60,6 +103,8 @@ class SceneShots:
         self.scene = scene
         self.base = tuple(base_overrides)
         self.loaded = load(scene, self.base)  # refused here, not at the first shot
+        as_loaded = Rig(self.loaded)
+        self.trigger_by = as_loaded.solver.duration - after_trigger(as_loaded)
         self.on_shot = on_shot
         self.allow_large = allow_large
         self.last: ShotRecord | None = None
@@ -85,7 +130,9 @@ class SceneShots:
                 self._rigs.move_to_end(key)
                 return self._rigs[key]
             rig = self._built(items)
-            twin = next((other for k, other in reversed(self._rigs.items()) if same_chain(key, k)), None)
+            solved = tuple(sorted(rig.scene.overrides))  # with the solver items its record needs
+            twin = next((other for other in reversed(self._rigs.values())
+                         if same_chain(solved, tuple(sorted(other.scene.overrides)))), None)
             if twin is not None:
                 rig.use_solution(twin.solution())
             self._rigs[key] = rig
@@ -94,9 +141,13 @@ class SceneShots:
             return rig
 
     def _built(self, items: tuple) -> Rig:
-        """A new rig of the scene with the "key=value" ``items``, refused (RigError) where it
-        could give no record or passes the size limits, before anything is solved."""
+        """A new rig of the scene with the "key=value" ``items`` and the solver items its
+        record needs (``record_solver``), refused (RigError) where it could give no record or
+        passes the size limits, before anything is solved."""
         rig = Rig(load(self.scene, items))
+        extra = record_solver(rig, self.trigger_by)
+        if extra:
+            rig = Rig(load(self.scene, items + extra))
         rig.check_record()
         rig.estimate().refuse_unless(self.allow_large, "this shot")
         return rig
@@ -117,6 +168,24 @@ class SceneShots:
     def __call__(self, overrides: Mapping[str, str], seed: int) -> ScopeRecord:
         """The ShotSource: the scope record of ``shot(overrides, seed)``."""
         return self.shot(overrides, seed).scope
+
+    def record_cost(self, overrides: Mapping[str, str]) -> str | None:
+        """None when a shot with ``overrides`` is within the solver's size limits
+        (rig/solver/estimate.py: its memory and seconds), else the one-line refusal naming
+        its estimate: what the scope refuses at the setting command (other refusals of the
+        rig wait for the shot, as they depend on more than the setting)."""
+        items = self.items(overrides)
+        try:
+            rig = Rig(load(self.scene, items + record_solver(Rig(load(self.scene, items)), self.trigger_by)))
+        except RigError:
+            return None  # refused at the shot, with its reason
+        cost = rig.estimate()
+        held = cost.bytes + record_bytes(rig)
+        if self.allow_large or (held <= LIMIT_BYTES and cost.seconds <= LIMIT_SECONDS):
+            return None
+        return (f"this record needs about {held / 1e9:.3g} GB (the solve: {cost.describe()}; the scope's record "
+                f"of {rig.scope.timebase.record_length} points a channel), beyond the served scope's limits of "
+                f"{LIMIT_BYTES / 1e9:g} GB and {LIMIT_SECONDS:g} s of solving a shot")
 
     def validate(self, key: str, text: str) -> str | None:
         """None when ``key`` (one of RIG_KEYS) may be set to ``text`` (a quantity with its

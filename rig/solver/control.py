@@ -38,6 +38,12 @@ refuses (AccuracyNotReached, naming the accuracy, the duration, the estimate rea
 steps tried and a way out), and a caller that bounds the step itself (a fit's pilot) takes the best try with
 its estimate.
 
+Fine records. A record asked on a grid finer than CONTROL_GRID_S (a scope sampling at
+GS/s) is controlled on that grid: the tries and their companions record every
+CONTROL_GRID_S, and the chosen try's step is integrated once more recording the asked grid
+(the same steps, the same motion; its estimate is the control's). Ten tries on a grid of
+millions of samples had cost ten times that one solve.
+
 Way out. The most accurate try and its companion give the error of every shorter record
 (``error_over_time``): where the error stays within the accuracy over the record's first
 part and grows with time after, the refusal names the longest solver.duration that
@@ -70,6 +76,7 @@ MAX_ATTEMPTS = 5
 COMPANION = 2        # the companion takes this many steps for each of the solution's
 WORK_BUDGET = 2048.0  # the control's steps, companions included, in solves at its first step
 NO_FALL = 2.0        # a step 4+ times finer whose estimate fell by less than this: the error does not fall
+CONTROL_GRID_S = 1e-7  # the control records no finer than this (s); a finer grid is recorded by the chosen step once
 
 
 class AccuracyNotReached(RigError):
@@ -136,6 +143,8 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
     above the accuracy: AccuracyNotReached if ``strict``, else the most accurate try,
     its estimate above the accuracy, with status ACCURACY_NOT_REACHED (its message says why)."""
     t0 = time.process_time()
+    asked, save = save, (replace(save, sample_interval=CONTROL_GRID_S) if save.sample_interval < CONTROL_GRID_S
+                         else save)
     first = default_step(problem, m, accuracy, t_end)
     longest = largest_step(problem, m, t_end)
     dt = max(min(first.dt, longest), shortest)
@@ -143,9 +152,11 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
     spent = 0
     stop = f"{MAX_ATTEMPTS} tries"  # what ended the control, should it end above the accuracy
     tried = []  # (solution, estimate, basis)
+    steppings = {}  # id(solution) -> its Stepping
     for _ in range(MAX_ATTEMPTS):
         stepping = Stepping(dt, first.head, first.inner_dt * dt / first.dt)
         sol = integrate_one(problem, t_end, save, m, stepping, accuracy)
+        steppings[id(sol)] = stepping
         if not sol.success:
             spent += time_grid(t_end, dt, t_end)[0]
             dt *= 0.5
@@ -173,6 +184,9 @@ def controlled_solve(problem: ChainProblem, t_end: float, save: SaveAt, m: Metho
     if not tried:
         raise Unstable(f"unstable at every step tried down to dt = {2 * dt:.4g} s", stepping)
     sol, est, basis, _ = _choice(tried, accuracy)
+    if asked is not save:  # the chosen step, recording the asked grid
+        sol = Unstable.check(integrate_one(problem, t_end, asked, m, steppings[id(sol)], accuracy),
+                             steppings[id(sol)])
     if est is not None and est > accuracy:
         why = _not_reached(tried, accuracy, first.dt, stop, t_end)
         if strict:

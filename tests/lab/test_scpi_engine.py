@@ -91,8 +91,9 @@ def test_event_text_and_the_queue_overflow():
         status.post(-222, f"value {k}")
     events = [status.next_event() for _ in range(QUEUE_SIZE)]
     assert [e.code for e in events[:-1]] == [-222] * (QUEUE_SIZE - 1)
-    assert events[-1].code == -350 and events[-1].text() == '-350,"Queue overflow"'
-    assert events[0].text() == '-222,"Data out of range; value 0"'
+    assert events[-1].code == -350 and events[-1].text() == '350,"Queue overflow"' \
+        and events[-1].text(scpi=True) == '-350,"Queue overflow"'
+    assert events[0].text() == '222,"Data out of range; value 0"'
     assert status.next_event().text() == '0,"No events to report - queue empty"'
 
 

@@ -101,14 +101,14 @@ def test_device_clear_interrupts_a_waiting_query(make_scope):
     s.device_clear()
     waiter.join(30)
     source.gate.set()
-    assert answer == [b""] and ask(s, "EVENT?") == "-410"
+    assert answer == [b""] and ask(s, "EVENT?") == "410"
 
 
 def test_the_rigs_refusal_is_an_event_and_takes_no_seed(make_scope):
     scope, s, _source = make_scope("mso4", seed=3)
     s.handle(b"HOR:SCALE 1E-3")  # the model takes 10 ms; the synthetic input stops at 8 ms
     s.handle(b"RIG:FIRE;*OPC?")
-    assert ask(s, "EVENT?") == "-200" and scope.acq.last is None
+    assert ask(s, "EVENT?") == "200" and scope.acq.last is None
     msg = ask(s, "RIG:SEED?")
     assert msg == "3"
     s.handle(b"HOR:SCALE 2E-4")
@@ -119,7 +119,7 @@ def test_the_rigs_refusal_is_an_event_and_takes_no_seed(make_scope):
 def test_rig_commands_take_quantities_checked_by_the_injected_validator(make_scope):
     scope, s, source = make_scope("tds2000", seed=1)
     s.handle(b'RIG:STRIKER:VELOCITY 1.2 m/s;:RIG:MAGNET:FORCE "2.38 N";POSITION 5 mm;:RIG:SEED 100')
-    assert ask(s, "EVENT?") == "-224"  # 5 mm: the validator wants m
+    assert ask(s, "EVENT?") == "224"  # 5 mm: the validator wants m
     assert ask(s, "RIG:STR:VEL?;:RIG:MAG:FORC?;POS?;:RIG:SEED?;:RIG:SCENE?") == \
         '"1.2 m/s";"2.38 N";"not set in the scene";100;"synthetic"'
     fire(s)
@@ -133,7 +133,7 @@ def test_rig_commands_take_quantities_checked_by_the_injected_validator(make_sco
 def test_the_rig_port_shares_the_instruments_state(make_scope):
     scope, s, source = make_scope("tds2000", seed=1)
     rig = scope.rig_port().open_session("rig")
-    assert rig.handle(b"CH1:SCALE 1") == b"" and ask(rig, "EVENT?") == "-113"  # no scope commands there
+    assert rig.handle(b"CH1:SCALE 1") == b"" and ask(rig, "EVENT?") == "113"  # no scope commands there
     rig.handle(b"RIG:STR:VEL 0.45 m/s;:RIG:FIRE")
     assert ask(rig, "*OPC?") == "1" and ask(s, "ACQ:NUMACQ?") == "1"
     assert source.calls[0][0] == {"striker.velocity": "0.45 m/s"}
@@ -141,11 +141,11 @@ def test_the_rig_port_shares_the_instruments_state(make_scope):
 
 def test_limits_of_messages_and_replies(make_scope):
     _scope, s, _ = make_scope("tds2000", max_message_bytes=100, max_reply_bytes=1000)
-    assert s.handle(b"*IDN?;" * 30) == b"" and ask(s, "EVENT?") == "-363"
+    assert s.handle(b"*IDN?;" * 30) == b"" and ask(s, "EVENT?") == "363"
     s.overflow(10_000)
-    assert ask(s, "EVENT?") == "-363"
+    assert ask(s, "EVENT?") == "363"
     fire(s)
-    assert s.handle(b"DATA:ENC ASCII;:CURVE?") == b"" and ask(s, "EVENT?") == "-350"
+    assert s.handle(b"DATA:ENC ASCII;:CURVE?") == b"" and ask(s, "EVENT?") == "350"
     s.handle(b"DATA:ENC RIB;START 1;STOP 500")
     assert len(s.handle(b"CURVE?")) == 506
 
@@ -214,8 +214,8 @@ def test_the_first_acquisition_is_the_first_shot_and_what_curve_answers_before_a
     scope, s, source = make_scope("mso4", seed=7)
     kept = []
     scope.acq.on_shot = kept.append
-    assert s.handle(b"CURVE?") == b""  # before it: an execution error, no record yet
-    assert ask(s, "EVENT?") == "-200"
+    assert s.handle(b"CURVE?") == b"#10\n"  # before it: an execution error, no record yet, answered at once
+    assert ask(s, "EVENT?") == "200"
     shot = scope.acq.first_acquisition()
     assert (shot.seed, scope.acq.count, kept) == (7, 1, [shot])
     assert source.calls == [(scope.overrides(), 7)]  # the settings the scope starts with
@@ -254,9 +254,9 @@ def test_a_shot_the_rig_refuses_leaves_no_record_that_could_pass_for_it(make_sco
     source.record = lambda overrides, seed: (_ for _ in ()).throw(InstrumentError(reason))
     s.handle(b"*CLS")
     fire(s)
-    assert s.handle(b"CURVe?") == b""  # no record: nothing sent
+    assert s.handle(b"CURVe?") == b"#10\n"  # no record: an empty block, at once
     events = ask(s, "ALLEv?")
-    assert reason.strip() in events and events.count("-200") == 2  # the refusal (whole), then CURVe?'s
+    assert reason.strip() in events and events.count("200,\"Execution error") == 2  # the refusal (whole), then CURVe?'s
     assert "the last shot failed" in events
     source.record = good
     fire(s)

@@ -89,7 +89,7 @@ def test_preamble_before_any_shot_follows_the_settings(make_scope):
     pre = preamble(s, "WFMOutpre")
     assert pre["YMULT"] == "8.0000E-3" and pre["XINCR"] == "400.0000E-9"
     assert pre["WFID"] == '"Ch1, DC coupling, 200.0mV/div, 400.0us/div, 10000 points, Sample mode"'
-    assert ask(s, "CURVE?;*ESR?") == "16" and ask(s, "ALLEV?").startswith('-200,"Execution error; CH1 has no record')
+    assert ask(s, "CURVE?;*ESR?") == "#10;16" and ask(s, "ALLEV?").startswith('200,"Execution error; CH1 has no record')
 
 
 @pytest.mark.parametrize("fields, encoding", [
@@ -102,7 +102,7 @@ def test_the_preambles_format_fields_set_the_data_encoding(make_scope, fields, e
     bn_fmt, byt_or = ask(s, "WFMO:BN_FMT?;BYT_OR?").split(";")
     assert bn_fmt == ("RP" if "BN_FMT RP" in fields else "RI")
     assert byt_or == ("LSB" if "LSB" in fields else "MSB")
-    assert s.handle(b"WFMO:BN_FMT FP") == b"" and ask(s, "EVENT?") == "-221"
+    assert s.handle(b"WFMO:BN_FMT FP") == b"" and ask(s, "EVENT?") == "221"
 
 
 def test_data_query_and_init(make_scope):

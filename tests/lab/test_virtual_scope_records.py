@@ -1,0 +1,98 @@
+"""A record for every horizontal setting the model offers (the scene's rig behind the scope):
+a record lasting longer than the scene's solve, one sampled finer than the solver records,
+each the very bits of ``Rig.fire`` with the items the shot was fired with; a record past
+the served scope's cost limit refused at the setting command, the settings unchanged; a
+``CURVe?`` without a record answered at once, its reason in the queue."""
+import numpy as np
+import pytest
+
+from instruments.virtual_scope.instrument import VirtualScope
+from rig.experiment.shot import Rig
+from rig.lab.shots import SceneShots
+
+SCENE = "ptfe52_magnetic"  # solver.duration 3 ms, solver.sample_interval 0.1 us
+
+
+def ask(session, text: str) -> str:
+    return session.handle(text.encode()).decode().strip()
+
+
+@pytest.fixture(scope="module")
+def served():
+    """(scope, shots) of an mso4 on the scene, its first shot fired."""
+    shots = SceneShots(SCENE)
+    scope = VirtualScope(shots.rig().scope, shots, personality_name="mso4", seed=3, validate=shots.validate,
+                         record_cost=shots.record_cost)
+    scope.acq.first_acquisition()
+    yield scope, shots
+    scope.close()
+
+
+def fire(session) -> str:
+    return ask(session, "ACQ:STOPA SEQ;STATE ON;*OPC?;:ALLEV?")
+
+
+def same_as_rig_fire(shots) -> None:
+    shot = shots.last
+    again = Rig.from_scene(SCENE, shot.overrides).fire(seed=shot.seed)
+    for ch, w in shot.scope.waveforms.items():
+        assert np.array_equal(w.codes, again.scope[ch].codes)
+        assert w.preamble == again.scope[ch].preamble
+
+
+def test_a_record_longer_than_the_scenes_solve_is_solved_for_and_is_rig_fire_with_its_items(served):
+    scope, shots = served
+    s = scope.open_session("t")
+    assert ask(s, "HOR:RECO 10000;:HOR:SCA 1E-3;:ALLEV?") == '0,"No events to report - queue empty"'
+    assert fire(s) == '1;0,"No events to report - queue empty"'
+    record = shots.last.scope
+    assert record.triggered and record["CH1"].preamble.x_increment == pytest.approx(1e-6, rel=1e-12)
+    # 10 ms recorded, 90% after the trigger: the chain solved past the scene's 3 ms
+    duration = Rig.from_scene(SCENE, shots.last.overrides).solver.duration
+    assert duration > 9e-3 and any(o.startswith("solver.duration=") for o in shots.last.overrides)
+    truth = shots.last.truth
+    assert (len(truth.gauges["lower"].average_force) - 1) * truth.sample_interval == pytest.approx(duration, rel=1e-6)
+    # past the pulses the chain rings and settles: the record's last tenth is well below the peak
+    v = record["CH2"].volts()
+    assert np.abs(v[-1000:] - np.median(v[-1000:])).max() < 0.5 * (v.max() - np.median(v[-1000:]))
+    same_as_rig_fire(shots)
+
+
+def test_a_record_finer_than_the_solvers_grid_samples_the_solution_finer(served):
+    scope, shots = served
+    s = scope.open_session("t")
+    assert ask(s, "HOR:RECO 100000;:HOR:SCA 2E-5;:ALLEV?") == '0,"No events to report - queue empty"'
+    assert fire(s) == '1;0,"No events to report - queue empty"'
+    w = shots.last.scope["CH1"]
+    assert w.preamble.x_increment == pytest.approx(2e-9, rel=1e-12) and w.preamble.points == 100_000
+    assert "solver.sample_interval=2e-09 s" in shots.last.overrides  # the solver recorded at the scope's rate
+    # no held values: the solution the scope sampled has a new value every 2 ns on the pulse's
+    # rise (a hold of the 0.1 us grid would repeat each value 50 times)
+    force = shots.last.truth.gauges["upper"].average_force
+    assert shots.last.truth.sample_interval == pytest.approx(2e-9, rel=1e-12)
+    rise = np.flatnonzero(force > 0.5 * force.max())[0]
+    assert np.count_nonzero(np.diff(force[rise - 500:rise]) > 0) == 499
+    same_as_rig_fire(shots)
+
+
+def test_a_record_past_the_cost_limit_is_refused_at_the_setting_and_nothing_changes(served):
+    scope, _ = served
+    s = scope.open_session("t")
+    before = ask(s, "HOR:RECO?;:HOR:SCA?")
+    reply = ask(s, "HOR:RECO 10000;:HOR:SCA 1E-7;:ALLEV?")  # 10 ps a sample over 3 ms: GB
+    assert reply.startswith('-221,"Settings conflict; this record needs about') and "2 GB" in reply
+    assert ask(s, "HOR:RECO 10000;:HOR:SCA?") == ask(s, "HOR:SCA?") != "1.0000E-9"
+    ask(s, f"HOR:RECO {before.split(';')[0]};:HOR:SCA {before.split(';')[1]}")
+
+
+def test_curve_without_a_record_answers_at_once_with_an_empty_block_and_the_reason_queued():
+    shots = SceneShots(SCENE)
+    scope = VirtualScope(shots.rig().scope, shots, personality_name="tds2000")
+    try:
+        s = scope.open_session("t")
+        assert s.handle(b"CURVE?") == b"#10\n"
+        assert ask(s, "DATA:ENC ASCII;:CURVE?") == ""
+        events = ask(s, "ALLEV?")
+        assert events.count("has no record: no record yet") == 2
+    finally:
+        scope.close()
