@@ -22,7 +22,7 @@ from ..scpi.engine import Engine, ReplyForm
 from ..scpi.status import OPC, ScpiError, StatusModel
 from ..scpi.tree import CommandTree
 from ..transports.device import InstrumentLock
-from . import commands, common, measurements, rig_commands, waveform_commands
+from . import commands, common, measurements, rig_commands, setup, waveform_commands
 from .acquisition import Acquisition, ShotSource
 from .measurements import default_slots
 from .personalities import personality, snap_to_steps
@@ -83,6 +83,7 @@ class VirtualScope:
         commands.register(tree, self)
         waveform_commands.register(tree, self)
         measurements.register(tree, self)
+        setup.register(tree, self)
         self.engine = Engine(tree, self.status, self.form)
         self.rig_engine = Engine(rig_tree, self.status, self.form)
 

@@ -37,7 +37,8 @@ class Personality:
     of s/div in a decade; preamble: "WFMPre" (16 fields) or "WFMOutpre" (22); preamble_fields
     in reply order; y_unit: YUNit's text; engineering: numbers with an exponent that is a
     multiple of 3 and at least 4 decimals (MDO, MSO) or plain NR3 (TDS); wfid_digits: the
-    significant digits of V/div and s/div in WFID."""
+    significant digits of V/div and s/div in WFID; encodings: DATa:ENCdg's words in its manual
+(the MDO3000's add FAStest, FPBinary and SFPbinary, the 4 Series' FPBinary and SFPbinary)."""
 
     name: str
     idn: str
@@ -49,6 +50,12 @@ class Personality:
     engineering: bool
     wfid_digits: int
     volt_steps: tuple = (1.0, 2.0, 5.0)
+    encodings: tuple = ("ASCIi", "RIBinary", "RPBinary", "SRIbinary", "SRPbinary")
+
+    @property
+    def floats(self) -> bool:
+        """Whether the model sends 4-byte floats (DATa:ENCdg FPBinary, BN_Fmt FP)."""
+        return "FPBinary" in self.encodings
 
     def number(self, x: float) -> str:
         """x in the model's notation, with every digit needed to read it back exactly."""
@@ -75,11 +82,14 @@ PERSONALITIES = {
                            (1.0, 2.5, 5.0), "WFMPre", WFMPRE_16, "Volts", False, 3),
     "mdo3000": Personality("mdo3000", "TEKTRONIX,MDO3024,C010001,CF:91.1CT FV:v1.30", (1000, 10000, 100000, 1000000,
                                                                                       5000000, 10000000),
-                           (1.0, 2.0, 4.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4),
+                           (1.0, 2.0, 4.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4,
+                           encodings=("ASCIi", "FAStest", "RIBinary", "RPBinary", "SRIbinary", "SRPbinary",
+                                      "FPBinary", "SFPbinary")),
     "mso4": Personality("mso4", "TEKTRONIX,MSO44,C010001,CF:91.1CT FV:2.0.3.950",
                         (1000, 2000, 5000, 10000, 20000, 50000, 100000, 200000, 500000, 1000000, 2000000, 5000000,
                          10000000, 20000000, 31250000),
-                        (1.0, 2.0, 5.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4),
+                        (1.0, 2.0, 5.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4,
+                        encodings=("ASCIi", "RIBinary", "RPBinary", "FPBinary", "SRIbinary", "SRPbinary", "SFPbinary")),
 }
 
 

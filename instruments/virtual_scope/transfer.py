@@ -2,8 +2,11 @@
 
 ``DATa:ENCdg`` (programmer manuals, "DATa:ENCdg"): ASCIi (comma-separated codes), RIBinary
 (signed, MSB first), RPBinary (unsigned, MSB first), SRIbinary and SRPbinary (the same, LSB
-first). ``DATa:WIDth 2`` sends the 8-bit converter's code in the high byte (code x 256),
-as the scopes do, so YMULT is V/div / 25 / 256. An unsigned encoding adds 2^(8 width - 1)
+first); on the models whose manuals list them, FPBinary and SFPbinary (4-byte IEEE floats,
+MSB or LSB first: BYT_NR 4, BN_FMT FP; the 8-bit codes as floats, YMULT and YOFF those of
+1-byte codes) and FAStest (the MDO3000's "fastest": RIBinary). ``DATa:WIDth 2`` sends the
+8-bit converter's code in the high byte (code x 256), as the scopes do, so YMULT is
+V/div / 25 / 256. An unsigned encoding adds 2^(8 width - 1)
 to every code and to YOFF. The preamble (``WFMPre?``/``WFMOutpre?``) always describes the
 bytes ``CURVe?`` sends with the current DATa settings: NR_PT the points from STARt to STOP
 (clipped to the record), XZERO the time of the first point sent (s from the trigger),
@@ -20,8 +23,10 @@ from ..scpi.engine import Fields, Word
 from .personalities import Personality
 
 ENCODINGS = ("ASCIi", "RIBinary", "RPBinary", "SRIbinary", "SRPbinary")
+FLOATS = ("FPBinary", "SFPbinary")
+FASTEST = "FAStest"
 BINARY = {(True, True): "RIBinary", (False, True): "RPBinary", (True, False): "SRIbinary", (False, False): "SRPbinary"}
-"""(signed, MSB first) -> the binary encoding."""
+"""(signed, MSB first) -> the binary encoding of integer codes."""
 
 
 @dataclass(frozen=True)
@@ -38,19 +43,36 @@ class DataSelection:
     binary: str = "RIBinary"
 
     def encoded(self, encoding: str) -> DataSelection:
-        """These settings with ``DATa:ENCdg encoding``."""
+        """These settings with ``DATa:ENCdg encoding`` (FAStest: RIBinary)."""
+        encoding = "RIBinary" if encoding == FASTEST else encoding
         return replace(self, encoding=encoding, binary=self.binary if encoding == "ASCIi" else encoding)
 
-    def formatted(self, *, signed: bool | None = None, msb_first: bool | None = None) -> DataSelection:
-        """These settings with the preamble's BN_Fmt (signed) or BYT_Or (msb_first) set, as
-        ``WFMPre:BN_Fmt``/``WFMOutpre:BYT_Or`` set them (the encoding stays ASCIi if it is)."""
-        was_signed, was_msb = next(k for k, v in BINARY.items() if v == self.binary)
-        binary = BINARY[(was_signed if signed is None else signed, was_msb if msb_first is None else msb_first)]
+    def formatted(self, *, signed: bool | None = None, msb_first: bool | None = None,
+                  floating: bool | None = None) -> DataSelection:
+        """These settings with the preamble's BN_Fmt (signed: RI/RP, or floating: FP) or BYT_Or
+        (msb_first) set, as ``WFMOutpre:BN_Fmt``/``BYT_Or`` set them (the encoding stays ASCIi
+        if it is)."""
+        msb = (not self.binary.startswith("S")) if msb_first is None else msb_first
+        if floating or (floating is None and signed is None and self.floating):
+            binary = FLOATS[0] if msb else FLOATS[1]
+        else:
+            was_signed = self.binary not in ("RPBinary", "SRPbinary")
+            binary = BINARY[(was_signed if signed is None else signed, msb)]
         return replace(self, binary=binary, encoding="ASCIi" if self.encoding == "ASCIi" else binary)
 
     @property
     def unsigned(self) -> bool:
         return self.encoding in ("RPBinary", "SRPbinary")
+
+    @property
+    def floating(self) -> bool:
+        """4-byte floats (FPBinary, SFPbinary), or ASCIi kept from them."""
+        return self.binary in FLOATS
+
+    @property
+    def sent_width(self) -> int:
+        """Bytes a point is sent in: 4 for floats, else DATa:WIDth."""
+        return 4 if self.floating else self.width
 
     def span(self, points: int) -> tuple:
         """(first index, end index) of the points sent from a record of ``points``: points
@@ -64,6 +86,8 @@ class DataSelection:
 def sent_codes(codes: np.ndarray, sel: DataSelection) -> np.ndarray:
     """The codes CURVe? sends (int64): the selected points, widened and offset."""
     first, end = sel.span(codes.size)
+    if sel.floating:
+        return codes[first:end].astype(np.int64)
     out = codes[first:end].astype(np.int64) * (256 if sel.width == 2 else 1)
     return out + (1 << (8 * sel.width - 1)) if sel.unsigned else out
 
@@ -74,13 +98,13 @@ def curve_bytes(codes: np.ndarray, sel: DataSelection) -> bytes:
     if sel.encoding == "ASCIi":
         return ",".join(map(str, values.tolist())).encode()
     order = "<" if sel.encoding.startswith("S") else ">"
-    kind = "u" if sel.unsigned else "i"
-    return definite_block(values.astype(f"{order}{kind}{sel.width}").tobytes())
+    kind = "f" if sel.floating else "u" if sel.unsigned else "i"
+    return definite_block(values.astype(f"{order}{kind}{sel.sent_width}").tobytes())
 
 
 def scaled(pre: Preamble, sel: DataSelection) -> tuple:
     """(YMULT, YOFF, YZERO) of the codes as sent."""
-    factor = 256 if sel.width == 2 else 1
+    factor = 256 if sel.width == 2 and not sel.floating else 1
     yoff = pre.y_offset * factor + ((1 << (8 * sel.width - 1)) if sel.unsigned else 0)
     return pre.y_multiplier / factor, yoff, pre.y_zero
 
@@ -99,9 +123,9 @@ def preamble_fields(pre: Preamble, sel: DataSelection, wfid: str, p: Personality
     ymult, yoff, yzero = scaled(pre, sel)
     binary = sel.encoding != "ASCIi"
     values = {
-        "BYT_Nr": str(sel.width), "BIT_Nr": str(8 * sel.width),
+        "BYT_Nr": str(sel.sent_width), "BIT_Nr": str(8 * sel.sent_width),
         "ENCdg": Word("BINary" if binary else "ASCIi"),
-        "BN_Fmt": Word("RP" if sel.binary in ("RPBinary", "SRPbinary") else "RI"),
+        "BN_Fmt": Word("FP" if sel.floating else "RP" if sel.binary in ("RPBinary", "SRPbinary") else "RI"),
         "BYT_Or": Word("LSB" if sel.binary.startswith("S") else "MSB"),
         "NR_Pt": str(end - first), "WFId": f'"{wfid}"', "PT_Fmt": Word("Y"),
         "XINcr": p.number(pre.x_increment), "PT_Off": "0",

@@ -17,7 +17,10 @@ from ..records import Preamble
 from ..scpi.engine import Call, Fields, Word
 from ..scpi.status import ScpiError
 from .commands import CHANNEL_WORDS
-from .transfer import ENCODINGS, DataSelection, curve_bytes, preamble_fields, waveform_id
+from .transfer import DataSelection, curve_bytes, preamble_fields, waveform_id
+
+WAVEFORM_FIELDS = ("WFId", "NR_Pt", "PT_Fmt", "XINcr", "PT_Off", "XZEro", "XUNit", "YMUlt", "YZEro", "YOFf", "YUNit")
+"""The preamble fields that describe one waveform (TDS2000 manual, WFMPre:<wfm>?), in its order."""
 
 
 def source_waveform(scope, ch: str, header: str, *, off_too: bool = False):
@@ -58,10 +61,24 @@ def register(tree, scope) -> None:
         return min(max(round(c.number()), 1), scope.max_record_length)
 
     def width(c: Call):
-        w = c.number()
-        if w not in (1, 2):
-            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed 1 or 2 bytes per point")
-        data(width=int(w))
+        """DATa:WIDth and BYT_Nr: 1 or 2 bytes of integer codes, or (BYT_Nr 4, where the
+        model sends floats) 4-byte floats."""
+        set_width(c, 8)
+
+    def set_width(c: Call, bits: int, floats: bool = False):
+        """The bytes a point is sent in, from the argument in units of ``bits`` bits (8: BYT_Nr,
+        DATa:WIDth; 1: BIT_Nr); ``floats``: 4 bytes are floats (the preamble's fields, on a
+        model that sends them)."""
+        w = c.number() * bits / 8
+        if w == 4 and floats:
+            scope.data = scope.data.formatted(floating=True)
+        elif w in (1, 2):
+            sel = scope.data.formatted(signed=True) if scope.data.floating else scope.data
+            scope.data = replace(sel, width=int(w))
+        else:
+            allowed = [f"{8 * n // bits:d}" for n in ((1, 2, 4) if floats else (1, 2))]
+            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed {', '.join(allowed[:-1])} or {allowed[-1]} "
+                                  f"{'bytes' if bits == 8 else 'bits'} per point")
 
     def preamble(c: Call) -> Fields:
         """The whole preamble; of a channel that is off, a TDS answers its format fields
@@ -116,15 +133,13 @@ def register(tree, scope) -> None:
     tree.add("DATa:SOUrce:AVAILable", read=lambda c: ",".join(ch for ch in CHANNEL_WORDS if ch in scope.shown))
     tree.add("DATa:STARt", write=lambda c: data(start=point(c)), read=lambda c: str(scope.data.start))
     tree.add("DATa:STOP", write=lambda c: data(stop=point(c)), read=lambda c: str(scope.data.stop))
-    tree.add("DATa:ENCdg", write=lambda c: setattr(scope, "data", scope.data.encoded(c.word(ENCODINGS))),
+    tree.add("DATa:ENCdg", write=lambda c: setattr(scope, "data", scope.data.encoded(c.word(p.encodings))),
              read=lambda c: Word(scope.data.encoding))
     tree.add("DATa:WIDth", write=width, read=lambda c: str(scope.data.width))
     tree.add(p.preamble, read=preamble)
     def set_format(c: Call):
-        fmt = c.word(("RI", "RP", "FP"))
-        if fmt == "FP":
-            raise ScpiError(-221, f"{c.header} FP: the scope sends integer codes (RI or RP)")
-        scope.data = scope.data.formatted(signed=fmt == "RI")
+        fmt = c.word(("RI", "RP", "FP") if p.floats else ("RI", "RP"))
+        scope.data = scope.data.formatted(floating=True) if fmt == "FP" else scope.data.formatted(signed=fmt == "RI")
 
     def set_encoding(c: Call):
         scope.data = scope.data.encoded("ASCIi" if c.word(("ASCIi", "BINary")) == "ASCIi" else scope.data.binary)
@@ -132,15 +147,34 @@ def register(tree, scope) -> None:
     def bits(c: Call):
         """BIT_Nr 8 or 16: the bits a point is sent in, with BYT_Nr (the 4/5/6 Series way to
         ask for 2 bytes a point; it had been refused, the client reading 1-byte codes as 2)."""
-        b = c.number()
-        if b not in (8, 16):
-            raise ScpiError(-222, f"{c.header} {c.arg().text}: allowed 8 or 16 bits per point")
-        data(width=int(b) // 8)
+        set_width(c, 1, p.floats)
 
-    setters = {"BYT_Nr": width, "BIT_Nr": bits, "ENCdg": set_encoding, "BN_Fmt": set_format,
+    setters = {"BYT_Nr": lambda c: set_width(c, 8, p.floats), "BIT_Nr": bits, "ENCdg": set_encoding,
+               "BN_Fmt": set_format,
                "BYT_Or": lambda c: setattr(scope, "data",
                                            scope.data.formatted(msb_first=c.word(("MSB", "LSB")) == "MSB"))}
     for name in p.preamble_fields:
         tree.add(f"{p.preamble}:{name}", read=preamble_field(name), write=setters.get(name))
+    def channel_preamble(c: Call) -> Fields:
+        """``WFMPre:CH<x>?`` (TDS2000 manual; the legacy form of the DPO4000's and MDO3000's):
+        the fields that describe channel x's waveform (WFID to YUNIT), whatever DATa:SOUrce
+        is; a channel that is off is 2244."""
+        ch = f"CH{c.suffix}"
+        if ch not in CHANNEL_WORDS:
+            raise ScpiError(-113, f"{c.header}: channels CH1 to CH4")
+        _, pre, wfid = source_waveform(scope, ch, c.header)
+        pairs = dict(preamble_fields(pre, scope.data, wfid, p).pairs)
+        return Fields(tuple((name, pairs[name]) for name in WAVEFORM_FIELDS))
+
+    def channel_field(name: str):
+        return lambda c: dict(channel_preamble(c).pairs)[name]
+
+    tree.add("WFMPre:CH<n>", read=channel_preamble)
+    for name in WAVEFORM_FIELDS:
+        tree.add(f"WFMPre:CH<n>:{name}", read=channel_field(name))
+    if p.preamble != "WFMPre":  # the legacy WFMPre of the DPO4000 and MDO3000 manuals: WFMOutpre's fields
+        tree.add("WFMPre", read=preamble)
+        for name in p.preamble_fields:
+            tree.add(f"WFMPre:{name}", read=preamble_field(name), write=setters.get(name))
     tree.add("CURVe", read=curve)
     tree.add("WAVFrm", read=wavfrm, bare=True)  # its parts carry their own headers

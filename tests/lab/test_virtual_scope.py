@@ -111,7 +111,7 @@ def test_a_channel_switched_on_is_recorded_with_all_its_settings_and_one_off_is_
 @pytest.mark.parametrize("command, code", [
     ("CH1:SCALE 20", -222), ("CH1:SCALE -1", -222), ("CH1:COUPLING GND", -221), ("CH1:POSITION 7", -222),
     ("TRIG:A:EDGE:SOURCE CH4", -221), ("TRIG:A:EDGE:COUPLING HFREJ", -221), ("ACQ:MODE PEAK", -221),
-    ("ACQ:NUMAVG 1024", -222), ("DATA:WIDTH 4", -222), ("DATA:ENC FASTEST", -224),
+    ("ACQ:NUMAVG 1024", -222), ("DATA:WIDTH 4", -222), ("DATA:ENC FASTER", -224),
     ("CH5:SCALE 1", -113), ("FILESYSTEM:READFILE \"/etc/passwd\"", -113), ("SAVE:WAVEFORM CH1,\"a.isf\"", -113),
     ("SAVE:SETUP 1", -113), ("RIG:STR:VEL 5 furlongs", -224), ("RIG:SEED -1", -222)])
 def test_refused_settings_queue_their_event_and_change_nothing(make_scope, command, code):
@@ -256,3 +256,33 @@ def test_display_waveform_off_leaves_the_records_as_they_are(make_scope):
     assert scope.acq.last.record.triggered
     s.handle(b"*RST")
     assert ask(s, "DISPLAY:WAVEFORM?") == "1"
+
+
+@pytest.mark.parametrize("personality", ["tds2000", "mso4"])
+def test_set_query_restores_the_setup_it_describes(make_scope, personality):
+    """SET? (and *LRN?) answer every setting as the commands that set it, headers on whatever
+    HEADer says; sent back, they restore the set-up."""
+    scope, s, _ = make_scope(personality)
+    s.handle(b"HEADER OFF;VERBOSE OFF")
+    setup = s.handle(b"SET?").rstrip(b"\n")
+    assert setup.startswith(b":") and b":CH1:SCALE " in setup and s.handle(b"*LRN?").rstrip(b"\n") == setup
+    before = scope.overrides()
+    s.handle(b"CH1:SCALE 0.5;:CH2:COUPLING AC;:SELECT:CH4 ON;:TRIG:A:LEVEL 0.07;:DATA:ENC ASCII;WIDTH 2")
+    assert scope.overrides() != before and ask(s, "*ESR?") == "128"  # power-on, read once
+    s.handle(setup)
+    assert scope.overrides() == before and ask(s, "DATA:ENC?;WIDTH?;*ESR?;:ALLEV?") == (
+        'RIB;1;0;0,"No events to report - queue empty"')
+
+
+@pytest.mark.parametrize("personality", ["tds2000", "mdo3000"])
+def test_the_legacy_wfmpre_forms_of_the_tds_and_dpo4000_manuals(make_scope, personality):
+    """WFMPre:CH<x>? gives channel x's waveform fields (WFID to YUNIT) whatever DATa:SOUrce
+    is, WFMPre:CH<x>:<field>? one of them; the MDO3000 takes WFMPre? as its WFMOutpre?."""
+    _scope, s, _ = make_scope(personality)
+    fire(s)
+    s.handle(b"DATA:SOURCE CH1")
+    fields = ask(s, "WFMPRE:CH2?").split(";")
+    assert len(fields) == 11 and fields[0].startswith('"Ch2, ') and fields[1] == ask(s, "WFMPRE:CH2:NR_PT?")
+    assert ask(s, "WFMPRE:CH2:YMULT?") == ask(s, "DATA:SOURCE CH2;:WFMPRE:YMULT?") and ask(s, "EVENT?") == "0"
+    if personality != "tds2000":
+        assert ask(s, "WFMPRE?") == ask(s, "WFMOUTPRE?")

@@ -102,7 +102,35 @@ def test_the_preambles_format_fields_set_the_data_encoding(make_scope, fields, e
     bn_fmt, byt_or = ask(s, "WFMO:BN_FMT?;BYT_OR?").split(";")
     assert bn_fmt == ("RP" if "BN_FMT RP" in fields else "RI")
     assert byt_or == ("LSB" if "LSB" in fields else "MSB")
-    assert s.handle(b"WFMO:BN_FMT FP") == b"" and ask(s, "EVENT?") == "221"
+    s.handle(b"WFMO:BN_FMT FP")  # the 4 Series manual: floats, BYT_NR 4, the byte order kept
+    assert ask(s, "DATA:ENCDG?;:WFMO:BYT_NR?;BIT_NR?;EVENT?") == (
+        f"{'SFPBINARY' if byt_or == 'LSB' else 'FPBINARY'};4;32;0" if encoding != "ASCII" else "ASCII;4;32;0")
+
+
+@pytest.mark.parametrize("personality, command, refused", [
+    ("mdo3000", "DATA:ENC FASTEST", None), ("mdo3000", "DATA:ENC FPBINARY", None), ("mso4", "DATA:ENC SFP", None),
+    ("mso4", "WFMO:BYT_NR 4", None), ("mso4", "WFMO:BIT_NR 32", None), ("mso4", "DATA:ENC FAS", "224"),
+    ("tds2000", "DATA:ENC FPB", "224"), ("tds2000", "WFMPRE:BN_FMT FP", "224"), ("tds2000", "WFMPRE:BYT_NR 4", "222")])
+def test_the_encodings_of_each_models_manual(make_scope, personality, command, refused):
+    """DATa:ENCdg takes the words of the model's manual: the MDO3000's FAStest (signed,
+    MSB first) and FPBinary, the 4 Series' FPBinary and SFPbinary (4-byte floats whose
+    preamble turns them into the record's volts); the TDS2000's integers only."""
+    scope, s, _ = make_scope(personality, seed=3)
+    s.handle(command.encode())
+    assert ask(s, "EVENT?") == (refused or "0")
+    if refused:
+        return
+    fire(s)
+    s.handle(b"DATA:SOURCE CH1;START 1;STOP 500")
+    pre = preamble(s, "WFMOutpre")
+    floats = pre["BN_FMT"] == "FP"
+    assert floats == ("FAS" not in command) and pre["BYT_NR"] == ("4" if floats else "1")
+    payload = block_payload(s.handle(b"CURVE?").rstrip(b"\n"))
+    kind = "f4" if floats else "i1"
+    values = np.frombuffer(payload, ("<" if pre["BYT_OR"] == "LSB" else ">") + kind)
+    volts = float(pre["YZERO"]) + float(pre["YMULT"]) * (values - float(pre["YOFF"]))
+    assert values.size == 500
+    assert np.allclose(volts, scope.acq.last.record["CH1"].volts()[:500], rtol=0, atol=1e-12)
 
 
 def test_data_query_and_init(make_scope):
