@@ -80,7 +80,7 @@ def test_a_record_past_the_cost_limit_is_refused_at_the_setting_and_nothing_chan
     s = scope.open_session("t")
     before = ask(s, "HOR:RECO?;:HOR:SCA?")
     reply = ask(s, "HOR:RECO 10000;:HOR:SCA 1E-7;:ALLEV?")  # 10 ps a sample over 3 ms: GB
-    assert reply.startswith('-221,"Settings conflict; this record needs about') and "2 GB" in reply
+    assert reply.startswith('221,"Settings conflict; this record needs about') and "2 GB" in reply
     assert ask(s, "HOR:RECO 10000;:HOR:SCA?") == ask(s, "HOR:SCA?") != "1.0000E-9"
     ask(s, f"HOR:RECO {before.split(';')[0]};:HOR:SCA {before.split(';')[1]}")
 
