@@ -9,6 +9,15 @@ shot and completes when its record is in. ``Magnet`` (``set(force)``, newtons) a
 event holds the value its shot was fired with. The devices share one ``ShotBackend``
 (rig/lab/backend.py); every backend call runs in a worker thread, never on the event loop.
 
+Pause and resume: the scope is bluesky's ``Pausable``. A plan with a checkpoint before each
+shot (bluesky's ``count``, ``scan``, ``list_scan``, ``grid_scan``; the rig's plans.py) paused
+at a checkpoint (one Ctrl-C, a deferred pause) has no shot in flight, and resumes with the
+next seed. Paused at once (Ctrl-C twice, ``RunEngine.request_pause()``) while a shot is in
+flight, the RunEngine drops the event being bundled, rewinds to the checkpoint before that
+shot and, on resume, triggers the scope again: that trigger fires the same shot again at its
+own seed (``ShotBackend.fire(seed)``), so the events keep the seeds N, N+1, ... with none
+skipped or used twice (``VirtualScope`` names the two instants of a pause where that fails).
+
     bench = InProcessBench("ptfe52_magnetic", seed=1)
     scope, magnet = VirtualScope(bench, name="scope"), Magnet(bench, name="magnet")
 """
@@ -17,7 +26,7 @@ from __future__ import annotations
 import asyncio
 
 import numpy as np
-from bluesky.protocols import Movable
+from bluesky.protocols import Movable, Pausable, Reading
 from ophyd_async.core import Array1D, AsyncStatus, StandardReadable, StandardReadableFormat, soft_signal_r_and_setter
 
 from instruments.errors import InstrumentError
@@ -47,14 +56,32 @@ class ScopeChannel(StandardReadable):
         self._show_scale(float(p.extra.get("volts_per_div", np.nan)))
 
 
-class VirtualScope(StandardReadable):
+class VirtualScope(StandardReadable, Pausable):
     """The rig's oscilloscope: ``trigger()`` fires the next shot (seed N + k - 1 for the
     k-th) and waits for its record; a shot that did not trigger fails the trigger with the
-    scope's reason."""
+    scope's reason.
+
+    A shot is in flight from its trigger until the scope is read (the reading goes into the
+    shot's event). ``pause()``, which the RunEngine calls as it pauses, keeps the shot in
+    flight, if any: the RunEngine rewinds to the checkpoint before it and triggers again on
+    resume, and that next trigger waits for the kept shot, then fires it again at its own
+    seed (a shot the rig refused fired nothing: its seed is the next one's). A shot already
+    read is delivered, and the next trigger fires the next seed.
+
+    The scope's reading is the mark it sees, not the event's save, so two instants of an
+    immediate pause stay as bluesky has them. After the scope's reading and before the save
+    (one loop turn of the RunEngine where the scope is read last, as in plans.py; in bluesky's
+    own plans, which read the detectors first, also while the motors are read), the RunEngine
+    redoes the event with the next seed, and the read shot's seed goes unused. Between the save
+    and the next checkpoint (one loop turn), it emits the event again (bluesky's replay: the
+    same seq_num, with the next seed). A pause at a checkpoint (one Ctrl-C) falls in neither.
+    """
 
     def __init__(self, backend: ShotBackend, name: str = ""):
         self.backend = backend
         self.last: Fired | None = None
+        self._in_flight: asyncio.Task[Fired] | None = None  # the last trigger's shot, until it is read
+        self._redo: asyncio.Task[Fired] | None = None  # the shot a pause caught in flight
         with self.add_children_as_readables():
             self.seed, self._show_seed = soft_signal_r_and_setter(int)
             for ch in backend.channels:
@@ -67,9 +94,24 @@ class VirtualScope(StandardReadable):
             raise InstrumentError(f"channel = {name!r}: displayed are {', '.join(self.backend.channels)}")
         return getattr(self, name.lower())
 
-    @AsyncStatus.wrap
-    async def trigger(self) -> None:
-        fired = await asyncio.to_thread(self.backend.fire)
+    def trigger(self) -> AsyncStatus:
+        """Fire a shot (the next seed, or again the one a pause caught) and show its record."""
+        redo, self._redo = self._redo, None
+        shot = asyncio.ensure_future(self._fire(redo))
+        self._in_flight = shot
+        return AsyncStatus(self._show(shot))
+
+    async def _fire(self, redo: asyncio.Task[Fired] | None) -> Fired:
+        seed = None
+        if redo is not None:
+            try:
+                seed = (await redo).seed  # the caught shot is in first: the rig fires one shot at a time
+            except InstrumentError:
+                seed = None  # refused, so never fired: the sequence has not given its seed
+        return await asyncio.to_thread(self.backend.fire, seed)
+
+    async def _show(self, shot: asyncio.Task[Fired]) -> None:
+        fired = await shot
         record = fired.record
         if not record.triggered:
             raise InstrumentError(f"the scope did not trigger (seed {fired.seed}): {record.reason}")
@@ -81,6 +123,20 @@ class VirtualScope(StandardReadable):
             self.channel(ch).show(waveform)
         self._show_seed(fired.seed)
         self.last = fired
+
+    async def read(self) -> dict[str, Reading]:
+        """The last shot's waveforms and seed; the shot is delivered (no longer in flight)."""
+        reading = await super().read()
+        self._in_flight = self._redo = None
+        return reading
+
+    def pause(self) -> None:
+        """The RunEngine pauses: a shot in flight is fired again, at its seed, by the next trigger."""
+        if self._in_flight is not None:
+            self._redo = self._in_flight
+
+    def resume(self) -> None:
+        """The RunEngine resumes: nothing to do (the rewound plan triggers again)."""
 
 
 class RigSetting(StandardReadable, Movable[float]):

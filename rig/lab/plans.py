@@ -2,6 +2,15 @@
 the magnet's force scanned, N shots per force, every shot one event holding the force it
 was fired with and the scope's waveforms.
 
+It is built as bluesky's own plans are (``one_nd_step``): a checkpoint before each shot, so
+that a pause (Ctrl-C once: a deferred pause) stops there, and an immediate one (Ctrl-C
+twice, ``RunEngine.request_pause()``) rewinds there: ``RunEngine.resume()`` goes on from
+that shot, which the scope fires again at its own seed if the pause caught it in flight
+(rig/lab/bluesky.py). The run then holds one event per planned shot, seq_num 1, 2, ... and
+the seeds N, N+1, ... once each (but for the two instants of an immediate pause that
+``VirtualScope`` names). bluesky's ``count``, ``scan``, ``list_scan`` and ``grid_scan`` take
+the same devices (``Magnet``, ``Striker`` as motors).
+
     from bluesky import RunEngine
     bench = InProcessBench("ptfe52_magnetic", seed=1)
     scope, magnet = VirtualScope(bench, name="scope"), Magnet(bench, name="magnet")
@@ -19,8 +28,9 @@ from rig.errors import invalid
 
 def magnet_force_scan(scope, magnet, forces: Iterable[float], shots: int = 1, md: dict | None = None):
     """A plan: for each force (N), move the magnet there, then ``shots`` times trigger the
-    scope and read it with the magnet (one event per shot). One run; its start document
-    names the forces and the shots per force."""
+    scope and read the magnet and the scope (one event per shot), a checkpoint before each
+    shot (and before the move to its force, for a force's first shot). One run; its start
+    document names the forces and the shots per force."""
     forces = [float(f) for f in forces]
     if not forces:
         raise invalid("forces", forces, "one force or more, in N")
@@ -34,15 +44,21 @@ def magnet_force_scan(scope, magnet, forces: Iterable[float], shots: int = 1, md
     @bpp.run_decorator(md=meta)
     def scan():
         for force in forces:
-            yield from bps.mv(magnet, force)
-            for _ in range(shots):
-                yield from bps.trigger_and_read([scope, magnet])
+            for shot in range(shots):
+                yield from bps.checkpoint()  # a pause stops here, and resume goes on from here
+                if shot == 0:
+                    yield from bps.mv(magnet, force)
+                # the scope read last: its reading marks its shot delivered (bluesky.py), so
+                # a pause between the mark and the event's save falls in one loop turn only
+                yield from bps.trigger_and_read([magnet, scope])
 
     return (yield from scan())
 
 
 def documents(run_engine, plan) -> list:
-    """Run ``plan`` on ``run_engine``; the (name, document) pairs it emitted, in order."""
+    """Run ``plan`` on ``run_engine``; the (name, document) pairs it emitted, in order. For a
+    run that may be paused, subscribe a callback of your own instead: a pause ends this call
+    (``RunEngineInterrupted``), and the rest of the documents come with ``resume()``."""
     out = []
     token = run_engine.subscribe(lambda name, doc: out.append((name, doc)))
     try:
