@@ -20,6 +20,7 @@ from .settings import channel_key
 
 CHANNEL_WORDS = ("CH1", "CH2", "CH3", "CH4")
 TWENTY_MHZ = 20e6
+LOGIC_LEVELS = {"ECL": -1.3, "TTL": 1.4}  # TRIGger:A:LEVel's preset words (MDO3000, DPO4000 manuals), V
 
 
 def register(tree, scope) -> None:
@@ -115,14 +116,14 @@ def register(tree, scope) -> None:
     def set_mode(c: Call):
         scope.horizontal_mode = c.word(("AUTO", "CONStant", "MANual"))
 
-    for head in ("HORizontal", "HORizontal:MAIn", "HORizontal:MODE"):
+    for head in ("HORizontal", "HORizontal:MAIn", "HORizontal:MODe"):
         tree.add(f"{head}:SCAle", write=set_scale, read=lambda c: p.number(s_div()))
     for head in ("HORizontal", "HORizontal:MAIn"):
         tree.add(f"{head}:POSition", write=set_position, read=read_position)
-    for head in ("HORizontal", "HORizontal:MODE"):
+    for head in ("HORizontal", "HORizontal:MODe"):
         tree.add(f"{head}:RECOrdlength", write=set_length, read=lambda c: str(scope.settings["scope.record_length"]))
         tree.add(f"{head}:SAMPLERate", read=lambda c: p.number(sample_rate()))
-    tree.add("HORizontal:MODE", write=set_mode, read=lambda c: Word(scope.horizontal_mode))
+    tree.add("HORizontal:MODe", write=set_mode, read=lambda c: Word(scope.horizontal_mode))
     tree.add("HORizontal:MAIn:UNIts", read=lambda c: '"s"')
     tree.add("HORizontal:ROLL", write=refuse_but("OFF"), read=lambda c: Word("OFF"))
 
@@ -149,8 +150,9 @@ def register(tree, scope) -> None:
 
     def set_level(c: Call):
         """TRIGger:A:LEVel (the source's) or TRIGger:A:LEVel:CH<x> (channel x's; the
-        trigger's own where x is its source), V."""
-        ch, level = level_channel(c), c.number("V")
+        trigger's own where x is its source), V, or the manuals' ECL (-1.3 V) and TTL (1.4 V)."""
+        ch = level_channel(c)
+        level = LOGIC_LEVELS[c.word(tuple(LOGIC_LEVELS))] if c.arg().kind != "number" else c.number("V")
         if ch == scope.settings["scope.trigger.source"]:
             scope.change({"scope.trigger.level": level}, code=-222)
         elif not abs(level) <= LEVEL_LIMIT_V:

@@ -1,0 +1,158 @@
+"""How much of each model's programmer manual the emulated scope answers.
+
+The manuals' commands (instruments/virtual_scope/manuals/, written by
+tools/manual_commands.py from the command trees of tm_devices, which Tektronix generates
+from the programmer manuals) are sent to an emulated scope one by one, <x> taken as 1: a
+header the scope answers (or takes) is *implemented*; an enumerated value of it the scope
+refuses with 221 "Settings conflict" is *refused by design* (a setting not emulated, such
+as GND coupling); a header the scope does not know (113 "Undefined header") is *not
+emulated*. ``python -m instruments.virtual_scope.coverage`` prints the table of
+docs/reference/scpi-coverage.md. The TDS2000 has no such tree; its commands are those of
+the emulation's own tests."""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from importlib import resources
+
+from ..errors import InstrumentError
+
+MODELS = ("mdo3000", "mso4")
+ENUM = re.compile(r"\{([^{}]*)\}")
+
+
+@dataclass(frozen=True)
+class ManualCommand:
+    """One header of a manual: its group, the header as the manual spells it, whether it
+    has a query form and a set form, and the set form's argument syntax."""
+
+    group: str
+    header: str
+    query: bool
+    write: bool
+    args: str = ""
+
+    @property
+    def concrete(self) -> str:
+        """The header with every <x> taken as 1 and every {A|B} choice as its first."""
+        return ENUM.sub(lambda m: m.group(1).split("|")[0], self.header.replace("<x>", "1"))
+
+    @property
+    def words(self) -> tuple:
+        """The enumerated words the set form takes (``{DC|AC|GND}``), in the manual's order."""
+        m = ENUM.search(self.args)
+        return tuple(w for w in m.group(1).split("|") if w and not w.startswith("<")) if m else ()
+
+
+def manual(model: str) -> tuple:
+    """The ManualCommands of a model's manual, in the file's order (one per header)."""
+    if model not in MODELS:
+        raise InstrumentError(f"model = {model!r}: allowed {', '.join(MODELS)}")
+    text = resources.files(__package__).joinpath("manuals").joinpath(f"{model}.txt").read_text(encoding="utf-8")
+    heads: dict = {}
+    for line in text.splitlines():
+        if not line or line.startswith("#"):
+            continue
+        group, syntax = line.split("\t", 1)
+        head, _, args = syntax.partition(" ")
+        query = head.endswith("?")
+        head = head.rstrip("?")
+        old = heads.get(head, ManualCommand(group, head, False, False))
+        heads[head] = ManualCommand(group, head, old.query or query, old.write or not query,
+                                    old.args or ("" if query else args))
+    return tuple(heads.values())
+
+
+@dataclass(frozen=True)
+class Probe:
+    """What the scope made of one manual command: ``status`` (implemented, not emulated),
+    the query's answer (None: no query form, or none given), the words refused by design."""
+
+    command: ManualCommand
+    status: str
+    answer: str | None
+    refused: tuple
+
+
+def events(session) -> list:
+    """The codes of the events queued since the last call (ALLEv? read whole)."""
+    reply = session.handle(b"ALLEV?").decode()
+    return [int(code) for code in re.findall(r'(?:^|[ ,])(-?\d+),"', reply) if int(code) != 0]
+
+
+def placeholder(args: str) -> str:
+    """An argument of the syntax's kind for a set form that has no query to echo."""
+    if "<" not in args and "{" not in args:  # a literal word (TRIGger FORCe)
+        return args
+    if "QString" in args:
+        return '"x"'
+    if "Block" in args:
+        return "#10"
+    return "1"
+
+
+def probe(session, command: ManualCommand) -> Probe:
+    """Send one command's query (and each of its enumerated words) to a session."""
+    session.handle(b"*RST;:HEADER OFF;:VERBOSE ON;*CLS")
+    answer, known = None, True
+    if command.query:
+        reply = session.handle(f"{command.concrete}?".encode()).decode().strip()
+        answer = reply or None
+        known = 113 not in events(session)
+    refused = []
+    if command.write and known:
+        for word in command.words or ("",):
+            if word == "" and command.args:  # a number, a string or a block: the query's own answer back
+                word = answer if answer is not None else placeholder(command.args)
+            session.handle(f"{command.concrete} {word}".strip().encode())
+            codes = events(session)
+            known = known and 113 not in codes
+            if 221 in codes:
+                refused.append(word)
+    return Probe(command, "implemented" if known else "not emulated", answer, tuple(refused))
+
+
+def table(probes: dict) -> str:
+    """The coverage table (markdown): per model and group, the manual's headers, how many
+    are implemented, the words refused by design, and the implemented headers."""
+    out = ["| model | group | manual headers | implemented | refused by design |", "|---|---|---|---|---|"]
+    for model, found in probes.items():
+        groups: dict = {}
+        for p in found:
+            groups.setdefault(p.command.group, []).append(p)
+        for group, ps in groups.items():
+            done = [p for p in ps if p.status == "implemented"]
+            refused = [f"`{p.command.header} {w}`" for p in done for w in p.refused]
+            out.append(f"| {model} | {group} | {len(ps)} | {len(done)} | {', '.join(refused) or '-'} |")
+    for model, found in probes.items():
+        out += ["", f"Implemented on the {model}:", ""]
+        groups = {}
+        for p in found:
+            if p.status == "implemented":
+                groups.setdefault(p.command.group, []).append(f"`{p.command.header}`")
+        out += [f"- {group}: {', '.join(heads)}" for group, heads in groups.items()]
+    return "\n".join(out) + "\n"
+
+
+def no_shots(overrides, seed):
+    raise InstrumentError("no shots while the manual's commands are probed")
+
+
+def probe_model(model: str) -> tuple:
+    """The Probes of every command of a model's manual, on an emulated scope of two
+    channels whose shots are refused (no command is probed for a record)."""
+    from ..devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
+    from .instrument import VirtualScope
+
+    scene = Oscilloscope(channels={"CH1": ChannelSettings(0.05), "CH2": ChannelSettings(0.05)},
+                         timebase=Timebase(4e-7, 10_000), trigger=Trigger("CH1", 0.03, "rising", 0.1))
+    scope = VirtualScope(scene, no_shots, personality_name=model, opc_timeout_s=1.0)
+    try:
+        session = scope.open_session("coverage")
+        return tuple(probe(session, c) for c in manual(model))
+    finally:
+        scope.close()
+
+
+if __name__ == "__main__":
+    print(table({model: probe_model(model) for model in MODELS}), end="")
