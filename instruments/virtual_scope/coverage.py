@@ -138,15 +138,20 @@ def no_shots(overrides, seed):
     raise InstrumentError("no shots while the manual's commands are probed")
 
 
-def probe_model(model: str) -> tuple:
-    """The Probes of every command of a model's manual, on an emulated scope of two
-    channels whose shots are refused (no command is probed for a record)."""
+def probing_scope(model: str):
+    """An emulated ``model`` of two channels whose shots are refused (a command is probed,
+    never a record); close it after use."""
     from ..devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
     from .instrument import VirtualScope
 
     scene = Oscilloscope(channels={"CH1": ChannelSettings(0.05), "CH2": ChannelSettings(0.05)},
                          timebase=Timebase(4e-7, 10_000), trigger=Trigger("CH1", 0.03, "rising", 0.1))
-    scope = VirtualScope(scene, no_shots, personality_name=model, opc_timeout_s=1.0)
+    return VirtualScope(scene, no_shots, personality_name=model, opc_timeout_s=1.0)
+
+
+def probe_model(model: str) -> tuple:
+    """The Probes of every command of a model's manual (``probing_scope``)."""
+    scope = probing_scope(model)
     try:
         session = scope.open_session("coverage")
         return tuple(probe(session, c) for c in manual(model))

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from instruments.virtual_scope.coverage import MODELS, events, probe_model, table
+from instruments.virtual_scope.coverage import MODELS, events, probe_model, probing_scope, table
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "reference" / "scpi-coverage.md"
 NUMBER = re.compile(r"[-+]?\d+(\.\d+)?(E[-+]?\d+)?")
@@ -35,14 +35,8 @@ def short(header: str) -> str:
 
 
 def test_short_and_long_forms_answer_alike_and_numbers_are_nr3(probes):
-    from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
-    from instruments.virtual_scope.coverage import no_shots
-    from instruments.virtual_scope.instrument import VirtualScope
-
     for model in MODELS:
-        scene = Oscilloscope(channels={"CH1": ChannelSettings(0.05), "CH2": ChannelSettings(0.05)},
-                             timebase=Timebase(4e-7, 10_000), trigger=Trigger("CH1", 0.03, "rising", 0.1))
-        scope = VirtualScope(scene, no_shots, personality_name=model, opc_timeout_s=1.0)
+        scope = probing_scope(model)
         session = scope.open_session("conformance")
         checked = 0
         try:
@@ -68,14 +62,8 @@ def test_short_and_long_forms_answer_alike_and_numbers_are_nr3(probes):
 def test_no_implemented_header_takes_a_manual_word_as_a_syntax_error(probes):
     """A word of the manual may be refused (221, or 224 where the emulation lacks it), but
     never parsed as something else: no 10x command error for a manual word."""
-    from instruments.devices.oscilloscope import ChannelSettings, Oscilloscope, Timebase, Trigger
-    from instruments.virtual_scope.coverage import no_shots
-    from instruments.virtual_scope.instrument import VirtualScope
-
     for model in MODELS:
-        scene = Oscilloscope(channels={"CH1": ChannelSettings(0.05), "CH2": ChannelSettings(0.05)},
-                             timebase=Timebase(4e-7, 10_000), trigger=Trigger("CH1", 0.03, "rising", 0.1))
-        scope = VirtualScope(scene, no_shots, personality_name=model, opc_timeout_s=1.0)
+        scope = probing_scope(model)
         session = scope.open_session("conformance")
         try:
             for p in probes[model]:
