@@ -13,6 +13,7 @@ its long form with VERBose ON, its short form otherwise. A query that fails answ
 an event (a bug) leaves -200 "internal fault" and the message goes on."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from .numbers import number
@@ -29,6 +30,14 @@ class Word(str):
     def form(self, verbose: bool) -> str:
         m = Mnemonic(self)
         return m.long if verbose else m.short
+
+
+class IllegalWord(ScpiError):
+    """-224 "Illegal parameter value": a word the handler does not take (``word``: as sent)."""
+
+    def __init__(self, detail: str, word: str) -> None:
+        super().__init__(-224, detail)
+        self.word = word
 
 
 @dataclass(frozen=True)
@@ -94,7 +103,7 @@ class Call:
             m = Mnemonic(c)
             if a.kind == "word" and text in (m.long, m.short):
                 return c
-        raise ScpiError(-224, f"{self.header} {a.text[:40]!r}: allowed {', '.join(choices)}")
+        raise IllegalWord(f"{self.header} {a.text[:40]!r}: allowed {', '.join(choices)}", a.text)
 
     def boolean(self, i: int = 0) -> bool:
         """Argument i as ON/OFF or a number (non-zero is ON, IEEE 488.2 7.7.2 rounded)."""
@@ -112,6 +121,10 @@ class Engine:
     tree: CommandTree
     status: StatusModel = field(default_factory=StatusModel)
     form: ReplyForm = field(default_factory=ReplyForm)
+    manual_word: Callable[[str, str], bool] | None = None
+    """(the header found, long form, e.g. ``:CH1:COUPLING``; a word as sent) -> whether the
+    instrument's manual lists it: such a word a handler does not take is a setting not
+    modelled (-221 "Settings conflict"), not an illegal value (-224)."""
 
     def execute(self, message: bytes, context=None) -> bytes:
         """Run every unit of a message; the replies of its queries, joined by ``;`` and
@@ -142,6 +155,9 @@ class Engine:
             try:
                 value = handler(call)
             except ScpiError as e:
+                if isinstance(e, IllegalWord) and self.manual_word is not None \
+                        and self.manual_word(found.header(True), e.word):
+                    e = ScpiError(-221, f"{unit.header[:60]} {e.word[:40]}: in the manual, not modelled here")
                 self.status.post(e.code, f"{e.detail}" if e.detail else unit.header[:60])
                 continue
             except Exception as e:  # noqa: BLE001 - a handler's fault must not drop the client

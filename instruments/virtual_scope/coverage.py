@@ -13,54 +13,11 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from importlib import resources
 
 from ..errors import InstrumentError
+from .manual import MODELS, ManualCommand, manual
 
-MODELS = ("mdo3000", "mso4")
-ENUM = re.compile(r"\{([^{}]*)\}")
-
-
-@dataclass(frozen=True)
-class ManualCommand:
-    """One header of a manual: its group, the header as the manual spells it, whether it
-    has a query form and a set form, and the set form's argument syntax."""
-
-    group: str
-    header: str
-    query: bool
-    write: bool
-    args: str = ""
-
-    @property
-    def concrete(self) -> str:
-        """The header with every <x> taken as 1 and every {A|B} choice as its first."""
-        return ENUM.sub(lambda m: m.group(1).split("|")[0], self.header.replace("<x>", "1"))
-
-    @property
-    def words(self) -> tuple:
-        """The enumerated words the set form takes (``{DC|AC|GND}``), in the manual's order."""
-        m = ENUM.search(self.args)
-        return tuple(w for w in m.group(1).split("|") if w and not w.startswith("<")) if m else ()
-
-
-def manual(model: str) -> tuple:
-    """The ManualCommands of a model's manual, in the file's order (one per header)."""
-    if model not in MODELS:
-        raise InstrumentError(f"model = {model!r}: allowed {', '.join(MODELS)}")
-    text = resources.files(__package__).joinpath("manuals").joinpath(f"{model}.txt").read_text(encoding="utf-8")
-    heads: dict = {}
-    for line in text.splitlines():
-        if not line or line.startswith("#"):
-            continue
-        group, syntax = line.split("\t", 1)
-        head, _, args = syntax.partition(" ")
-        query = head.endswith("?")
-        head = head.rstrip("?")
-        old = heads.get(head, ManualCommand(group, head, False, False))
-        heads[head] = ManualCommand(group, head, old.query or query, old.write or not query,
-                                    old.args or ("" if query else args))
-    return tuple(heads.values())
+SHOWN = 6  # words refused by design named in a row of the table
 
 
 @dataclass(frozen=True)
@@ -114,8 +71,9 @@ def probe(session, command: ManualCommand) -> Probe:
 
 def table(probes: dict) -> str:
     """The coverage table (markdown): per model and group, the manual's headers, how many
-    are implemented, the words refused by design, and the implemented headers."""
-    out = ["| model | group | manual headers | implemented | refused by design |", "|---|---|---|---|---|"]
+    are implemented, how many words they refuse by design (the first SHOWN named), and the
+    implemented headers."""
+    out = ["| model | group | manual headers | implemented | words refused by design |", "|---|---|---|---|---|"]
     for model, found in probes.items():
         groups: dict = {}
         for p in found:
@@ -123,7 +81,8 @@ def table(probes: dict) -> str:
         for group, ps in groups.items():
             done = [p for p in ps if p.status == "implemented"]
             refused = [f"`{p.command.header} {w}`" for p in done for w in p.refused]
-            out.append(f"| {model} | {group} | {len(ps)} | {len(done)} | {', '.join(refused) or '-'} |")
+            shown = ", ".join(refused[:SHOWN]) + (f" and {len(refused) - SHOWN} more" if len(refused) > SHOWN else "")
+            out.append(f"| {model} | {group} | {len(ps)} | {len(done)} | {len(refused)}: {shown or '-'} |")
     for model, found in probes.items():
         out += ["", f"Implemented on the {model}:", ""]
         groups = {}

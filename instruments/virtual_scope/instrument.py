@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Callable
+from functools import partial
 
 from ..devices.oscilloscope import Oscilloscope
 from ..errors import InstrumentError
@@ -24,6 +25,7 @@ from ..scpi.tree import CommandTree
 from ..transports.device import InstrumentLock
 from . import commands, common, measurements, rig_commands, setup, waveform_commands
 from .acquisition import Acquisition, ShotSource
+from .manual import in_manual
 from .measurements import default_slots
 from .personalities import personality, snap_to_steps
 from .settings import acquired, overrides, scene_settings, scope_of
@@ -84,8 +86,9 @@ class VirtualScope:
         waveform_commands.register(tree, self)
         measurements.register(tree, self)
         setup.register(tree, self)
-        self.engine = Engine(tree, self.status, self.form)
-        self.rig_engine = Engine(rig_tree, self.status, self.form)
+        in_model_manual = partial(in_manual, self.personality.name)
+        self.engine = Engine(tree, self.status, self.form, in_model_manual)
+        self.rig_engine = Engine(rig_tree, self.status, self.form, in_model_manual)
 
     def _personality_settings(self, s: dict) -> dict:
         """The scene's settings on this model: its record length nearest the scene's (within
