@@ -62,16 +62,22 @@ def _guarded(link: Link, send, loop) -> None:
     try:
         loop(link)
     except ProtocolError as e:
+        link.report(f"{e}: FatalError sent, the session ends")
         send(Kind.FATAL_ERROR, Fatal.POORLY_FORMED_HEADER, 0, str(e).encode())
+        link.close("after the protocol violation")
 
 
 def _sync_loop(link: Link) -> None:
     pending = _Message()
     while not link.closed.is_set():
         header = read_header(link.sync)
+        link.clock.heard()
         if link.asynchronous is None:
+            link.report(f"message type {header.kind} on the synchronous channel before AsyncInitialize: "
+                        "FatalError sent, the session ends")
             link.send_sync(Kind.FATAL_ERROR, Fatal.NO_ASYNC_CHANNEL, 0,
                            b"message on the synchronous channel before AsyncInitialize")
+            link.close("after the protocol violation")
             return
         if header.kind in (Kind.DATA, Kind.DATA_END):
             _data(link, header, pending)
@@ -79,15 +85,16 @@ def _sync_loop(link: Link) -> None:
             discard(link.sync, header.length)
             if not link.clearing.is_set():
                 _start(link, header)
-                if link.wait_unlocked():
-                    link.session.trigger()
+                with link.clock.working():
+                    if link.wait_unlocked():
+                        link.session.trigger()
         elif header.kind == Kind.DEVICE_CLEAR_COMPLETE:
             discard(link.sync, header.length)
             pending.reset()
             link.undelivered = False
             link.clearing.clear()
             link.send_sync(Kind.DEVICE_CLEAR_ACKNOWLEDGE, 0)  # feature: synchronized mode
-        elif not _common(header, link.sync, link.send_sync):
+        elif not _common(header, link.sync, link.send_sync, link.report):
             return
 
 
@@ -101,6 +108,7 @@ def _data(link: Link, header: Header, pending: _Message) -> None:
         pending.started = True
     if header.length > link.max_message:
         discard(link.sync, header.length)
+        link.report(f"a Data message of {header.length} bytes: allowed at most {link.max_message}; Error sent")
         link.send_sync(Kind.ERROR, Error.MESSAGE_TOO_LARGE, 0,
                        f"message length = {header.length}: allowed at most {link.max_message} bytes".encode())
     else:
@@ -114,13 +122,18 @@ def _data(link: Link, header: Header, pending: _Message) -> None:
     pending.reset()
     if size > link.max_message:
         link.session.overflow(size)
+        link.report(f"a program message of {size} bytes in Data parts: allowed at most {link.max_message}; refused")
+        link.clock.done()
         return
     program = program[:-1] if program.endswith(b"\n") else program  # the terminator before END
     program = program[:-1] if program.endswith(b"\r") else program
-    if program and link.wait_unlocked():
-        reply = link.session.handle(program)
-        if reply:
-            link.send_reply(reply, header.parameter)
+    if not program:
+        return
+    with link.clock.working():
+        reply = link.session.handle(program) if link.wait_unlocked() else b""
+    if reply:
+        link.send_reply(reply, header.parameter)
+        link.clock.done()
 
 
 def _start(link: Link, header: Header) -> None:
@@ -138,12 +151,15 @@ def _async_loop(link: Link) -> None:
     assert conn is not None, "served once both channels are paired"
     while not link.closed.is_set():
         header = read_header(conn)
+        link.clock.done()
         kind = header.kind
         if kind == Kind.ASYNC_MAXIMUM_MESSAGE_SIZE and header.length == 8:
             link.client_max = struct.unpack("!Q", recv_exact(conn, 8))[0]
             link.send_async(Kind.ASYNC_MAXIMUM_MESSAGE_SIZE_RESPONSE, 0, 0, struct.pack("!Q", link.max_message))
         elif kind == Kind.ASYNC_LOCK and header.control in (0, 1):
-            link.send_async(Kind.ASYNC_LOCK_RESPONSE, _lock(link, header))
+            with link.clock.working():  # a lock request may wait its timeout
+                granted = _lock(link, header)
+            link.send_async(Kind.ASYNC_LOCK_RESPONSE, granted)
         elif kind == Kind.ASYNC_LOCK_INFO:
             discard(conn, header.length)
             state = link.lock.state()
@@ -162,7 +178,7 @@ def _async_loop(link: Link) -> None:
         elif kind == Kind.ASYNC_REMOTE_LOCAL_CONTROL and header.control <= 6:
             discard(conn, header.length)  # no front panel to lock out: every request is granted
             link.send_async(Kind.ASYNC_REMOTE_LOCAL_RESPONSE)
-        elif not _common(header, conn, link.send_async):
+        elif not _common(header, conn, link.send_async, link.report):
             return
 
 
@@ -195,7 +211,7 @@ def _lock(link: Link, header: Header) -> int:
             return LockReply.FAILURE
 
 
-def _common(header: Header, conn: socket.socket, send) -> bool:
+def _common(header: Header, conn: socket.socket, send, report) -> bool:
     """Messages either channel may get: errors from the client, unknown types. False when the
     session must end."""
     if header.kind == Kind.FATAL_ERROR:
@@ -212,5 +228,6 @@ def _common(header: Header, conn: socket.socket, send) -> bool:
         code, text = Error.UNRECOGNIZED_VENDOR_MESSAGE, f"vendor message type = {header.kind}: none served"
     else:
         code, text = Error.UNRECOGNIZED_MESSAGE_TYPE, f"message type = {header.kind}: not served on this channel"
+    report(f"{text}; Error sent")
     send(Kind.ERROR, code, 0, text.encode())
     return True

@@ -9,7 +9,7 @@ import struct
 from dataclasses import dataclass
 from enum import IntEnum
 
-from instruments.transports.tcp import recv_exact
+from instruments.transports.tcp import await_message, recv_exact
 
 PROLOGUE = b"HS"
 HEADER = struct.Struct("!2sBBIQ")
@@ -101,7 +101,9 @@ def message(kind: int, control: int = 0, parameter: int = 0, payload: bytes = b"
 
 
 def read_header(conn: socket.socket) -> Header:
-    """The next header on ``conn``; ProtocolError when it lacks the prologue."""
+    """The next header on ``conn``, waited for as long as it takes (its bytes, once begun,
+    within the socket's timeout); ProtocolError when it lacks the prologue."""
+    await_message(conn)
     prologue, kind, control, parameter, length = HEADER.unpack(recv_exact(conn, HEADER.size))
     if prologue != PROLOGUE:
         raise ProtocolError(f"header prologue = {prologue!r}: allowed b'HS'")

@@ -6,9 +6,12 @@ from __future__ import annotations
 import contextlib
 import socket
 import threading
+from collections.abc import Callable
 
 from instruments.transports.device import InstrumentLock, Session
 from instruments.transports.hislip_codec import HEADER, Kind, message
+from instruments.transports.tcp import send_all
+from instruments.transports.wire import Clock, Connection
 
 DEFAULT_CLIENT_MAX = 1 << 20
 """The client's maximum message size until it says another (VISA's default, bytes)."""
@@ -21,7 +24,8 @@ class Link:
     session behind them, and what the two channels share."""
 
     def __init__(self, session_id: int, sync: socket.socket, session: Session, lock: InstrumentLock,
-                 max_message: int) -> None:
+                 max_message: int, *, watch: Connection | None = None,
+                 report: Callable[[str], None] = lambda text: None) -> None:
         self.id = session_id
         self.sync = sync
         self.asynchronous: socket.socket | None = None
@@ -41,22 +45,39 @@ class Link:
         self._ending = threading.Lock()
         self._sync_out = threading.Lock()
         self._async_out = threading.Lock()
+        self.watched: list[Connection] = [watch] if watch is not None else []
+        """The connections as their listener watches them (idle, half-open)."""
+        self.clock: Clock = watch.clock if watch is not None else Clock()
+        """The session's clock: either channel's traffic keeps both alive."""
+        self.report = report
+        """Tells the server's owner of a protocol violation (in words)."""
 
-    def attach_async(self, conn: socket.socket) -> bool:
-        """Pair the asynchronous connection; False when one is paired already."""
+    @property
+    def half_open(self) -> bool:
+        """Initialized on its synchronous channel, its asynchronous one not paired yet."""
+        return self.asynchronous is None
+
+    def attach_async(self, conn: socket.socket, watch: Connection | None = None) -> bool:
+        """Pair the asynchronous connection; False when one is paired already. Both
+        connections are then open and share the session's clock."""
         if self.asynchronous is not None:
             return False
         self.asynchronous = conn
+        if watch is not None:
+            watch.clock = self.clock
+            self.watched.append(watch)
+        for c in self.watched:
+            c.awaiting = None
         return True
 
     def send_sync(self, kind: int, control: int = 0, parameter: int = 0, payload: bytes = b"") -> None:
         with self._sync_out:
-            self.sync.sendall(message(kind, control, parameter, payload))
+            send_all(self.sync, message(kind, control, parameter, payload))
 
     def send_async(self, kind: int, control: int = 0, parameter: int = 0, payload: bytes = b"") -> None:
         assert self.asynchronous is not None, "the channels are served once both are paired"
         with self._async_out:
-            self.asynchronous.sendall(message(kind, control, parameter, payload))
+            send_all(self.asynchronous, message(kind, control, parameter, payload))
 
     def send_reply(self, reply: bytes, message_id: int) -> None:
         """The instrument's reply to message ``message_id``, in parts the client takes; a
@@ -68,8 +89,8 @@ class Link:
                 if self.clearing.is_set():
                     return
                 last = start + part >= len(reply)
-                self.sync.sendall(message(Kind.DATA_END if last else Kind.DATA, 0, message_id,
-                                          reply[start:start + part]))
+                send_all(self.sync, message(Kind.DATA_END if last else Kind.DATA, 0, message_id,
+                                            reply[start:start + part]))
 
     def wait_unlocked(self) -> bool:
         """Hold a message while another client holds the lock exclusively; False when the
@@ -79,8 +100,14 @@ class Link:
                 return False
         return True
 
-    def close(self) -> None:
-        """End the session: its lock released, both connections shut (once)."""
+    def close(self, reason: str = "the other connection of its HiSLIP session ended", *,
+              by: Connection | None = None) -> None:
+        """End the session: its lock released, both connections shut (once); ``reason`` is
+        what the log says of each connection but ``by`` (the one whose end ends the session)
+        that its listener had not closed for another reason."""
+        for c in self.watched:
+            if c is not by and c.reason is None:
+                c.reason = reason
         with self._ending:
             if self._ended:
                 return

@@ -7,7 +7,9 @@ A server is a set of ``Program``s; ``answer`` turns one call record into its rep
 PROG_UNAVAIL, PROG_MISMATCH, PROC_UNAVAIL and GARBAGE_ARGS as RFC 5531 gives them, and
 RPC_MISMATCH for a caller that speaks another RPC version. Every length read off the wire is
 bounded before anything is allocated: a record fragment over the connection's limit is a
-protocol violation (``RecordTooLarge``) on which the connection is closed unread."""
+protocol violation (``RecordTooLarge``) on which the connection is closed unread.
+``RpcClient`` calls over one connection it keeps (a portmapper registration lives as long
+as the connection that made it)."""
 from __future__ import annotations
 
 import builtins
@@ -18,7 +20,8 @@ import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
-from instruments.transports.tcp import recv_exact
+from instruments.transports.tcp import ProtocolViolation, await_message, recv_exact, send_all
+from instruments.transports.wire import Connection
 
 RPC_VERSION = 2
 CALL, REPLY = 0, 1
@@ -36,7 +39,7 @@ class XdrError(ValueError):
     bound); the server answers GARBAGE_ARGS."""
 
 
-class RecordTooLarge(ConnectionError):
+class RecordTooLarge(ProtocolViolation):
     """A TCP record (or one of its fragments) longer than the connection allows."""
 
 
@@ -146,7 +149,7 @@ def read_record(conn: socket.socket, max_bytes: int) -> bytes:
 
 def write_record(conn: socket.socket, record: bytes) -> None:
     """Send ``record`` as one last fragment."""
-    conn.sendall(struct.pack(">I", LAST_FRAGMENT | len(record)) + record)
+    send_all(conn, struct.pack(">I", LAST_FRAGMENT | len(record)) + record)
 
 
 # ---- calls and replies ---------------------------------------------------------------------
@@ -233,18 +236,27 @@ def answer(record: bytes, programs: Mapping[int, Program]) -> bytes | None:
     return _accepted(call.xid, SUCCESS, result)
 
 
-def serve_connection(conn: socket.socket, programs: Mapping[int, Program], max_record: int) -> None:
+def serve_connection(conn: socket.socket, programs: Mapping[int, Program], max_record: int,
+                     watch: Connection | None = None) -> None:
     """Answer the calls of one TCP connection in order until the peer goes; a record over
-    ``max_record`` bytes ends the connection (``RecordTooLarge``, an OSError the listener
-    treats as the client gone)."""
+    ``max_record`` bytes ends the connection (``RecordTooLarge``, a protocol violation the
+    listener reports). ``watch``: the connection's record with its listener, whose clock
+    says when the client was heard and while a call of its runs (a device_read waiting)."""
     while True:
         try:
+            await_message(conn)
+            if watch is not None:
+                watch.clock.heard()
             record = read_record(conn, max_record)
         except RecordTooLarge:
             raise
         except ConnectionError:
             return  # the peer closed, between calls or within one
-        reply = answer(record, programs)
+        if watch is None:
+            reply = answer(record, programs)
+        else:
+            with watch.clock.working():
+                reply = answer(record, programs)
         if reply is not None:
             write_record(conn, reply)
 

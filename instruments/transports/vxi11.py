@@ -31,6 +31,7 @@ import threading
 
 from instruments.errors import InstrumentError
 from instruments.transports import oncrpc
+from instruments.transports.addresses import visa_host
 from instruments.transports.device import MessageInstrument
 from instruments.transports.portmap import PMAP_PORT, Announcement, announce
 from instruments.transports.tcp import TcpService
@@ -50,6 +51,7 @@ from instruments.transports.vxi11_codec import (
 )
 from instruments.transports.vxi11_link import Link
 from instruments.transports.vxi11_procedures import LinkProcedures
+from instruments.transports.wire import EventKind, EventSink, Limits
 
 __all__ = ["DEVICE_NAMES", "Vxi11Server"]
 
@@ -62,7 +64,8 @@ class Vxi11Server:
     ``close()`` ends every link, stops both channels and unregisters it."""
 
     def __init__(self, instrument: MessageInstrument, host: str = "127.0.0.1", port: int = 0, *,
-                 max_recv_size: int = 1 << 16, max_links: int = 64, max_clients: int = 32) -> None:
+                 max_recv_size: int = 1 << 16, max_links: int = 64, max_clients: int | None = None,
+                 limits: Limits | None = None, on_event: EventSink | None = None) -> None:
         self.instrument = instrument
         self.max_recv_size = max_recv_size
         """The largest data one device_write takes (told to the client at create_link)."""
@@ -70,12 +73,20 @@ class Vxi11Server:
         self._links: dict[int, Link] = {}
         self._guard = threading.Lock()
         self._ids = itertools.count(1)
+        self._on_event = on_event
         try:
-            self._core = TcpService(self._serve_core, host, port, max_clients=max_clients, name="vxi11-core")
+            self._core = TcpService(self._serve_core, host, port, max_clients=max_clients, name="vxi11-core",
+                                    limits=limits, on_event=on_event)
         except OSError as e:
             raise InstrumentError(f"VXI-11 port = {port}: cannot listen on {host} ({e.strerror}); "
                                   f"allowed: a free port, or 0 for any") from None
-        self._abort = TcpService(self._serve_abort, host, 0, max_clients=max_clients, name="vxi11-abort")
+        self.limits = self._core.limits
+        try:
+            self._abort = TcpService(self._serve_abort, self._core.host, 0, name="vxi11-abort", limits=self.limits,
+                                     on_event=on_event)
+        except OSError:
+            self._core.close()
+            raise
         self.host, self.port, self.abort_port = self._core.host, self._core.port, self._abort.port
         self._procedures = LinkProcedures(instrument, self._link, max_recv_size)
         self._abort_programs = {DEVICE_ASYNC_PROG: oncrpc.Program(
@@ -90,8 +101,15 @@ class Vxi11Server:
     @property
     def resource(self) -> str:
         """The VISA resource string: through the portmapper when announced, else with the port."""
-        return (f"TCPIP::{self.host}::INSTR" if self.announcement and self.announcement.port == PMAP_PORT
-                else f"TCPIP::{self.host},{self.port}::INSTR")
+        return self.resource_at(self.host)
+
+    def resource_at(self, host: str, *, by_port: bool = False) -> str:
+        """The VISA resource string of this server at ``host`` (an address of its machine):
+        through the portmapper when announced on port 111 (unless ``by_port``), else with the
+        core channel's port."""
+        announced = self.announcement is not None and self.announcement.port == PMAP_PORT
+        return (f"TCPIP::{visa_host(host)}::INSTR" if announced and not by_port
+                else f"TCPIP::{visa_host(host)},{self.port}::INSTR")
 
     @property
     def links(self) -> int:
@@ -105,7 +123,8 @@ class Vxi11Server:
         neither can be done."""
         self.announcement = announce([(DEVICE_CORE_PROG, VERSION, self.port),
                                       (DEVICE_ASYNC_PROG, VERSION, self.abort_port)],
-                                     self.host, port=portmapper_port, start=start_portmapper)
+                                     self.host, port=portmapper_port, start=start_portmapper,
+                                     on_event=self._on_event)
         return self.announcement.how
 
     def close(self) -> None:
@@ -135,14 +154,16 @@ class Vxi11Server:
 
         procedures = {CREATE_LINK: create_link, DESTROY_LINK: destroy_link, **self._procedures.core}
         programs = {DEVICE_CORE_PROG: oncrpc.Program(DEVICE_CORE_PROG, VERSION, VERSION, procedures)}
+        conn.settimeout(self.limits.stall_timeout_s)
         try:  # the largest call is a device_write: its data and at most 1 KiB of headers
-            oncrpc.serve_connection(conn, programs, self.max_recv_size + 1024)
+            oncrpc.serve_connection(conn, programs, self.max_recv_size + 1024, self._core.connection(conn))
         finally:
             for link_id in mine:  # the client is gone: so are its links and its lock
                 self._destroy_link(link_id)
 
     def _serve_abort(self, conn: socket.socket, peer: str) -> None:
-        oncrpc.serve_connection(conn, self._abort_programs, 1024)
+        conn.settimeout(self.limits.stall_timeout_s)
+        oncrpc.serve_connection(conn, self._abort_programs, 1024, self._abort.connection(conn))
 
     # ---- links ---------------------------------------------------------------------------
 
@@ -151,11 +172,13 @@ class Vxi11Server:
         lock_device, lock_timeout_ms, name = r.bool(), r.uint(), r.string(256)
         r.done()
 
-        def refused(error: int) -> bytes:
+        def refused(error: int, why: str) -> bytes:
+            self._core.report(EventKind.REFUSED, peer, f"create_link: {why} (VXI-11 error {error})")
             return reply(error, 0, self.abort_port, self.max_recv_size)
 
-        if name.decode("ascii", "replace").lower() not in DEVICE_NAMES:
-            return refused(DEVICE_NOT_ACCESSIBLE)
+        device = name.decode("ascii", "replace")
+        if device.lower() not in DEVICE_NAMES:
+            return refused(DEVICE_NOT_ACCESSIBLE, f"device name {device!r}: allowed {', '.join(DEVICE_NAMES)}")
         link = Link(next(self._ids), self.instrument.open_session(peer), conn)
         with self._guard:
             full = len(self._links) >= self._max_links
@@ -163,10 +186,11 @@ class Vxi11Server:
                 self._links[link.id] = link
         if full:
             link.session.close()
-            return refused(OUT_OF_RESOURCES)
+            return refused(OUT_OF_RESOURCES, f"{self._max_links} links open: allowed at most {self._max_links}")
         if lock_device and not self.instrument.lock.acquire(link, timeout_s=lock_timeout_ms / 1000):
             self._drop(link)
-            return refused(DEVICE_LOCKED)
+            return refused(DEVICE_LOCKED, f"the lock asked with the link is held by another client after "
+                                          f"{lock_timeout_ms} ms")
         mine.add(link.id)
         return reply(NO_ERROR, link.id, self.abort_port, self.max_recv_size)
 

@@ -9,21 +9,42 @@ answers with before a client fires, as a real scope holds one from power-on. Sho
 scene's (``rig.lab.shots.SceneShots``): the k-th one, the warm-up shot the first, is fired
 at seed N + k - 1 and its record has the bits of ``rig shot SCENE --set ... --seed N+k-1``;
 ``--out`` archives each.
+
+The address and every port are taken before the warm-up shot (a bad ``--host`` or a port in
+use is refused at once, not after seconds of compiling); clients are let in after it. The
+wire's limits are ``instruments.transports.wire.Limits`` (idle, half-open and stall timeouts,
+a share of the connections per address, eviction of a quiet connection for a newcomer); an
+address other than loopback is warned of in one line, and the resources printed are ones a
+remote client can open. ``--log`` gets one line per listener, connection, disconnect (and
+why), refusal, protocol violation, refused command (with the event it left in the queue),
+shot and refused shot. A second ``--vxi11`` server on loopback whose portmapper maps another
+server's VXI-11 moves its VXI-11 channels to a loopback address of its own (127.0.0.2, ...),
+with a portmapper there, so that both are found and neither unregisters the other.
 """
 from __future__ import annotations
 
 import errno
+import itertools
 import logging
 import os
+import socket
 import threading
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections import deque
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 from instruments.errors import InstrumentError
+from instruments.records import ScopeRecord
+from instruments.scpi.status import esr_bit
+from instruments.transports.addresses import LOOPBACK_V4, is_loopback, is_wildcard, machine_addresses
+from instruments.transports.device import InstrumentLock, MessageInstrument, Session
 from instruments.transports.hislip import HislipServer
+from instruments.transports.portmap import PMAP_PORT, MappingTaken
 from instruments.transports.socket import SocketServer
 from instruments.transports.vxi11 import Vxi11Server
+from instruments.transports.wire import ConnectionEvent, EventKind, Limits, printable, quoted
 from instruments.virtual_scope.instrument import VirtualScope
 from rig.errors import invalid
 from rig.experiment.shot import ShotRecord, fresh_seed
@@ -34,7 +55,8 @@ from rig.lab.shots import SceneShots, append_shot
 class ServeSettings:
     """What ``rig serve scope`` was asked: the scene and its overrides ("key=value"), the
     address and ports (0: a free one; None: that transport off), the personality and an
-    ``*IDN?`` to claim, how shots are fired, the first seed, the archive and log files."""
+    ``*IDN?`` to claim, how shots are fired, the first seed, the archive and log files, the
+    wire's limits and the port a VXI-11 portmapper answers on (111, where clients ask)."""
 
     scene: str
     overrides: tuple = ()
@@ -49,6 +71,8 @@ class ServeSettings:
     rig_port: int | None = None
     out: Path | None = None
     log: Path | None = None
+    limits: Limits = field(default_factory=Limits)
+    portmapper_port: int = PMAP_PORT
 
 
 def fire_period(text: str) -> float | None:
@@ -82,6 +106,15 @@ def _port(name: str, port: int | None) -> None:
         raise invalid(name, port, "a TCP port 0..65535 (0: a free one)")
 
 
+_Server = TypeVar("_Server", SocketServer, HislipServer, Vxi11Server)
+_LOGS = itertools.count(1)
+MAX_LOGGED_REFUSALS = 100
+"""Refused commands logged per client; past them one line says the rest are not (a client
+that sends junk cannot fill the disk through the log)."""
+VXI11_ADDRESSES = 8
+"""Loopback addresses (127.0.0.2 on) a second VXI-11 server tries for a portmapper of its own."""
+
+
 class ScopeServer:
     """The served scope and its transports; ``resources`` names them as VISA does."""
 
@@ -93,63 +126,182 @@ class ScopeServer:
         self.settings, self.say = s, say
         self.seed = fresh_seed() if s.seed is None else s.seed
         self.log = _logger(s.log)
+        self.servers: list = []
+        self._names: dict[int, str] = {}  # a server's id: what it serves, in words
+        self.resources: list[str] = []
+        self.stopped = threading.Event()
         self.shots = SceneShots(s.scene, s.overrides, on_shot=self._record)
         try:
-            self.scope = VirtualScope(self.shots.rig().scope, self.shots, personality_name=s.personality,
+            self.scope = VirtualScope(self.shots.rig().scope, self._fire, personality_name=s.personality,
                                       idn=s.idn, seed=self.seed, validate=self.shots.validate,
                                       record_cost=self.shots.record_cost,
                                       scene_name=str(s.scene), fire_period_s=period,
                                       on_command=s.fire == "on-command", rig_scene=rig_scene(self.shots))
         except InstrumentError as e:  # it names the setting (the personality, its record, --idn)
             raise invalid("rig serve scope", s.scene, str(e)) from None
-        say(f"warm-up shot of {s.scene} at seed {self.seed}, the scope's first acquisition "
-            "(compiles what the shots need)")
-        self.servers: list = []
-        self.resources: list[str] = []
+        self.refusals = Refusals(self.scope, self.log)
         try:
+            self._bind(s)  # the address and the ports, before the costly warm-up shot
+            self._warn_if_exposed()
+            say(f"warm-up shot of {s.scene} at seed {self.seed}, the scope's first acquisition "
+                "(compiles what the shots need)")
             self.scope.acq.first_acquisition()  # InstrumentError: the rig refuses the scope's settings
             self._open(s)
         except BaseException:
             self.close()
             raise
-        self.stopped = threading.Event()
 
-    def _open(self, s: ServeSettings) -> None:
-        sock = self._start(lambda: SocketServer(self.scope, s.host, s.port), "raw socket", "--port", s.port)
-        self.resources.append(sock.resource)
-        if s.hislip is not None:
-            hs = self._start(lambda: HislipServer(self.scope, s.host, s.hislip), "HiSLIP", "--hislip", s.hislip)
-            self.resources.append(hs.resource)
+    # ---- the transports ------------------------------------------------------------------
+
+    def _bind(self, s: ServeSettings) -> None:
+        """Make every server of the settings: their address and ports taken, nobody let in."""
+        def logged(inner: MessageInstrument, transport: str) -> LoggedInstrument:
+            return LoggedInstrument(inner, self.refusals, transport)
+
+        lim, on = s.limits, self._on_event
+        self._socket: SocketServer = self._bind_one(
+            lambda: SocketServer(logged(self.scope, "raw socket"), s.host, s.port, limits=lim, on_event=on),
+            "raw socket", "--port", s.port)
+        self._hislip: HislipServer | None = None
+        self._vxi11: Vxi11Server | None = None
+        self._rig: SocketServer | None = None
+        hislip, rig_port = s.hislip, s.rig_port
+        if hislip is not None:
+            self._hislip = self._bind_one(
+                lambda: HislipServer(logged(self.scope, "HiSLIP"), s.host, hislip, limits=lim, on_event=on),
+                "HiSLIP", "--hislip", hislip)
         if s.vxi11:
-            vx = self._start(lambda: Vxi11Server(self.scope, s.host, 0), "VXI-11 core channel", "--host", s.host)
-            self.say(f"VXI-11 abort channel on {vx.host} port {vx.abort_port}")
-            try:
-                self.say(f"VXI-11: {vx.announce()}")
-            except InstrumentError as e:  # no portmapper: clients name the core port
-                self.say(f"VXI-11: {e}")
-            self.resources.append(vx.resource)
-            if vx.resource != f"TCPIP::{s.host},{vx.port}::INSTR":  # the core port named: no portmapper asked
-                self.resources.append(f"TCPIP::{s.host},{vx.port}::INSTR")
-        if s.rig_port is not None:
-            rp = self._start(lambda: SocketServer(self.scope.rig_port(), s.host, s.rig_port),
-                             "RIG: commands, raw socket", "--rig-port", s.rig_port)
-            self.resources.append(f"{rp.resource} (RIG: commands)")
+            self._vxi11 = self._bind_one(
+                lambda: Vxi11Server(logged(self.scope, "VXI-11"), s.host, 0, limits=lim, on_event=on),
+                "VXI-11 core channel", "--host", s.host)
+        if rig_port is not None:
+            self._rig = self._bind_one(
+                lambda: SocketServer(logged(self.scope.rig_port(), "RIG: port"), s.host, rig_port, name="rig-port",
+                                     limits=lim, on_event=on), "RIG: commands, raw socket", "--rig-port", rig_port)
+        self.host = self._socket.host
 
-    def _start(self, make, what: str, option: str, port: int | str):
-        """Start the server ``make()`` builds; a port it cannot take is one line naming the
-        option."""
+    def _bind_one(self, make: Callable[[], _Server], what: str, option: str, port: int | str) -> _Server:
+        """The server ``make()`` builds, its address and port taken; one it cannot take is
+        one line naming the option."""
         try:
             server = make()
         except OSError as e:
-            why = os.strerror(e.errno) if e.errno else str(e)
-            if e.errno == errno.EADDRNOTAVAIL:  # no interface of this machine has that address
+            why = e.strerror or (os.strerror(e.errno) if e.errno else str(e))
+            if isinstance(e, socket.gaierror) or e.errno in (errno.EADDRNOTAVAIL, errno.EAFNOSUPPORT):
                 raise invalid("--host", self.settings.host, f"an address of this machine ({why}); "
                               "127.0.0.1 (loopback) unless clients elsewhere must reach it") from None
             raise invalid(option, port, f"a port free on {self.settings.host} ({why}), or 0 for any") from None
-        self.servers.append(server.start())
-        self.say(f"{what} on {server.host} port {server.port}")
-        self.log.info("%s on %s port %d", what, server.host, server.port)
+        self.servers.append(server)
+        self._names[id(server)] = what
         return server
+
+    def _warn_if_exposed(self) -> None:
+        """One line (and the log's) when the instrument listens beyond this machine."""
+        if is_loopback(self.host):
+            return
+        where = (f"every address of this machine ({self.host})" if is_wildcard(self.host) else self.host)
+        line = (f"warning: the instrument is exposed unauthenticated on {where}: anyone who reaches it can "
+                "command the scope and fire shots (--host 127.0.0.1 keeps it on this machine)")
+        self.say(line)
+        self.log.warning("%s", line)
+
+    def _open(self, s: ServeSettings) -> None:
+        """Let clients in, announce VXI-11, and name the resources."""
+        for server in list(self.servers):
+            server.start()
+            self._listening(self._names[id(server)], server)
+            if isinstance(server, Vxi11Server):
+                self._tell(f"VXI-11 abort channel on {server.host} port {server.abort_port}")
+                self._vxi11 = self._announce(server, s)
+        self.resources += [self._socket.resource_at(a) for a in self._addresses(self._socket.host)]
+        if self._hislip is not None:
+            self.resources += [self._hislip.resource_at(a) for a in self._addresses(self._hislip.host)]
+        if self._vxi11 is not None:
+            vx = self._vxi11
+            for a in self._addresses(vx.host):  # and by its core port, no portmapper asked
+                self.resources += list(dict.fromkeys([vx.resource_at(a), vx.resource_at(a, by_port=True)]))
+        if self._rig is not None:
+            self.resources += [f"{self._rig.resource_at(a)} (RIG: commands)" for a in self._addresses(self._rig.host)]
+
+    def _listening(self, what: str, server: SocketServer | HislipServer | Vxi11Server) -> None:
+        self._tell(f"{what} on {server.host} port {server.port}")
+
+    def _tell(self, line: str) -> None:
+        """Say ``line`` and log it."""
+        self.say(line)
+        self.log.info("%s", line)
+
+    @staticmethod
+    def _addresses(host: str) -> list[str]:
+        """The addresses a client opens a server listening on ``host`` at: this machine's
+        own for a wildcard (0.0.0.0, ::), which no remote client can open."""
+        return machine_addresses(host) if is_wildcard(host) else [host]
+
+    def _announce(self, vx: Vxi11Server, s: ServeSettings) -> Vxi11Server:
+        """Make VXI-11 findable through the portmapper; where another server's VXI-11 holds the
+        loopback portmapper, on a loopback address of its own. The server that serves it."""
+        try:
+            self._tell(f"VXI-11: {vx.announce(portmapper_port=s.portmapper_port)}")
+            return vx
+        except MappingTaken as e:
+            moved = self._vxi11_elsewhere(e.port, s) if vx.host == LOOPBACK_V4 else None
+            if moved is None:
+                self._tell(f"VXI-11: {e}")
+                return vx
+        except InstrumentError as e:  # no portmapper: clients name the core port
+            self._tell(f"VXI-11: {e}")
+            return vx
+        self.servers[self.servers.index(vx)] = moved
+        vx.close()
+        return moved
+
+    def _vxi11_elsewhere(self, taken: int, s: ServeSettings) -> Vxi11Server | None:
+        """VXI-11 on 127.0.0.2, 127.0.0.3, ... with a portmapper there; None when no loopback
+        address of this machine takes it (one portmapper answering on all of them, or no
+        such address, as off Linux)."""
+        for last in range(2, 2 + VXI11_ADDRESSES):
+            address = f"127.0.0.{last}"
+            try:
+                vx = Vxi11Server(LoggedInstrument(self.scope, self.refusals, "VXI-11"), address, 0,
+                                 limits=s.limits, on_event=self._on_event).start()
+            except (InstrumentError, OSError):
+                return None
+            try:
+                how = vx.announce(portmapper_port=s.portmapper_port)
+            except MappingTaken as e:
+                vx.close()
+                if e.port == taken:  # the same portmapper answers there: no address of its own helps
+                    return None
+                continue
+            except InstrumentError:
+                vx.close()
+                continue
+            self._tell(f"VXI-11: the portmapper on {LOOPBACK_V4} port {s.portmapper_port} maps another server's "
+                       f"VXI-11 (core port {taken}): this one moves to {address}, a loopback address of its own")
+            self._names[id(vx)] = "VXI-11 core channel"
+            self._listening("VXI-11 core channel", vx)
+            self._tell(f"VXI-11 abort channel on {vx.host} port {vx.abort_port}")
+            self._tell(f"VXI-11: {how}")
+            return vx
+        return None
+
+    # ---- what the log says ---------------------------------------------------------------
+
+    def _on_event(self, event: ConnectionEvent) -> None:
+        """A transport's event: one line of the log."""
+        quiet = event.kind in (EventKind.CONNECTED, EventKind.DISCONNECTED)
+        self.log.log(logging.INFO if quiet else logging.WARNING, "%s", event.line())
+
+    def _fire(self, overrides: Mapping[str, str], seed: int) -> ScopeRecord:
+        """The scope's shot source: the scene's shot, a refusal logged (then raised, for the
+        scope to queue)."""
+        try:
+            return self.shots(overrides, seed)
+        except Exception as e:
+            settings = " ".join(f"{k}={v}" for k, v in overrides.items()) or "the scene as loaded"
+            self.refusals.shot_refused(str(e))
+            self.log.warning("refused shot at seed %d (%s): %s", seed, printable(settings), printable(str(e)))
+            raise
 
     def _record(self, shot: ShotRecord) -> None:
         """A served shot finished: log it, archive it (``--out``)."""
@@ -181,12 +333,90 @@ class ScopeServer:
             self.log.removeHandler(handler)
 
 
+class Refusals:
+    """Which errors each message left in the scope's queue, for the log: the queue as last
+    seen, so that an event is told once, with the message that left it (a warning, such as a
+    measurement's clipping, sets no error bit and is no refusal). An event posted
+    outside any message (the acquisition's: a shot that failed or did not trigger) is not
+    a refused command: the refused shot is logged where it is fired."""
+
+    def __init__(self, scope: VirtualScope, log: logging.Logger) -> None:
+        self.scope, self.log = scope, log
+        self._seen: list = []
+        self._shots: deque[str] = deque(maxlen=16)
+
+    def shot_refused(self, reason: str) -> None:
+        with self.scope.cond:
+            self._shots.append(reason)
+
+    def fresh(self) -> list:
+        """The events posted since the last look (holding the scope's condition)."""
+        events = list(self.scope.status.events)
+        new = [e for e in events if not any(e is seen for seen in self._seen)]
+        self._seen = events
+        return [e for e in new if esr_bit(e.code) and not (e.code == -200 and (  # an error, not a warning
+            e.detail.startswith("the shot of seed") or any(reason.startswith(e.detail) for reason in self._shots)))]
+
+
+class LoggedInstrument:
+    """The scope (or its RIG: port) as a transport serves it, each refused command logged."""
+
+    def __init__(self, inner: MessageInstrument, refusals: Refusals, transport: str) -> None:
+        self.inner, self.refusals, self.transport = inner, refusals, transport
+        self.max_message_bytes: int = inner.max_message_bytes
+        self.lock: InstrumentLock = inner.lock
+
+    def open_session(self, peer: str) -> Session:
+        return LoggedSession(self.inner.open_session(peer), self.refusals, f"{self.transport} {peer}")
+
+
+class LoggedSession:
+    """One client's session; a message that leaves events in the queue is logged with them."""
+
+    def __init__(self, session: Session, refusals: Refusals, who: str) -> None:
+        self.session, self.refusals, self.who = session, refusals, who
+        self.logged = 0
+
+    def handle(self, message: bytes) -> bytes:
+        with self.refusals.scope.cond:  # the scope's own: the message runs under it
+            self.refusals.fresh()  # posted outside any message meanwhile: not this one's
+            reply = self.session.handle(message)
+            events = self.refusals.fresh()
+        for event in events:
+            self.logged += 1
+            if self.logged <= MAX_LOGGED_REFUSALS:
+                self.refusals.log.warning("refused command from %s: %s: %s", self.who, quoted(message),
+                                          printable(event.text(scpi=True)))
+            elif self.logged == MAX_LOGGED_REFUSALS + 1:
+                self.refusals.log.warning("refused command from %s: more than %d; the rest are not logged",
+                                          self.who, MAX_LOGGED_REFUSALS)
+        return reply
+
+    def device_clear(self) -> None:
+        self.session.device_clear()
+
+    def trigger(self) -> None:
+        self.session.trigger()
+
+    def status_byte(self) -> int:
+        return self.session.status_byte()
+
+    def overflow(self, size: int) -> None:
+        self.session.overflow(size)  # the transport logs it, as a protocol violation
+
+    def close(self) -> None:
+        self.session.close()
+
+
 def _logger(path: Path | None) -> logging.Logger:
-    """The server's log (``--log FILE``: appended, one line per event); silent without one."""
-    log = logging.getLogger(f"rig.lab.serve.{id(path)}")
+    """The server's log (``--log FILE``: appended, one line per event); silent without one
+    (not even Python's last-resort handler on stderr). Each server has a log of its own."""
+    log = logging.getLogger(f"rig.lab.serve.{next(_LOGS)}")
     log.propagate = False
     log.setLevel(logging.INFO)
-    if path is not None:
+    if path is None:
+        log.addHandler(logging.NullHandler())
+    else:
         try:
             handler = logging.FileHandler(path, encoding="utf-8")
         except OSError as e:

@@ -32,8 +32,8 @@ class Served:
         return next(r for r in self.resources if kind in r)
 
     def port(self) -> int:
-        """The raw socket's port."""
-        return int(self.resource("SOCKET").split("::")[2])
+        """The raw socket's port (the next to last field: an IPv6 address holds '::' too)."""
+        return int(self.resource("SOCKET").split("::")[-2])
 
     def stop(self) -> tuple:
         self.proc.send_signal(signal.SIGTERM)

@@ -13,6 +13,7 @@ import pytest
 from pyvisa.errors import VisaIOError
 
 from instruments.transports.hislip import HislipServer
+from instruments.transports.wire import EventKind, Limits
 from lab.many_clients import talk_at_once
 
 
@@ -350,3 +351,32 @@ def test_sessions_over_the_maximum_are_refused_with_a_reason(rm, instrument, eve
         assert third.query("*IDN?") == second.query("*IDN?") == instrument.IDN.decode()
     finally:
         server.close()
+
+
+def test_half_open_sessions_make_room_for_a_client_and_are_closed_soon(rm, instrument, eventually):
+    """Sessions whose async channel never comes (an Initialize alone) do not lock the server
+    out: a new client takes the oldest one's place at once, and each is closed after the
+    half-open timeout, as is a connection that never says anything."""
+    events = []
+    server = HislipServer(instrument, max_sessions=2, limits=Limits(half_open_timeout_s=0.5),
+                          on_event=events.append).start()
+    half = [socket.create_connection(("127.0.0.1", server.port), timeout=3) for _ in range(3)]
+    mute = socket.create_connection(("127.0.0.1", server.port), timeout=3)
+    try:
+        for s in half:
+            initialize(s)
+            assert hislip_module().InitializeResponse(s).session_id >= 1  # each evicts the oldest past two
+        assert server.sessions == 2
+        inst = open_hislip(rm, server.port)  # a third Initialize: a half-open session makes room
+        assert inst.query("*IDN?") == instrument.IDN.decode()
+        assert eventually(lambda: server.sessions == 1, 3)  # the half-open ones closed after 0.5 s
+        assert mute.recv(10) == b""
+        assert inst.query("ECHO? stays") == "stays"
+    finally:
+        for s in [*half, mute]:
+            s.close()
+        server.close()
+    ends = [e.detail for e in events if e.kind == EventKind.DISCONNECTED]
+    assert sum("evicted: a half-open session (no AsyncInitialize)" in d for d in ends) == 2
+    assert "half-open: no AsyncInitialize (the session's second connection) within 0.5 s" in ends
+    assert "half-open: no Initialize or AsyncInitialize within 0.5 s" in ends

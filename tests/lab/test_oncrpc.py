@@ -123,7 +123,9 @@ def test_server_answers_success_and_each_rpc_failure_as_rfc_5531_gives_it():
 
 
 def test_a_served_connection_answers_in_order_and_is_closed_on_an_oversize_record():
-    service = TcpService(lambda conn, peer: oncrpc.serve_connection(conn, PROGRAMS, 512)).start()
+    events = []
+    service = TcpService(lambda conn, peer: oncrpc.serve_connection(conn, PROGRAMS, 512), name="rpc",
+                         on_event=events.append).start()
     try:
         client = oncrpc.RpcClient("127.0.0.1", service.port, PROG, 2)
         for k in range(5):
@@ -143,6 +145,12 @@ def test_a_served_connection_answers_in_order_and_is_closed_on_an_oversize_recor
         again.close()
     finally:
         service.close()
+    # the violation is told, with the connection and its end
+    assert [e.kind.value for e in events if e.kind.value != "connected"].count("protocol violation") == 1
+    (violation,) = [e.line() for e in events if e.kind.value == "protocol violation"]
+    assert violation.startswith("rpc 127.0.0.1:") and violation.endswith(
+        "protocol violation: record of at least 640 bytes: allowed at most 512")  # with its call header
+    assert any(e.line().endswith("disconnected: after the protocol violation") for e in events)
 
 
 def test_a_client_that_closes_mid_record_ends_only_its_own_connection():

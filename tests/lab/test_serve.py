@@ -142,6 +142,10 @@ def test_sigterm_stops_it_cleanly_and_out_has_archived_the_warm_up_shot(tmp_path
     ([SCENE, "--set", "striker.velocity=fast"], "striker.velocity"),
     ([SCENE, "--idn", "junk"], "idn = 'junk'"),
     ([SCENE, "--host", "192.0.2.1"], "--host"),  # TEST-NET-1: no interface here has it
+    ([SCENE, "--host", "no-such-host.invalid"], "--host"),
+    ([SCENE, "--idle-timeout", "-1"], "--idle-timeout"),
+    ([SCENE, "--stall-timeout", "0"], "--stall-timeout"),
+    ([SCENE, "--max-clients", "4", "--per-address", "9"], "--per-address"),
 ])
 def test_bad_input_is_one_line_and_exit_2(args, field):
     r = subprocess.run([*RIG, "serve", "scope", *args, "--port", "0"] if "--port" not in args else
@@ -175,3 +179,73 @@ def test_the_parsers_personalities_are_the_scopes():
     scope = serve._subparsers._group_actions[0].choices["scope"]
     (action,) = [a for a in scope._actions if a.dest == "personality"]
     assert sorted(action.choices) == sorted(PERSONALITIES)
+
+
+@pytest.mark.parametrize("host", ["192.0.2.1", "no-such-host.invalid"])
+def test_a_bad_host_is_refused_before_the_warm_up_shot(host):
+    r = subprocess.run([*RIG, "serve", "scope", SCENE, "--host", host, "--port", "0"], check=False,
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 2 and "--host" in r.stderr
+    assert "warm-up shot" not in r.stdout  # refused before seconds of compiling, not after
+
+
+def test_the_parsers_wire_defaults_are_the_limits():
+    """The parser names the defaults literally (it loads nothing of the instruments): they
+    must be the transports' own."""
+    from instruments.transports.wire import Limits
+    from rig.cli import build_parser
+
+    args = build_parser().parse_args(["serve", "scope", SCENE])
+    limits = Limits()
+    assert (args.idle_timeout, args.half_open_timeout, args.stall_timeout, args.max_clients, args.per_address) == (
+        limits.idle_timeout_s, limits.half_open_timeout_s, limits.stall_timeout_s, limits.max_clients,
+        limits.per_address)
+
+
+def test_ipv6_loopback_is_served_and_its_resources_name_it_in_brackets():
+    if not socket.has_ipv6:
+        pytest.skip("no IPv6 here")
+    try:
+        socket.create_server(("::1", 0), family=socket.AF_INET6).close()
+    except OSError as e:
+        pytest.skip(f"::1 cannot be listened on here ({e.strerror})")
+    s = Served(SCENE, "--host", "::1", "--port", "0", "--hislip", "0", "--seed", "2")
+    try:
+        assert not any("exposed" in line for line in s.lines)  # ::1 is loopback
+        port = s.port()
+        assert s.resources[0] == f"TCPIP::[::1]::{port}::SOCKET"
+        assert s.resource("hislip0").startswith("TCPIP::[::1]::hislip0,")
+        with socket.create_connection(("::1", port), timeout=10) as c:
+            c.sendall(b"*IDN?\n")
+            assert c.recv(100).startswith(b"TEKTRONIX,TDS 2024C")
+    finally:
+        code, rest = s.stop()
+    assert code == 0, rest
+
+
+def test_another_address_than_loopback_is_warned_of_and_named_as_remote_clients_open_it(tmp_path):
+    from instruments.transports.addresses import machine_addresses
+    from rig.lab.serve import ScopeServer, ServeSettings
+
+    said = []
+    server = ScopeServer(ServeSettings(scene=SCENE, host="0.0.0.0", port=0, hislip=0, seed=3, log=tmp_path / "l"),
+                         say=said.append)
+    try:
+        warnings = [line for line in said if "exposed" in line]
+        assert warnings == ["warning: the instrument is exposed unauthenticated on every address of this machine "
+                            "(0.0.0.0): anyone who reaches it can command the scope and fire shots (--host 127.0.0.1 "
+                            "keeps it on this machine)"]
+        assert said.index(warnings[0]) < next(i for i, line in enumerate(said) if line.startswith("warm-up shot"))
+        assert "0.0.0.0" not in " ".join(server.resources)
+        addresses = machine_addresses("0.0.0.0")
+        assert server.resources[0] == f"TCPIP::{addresses[0]}::{server._socket.port}::SOCKET"
+        try:
+            c = socket.create_connection((addresses[0], server._socket.port), timeout=5)
+        except OSError:
+            pytest.skip(f"{addresses[0]} cannot be reached from here")
+        with c:
+            c.sendall(b"*IDN?\n")
+            assert c.recv(100).startswith(b"TEKTRONIX,TDS 2024C")
+    finally:
+        server.close()
+    assert "WARNING warning: the instrument is exposed unauthenticated" in (tmp_path / "l").read_text()

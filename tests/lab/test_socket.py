@@ -9,6 +9,7 @@ from pyvisa.errors import VisaIOError
 
 from instruments.transports.hislip import HislipServer
 from instruments.transports.socket import MessageFramer, SocketServer
+from instruments.transports.wire import EventKind, Limits
 from lab.many_clients import talk_at_once
 
 
@@ -75,6 +76,46 @@ def test_framer_cuts_the_same_messages_whatever_the_pieces(chunk):
     for i in range(0, len(stream), chunk):
         out += framer.feed(stream[i:i + chunk])
     assert out == [b"A", b'B "q\n;""x" #2100123\n5678\n', b"C", 50, b"E #0"]
+
+
+def test_framer_does_not_follow_a_block_length_past_its_limit():
+    """A block that claims more than the limit is not followed: its message is refused (the
+    size it claimed) and ends at the next newline, so the messages after it are kept."""
+    framer = MessageFramer(limit=40)
+    assert framer.feed(b"CURVE #9999999999 data\n*IDN?\nECHO? \"a\nb\"\n") == [
+        17 + 999_999_999, b"*IDN?", b'ECHO? "a\nb"']
+    # within the limit a block is data, newlines and all; past the limit no string or block hides a newline
+    assert framer.feed(b"X #15a\nb\nc\n" + b'"' + b"q" * 45 + b"\nY\n") == [b"X #15a\nb\nc", 46, b"Y"]
+
+
+def test_framer_abandons_a_block_that_stops_coming():
+    framer = MessageFramer(limit=1000)
+    assert framer.feed(b"CURVE #3100abc") == [] and framer.in_block and framer.pending == 14
+    assert framer.abandon() == 14 and not framer.in_block and framer.pending == 0
+    assert framer.feed(b"\n*IDN?\n") == [b"", b"*IDN?"]
+
+
+def test_a_lying_block_length_swallows_no_later_message(instrument):
+    events = []
+    server = SocketServer(instrument, limits=Limits(stall_timeout_s=0.3), on_event=events.append).start()
+    try:
+        with socket.create_connection(("127.0.0.1", server.port), timeout=3) as s:
+            started = time.monotonic()
+            s.sendall(b"ECHO? #9999999999 lie\n*IDN?\n")
+            assert s.recv(100) == instrument.IDN + b"\n"
+            assert time.monotonic() - started < 0.25  # not the stall timeout: the length was never followed
+            s.sendall(b"SYST:ERR?\n")
+            assert s.recv(200).startswith(b"-363,")
+            s.sendall(b"ECHO? #3100short")  # a length within the limit whose bytes stop coming
+            time.sleep(0.5)
+            s.sendall(b"\nECHO? after\n")
+            assert s.recv(100) == b"after\n"
+    finally:
+        server.close()
+    violations = [e.detail for e in events if e.kind == EventKind.VIOLATION]
+    assert violations[0] == "a program message of 1000000016 bytes (a block's claim included): allowed at most " \
+                            f"{instrument.max_message_bytes}; refused"
+    assert violations[1].startswith("a definite-length block stopped coming: no byte for 0.3 s; its message (16 bytes")
 
 
 def test_message_over_the_limit_is_refused_and_the_connection_lives(rm, server, instrument):

@@ -257,14 +257,19 @@ def test_a_slow_message_runs_while_the_link_still_answers_out_of_band_and_the_ne
 
 
 def test_links_are_bounded_the_one_over_gets_out_of_resources():
-    server = Vxi11Server(EchoInstrument(), max_links=2).start()
+    events = []
+    server = Vxi11Server(EchoInstrument(), max_links=2, on_event=events.append).start()
     client = Vxi11CoreClient(HOST, server.port)
     try:
         assert [client.create_link(k, 0, 0, "inst0")[0] for k in range(3)] == [0, 0, v.ErrorCodes.out_of_resources]
         assert server.links == 2
+        assert client.create_link(9, 0, 0, "gpib0,5")[0] == v.ErrorCodes.device_not_accessible
     finally:
         client.close()
         server.close()
+    refused = [e.detail for e in events if e.kind.value == "refused"]  # each refusal is told, with its error
+    assert refused == ["create_link: 2 links open: allowed at most 2 (VXI-11 error 9)",
+                       "create_link: device name 'gpib0,5': allowed inst0 (VXI-11 error 3)"]
 
 
 def test_a_port_in_use_is_refused_in_one_line(served):
