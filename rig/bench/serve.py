@@ -8,7 +8,13 @@ rounds; CPU time of this process (server threads and client together), medians:
   ``Rig.fire``: at the scene's settings (the solve reused, as a repeated shot reuses it) and
   with a new striker velocity per shot (each one solved);
 - ``CURVe?`` of 10,000 points, 16-bit binary (an mso4's record);
-- 100 acquire cycles (arm, wait, fetch CH1) against 100 shots in process.
+- 100 acquire cycles (arm, wait, fetch CH1) against 100 shots in process;
+- time to the first ``CURVe?`` answer (wall clock: what the client waits) after a new
+  striker velocity, at records of 2,500 points (tds2000), 10,000, 1,000,000 and the longest
+  the served scope's limits let through at the scene's span (5,000,000; 10,000,000 would
+  hold about 3.4 GB, past the 2 GB limit, and is refused at HORizontal:RECOrdlength; mso4),
+  each spanning the scene's own time (so the longer the record, the finer its samples and the solver's grid),
+  against the same shot fired in process (``SceneShots.shot``); the longest once a round.
 """
 from __future__ import annotations
 
@@ -19,6 +25,8 @@ SCENE = "ptfe52_magnetic"
 ROUNDS = 5
 CYCLES = 100
 CURVE_POINTS = 10_000
+RECORDS = (("tds2000", 2_500), ("mso4", 10_000), ("mso4", 1_000_000), ("mso4", 5_000_000))
+"""(personality, points) of the time-to-first-CURVe? rows."""
 
 
 def _client(rm, resource: str):
@@ -99,8 +107,56 @@ def run(scene: str = SCENE, rounds: int = ROUNDS, cycles: int = CYCLES) -> dict:
         ratio = statistics.median(a / b for a, b in zip(rows[name], base[against])) if against else None
         out.append(dict(figure=name, served_ms=ms, in_process=against, in_process_ms=ref, ratio=ratio))
     return dict(scene=scene, rounds=rounds, personality="mso4", record_points=CURVE_POINTS, rows=out,
+                first_curve=first_curve(scene, rounds),
                 targets={"arm to record ready": "<= 1.5x Rig.fire", "CURVe? 10,000 points 16-bit": "<= 20 ms",
                          f"{cycles} acquire cycles": "<= 2x"})
+
+
+def first_curve(scene: str = SCENE, rounds: int = ROUNDS) -> list:
+    """Rows of the time to the first CURVe? answer per record length (module doc)."""
+    import numpy as np
+    import pyvisa
+
+    from rig.lab.serve import ScopeServer, ServeSettings
+    from rig.lab.shots import SceneShots
+
+    rows = []
+    rm = pyvisa.ResourceManager("@py")
+    try:
+        for personality in dict(RECORDS):
+            server = ScopeServer(ServeSettings(scene=scene, port=0, personality=personality, seed=1),
+                                 say=lambda line: None)
+            try:
+                inst = _client(rm, server.resources[0])
+                in_process = SceneShots(scene)
+                for name, points in RECORDS:
+                    if name != personality:
+                        continue
+                    if personality != "tds2000":  # the record spans the scene's time: HOR:SCA kept
+                        inst.write(f"HORIZONTAL:RECORDLENGTH {points}")
+                    inst.write(f"DATA:SOURCE CH1;:DATA:ENCDG RIBINARY;:DATA:WIDTH 1;:DATA:START 1;:DATA:STOP {points}")
+                    served, fired = [], []
+                    for k in range(1 if points > 1_000_000 else rounds):
+                        inst.write(f"RIG:STRIKER:VELOCITY {0.80 + 0.01 * k + 1e-6 * points:.6f} m/s")
+                        t0 = time.perf_counter()
+                        _arm(inst)
+                        codes = inst.query_binary_values("CURVE?", datatype="b", container=np.array)
+                        served.append(time.perf_counter() - t0)
+                        if codes.size != points:
+                            raise RuntimeError(f"CURVe? gave {codes.size} points, not {points}")
+                        overrides = {k: v for k, v in (o.split("=", 1) for o in server.shots.last.overrides)}
+                        t0 = time.perf_counter()
+                        in_process.shot(overrides, server.shots.last.seed)
+                        fired.append(time.perf_counter() - t0)
+                    rows.append(dict(personality=personality, points=points, rounds=len(served),
+                                     served_s=statistics.median(served), in_process_s=statistics.median(fired),
+                                     ratio=statistics.median(a / b for a, b in zip(served, fired))))
+                inst.close()
+            finally:
+                server.close()
+    finally:
+        rm.close()
+    return rows
 
 
 def table(r: dict) -> str:
@@ -111,4 +167,10 @@ def table(r: dict) -> str:
         ref = f"{row['in_process_ms']:9.2f} {row['ratio']:6.2f}" if row["in_process"] else f"{'':9s} {'':6s}"
         lines.append(f"  {row['figure']:34s} {row['served_ms']:10.2f}  {row['in_process'] or '':22s} {ref}")
     lines.append("  targets: " + "; ".join(f"{k} {v}" for k, v in r["targets"].items()))
+    lines.append("time to the first CURVe? answer after a new striker velocity (wall-clock medians), the record "
+                 "spanning the scene's time")
+    lines.append(f"  {'model':8s} {'points':>11s} {'rounds':>6s} {'served s':>9s} {'in process s':>13s} {'ratio':>6s}")
+    for row in r["first_curve"]:
+        lines.append(f"  {row['personality']:8s} {row['points']:11,d} {row['rounds']:6d} {row['served_s']:9.3f} "
+                     f"{row['in_process_s']:13.3f} {row['ratio']:6.2f}")
     return "\n".join(lines)
