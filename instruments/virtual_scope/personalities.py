@@ -16,6 +16,7 @@ Every model: V/div in a 1-2-5 sequence, 25 codes per division of the 8-bit conve
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from decimal import Decimal
 
@@ -51,6 +52,10 @@ class Personality:
     wfid_digits: int
     volt_steps: tuple = (1.0, 2.0, 5.0)
     encodings: tuple = ("ASCIi", "RIBinary", "RPBinary", "SRIbinary", "SRPbinary")
+    models: str = ""
+    """The models whose programmer manual the personality follows (a regular expression of
+    ``*IDN?``'s model field): the only ones ``idn`` may claim; model_names says them."""
+    model_names: str = ""
 
     @property
     def floats(self) -> bool:
@@ -79,17 +84,21 @@ class Personality:
 
 PERSONALITIES = {
     "tds2000": Personality("tds2000", "TEKTRONIX,TDS 2024C,C010001,CF:91.1CT FV:v24.26", (2500,),
-                           (1.0, 2.5, 5.0), "WFMPre", WFMPRE_16, "Volts", False, 3),
+                           (1.0, 2.5, 5.0), "WFMPre", WFMPRE_16, "Volts", False, 3,
+                           models=r"TDS ?(2[0-9]{2}|1[0-9]{3}[A-Z]?|2[0-9]{3}[A-Z]?)(-EDU)?|TPS ?20[0-9]{2}[A-Z]?",
+                           model_names="TDS 210 to TDS 224, TDS 1001 to TDS 2024 (B, C), TPS 2012 to TPS 2024"),
     "mdo3000": Personality("mdo3000", "TEKTRONIX,MDO3024,C010001,CF:91.1CT FV:v1.30", (1000, 10000, 100000, 1000000,
                                                                                       5000000, 10000000),
                            (1.0, 2.0, 4.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4,
                            encodings=("ASCIi", "FAStest", "RIBinary", "RPBinary", "SRIbinary", "SRPbinary",
-                                      "FPBinary", "SFPbinary")),
+                                      "FPBinary", "SFPbinary"), models=r"MDO3[0-9]{3}",
+                           model_names="MDO3012 to MDO3104"),
     "mso4": Personality("mso4", "TEKTRONIX,MSO44,C010001,CF:91.1CT FV:2.0.3.950",
                         (1000, 2000, 5000, 10000, 20000, 50000, 100000, 200000, 500000, 1000000, 2000000, 5000000,
                          10000000, 20000000, 31250000),
                         (1.0, 2.0, 5.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4,
-                        encodings=("ASCIi", "RIBinary", "RPBinary", "FPBinary", "SRIbinary", "SRPbinary", "SFPbinary")),
+                        encodings=("ASCIi", "RIBinary", "RPBinary", "FPBinary", "SRIbinary", "SRPbinary", "SFPbinary"),
+                        models=r"MSO4[4-8]B?", model_names="MSO44, MSO46, MSO48 (B too)"),
 }
 
 
@@ -103,6 +112,10 @@ def personality(name: str, idn: str | None = None) -> Personality:
         if len(fields) != 4 or not all(f.strip() for f in fields) or not idn.isprintable():
             raise InstrumentError(f"idn = {idn!r}: allowed four comma-separated fields, "
                                   f"MAKER,MODEL,SERIAL,FIRMWARE (e.g. TEKTRONIX,MSO44,C000001,FV:1.0)")
+        maker, model = fields[0].strip().upper(), fields[1].strip().upper()
+        if maker != "TEKTRONIX" or not re.fullmatch(p.models, model):
+            raise InstrumentError(f"idn = {idn!r}: the {name} personality answers as the models of its manual, "
+                                  f"TEKTRONIX {p.model_names}; another model's commands differ")
         p = Personality(**{**p.__dict__, "idn": idn})
     return p
 

@@ -49,6 +49,12 @@ def test_idn_text_overrides_and_is_checked(make_scope):
     assert ask(s, "*IDN?") == "TEKTRONIX,MSO46,X1,FV:1.0"
     with pytest.raises(InstrumentError, match="idn"):
         make_scope("mso4", idn="just a model")
+    for personality, other in (("mso4", "TEKTRONIX,MSO58,X1,FV:1.0"), ("mdo3000", "TEKTRONIX,DPO4104,X1,FV:1.0"),
+                               ("tds2000", "KEYSIGHT,TDS 2024C,X1,FV:1.0")):  # a model another manual describes
+        with pytest.raises(InstrumentError, match="answers as the models of its manual"):
+            make_scope(personality, idn=other)
+    _scope, s, _ = make_scope("tds2000", idn="TEKTRONIX,TDS 1002B,C1,FV:v22.11")
+    assert ask(s, "*IDN?") == "TEKTRONIX,TDS 1002B,C1,FV:v22.11"
 
 
 def test_settings_snap_to_the_models_steps_and_become_overrides(make_scope):
