@@ -177,6 +177,12 @@ def register(tree, scope) -> None:
         tree.add(f"{head}:LEVel", write=set_level, read=level)
         tree.add(f"{head}:LEVel:CH<n>", write=set_level, read=level)
 
+    for head in ("TRIGger:A", "TRIGger:MAIn"):  # AUTO or NORMal: the rig's shot is the record either way
+        tree.add(f"{head}:MODe", write=lambda c: setattr(scope, "trigger_mode", c.word(("AUTO", "NORMal"))),
+                 read=lambda c: Word(scope.trigger_mode))
+    if p.name != "tds2000":  # the B trigger of the MDO3000 and 4 Series: its edge settings kept, the B state off
+        register_b_trigger(tree, scope)
+
     # --- acquisition -----------------------------------------------------------------
     def set_state(c: Call):
         a = c.arg()
@@ -227,6 +233,34 @@ def register(tree, scope) -> None:
              read=lambda c: "1" if scope.display_waveform else "0")
     tree.add("CONFIGuration:ANALOg:NUMCHANnels", read=lambda c: str(len(CHANNEL_WORDS)))
     tree.add("AUTOSet", write=lambda c: c.word(("EXECute", "UNDo")) and None)
+
+
+def register_b_trigger(tree, scope) -> None:
+    """TRIGger:B (the A-then-B sequence): the edge settings of the manual taken and read
+    back, TRIGger:B:STATE OFF (ON, the sequence, is not modelled: 221); the record is the A
+    trigger's."""
+    b = scope.b_trigger
+
+    def keep(field: str):
+        def write(c: Call):
+            if field == "level":
+                b[field] = LOGIC_LEVELS[c.word(tuple(LOGIC_LEVELS))] if c.arg().kind != "number" else c.number("V")
+            else:
+                b[field] = c.word(CHANNEL_WORDS if field == "source" else ("RISe", "FALL"))
+        return write
+
+    tree.add("TRIGger:B:EDGE:SOUrce", write=keep("source"), read=lambda c: Word(b["source"]))
+    tree.add("TRIGger:B:EDGE:SLOpe", write=keep("slope"), read=lambda c: Word(b["slope"]))
+    tree.add("TRIGger:B:EDGE:COUPling", write=lambda c: c.word(("DC",)) and None, read=lambda c: Word("DC"))
+    for head in ("TRIGger:B:LEVel", "TRIGger:B:LEVel:CH<n>"):
+        tree.add(head, write=keep("level"), read=lambda c: scope.personality.number(b["level"]))
+    tree.add("TRIGger:B:TYPe", write=lambda c: c.word(("EDGe",)) and None, read=lambda c: Word("EDGe"))
+
+    def state(c: Call):
+        if c.boolean():
+            raise ScpiError(-221, f"{c.header} ON: the A-then-B trigger sequence is not modelled (the A trigger's)")
+
+    tree.add("TRIGger:B:STATE", write=state, read=lambda c: "0")
 
 
 def _positive(c: Call, x: float) -> float:

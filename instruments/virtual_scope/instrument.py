@@ -115,6 +115,8 @@ class VirtualScope:
         self.numavg = self.scene.averages if self.scene.mode == "average" else 16
         self.trigger_levels: dict = {}  # TRIGger:A:LEVel:CH<x>: each channel's own level (V), set by a client
         self.display_waveform = True  # DISplay:WAVEform: the screen only, the records are the same
+        self.trigger_mode = "AUTO"  # TRIGger:A:MODe: a record comes either way (the rig's shot says if it triggered)
+        self.b_trigger = {"source": "CH1", "slope": "RISe", "level": 0.0}  # TRIGger:B:EDGE, kept; B is off
         self.acq.stop_after, self.acq.pending = "RUNSTop", 0
         self.acq.run(False)
 

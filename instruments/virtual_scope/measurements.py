@@ -4,7 +4,8 @@ the immediate one, ``MEASUrement:IMMed:TYPe/SOUrce/VALue?/UNIts?``, and the numb
 only: AMPlitude and PK2pk (max - min: the min-max method of HIGH and LOW), MAXimum,
 MINimum, HIGH, LOW, MEAN, RMS, in volts. Without a record the value is 9.91E37 with event
 2225, as the scopes answer; a source that is off is 2244; a source at the converter's rail
-gives its value with the clipping warning (547, 548 or 549)."""
+gives its value with the clipping warning (547, 548 or 549). The 4 Series adds
+``MEASUrement:ADDMEAS`` and the current acquisition's ``RESUlts``."""
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -74,3 +75,33 @@ def register(tree, scope) -> None:
         tree.add(f"MEASUrement:{node}:VALue", read=value)
         tree.add(f"MEASUrement:{node}:UNIts", read=lambda c: '"V"')
     tree.add("MEASUrement:MEAS<n>:STATE", write=set_state, read=lambda c: "1" if slot(c)["state"] else "0")
+    if p.name == "mso4":
+        register_results(tree, scope, slot, value)
+
+
+def register_results(tree, scope, slot, value) -> None:
+    """The 4 Series' way: ``MEASUrement:ADDMEAS <type>`` switches on the first slot that is
+    off with that type (on DATa:SOUrce's channel), and ``MEASUrement:MEAS<x>:RESUlts:
+    CURRentacq:<statistic>?`` gives the statistics of the current acquisition's one value:
+    MEAN, MAXimum and MINimum the value, PK2PK and STDDev 0, POPUlation 1."""
+    p = scope.personality
+
+    def add(c: Call):
+        kind = c.word(tuple(MEASUREMENTS))
+        free = next((n for n in range(1, SLOTS + 1) if not scope.measurements[n]["state"]), None)
+        if free is None:
+            raise ScpiError(-221, f"{c.header} {c.arg().text}: all {SLOTS} measurements are on")
+        scope.measurements[free] = {"type": kind, "source": scope.data.source, "state": True}
+
+    tree.add("MEASUrement:ADDMEAS", write=add)
+    for stat in ("MEAN", "MAXimum", "MINimum"):
+        tree.add(f"MEASUrement:MEAS<n>:RESUlts:CURRentacq:{stat}", read=value)
+
+    def spread(c: Call) -> str:
+        v = value(c)
+        return v if float(v) >= NO_VALUE else p.number(0.0)
+
+    for stat in ("PK2PK", "STDDev"):
+        tree.add(f"MEASUrement:MEAS<n>:RESUlts:CURRentacq:{stat}", read=spread)
+    tree.add("MEASUrement:MEAS<n>:RESUlts:CURRentacq:POPUlation",
+             read=lambda c: "0" if float(value(c)) >= NO_VALUE else "1")

@@ -78,8 +78,10 @@ class Personality:
         return f"{text}E{exp}"
 
     def per_div(self, x: float, unit: str) -> str:
-        """A V/div or s/div figure as WFID prints it: ``50.0mV``, ``10.0us``, ``1.000V``."""
-        return per_division(x, unit, self.wfid_digits)
+        """A V/div or s/div figure as WFID prints it: ``50.00mV``, ``10.00us`` on the MDO and
+        MSO; in NR3 and a space on the TDS, ``5.0E-2 V``, ``2.5E-4 s`` (the TDS1000/2000
+        answer "Ch1, DC coupling, 5.0E-1 V/div, 5.0E-2 s/div, 2500 points, Sample mode")."""
+        return per_division(x, unit, self.wfid_digits) if self.engineering else f"{self.number(x)} {unit}"
 
 
 PERSONALITIES = {

@@ -124,7 +124,7 @@ def preamble_fields(pre: Preamble, sel: DataSelection, wfid: str, p: Personality
     binary = sel.encoding != "ASCIi"
     values = {
         "BYT_Nr": str(sel.sent_width), "BIT_Nr": str(8 * sel.sent_width),
-        "ENCdg": Word("BINary" if binary else "ASCIi"),
+        "ENCdg": (Word("BINary" if binary else "ASCIi") if p.engineering else "BIN" if binary else "ASC"),
         "BN_Fmt": Word("FP" if sel.floating else "RP" if sel.binary in ("RPBinary", "SRPbinary") else "RI"),
         "BYT_Or": Word("LSB" if sel.binary.startswith("S") else "MSB"),
         "NR_Pt": str(end - first), "WFId": f'"{wfid}"', "PT_Fmt": Word("Y"),

@@ -20,7 +20,8 @@ def test_personalities_identify_and_answer_their_preamble(make_scope, personalit
     assert ask(s, f"{name}:YUNIT?") == yunit
     s.handle(b"HEADER ON")
     reply = ask(s, f"{name}?")
-    assert reply.startswith(f":{name.upper()}:BYT_NR 1;BIT_NR 8;ENCDG BINARY;BN_FMT RI;BYT_OR MSB;")
+    encoding = "BIN" if personality == "tds2000" else "BINARY"  # the TDS answers the short form (captured replies)
+    assert reply.startswith(f":{name.upper()}:BYT_NR 1;BIT_NR 8;ENCDG {encoding};BN_FMT RI;BYT_OR MSB;")
     s.handle(b"VERBOSE OFF")
     assert ask(s, f"{name}:NR_PT?") == f":{'WFMP' if name == 'WFMPre' else 'WFMO'}:NR_P " + \
         ("2500" if personality == "tds2000" else "10000")
@@ -29,7 +30,7 @@ def test_personalities_identify_and_answer_their_preamble(make_scope, personalit
 def test_tds_wfid_and_numbers_are_in_the_tek_form(make_scope):
     _scope, s, _ = make_scope("tds2000")
     fire(s)
-    assert ask(s, "WFMPRE:WFID?") == '"Ch1, DC coupling, 50.0mV/div, 50.0us/div, 2500 points, Sample mode"'
+    assert ask(s, "WFMPRE:WFID?") == '"Ch1, DC coupling, 5.0E-2 V/div, 5.0E-5 s/div, 2500 points, Sample mode"'
     assert ask(s, "WFMPRE:XINCR?;YMULT?;YZERO?") == "2.0E-7;2.0E-3;0.0E0"
 
 
@@ -105,7 +106,7 @@ def test_a_channel_switched_on_is_recorded_with_all_its_settings_and_one_off_is_
     fire(s)
     assert set(scope.acq.last.record.waveforms) == {"CH1", "CH2", "CH3"}  # the rig still records CH2
     assert ask(s, "*ESR?") == "128"
-    assert s.handle(b"DATA:SOURCE CH2;:CURVE?") == b"#10\n" and ask(s, "WFMPRE?") == "1;8;BINARY;RI;MSB"
+    assert s.handle(b"DATA:SOURCE CH2;:CURVE?") == b"#10\n" and ask(s, "WFMPRE?") == "1;8;BIN;RI;MSB"
     assert s.handle(b"WFMPRE:NR_PT?") == b""
     assert ask(s, "*ESR?") == "16"
     assert ask(s, "ALLEV?") == ('2244,"Source waveform is not active; CH2 is off; :CURVE?",'
@@ -292,3 +293,29 @@ def test_the_legacy_wfmpre_forms_of_the_tds_and_dpo4000_manuals(make_scope, pers
     assert ask(s, "WFMPRE:CH2:YMULT?") == ask(s, "DATA:SOURCE CH2;:WFMPRE:YMULT?") and ask(s, "EVENT?") == "0"
     if personality != "tds2000":
         assert ask(s, "WFMPRE?") == ask(s, "WFMOUTPRE?")
+
+
+def test_the_4_series_adds_measurements_and_gives_the_current_acquisitions_results(make_scope):
+    """MEASUrement:ADDMEAS switches on the first free slot (tm_devices' example's way);
+    RESUlts:CURRentacq:MEAN? is the slot's value on the current record, PK2PK 0 and
+    POPUlation 1 (one acquisition)."""
+    scope, s, _ = make_scope("mso4")
+    fire(s)
+    s.handle(b"DATA:SOURCE CH2;:MEASUREMENT:ADDMEAS PK2PK")
+    assert ask(s, "MEASU:MEAS1:TYPE?;SOURCE1?;STATE?") == "PK2PK;CH2;1"
+    volts = scope.acq.last.record["CH2"].volts()
+    mean = ask(s, "MEASUREMENT:MEAS1:RESULTS:CURRENTACQ:MEAN?")
+    assert float(mean) == pytest.approx(volts.max() - volts.min(), rel=1e-4)
+    assert ask(s, "MEASU:MEAS1:RESU:CURR:MAX?;MIN?;PK2PK?;POPU?;:EVENT?") == f"{mean};{mean};0.0E+0;1;0"
+
+
+@pytest.mark.parametrize("personality", ["mdo3000", "mso4"])
+def test_the_trigger_mode_and_the_b_trigger_are_kept_and_the_record_is_the_a_triggers(make_scope, personality):
+    scope, s, _ = make_scope(personality)
+    before = scope.overrides()
+    s.handle(b"TRIG:A:MODE NORMAL;:TRIG:B:EDGE:SOURCE CH3;SLOPE FALL;:TRIG:B:LEVEL:CH3 TTL;:TRIG:B:STATE OFF")
+    assert ask(s, "TRIG:A:MODE?;:TRIG:B:EDGE:SOURCE?;SLOPE?;:TRIG:B:LEVEL:CH3?;:TRIG:B:STATE?;:EVENT?") == (
+        f"NORMAL;CH3;FALL;{scope.personality.number(1.4)};0;0")
+    assert scope.overrides() == before  # nothing of the record changed
+    s.handle(b"TRIG:B:STATE ON")
+    assert ask(s, "EVENT?") == "221" and ask(s, "TRIG:B:STATE?") == "0"

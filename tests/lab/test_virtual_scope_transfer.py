@@ -22,7 +22,7 @@ def preamble(session, name):
 
 def decode(reply: bytes, pre: dict) -> np.ndarray:
     """The codes of a CURVe? reply, read as its preamble says."""
-    if pre["ENCDG"] == "ASCII":
+    if pre["ENCDG"] in ("ASCII", "ASC"):
         return np.array([int(x) for x in reply.decode().strip().split(",")])
     order = "<" if pre["BYT_OR"] == "LSB" else ">"
     kind = "u" if pre["BN_FMT"] == "RP" else "i"
