@@ -23,7 +23,7 @@ from ..scpi.engine import Engine, ReplyForm
 from ..scpi.status import OPC, ScpiError, StatusModel
 from ..scpi.tree import CommandTree
 from ..transports.device import InstrumentLock
-from . import commands, common, measurements, rig_commands, setup, waveform_commands
+from . import commands, common, display, measurements, rig_commands, setup, waveform_commands
 from .acquisition import Acquisition, ShotSource
 from .manual import in_manual
 from .measurements import default_slots
@@ -86,6 +86,7 @@ class VirtualScope:
         waveform_commands.register(tree, self)
         measurements.register(tree, self)
         setup.register(tree, self)
+        display.register(tree, self)  # after the modelled display commands: the manual's others, kept
         in_model_manual = partial(in_manual, self.personality.name)
         self.engine = Engine(tree, self.status, self.form, in_model_manual)
         self.rig_engine = Engine(rig_tree, self.status, self.form, in_model_manual)

@@ -16,6 +16,7 @@ from ..scpi.tree import Mnemonic
 
 MODELS = ("mdo3000", "mso4")
 ENUM = re.compile(r"\{([^{}]*)\}")
+WORD = re.compile(r"[A-Za-z0-9_]+(<x>[A-Za-z0-9_]*)?")  # a word of an enumeration (CH<x>: a numbered one)
 
 
 @dataclass(frozen=True)
@@ -38,7 +39,7 @@ class ManualCommand:
     def words(self) -> tuple:
         """The enumerated words the set form takes (``{DC|AC|GND}``), in the manual's order."""
         m = ENUM.search(self.args)
-        return tuple(w for w in m.group(1).split("|") if w and not w.startswith("<")) if m else ()
+        return tuple(w for w in m.group(1).split("|") if WORD.fullmatch(w)) if m else ()
 
 
 @cache

@@ -319,3 +319,16 @@ def test_the_trigger_mode_and_the_b_trigger_are_kept_and_the_record_is_the_a_tri
     assert scope.overrides() == before  # nothing of the record changed
     s.handle(b"TRIG:B:STATE ON")
     assert ask(s, "EVENT?") == "221" and ask(s, "TRIG:B:STATE?") == "0"
+
+
+@pytest.mark.parametrize("personality", ["mdo3000", "mso4"])
+def test_display_settings_of_the_manual_are_kept_and_change_no_record(make_scope, personality):
+    """The screen is not modelled: a display setting of the model's manual is taken as its
+    syntax gives it and read back; a word outside it is 224; the record's settings stay."""
+    scope, s, _ = make_scope(personality)
+    before = scope.overrides()
+    s.handle(b"DISPLAY:PERSISTENCE INFINITE;:DIS:PERS?")
+    assert ask(s, "DIS:PERS?;:EVENT?") == "INFINITE;0"
+    s.handle(b"DIS:PERS SOMETIMES")
+    assert ask(s, "EVENT?") == "224" and ask(s, "DIS:PERS?") == "INFINITE"
+    assert scope.overrides() == before
