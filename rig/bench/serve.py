@@ -144,9 +144,12 @@ def first_curve(scene: str = SCENE, rounds: int = ROUNDS) -> list:
                         served.append(time.perf_counter() - t0)
                         if codes.size != points:
                             raise RuntimeError(f"CURVe? gave {codes.size} points, not {points}")
-                        overrides = {k: v for k, v in (o.split("=", 1) for o in server.shots.last.overrides)}
+                        last = server.shots.last
+                        if last is None:
+                            raise RuntimeError("the served shot was not kept")
+                        overrides = {k: v for k, v in (o.split("=", 1) for o in last.overrides)}
                         t0 = time.perf_counter()
-                        in_process.shot(overrides, server.shots.last.seed)
+                        in_process.shot(overrides, last.seed)
                         fired.append(time.perf_counter() - t0)
                     rows.append(dict(personality=personality, points=points, rounds=len(served),
                                      served_s=statistics.median(served), in_process_s=statistics.median(fired),
