@@ -5,6 +5,12 @@ class RigError(ValueError):
     """Bad input: the message names the field, the value and what is allowed."""
 
 
+class RigNote(UserWarning):
+    """A note on how the rig read the input (a key read another way than its name says): a
+    warning, shown once per distinct text; the command line prints it as one line ``note:
+    ...`` on stderr."""
+
+
 class Interrupted(RigError):
     """A run stopped by the user (Ctrl-C): the message says what it kept."""
 

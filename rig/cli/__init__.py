@@ -9,6 +9,7 @@ import argparse
 import json
 import os
 import sys
+import warnings
 
 from rig import __version__
 from rig.cli import data, fitting, lab, shots, study, sweeps, tools
@@ -83,8 +84,22 @@ def main(argv=None) -> int:
         return SIGPIPE_EXIT
 
 
+def _note(message, category, filename, lineno, file=None, line=None) -> None:
+    """warnings.showwarning for the command line: a RigNote as one line ``note: ...``."""
+    from rig.errors import RigNote
+
+    if issubclass(category, RigNote):
+        print(f"note: {message}", file=sys.stderr)
+    else:
+        _show_warning(message, category, filename, lineno, file, line)
+
+
+_show_warning = warnings.showwarning
+
+
 def _run(argv) -> int:
     _own_instruments()  # before any command imports the rig's instruments
+    warnings.showwarning = _note
     from instruments.errors import InstrumentError
 
     args, extra = build_parser().parse_known_args(argv)

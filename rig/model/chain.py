@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from rig.errors import invalid
+from rig.errors import RigNote, invalid
 from rig.memo import computed_once
 from rig.model.laws import contact_law as lookup_law
 from rig.model.laws import law_values
@@ -23,12 +24,19 @@ from rig.model.statics import (
     contact_constants_of,
     equilibrium_positions_of,
     follows_law,
+    reduced_radii_of,
     static_forces_of,
     static_overlaps_of,
 )
 from rig.units import quantity
 
 STANDARD_GRAVITY = 9.80665  # m/s^2
+YIELD_NOTE_SAID = False  # the note on chain.yield_force read as a pressure is given once a process
+
+
+def _said_yield_note() -> None:
+    global YIELD_NOTE_SAID
+    YIELD_NOTE_SAID = True
 
 
 @dataclass(frozen=True)
@@ -86,6 +94,7 @@ class Chain:
     dashpot_gamma: float
     dashpot_exponent: float
     yield_force: float
+    yield_pressure: float
     yield_rate_exponent: float
     yield_reference_rate: float
     static_yield_ratio: float
@@ -120,6 +129,12 @@ class Chain:
         self.contact_parameters = law_values(self.law, contact)
         for key, value in self.contact_parameters.items():  # chain.damping_time, chain.contact_exponent, ...
             setattr(self, key, value)
+        if self.contact_parameters.get("yield_pressure", 0.0) > 0 and self.contact_exponent != 1.5:
+            raise invalid("chain.yield_pressure", self.yield_pressure,
+                          f"a yield pressure needs Hertz contacts (chain.contact_exponent = 1.5, here "
+                          f"{self.contact_exponent:g}); with another exponent give chain.yield_force, every "
+                          "contact's yield force")
+        self._say_yield_pressure()
         self.hold = quantity(hold, "s", "magnet.hold", bare_ok=True)
         if not self.hold >= 0:
             raise invalid("magnet.hold", hold, "must be >= 0 s")
@@ -226,10 +241,73 @@ class Chain:
         d_el = static_overlaps_of(A, F, n)
         terms = self.law.yielding(self.contact_parameters) if self.law.yielding else NO_YIELD
         live = follows_law(self) & np.isfinite(A)
-        state, d0, work = initial_state(np.where(live, A, 0.0), n, np.where(live, F, 0.0), d_el, terms, self.hold)
+        state, d0, work = initial_state(np.where(live, A, 0.0), n, np.where(live, F, 0.0), d_el, terms, self.hold,
+                                        self.contact_yield_forces(A))
         ap = STATE_ROWS.index("unloading_constant")
         state[ap] = np.where(live, state[ap], np.where(np.isfinite(A), A, 0.0))  # as new: A_p = A
         return state, np.where(live, d0, d_el), work
+
+    def _say_yield_pressure(self) -> None:
+        """Where chain.yield_force (a force) is read as the pressure that yields the chain's
+        bead-bead contacts, say so, once a process (a RigNote), with the pressure and the
+        other contacts' forces of the first chain read so."""
+        if YIELD_NOTE_SAID or not (self.law.yielding and self.contact_parameters.get("yield_force", 0.0) > 0):
+            return
+        p = self.contact_yield_pressure()
+        if p is None:
+            return
+        forces = self.contact_yield_forces()
+        live = follows_law(self) & np.isfinite(forces)
+        others = sorted({round(float(f), 3) for f in forces[live]} - {round(self.yield_force, 3)})
+        _said_yield_note()
+        warnings.warn(f"chain.yield_force = {self.yield_force:g} N is read as the yield pressure of the chain's "
+                      f"bead-bead contacts, p_y = {p / 1e6:.4g} MPa (chain.yield_pressure); at that pressure the "
+                      f"other contacts yield at their own forces"
+                      f"{' (here ' + ', '.join(f'{f:g} N' for f in others) + ')' if others else ''}",
+                      RigNote, stacklevel=3)
+
+    def yield_reference_contact(self) -> int | None:
+        """The contact chain.yield_force names: the first between two beads of the chain's
+        material (None: the chain has no such pair)."""
+        b = self.beads
+        return next((k for k in range(1, self.n_beads) if b[k - 1].kind != "magnetic" and b[k].kind != "magnetic"),
+                    None)
+
+    def contact_yield_pressure(self, A=None):
+        """The yield pressure p_y (Pa; per shot where A is an array of shots' constants) of
+        the chain's contacts (rig.model.laws.thornton): chain.yield_pressure, or the pressure
+        at which chain.yield_force yields the chain's bead-bead contacts; None where the law
+        does not yield, the contacts are not Hertz's, or no bead-bead contact names it."""
+        from rig.model.laws.thornton import yield_pressure_of
+
+        terms = self.law.yielding(self.contact_parameters) if self.law.yielding else None
+        if terms is None or self.contact_exponent != 1.5:
+            return None
+        if terms.yield_pressure > 0:
+            return terms.yield_pressure
+        k = self.yield_reference_contact()
+        if terms.yield_force == 0 or k is None:
+            return None
+        A = self.contact_constants() if A is None else np.asarray(A, float)
+        return yield_pressure_of(terms.yield_force, float(reduced_radii_of(self)[k]), A[..., k])
+
+    def contact_yield_forces(self, A=None) -> np.ndarray:
+        """Each contact's yield force F_y (N) at the reference closing rate (contacts 0..n,
+        last axis; per shot where A, the contacts' constants, is an array of shots'): the
+        force at which the yield pressure (contact_yield_pressure) is reached in that contact,
+        F_y = pi^3 R*^2 p_y^3 / (6 E*^2) from its own radius and moduli; chain.yield_force for
+        every contact where there is no pressure (another exponent); 0 where it never yields."""
+        from rig.model.laws.thornton import pressure_yield_force
+
+        A = self.contact_constants() if A is None else np.asarray(A, float)
+        terms = self.law.yielding(self.contact_parameters) if self.law.yielding else None
+        if terms is None:
+            return np.zeros(A.shape)
+        p = self.contact_yield_pressure(A)
+        if p is None:
+            return np.full(A.shape, terms.yield_force)
+        p = np.asarray(p, float)[..., None] if np.ndim(p) else float(p)
+        return pressure_yield_force(p, reduced_radii_of(self), A)
 
     def contact_yield_rates(self) -> tuple:
         """(m, r_ref): each contact's yield rate exponent and reference closing rate (m/s)

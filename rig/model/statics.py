@@ -49,6 +49,21 @@ def follows_law(chain: Layout) -> np.ndarray:
     return out
 
 
+def reduced_radii_of(chain: Layout) -> np.ndarray:
+    """R* = R1 R2 / (R1 + R2) (m) of contacts 0..n_beads of ``chain`` (the sphere's own
+    radius on a flat: the striker's face, the wall; nan where there is no partner), the
+    radii of contact_constants_of's Hertz constants."""
+    b = chain.beads
+    R = np.full(chain.n_contacts, np.nan)
+    if chain.striker is not None:
+        R[0] = b[0].radius
+    for k in range(1, chain.n_beads):
+        R[k] = b[k - 1].radius * b[k].radius / (b[k - 1].radius + b[k].radius)
+    if chain.wall is not None:
+        R[chain.n_beads] = b[-1].radius
+    return R
+
+
 def contact_constants_of(chain: Layout, E=None, nu=None) -> np.ndarray:
     """Contact constants of contacts 0..n_beads of ``chain`` (and the rod of a compliant
     wall; last axis; nan where there is no partner): Hertz constants (N/m^1.5), the

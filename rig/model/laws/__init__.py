@@ -22,6 +22,9 @@ PARAMETERS: dict[str, LawParameter] = {p.key: p for p in tuple(
     q for law in LAWS for q in law.parameters) + hertz.ELASTIC_PARAMETERS}
 """Every law's parameters by scene key (chain.<key>): each law's own, then the elastic ones."""
 
+ALTERNATIVE_SWITCHES = {"yield_force": ("yield_pressure",)}
+"""A law's switch that another parameter may turn on instead (not both): Thornton's yield
+is a force (chain.yield_force) or a pressure (chain.yield_pressure)."""
 OWNER: dict[str, tuple] = {p.key: tuple(law for law in LAWS if p in law.parameters)
                            for p in (q for law in LAWS for q in law.parameters)}
 """The laws each law-specific parameter belongs to (a dashpot's coefficient: the dashpot's and
@@ -51,6 +54,14 @@ def law_values(law: ContactLaw, given: dict) -> dict:
             names = " or ".join(repr(o.name) for o in owners)
             raise invalid(p.field, values[key], f"belongs to contact law {names}, not {law.name!r}; "
                                                 f"leave it {p.default:g}")
-        if p.switch and values[key] == 0 and p.key == law.parameter:
-            raise invalid(p.field, values[key], f"contact law {law.name!r} needs it > 0")
+        if p.switch and values[key] == 0 and p.key == law.parameter and not any(
+                values[k] > 0 for k in ALTERNATIVE_SWITCHES.get(key, ())):
+            also = "".join(f" (or {PARAMETERS[k].field} > 0)" for k in ALTERNATIVE_SWITCHES.get(key, ()))
+            raise invalid(p.field, values[key], f"contact law {law.name!r} needs it > 0{also}")
+    for key, others in ALTERNATIVE_SWITCHES.items():
+        for other in others:
+            if values[key] > 0 and values[other] > 0:
+                raise invalid(PARAMETERS[other].field, values[other],
+                              f"give one of {PARAMETERS[other].field} or {PARAMETERS[key].field} "
+                              f"(here {values[key]:g} {PARAMETERS[key].unit}), not both")
     return values

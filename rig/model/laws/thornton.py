@@ -17,6 +17,15 @@ are elastic with the enlarged radius and the permanent overlap,
 (3 F_y); for n = 3/2 this is Thornton's R_p and delta_p exactly). The contact yields again
 where its elastic curve meets the envelope (its elastic limit).
 
+Each contact yields at its own force. A material yields at a pressure: Hertz's peak
+pressure reaches p_y (chain.yield_pressure) at F_y = pi^3 R*^2 p_y^3 / (6 E*^2)
+(pressure_yield_force), so a steel-PTFE contact (E* about twice PTFE-PTFE's) yields at about a
+quarter of the PTFE-PTFE force and a bead on a flat wall near it (R* twice, E* about
+twice). chain.yield_force, the older key, gives the yield force of the chain's own bead-bead
+contacts, read as the pressure that yields them there (yield_pressure_of); the other
+contacts yield at that pressure too. With an exponent other than Hertz's (a power law
+matched to Hertz) chain.yield_force is every contact's force, as before.
+
 The yield rises with the loading rate (polymers: Rae & Dattelbaum, Polymer 45, 7615 (2004);
 a rate-dependent yield in granular chains: Burgoyne & Daraio, Phys. Rev. E 89, 032203
 (2014)): above the reference closing rate r_ref the yield pressure goes as (r / r_ref)^m, r
@@ -69,6 +78,10 @@ RATE_EXPONENT = LawParameter("yield_rate_exponent", "1", 0.0, 0.5, 0.0,
 REFERENCE_RATE = LawParameter("yield_reference_rate", "m/s", 0.0, float("inf"), 0.01,
                               "closing rate r_ref (m/s) at and below which a contact yields at "
                               "chain.yield_force (a pulse's contacts close at 0.01-1 m/s)", lo_open=True)
+YIELD_PRESSURE = LawParameter("yield_pressure", "Pa", 0.0, float("inf"), 0.0,
+                              "pressure p_y (Pa) at which a virgin contact yields, closing at the reference rate: "
+                              "each contact at its own force F_y = pi^3 R*^2 p_y^3 / (6 E*^2) (0: from "
+                              "chain.yield_force)")
 STATIC_RATIO = LawParameter("static_yield_ratio", "1", 0.05, 1.0, 1.0,
                             "yield pressure of a static hold over the dynamic one (chain.yield_force's)")
 
@@ -96,6 +109,7 @@ class YieldTerms:
     rate_exponent: float = 0.0
     reference_rate: float = 1.0
     static_ratio: float = 1.0
+    yield_pressure: float = 0.0
 
 
 NO_YIELD = YieldTerms()
@@ -104,7 +118,25 @@ NO_YIELD = YieldTerms()
 def yield_terms(values: dict) -> YieldTerms:
     """The chain's values ({key: SI value}) as YieldTerms."""
     return YieldTerms(values["yield_force"], values["yield_rate_exponent"], values["yield_reference_rate"],
-                      values["static_yield_ratio"])
+                      values["static_yield_ratio"], values["yield_pressure"])
+
+
+def pressure_yield_force(p_y, R, A):
+    """F_y (N) at which a Hertz contact of reduced radius R* (m) and constant A (N/m^1.5)
+    reaches the yield pressure p_y (Pa) at its centre: Hertz's peak pressure p0 = (6 F E*^2 /
+    (pi^3 R*^2))^(1/3) reaches p_y at F_y = pi^3 R*^2 p_y^3 / (6 E*^2), and with E* = 3 A /
+    (4 sqrt(R*)), F_y = 8 pi^3 p_y^3 R*^3 / (27 A^2). 0 where there is no contact."""
+    p, R, A = np.broadcast_arrays(np.asarray(p_y, float), np.asarray(R, float), np.asarray(A, float))
+    ok = np.isfinite(R) & np.isfinite(A) & (A > 0)
+    out = np.zeros(A.shape)
+    out[ok] = 8.0 * math.pi**3 * p[ok] ** 3 * R[ok] ** 3 / (27.0 * A[ok] ** 2)
+    return out
+
+
+def yield_pressure_of(F_y, R, A):
+    """The yield pressure p_y (Pa) at which a Hertz contact (R* m, A N/m^1.5) yields at F_y
+    (N): pressure_yield_force's inverse, p_y = (27 F_y A^2 / (8 pi^3 R*^3))^(1/3)."""
+    return (27.0 * F_y * A**2 / (8.0 * math.pi**3 * R**3)) ** (1.0 / 3.0)
 
 
 def viscous_terms(values: dict) -> ViscousTerms:
@@ -265,7 +297,7 @@ def yield_overlap(A, Fy, n):
     return out
 
 
-def initial_state(A, n, F_static, d_static, terms: YieldTerms, hold: float = 0.0) -> tuple:
+def initial_state(A, n, F_static, d_static, terms: YieldTerms, hold: float = 0.0, yield_forces=None) -> tuple:
     """(state, d0, hold_work): the kernels' memory (STATE_ROWS, contacts) before the shot,
     the static overlaps d0 (m) and the plastic work (J, per contact) the static load took
     (before the shot: not in its energy), for contacts of constants A (N/m^n), exponents n,
@@ -276,10 +308,12 @@ def initial_state(A, n, F_static, d_static, terms: YieldTerms, hold: float = 0.0
     d_static. The yield is chain.yield_force's; after a static hold (``hold`` > 0 s) the
     static one, static_ratio x its pressure (the yield overlap x ratio^2, the force x
     ratio^(2n)). The others are as new (A_p = A, delta_p = 0) at d_static. Each yields
-    again where its curve meets the envelope of chain.yield_force (elastic_limit)."""
+    again where its curve meets the envelope of chain.yield_force (elastic_limit).
+    ``yield_forces``: each contact's own F_y (N; a yield pressure's, Chain.contact_yield_forces)
+    in place of terms.yield_force for every one."""
     A, n, F, d0 = (np.array(x, float) for x in np.broadcast_arrays(A, n, F_static, d_static))
     state = np.zeros((len(STATE_ROWS),) + A.shape)
-    dy = yield_overlap(A, terms.yield_force, n)
+    dy = yield_overlap(A, terms.yield_force if yield_forces is None else yield_forces, n)
     state[AP], state[DY], state[DYREF] = A, dy, dy
     state[DC] = np.where(dy > 0, dy, np.inf)
     work = np.zeros(A.shape)
@@ -302,9 +336,10 @@ def initial_state(A, n, F_static, d_static, terms: YieldTerms, hold: float = 0.0
 LAW = ContactLaw(
     "thornton",
     "elastic-plastic with memory (Thornton, J. Appl. Mech. 64, 383 (1997)): elastic A delta^n up to the yield "
-    "force chain.yield_force, then the tangent line; unloading and reloading elastic with the enlarged radius "
+    "force, each contact's own at the yield pressure chain.yield_pressure (or the one chain.yield_force gives "
+    "the chain's bead-bead contacts), then the tangent line; unloading and reloading elastic with the enlarged radius "
     "and the permanent overlap; the yield pressure rises as (rate / chain.yield_reference_rate)^"
     "chain.yield_rate_exponent; magnet.hold seconds of the magnet's load flatten the contacts before the "
     "shot at static_yield_ratio x that yield; an optional linear dashpot chain.contact_damping beside it",
-    (YIELD_FORCE, RATE_EXPONENT, REFERENCE_RATE, STATIC_RATIO, dashpot.CONTACT_DAMPING),
+    (YIELD_FORCE, YIELD_PRESSURE, RATE_EXPONENT, REFERENCE_RATE, STATIC_RATIO, dashpot.CONTACT_DAMPING),
     viscous_terms, PLASTIC, yield_terms)
