@@ -26,6 +26,9 @@ MESSAGES = {
     -160: "Block data error", -200: "Execution error", -221: "Settings conflict",
     -222: "Data out of range", -224: "Illegal parameter value", -350: "Queue overflow",
     -363: "Input buffer overrun", -410: "Query INTERRUPTED", -420: "Query UNTERMINATED",
+    2202: "Measurement error, No period found", 2209: "Measurement error, No second Mid Ref crossing",
+    2211: "Measurement error, No backwards Mid Ref crossing", 2212: "Measurement error, No negative crossing",
+    2213: "Measurement error, No positive crossing",
     2225: "Measurement error, No waveform to measure",
     2244: "Source waveform is not active",
 }

@@ -120,9 +120,15 @@ def register(tree, scope) -> None:
         tree.add(f"{head}:SCAle", write=set_scale, read=lambda c: p.number(s_div()))
     for head in ("HORizontal", "HORizontal:MAIn"):
         tree.add(f"{head}:POSition", write=set_position, read=read_position)
+    def set_rate(c: Call):
+        """HORizontal:MODe:SAMPLERate (manual mode): the sample interval 1/rate, the record
+        length kept (the time per division follows)."""
+        scope.change({"scope.sample_interval": 1.0 / _positive(c, c.number("HZ"))}, code=-222)
+
     for head in ("HORizontal", "HORizontal:MODe"):
         tree.add(f"{head}:RECOrdlength", write=set_length, read=lambda c: str(scope.settings["scope.record_length"]))
-        tree.add(f"{head}:SAMPLERate", read=lambda c: p.number(sample_rate()))
+        tree.add(f"{head}:SAMPLERate", read=lambda c: p.number(sample_rate()),
+                 write=set_rate if p.name != "tds2000" else None)
     tree.add("HORizontal:MODe", write=set_mode, read=lambda c: Word(scope.horizontal_mode))
     tree.add("HORizontal:MAIn:UNIts", read=lambda c: '"s"')
     tree.add("HORizontal:ROLL", write=refuse_but("OFF"), read=lambda c: Word("OFF"))

@@ -112,7 +112,7 @@ class VirtualScope:
         self.rig_values: dict = {}  # RIG: settings, scene key -> value text
         self.data = DataSelection(stop=self.initial["scope.record_length"])
         self.horizontal_mode = "MANual"
-        self.measurements = default_slots(next(iter(self.scene.channels)))
+        self.measurements = default_slots(next(iter(self.scene.channels)), self.personality.name)
         self.numavg = self.scene.averages if self.scene.mode == "average" else 16
         self.trigger_levels: dict = {}  # TRIGger:A:LEVel:CH<x>: each channel's own level (V), set by a client
         self.display_waveform = True  # DISplay:WAVEform: the screen only, the records are the same

@@ -1,6 +1,8 @@
 """The emulated scope's front panel: personalities' identities and preambles, settings
 snapped to the model's steps and handed to the rig as scene overrides, *RST, channels on
 and off, the events of refused settings, no file commands."""
+import math
+
 import numpy as np
 import pytest
 
@@ -332,3 +334,46 @@ def test_display_settings_of_the_manual_are_kept_and_change_no_record(make_scope
     s.handle(b"DIS:PERS SOMETIMES")
     assert ask(s, "EVENT?") == "224" and ask(s, "DIS:PERS?") == "INFINITE"
     assert scope.overrides() == before
+
+
+def test_timing_measurements_of_a_single_pulse_and_a_period_it_does_not_have(make_scope):
+    """A Gaussian pulse a exp(-(t/w)^2): its width at the 50% mid reference is 2 w sqrt(ln 2)
+    and its 10-90% rise w (sqrt(ln 10) - sqrt(ln(10/9))), each crossing placed to within a
+    code over the pulse's slope there (the 8-bit converter's step in time; the noise is a
+    tenth of a code) and a sample; a single pulse has no period: 9.91E37 and event 2202, as
+    the scopes answer. The TDS2000 takes its manual's words (MINImum, CRMs, ...), not
+    AMPlitude."""
+    scope, s, _ = make_scope("mdo3000")
+    fire(s)
+    a, w = 0.2, 5e-5
+    pre = scope.acq.last.record["CH1"].preamble
+    dt, code = pre.x_increment, pre.y_multiplier
+
+    def slope(f):  # |dv/dt| of the Gaussian where it is at f x its peak
+        x = math.sqrt(math.log(1 / f))
+        return a * 2 * x / w * f
+
+    s.handle(b"MEASU:IMM:SOU1 CH1;TYP PWIDTH")
+    assert float(ask(s, "MEASU:IMM:VAL?")) == pytest.approx(2 * w * math.sqrt(math.log(2)),
+                                                            abs=2 * (code / slope(0.5) + dt))
+    s.handle(b"MEASU:IMM:TYP RISE")
+    rise = w * (math.sqrt(math.log(10)) - math.sqrt(math.log(10 / 9)))
+    assert float(ask(s, "MEASU:IMM:VAL?")) == pytest.approx(rise, abs=code / slope(0.1) + code / slope(0.9) + 2 * dt)
+    assert ask(s, "MEASU:IMM:UNITS?;:EVENT?") == '"s";0'
+    s.handle(b"MEASU:IMM:TYP FREQ")
+    assert ask(s, "MEASU:IMM:VAL?;:EVENT?;:MEASU:IMM:UNI?") == '99.1000E+36;2202;"Hz"'
+    _scope, tds, _ = make_scope("tds2000")
+    tds.handle(b"MEASU:IMM:TYP AMPLITUDE")
+    assert ask(tds, "EVENT?") == "224"
+    tds.handle(b"MEASU:IMM:TYP MINI;:MEASU:IMM:SOU CH2;:SEL:CH2 OFF")
+    assert ask(tds, "MEASU:IMM:TYP?;VAL?;:EVENT?") == "MINIMUM;9.91E37;2225"  # the TDS manual: no time-out
+
+
+def test_4_series_results_of_a_measurement_that_is_off_are_not_values(make_scope):
+    _scope, s, _ = make_scope("mso4")
+    fire(s)
+    assert ask(s, "MEASU:LIST?") == "NONE"
+    assert ask(s, "MEASU:MEAS1:RESU:CURR:MEAN?;:EVENT?") == "99.1000E+36;2225"
+    s.handle(b"MEASUREMENT:ADDMEAS RISETIME")
+    assert ask(s, "MEASU:LIST?;:MEASU:MEAS1:TYPE?;:EVENT?") == "MEAS1;RISETIME;0"
+    assert 0 < float(ask(s, "MEASU:MEAS1:RESU:CURR:MEAN?")) < 1e-3
