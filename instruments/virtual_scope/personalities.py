@@ -8,7 +8,8 @@
 - time bases of the mdo3000 in a 1-2-4 sequence (its WFID reads "400.0us/div"), of the mso4
   in 1-2-5.
 - ``mdo3000`` (MDO3000 Series Programmer Manual, 077-0968) and ``mso4`` (4 Series MSO
-  Programmer Manual, 077-1497): the 22-field ``WFMOutpre?`` (... PT_ORDER, ..., DOMAIN,
+  Programmer Manual, 077-1497): the 22-field ``WFMOutpre?`` (the 4 Series' 23 with ASC_FMT
+  after BYT_OR) (... PT_ORDER, ..., DOMAIN,
   WFMTYPE, CENTERFREQUENCY, SPAN, REFLEVEL), record lengths from the model's list, 16-bit
   data with ``DATa:WIDth 2``, numbers in engineering notation such as ``400.0000E-9``,
   ``1.0000``, ``0.0E+0``.
@@ -28,6 +29,9 @@ WFMPRE_16 = ("BYT_Nr", "BIT_Nr", "ENCdg", "BN_Fmt", "BYT_Or", "NR_Pt", "WFId", "
 WFMOUTPRE_22 = ("BYT_Nr", "BIT_Nr", "ENCdg", "BN_Fmt", "BYT_Or", "WFId", "NR_Pt", "PT_Fmt", "PT_ORder", "XUNit",
                 "XINcr", "XZEro", "PT_Off", "YUNit", "YMUlt", "YOFf", "YZEro", "DOMain", "WFMTYpe",
                 "CENTERFREQuency", "SPAN", "REFLevel")
+WFMOUTPRE_4SERIES = WFMOUTPRE_22[:5] + ("ASC_Fmt",) + WFMOUTPRE_22[5:]
+"""The 4 Series' WFMOutpre? (23 fields): ASC_FMT, the form of ASCII data, after BYT_OR, as the
+4 Series' command tree lists it and its clients read it (pymeasure's MSO44: WFID at index 6)."""
 
 
 @dataclass(frozen=True)
@@ -98,7 +102,7 @@ PERSONALITIES = {
     "mso4": Personality("mso4", "TEKTRONIX,MSO44,C010001,CF:91.1CT FV:2.0.3.950",
                         (1000, 2000, 5000, 10000, 20000, 50000, 100000, 200000, 500000, 1000000, 2000000, 5000000,
                          10000000, 20000000, 31250000),
-                        (1.0, 2.0, 5.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4,
+                        (1.0, 2.0, 5.0), "WFMOutpre", WFMOUTPRE_4SERIES, "V", True, 4,
                         encodings=("ASCIi", "RIBinary", "RPBinary", "FPBinary", "SRIbinary", "SRPbinary", "SFPbinary"),
                         models=r"MSO4[4-8]B?", model_names="MSO44, MSO46, MSO48 (B too)"),
 }

@@ -132,6 +132,7 @@ def preamble_fields(pre: Preamble, sel: DataSelection, wfid: str, p: Personality
         "XZEro": p.number(pre.x_zero + first * pre.x_increment), "XUNit": '"s"',
         "YMUlt": p.number(ymult), "YZEro": p.number(yzero), "YOFf": p.number(yoff),
         "YUNit": f'"{p.y_unit}"', "PT_ORder": Word("LINEAR"), "DOMain": Word("TIMe"),
+        "ASC_Fmt": "FLOAT" if sel.floating else "INTEGER",  # what ASCIi sends: the codes as integers (or floats)
         "WFMTYpe": Word("ANALOG"), "CENTERFREQuency": p.number(0.0), "SPAN": p.number(0.0),
         "REFLevel": p.number(0.0)}
     return Fields(tuple((name, values[name]) for name in p.preamble_fields))

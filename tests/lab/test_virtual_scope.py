@@ -12,7 +12,7 @@ from lab.lab_scope import ask, fire, scene_scope
 
 
 @pytest.mark.parametrize("personality, model, fields, yunit", [
-    ("tds2000", "TDS 2024C", 16, '"Volts"'), ("mdo3000", "MDO3024", 22, '"V"'), ("mso4", "MSO44", 22, '"V"')])
+    ("tds2000", "TDS 2024C", 16, '"Volts"'), ("mdo3000", "MDO3024", 22, '"V"'), ("mso4", "MSO44", 23, '"V"')])
 def test_personalities_identify_and_answer_their_preamble(make_scope, personality, model, fields, yunit):
     _scope, s, _ = make_scope(personality)
     idn = ask(s, "*IDN?").split(",")

@@ -13,8 +13,8 @@ ENCODINGS = ("ASCIi", "RIBinary", "RPBinary", "SRIbinary", "SRPbinary")
 
 def preamble(session, name):
     """{field: text} of a header-off preamble reply, by the personality's field names."""
-    from instruments.virtual_scope.personalities import WFMOUTPRE_22, WFMPRE_16
-    fields = WFMPRE_16 if name == "WFMPre" else WFMOUTPRE_22
+    from instruments.virtual_scope.personalities import WFMOUTPRE_4SERIES, WFMOUTPRE_22, WFMPRE_16
+    fields = WFMPRE_16 if name == "WFMPre" else WFMOUTPRE_4SERIES if "MSO4" in ask(session, "*IDN?") else WFMOUTPRE_22
     values = ask(session, f"{name}?").split(";")
     assert len(values) == len(fields)
     return {f.upper(): v for f, v in zip(fields, values)}
