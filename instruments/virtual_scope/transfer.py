@@ -36,6 +36,7 @@ class DataSelection:
     the preamble names (BN_FMT, BYT_OR) and ``ENCdg BINary`` returns to, kept under ASCIi."""
 
     source: str = "CH1"
+    sources: tuple = ()  # DATa:SOUrce's list where a client named more than one (the first is ``source``)
     start: int = 1
     stop: int = 10_000
     encoding: str = "RIBinary"

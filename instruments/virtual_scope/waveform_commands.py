@@ -101,6 +101,10 @@ def register(tree, scope) -> None:
         """The record's codes; where there is none (no shot yet, the last one failed, the
         source is off) an empty answer at once (``#10``, or an empty line in ASCIi) with the reason in the
         queue, so that a client reads the error instead of waiting out its timeout."""
+        if scope.data.sources:  # several sources at once: their blocks' layout is not the manuals'
+            scope.status.post(-221, f"DATa:SOUrce {','.join(scope.data.sources)}: CURVe? sends one source at a time "
+                                    f"here (DATa:SOUrce {scope.data.source}); {c.header}")
+            return curve_bytes(np.zeros(0, np.int8), scope.data)
         try:
             codes, _, _ = source_waveform(scope, scope.data.source, c.header)
         except ScpiError as off:  # 2244: the source is off
@@ -128,8 +132,14 @@ def register(tree, scope) -> None:
     tree.add("DATa", write=data_init, read=lambda c: Fields((
         ("DESTination", destination), ("ENCdg", Word(scope.data.encoding)), ("SOUrce", Word(scope.data.source)),
         ("STARt", str(scope.data.start)), ("STOP", str(scope.data.stop)), ("WIDth", str(scope.data.width)))))
-    tree.add("DATa:SOUrce", write=lambda c: data(source=c.word(CHANNEL_WORDS)),
-             read=lambda c: Word(scope.data.source))
+    def set_sources(c: Call):
+        """DATa:SOUrce <wfm>[,<wfm>...] (the MDO3000's and 4 Series' manuals: a list; the
+        TDS2000 takes one): the first is the source of the preamble and CURVe?."""
+        names = [c.word(CHANNEL_WORDS, i) for i in range(len(c.args) if p.name != "tds2000" else 1)]
+        data(source=names[0], sources=tuple(names) if len(names) > 1 else ())
+
+    tree.add("DATa:SOUrce", write=set_sources,
+             read=lambda c: ",".join(scope.data.sources) if scope.data.sources else Word(scope.data.source))
     tree.add("DATa:SOUrce:AVAILable", read=lambda c: ",".join(ch for ch in CHANNEL_WORDS if ch in scope.shown))
     tree.add("DATa:STARt", write=lambda c: data(start=point(c)), read=lambda c: str(scope.data.start))
     tree.add("DATa:STOP", write=lambda c: data(stop=point(c)), read=lambda c: str(scope.data.stop))

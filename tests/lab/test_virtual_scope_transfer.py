@@ -139,3 +139,19 @@ def test_data_query_and_init(make_scope):
     assert ask(s, "DATA?") == "REFA;ASCII;CH2;5;50;2"
     s.handle(b"DATA INIT")
     assert ask(s, "DATA?") == "REFA;RIBINARY;CH1;1;2500;1"
+
+
+def test_a_list_of_sources_is_taken_where_the_manual_has_one(make_scope):
+    """DATa:SOUrce CH1,CH2 (4 Series, MDO3000 manuals): taken and read back; the preamble is
+    the first source's; CURVe? answers one source at a time (221 and an empty block at once
+    for the list); the TDS2000 takes one source (108 for the rest)."""
+    _scope, s, _ = make_scope("mso4")
+    fire(s)
+    s.handle(b"DATA:SOURCE CH1,CH2")
+    assert ask(s, "DATA:SOURCE?;:WFMO:WFID?;:EVENT?").startswith('CH1,CH2;"Ch1, ')
+    assert s.handle(b"CURVE?") == b"#10\n" and ask(s, "EVENT?") == "221"
+    s.handle(b"DATA:SOURCE CH2")
+    assert ask(s, "DATA:SOURCE?") == "CH2" and len(block_payload(s.handle(b"CURVE?").rstrip(b"\n"))) > 0
+    _scope, tds, _ = make_scope("tds2000")
+    tds.handle(b"DATA:SOURCE CH2,CH1")
+    assert ask(tds, "DATA:SOURCE?;:EVENT?") == "CH2;108"
