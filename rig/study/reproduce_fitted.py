@@ -49,7 +49,7 @@ KEPT_KEYS = ("table1_chi2_per_dof", "table1_rms_relative", "table1_max_sigma", "
 def fig3_figures(truths: dict) -> dict:
     """Fig. 3's figures of the fitted shots ({scene: Truth}), measured as the observation
     kinds measure them: speeds between the gauges, the full duration at the upper gauge
-    (10% rise to 10% fall or first minimum), the pulses at the lower gauge (bead 29) above
+    (10% rise to 10% fall or first real dip), the pulses at the lower gauge (bead 29) above
     10% of the leading one, the ratio of the upper gauge READINGS' peaks (not F_d), the
     wall's peaks, and the magnetic shot's tail at the lower gauge relative to its leading
     pulse."""

@@ -47,6 +47,32 @@ def test_duration_ends_at_the_first_minimum_in_a_train():
     assert start == pytest.approx(3e-4 - SIGMA * math.sqrt(2 * math.log(10)), abs=0.02 * SIGMA)
 
 
+def test_a_ripple_on_a_shock_like_fall_is_no_end_of_the_pulse():
+    """A sharp rise and a slow exponential fall (150 us) with a ripple of 2e-6 of the peak on
+    it: its first minimum is no dip (the signal rises from it by far less than 5% of the
+    amplitude), so the duration runs from the 10% rise to the 10% fall, 150 us ln 10 after
+    the peak; the old rule (any first minimum) ended it at the first ripple, 45 us
+    after the peak."""
+    rise = 5e-6
+    f = np.where(T < 3e-4, 3 * np.exp(-0.5 * ((T - 3e-4) / rise) ** 2), 3 * np.exp(-(T - 3e-4) / 150e-6))
+    f = f + 6e-6 * np.sin(2 * np.pi * (T - 3e-4) / 20e-6) * (T > 3.2e-4)
+    cut = 0.1 * measures.peak(T, f)  # 10% of the amplitude the pipeline finds at the pulse's kinked top
+    expected = 150e-6 * math.log(3 / cut) + rise * math.sqrt(2 * math.log(3 / cut))
+    assert measures.full_duration(T, f) == pytest.approx(expected, rel=1e-3)
+    # a real dip still ends a pulse: a second pulse that rises 5% and more from the minimum
+    two = gauss(3e-4) + gauss(3e-4 + 5 * SIGMA, 0.5)
+    assert measures.pulse_span(T, two)[1] < 3e-4 + 5 * SIGMA
+
+
+def test_top_fraction_flags_a_flat_topped_leader():
+    """Time above 90% over FWHM: a Gaussian 2 sqrt(2 ln(10/9)) / (2 sqrt(2 ln 2)) = 0.390;
+    a pulse with a plateau of four FWHMs of its flanks above FLAT_TOP."""
+    assert measures.top_fraction(T, gauss()) == pytest.approx(
+        math.sqrt(math.log(10 / 9)) / math.sqrt(math.log(2)), rel=1e-3)
+    plateau = np.clip(gauss(3e-4, 12.0, 60e-6), 0, 3.0)
+    assert measures.top_fraction(T, plateau) > measures.FLAT_TOP
+
+
 def test_pulses_in_a_train():
     amplitudes = [3.0, 2.5, 1.5, 0.8, 0.2]  # the last one below 10% of the leading one
     f = sum(gauss(3e-4 + k * 6 * SIGMA, a) for k, a in enumerate(amplitudes))

@@ -108,7 +108,10 @@ KINDS = {
                  "the leading pulse's full width at half maximum"),
     "duration": Kind("s", True, lambda tr, w: measures.full_duration(*signal(tr, w)),
                      "the leading pulse's full duration: its 10% rise to the earlier of its 10% fall "
-                     "and its first minimum"),
+                     "and its first real dip (a minimum the signal rises 5% of the amplitude from)"),
+    "top_fraction": Kind("1", True, lambda tr, w: measures.top_fraction(*signal(tr, w)),
+                         "the leading pulse's time above 90% of its amplitude over its FWHM: about 0.4 for a "
+                         "bell-shaped pulse, above 0.6 a flat-topped or shock-like one"),
     "pulses": Kind("1", True, lambda tr, w: measures.pulses_in_train(*signal(tr, w), until=look_until(tr, w)),
                    "the number of pulses in the train (above 10% of the leading one, apart where the "
                    "signal falls below half the smaller)"),

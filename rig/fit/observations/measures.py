@@ -21,6 +21,13 @@ TRAIN_HEIGHT = 0.1
 TRAIN_DIP = 0.5
 """Two maxima are two pulses where the signal between them falls below this fraction of
 the smaller one (a shoulder or a ripple on one pulse is not a second pulse)."""
+DIP_DEPTH = 0.05
+"""A minimum after the leading pulse's peak ends the pulse only where the signal rises
+again from it by at least this fraction of the pulse's amplitude before the next minimum
+(a real dip between two pulses, not a ripple on a shock-like pulse's slow fall)."""
+FLAT_TOP = 0.6
+"""A leading pulse is flat-topped or shock-like where its time above 90% of its amplitude
+is more than this fraction of its FWHM (a Gaussian: 0.39; a sech^2 solitary wave: 0.37)."""
 TAIL_LEVEL = 0.01
 """The tail begins where the leading pulse has fallen to this fraction of its amplitude
 (or at its first minimum, where that comes first): the pipeline's base level."""
@@ -64,10 +71,11 @@ def _crossing(t: np.ndarray, f: np.ndarray, k: int, level: float) -> float:
 
 def pulse_span(t: np.ndarray, f: np.ndarray, level: float = DURATION_LEVEL) -> tuple:
     """(start, end) of the leading pulse (s): start where it rises through ``level`` x its
-    amplitude, end the earlier of where it falls through that level and its first minimum
-    after the peak (a parabola's vertex through the minimum's samples: in a train the next
-    pulse rises before this one has fallen). (nan, nan) where the record has no pulse or cuts
-    it off."""
+    amplitude, end the earlier of where it falls through that level and its first real dip
+    after the peak (a minimum the signal rises from again by DIP_DEPTH of the amplitude
+    before its next minimum: in a train the next pulse rises before this one has fallen; a
+    ripple on the fall is no end), at the vertex of a parabola through the minimum's
+    samples. (nan, nan) where the record has no pulse or cuts it off."""
     t, f = np.asarray(t, dtype=float), np.asarray(f, dtype=float)
     p = leading_pulse(t, f)
     if p is None:
@@ -81,9 +89,11 @@ def pulse_span(t: np.ndarray, f: np.ndarray, level: float = DURATION_LEVEL) -> t
     fall = np.flatnonzero(after <= cut)
     end = _crossing(t, f, i + int(fall[0]) - 1, cut) if fall.size else math.inf
     d = np.diff(after)
-    turn = np.flatnonzero((d[:-1] <= 0) & (d[1:] > 0))
-    if turn.size:
-        m = i + int(turn[0]) + 1  # the first sample after the peak with f rising after it
+    turns = np.flatnonzero((d[:-1] <= 0) & (d[1:] > 0)) + 1  # samples after the peak with f rising after them
+    real = [k for k, nxt in zip(turns.tolist(), turns[1:].tolist() + [after.size])
+            if after[k:nxt].max() - after[k] >= DIP_DEPTH * p.amplitude]
+    if real:
+        m = i + real[0]
         den = f[m - 1] - 2.0 * f[m] + f[m + 1]
         shift = 0.5 * (f[m - 1] - f[m + 1]) / den if den > 0 else 0.0
         end = min(end, float(t[m] + shift * (t[1] - t[0])))
@@ -92,10 +102,27 @@ def pulse_span(t: np.ndarray, f: np.ndarray, level: float = DURATION_LEVEL) -> t
 
 def full_duration(t: np.ndarray, f: np.ndarray, level: float = DURATION_LEVEL) -> float:
     """The leading pulse's full duration (s): from its rise through ``level`` (10%) of its
-    amplitude to the earlier of its fall through that level and its first minimum after
+    amplitude to the earlier of its fall through that level and its first real dip after
     the peak (pulse_span)."""
     start, end = pulse_span(t, f, level)
     return end - start
+
+
+def top_fraction(t: np.ndarray, f: np.ndarray) -> float:
+    """The leading pulse's time above 90% of its amplitude over its FWHM: about 0.35-0.4
+    for a bell-shaped pulse (Gaussian 0.39, sech^2 0.37), towards 1 for a flat-topped or
+    shock-like one (flagged above FLAT_TOP). nan without a pulse."""
+    t, f = np.asarray(t, dtype=float), np.asarray(f, dtype=float)
+    p = leading_pulse(t, f)
+    if p is None or not p.fwhm > 0:
+        return math.nan
+    i = _top_index(t, f, p)
+    cut = 0.9 * p.amplitude
+    up, down = np.flatnonzero(f[:i + 1] < cut), np.flatnonzero(f[i:] < cut)
+    if not (up.size and down.size):
+        return math.nan
+    k, j = int(up[-1]), i + int(down[0]) - 1
+    return (_crossing(t, f, j, cut) - _crossing(t, f, k, cut)) / p.fwhm
 
 
 def pulses_in_train(t: np.ndarray, f: np.ndarray, until: float = math.inf, height: float = TRAIN_HEIGHT,
