@@ -24,6 +24,8 @@ MEANINGS = {
     "chain.mass": "each bead's mass (nominal; a study may draw each bead's own)",
     "chain.beads": "number of beads below the magnetic bead",
     "chain.magnetic_bead": "a magnetic bead on top, pulled by the ring magnet",
+    "chain.previous_shots": "shots fired on this chain before this one (0-100): elastic-plastic contacts keep "
+                            "the flattening each left (rig/experiment/history.py)",
     "chain.contact_law": "the contact law between neighbours",
     "chain.youngs_modulus": "the beads' Young's modulus (default: the material's)",
     "chain.poisson_ratio": "the beads' Poisson ratio (default: the material's)",

@@ -20,6 +20,7 @@ from rig.model.materials import Material, material
 from rig.model.parts import Bead, GaugeBead, MagneticBead, Striker, Wall
 
 REQUIRED_TABLES = ("chain", "striker", "holder", "wall", "scope", "solver")
+MAX_PREVIOUS_SHOTS = 100  # chain.previous_shots: each is a solve of the chain before this shot
 MAX_BEADS = 10_000_000  # a list of 1e9 beads is 8 GB before the tube's length could refuse it
 
 
@@ -142,6 +143,10 @@ class Assembly:
             self._check_connections()
         with scene_key("solver"):
             self.solver = like.solver if shared(like, "solver") else SolverSettings.from_table(v["solver"])
+        self.previous_shots = v["chain"].get("previous_shots", 0)
+        if not 0 <= self.previous_shots <= MAX_PREVIOUS_SHOTS:
+            raise invalid("chain.previous_shots", self.previous_shots,
+                          f"a whole number of shots from 0 to {MAX_PREVIOUS_SHOTS}")
 
     def _beads(self, table: dict) -> tuple:
         """(the chain's beads, 1 if the top one is the magnetic bead else 0)."""

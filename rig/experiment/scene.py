@@ -33,7 +33,7 @@ SCHEMA = {
     "chain": {"material": str, "diameter": "m", "mass": "kg", "beads": int,
               "magnetic_bead": bool, "contact_law": str,
               **{key: p.scene_spec for key, p in LAW_PARAMETERS.items()},  # the contact laws' (rig.model.laws)
-              "youngs_modulus": "Pa", "poisson_ratio": float,
+              "youngs_modulus": "Pa", "poisson_ratio": float, "previous_shots": int,
               "magnetic_youngs_modulus": "Pa", "magnetic_poisson_ratio": float},
     "striker": {"material": str, "mass": "kg", "velocity": "m/s", "diameter": "m", "gap": "m"},
     "magnet": {"force": "N", "position": "m", "peak_force": "N", "schedule": list, "hold": "s"},

@@ -17,6 +17,7 @@ from instruments.records import ScopeRecord
 from rig.errors import RigError, invalid
 from rig.experiment import scene as scene_io
 from rig.experiment.assembly import Assembly
+from rig.experiment.history import after_shots
 from rig.experiment.truth import Truth, truth_of
 from rig.solver.estimate import RunEstimate, estimate_solve
 from rig.solver.problem import ChainProblem
@@ -81,6 +82,8 @@ class Rig(Assembly):
         super().__init__(scene, bead_masses, like)
         self._solution: Solution | None = None
         self._truth_report: Report | None = None
+        if self.previous_shots:  # the chain as its earlier shots left it (rig/experiment/history.py)
+            self.chain = after_shots(self.chain, self.previous_shots, self.solver, self.save_at())
 
     @classmethod
     def from_scene(cls, name_or_path, overrides=()) -> Rig:

@@ -8,6 +8,7 @@ The chain starts in static equilibrium, nothing moving before the impact (static
 """
 from __future__ import annotations
 
+import copy
 import functools
 import math
 import warnings
@@ -221,6 +222,29 @@ class Chain:
         constants and static forces)."""
         return self._at_rest[0]
 
+    prior: np.ndarray | None = None
+    """The contacts' memory a previous shot left (STATE_ROWS, contacts; after_shot), or None:
+    contacts as the static load alone left them."""
+
+    def after_shot(self, solution) -> Chain:
+        """This chain as it rests after the shot ``solution`` solved (a single shot's solve of
+        this chain, which carries its contacts' memory at the end): the contacts keep their
+        flattening (permanent overlaps, enlarged radii, elastic limits) and rest on their
+        elastic curves under the static load, as a real chain does between two shots
+        (rig.model.laws.thornton.rest_after). The same chain where no contact yields."""
+        from rig.model.laws.thornton import STATE_ROWS
+
+        if solution.memory is None:
+            raise invalid("solution", "a batch's", "a single shot's solve of this chain (it keeps the memory)")
+        off = solution.problem.offset
+        memory = np.array(solution.memory[:, off:off + self.n_contacts], dtype=float)
+        if memory.shape != (len(STATE_ROWS), self.n_contacts):
+            raise invalid("solution", memory.shape, f"a solve of this chain ({self.n_contacts} contacts)")
+        chain = copy.copy(self)
+        chain.__dict__ = {k: v for k, v in self.__dict__.items() if k not in ("_at_rest", "_computed")}
+        chain.prior = memory
+        return chain
+
     @functools.cached_property
     def _at_rest(self) -> tuple:
         """(rest_state, static_overlaps), computed once, read-only."""
@@ -235,10 +259,15 @@ class Chain:
         (rig.model.laws.thornton.STATE_ROWS, first axis), the static overlaps (m) and the
         plastic work (J) a static hold took. Contacts that do not follow a yielding law are
         elastic and as new."""
-        from rig.model.laws.thornton import NO_YIELD, STATE_ROWS, initial_state
+        from rig.model.laws.thornton import NO_YIELD, STATE_ROWS, initial_state, rest_after
 
         n = self.contact_exponents()
         d_el = static_overlaps_of(A, F, n)
+        if self.prior is not None:  # the memory a previous shot left, at rest under the static load again
+            prior = self.prior if np.ndim(A) == 1 else np.broadcast_to(
+                self.prior[:, None, :], (len(STATE_ROWS),) + np.shape(A))
+            state, d0 = rest_after(prior, n, F, d_el)
+            return state, d0, np.zeros(np.shape(A))
         terms = self.law.yielding(self.contact_parameters) if self.law.yielding else NO_YIELD
         live = follows_law(self) & np.isfinite(A)
         state, d0, work = initial_state(np.where(live, A, 0.0), n, np.where(live, F, 0.0), d_el, terms, self.hold,

@@ -7,6 +7,7 @@ import math
 import os
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
@@ -167,7 +168,8 @@ def integrate_at(problem: ChainProblem, t_end: float, save: SaveAt, m: Method, s
     wall = time.perf_counter() - t0
     shown = slice(0, problem.offset + problem.chain.n_beads)  # the striker and the beads (not a wall's plate)
     frames_abs = frames[:, shown] + frame_origin(problem.chain) if n_frames else None
-    return solution_of(problem, save, out, frames_abs, u, v, KernelReport.of(diag), m, step, n_steps, wall, accuracy)
+    sol = solution_of(problem, save, out, frames_abs, u, v, KernelReport.of(diag), m, step, n_steps, wall, accuracy)
+    return replace(sol, memory=k.contacts.state)  # the kernel renewed it in place: the memory at the end
 
 
 def solution_of(problem: ChainProblem, save: SaveAt, out: np.ndarray, frames: np.ndarray | None, u: np.ndarray,

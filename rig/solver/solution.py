@@ -131,6 +131,9 @@ class Solution:
     frames: positions (m, down from bead 0's equilibrium centre) of the striker (if any)
     and the beads at t = j * frame_interval, only when frames were asked for.
     final_u, final_v: each body's displacement (m) and velocity (m/s) at the end.
+    memory: the contacts' memory at the end (rig.model.laws.thornton.STATE_ROWS, the
+    problem's slots), of a single shot's solve (None from a batch): what the chain keeps
+    for its next shot (Chain.after_shot).
     status: how the solve ended (Status); detail: what it adds to the status's message for
     this solve (where and at what step it blew up, how far the control got), "" where
     nothing. A solve that is not SUCCESS returns its record as far as it went.
@@ -146,6 +149,7 @@ class Solution:
     problem: ChainProblem
     status: Status = Status.SUCCESS
     detail: str = ""
+    memory: np.ndarray | None = None  # the contacts' memory at the end (STATE_ROWS, the problem's slots); one shot
 
     @property
     def message(self) -> str:

@@ -333,6 +333,22 @@ def initial_state(A, n, F_static, d_static, terms: YieldTerms, hold: float = 0.0
     return state, d0, work
 
 
+def rest_after(memory, n, F_static, d_static) -> tuple:
+    """(state, d0): a contact's memory kept from a shot (STATE_ROWS, contacts; the kernels'
+    state at the shot's end) at rest again under its static force F_static (N): on its
+    elastic curve F = A_p (d - d_p)^n, d0 = d_p + (F / A_p)^(1/n) where the shot flattened
+    it (d_p > 0), else its elastic static overlap d_static (m); the plastic work and the
+    last closing rate zeroed, the last overlap d0. Its largest rate, yield overlaps and
+    elastic limit are kept: the next shot meets the flattened contacts."""
+    state = np.array(memory, dtype=float, copy=True)
+    n, F, d0 = (np.array(x, float) for x in np.broadcast_arrays(n, F_static, d_static))
+    dp, ap = state[DP], state[AP]
+    flat = (dp > 0) & (ap > 0) & (F > 0)
+    d0[flat] = dp[flat] + (F[flat] / ap[flat]) ** (1.0 / n[flat])
+    state[WORK], state[RLAST], state[DLAST] = 0.0, 0.0, d0
+    return state, d0
+
+
 LAW = ContactLaw(
     "thornton",
     "elastic-plastic with memory (Thornton, J. Appl. Mech. 64, 383 (1997)): elastic A delta^n up to the yield "
