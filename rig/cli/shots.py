@@ -36,6 +36,10 @@ def cmd_shot(args) -> dict:
     from rig.experiment.measure import shot_blocks
     from rig.experiment.shot import Rig
 
+    if args.repeat is not None:
+        if args.export:
+            raise invalid("--export", args.export, "one shot's scope files; with --repeat archive the shots (--out)")
+        return repeat_shots(args, scene)
     rig = Rig(scene)
     check_size(rig.estimate(), args, "this shot")
     compile_cold("shot", "shot")  # after the refusals that need no kernel: a refused shot leaves no side process
@@ -59,6 +63,56 @@ def cmd_shot(args) -> dict:
             out["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot_entry(shot)])[0]}
     if not args.json:
         print_shot(out, "the striker's kinetic energy" if rig.chain.striker is not None else "the static energy")
+    return out
+
+
+def repeat_shots(args, scene) -> dict:
+    """``rig shot --repeat N``: N shots on one chain (chain.previous_shots from the scene's
+    on, seeds N0, N0 + 1, ...), each meeting the contacts the last one flattened; per shot
+    the truth's speed and amplitude and the energy the contacts took, and their drift from
+    the first shot to the last ({"repeat": [...], "drift": {...}})."""
+    from rig.experiment.scene import load
+    from rig.experiment.shot import Rig, fresh_seed
+
+    seed = fresh_seed() if args.seed is None else args.seed
+    first = Rig(scene)
+    check_size(first.estimate(), args, "each shot")
+    compile_cold("shot", "shot")
+    rows, rig = [], first
+    for k in range(args.repeat):
+        if k:
+            items = tuple(o for o in scene.overrides if o.split("=", 1)[0].strip() != "chain.previous_shots")
+            rig = Rig(load(args.scene, items + (f"chain.previous_shots={first.previous_shots + k}",)), after=rig)
+        shot = rig.fire(seed=seed + k)
+        truth = rig.truth_analysis().as_dict()
+        rows.append({"shot": first.previous_shots + k + 1, "seed": seed + k, "overrides": list(shot.overrides),
+                     "speed_m_per_s": truth.get("speed_m_per_s"),
+                     "averaged_amplitude_N": truth.get("averaged_amplitude_N"),
+                     "dissipated_energy_J": rig.solution().stats.dissipated_energy_J,
+                     "triggered": shot.scope.triggered})
+        if args.out:
+            from instruments.archive import Archive
+            from rig.experiment.entry import shot_entry
+
+            with writing_to(args.out):
+                rows[-1]["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot_entry(shot)])[0]}
+
+    def drift(key):
+        a, b = rows[0][key], rows[-1][key]
+        return None if a is None or b is None else {"first": a, "last": b, "relative": b / a - 1.0 if a else None}
+
+    out = {"scenario": scene.name, "repeat": rows,
+           "drift": {key: drift(key) for key in ("speed_m_per_s", "averaged_amplitude_N", "dissipated_energy_J")}}
+    if not args.json:
+        print(f"{scene.name}: {args.repeat} shots on one chain (the truth, noise-free)")
+        print(f"  {'shot':>4s} {'seed':>8s} {'speed m/s':>10s} {'F_d N':>8s} {'plastic+viscous J':>18s}")
+        for r in rows:
+            speed = "-" if r["speed_m_per_s"] is None else f"{r['speed_m_per_s']:.1f}"
+            amp = "-" if r["averaged_amplitude_N"] is None else f"{r['averaged_amplitude_N']:.3f}"
+            print(f"  {r['shot']:4d} {r['seed']:8d} {speed:>10s} {amp:>8s} {r['dissipated_energy_J']:18.3e}")
+        d = out["drift"]["speed_m_per_s"]
+        if d is not None and d["relative"] is not None:
+            print(f"  speed drift from shot {rows[0]['shot']} to {rows[-1]['shot']}: {d['relative']:+.1%}")
     return out
 
 
@@ -167,6 +221,19 @@ def cmd_animate(args) -> dict:
     return out
 
 
+def repeat_arg(text: str) -> int:
+    """--repeat: a whole number of shots 1..100."""
+    import argparse
+
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if not 1 <= n <= 100 or str(n) != text.strip():
+        raise argparse.ArgumentTypeError(f"--repeat = {text!r}: a whole number of shots from 1 to 100")
+    return n
+
+
 def add_shot(sub) -> None:
     """The parser of ``rig shot``."""
     sh = command(sub, "shot", "fire one virtual shot of a scene", cmd_shot)
@@ -177,6 +244,9 @@ def add_shot(sub) -> None:
     sh.add_argument("--export", metavar="DIR", help="write the scope records to DIR")
     sh.add_argument("--format", choices=["isf", "csv"], help="with --export: scope file format (default isf)")
     sh.add_argument("--out", metavar="ARCHIVE.h5", help="append the shot to an HDF5 archive")
+    sh.add_argument("--repeat", type=repeat_arg, metavar="N",
+                    help="fire N shots (1-100) on one chain: each meets the contacts the last flattened "
+                         "(chain.previous_shots), seeds SEED, SEED+1, ...; prints the drift of speed and amplitude")
     allow_large(sh)
 
 

@@ -76,13 +76,22 @@ def fresh_seed() -> int:
 
 
 class Rig(Assembly):
-    """An assembled scene that fires shots (see Assembly for the parts and instruments)."""
+    """An assembled scene that fires shots (see Assembly for the parts and instruments).
+    ``after``: the rig of the shot before on the same chain (its scene the same but for
+    chain.previous_shots, one less): this rig's chain is the one that shot left, as
+    chain.previous_shots would solve it again (the same solve, the same bits)."""
 
-    def __init__(self, scene, bead_masses=None, like: Assembly | None = None):
+    def __init__(self, scene, bead_masses=None, like: Assembly | None = None, after: Rig | None = None):
         super().__init__(scene, bead_masses, like)
         self._solution: Solution | None = None
         self._truth_report: Report | None = None
-        if self.previous_shots:  # the chain as its earlier shots left it (rig/experiment/history.py)
+        if after is not None:  # the next shot on ``after``'s chain: its history is after's and after's shot
+            if self.previous_shots != after.previous_shots + 1:
+                raise invalid("chain.previous_shots", self.previous_shots,
+                              f"the shot after one with chain.previous_shots = {after.previous_shots} is "
+                              f"{after.previous_shots + 1}")
+            self.chain = after.chain.after_shot(after.solution())
+        elif self.previous_shots:  # the chain as its earlier shots left it (rig/experiment/history.py)
             self.chain = after_shots(self.chain, self.previous_shots, self.solver, self.save_at())
 
     @classmethod

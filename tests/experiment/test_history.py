@@ -61,3 +61,26 @@ def test_a_chain_that_never_yields_is_the_same_chain_and_the_history_is_determin
 def test_a_history_out_of_range_is_refused_by_name(value):
     with pytest.raises(RigError, match="chain.previous_shots"):
         rig(0, (f"chain.previous_shots={value}",))
+
+
+def test_rig_shot_repeat_fires_shots_on_one_chain_each_reproducible_from_its_items(history, capsys, tmp_path):
+    """rig shot --repeat 3: the drift of the shots above, and each archived shot the bits of
+    the scene with its own items (chain.previous_shots and its seed) fired alone."""
+    import json
+
+    from instruments.archive import Archive
+    from rig.cli import main
+
+    items = [a for o in fig3.PARAMETER_SET + QUICK + ("scope.record_length=2500",) for a in ("--set", o)]
+    archive = tmp_path / "shots.h5"
+    assert main(["shot", fig3.GRAVITY, *items, "--seed", "7", "--repeat", "3", "--out", str(archive), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    rows = out["repeat"]
+    assert [r["shot"] for r in rows] == [1, 2, 3] and [r["seed"] for r in rows] == [7, 8, 9]
+    assert [r["speed_m_per_s"] for r in rows] == [r.truth_analysis().as_dict()["speed_m_per_s"] for r in history]
+    assert out["drift"]["speed_m_per_s"]["relative"] > 0.03
+    last = Archive(archive).read(3)
+    alone = Rig.from_scene(fig3.GRAVITY, tuple(rows[2]["overrides"])).fire(seed=9)
+    assert "chain.previous_shots=2" in rows[2]["overrides"]
+    for ch, w in alone.scope.waveforms.items():
+        assert np.array_equal(w.codes, last.record[ch].codes)
