@@ -47,6 +47,8 @@ POSITIVE = {"chain.diameter", "chain.mass", "chain.reference_force", "chain.youn
             "scope.channels.CH1.volts_per_div", "solver.duration", "solver.sample_interval",
             "scope.channels.CH1.bandwidth"}
 """Quantity keys that are refused at 0 and below."""
+ZERO_ALLOWED = {"chain.previous_shots"}
+"""Whole-number keys whose 0 is allowed (no earlier shot on the chain); 101 is their bad case."""
 CHOICES = ("chain.material", "chain.contact_law", "striker.material", "wall.material", "scope.mode",
            "scope.trigger.source", "scope.trigger.slope", "scope.channels.CH1.coupling",
            "solver.method", "gauges.upper.channel", "wall_sensor.channel")
@@ -62,7 +64,8 @@ def _scene_cases():
             bad += ["0", "-1", f"-3 {spec}"] if key in POSITIVE else []
             bad += [f"{text} {spec}" for text in NOT_ONE_NUMBER]
         elif spec is int:
-            bad = ["2.5", "abc", "", "1,0", "1 000", "nan", "inf", "-1", "0", "true"] + NOT_ONE_NUMBER
+            bad = ["2.5", "abc", "", "1,0", "1 000", "nan", "inf", "-1", "true"] + NOT_ONE_NUMBER
+            bad += ["101"] if key in ZERO_ALLOWED else ["0"]
         elif spec is float:
             bad = ["abc", "", "0,5", "nan", "inf", "1 m", "1_0"] + NOT_ONE_NUMBER
         elif spec is bool:

@@ -20,6 +20,7 @@ from pyvisa_py.tcpip import Vxi11CoreClient
 from instruments.transports import oncrpc, portmap
 from instruments.transports.vxi11_codec import DEVICE_CORE_PROG
 from instruments.transports.wire import Limits
+from lab.wire_client import query
 from rig.lab.serve import ScopeServer, ServeSettings
 
 SCENE = "ptfe52_magnetic"
@@ -58,14 +59,7 @@ def logged(server, *needles) -> bool:
 def ask(port: int, message: bytes, timeout_s: float = 5.0) -> bytes:
     """One query on a fresh raw socket; its reply line."""
     with socket.create_connection(("127.0.0.1", port), timeout=timeout_s) as s:
-        s.sendall(message)
-        reply = b""
-        while not reply.endswith(b"\n"):
-            chunk = s.recv(4096)
-            if not chunk:
-                break
-            reply += chunk
-    return reply
+        return query(s, message)
 
 
 def test_slowloris_clients_lose_their_slots_to_a_new_client(served, rm, eventually):

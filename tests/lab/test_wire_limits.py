@@ -19,6 +19,7 @@ from instruments.transports.hislip import HislipServer
 from instruments.transports.socket import SocketServer
 from instruments.transports.vxi11 import Vxi11Server
 from instruments.transports.wire import ConnectionEvent, EventKind, Limits
+from lab.wire_client import query
 
 
 class Events(list):
@@ -31,15 +32,6 @@ class Events(list):
         return [e.line() for e in list(self) if e.kind == kind]
 
 
-def query(s: socket.socket, message: bytes) -> bytes:
-    s.sendall(message)
-    reply = b""
-    while not reply.endswith(b"\n"):
-        chunk = s.recv(4096)
-        if not chunk:
-            break
-        reply += chunk
-    return reply
 
 
 def closed_by_server(s: socket.socket, within_s: float) -> bool:
