@@ -59,6 +59,8 @@ def cmd_theory(args) -> dict:
             reasons.update(dict.fromkeys(wave_keys[2:], (
                 f"Fm/F0 = {Fm / F0:.4g} is below {MIN_FORCE_RATIO}: a wide, weakly nonlinear wave the discrete "
                 "computation does not reach; Eq (1) describes it")))
+    if args.yield_pressure is not None or args.yield_force is not None:
+        out["yield_pressure_Pa"], out["yield_force_N"] = contact_yields(m, a, A, args)
     if not args.json:
         print(f"{m.name}, diameter {a * 1e3:g} mm, F0 = {F0:g} N" + (f", Fm = {Fm:g} N" if Fm is not None else ""))
         rows = [("sound speed c0, Eq (2)", "sound_speed_m_per_s"),
@@ -71,7 +73,46 @@ def cmd_theory(args) -> dict:
             print(f"  {label:30s} {'-' if v is None else f'{v:9.2f} m/s'}")
         for why in dict.fromkeys(reasons.values()):
             print(f"  -: {why}")
+        if "yield_force_N" in out:
+            print(f"  yield pressure p_y = {out['yield_pressure_Pa'] / 1e6:.4g} MPa: each contact yields at "
+                  "F_y = pi^3 R*^2 p_y^3 / (6 E*^2)")
+            for partner, f in out["yield_force_N"].items():
+                print(f"    {partner:40s} {f:9.4g} N")
     return out
+
+
+def contact_yields(m, a: float, A: float, args) -> tuple:
+    """(p_y in Pa, {partner: F_y in N}) of a bead of material ``m`` and diameter ``a`` (m;
+    A its bead-bead Hertz constant) against each partner the rig's parts give it: another
+    such bead, the magnetic bead (chrome steel, 5 mm), the wall (brass, flat) and the
+    striker's face (alumina, flat); --yield-force is the bead-bead force, read as the
+    pressure that yields that contact (as chain.yield_force)."""
+    from rig.model.contact import hertz_constant
+    from rig.model.laws.thornton import pressure_yield_force, yield_pressure_of
+    from rig.model.materials import material
+    from rig.model.parts import MagneticBead
+
+    if args.yield_pressure is not None and args.yield_force is not None:
+        raise RigError(f"--yield-force = {args.yield_force!r}: give one of --yield-pressure or --yield-force")
+    r = a / 2
+    if args.yield_pressure is not None:
+        p = typed_quantity(args.yield_pressure, "Pa", "--yield-pressure")
+        if not 0 < p < math.inf:
+            raise RigError(f"--yield-pressure = {args.yield_pressure!r}: a pressure > 0 Pa, e.g. '30 MPa'")
+    else:
+        F = typed_quantity(args.yield_force, "N", "--yield-force")
+        if not 0 < F < math.inf:
+            raise RigError(f"--yield-force = {args.yield_force!r}: a force > 0 N, e.g. '0.8 N'")
+        p = float(yield_pressure_of(F, r / 2, A))
+    steel, brass, alumina = material(MagneticBead().material), material("brass"), material("alumina")
+    r_steel = MagneticBead().diameter / 2
+    partners = {"another bead": (r / 2, A),
+                "the magnetic bead (chrome steel, 5 mm)": (r * r_steel / (r + r_steel),
+                                                           hertz_constant(m.E, m.nu, r, steel.E, steel.nu, r_steel)),
+                "the wall (brass, flat)": (r, hertz_constant(m.E, m.nu, r, brass.E, brass.nu, math.inf)),
+                "the striker's face (alumina, flat)": (r, hertz_constant(m.E, m.nu, r, alumina.E, alumina.nu,
+                                                                         math.inf))}
+    return p, {name: float(pressure_yield_force(p, R, k)) for name, (R, k) in partners.items()}
 
 
 def cmd_bench(args) -> dict:
@@ -122,6 +163,10 @@ def add_theory(sub) -> None:
     th.add_argument("--diameter", default="4.76 mm", help="bead diameter, e.g. 4.76mm (plain number: m)")
     th.add_argument("--f0", required=True, help="precompression F0 (plain number: N)")
     th.add_argument("--fm", help="maximum contact force Fm of the wave (plain number: N)")
+    th.add_argument("--yield-pressure", help="a yield pressure (e.g. 30MPa; plain number: Pa): each contact's yield "
+                                             "force, the bead's against its partners in the rig")
+    th.add_argument("--yield-force", help="the bead-bead contacts' yield force (as chain.yield_force, e.g. 0.8N): "
+                                          "the pressure it is and the other contacts' forces")
 
 
 def add_bench(sub) -> None:

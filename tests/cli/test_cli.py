@@ -21,6 +21,25 @@ def test_theory_json_keys_and_values(capsys):
     assert out["discrete_speed_m_per_s"] == pytest.approx(out["speed_m_per_s"], rel=0.02)
 
 
+def test_theory_gives_each_contacts_yield_force_at_one_pressure(capsys):
+    """--yield-force is the bead-bead force; the pressure it is gives each partner its own
+    force, F_y = pi^3 R*^2 p_y^3 / (6 E*^2): the chain against the same computed by the
+    model for a published scene's contacts (magnetic bead, PTFE, brass wall)."""
+    from rig.experiment.shot import Rig
+
+    out = _json(capsys, "theory", "--material", "ptfe", "--diameter", "4.76mm", "--f0", "0.017",
+                "--yield-force", "0.8 N", "--json")
+    forces = out["yield_force_N"]
+    assert forces["another bead"] == pytest.approx(0.8, rel=1e-12)
+    chain = Rig.from_scene("ptfe52_magnetic", ("chain.contact_law=thornton", "chain.yield_force=0.8 N")).chain
+    model = chain.contact_yield_forces()
+    assert forces["the magnetic bead (chrome steel, 5 mm)"] == pytest.approx(model[1], rel=1e-9)
+    assert forces["the wall (brass, flat)"] == pytest.approx(model[chain.n_beads], rel=1e-9)
+    again = _json(capsys, "theory", "--material", "ptfe", "--f0", "0.017", "--yield-pressure",
+                  f"{out['yield_pressure_Pa']!r} Pa", "--json")
+    assert again["yield_force_N"] == pytest.approx(forces, rel=1e-12)
+
+
 def test_theory_without_fm_prints_only_the_sound_speed(capsys):
     out = _json(capsys, "theory", "--material", "steel316", "--f0", "2.44 N", "--json")
     assert out["sound_speed_m_per_s"] == pytest.approx(539.6, rel=1e-3)
