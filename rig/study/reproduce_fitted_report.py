@@ -54,20 +54,42 @@ def _inside(value, window) -> bool | None:
     return bool(window[0] <= value <= window[1])
 
 
-def targets(fitted: dict) -> list:
-    """[{"target", "value", "met"}] of the kept model (met None where it has no value)."""
+def observed_targets(row: dict) -> list:
+    """[{"target", "value", "met", "by"}] of Table 1 and Fig. 3 for a family's row (its
+    table1_* keys and its "fig3" figures): met None where it has no value, ``by`` how far
+    outside the window the value lies (in the target's unit; 0 where met, None without one)."""
     out = []
     for key, what, limit in TABLE1:
-        v = fitted.get(key)
-        out.append({"target": what, "value": v, "met": _inside(v, (-math.inf, limit))})
-    fig3 = fitted.get("fig3") or {}
+        v = row.get(key)
+        out.append({"target": what, "value": v, "met": _inside(v, (-math.inf, limit)), "by": _beyond(v, (-math.inf,
+                                                                                                       limit))})
+    fig3 = row.get("fig3") or {}
     for key, what, published, window in FIG3:
         if window is not None:
+            v = fig3.get(key)
             out.append({"target": f"{what}: {published}, window {window[0]:g} to {window[1]:g}",
-                        "value": fig3.get(key), "met": _inside(fig3.get(key), window)})
+                        "value": v, "met": _inside(v, window), "by": _beyond(v, window)})
     g, m = fig3.get("wall_peak_gravity_N"), fig3.get("wall_peak_magnetic_N")
     out.append({"target": "the magnet does not reduce the wall's peak", "value": [g, m],
-                "met": None if g is None or m is None else bool(m >= g)})
+                "met": None if g is None or m is None else bool(m >= g),
+                "by": None if g is None or m is None else max(g - m, 0.0)})
+    return out
+
+
+def misses(row: dict) -> list:
+    """The targets a family's row does not meet: [{"target", "value", "by"}]."""
+    return [{k: t[k] for k in ("target", "value", "by")} for t in observed_targets(row) if t["met"] is not True]
+
+
+def _beyond(value, window):
+    if value is None or not math.isfinite(value):
+        return None
+    return float(max(window[0] - value, value - window[1], 0.0))
+
+
+def targets(fitted: dict) -> list:
+    """[{"target", "value", "met"}] of the kept model (met None where it has no value)."""
+    out = [{k: t[k] for k in ("target", "value", "met")} for t in observed_targets(fitted)]
     for key, what, speed in STEEL:
         v = fitted["steel"].get(key)
         out.append({"target": f"{what}: {speed:g} +- 10%", "value": v,
@@ -106,6 +128,10 @@ def markdown(f: dict) -> str:
              "|---|---|---|---|---|---|---|---|---|"]
     lines += [_family_line(n, b) for n, b in models.items()]
     lines += ["", f"Kept ({f['selection']}): **{f['model'] or 'none'}**."]
+    for n, b in models.items():
+        if b.get("fails"):
+            lines.append(f"- {n} fails: " + "; ".join(f"{m['target']} ({_shown(m['value'])}, by {_shown(m['by'])})"
+                                                    for m in b["fails"]))
     lines += ["", "| Fig. 3 figure | published | " + " | ".join(fitted) + " |",
               "|---|---|" + "---|" * len(fitted)]
     for key, what, published, _ in FIG3:
