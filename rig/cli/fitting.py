@@ -95,7 +95,7 @@ def cmd_fit(args) -> dict:
     progress = None if args.quiet else stderr_progress
     with writing_to(args.out):
         block = run_fit(args.scene, objective, args.out, progress, args.max_evaluations, args.posterior,
-                        args.walkers, args.seed or 0)
+                        args.walkers, args.seed or 0, args.starts)
     if not args.json:
         for k, p in block["parameters"].items():
             unit = "" if p["unit"] == "1" else f" {p['unit']}"
@@ -104,6 +104,9 @@ def cmd_fit(args) -> dict:
         goodness = ("chi2/dof undefined (no degrees of freedom)" if block["chi2_reduced"] is None else
                     f"chi2/dof {block['chi2_reduced']:.3f} (p = {block['p_value']:.3g})")
         print(f"{goodness}, BIC {block['bic']:.2f}, residual rms {block['residual_rms_relative']:.2%}")
+        for o in block.get("optima", [])[1:]:
+            print("another optimum: " + ", ".join(f"{k} {v:.6g}" for k, v in o["estimate"].items())
+                  + f", chi2 {o['chi2']:.6g} ({'converged' if o['converged'] else 'not converged'})")
         for line in block["warnings"]:
             print(f"warning: {line}")
         for pair in block["highly_correlated"]:
@@ -149,6 +152,13 @@ def cmd_fit(args) -> dict:
     return block
 
 
+def starts_arg(text: str) -> int:
+    """--starts: a whole number of starts 1..100."""
+    from rig.cli.common import whole_number
+
+    return whole_number(text, 1, 100, "a whole number of starts from 1 to 100")
+
+
 def add_fit(sub) -> None:
     """The parser of ``rig fit``."""
     fi = command(sub, "fit", "fit scene keys to measured points, scope records or observations", cmd_fit)
@@ -169,6 +179,10 @@ def add_fit(sub) -> None:
     fi.add_argument("--out", required=True, metavar="DIR",
                     help="folder for fit.json, residuals.csv, fit.png, fitted.toml; its evaluations/ resume a fit")
     fi.add_argument("--max-evaluations", type=count_arg, default=400, help="the fit's budget (default 400)")
+    fi.add_argument("--starts", type=starts_arg, default=1, metavar="N",
+                    help="start the fit from N points (the scene's values, then points spread over the bounds) and "
+                         "keep the best: a narrow window or a second minimum is found; every distinct optimum is in "
+                         "fit.json's \"optima\" (default 1)")
     fi.add_argument("--posterior", type=count_arg, default=0, metavar="STEPS",
                     help="then sample the posterior by MCMC for STEPS steps (needs the extra: "
                          "pip install 'sonic-rig[posterior]'); resumes in DIR/posterior.h5")
