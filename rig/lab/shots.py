@@ -42,6 +42,15 @@ RIG_KEYS = ("striker.velocity", "magnet.force", "magnet.position")
 SCOPE_PREFIX = "scope."  # settings of the scope only: the chain's solve does not depend on them
 
 
+HISTORY_KEY = "chain.previous_shots"
+
+
+def without_history(items) -> tuple:
+    """The "key=value" items without chain.previous_shots: a rig built from them to check a
+    setting or read its sizes solves no earlier shots (each would be a solve of the chain)."""
+    return tuple(i for i in items if key_of(i) != HISTORY_KEY)
+
+
 def after_trigger(rig: Rig) -> float:
     """Seconds the rig's scope records after its trigger: (1 - pre_trigger) x the record's span."""
     tb = rig.scope.timebase
@@ -103,7 +112,7 @@ class SceneShots:
         self.scene = scene
         self.base = tuple(base_overrides)
         self.loaded = load(scene, self.base)  # refused here, not at the first shot
-        as_loaded = Rig(self.loaded)
+        as_loaded = Rig(load(scene, without_history(self.base)))  # its record's timing: no history solved
         self.trigger_by = as_loaded.solver.duration - after_trigger(as_loaded)
         self.on_shot = on_shot
         self.allow_large = allow_large
@@ -174,7 +183,7 @@ class SceneShots:
         (rig/solver/estimate.py: its memory and seconds), else the one-line refusal naming
         its estimate: what the scope refuses at the setting command (other refusals of the
         rig wait for the shot, as they depend on more than the setting)."""
-        items = self.items(overrides)
+        items = without_history(self.items(overrides))  # the size of one shot: its history is solved once, apart
         try:
             rig = Rig(load(self.scene, items + record_solver(Rig(load(self.scene, items)), self.trigger_by)))
         except RigError:
@@ -195,7 +204,7 @@ class SceneShots:
         if key not in RIG_KEYS:
             return str(invalid("rig key", key, f"one of {', '.join(RIG_KEYS)}"))
         try:
-            self._built(self.items({key: text}))
+            self._built(without_history(self.items({key: text})))  # the value's check: no earlier shot solved
         except (RigError, InstrumentError) as exc:
             return str(exc)
         return None

@@ -135,3 +135,20 @@ def test_shots_asked_from_many_threads_at_once_are_the_shots_asked_one_by_one(sh
     for (overrides, seed), record in zip(asks, together):
         one = alone(overrides, seed)
         assert all(np.array_equal(one[ch].codes, record[ch].codes) for ch in one.waveforms), seed
+
+
+def test_checking_a_setting_solves_no_earlier_shot_of_the_chain(monkeypatch):
+    """A scene served with a shot history (chain.previous_shots): checking a RIG: value or a
+    record's size builds the rig without its history (each earlier shot is a solve); the
+    shot itself has it."""
+    import rig.experiment.shot as shot_module
+
+    solved = []
+    real = shot_module.after_shots
+    monkeypatch.setattr(shot_module, "after_shots", lambda *a: solved.append(a[1]) or real(*a))
+    shots = SceneShots(SCENE, QUICK + ("chain.contact_law=thornton", "chain.yield_force=0.8 N",
+                                       "chain.previous_shots=2"))
+    assert shots.validate("striker.velocity", "1.0 m/s") is None
+    assert shots.record_cost({"scope.record_length": "2500"}) is None
+    assert solved == []
+    assert "chain.previous_shots=2" in shots.shot({}, 1).overrides and solved == [2]
