@@ -39,12 +39,33 @@ class NotMeasured(Exception):
         self.code = code
 
 
-def crossings(v: np.ndarray, level: float, rising: bool) -> np.ndarray:
+HYSTERESIS = 0.1
+"""A crossing of a reference level counts where the signal goes from below the level less
+this fraction of the amplitude to above the level plus it (or the other way): a noise
+ripple on an edge is no second crossing, as the scopes' measurement hysteresis has it."""
+
+
+def crossings(v: np.ndarray, level: float, rising: bool, band: float = 0.0) -> np.ndarray:
     """Sample positions (fractional, linear between samples) where ``v`` crosses ``level``
-    upwards (``rising``) or downwards."""
-    a, b = (v[:-1] < level, v[1:] >= level) if rising else (v[:-1] > level, v[1:] <= level)
-    i = np.flatnonzero(a & b)
-    return i + (level - v[i]) / (v[i + 1] - v[i])
+    upwards (``rising``) or downwards, with hysteresis: a crossing is the last one of the
+    level on the way from below level - band to above level + band (or back)."""
+    state = np.where(v <= level - band, -1, np.where(v >= level + band, 1, 0))
+    decisive = np.flatnonzero(state)
+    if decisive.size < 2:
+        return np.zeros(0)
+    d = state[decisive]
+    flips = np.flatnonzero(d[1:] != d[:-1]) + 1
+    out = []
+    for f in flips.tolist():
+        if (d[f] == 1) != rising:
+            continue
+        a, b = int(decisive[f - 1]), int(decisive[f])
+        seg = v[a:b + 1]
+        through = (seg[:-1] < level) & (seg[1:] >= level) if rising else (seg[:-1] > level) & (seg[1:] <= level)
+        k = np.flatnonzero(through)
+        i = a + int(k[-1])
+        out.append(i + (level - v[i]) / (v[i + 1] - v[i]))
+    return np.array(out)
 
 
 def levels(v: np.ndarray) -> tuple:
@@ -57,7 +78,8 @@ def levels(v: np.ndarray) -> tuple:
 def first_cycle(v: np.ndarray) -> tuple:
     """(start, end) sample positions of the first cycle: two rising crossings of the mid
     reference; NotMeasured 2202 "No period found" without two."""
-    up = crossings(v, levels(v)[3], True)
+    low, high, _, mid, _ = levels(v)
+    up = crossings(v, mid, True, HYSTERESIS * (high - low))
     if up.size < 2:
         raise NotMeasured(2202)
     return float(up[0]), float(up[1])
@@ -72,11 +94,12 @@ def period(v: np.ndarray, dt: float) -> float:
 def width(v: np.ndarray, dt: float, positive: bool) -> float:
     """Time (s) from the first mid-reference crossing up (positive) or down to the next one
     the other way."""
-    mid = levels(v)[3]
-    first = crossings(v, mid, positive)
+    low, high, _, mid, _ = levels(v)
+    band = HYSTERESIS * (high - low)
+    first = crossings(v, mid, positive, band)
     if first.size == 0:
         raise NotMeasured(2213 if positive else 2212)
-    back = crossings(v, mid, not positive)
+    back = crossings(v, mid, not positive, band)
     back = back[back > first[0]]
     if back.size == 0:
         raise NotMeasured(2209)
@@ -85,11 +108,12 @@ def width(v: np.ndarray, dt: float, positive: bool) -> float:
 
 def edge(v: np.ndarray, dt: float, rising: bool) -> float:
     """Rise (10% to 90%) or fall (90% to 10%) time (s) of the first such edge."""
-    _, _, p10, _, p90 = levels(v)
-    far = crossings(v, p90 if rising else p10, rising)
+    low, high, p10, _, p90 = levels(v)
+    band = 0.5 * HYSTERESIS * (high - low)  # half the mid reference's: the 10% level lies 10% above the base
+    far = crossings(v, p90 if rising else p10, rising, band)
     if far.size == 0:
         raise NotMeasured(2213 if rising else 2212)
-    near = crossings(v, p10 if rising else p90, rising)
+    near = crossings(v, p10 if rising else p90, rising, band)
     near = near[near <= far[0]]
     if near.size == 0:
         raise NotMeasured(2211)

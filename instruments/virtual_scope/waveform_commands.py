@@ -131,7 +131,7 @@ def register(tree, scope) -> None:
     destination = Word("REFA" if p.name == "tds2000" else "REF1")  # where DATa:DESTination would write (no refs)
     tree.add("DATa", write=data_init, read=lambda c: Fields((
         ("DESTination", destination), ("ENCdg", Word(scope.data.encoding)), ("SOUrce", Word(scope.data.source)),
-        ("STARt", str(scope.data.start)), ("STOP", str(scope.data.stop)), ("WIDth", str(scope.data.width)))))
+        ("STARt", str(scope.data.start)), ("STOP", str(scope.data.stop)), ("WIDth", str(scope.data.sent_width)))))
     def set_sources(c: Call):
         """DATa:SOUrce <wfm>[,<wfm>...] (the MDO3000's and 4 Series' manuals: a list; the
         TDS2000 takes one): the first is the source of the preamble and CURVe?."""
@@ -145,7 +145,7 @@ def register(tree, scope) -> None:
     tree.add("DATa:STOP", write=lambda c: data(stop=point(c)), read=lambda c: str(scope.data.stop))
     tree.add("DATa:ENCdg", write=lambda c: setattr(scope, "data", scope.data.encoded(c.word(p.encodings))),
              read=lambda c: Word(scope.data.encoding))
-    tree.add("DATa:WIDth", write=width, read=lambda c: str(scope.data.width))
+    tree.add("DATa:WIDth", write=width, read=lambda c: str(scope.data.sent_width))  # 4 with floats, as BYT_NR
     tree.add(p.preamble, read=preamble)
     def set_format(c: Call):
         fmt = c.word(("RI", "RP", "FP") if p.floats else ("RI", "RP"))

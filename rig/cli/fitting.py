@@ -105,7 +105,8 @@ def cmd_fit(args) -> dict:
                     f"chi2/dof {block['chi2_reduced']:.3f} (p = {block['p_value']:.3g})")
         print(f"{goodness}, BIC {block['bic']:.2f}, residual rms {block['residual_rms_relative']:.2%}")
         for o in block.get("optima", [])[1:]:
-            print("another optimum: " + ", ".join(f"{k} {v:.6g}" for k, v in o["estimate"].items())
+            print("another optimum: " + ", ".join(f"{k} {v:.6g}{'' if o['unit'][k] == '1' else ' ' + o['unit'][k]}"
+                                                   for k, v in o["estimate"].items())
                   + f", chi2 {o['chi2']:.6g} ({'converged' if o['converged'] else 'not converged'})")
         for line in block["warnings"]:
             print(f"warning: {line}")
@@ -180,7 +181,8 @@ def add_fit(sub) -> None:
                     help="folder for fit.json, residuals.csv, fit.png, fitted.toml; its evaluations/ resume a fit")
     fi.add_argument("--max-evaluations", type=count_arg, default=400, help="the fit's budget (default 400)")
     fi.add_argument("--starts", type=starts_arg, default=1, metavar="N",
-                    help="start the fit from N points (the scene's values, then points spread over the bounds) and "
+                    help="start the fit from N points (the scene's values where it sets them, else the bounds' middle; "
+                         "then points spread over the bounds) and "
                          "keep the best: a narrow window or a second minimum is found; every distinct optimum is in "
                          "fit.json's \"optima\" (default 1)")
     fi.add_argument("--posterior", type=count_arg, default=0, metavar="STEPS",

@@ -104,15 +104,17 @@ def repeat_shots(args, scene) -> dict:
     out = {"scenario": scene.name, "repeat": rows,
            "drift": {key: drift(key) for key in ("speed_m_per_s", "averaged_amplitude_N", "dissipated_energy_J")}}
     if not args.json:
-        print(f"{scene.name}: {args.repeat} shots on one chain (the truth, noise-free)")
-        print(f"  {'shot':>4s} {'seed':>8s} {'speed m/s':>10s} {'F_d N':>8s} {'plastic+viscous J':>18s}")
+        print(f"{scene.name}: {args.repeat} shot{'s' if args.repeat > 1 else ''} on one chain (the truth, noise-free)")
+        print(f"  {'shot':>4s} {'seed':>8s} {'speed m/s':>10s} {'F_m,e N':>8s} {'plastic+viscous J':>18s}")
         for r in rows:
             speed = "-" if r["speed_m_per_s"] is None else f"{r['speed_m_per_s']:.1f}"
             amp = "-" if r["averaged_amplitude_N"] is None else f"{r['averaged_amplitude_N']:.3f}"
             print(f"  {r['shot']:4d} {r['seed']:8d} {speed:>10s} {amp:>8s} {r['dissipated_energy_J']:18.3e}")
-        d = out["drift"]["speed_m_per_s"]
-        if d is not None and d["relative"] is not None:
-            print(f"  speed drift from shot {rows[0]['shot']} to {rows[-1]['shot']}: {d['relative']:+.1%}")
+        for key, what in (("speed_m_per_s", "speed"), ("averaged_amplitude_N", "F_m,e"),
+                          ("dissipated_energy_J", "energy the contacts took")):
+            d = out["drift"][key]
+            if len(rows) > 1 and d is not None and d["relative"] is not None:
+                print(f"  {what} drift from shot {rows[0]['shot']} to {rows[-1]['shot']}: {d['relative']:+.1%}")
     return out
 
 

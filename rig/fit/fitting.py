@@ -20,7 +20,7 @@ import hashlib
 import json
 import math
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -250,7 +250,8 @@ DISTINCT = 0.01  # optima closer than this fraction of every parameter's range a
 
 
 def start_points(objective, starts: int) -> list:
-    """``starts`` starts (SI): the objective's own, then points spread over the bounds by a
+    """``starts`` starts (SI): the objective's own (the scene's value where the scene sets the
+    key inside the bounds, else the bounds' middle), then points spread over the bounds by a
     Kronecker sequence (x_i = frac(1/2 + i a_j) in each parameter's normalised range, a_j
     the powers of the generalised golden ratio: every start is new and the starts fill the
     box evenly; deterministic, so a fit run again starts from the same points)."""
@@ -280,11 +281,12 @@ class Optimum:
 
 
 def multistart(objective, starts: int, cache_folder=None, max_evaluations: int = 400, progress=None) -> tuple:
-    """(the best FitResult, its Optimum list): ``fit`` from each of ``start_points``; the
-    optima found, distinct where some parameter differs by more than DISTINCT of its
-    range, best first (lowest chi2 of the converged fits, then of the others). Every
-    evaluation shares ``cache_folder``: a run stopped and started again replays what it
-    had solved. One start is ``fit`` itself."""
+    """(the best FitResult, its evaluations and replayed counts those of every start, and
+    the Optimum list): ``fit`` from each of ``start_points``; the optima found, distinct
+    where some parameter differs by more than DISTINCT of its range, best first (lowest
+    chi2 of the converged fits, then of the others). Every evaluation shares
+    ``cache_folder``: a run stopped and started again replays what it had solved. One start
+    is ``fit`` itself."""
     tell = progress or (lambda text: None)
     span = np.array([p.hi - p.lo for p in objective.params])
     results = []
@@ -294,6 +296,8 @@ def multistart(objective, starts: int, cache_folder=None, max_evaluations: int =
                 p.key + " " + p.shown(v) for p, v in zip(objective.params, theta0)))
         results.append((theta0, fit(objective, cache_folder, max_evaluations, progress, start=theta0)))
     ranked = sorted(results, key=lambda tr: (not tr[1].converged, tr[1].chi2))
+    best = replace(ranked[0][1], evaluations=sum(r.evaluations for _, r in results),
+                   replayed=sum(r.replayed for _, r in results))  # what every start solved and replayed
     optima: list = []
     for theta0, r in ranked:
         same = next((i for i, o in enumerate(optima)
@@ -304,7 +308,7 @@ def multistart(objective, starts: int, cache_folder=None, max_evaluations: int =
         else:
             o = optima[same]
             optima[same] = Optimum(o.estimate, o.chi2, o.converged, o.starts + (tuple(float(x) for x in theta0),))
-    return ranked[0][1], optima
+    return best, optima
 
 
 def _savez(path, arrays: dict):

@@ -60,7 +60,9 @@ def _fit_into(scene, objective, out: Path, progress, max_evaluations, posterior_
         fitted = atomic_write(stale, write)
     block = report.summary(result, objective, fitted)
     if starts > 1:
-        block["optima"] = [{"estimate": dict(zip(result.keys, o.estimate)), "chi2": o.chi2, "converged": o.converged,
+        units = dict(zip(result.keys, result.units))
+        block["optima"] = [{"estimate": dict(zip(result.keys, o.estimate)), "unit": units,
+                            "chi2": o.chi2, "converged": o.converged,
                             "starts": [dict(zip(result.keys, s)) for s in o.starts]} for o in optima]
     if posterior_steps and result.converged:
         from rig.fit import posterior

@@ -287,12 +287,15 @@ class Chain:
             return
         forces = self.contact_yield_forces()
         live = follows_law(self) & np.isfinite(forces)
-        others = sorted({round(float(f), 3) for f in forces[live]} - {round(self.yield_force, 3)})
+        names = {0: "the striker's", self.n_beads: "the wall's"}
+        if self.beads[0].kind == "magnetic":
+            names[1] = "the magnetic bead's"
+        others = [f"{name} {forces[k]:.3g} N" for k, name in sorted(names.items()) if k < forces.size and live[k]]
         _said_yield_note()
         warnings.warn(f"chain.yield_force = {self.yield_force:g} N is read as the yield pressure of the chain's "
                       f"bead-bead contacts, p_y = {p / 1e6:.4g} MPa (chain.yield_pressure); at that pressure the "
                       f"other contacts yield at their own forces"
-                      f"{' (here ' + ', '.join(f'{f:g} N' for f in others) + ')' if others else ''}",
+                      f"{' (' + ', '.join(others) + ')' if others else ''}; rig theory --yield-force lists them",
                       RigNote, stacklevel=3)
 
     def yield_reference_contact(self) -> int | None:

@@ -377,3 +377,22 @@ def test_4_series_results_of_a_measurement_that_is_off_are_not_values(make_scope
     s.handle(b"MEASUREMENT:ADDMEAS RISETIME")
     assert ask(s, "MEASU:LIST?;:MEASU:MEAS1:TYPE?;:EVENT?") == "MEAS1;RISETIME;0"
     assert 0 < float(ask(s, "MEASU:MEAS1:RESU:CURR:MEAN?")) < 1e-3
+
+
+def test_noise_on_an_edge_is_no_cycle():
+    """A single pulse in 8-bit codes with noise a tenth of a code: its rising edge crosses
+    the 50% level back and forth between codes, which a crossing without hysteresis had
+    counted as cycles (a 'frequency' set by the sample rate: 5 MHz at 10 samples' noise);
+    with the scopes' hysteresis it has no period (2202) and its width is the pulse's."""
+    from instruments.virtual_scope.measurements import MEASUREMENTS, NotMeasured
+
+    dt, w = 1e-7, 5e-5
+    t = np.arange(10_000) * dt
+    rng = np.random.default_rng(1)
+    code = 0.002
+    v = np.round((0.2 * np.exp(-((t - 5e-4) / w) ** 2) + 0.1 * code * rng.standard_normal(t.size)) / code) * code
+    with pytest.raises(NotMeasured) as no_period:
+        MEASUREMENTS["FREQuency"](v, dt)
+    assert no_period.value.code == 2202
+    slope = 0.2 * 2 * math.sqrt(math.log(2)) / w * 0.5  # |dv/dt| at the half-amplitude crossings
+    assert MEASUREMENTS["PWIdth"](v, dt) == pytest.approx(2 * w * math.sqrt(math.log(2)), abs=2 * (code / slope + dt))
