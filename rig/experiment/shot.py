@@ -7,6 +7,7 @@ instrument and the oscilloscope, and returns a ShotRecord. Same seed, same bits.
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,7 +15,7 @@ import numpy as np
 from instruments.analysis.report import Report
 from instruments.devices.gauges import GaugeDraw, PiezoGauge
 from instruments.records import ScopeRecord
-from rig.errors import RigError, invalid
+from rig.errors import RigError, RigNote, invalid
 from rig.experiment import scene as scene_io
 from rig.experiment.assembly import Assembly
 from rig.experiment.history import after_shots
@@ -91,6 +92,10 @@ class Rig(Assembly):
                               f"the shot after one with chain.previous_shots = {after.previous_shots} is "
                               f"{after.previous_shots + 1}")
             self.chain = after.chain.after_shot(after.solution())
+        elif self.previous_shots and not self.chain.law.yielding:  # the same chain: nothing to solve
+            warnings.warn(f"chain.previous_shots = {self.previous_shots} changes nothing here: the contact law "
+                          f"{self.chain.law.name!r} keeps no memory of a shot (chain.contact_law = thornton does)",
+                          RigNote, stacklevel=2)
         elif self.previous_shots:  # the chain as its earlier shots left it (rig/experiment/history.py)
             self.chain = after_shots(self.chain, self.previous_shots, self.solver, self.save_at())
 

@@ -192,9 +192,14 @@ class SceneShots:
         held = cost.bytes + record_bytes(rig)
         if self.allow_large or (held <= LIMIT_BYTES and cost.seconds <= LIMIT_SECONDS):
             return None
-        return (f"this record needs about {held / 1e9:.3g} GB (the solve: {cost.describe()}; the scope's record "
-                f"of {rig.scope.timebase.record_length} points a channel), beyond the served scope's limits of "
-                f"{LIMIT_BYTES / 1e9:g} GB and {LIMIT_SECONDS:g} s of solving a shot")
+        s = rig.solver
+        over = ([f"{LIMIT_BYTES / 1e9:g} GB"] if held > LIMIT_BYTES else []) + (
+            [f"{LIMIT_SECONDS:g} s of solving"] if cost.seconds > LIMIT_SECONDS else [])
+        return (f"this record needs about {held / 1e9:.3g} GB and {cost.seconds:.3g} s: the chain's whole "
+                f"{s.duration * 1e3:.3g} ms solve recorded every {s.sample_interval:.3g} s, the scope's sample "
+                f"interval ({cost.samples:,} samples a channel), and the scope's {rig.scope.timebase.record_length:,} "
+                f"points a channel; beyond the served scope's limit of {' and '.join(over)} (a coarser "
+                "HORizontal:SCAle or a shorter record)")
 
     def validate(self, key: str, text: str) -> str | None:
         """None when ``key`` (one of RIG_KEYS) may be set to ``text`` (a quantity with its
