@@ -11,13 +11,13 @@ from __future__ import annotations
 import copy
 import functools
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from rig.errors import RigNote, invalid
+from rig.errors import invalid
 from rig.memo import computed_once
+from rig.model import contact_yield
 from rig.model.laws import contact_law as lookup_law
 from rig.model.laws import law_values
 from rig.model.parts import Bead, Striker, Wall
@@ -25,19 +25,12 @@ from rig.model.statics import (
     contact_constants_of,
     equilibrium_positions_of,
     follows_law,
-    reduced_radii_of,
     static_forces_of,
     static_overlaps_of,
 )
 from rig.units import quantity
 
 STANDARD_GRAVITY = 9.80665  # m/s^2
-YIELD_NOTE_SAID = False  # the note on chain.yield_force read as a pressure is given once a process
-
-
-def _said_yield_note() -> None:
-    global YIELD_NOTE_SAID
-    YIELD_NOTE_SAID = True
 
 
 @dataclass(frozen=True)
@@ -135,7 +128,7 @@ class Chain:
                           f"a yield pressure needs Hertz contacts (chain.contact_exponent = 1.5, here "
                           f"{self.contact_exponent:g}); with another exponent give chain.yield_force, every "
                           "contact's yield force")
-        self._say_yield_pressure()
+        contact_yield.say_yield_pressure(self)
         self.hold = quantity(hold, "s", "magnet.hold", bare_ok=True)
         if not self.hold >= 0:
             raise invalid("magnet.hold", hold, "must be >= 0 s")
@@ -268,85 +261,33 @@ class Chain:
                 self.prior[:, None, :], (len(STATE_ROWS),) + np.shape(A))
             state, d0 = rest_after(prior, n, F, d_el)
             return state, d0, np.zeros(np.shape(A))
-        terms = self.law.yielding(self.contact_parameters) if self.law.yielding else NO_YIELD
+        terms = self.yield_terms or NO_YIELD
         live = follows_law(self) & np.isfinite(A)
-        state, d0, work = initial_state(np.where(live, A, 0.0), n, np.where(live, F, 0.0), d_el, terms, self.hold,
-                                        self.contact_yield_forces(A))
+        state, d0, work = initial_state(np.where(live, A, 0.0), n, np.where(live, F, 0.0), d_el, terms,
+                                        self.contact_yield_forces(A), self.hold)
         ap = STATE_ROWS.index("unloading_constant")
         state[ap] = np.where(live, state[ap], np.where(np.isfinite(A), A, 0.0))  # as new: A_p = A
         return state, np.where(live, d0, d_el), work
 
-    def _say_yield_pressure(self) -> None:
-        """Where chain.yield_force (a force) is read as the pressure that yields the chain's
-        bead-bead contacts, say so, once a process (a RigNote), with the pressure and the
-        other contacts' forces of the first chain read so."""
-        if YIELD_NOTE_SAID or not (self.law.yielding and self.contact_parameters.get("yield_force", 0.0) > 0):
-            return
-        p = self.contact_yield_pressure()
-        if p is None:
-            return
-        forces = self.contact_yield_forces()
-        live = follows_law(self) & np.isfinite(forces)
-        names = {0: "the striker's", self.n_beads: "the wall's"}
-        if self.beads[0].kind == "magnetic":
-            names[1] = "the magnetic bead's"
-        others = [f"{name} {forces[k]:.3g} N" for k, name in sorted(names.items()) if k < forces.size and live[k]]
-        _said_yield_note()
-        warnings.warn(f"chain.yield_force = {self.yield_force:g} N is read as the yield pressure of the chain's "
-                      f"bead-bead contacts, p_y = {p / 1e6:.4g} MPa (chain.yield_pressure); at that pressure the "
-                      f"other contacts yield at their own forces"
-                      f"{' (' + ', '.join(others) + ')' if others else ''}; rig theory --yield-force lists them",
-                      RigNote, stacklevel=3)
-
-    def yield_reference_contact(self) -> int | None:
-        """The contact chain.yield_force names: the first between two beads of the chain's
-        material (None: the chain has no such pair)."""
-        b = self.beads
-        return next((k for k in range(1, self.n_beads) if b[k - 1].kind != "magnetic" and b[k].kind != "magnetic"),
-                    None)
+    @property
+    def yield_terms(self):
+        """Its law's rig.model.laws.thornton.YieldTerms, or None where the law never yields."""
+        return self.law.yielding(self.contact_parameters) if self.law.yielding else None
 
     def contact_yield_pressure(self, A=None):
-        """The yield pressure p_y (Pa; per shot where A is an array of shots' constants) of
-        the chain's contacts (rig.model.laws.thornton): chain.yield_pressure, or the pressure
-        at which chain.yield_force yields the chain's bead-bead contacts; None where the law
-        does not yield, the contacts are not Hertz's, or no bead-bead contact names it."""
-        from rig.model.laws.thornton import yield_pressure_of
-
-        terms = self.law.yielding(self.contact_parameters) if self.law.yielding else None
-        if terms is None or self.contact_exponent != 1.5:
-            return None
-        if terms.yield_pressure > 0:
-            return terms.yield_pressure
-        k = self.yield_reference_contact()
-        if terms.yield_force == 0 or k is None:
-            return None
-        A = self.contact_constants() if A is None else np.asarray(A, float)
-        return yield_pressure_of(terms.yield_force, float(reduced_radii_of(self)[k]), A[..., k])
+        """The yield pressure p_y (Pa) of its contacts, or None (rig.model.contact_yield)."""
+        return contact_yield.yield_pressure(self, A)
 
     def contact_yield_forces(self, A=None) -> np.ndarray:
-        """Each contact's yield force F_y (N) at the reference closing rate (contacts 0..n,
-        last axis; per shot where A, the contacts' constants, is an array of shots'): the
-        force at which the yield pressure (contact_yield_pressure) is reached in that contact,
-        F_y = pi^3 R*^2 p_y^3 / (6 E*^2) from its own radius and moduli; chain.yield_force for
-        every contact where there is no pressure (another exponent); 0 where it never yields."""
-        from rig.model.laws.thornton import pressure_yield_force
-
-        A = self.contact_constants() if A is None else np.asarray(A, float)
-        terms = self.law.yielding(self.contact_parameters) if self.law.yielding else None
-        if terms is None:
-            return np.zeros(A.shape)
-        p = self.contact_yield_pressure(A)
-        if p is None:
-            return np.full(A.shape, terms.yield_force)
-        p = np.asarray(p, float)[..., None] if np.ndim(p) else float(p)
-        return pressure_yield_force(p, reduced_radii_of(self), A)
+        """Each contact's yield force F_y (N) (rig.model.contact_yield)."""
+        return contact_yield.yield_forces(self, A)
 
     def contact_yield_rates(self) -> tuple:
         """(m, r_ref): each contact's yield rate exponent and reference closing rate (m/s)
         (rig.model.laws.thornton); (0, 1) where it does not follow a yielding law."""
         from rig.model.laws.thornton import NO_YIELD
 
-        terms = self.law.yielding(self.contact_parameters) if self.law.yielding else NO_YIELD
+        terms = self.yield_terms or NO_YIELD
         law = follows_law(self)
         return np.where(law, terms.rate_exponent, 0.0), np.where(law, terms.reference_rate, 1.0)
 

@@ -297,7 +297,7 @@ def yield_overlap(A, Fy, n):
     return out
 
 
-def initial_state(A, n, F_static, d_static, terms: YieldTerms, hold: float = 0.0, yield_forces=None) -> tuple:
+def initial_state(A, n, F_static, d_static, terms: YieldTerms, yield_forces, hold: float = 0.0) -> tuple:
     """(state, d0, hold_work): the kernels' memory (STATE_ROWS, contacts) before the shot,
     the static overlaps d0 (m) and the plastic work (J, per contact) the static load took
     (before the shot: not in its energy), for contacts of constants A (N/m^n), exponents n,
@@ -305,15 +305,14 @@ def initial_state(A, n, F_static, d_static, terms: YieldTerms, hold: float = 0.0
 
     A contact whose static force passes its yield force was flattened as the load went on:
     it rests on its elastic curve through (delta*, F_static) on the envelope, at delta* >
-    d_static. The yield is chain.yield_force's; after a static hold (``hold`` > 0 s) the
-    static one, static_ratio x its pressure (the yield overlap x ratio^2, the force x
-    ratio^(2n)). The others are as new (A_p = A, delta_p = 0) at d_static. Each yields
-    again where its curve meets the envelope of chain.yield_force (elastic_limit).
-    ``yield_forces``: each contact's own F_y (N; a yield pressure's, Chain.contact_yield_forces)
-    in place of terms.yield_force for every one."""
+    d_static. The yield is each contact's own, ``yield_forces`` (N; a yield pressure's,
+    Chain.contact_yield_forces); after a static hold (``hold`` > 0 s) the static one,
+    static_ratio x its pressure (the yield overlap x ratio^2, the force x ratio^(2n)). The
+    others are as new (A_p = A, delta_p = 0) at d_static. Each yields again where its curve
+    meets its dynamic envelope (elastic_limit)."""
     A, n, F, d0 = (np.array(x, float) for x in np.broadcast_arrays(A, n, F_static, d_static))
     state = np.zeros((len(STATE_ROWS),) + A.shape)
-    dy = yield_overlap(A, terms.yield_force if yield_forces is None else yield_forces, n)
+    dy = yield_overlap(A, yield_forces, n)
     state[AP], state[DY], state[DYREF] = A, dy, dy
     state[DC] = np.where(dy > 0, dy, np.inf)
     work = np.zeros(A.shape)
