@@ -158,7 +158,7 @@ def register(tree, scope) -> None:
         """TRIGger:A:LEVel (the source's) or TRIGger:A:LEVel:CH<x> (channel x's; the
         trigger's own where x is its source), V, or the manuals' ECL (-1.3 V) and TTL (1.4 V)."""
         ch = level_channel(c)
-        level = LOGIC_LEVELS[c.word(tuple(LOGIC_LEVELS))] if c.arg().kind != "number" else c.number("V")
+        level = level_value(c)
         if ch == scope.settings["scope.trigger.source"]:
             scope.change({"scope.trigger.level": level}, code=-222)
         elif not abs(level) <= LEVEL_LIMIT_V:
@@ -241,6 +241,11 @@ def register(tree, scope) -> None:
     tree.add("AUTOSet", write=lambda c: c.word(("EXECute", "UNDo")) and None)
 
 
+def level_value(c: Call) -> float:
+    """A trigger level's argument (V): a number, or the manuals' ECL and TTL words."""
+    return LOGIC_LEVELS[c.word(tuple(LOGIC_LEVELS))] if c.arg().kind != "number" else c.number("V")
+
+
 def register_b_trigger(tree, scope) -> None:
     """TRIGger:B (the A-then-B sequence): the edge settings of the manual taken and read
     back, TRIGger:B:STATE OFF (ON, the sequence, is not modelled: 221); the record is the A
@@ -250,7 +255,7 @@ def register_b_trigger(tree, scope) -> None:
     def keep(field: str):
         def write(c: Call):
             if field == "level":
-                b[field] = LOGIC_LEVELS[c.word(tuple(LOGIC_LEVELS))] if c.arg().kind != "number" else c.number("V")
+                b[field] = level_value(c)
             else:
                 b[field] = c.word(CHANNEL_WORDS if field == "source" else ("RISe", "FALL"))
         return write

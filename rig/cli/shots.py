@@ -56,14 +56,19 @@ def cmd_shot(args) -> dict:
             paths = WRITERS[args.format or "isf"](shot.scope.waveforms, folder, f"{shot.scene}_seed{shot.seed}")
         out["exported"] = [str(p) for p in paths]
     if args.out:
-        from instruments.archive import Archive
-        from rig.experiment.entry import shot_entry
-
-        with writing_to(args.out):
-            out["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot_entry(shot)])[0]}
+        out["archived"] = archived(args.out, shot)
     if not args.json:
         print_shot(out, "the striker's kinetic energy" if rig.chain.striker is not None else "the static energy")
     return out
+
+
+def archived(path: str, shot) -> dict:
+    """Append ``shot`` to the archive at ``path`` (rig.lab.shots.append_shot, as the served
+    scope's --out does): {"archive", "shot": its number}; an I/O failure names the path."""
+    from rig.lab.shots import append_shot
+
+    with writing_to(path):
+        return {"archive": path, "shot": append_shot(path, shot)}
 
 
 def repeat_shots(args, scene) -> dict:
@@ -91,11 +96,7 @@ def repeat_shots(args, scene) -> dict:
                      "dissipated_energy_J": rig.solution().stats.dissipated_energy_J,
                      "triggered": shot.scope.triggered})
         if args.out:
-            from instruments.archive import Archive
-            from rig.experiment.entry import shot_entry
-
-            with writing_to(args.out):
-                rows[-1]["archived"] = {"archive": args.out, "shot": Archive(args.out).append([shot_entry(shot)])[0]}
+            rows[-1]["archived"] = archived(args.out, shot)
 
     def drift(key):
         a, b = rows[0][key], rows[-1][key]

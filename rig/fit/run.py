@@ -9,7 +9,7 @@ from instruments.files import atomic_write, folder_lock, left_as_found, write_te
 from rig.errors import Interrupted, RigError
 from rig.experiment import scene as scene_io
 from rig.fit import report
-from rig.fit.fitting import multistart
+from rig.fit.multistart import multistart
 
 LOCK = "fit.lock"  # held in the --out folder while a fit writes it: a second fit into it is refused
 

@@ -153,13 +153,17 @@ class SceneShots:
         """A new rig of the scene with the "key=value" ``items`` and the solver items its
         record needs (``record_solver``), refused (RigError) where it could give no record or
         passes the size limits, before anything is solved."""
-        rig = Rig(load(self.scene, items))
-        extra = record_solver(rig, self.trigger_by)
-        if extra:
-            rig = Rig(load(self.scene, items + extra))
+        rig = self._recording(items)
         rig.check_record()
         rig.estimate().refuse_unless(self.allow_large, "this shot")
         return rig
+
+    def _recording(self, items: tuple) -> Rig:
+        """The rig of the scene with ``items`` and the solver items its record needs
+        (record_solver), built before anything is solved (RigError where the scene refuses)."""
+        rig = Rig(load(self.scene, items))
+        extra = record_solver(rig, self.trigger_by)
+        return Rig(load(self.scene, items + extra)) if extra else rig
 
     def shot(self, overrides: Mapping[str, str], seed: int) -> ShotRecord:
         """The whole shot (scope record, settings, truth) with ``overrides`` and ``seed``;
@@ -183,9 +187,8 @@ class SceneShots:
         (rig/solver/estimate.py: its memory and seconds), else the one-line refusal naming
         its estimate: what the scope refuses at the setting command (other refusals of the
         rig wait for the shot, as they depend on more than the setting)."""
-        items = without_history(self.items(overrides))  # the size of one shot: its history is solved once, apart
-        try:
-            rig = Rig(load(self.scene, items + record_solver(Rig(load(self.scene, items)), self.trigger_by)))
+        try:  # the size of one shot: its history is solved once, apart
+            rig = self._recording(without_history(self.items(overrides)))
         except RigError:
             return None  # refused at the shot, with its reason
         cost = rig.estimate()
