@@ -24,12 +24,10 @@ with a portmapper there, so that both are found and neither unregisters the othe
 from __future__ import annotations
 
 import errno
-import itertools
 import logging
 import os
 import socket
 import threading
-from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,17 +35,17 @@ from typing import TypeVar
 
 from instruments.errors import InstrumentError
 from instruments.records import ScopeRecord
-from instruments.scpi.status import esr_bit
 from instruments.transports.addresses import LOOPBACK_V4, is_loopback, is_wildcard, machine_addresses
-from instruments.transports.device import InstrumentLock, MessageInstrument, Session
+from instruments.transports.device import MessageInstrument
 from instruments.transports.hislip import HislipServer
 from instruments.transports.portmap import PMAP_PORT, MappingTaken
 from instruments.transports.socket import SocketServer
 from instruments.transports.vxi11 import Vxi11Server
-from instruments.transports.wire import ConnectionEvent, EventKind, Limits, printable, quoted
+from instruments.transports.wire import ConnectionEvent, EventKind, Limits, printable
 from instruments.virtual_scope.instrument import VirtualScope
 from rig.errors import invalid
 from rig.experiment.shot import ShotRecord, fresh_seed
+from rig.lab.serve_log import LoggedInstrument, Refusals, server_log
 from rig.lab.shots import SceneShots, append_shot
 
 
@@ -107,10 +105,6 @@ def _port(name: str, port: int | None) -> None:
 
 
 _Server = TypeVar("_Server", SocketServer, HislipServer, Vxi11Server)
-_LOGS = itertools.count(1)
-MAX_LOGGED_REFUSALS = 100
-"""Refused commands logged per client; past them one line says the rest are not (a client
-that sends junk cannot fill the disk through the log)."""
 VXI11_ADDRESSES = 8
 """Loopback addresses (127.0.0.2 on) a second VXI-11 server tries for a portmapper of its own."""
 
@@ -125,7 +119,7 @@ class ScopeServer:
         period = fire_period(s.fire)
         self.settings, self.say = s, say
         self.seed = fresh_seed() if s.seed is None else s.seed
-        self.log = _logger(s.log)
+        self.log = server_log(s.log)
         self.servers: list = []
         self._names: dict[int, str] = {}  # a server's id: what it serves, in words
         self.resources: list[str] = []
@@ -331,99 +325,6 @@ class ScopeServer:
         for handler in list(self.log.handlers):
             handler.close()
             self.log.removeHandler(handler)
-
-
-class Refusals:
-    """Which errors each message left in the scope's queue, for the log: the queue as last
-    seen, so that an event is told once, with the message that left it (a warning, such as a
-    measurement's clipping, sets no error bit and is no refusal). An event posted
-    outside any message (the acquisition's: a shot that failed or did not trigger) is not
-    a refused command: the refused shot is logged where it is fired."""
-
-    def __init__(self, scope: VirtualScope, log: logging.Logger) -> None:
-        self.scope, self.log = scope, log
-        self._seen: list = []
-        self._shots: deque[str] = deque(maxlen=16)
-
-    def shot_refused(self, reason: str) -> None:
-        with self.scope.cond:
-            self._shots.append(reason)
-
-    def fresh(self) -> list:
-        """The events posted since the last look (holding the scope's condition)."""
-        events = list(self.scope.status.events)
-        new = [e for e in events if not any(e is seen for seen in self._seen)]
-        self._seen = events
-        return [e for e in new if esr_bit(e.code) and not (e.code == -200 and (  # an error, not a warning
-            e.detail.startswith("the shot of seed") or any(reason.startswith(e.detail) for reason in self._shots)))]
-
-
-class LoggedInstrument:
-    """The scope (or its RIG: port) as a transport serves it, each refused command logged."""
-
-    def __init__(self, inner: MessageInstrument, refusals: Refusals, transport: str) -> None:
-        self.inner, self.refusals, self.transport = inner, refusals, transport
-        self.max_message_bytes: int = inner.max_message_bytes
-        self.lock: InstrumentLock = inner.lock
-
-    def open_session(self, peer: str) -> Session:
-        return LoggedSession(self.inner.open_session(peer), self.refusals, f"{self.transport} {peer}")
-
-
-class LoggedSession:
-    """One client's session; a message that leaves events in the queue is logged with them."""
-
-    def __init__(self, session: Session, refusals: Refusals, who: str) -> None:
-        self.session, self.refusals, self.who = session, refusals, who
-        self.logged = 0
-
-    def handle(self, message: bytes) -> bytes:
-        with self.refusals.scope.cond:  # the scope's own: the message runs under it
-            self.refusals.fresh()  # posted outside any message meanwhile: not this one's
-            reply = self.session.handle(message)
-            events = self.refusals.fresh()
-        for event in events:
-            self.logged += 1
-            if self.logged <= MAX_LOGGED_REFUSALS:
-                self.refusals.log.warning("refused command from %s: %s: %s", self.who, quoted(message),
-                                          printable(event.text(scpi=True)))
-            elif self.logged == MAX_LOGGED_REFUSALS + 1:
-                self.refusals.log.warning("refused command from %s: more than %d; the rest are not logged",
-                                          self.who, MAX_LOGGED_REFUSALS)
-        return reply
-
-    def device_clear(self) -> None:
-        self.session.device_clear()
-
-    def trigger(self) -> None:
-        self.session.trigger()
-
-    def status_byte(self) -> int:
-        return self.session.status_byte()
-
-    def overflow(self, size: int) -> None:
-        self.session.overflow(size)  # the transport logs it, as a protocol violation
-
-    def close(self) -> None:
-        self.session.close()
-
-
-def _logger(path: Path | None) -> logging.Logger:
-    """The server's log (``--log FILE``: appended, one line per event); silent without one
-    (not even Python's last-resort handler on stderr). Each server has a log of its own."""
-    log = logging.getLogger(f"rig.lab.serve.{next(_LOGS)}")
-    log.propagate = False
-    log.setLevel(logging.INFO)
-    if path is None:
-        log.addHandler(logging.NullHandler())
-    else:
-        try:
-            handler = logging.FileHandler(path, encoding="utf-8")
-        except OSError as e:
-            raise invalid("--log", str(path), f"a file this process can write ({e.strerror})") from None
-        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(message)s"))
-        log.addHandler(handler)
-    return log
 
 
 def serve(settings: ServeSettings, say: Callable[[str], None] = print, as_json: bool = False) -> None:
