@@ -25,6 +25,7 @@ line, the form the instrument side puts in its error queue.
 """
 from __future__ import annotations
 
+import math
 import threading
 from collections import OrderedDict
 from collections.abc import Callable, Iterable, Mapping
@@ -38,6 +39,12 @@ from rig.solver.estimate import LIMIT_BYTES, LIMIT_SECONDS
 
 RIG_KEYS = ("striker.velocity", "magnet.force", "magnet.position")
 """The settings of the rig itself (not of the scope) that a lab client may change."""
+
+HORIZONTAL_KEYS = ("scope.sample_interval", "scope.record_length", "scope.trigger.pre_trigger")
+"""The scope's horizontal settings (scene keys): where its record lies in time."""
+
+RECORD_KEYS = ("solver.duration", "solver.sample_interval")
+"""The solver settings a record may need other than the scene's (record_solver)."""
 
 SCOPE_PREFIX = "scope."  # settings of the scope only: the chain's solve does not depend on them
 
@@ -70,18 +77,34 @@ def record_bytes(rig: Rig) -> float:
 
 def record_solver(rig: Rig, trigger_by: float) -> tuple:
     """The solver items ("key=value") the rig's scope record needs beyond its solver settings:
-    a solve lasting ``trigger_by`` (s, when the scene's own record triggers at the latest:
-    its solver.duration less what its scope records after the trigger) plus what this scope
-    records after its trigger, and recorded at the scope's sample interval where that is
-    finer. () when the rig's solver already gives the record."""
+    a solve lasting ``trigger_by`` (s, when the record triggers at the latest) plus what
+    this scope records after its trigger, and recorded at the scope's sample interval where
+    that is finer. Where the scope samples finer than the solver records, the solve lasts
+    just that long (shorter than the scene's, if so: every sample of it is held at the fine
+    interval); otherwise it is only ever lengthened. () when the rig's solver already gives
+    the record."""
     s, dt = rig.solver, rig.scope.timebase.sample_interval
     items = []
-    needed = trigger_by + after_trigger(rig)
-    if needed > s.duration * (1 + 1e-12):
+    finer = s.sample_interval > dt * (1 + 1e-9)
+    grid = dt if finer else s.sample_interval  # the solve's record ends on its last sample
+    needed = math.ceil((trigger_by + after_trigger(rig)) / grid * (1 - 1e-12)) * grid
+    if needed > s.duration * (1 + 1e-12) or (finer and needed < s.duration * (1 - 1e-12)):
         items.append(f"solver.duration={needed!r} s")
-    if s.sample_interval > dt * (1 + 1e-9):
+    if finer:
         items.append(f"solver.sample_interval={float(dt)!r} s")
     return tuple(items)
+
+
+TRIGGER_MARGIN = 0.25
+"""How much later than its estimate (a fraction of the estimated time after the impact) a
+record sampled finer than the scene's solver may trigger: the estimate is the trigger of
+the scene's own time base at seed ESTIMATE_SEED, and a shot at another seed triggers
+earlier or later by its draws (the gauges' gains and misalignments, the noise). For the
+published PTFE scene (trigger 0.39 ms after the impact) 30 seeds spread +-3%; a shot that
+triggers later still is refused as a late trigger, naming the solve to lengthen."""
+
+ESTIMATE_SEED = 0
+"""The seed of the shot that estimates when a fine record triggers (trigger_estimate)."""
 
 
 def key_of(item: str) -> str:
@@ -119,6 +142,7 @@ class SceneShots:
         self.last: ShotRecord | None = None
         self._size = cache
         self._rigs: OrderedDict[tuple, Rig] = OrderedDict()
+        self._estimates: OrderedDict[tuple, float | None] = OrderedDict()
         self._lock = threading.RLock()
 
     def items(self, overrides: Mapping[str, str]) -> tuple:
@@ -132,7 +156,11 @@ class SceneShots:
 
     def rig(self, overrides: Mapping[str, str] | None = None) -> Rig:
         """The rig of the scene with ``overrides`` (built once per distinct set; RigError)."""
-        items = self.items(overrides or {})
+        return self.rig_of(self.items(overrides or {}))
+
+    def rig_of(self, items: tuple) -> Rig:
+        """The rig of the scene with the "key=value" ``items`` (built once per distinct set;
+        RigError)."""
         key = tuple(sorted(items))
         with self._lock:
             if key in self._rigs:
@@ -160,10 +188,40 @@ class SceneShots:
 
     def _recording(self, items: tuple) -> Rig:
         """The rig of the scene with ``items`` and the solver items its record needs
-        (record_solver), built before anything is solved (RigError where the scene refuses)."""
+        (record_solver), built before anything is solved (RigError where the scene refuses).
+        A record the items' solve does not hold is solved until it ends: until its
+        trigger, estimated by trigger_estimate and TRIGGER_MARGIN later (the scene's latest
+        trigger where none is estimated), plus what it records after the trigger. The shot's
+        items given again need nothing more (the same estimate: it reads the items without
+        the solver's duration and interval)."""
         rig = Rig(load(self.scene, items))
-        extra = record_solver(rig, self.trigger_by)
+        trigger_by = self.trigger_by
+        if record_solver(rig, trigger_by):
+            t = self.trigger_estimate(items)
+            if t is not None:
+                trigger_by = min(trigger_by, t * (1 + TRIGGER_MARGIN))
+        extra = record_solver(rig, trigger_by)
         return Rig(load(self.scene, items + extra)) if extra else rig
+
+    def trigger_estimate(self, items: tuple) -> float | None:
+        """When (s after the impact) the scope with ``items``' settings triggers on the
+        scene's own time base (its sample interval, record length and pre-trigger: a record
+        that its solve holds, the solver's duration and interval the scene's) and its chain
+        without earlier shots (history makes the pulse
+        faster: the trigger earlier), at seed ESTIMATE_SEED; None where it does not trigger.
+        Kept per set of items (a shot fired once; its chain solved once, in the rig cache)."""
+        coarse = tuple(sorted(i for i in without_history(items) if key_of(i) not in HORIZONTAL_KEYS + RECORD_KEYS))
+        with self._lock:
+            if coarse not in self._estimates:
+                self._estimates[coarse] = None  # a scene whose own time base is finer than its solver: no estimate
+                try:
+                    record = self.rig_of(coarse).fire(seed=ESTIMATE_SEED, truth=False).scope
+                except RigError:
+                    record = None  # refused on the scene's time base: the shot says why
+                self._estimates[coarse] = record.trigger_time if record is not None and record.triggered else None
+                if len(self._estimates) > self._size:
+                    self._estimates.popitem(last=False)
+            return self._estimates[coarse]
 
     def shot(self, overrides: Mapping[str, str], seed: int) -> ShotRecord:
         """The whole shot (scope record, settings, truth) with ``overrides`` and ``seed``;
@@ -198,8 +256,9 @@ class SceneShots:
         s = rig.solver
         over = ([f"{LIMIT_BYTES / 1e9:g} GB"] if held > LIMIT_BYTES else []) + (
             [f"{LIMIT_SECONDS:g} s of solving"] if cost.seconds > LIMIT_SECONDS else [])
-        return (f"this record needs about {held / 1e9:.3g} GB and {cost.seconds:.3g} s: the chain's whole "
-                f"{s.duration * 1e3:.3g} ms solve recorded every {s.sample_interval:.3g} s, the scope's sample "
+        return (f"this record needs about {held / 1e9:.3g} GB and {cost.seconds:.3g} s: the chain's "
+                f"{s.duration * 1e3:.3g} ms solve (until the record ends) recorded every {s.sample_interval:.3g} s, "
+                "the scope's sample "
                 f"interval ({cost.samples:,} samples a channel), and the scope's {rig.scope.timebase.record_length:,} "
                 f"points a channel; beyond the served scope's limit of {' and '.join(over)} (a coarser "
                 "HORizontal:SCAle or a shorter record)")

@@ -70,6 +70,33 @@ def test_time_of_flight_two_ways_and_train_count():
     assert rep.pulses == 3  # the 2% one is below 5% of the leading pulse
 
 
+def test_the_delay_of_a_finely_sampled_pair_is_the_full_correlations_at_a_bounded_cost():
+    """0.2 ns samples (a 200 ns/div record): the leading pulse's window holds 0.35 M samples,
+    searched every 85th sample first, then at every sample near that peak: the delay to a
+    sample's fraction (the coarse search alone would be off by up to 85/2 samples, 8 ns);
+    a window just past XCORR_POINTS (every 2nd sample first) gives the full correlation's
+    peak and parabola, computed here with numpy."""
+    from instruments.analysis._kernels.pulses import XCORR_POINTS
+
+    h = 2e-10
+    t = np.arange(int(0.32e-3 / h)) * h
+    a = 1.0 / np.cosh((t - 0.05e-3) / 2e-5) ** 2
+    b = 1.0 / np.cosh((t - (0.25e-3 + 0.37 * h)) / 2e-5) ** 2
+    pa, pb = find_pulses(t, a)[0], find_pulses(t, b)[0]
+    assert xcorr_delay(t, a, pa, b, pb) == pytest.approx(0.2e-3 + 0.37 * h, abs=0.05 * h)
+    h = 2 * pa.fwhm / (XCORR_POINTS * 2.5)  # a window of 2.5 XCORR_POINTS samples: searched every 2nd first
+    t = np.arange(int(0.32e-3 / h)) * h
+    a = 1.0 / np.cosh((t - 0.05e-3) / 2e-5) ** 2
+    b = 0.7 / np.cosh((t - 0.25e-3) / 2.2e-5) ** 2  # wider and lower: a correlation peak of its own shape
+    pa, pb = find_pulses(t, a)[0], find_pulses(t, b)[0]
+    ia0, ia1 = np.searchsorted(t, [pa.time - pa.fwhm, pa.time + pa.fwhm])  # a's window, b's twice as wide
+    ib0, ib1 = np.searchsorted(t, [pb.time - 2 * pa.fwhm, pb.time + 2 * pa.fwhm])
+    c = np.correlate(b[ib0:ib1], a[ia0:ia1], mode="valid")
+    k = int(np.argmax(c))
+    full = (ib0 + k + 0.5 * (c[k - 1] - c[k + 1]) / (c[k - 1] - 2 * c[k] + c[k + 1]) - ia0) * h
+    assert xcorr_delay(t, a, pa, b, pb) == pytest.approx(full, abs=1e-6 * h)
+
+
 def test_a_quantised_train_counts_each_flat_top_once():
     # 8-bit-like codes with a flicker of one code: each flat top holds several local maxima
     # at the top code, each with the whole pulse as its prominence (scipy's ties); they are

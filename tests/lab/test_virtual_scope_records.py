@@ -1,5 +1,6 @@
 """A record for every horizontal setting the model offers (the scene's rig behind the scope):
 a record lasting longer than the scene's solve, one sampled finer than the solver records,
+a fine short one solved only until it ends,
 each the very bits of ``Rig.fire`` with the items the shot was fired with; a record past
 the served scope's cost limit refused at the setting command, the settings unchanged; a
 ``CURVe?`` without a record answered at once, its reason in the queue."""
@@ -75,13 +76,37 @@ def test_a_record_finer_than_the_solvers_grid_samples_the_solution_finer(served)
     same_as_rig_fire(shots)
 
 
+def test_a_fine_short_record_solves_the_chain_only_until_it_ends_as_the_scenes_solve_does(served):
+    """200 ns/div, 10,000 points (0.2 ns a sample) over the scene's whole 3 ms would hold
+    2.4 GB: solved only until the record ends (its trigger, estimated, and the 1.8 us after
+    it), it gives a record, the chain's forces those of the scene's own solve within the
+    solver's accuracy (1e-4 of the peak), and the bits of Rig.fire with its items."""
+    scope, shots = served
+    s = scope.open_session("t")
+    assert ask(s, "HOR:RECO 10000;:HOR:SCA 2E-7;:ALLEV?") == '0,"No events to report - queue empty"'
+    assert fire(s) == '1;0,"No events to report - queue empty"'
+    fine = shots.last
+    w = fine.scope["CH1"]
+    assert fine.scope.triggered and w.preamble.x_increment == pytest.approx(2e-10, rel=1e-12)
+    duration = Rig.from_scene(SCENE, fine.overrides).solver.duration
+    assert fine.scope.trigger_time + 0.9 * 2e-6 < duration < 0.25 * 3e-3  # past the record's end, a sixth of 3 ms
+    coarse = shots.rig({}).truth()
+    step = round(coarse.sample_interval / fine.truth.sample_interval)
+    for name, g in coarse.gauges.items():
+        f = fine.truth.gauges[name].average_force[::step]
+        peak = g.average_force.max()
+        assert np.abs(f - g.average_force[:f.size]).max() < 1e-4 * peak
+    same_as_rig_fire(shots)
+    ask(s, "HOR:RECO 10000;:HOR:SCA 1E-4")
+
+
 def test_a_record_past_the_cost_limit_is_refused_at_the_setting_and_nothing_changes(served):
     scope, _ = served
     s = scope.open_session("t")
     before = ask(s, "HOR:RECO?;:HOR:SCA?")
-    reply = ask(s, "HOR:RECO 10000;:HOR:SCA 1E-7;:ALLEV?")  # 10 ps a sample over 3 ms: GB
+    reply = ask(s, "HOR:RECO 10000;:HOR:SCA 2E-8;:ALLEV?")  # 20 ps a sample over the 0.5 ms to the record's end
     assert reply.startswith('221,"Settings conflict; this record needs about') and "2 GB" in reply
-    assert ask(s, "HOR:RECO 10000;:HOR:SCA?") == ask(s, "HOR:SCA?") != "1.0000E-9"
+    assert ask(s, "HOR:RECO 10000;:HOR:SCA?") == ask(s, "HOR:SCA?") != "20.0000E-9"
     ask(s, f"HOR:RECO {before.split(';')[0]};:HOR:SCA {before.split(';')[1]}")
 
 
