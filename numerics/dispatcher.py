@@ -30,7 +30,7 @@ from numba.core.types import unliteral
 from numba.core.untyped_passes import IRProcessing
 from numba.extending import typeof_impl
 
-PER_VALUE = frozenset({"law", "flows"})  # the parameters compiled per value (module doc)
+PER_VALUE = frozenset({"law", "flows", "multirate"})  # the parameters compiled per value (module doc)
 
 
 @dataclass(frozen=True, eq=False)

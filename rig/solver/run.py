@@ -114,7 +114,7 @@ def kernel_inputs(problems: ChainProblem | ProblemArrays, take: Callable[[str], 
         bundles.Contacts(Constant(problems.law), con, rows(STATE_ROWS)),
         bundles.Holder(onsite, layout.slip_speed, viscous_rate(problems), flows),
         bundles.Method(np.array(m.drifts), np.array(m.kicks), step, n_steps, stepping.head,
-                       stepping.substeps(step, m.drifts)),
+                       stepping.substeps(step, m.drifts), Constant(int(stepping.head > 0))),
         bundles.Schedule(layout.sched_body, layout.sched_t, layout.sched_f),
         bundles.Record(ch_slot, ch_weight, save.sample_interval, out, frame_dt, frames),
         bundles.Checks(check_interval(n_steps), take("energy_scale"), take("momentum_scale"), layout.wall_slot))

@@ -123,3 +123,26 @@ def test_a_drift_of_one_substep_still_feels_the_striker():
     ref = _reference(p, 0.45e-3, save)
     sol = solve(p, 0.45e-3, dt=st, save=save, estimate=False)
     assert relative_error(sol.forces, ref.forces) < 1e-3
+
+
+def test_a_pass_without_a_head_compiles_no_head_flow(tmp_path):
+    """bundles.Method.multirate, a Constant: the batched pass handed 0 (no head) is compiled
+    without the head flow (about 8 s of a cold study's compile), in a fresh process with an
+    empty cache; the head flow's kernels never compiled."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    probe = ("import numpy as np\nfrom numerics.dispatcher import Constant\n"
+             "from rig.model.contact import HERTZ\nfrom rig.solver.kernels import ensemble_passes, multirate\n"
+             "from rig.solver.methods import method\nfrom rig.solver.problem import CONTACT_ROWS, STATE_ROWS\n"
+             "nb, W = 8, 4\nm = method('srkn6b')\nz = np.zeros((nb, W))\n"
+             "ensemble_passes.kick_drift_forces(z, z.copy(), np.ones((nb, W)), np.zeros((nb + 1, W)), np.ones((nb, W)),"
+             " np.full((nb, W), 1e-7), np.zeros((nb + 1, W)), 1e-9, 1e-9, 0, Constant(0), np.array(m.drifts),"
+             " np.array(m.kicks), 1, np.zeros((2, 3, 1, W)), np.zeros((5, W)), Constant(HERTZ),"
+             " np.full((len(CONTACT_ROWS), nb, W), 1.5), np.zeros((len(STATE_ROWS), nb, W)), nb)\n"
+             "print(len(ensemble_passes.kick_drift_forces.signatures), len(multirate.head_flow.signatures))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True,
+                          cwd=Path(__file__).resolve().parents[2], env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path)))
+    assert done.stdout.split() == ["1", "0"]

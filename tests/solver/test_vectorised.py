@@ -63,7 +63,7 @@ def test_the_batched_pass_runs_its_rows_inline():
     m = method("srkn6b")
     z = np.zeros((nb, W))
     ir = _llvm(ensemble_passes.kick_drift_forces, z, z.copy(), np.ones((nb, W)), np.zeros((nb + 1, W)),
-               np.ones((nb, W)), np.full((nb, W), 1e-7), np.zeros((nb + 1, W)), 1e-9, 1e-9, 0, np.array(m.drifts),
+               np.ones((nb, W)), np.full((nb, W), 1e-7), np.zeros((nb + 1, W)), 1e-9, 1e-9, 0, 0, np.array(m.drifts),
                np.array(m.kicks),
                1, np.zeros((2, 3, 1, W)), np.zeros((5, W)), HERTZ, np.full((len(CONTACT_ROWS), nb, W), 1.5),
                np.zeros((len(STATE_ROWS), nb, W)), nb)

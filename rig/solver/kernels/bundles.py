@@ -62,7 +62,10 @@ class Holder(NamedTuple):
 class Method(NamedTuple):
     """The stepping: the composition's drift and kick coefficients (a_coef, b_coef: one more
     kick than drifts), the step dt (s), the steps n_steps, the multirate head's bodies
-    (``head``, 0: none) and its substeps in each drift (``sub``, int64)."""
+    (``head``, 0: none), its substeps in each drift (``sub``, int64) and ``multirate``, 1
+    where there is a head (head > 0), else 0: handed as a Constant, the kernels of a solve
+    without a head are compiled without the head flow's code (multirate.py; the same bits:
+    it is never run there)."""
 
     a_coef: np.ndarray
     b_coef: np.ndarray
@@ -70,6 +73,7 @@ class Method(NamedTuple):
     n_steps: int
     head: int
     sub: np.ndarray
+    multirate: "int | Constant"
 
 
 class Schedule(NamedTuple):

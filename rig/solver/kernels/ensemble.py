@@ -78,7 +78,7 @@ def integrate_chunks(first, last, u3, v3, chain, contacts, holder, method, recor
     mass3, invm3, bias3, load3, A3, d03, d_limit3 = chain  # each bundle's fields, in their order (bundles.py)
     law, con3, state3 = contacts
     onsite3, slip, viscous_rate, flows = holder
-    a_coef, b_coef, dt, n_steps, head, sub = method
+    a_coef, b_coef, dt, n_steps, head, sub, multirate = method
     ch_slot, ch_weight, sample_dt, out = record.ch_slot, record.ch_weight, record.sample_dt, record.out
     check_every, e_ref3, p_ref3, wall_slot = checks.check_every, checks.e_ref, checks.p_ref, checks.wall_slot
     n_ch = ch_slot.shape[0]
@@ -155,8 +155,8 @@ def integrate_chunks(first, last, u3, v3, chain, contacts, holder, method, recor
                     for s in range(W):
                         j_wall[s] += hb * f[wall_slot, s]
                 h = a_coef[st] * dt
-                kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, a_coef, b_coef, sub[st], h_work, h_busy,
-                                   law, con, state, reach)
+                kick_drift_forces(u, v, invm, f, A, d0, load, hb, h, head, multirate, a_coef, b_coef, sub[st], h_work,
+                                  h_busy, law, con, state, reach)
             t_new = (n + 1) * dt
             pending = b_coef[n_drift] * dt
             check = (n + 1) % check_every == 0 or n == n_steps - 1

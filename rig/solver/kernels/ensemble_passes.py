@@ -100,14 +100,14 @@ def kick_drift(u, v, invm, f, hb, ha, head, reach):
 
 
 @jit
-def kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, a_coef, b_coef, n_sub, h_work, h_busy, law, con,
-                       state, reach):
+def kick_drift_forces(u, v, invm, f, A, d0, load, hb, ha, head, multirate, a_coef, b_coef, n_sub, h_work, h_busy,
+                       law, con, state, reach):
     """kick_drift (and the head's flow) then shot_forces in one pass over rows 0..reach-1 (the
     others at rest bit for bit, integrators.integrate's front): row i is kicked and drifted
     (reading f[i], f[i+1], not yet renewed), then contact i is renewed from rows i-1 and i
     (both moved). The same operations as the two passes, so the same bits."""
     start = 0
-    if head > 0:
+    if multirate:  # a Constant (bundles.Method): 1 where head > 0; without, no head flow compiled
         head_kick(v, invm, f, hb, head)
         head_flow(u, v, invm, f, A, d0, load, head, a_coef, b_coef, ha, n_sub, h_work, h_busy)
         start = head + 1

@@ -107,7 +107,7 @@ def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks
     mass, invm, bias, load, A, d0, d_limit = chain  # each bundle's fields, in their order (bundles.py)
     law, con, state = contacts
     onsite, slip, viscous_rate, flows = holder
-    a_coef, b_coef, dt, n_steps, head, sub = method
+    a_coef, b_coef, dt, n_steps, head, sub, multirate = method
     sched_body, sched_t, sched_f = schedule.body, schedule.t, schedule.f
     ch_slot, ch_weight, sample_dt, out = record.ch_slot, record.ch_weight, record.sample_dt, record.out
     frame_dt, frames = record.frame_dt, record.frames
@@ -199,7 +199,7 @@ def integrate(u, v, f, chain, contacts, holder, method, schedule, record, checks
         reach = min(nb, still + n_drift + 2)
         stepped += reach
         step(u, v, invm, f, A, d0, load, law, expo, state3, A_el, d0_el, a_coef, b_coef, dt, t, pending, head, sub,
-              sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach)
+             multirate, sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach)
         t_new = (n + 1) * dt
         pending = b_coef[n_drift] * dt
         check = (n + 1) % check_every == 0 or n == n_steps - 1

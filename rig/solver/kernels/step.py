@@ -103,7 +103,7 @@ BLOCK = 2048  # bodies per block of a step's wavefront (their arrays stay in the
 
 @jit(inline="always")
 def step(u, v, invm, f, A, d0, load, law, expo, state, A_el, d0_el, a_coef, b_coef, dt, t, pending, head, sub,
-          sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach):
+          multirate, sched_body, sched_t, sched_f, wall_slot, heads, h_work, h_busy, impulses, reach):
     """One step of the composition (its closing kick owed), bodies 0..reach-1, every stage.
     ``reach``: the bodies beyond it are still at rest and unforced (integrators.rest_from):
     the step would leave them bit for bit as they are.
@@ -113,7 +113,7 @@ def step(u, v, invm, f, A, d0, load, law, expo, state, A_el, d0_el, a_coef, b_co
     bodies, each block taken through every stage (stage s on bodies kB - s .. (k+1)B - s)
     while it is in cache, instead of every stage streaming the whole chain from memory.
     Each body sees the same operations in the same order as in stage-by-stage sweeps.
-    With a multirate head, bodies 0..head get the kick of slot
+    With a multirate head (``multirate`` 1: head > 0), bodies 0..head get the kick of slot
     head + 1 and the head's flow (multirate.head_flow) instead. ``heads``: the
     (bodies, 1) views the head flow takes, h_work and h_busy its work arrays;
     impulses[0] += the wall's dynamic impulse, impulses[1] += the schedule's (N s).
@@ -135,7 +135,7 @@ def step(u, v, invm, f, A, d0, load, law, expo, state, A_el, d0_el, a_coef, b_co
             if k == 0:
                 if sched_t.shape[0] > 0:  # entered only with a schedule: the inlined kick's reference counts
                     impulses[1] += external_kick(v, invm, hb, ts, sched_body, sched_t, sched_f)
-                if head > 0:
+                if multirate:  # a Constant (bundles.Method): a solve without a head compiles no head flow
                     v[head] += hb * (0.0 - f[head + 1]) * invm[head]
                     head_flow(u2, v2, im2, f2, A2, d02, load2, head, a_coef, b_coef, h, sub[s], h_work, h_busy)
                     lo = head + 1
