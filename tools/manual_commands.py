@@ -19,7 +19,7 @@ from pathlib import Path
 
 MODELS = {"mdo3000": "mdo3k_commands", "mso4": "mso4_commands"}
 GROUPS = {
-    "waveform transfer": ("curve", "data", "wfmoutpre", "wavfrm"),
+    "waveform transfer": ("curve", "curvestream", "data", "wfmoutpre", "wavfrm"),
     "horizontal": ("horizontal",),
     "trigger": ("trigger",),
     "vertical": ("ch", "select"),

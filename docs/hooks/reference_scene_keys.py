@@ -75,6 +75,8 @@ MEANINGS = {
     "scope.trigger.level": "the trigger level",
     "scope.trigger.slope": "the trigger slope: rising or falling",
     "scope.trigger.pre_trigger": "the share of the record before the trigger (0..1)",
+    "scope.trigger.mode": "normal: a shot that does not trigger gives no record; auto: it gives one all the same, "
+                          "untriggered, its trigger point at the impact (the manuals' TRIGger:A:MODe NORMal and AUTO)",
     "scope.channels.CHn.volts_per_div": "the channel's vertical scale",
     "scope.channels.CHn.position": "the trace's position on screen (divisions)",
     "scope.channels.CHn.offset": "the channel's offset",

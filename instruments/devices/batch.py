@@ -18,7 +18,8 @@ from ._kernels import acquisition
 from .frontend import highpass_coefficients
 from .oscilloscope import CODE_MAX, CODE_MIN, AcquisitionStatus, Oscilloscope
 
-OK, NO_TRIGGER, PAST_INPUT = AcquisitionStatus  # a record's status (Records.outcome)
+OK, NO_TRIGGER, PAST_INPUT = AcquisitionStatus.OK, AcquisitionStatus.NO_TRIGGER, AcquisitionStatus.PAST_INPUT
+"""A record's status (Records.outcome; AcquisitionStatus.AUTO: taken untriggered in AUTO mode)."""
 
 
 @dataclass(frozen=True)
@@ -119,7 +120,8 @@ def acquire(forces: np.ndarray, h: float, wiring: Wiring, seeds, fixed: np.ndarr
     rested = np.array([g for g in wired if g >= 0 and settings[g].noise], np.int64)  # noisy before the impact
     gauges = (cal, mis, noisy, sens, delayed, gauge_filter, noise_sd)
     panel = (wired, front.probe, front.ac, front.lowpass, front.source, front.level, front.rising, front.n_pre, dx,
-             front.offset, front.ymult, front.yoff, front.sd, float(CODE_MIN), float(CODE_MAX), bool(scope.noise_floor))
+             front.offset, front.ymult, front.yoff, front.sd, float(CODE_MIN), float(CODE_MAX), bool(scope.noise_floor),
+             front.auto)
     seeds = np.asarray(seeds, np.int64)
     over_threads(S, acquisition.shots, seeds, forces, float(h), speed, replace, gauges, panel, reads, drawn_rows,
                  rested, codes, over, status, times, drawn)

@@ -3,10 +3,11 @@
 Per channel: V/div, vertical position (div), offset (V), DC/AC coupling, bandwidth limit,
 probe attenuation. Horizontal: sample interval and record length. Edge trigger on one
 channel (level, slope, pre-trigger fraction) with a random sub-sample phase of the
-sampling clock. 8-bit ADC, 25 codes per division (Tektronix), codes clipped to
-[-128, 127] with an over-range flag. Sample or average-N acquisition (averaging the
-scope's own noise over N acquisitions of the same input). A channel with no input reads
-the scope's noise floor.
+sampling clock, in NORMal mode (no trigger, no record) or AUTO (no trigger: a record taken
+untriggered, its trigger point at the impact; ``Trigger``). 8-bit ADC, 25 codes per
+division (Tektronix), codes clipped to [-128, 127] with an over-range flag. Sample or
+average-N acquisition (averaging the scope's own noise over N acquisitions of the same
+input). A channel with no input reads the scope's noise floor.
 """
 from __future__ import annotations
 
@@ -36,6 +37,7 @@ class AcquisitionStatus(enum.IntEnum):
     OK = acquisition.OK
     NO_TRIGGER = acquisition.NO_TRIGGER
     PAST_INPUT = acquisition.PAST_INPUT  # the record would run past the input
+    AUTO = acquisition.AUTO  # no trigger; taken untriggered in AUTO mode, its trigger point at the impact
 
     @property
     def message(self) -> str:
@@ -44,7 +46,9 @@ class AcquisitionStatus(enum.IntEnum):
 
 _ACQUISITION_MESSAGES = {AcquisitionStatus.OK: "the scope triggered and its record lies within the input",
                          AcquisitionStatus.NO_TRIGGER: "the scope did not trigger",
-                         AcquisitionStatus.PAST_INPUT: "the scope's record runs past the input"}
+                         AcquisitionStatus.PAST_INPUT: "the scope's record runs past the input",
+                         AcquisitionStatus.AUTO: "the scope did not trigger; in AUTO mode it took the record "
+                                                 "untriggered, its trigger point at the impact"}
 
 
 @dataclass(frozen=True)
@@ -92,18 +96,32 @@ class Timebase:
 @dataclass(frozen=True)
 class Trigger:
     """Edge trigger: source channel, level (V), slope ("rising" | "falling"),
-    pre_trigger (fraction of the record before the trigger, 0..1)."""
+    pre_trigger (fraction of the record before the trigger, 0..1), mode ("normal" |
+    "auto", the manuals' TRIGger:A:MODe NORMal | AUTO).
+
+    NORMal waits for a valid trigger event: a shot whose input never crosses the level
+    gives no record. AUTO "generates a trigger if one is not detected within a specified
+    time period" (the 4 Series and MDO3000 manuals, TRIGger:A:MODe): a shot that does not
+    trigger still gives a record, untriggered. A real scope's auto trigger fires when its
+    timer runs out, at a time unrelated to the signal; here it is put at the impact
+    (t = 0 of the input), so that the record is reproducible, shows the input at rest
+    before the impact (its pre-trigger share, read at rest where it lies before the input)
+    and what the shot did after it, and lies within the solved input wherever a triggered
+    record of the same settings could (its trigger crossing is never before the impact).
+    A shot that triggers gives the same record in either mode."""
 
     source: str = "CH1"
     level: float = 0.05
     slope: str = "rising"
     pre_trigger: float = 0.1
+    mode: str = "normal"
 
     def __post_init__(self):
         check("scope.trigger.source", self.source, choices=CHANNELS)
         check("scope.trigger.level", self.level, lo=-LEVEL_LIMIT_V, hi=LEVEL_LIMIT_V, unit="V")
         check("scope.trigger.slope", self.slope, choices=("rising", "falling"))
         check("scope.trigger.pre_trigger", self.pre_trigger, lo=0, hi=1, lo_closed=True, hi_closed=False)
+        check("scope.trigger.mode", self.mode, choices=("normal", "auto"))
 
 
 def per_division(x: float, unit: str, digits: int = 4) -> str:
@@ -154,43 +172,59 @@ class Oscilloscope:
         impact). Before t = 0 each input is at rest: its noise ``rest[channel]`` (V rms; a
         gauge's noise) about its rest level, or, without noise, its first value held. Displayed
         channels without an input read noise. Returns a ScopeRecord; a record that does not
-        trigger says so. Draws from rng the clock's phase, then each displayed channel's noise
-        (shot_draws' order), then, only for a record that starts before t = 0, the rest noise
-        of each input over the samples before it, in the order of the displayed channels.
+        trigger says so (in AUTO mode it is taken all the same, untriggered, its trigger
+        point at the impact). Draws from rng the clock's phase, then each displayed
+        channel's noise (shot_draws' order), then, only for a record that starts before
+        t = 0, the rest noise of each input over the samples before it, in the order of the
+        displayed channels. The conversions follow acquisition.shots' order, so a batch's
+        shot has these bits.
         """
         tb = self.timebase
         phase = rng.uniform(0.0, tb.sample_interval)
         shape = (len(self.channels), int(tb.record_length) if self.noise_floor else 0)
         noise = rng.standard_normal(shape) if self.noise_floor else np.empty(shape)
         n_in = max((len(v) for v in inputs.values()), default=0)
-        status, t_cross, x_zero, codes, over = self._convert(inputs, h, phase, noise)
-        n_pad = samples_before_input(status, t_cross, x_zero, h)
-        if n_pad:
-            rest = rest or {}
-            padded = {}
-            for ch in self.channels:
-                if ch in inputs:
-                    sd = float(rest.get(ch, 0.0))
-                    z = rng.standard_normal(n_pad) if sd > 0 else np.zeros(n_pad)
-                    padded[ch] = at_rest_before(np.ascontiguousarray(inputs[ch], dtype=float), sd, z)
-            status, t_cross, x_zero, codes, over = self._convert(padded, h, phase, noise)
-            t_cross -= n_pad * h
+        forced, n_pad, read = math.nan, 0, inputs
+        for _ in range(3):  # the edge; in AUTO, none found: the impact; the record again from before the input
+            status, t_cross, x_zero, codes, over = self._convert(read, h, phase, noise, forced + n_pad * h)
+            if status == AcquisitionStatus.NO_TRIGGER and self.trigger.mode == "auto":
+                forced = 0.0
+                continue
+            if n_pad:
+                break
+            n_pad = samples_before_input(status, t_cross, x_zero, h)
+            if not n_pad:
+                break
+            read = self._at_rest_before(inputs, rest or {}, n_pad, rng)
+        t_cross -= n_pad * h
         return self.record_of(status, t_cross, x_zero, codes, over, n_in, h)
 
-    def _convert(self, inputs: dict, h: float, phase: float, noise: np.ndarray) -> tuple:
+    def _at_rest_before(self, inputs: dict, rest: dict, n_pad: int, rng: np.random.Generator) -> dict:
+        """The inputs with n_pad samples of rest before them (at_rest_before), each input's
+        rest noise drawn in the order of the displayed channels."""
+        padded = {}
+        for ch in self.channels:
+            if ch in inputs:
+                sd = float(rest.get(ch, 0.0))
+                z = rng.standard_normal(n_pad) if sd > 0 else np.zeros(n_pad)
+                padded[ch] = at_rest_before(np.ascontiguousarray(inputs[ch], dtype=float), sd, z)
+        return padded
+
+    def _convert(self, inputs: dict, h: float, phase: float, noise: np.ndarray, forced: float = math.nan) -> tuple:
         """The trigger and the 8-bit conversion of inputs (every h s from their first sample)
-        with the clock's phase and the scope's noise draws: (status, time of the trigger
-        crossing from the first input sample s, time of the first sample after it s, codes,
-        over-range flags)."""
+        with the clock's phase and the scope's noise draws; ``forced`` (s from the first
+        input sample): an AUTO record's trigger point, no edge looked for (nan: the edge's).
+        Returns (status, time of the trigger point from the first input sample s, time of
+        the first sample after it s, codes, over-range flags)."""
         front = self.front_panel(h)
         tb = self.timebase
         codes = np.empty((len(self.channels), int(tb.record_length)), np.int8)
         over = np.empty(len(self.channels), np.bool_)
         status, t_cross, x_zero = scope_shot(self.analog(inputs, h), float(h), front.source, front.level,
-                                             front.rising, phase, front.n_pre, tb.sample_interval, front.offset,
-                                             front.ymult, front.yoff, front.sd, noise, float(CODE_MIN),
+                                             front.rising, float(forced), phase, front.n_pre, tb.sample_interval,
+                                             front.offset, front.ymult, front.yoff, front.sd, noise, float(CODE_MIN),
                                              float(CODE_MAX), codes, over, np.ones(len(self.channels), np.bool_))
-        return status, t_cross, x_zero, codes, over
+        return AcquisitionStatus(status), t_cross, x_zero, codes, over
 
     def analog(self, inputs: dict, h: float) -> np.ndarray:
         """(channels, samples): each displayed channel's input (volts at the probe tip, every
@@ -212,20 +246,24 @@ class Oscilloscope:
         of n_in samples every h s."""
         tb, tr = self.timebase, self.trigger
         status = AcquisitionStatus(status)
+        band = TRIGGER_BAND_CODES * self.channels[tr.source].y_multiplier
+        no_edge = (f"no {tr.slope} crossing of {tr.level:g} V on {tr.source} in {n_in * h:.4g} s (past the "
+                   f"trigger's noise band of {band:.3g} V: it fires where the signal goes {band / 2:.3g} V beyond "
+                   f"the level)")
         if status is AcquisitionStatus.NO_TRIGGER:
-            band = TRIGGER_BAND_CODES * self.channels[tr.source].y_multiplier
-            return ScopeRecord({}, False,
-                               f"no {tr.slope} crossing of {tr.level:g} V on {tr.source} in {n_in * h:.4g} s "
-                               f"(past the trigger's noise band of {band:.3g} V: it fires where the signal goes "
-                               f"{band / 2:.3g} V beyond the level)")
+            return ScopeRecord({}, False, no_edge)
         if status is AcquisitionStatus.PAST_INPUT:
             last = t_cross + x_zero + tb.sample_interval * (int(tb.record_length) - 1)
             raise InstrumentError(
                 f"scope record ends {last:.4g} s after t = 0 but the input stops at {(n_in - 1) * h:.4g} s: "
                 f"record a longer input or shorten the record")
         n_pre = int(round(tr.pre_trigger * tb.record_length))
-        waves = {ch: self._waveform(ch, s, codes[c], bool(over[c]), float(x_zero), n_pre)
+        auto = status is AcquisitionStatus.AUTO
+        waves = {ch: self._waveform(ch, s, codes[c], bool(over[c]), float(x_zero), n_pre, auto)
                  for c, (ch, s) in enumerate(self.channels.items()) if read is None or read[c]}
+        if auto:  # untriggered: the record's time zero is the impact
+            return ScopeRecord(waves, False, f"auto-triggered: {no_edge}; in AUTO mode the scope took the record "
+                                             "untriggered, its trigger point at the impact", float(t_cross))
         return ScopeRecord(waves, True, None, float(t_cross))
 
     def front_panel(self, h: float) -> FrontPanel:
@@ -247,9 +285,11 @@ class Oscilloscope:
         return FrontPanel(probe, ac, low, list(self.channels).index(tr.source), float(tr.level), tr.slope == "rising",
                           int(round(tr.pre_trigger * tb.record_length)),
                           np.array([float(s.offset) for s in chans]), ymult,
-                          np.array([s.position * CODES_PER_DIV for s in chans]), sd)
+                          np.array([s.position * CODES_PER_DIV for s in chans]), sd, tr.mode == "auto")
 
-    def _waveform(self, ch, s: ChannelSettings, codes, overrange: bool, x_zero: float, n_pre: int) -> Waveform:
+    def _waveform(self, ch, s: ChannelSettings, codes, overrange: bool, x_zero: float, n_pre: int,
+                  auto: bool = False) -> Waveform:
+        """One channel's Waveform; an AUTO record's preamble says so (extra "auto_triggered")."""
         pre = Preamble(points=codes.size, x_increment=self.timebase.sample_interval, x_zero=x_zero,
                        trigger_index=n_pre, y_multiplier=s.y_multiplier, y_offset=s.position * CODES_PER_DIV,
                        y_zero=s.offset, byte_count=1,
@@ -259,7 +299,7 @@ class Oscilloscope:
                                     f"{'Sample' if self.mode == 'sample' else f'Average {self.averages}'} mode"),
                        extra={"volts_per_div": s.volts_per_div, "position_div": s.position,
                               "coupling": s.coupling, "bandwidth_Hz": s.bandwidth, "probe": s.probe,
-                              "model": self.model})
+                              "model": self.model, **({"auto_triggered": True} if auto else {})})
         return Waveform(ch, pre, codes=codes, overrange=overrange)
 
 
@@ -268,7 +308,8 @@ class FrontPanel:
     """An oscilloscope's settings as arrays, one row per displayed channel (in display
     order): probe attenuation, AC coupling and bandwidth limit ((b0, b1, a1) one-pole
     coefficients, nan: off), the trigger (source channel index, level V, rising, pre-trigger
-    samples) and the converter (offset V, V per code, code offset, noise in codes)."""
+    samples), the converter (offset V, V per code, code offset, noise in codes) and the
+    trigger's mode (auto: AUTO, a shot that does not trigger taken untriggered)."""
 
     probe: np.ndarray
     ac: np.ndarray
@@ -281,3 +322,4 @@ class FrontPanel:
     ymult: np.ndarray
     yoff: np.ndarray
     sd: np.ndarray
+    auto: bool

@@ -22,6 +22,9 @@ from .status import ScpiError, StatusModel
 from .tree import CommandTree, Mnemonic
 
 INTERNAL = "internal fault"  # the words of the event a handler's own fault (a bug) leaves
+LATER = object()
+"""What a query's handler returns when its answers come later, one at a time, from its
+instrument (CURVEStream?): the message answers nothing for it now."""
 
 
 class Word(str):
@@ -167,7 +170,7 @@ class Engine:
             if extra and not unit.query:  # IEEE 488.2: -108 Parameter not allowed (the value read was set)
                 self.status.post(-108, f"{unit.header[:60]} takes {call.taken[0]} argument(s); "
                                        f"{', '.join(a.text[:20] for a in extra)} not allowed")
-            if unit.query:
+            if unit.query and value is not LATER:
                 replies.append(self.reply(value, found))
         return b";".join(replies) + b"\n" if replies else b""
 

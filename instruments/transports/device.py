@@ -3,6 +3,9 @@
 A transport takes complete program messages off the wire (the terminator or END already
 removed) and hands each to its connection's ``Session``; what the session answers is the
 response message the client reads next (ending in ``\\n``, as a Tektronix scope's replies do).
+A query that streams (``Session.next_reply``) answers again and again until the client's next
+message or device clear: VXI-11 hands out the next response on a read, a raw socket and
+HiSLIP send it once the last one has left the connection (``stream.Pump``).
 The instrument is one, shared by every connection and transport; a ``Session`` is one
 client's view of it (its output queue). ``InstrumentLock`` is the lock VISA clients take
 (HiSLIP's exclusive and shared locks, VXI-11's ``device_lock``), one per instrument, so a lock
@@ -26,6 +29,14 @@ class Session(Protocol):
         """IEEE 488.2 device clear: drop this session's pending input and output. It may come
         while ``handle`` runs in another thread (HiSLIP's clear arrives on its own channel):
         a query waiting there (``*OPC?``) should then end."""
+
+    def next_reply(self, wait_s: float) -> bytes | None:
+        """The next response of a query that answers more than once (a stream: the 4 Series'
+        ``CURVEStream?`` sends a record per acquisition until another message or a device
+        clear), asked for now that the transport can deliver it; b"" when it is not ready
+        within ``wait_s`` (it comes on a later call); None when no stream is on. A transport
+        asks for the next one only once the last has left it (a pulled read, or the
+        connection's send queue empty), so nothing piles up where the client does not read."""
 
     def trigger(self) -> None:
         """The group execute trigger (``*TRG``) sent out of band (VXI-11 ``device_trigger``)."""

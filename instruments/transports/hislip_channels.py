@@ -2,7 +2,8 @@
 
 Synchronous channel: Data parts are gathered into one program message up to DataEnd (at most
 ``max_message`` bytes kept); the instrument's reply goes back as Data parts and a DataEnd no
-larger than the client's maximum message size, carrying the id of the message it answers.
+larger than the client's maximum message size, carrying the id of the message it answers (a
+streamed reply, CURVEStream?, each of its responses so, until the next message or clear).
 A client that starts a new message without having taken the last reply (RMT-delivered clear)
 interrupts it: Interrupted and AsyncInterrupted are sent. AsyncDeviceClear clears the
 instrument session at once; from then to DeviceClearComplete whatever arrives on the
@@ -28,6 +29,7 @@ from instruments.transports.hislip_codec import (
     read_header,
 )
 from instruments.transports.hislip_link import WAIT_SLICE_S, Link
+from instruments.transports.stream import pump_if_streaming
 from instruments.transports.tcp import recv_exact
 
 MAX_LOCK_STRING = 256
@@ -90,6 +92,7 @@ def _sync_loop(link: Link) -> None:
                         link.session.trigger()
         elif header.kind == Kind.DEVICE_CLEAR_COMPLETE:
             discard(link.sync, header.length)
+            link.stop_pump()
             pending.reset()
             link.undelivered = False
             link.clearing.clear()
@@ -129,11 +132,17 @@ def _data(link: Link, header: Header, pending: _Message) -> None:
     program = program[:-1] if program.endswith(b"\r") else program
     if not program:
         return
+    link.stop_pump()  # a new message ends a streamed reply
     with link.clock.working():
-        reply = link.session.handle(program) if link.wait_unlocked() else b""
+        ran = link.wait_unlocked()
+        reply = link.session.handle(program) if ran else b""
     if reply:
         link.send_reply(reply, header.parameter)
         link.clock.done()
+    if ran:
+        link.pump = pump_if_streaming(link.session, link.sync, lambda r: link.send_reply(r, header.parameter),
+                                      lambda e: link.close("stalled: a streamed reply not taken"),
+                                      f"hislip{link.id}-stream", link.clock)
 
 
 def _start(link: Link, header: Header) -> None:

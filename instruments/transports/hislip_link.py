@@ -10,6 +10,7 @@ from collections.abc import Callable
 
 from instruments.transports.device import InstrumentLock, Session
 from instruments.transports.hislip_codec import HEADER, Kind, message
+from instruments.transports.stream import Pump
 from instruments.transports.tcp import send_all
 from instruments.transports.wire import Clock, Connection
 
@@ -51,6 +52,8 @@ class Link:
         """The session's clock: either channel's traffic keeps both alive."""
         self.report = report
         """Tells the server's owner of a protocol violation (in words)."""
+        self.pump: Pump | None = None
+        """Sends a streamed reply (CURVEStream?) while it lasts; the next message stops it."""
 
     @property
     def half_open(self) -> bool:
@@ -92,6 +95,12 @@ class Link:
                 send_all(self.sync, message(Kind.DATA_END if last else Kind.DATA, 0, message_id,
                                             reply[start:start + part]))
 
+    def stop_pump(self) -> None:
+        """No more of a streamed reply: a new message came, the device was cleared, the end."""
+        pump, self.pump = self.pump, None
+        if pump is not None:
+            pump.stop()
+
     def wait_unlocked(self) -> bool:
         """Hold a message while another client holds the lock exclusively; False when the
         session ends or is cleared first."""
@@ -114,6 +123,7 @@ class Link:
             self._ended = True
         self.closed.set()
         self.lock.release(self)
+        self.stop_pump()
         self.session.close()
         for conn in (self.sync, self.asynchronous):
             if conn is not None:

@@ -12,7 +12,9 @@ swallows no later message for long.
 
 The scope's socket server also has a TERMinal protocol (a prompt and ``!``-commands such as
 ``!d``, device clear, for people typing at telnet); VISA clients use protocol NONe, which has
-no out-of-band messages, so none is read here: a socket client clears with ``*CLS``."""
+no out-of-band messages, so none is read here: a socket client clears with ``*CLS``. A
+streamed reply (CURVEStream?) is sent block after block by a ``stream.Pump`` while the
+reader goes on; the client's next message stops it before that message runs."""
 from __future__ import annotations
 
 import re
@@ -21,6 +23,7 @@ import threading
 
 from instruments.transports.addresses import visa_host
 from instruments.transports.device import MessageInstrument, Session
+from instruments.transports.stream import Pump, pump_if_streaming
 from instruments.transports.tcp import TcpService, send_all
 from instruments.transports.wire import Connection, EventKind, EventSink, Limits
 
@@ -207,6 +210,7 @@ class SocketServer:
         framer = MessageFramer(limit)
         owner = object()  # a socket client never holds the lock; it waits while another does
         conn.settimeout(self.limits.stall_timeout_s)
+        pump: Pump | None = None
         try:
             while True:
                 try:
@@ -222,28 +226,44 @@ class SocketServer:
                     break
                 c.clock.heard()
                 for message in framer.feed(chunk):
-                    self._execute(message, session, conn, c, owner, peer, limit)
+                    if pump is not None and isinstance(message, bytes) and message:
+                        pump.stop()  # the client's next message ends its stream
+                        pump = None
+                    if self._execute(message, session, conn, c, owner, peer, limit):
+                        pump = pump_if_streaming(session, conn, lambda r: send_all(conn, r),
+                                                 lambda e: self._stalled(c, peer), f"{self._service.name}-stream",
+                                                 c.clock)
         finally:
+            if pump is not None:
+                pump.stop()
             session.close()
 
+    def _stalled(self, c: Connection, peer: str) -> None:
+        """A streamed reply not taken within the stall timeout: the connection ends."""
+        self._service.report(EventKind.VIOLATION, peer, f"stalled: a streamed reply made no progress for "
+                                                        f"{self.limits.stall_timeout_s:g} s")
+        c.close("stalled")
+
     def _execute(self, message: bytes | int, session: Session, conn: socket.socket, c: Connection, owner: object,
-                 peer: str, limit: int) -> None:
-        """One message the framer cut: refused for its size, or run and its reply sent."""
+                 peer: str, limit: int) -> bool:
+        """One message the framer cut: refused for its size, or run and its reply sent; True
+        when it ran."""
         if isinstance(message, int):
             session.overflow(message)
             self._service.report(EventKind.VIOLATION, peer, f"a program message of {message} bytes (a block's "
                                                             f"claim included): allowed at most {limit}; refused")
             c.clock.done()
-            return
+            return False
         if not message:
-            return
+            return False
         with c.clock.working():
             if not self._wait_unlocked(owner):
-                return
+                return False
             reply = session.handle(message)
         if reply:
             send_all(conn, reply)
             c.clock.done()
+        return True
 
     def _wait_unlocked(self, owner: object) -> bool:
         """Hold the message while another client holds the lock exclusively; False when the

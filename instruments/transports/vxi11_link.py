@@ -42,6 +42,16 @@ class Link:
     def unread(self) -> bool:
         return self.read_at < len(self.response)
 
+    def streamed(self) -> bool:
+        """unread(), after taking a streamed reply's next response where nothing is left to
+        read and no message runs (holding ``cond``; Session.next_reply, without waiting: a
+        read's wait asks again)."""
+        if not self.unread() and not self.busy:
+            response = self.session.next_reply(0.0)
+            if response:
+                self.response, self.read_at = response, 0
+        return self.unread()
+
     def wait(self, ready: Callable[[], bool], timeout_ms: int) -> int:
         """Wait (holding ``cond``) until ``ready()``; the error that ended the wait
         otherwise: 15 past ``timeout_ms``, 23 on device_abort, 17 when the link or its client

@@ -4,6 +4,8 @@ its XDR arguments and returns its packed response (``reply``).
 
 A message is executed on a thread of its own (``Link.execute``), so that device_read,
 device_readstb and the abort channel keep answering while a query waits on the instrument.
+A streamed reply (CURVEStream?) is pulled: a device_read with nothing left to read takes the
+stream's next response (``Link.streamed``), so each response is made when the client reads.
 The interrupt channel (create_intr_chan, device_enable_srq) and device_docmd are not
 offered: their arguments are read and error 8 (operation not supported) answered."""
 from __future__ import annotations
@@ -120,7 +122,7 @@ class LinkProcedures:
         if error:
             return reply(error, 0, data=b"")
         with link.cond:
-            error = link.wait(link.unread, io_timeout_ms)
+            error = link.wait(link.streamed, io_timeout_ms)
             if error:
                 return reply(error, 0, data=b"")
             start = link.read_at

@@ -9,7 +9,10 @@ the ticks of a period (every=SECONDS, as a rig that drops its striker periodical
 only from those fire commands (on-command: the armed scope waits for the impact). A shot
 takes the settings as they are when it starts (a change during a shot applies to the
 next) and the next seed: the k-th shot fired uses seed N + k - 1 (a refused shot uses
-none). ``*OPC?``/``*WAI`` wait while a single sequence or a forced shot is pending."""
+none). ``*OPC?``/``*WAI`` wait while a single sequence or a forced shot is pending. While
+a curve stream is on (``stream``: CURVEStream?) the stream paces the acquisition: a shot
+is due only when the stream asks for its next record (``want``), at once, at the next
+tick or on a fire command as above, so that no record is made that no client asked for."""
 from __future__ import annotations
 
 import math
@@ -56,6 +59,9 @@ class Acquisition:
         self.busy = False
         self.opc_armed = False
         self.count = 0
+        self.finished = 0  # shots ended, refused ones too: a stream waits for the next
+        self.streaming = False  # a curve stream paces the shots (CURVEStream?)
+        self.wanted = False  # the stream asked for its next record
         self.last: Shot | None = None
         self.failure: str | None = None  # why the last shot failed (its record is gone), None after a good one
         self.closed = False
@@ -70,15 +76,33 @@ class Acquisition:
 
     @property
     def acquiring(self) -> bool:
-        """ACQuire:STATE? 1: running, or a shot on its way."""
-        return bool(self.running or self.busy or self.pending)
+        """ACQuire:STATE? 1: running, streaming, or a shot on its way."""
+        return bool(self.running or self.streaming or self.busy or self.pending)
 
     def run(self, on: bool) -> None:
         """ACQuire:STATE: armed or stopped; once armed, the first tick is the next one."""
-        if on and not self.running and self.period_s is not None:
+        if on and not self.running:
+            self._next_tick()
+        self.running = on
+        self.cond.notify_all()
+
+    def _next_tick(self) -> None:
+        """The first tick from now, where shots come every period."""
+        if self.period_s is not None:
             now = time.monotonic()
             self.next_tick = self.epoch + self.period_s * (math.floor((now - self.epoch) / self.period_s) + 1)
-        self.running = on
+
+    def stream(self, on: bool) -> None:
+        """A curve stream begins (its shots due only when it asks, ``want``) or ends (a
+        record asked for and not begun is not made)."""
+        if on and not self.streaming:
+            self._next_tick()
+        self.streaming, self.wanted = on, False
+        self.cond.notify_all()
+
+    def want(self) -> None:
+        """The stream asks for the next record."""
+        self.wanted = True
         self.cond.notify_all()
 
     def force(self) -> None:
@@ -100,18 +124,22 @@ class Acquisition:
 
     def _wait_for_a_shot(self) -> bool:
         """Wait (holding ``cond``) until a shot is due; False once closed. Due: a forced shot,
-        or while armed (ACQuire:STATE ON) at once, or at the next tick of the period, or
-        never (on_command: only forced shots fire, an armed scope waits for them)."""
+        or while armed (ACQuire:STATE ON; while a stream is on, only when it asked for a
+        record) at once, or at the next tick of the period, or never (on_command: only
+        forced shots fire, an armed scope waits for them)."""
         while not self.closed:
             if self.pending:
                 self.pending -= 1
+                self.wanted = False  # the stream's next record is this one
                 return True
-            armed = self.running and not self.on_command
-            if armed and self.period_s is None:
-                return True
+            armed = (self.wanted if self.streaming else self.running) and not self.on_command
+            due = armed and self.period_s is None
             now = time.monotonic()
             if armed and self.period_s is not None and now >= self.next_tick:
                 self.next_tick += self.period_s * (1 + math.floor((now - self.next_tick) / self.period_s))
+                due = True
+            if due:
+                self.wanted = False
                 return True
             self.cond.wait(self.next_tick - now if armed else None)
         return False
@@ -167,7 +195,7 @@ class Acquisition:
             return None, f"the shot failed: {type(e).__name__}: {e}"
 
     def _finish(self, shot: Shot | None, seed: int, error: str | None) -> None:
-        self.busy = False
+        self.busy, self.finished = False, self.finished + 1
         if shot is None:  # no stale record may pass for this shot's: the last one is dropped
             self.post(-200, error)
             self.last, self.failure = None, error
@@ -176,7 +204,7 @@ class Acquisition:
             self.running = False
         else:
             self.last, self.failure, self.count = shot, None, self.count + 1
-            if not shot.record.triggered:
+            if not shot.record.waveforms:  # NORMal: no trigger, no record (AUTO took one untriggered)
                 self.post(-200, f"the shot of seed {seed} did not trigger: {shot.record.reason}")
         if self.stop_after == "SEQuence":
             self.running = False

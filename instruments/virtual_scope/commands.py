@@ -23,6 +23,18 @@ TWENTY_MHZ = 20e6
 LOGIC_LEVELS = {"ECL": -1.3, "TTL": 1.4}  # TRIGger:A:LEVel's preset words (MDO3000, DPO4000 manuals), V
 
 
+def trigger_state(scope) -> str:
+    """TRIGger:STATE? in the manuals' words: SAVe while no acquisition is under way
+    ("acquisition is stopped"); AUTO while acquiring in AUTO mode with the last record taken
+    untriggered ("in the automatic mode and acquires data even in the absence of a
+    trigger"); READy while acquiring otherwise (the pretrigger taken, waiting for a trigger)."""
+    if not scope.acq.acquiring:
+        return "SAVe"
+    last = scope.acq.last
+    untriggered = last is not None and bool(last.record.waveforms) and not last.record.triggered
+    return "AUTO" if untriggered and scope.settings["scope.trigger.mode"] == "auto" else "READy"
+
+
 def register(tree, scope) -> None:
     """Add the front-panel commands of ``scope`` (a VirtualScope) to a command tree."""
     p = scope.personality
@@ -139,7 +151,7 @@ def register(tree, scope) -> None:
         scope.acq.force()
 
     tree.add("TRIGger", write=force)
-    tree.add("TRIGger:STATE", read=lambda c: Word("READy" if scope.acq.acquiring else "SAVe"))
+    tree.add("TRIGger:STATE", read=lambda c: Word(trigger_state(scope)))
     def set_source(c: Call):
         """The edge trigger's source; the level follows the channel's own where a client set
         one (TRIGger:A:LEVel:CH<x>), as each channel keeps its level on the scopes."""
@@ -183,9 +195,10 @@ def register(tree, scope) -> None:
         tree.add(f"{head}:LEVel", write=set_level, read=level)
         tree.add(f"{head}:LEVel:CH<n>", write=set_level, read=level)
 
-    for head in ("TRIGger:A", "TRIGger:MAIn"):  # AUTO or NORMal: the rig's shot is the record either way
-        tree.add(f"{head}:MODe", write=lambda c: setattr(scope, "trigger_mode", c.word(("AUTO", "NORMal"))),
-                 read=lambda c: Word(scope.trigger_mode))
+    for head in ("TRIGger:A", "TRIGger:MAIn"):  # the shot's scope.trigger.mode: AUTO takes an untriggered record
+        tree.add(f"{head}:MODe", read=lambda c: Word("AUTO" if scope.settings["scope.trigger.mode"] == "auto"
+                                                     else "NORMal"),
+                 write=lambda c: scope.change({"scope.trigger.mode": c.word(("AUTO", "NORMal")).lower()}))
     if p.name != "tds2000":  # the B trigger of the MDO3000 and 4 Series: its edge settings kept, the B state off
         register_b_trigger(tree, scope)
 

@@ -23,12 +23,13 @@ from ..scpi.engine import Engine, ReplyForm
 from ..scpi.status import OPC, ScpiError, StatusModel
 from ..scpi.tree import CommandTree
 from ..transports.device import InstrumentLock
-from . import commands, common, display, measurements, rig_commands, setup, waveform_commands
+from . import commands, common, display, measurements, rig_commands, setup, stream, waveform_commands
 from .acquisition import Acquisition, ShotSource
 from .manual import in_manual
 from .measurements import default_slots
 from .personalities import personality, snap_to_steps
 from .settings import acquired, overrides, scene_settings, scope_of
+from .stream import CurveStream
 from .transfer import DataSelection
 
 Validate = Callable[[str, str], "str | None"]
@@ -50,14 +51,17 @@ class VirtualScope:
     only from TRIGger FORCe, *TRG and RIG:FIRE; neither: at once. rig_scene: the scene's
     values of the RIG: settings as text ({"striker.velocity": "0.89 m/s", ...}), what their
     queries answer until a client sets them. record_cost: asked when a horizontal setting
-    changes (HORIZONTAL); a record past the shot source's limits is refused there (-221)."""
+    changes (HORIZONTAL); a record past the shot source's limits is refused there (-221).
+    trigger_mode: TRIGger:A:MODe at power-on and after *RST, "auto" or "normal" (None: the
+    scene's scope.trigger.mode); the shots take it as the scene key scope.trigger.mode."""
 
     def __init__(self, scope: Oscilloscope, shot_source: ShotSource, *, personality_name: str = "tds2000",
                  idn: str | None = None, seed: int = 0, validate: Validate | None = None, on_shot=None,
                  scene_name: str = "", max_message_bytes: int = 1 << 20, max_reply_bytes: int = 64 << 20,
                  max_record_length: int | None = None, opc_timeout_s: float = 600.0,
                  fire_period_s: float | None = None, on_command: bool = False,
-                 rig_scene: dict | None = None, record_cost: RecordCost | None = None) -> None:
+                 rig_scene: dict | None = None, record_cost: RecordCost | None = None,
+                 trigger_mode: str | None = None) -> None:
         if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 63:
             raise InstrumentError(f"seed = {seed!r}: a whole number from 0 to 2^63 - 1")
         self.scene, self.scene_name = scope, scene_name
@@ -71,8 +75,11 @@ class VirtualScope:
         self.lock = InstrumentLock()
         self.cond = threading.Condition()
         self.status = StatusModel()
+        self.stream: CurveStream | None = None  # the curve stream on (CURVEStream?), one at a time
         self.form = ReplyForm(header=False)
         self.initial = self._personality_settings(scene_settings(scope))
+        if trigger_mode is not None:
+            self.initial["scope.trigger.mode"] = trigger_mode
         scope_of(self.initial, acquired(scope, set()), scope)  # InstrumentError: the scene suits no such model
         self.acq = Acquisition(self.cond, shot_source, self.overrides_locked, self.status.post, self._set_opc,
                                seed, on_shot, period_s=fire_period_s, on_command=on_command)
@@ -84,6 +91,7 @@ class VirtualScope:
             rig_commands.register(t, self)
         commands.register(tree, self)
         waveform_commands.register(tree, self)
+        stream.register(tree, self)
         measurements.register(tree, self)
         setup.register(tree, self)
         display.register(tree, self)  # after the modelled display commands: the manual's others, kept
@@ -116,7 +124,6 @@ class VirtualScope:
         self.numavg = self.scene.averages if self.scene.mode == "average" else 16
         self.trigger_levels: dict = {}  # TRIGger:A:LEVel:CH<x>: each channel's own level (V), set by a client
         self.display_waveform = True  # DISplay:WAVEform: the screen only, the records are the same
-        self.trigger_mode = "AUTO"  # TRIGger:A:MODe: a record comes either way (the rig's shot says if it triggered)
         self.b_trigger = {"source": "CH1", "slope": "RISe", "level": 0.0}  # TRIGger:B:EDGE, kept; B is off
         self.acq.stop_after, self.acq.pending = "RUNSTop", 0
         self.acq.run(False)
@@ -188,15 +195,36 @@ class RigPort:
 
 
 class ScopeSession:
-    """One client: runs its messages on the shared engine, one at a time."""
+    """One client: runs its messages on the shared engine, one at a time. A message, a
+    device clear or the client's going ends its curve stream (stream.py)."""
 
     def __init__(self, scope: VirtualScope, engine: Engine, peer: str) -> None:
         self.scope, self.engine, self.peer = scope, engine, peer
         self.clears = 0
+        self.stream: CurveStream | None = None
+
+    def _end_stream(self) -> None:
+        """Out of streaming mode (holding the scope's condition)."""
+        if self.stream is not None:
+            self.stream.end()
+            self.stream = None
+
+    def next_reply(self, wait_s: float) -> bytes | None:
+        """The next block of this client's curve stream (CurveStream.next_block): b"" when
+        not in within ``wait_s``, None when no stream is on."""
+        with self.scope.cond:
+            stream = self.stream
+            if stream is None:
+                return None
+            block = stream.next_block(wait_s)
+            if stream.ended and self.stream is stream:
+                self.stream = None
+            return block
 
     def handle(self, message: bytes) -> bytes:
         scope = self.scope
         with scope.cond:
+            self._end_stream()  # the manual: another command or query ends the streaming mode
             if len(message) > scope.max_message_bytes:
                 scope.status.post(-363, f"a message of {len(message)} bytes (at most {scope.max_message_bytes})")
                 return b""
@@ -210,6 +238,7 @@ class ScopeSession:
     def device_clear(self) -> None:
         with self.scope.cond:
             self.clears += 1
+            self._end_stream()
             self.scope.cond.notify_all()
 
     def trigger(self) -> None:

@@ -12,7 +12,7 @@
   after BYT_OR) (... PT_ORDER, ..., DOMAIN,
   WFMTYPE, CENTERFREQUENCY, SPAN, REFLEVEL), record lengths from the model's list, 16-bit
   data with ``DATa:WIDth 2``, numbers in engineering notation such as ``400.0000E-9``,
-  ``1.0000``, ``0.0E+0``.
+  ``1.0000``, ``0.0E+0``; the 4 Series' ``CURVEStream?`` (stream.py).
 Every model: V/div in a 1-2-5 sequence, 25 codes per division of the 8-bit converter."""
 from __future__ import annotations
 
@@ -60,6 +60,9 @@ class Personality:
     """The models whose programmer manual the personality follows (a regular expression of
     ``*IDN?``'s model field): the only ones ``idn`` may claim; model_names says them."""
     model_names: str = ""
+    streams: bool = False
+    """Whether the model's manual has CURVEStream? (the 4 Series'; not the TDS2000's nor
+    the MDO3000's)."""
 
     @property
     def floats(self) -> bool:
@@ -104,7 +107,7 @@ PERSONALITIES = {
                          10000000, 20000000, 31250000),
                         (1.0, 2.0, 5.0), "WFMOutpre", WFMOUTPRE_4SERIES, "V", True, 4,
                         encodings=("ASCIi", "RIBinary", "RPBinary", "FPBinary", "SRIbinary", "SRPbinary", "SFPbinary"),
-                        models=r"MSO4[4-8]B?", model_names="MSO44, MSO46, MSO48 (B too)"),
+                        models=r"MSO4[4-8]B?", model_names="MSO44, MSO46, MSO48 (B too)", streams=True),
 }
 
 

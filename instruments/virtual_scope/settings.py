@@ -29,7 +29,8 @@ def scene_settings(scope: Oscilloscope) -> dict:
     out = {"scope.sample_interval": float(tb.sample_interval), "scope.record_length": int(tb.record_length),
            "scope.mode": scope.mode, "scope.averages": int(scope.averages),
            "scope.trigger.source": tr.source, "scope.trigger.level": float(tr.level),
-           "scope.trigger.slope": tr.slope, "scope.trigger.pre_trigger": float(tr.pre_trigger)}
+           "scope.trigger.slope": tr.slope, "scope.trigger.pre_trigger": float(tr.pre_trigger),
+           "scope.trigger.mode": tr.mode}
     for ch in CHANNELS:
         s = scope.channels.get(ch, ChannelSettings())
         out.update({channel_key(ch, f): getattr(s, f) for f in CHANNEL_FIELDS})
@@ -78,6 +79,7 @@ def scope_of(settings: dict, channels, base: Oscilloscope) -> Oscilloscope:
     return Oscilloscope(channels=chans,
                         timebase=Timebase(settings["scope.sample_interval"], settings["scope.record_length"]),
                         trigger=Trigger(settings["scope.trigger.source"], settings["scope.trigger.level"],
-                                        settings["scope.trigger.slope"], settings["scope.trigger.pre_trigger"]),
+                                        settings["scope.trigger.slope"], settings["scope.trigger.pre_trigger"],
+                                        settings["scope.trigger.mode"]),
                         mode=settings["scope.mode"], averages=settings["scope.averages"],
                         noise_floor=base.noise_floor, model=base.model)

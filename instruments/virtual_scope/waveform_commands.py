@@ -48,6 +48,32 @@ def source_waveform(scope, ch: str, header: str, *, off_too: bool = False):
     return None, pre, waveform_id(ch, pre, s[f"scope.channels.{ch}.coupling"], vdiv, mode, scope.personality)
 
 
+def curve_answer(scope, header: str) -> tuple:
+    """(CURVe?'s answer without its header, whether it holds the record): the last record's
+    codes of DATa:SOUrce as DATa sets them; where there is none (no shot yet, the last one
+    failed or, in NORMal, did not trigger, the source is off) an empty answer (``#10``, or an
+    empty line in ASCIi) with the reason in the queue, so that a client reads the error
+    instead of waiting out its timeout."""
+    empty = curve_bytes(np.zeros(0, np.int8), scope.data)
+    if scope.data.sources:  # several sources at once: their blocks' layout is not the manuals'
+        scope.status.post(-221, f"DATa:SOUrce {','.join(scope.data.sources)}: CURVe? sends one source at a time "
+                                f"here (DATa:SOUrce {scope.data.source}); {header}")
+        return empty, False
+    try:
+        codes, _, _ = source_waveform(scope, scope.data.source, header)
+    except ScpiError as off:  # 2244: the source is off
+        scope.status.post(off.code, off.detail)
+        return empty, False
+    if codes is None:
+        last = scope.acq.last
+        why = (f"the last shot failed ({scope.acq.failure})" if scope.acq.failure else
+               f"the last shot did not trigger ({last.record.reason})" if last and not last.record.waveforms else
+               "no record yet; fire a shot (ACQuire:STATE ON, TRIGger FORCe or RIG:FIRE)")
+        scope.status.post(-200, f"{scope.data.source} has no record: {why}; {header}")
+        return empty, False
+    return curve_bytes(codes, scope.data), True
+
+
 def register(tree, scope) -> None:
     """Add the waveform commands of ``scope`` (a VirtualScope)."""
     p = scope.personality
@@ -98,24 +124,7 @@ def register(tree, scope) -> None:
         return read
 
     def curve(c: Call) -> bytes:
-        """The record's codes; where there is none (no shot yet, the last one failed, the
-        source is off) an empty answer at once (``#10``, or an empty line in ASCIi) with the reason in the
-        queue, so that a client reads the error instead of waiting out its timeout."""
-        if scope.data.sources:  # several sources at once: their blocks' layout is not the manuals'
-            scope.status.post(-221, f"DATa:SOUrce {','.join(scope.data.sources)}: CURVe? sends one source at a time "
-                                    f"here (DATa:SOUrce {scope.data.source}); {c.header}")
-            return curve_bytes(np.zeros(0, np.int8), scope.data)
-        try:
-            codes, _, _ = source_waveform(scope, scope.data.source, c.header)
-        except ScpiError as off:  # 2244: the source is off
-            scope.status.post(off.code, off.detail)
-            return curve_bytes(np.zeros(0, np.int8), scope.data)
-        if codes is None:
-            why = (f"the last shot failed ({scope.acq.failure})" if scope.acq.failure else
-                   "no record yet; fire a shot (ACQuire:STATE ON, TRIGger FORCe or RIG:FIRE)")
-            scope.status.post(-200, f"{scope.data.source} has no record: {why}; {c.header}")
-            return curve_bytes(np.zeros(0, np.int8), scope.data)
-        return curve_bytes(codes, scope.data)
+        return curve_answer(scope, c.header)[0]
 
     def wavfrm(c: Call) -> bytes:
         """``WFMPre?;CURVe?`` in one reply, each part in the current reply form (with

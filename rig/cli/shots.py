@@ -47,7 +47,7 @@ def cmd_shot(args) -> dict:
     out = shot_summary(rig, shot)
     out.update(shot_blocks(rig, shot))
     if args.export:
-        if not shot.scope.triggered:
+        if not shot.scope.waveforms:  # NORMal and no trigger (AUTO took an untriggered record)
             raise RigError(f"--export: nothing to export, the scope did not trigger ({shot.scope.reason})")
         from instruments.files import made_folder
 

@@ -250,7 +250,7 @@ class Assembly:
             reach = st.gap / st.velocity if g == 0 else (math.sqrt(st.velocity**2 + 2 * g * st.gap) - st.velocity) / g
             raise RigError(f"striker.gap = {st.gap:g} m at striker.velocity = {st.velocity:g} m/s: the striker "
                            f"reaches the top bead after {reach:.4g} s, not within solver.duration = {s.duration:g} s")
-        if tr.slope == "rising" and tr.level <= 0:
+        if tr.slope == "rising" and tr.level <= 0 and tr.mode == "normal":  # in AUTO a record comes all the same
             raise invalid("scope.trigger.level", f"{tr.level:g} V", "a rising trigger needs a level above the "
                                                                    "gauges' rest at 0 V, e.g. '30 mV'")
 

@@ -45,7 +45,7 @@ SCHEMA = {
     "gauges": {"*": GAUGE_KEYS},
     "scope": {"sample_interval": "s", "record_length": int, "mode": str, "averages": int,
               "noise_floor": "V", "model": str,
-              "trigger": {"source": str, "level": "V", "slope": str, "pre_trigger": float},
+              "trigger": {"source": str, "level": "V", "slope": str, "pre_trigger": float, "mode": str},
               "channels": {"*": CHANNEL_KEYS}},
     "solver": {"method": str, "accuracy": float, "duration": "s", "sample_interval": "s"},
 }

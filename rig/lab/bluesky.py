@@ -113,7 +113,7 @@ class VirtualScope(StandardReadable, Pausable):
     async def _show(self, shot: asyncio.Task[Fired]) -> None:
         fired = await shot
         record = fired.record
-        if not record.triggered:
+        if not record.waveforms:  # NORMal and no trigger (in AUTO the scope takes an untriggered record)
             raise InstrumentError(f"the scope did not trigger (seed {fired.seed}): {record.reason}")
         missing = [ch for ch in self.backend.channels if ch not in record.waveforms]
         if missing:  # an event must not carry an earlier shot's waveform

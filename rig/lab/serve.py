@@ -99,6 +99,13 @@ def rig_scene(shots: SceneShots) -> dict:
     return out
 
 
+def front_panel_mode(shots: SceneShots) -> str | None:
+    """The served scope's TRIGger:A:MODe at power-on and *RST: AUTO, the models' default,
+    where the scene (with its --set items) does not give scope.trigger.mode; None (the
+    scene's) where it does. The shots take it as an override like any setting."""
+    return None if "mode" in shots.loaded.values.get("scope", {}).get("trigger", {}) else "auto"
+
+
 def _port(name: str, port: int | None) -> None:
     if port is not None and not 0 <= port <= 65535:
         raise invalid(name, port, "a TCP port 0..65535 (0: a free one)")
@@ -130,7 +137,8 @@ class ScopeServer:
                                       idn=s.idn, seed=self.seed, validate=self.shots.validate,
                                       record_cost=self.shots.record_cost,
                                       scene_name=str(s.scene), fire_period_s=period,
-                                      on_command=s.fire == "on-command", rig_scene=rig_scene(self.shots))
+                                      on_command=s.fire == "on-command", rig_scene=rig_scene(self.shots),
+                                      trigger_mode=front_panel_mode(self.shots))
         except InstrumentError as e:  # it names the setting (the personality, its record, --idn)
             raise invalid("rig serve scope", s.scene, str(e)) from None
         self.refusals = Refusals(self.scope, self.log)

@@ -1,7 +1,8 @@
 """What ``rig serve scope --log FILE`` records of the clients' commands: each command a
 client sent that left an error in the scope's queue (a refused command, with its error in
-SCPI form), at most MAX_LOGGED_REFUSALS a client; the server's log itself (one line per
-event, appended; silent without --log)."""
+SCPI form), at most MAX_LOGGED_REFUSALS a client; a client's curve stream (CURVEStream?):
+its first record and its end, with how many records it gave and what ended it; the
+server's log itself (one line per event, appended; silent without --log)."""
 from __future__ import annotations
 
 import itertools
@@ -59,13 +60,31 @@ class LoggedInstrument:
 
 
 class LoggedSession:
-    """One client's session; a message that leaves events in the queue is logged with them."""
+    """One client's session; a message that leaves events in the queue is logged with them,
+    a curve stream when it gives its first record and when it ends."""
 
     def __init__(self, session: Session, refusals: Refusals, who: str) -> None:
         self.session, self.refusals, self.who = session, refusals, who
         self.logged = 0
+        self.streamed = 0  # records of the stream on, handed to the transport
+
+    def next_reply(self, wait_s: float) -> bytes | None:
+        response = self.session.next_reply(wait_s)
+        if response:
+            if not self.streamed:
+                self.refusals.log.info("curve stream to %s: its first record (CURVEStream?)", self.who)
+            self.streamed += 1
+        elif response is None and self.streamed:
+            self._stream_ended("it ended: a shot gave no record, or the scope closed")
+        return response
+
+    def _stream_ended(self, how: str) -> None:
+        if self.streamed:
+            self.refusals.log.info("curve stream to %s ended after %d records: %s", self.who, self.streamed, how)
+            self.streamed = 0
 
     def handle(self, message: bytes) -> bytes:
+        self._stream_ended("the client's next message")
         with self.refusals.scope.cond:  # the scope's own: the message runs under it
             self.refusals.fresh()  # posted outside any message meanwhile: not this one's
             reply = self.session.handle(message)
@@ -81,6 +100,7 @@ class LoggedSession:
         return reply
 
     def device_clear(self) -> None:
+        self._stream_ended("a device clear")
         self.session.device_clear()
 
     def trigger(self) -> None:
@@ -93,6 +113,7 @@ class LoggedSession:
         self.session.overflow(size)  # the transport logs it, as a protocol violation
 
     def close(self) -> None:
+        self._stream_ended("the client went")
         self.session.close()
 
 

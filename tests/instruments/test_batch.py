@@ -201,3 +201,29 @@ def test_the_figures_of_a_batch_are_its_reports_figures_whatever_refuses_them(ba
         assert reports[5].speed_m_per_s is None and "ran off the scope's range" in reports[5].reasons["speed_m_per_s"]
     assert "did not trigger" in reports[6].reasons["speed_m_per_s"]
     assert "runs past the input" in reports[7].reasons["speed_m_per_s"]
+
+
+def test_auto_mode_in_a_batch_gives_each_shot_its_bits_alone():
+    """AUTO: a shot that does not trigger is taken untriggered at the impact (its record
+    starts before the input, read at rest), one that triggers as in NORMal; in a batch each
+    has the bits it has alone, and the analysis refuses the untriggered one with its reason."""
+    wiring = _wiring()
+    wiring = batch.Wiring(wiring.gauges, Oscilloscope(
+        channels=wiring.scope.channels, timebase=wiring.scope.timebase,
+        trigger=Trigger("CH1", 0.02, "rising", 0.3, "auto"), noise_floor=wiring.scope.noise_floor))
+    forces = np.stack([np.stack([_pulse(2e-4, 1e-4), _pulse(1.8e-4, 1e-4), _pulse(4e-4)]),  # far below the level
+                       np.stack([_pulse(2.0e-4), _pulse(1.8e-4), _pulse(4e-4, 9.0)])])
+    seeds, speeds = [1, 2], np.full(2, 230.0)
+    records = batch.acquire(forces, H, wiring, seeds, None, speeds)
+    assert [records.outcome(s) for s in (0, 1)] == [AcquisitionStatus.AUTO, AcquisitionStatus.OK]
+    for s in range(2):
+        alone = _alone(forces[s], wiring, seeds[s], np.full((3, 2), np.nan), speeds[s])
+        together = records.record(s)
+        assert together.triggered == alone.triggered == (s == 1)
+        assert together.trigger_time == alone.trigger_time == (0.0 if s == 0 else together.trigger_time)
+        for ch, w in alone.waveforms.items():
+            assert np.array_equal(together.waveforms[ch].codes, w.codes), (s, ch)
+            assert together.waveforms[ch].preamble == w.preamble
+    assert records.record(0)["CH1"].preamble.x_zero < -1e-4  # 30% of 400 us before the impact
+    setup = Setup(GaugeSetup("CH2"), GaugeSetup("CH1", 0.0043))
+    assert AcquisitionStatus.AUTO.message in analysed(records, setup)[0].reasons["speed_m_per_s"]

@@ -119,3 +119,45 @@ def test_an_edge_trigger_has_a_noise_band_and_fires_on_its_own_flank(slope):
     expected = rise if slope == "rising" else fall
     # the ripple moves a crossing by up to 3 mV over the flank's 590 V/s, 5 us; the other flank is 471 us away
     assert abs(rec.trigger_time - expected) < 10e-6, (rec.trigger_time, expected)
+
+
+def _auto(mode="auto", pre=0.2):
+    """A rising trigger at -0.4 V: an input resting at 0 V never crosses it (TRIGger:A:MODe's case)."""
+    return _scope(noise_floor=0.0, trigger=Trigger("CH1", -0.4, "rising", pre, mode))
+
+
+@pytest.mark.parametrize("pre,seed", [(0.2, 3), (0.0, 4)])
+def test_auto_mode_takes_an_untriggered_record_whose_trigger_point_is_the_impact(pre, seed):
+    """No crossing, AUTO: a record all the same, of the set length and interval, flagged
+    untriggered; its samples are the input at t = x_zero + n dt from the impact (at rest,
+    its first value, before it), each within one code; the clock's phase is drawn as for a
+    triggered record, so the trigger point lies within one sample of the impact."""
+    x = _pulse(at=3e-4)
+    rec = _auto(pre=pre).acquire({"CH1": x}, H, np.random.default_rng(seed))
+    w = rec["CH1"]
+    assert not rec.triggered and rec.reason.startswith("auto-triggered: no rising crossing of -0.4 V")
+    assert rec.trigger_time == 0.0 and w.preamble.extra["auto_triggered"] is True
+    assert w.preamble.points == 5000 and w.preamble.x_increment == 2e-7
+    assert w.preamble.trigger_index == round(pre * 5000)
+    first_after = w.preamble.x_zero + w.preamble.trigger_index * 2e-7  # the first sample at or after t = 0
+    assert 0.0 <= first_after < 2e-7
+    t = w.time()
+    expected = np.interp(t, np.arange(x.size) * H, x)  # np.interp holds x[0] before the input: its rest
+    assert np.abs(w.volts() - expected).max() <= w.preamble.y_multiplier
+    assert np.ptp(w.codes) > 50  # the pulse is in the record, not a flat line that matches anything
+
+
+def test_normal_mode_gives_no_record_where_auto_gives_one_and_a_trigger_gives_the_same_record_in_both():
+    x = _pulse(at=3e-4)
+    normal = _auto("normal").acquire({"CH1": x}, H, np.random.default_rng(3))
+    assert not normal.triggered and normal.waveforms == {} and normal.reason.startswith("no rising crossing")
+    kw = {"noise_floor": 2e-4}
+    a, n = (_scope(trigger=Trigger("CH1", 0.05, "rising", 0.2, mode), **kw).acquire(
+        {"CH1": x}, H, np.random.default_rng(5)) for mode in ("auto", "normal"))
+    assert a.triggered and n.triggered and a.trigger_time == n.trigger_time
+    assert np.array_equal(a["CH1"].codes, n["CH1"].codes) and a["CH1"].preamble == n["CH1"].preamble
+
+
+def test_the_trigger_mode_is_checked():
+    with pytest.raises(InstrumentError, match="scope.trigger.mode = 'free': allowed normal, auto"):
+        Trigger(mode="free")

@@ -89,6 +89,9 @@ class EchoSession:
         self.errors.append(b'-113,"Undefined header; %s"' % header[:40])
         return b""
 
+    def next_reply(self, wait_s: float) -> bytes | None:
+        return None  # no query of this instrument streams
+
     def device_clear(self) -> None:
         self.instrument.clears += 1
         self.cleared.set()

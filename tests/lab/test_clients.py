@@ -207,3 +207,25 @@ def test_qcodes_tps2012_curvedata_is_the_record_in_volts(tds, rm, rig_shots):
     assert events.startswith("0,"), events
     assert waveform.codes.size == 2500
     assert_same_volts(np.asarray(volts) + waveform.preamble.y_zero, waveform)
+
+
+def test_a_curvestream_program_reads_the_next_shots_of_the_rig_block_by_block(mso, rm, rig_shots):
+    """A lab program's stream, its address alone changed: CURVESTREAM? written, then a
+    binary block read per acquisition; each block is the rig's shot at the next seed, code
+    for code, and a command ends the stream (the socket drained, as VISA's clear does)."""
+    scope = open_scope(rm, mso.resource("SOCKET"))
+    try:
+        scope.write("*CLS;:HEADER OFF;:DATA:SOURCE CH1;:DATA:ENCDG SRIBINARY;:DATA:WIDTH 2;:DATA:START 1;"
+                    ":DATA:STOP 100000")
+        seed = int(scope.query("RIG:SEED?"))
+        items = [o for o in scope.query("RIG:OVERRIDES?").strip().strip('"').split(",") if o]
+        scope.write("CURVESTREAM?")
+        blocks = [scope.read_binary_values(datatype="h", is_big_endian=False, container=np.array) for _ in range(3)]
+        scope.write("*CLS")
+        scope.clear()
+        assert int(scope.query("RIG:SEED?")) >= seed + 3 and scope.query("*ESR?").strip() == "0"
+    finally:
+        scope.close()
+    for k, codes in enumerate(blocks):
+        expected = rig_shots(dict(item.split("=", 1) for item in items), seed + k)["CH1"].codes
+        assert np.array_equal(codes, expected.astype(np.int16) * 256), k  # DATa:WIDth 2: the code in the high byte

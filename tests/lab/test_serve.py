@@ -89,6 +89,25 @@ def test_a_shot_over_each_transport_is_the_rig_shot_of_its_settings_and_seed(ser
     assert np.array_equal(codes, rig_shot_codes(tmp_path, overrides, seed))
 
 
+def test_served_in_auto_an_untriggered_shot_is_the_rig_shot_of_its_items_and_seed(served, rm, tmp_path):
+    """The served scope starts in AUTO, the models' default, which its shots carry as an item
+    (scope.trigger.mode=auto): a rising edge at -0.4 V on gauges resting at 0 V never fires,
+    and the shot's record is the bits of ``rig shot`` with the same items at the same seed."""
+    scope = open_scope(rm, served.resource("SOCKET"))
+    try:
+        scope.write("*RST;:HEADER OFF")
+        assert scope.query("TRIG:A:MODE?").strip() == "AUTO"
+        scope.write("TRIG:A:EDGE:SLOPE RISE;:TRIG:A:LEVEL -0.4")
+        codes, overrides, seed = shot_codes(rm, served.resource("SOCKET"))
+        assert scope.query("ALLEV?").strip().startswith("0,")  # no event: the record came
+    finally:
+        scope.write("*RST")
+        scope.close()
+    assert "scope.trigger.mode=auto" in overrides and "scope.trigger.level=-0.4 V" in overrides
+    assert codes.size == 2500 and np.ptp(codes.astype(int)) > 25
+    assert np.array_equal(codes, rig_shot_codes(tmp_path, overrides, seed))
+
+
 def test_the_kth_shot_uses_seed_n_plus_k_minus_1_and_settings_apply_to_the_next(served, rm, tmp_path):
     resource = served.resource("SOCKET")
     scope = open_scope(rm, resource)

@@ -121,3 +121,28 @@ def test_curve_without_a_record_answers_at_once_with_an_empty_block_and_the_reas
         assert events.count("has no record: no record yet") == 2
     finally:
         scope.close()
+
+
+def test_auto_gives_an_untriggered_record_that_is_rig_fire_with_its_items_and_normal_none(served):
+    """A rising edge at -0.4 V on gauges resting at 0 V never fires. TRIGger:A:MODe AUTO: the
+    shot gives a record all the same, untriggered, with no event, the very bits of Rig.fire
+    with the items it was fired with (scope.trigger.mode=auto among them); the gauges' pulses
+    are in it, its trigger point at the impact. NORMal: the rig refuses the level (a rising
+    trigger below the gauges' rest), no record, CURVe? the empty block, the reason queued."""
+    scope, shots = served
+    s = scope.open_session("t")
+    s.handle(b"*RST;:TRIG:A:MODE AUTO;:TRIG:A:EDGE:SLOPE RISE;:TRIG:A:LEVEL -0.4")
+    assert fire(s) == '1;0,"No events to report - queue empty"'
+    record = shots.last.scope
+    assert not record.triggered and record.trigger_time == 0.0 and record.reason.startswith("auto-triggered")
+    assert "scope.trigger.mode=auto" in shots.last.overrides and "scope.trigger.level=-0.4 V" in shots.last.overrides
+    w = record["CH1"]
+    assert w.preamble.points == scope.settings["scope.record_length"] and w.preamble.extra["auto_triggered"]
+    assert -w.preamble.trigger_index * w.preamble.x_increment <= w.preamble.x_zero < 0  # the impact in the record
+    assert np.ptp(w.codes.astype(int)) > 25  # the pulse, not the rest alone
+    same_as_rig_fire(shots)
+    s.handle(b"TRIG:A:MODE NORMAL")
+    reply = fire(s)
+    assert reply.startswith("1;") and "a rising trigger needs a level above" in reply
+    assert s.handle(b"CURVE?") == b"#10\n" and "the last shot failed" in ask(s, "ALLEV?")
+    s.handle(b"*RST")

@@ -269,3 +269,34 @@ def test_rig_settings_read_back_the_scenes_value_until_set(make_scope):
     assert ask(s, "RIG:MAGnet:POSition?") == '"not set in the scene"'
     s.handle(b"RIG:STR:VEL 0.95 m/s")
     assert ask(s, "RIG:STRIKER:VELOCITY?") == '"0.95 m/s"'
+
+
+@pytest.mark.parametrize("personality", ["tds2000", "mso4"])
+def test_auto_takes_a_record_without_a_trigger_and_the_trigger_state_says_auto(make_scope, personality):
+    """TRIGger:A:MODe AUTO: a rising edge at -0.4 V on a pulse resting at 0 V never fires,
+    yet each shot gives a record (its settings' length and interval, flagged untriggered)
+    and no event; while the scope runs so, TRIGger:STATE? is AUTO, stopped SAVE. NORMal:
+    no record, CURVe? answers the empty block and the reason is queued."""
+    scope, s, source = make_scope(personality, seed=4)
+    s.handle(b"TRIG:A:MODE AUTO;:TRIG:A:EDGE:SLOPE RISE;:TRIG:A:LEVEL -0.4")
+    assert scope.overrides()["scope.trigger.mode"] == "auto" and ask(s, "TRIG:A:MODE?") == "AUTO"
+    fire(s)
+    record = scope.acq.last.record
+    n = scope.settings["scope.record_length"]
+    assert not record.triggered and record["CH1"].codes.size == n and ask(s, "*ESR?;:ALLEV?").endswith(
+        '0,"No events to report - queue empty"')
+    assert record["CH1"].preamble.x_increment == scope.settings["scope.sample_interval"]
+    assert np.array_equal(record["CH1"].codes, source.record(*source.calls[-1])["CH1"].codes)
+    assert ask(s, "TRIG:STATE?") == "SAVE"
+    s.handle(b"ACQ:STOPAFTER RUNSTOP;STATE RUN")
+    wait_for(lambda: scope.acq.count >= 3)
+    assert ask(s, "TRIG:STATE?") == "AUTO"
+    s.handle(b"ACQ:STATE STOP")
+    wait_for(lambda: not scope.acq.busy)
+    assert ask(s, "TRIG:STATE?") == "SAVE"
+    s.handle(b"TRIG:A:MODE NORMAL")
+    assert "scope.trigger.mode" not in scope.overrides()  # the scene's mode
+    fire(s)
+    assert scope.acq.last.record.waveforms == {} and s.handle(b"CURVE?") == b"#10\n"
+    events = ask(s, "ALLEV?")
+    assert "did not trigger: no rising crossing of -0.4 V" in events and "the last shot did not trigger" in events

@@ -81,6 +81,9 @@ class EchoSession:
                 inst.errors.append(f'-113,"Undefined header; {head}"')
         return b""
 
+    def next_reply(self, wait_s: float) -> bytes | None:
+        return None  # no query of this instrument streams
+
     def device_clear(self) -> None:
         with self.inst._guard:
             self.inst.clears += 1

@@ -15,7 +15,7 @@ from numerics.jit import jit
 from .quantiser import quantise
 from .resample import at_positions, read_at
 
-OK, NO_TRIGGER, PAST_INPUT = 0, 1, 2  # how an acquisition ended
+OK, NO_TRIGGER, PAST_INPUT, AUTO = 0, 1, 2, 3  # how an acquisition ended (AUTO: untriggered, in AUTO mode)
 
 
 @jit
@@ -95,18 +95,24 @@ def first_crossing(x, h, level, rising, band):
 
 
 @jit
-def scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult, yoff, sd, z, lo, hi,
+def scope_shot(analog, h, source, level, rising, forced, phase, n_pre, dt, offset, ymult, yoff, sd, z, lo, hi,
                codes, over, read):
     """One acquisition of conditioned channels ``analog`` (channels, samples every h s):
     the edge trigger on channel ``source``, the record of codes.shape[1] samples every dt s
     from n_pre samples before it (plus the clock's phase), read linearly between input
     samples, through the 8-bit converter (quantise) with the scope's noise sd x z[c]
-    (z[c] empty: none). Fills codes (channels, samples) and over of the channels ``read``
-    (the others: codes 0, not over); returns (status, time of the trigger crossing s, time
-    of the first sample after the trigger s)."""
-    t_cross = first_crossing(analog[source], h, level, rising, TRIGGER_BAND_CODES * abs(ymult[source]))
-    if math.isnan(t_cross):
-        return NO_TRIGGER, t_cross, math.nan
+    (z[c] empty: none). ``forced`` (s from the first input sample; nan: none): the trigger
+    point of an untriggered acquisition in AUTO mode, taken without looking for an edge
+    (status AUTO). Fills codes (channels, samples) and over of the channels ``read`` (the
+    others: codes 0, not over); returns (status, time of the trigger point s, time of the
+    first sample after it s)."""
+    status = OK
+    if math.isnan(forced):
+        t_cross = first_crossing(analog[source], h, level, rising, TRIGGER_BAND_CODES * abs(ymult[source]))
+        if math.isnan(t_cross):
+            return NO_TRIGGER, t_cross, math.nan
+    else:
+        t_cross, status = forced, AUTO
     x_zero = phase - n_pre * dt
     t = t_cross + x_zero + dt * np.arange(codes.shape[1])
     if t[-1] > (analog.shape[1] - 1) * h * (1 + 1e-12):
@@ -119,17 +125,17 @@ def scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult
         else:
             codes[c] = 0
             over[c] = False
-    return OK, t_cross, x_zero
+    return status, t_cross, x_zero
 
 
 @jit
 def samples_before_input(status, t_cross, x_zero, h):
     """How many input samples (every h s) to put before the input's start so that a record
     whose first sample lies before it (t_cross + x_zero < 0 s: a pre-trigger longer than
-    the time from the impact to the trigger) reads the input at rest there, with a margin
-    of two; 0 where the record starts within the input or did not trigger."""
+    the time from the impact to the trigger point) reads the input at rest there, with a
+    margin of two; 0 where the record starts within the input or was not taken."""
     first = t_cross + x_zero
-    if status != OK or not first < 0.0:
+    if (status != OK and status != AUTO) or not first < 0.0:
         return 0
     return int(math.ceil(-first / h)) + 2
 
@@ -149,14 +155,15 @@ def at_rest_before(v, rest_sd, z_rest):
 
 @jit(nogil=True)
 def one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired, probe, ac, lowpass, source,
-             level, rising, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over, read):
+             level, rising, forced, phase, n_pre, dt, offset, ymult, yoff, sd, z_scope, lo, hi, codes, over, read):
     """One shot: gauge g reads force[g] (N, every h s) delayed by shift[g] s with gain
     scale[g] V/N, its high-pass gauge_filter[g] and noise noise_sd[g] z_gauge[g], and before
     the impact, for z_rest.shape[1] samples, its rest: noise_sd[g] z_rest[g]
     (at_rest_before); scope channel c displays gauge wired[c] (-1: nothing), with probe[c],
     ac[c] and lowpass[c] (condition), offset, ymult, yoff (the converter) and noise sd[c]
-    z_scope[c]; the trigger on channel ``source`` at ``level`` V, the clock's phase s,
-    n_pre pre-trigger samples every dt s. Fills codes (channels, samples) and over
+    z_scope[c]; the trigger on channel ``source`` at ``level`` V (``forced``: an AUTO
+    acquisition's trigger point, s from the impact, nan: none; scope_shot), the clock's
+    phase s, n_pre pre-trigger samples every dt s. Fills codes (channels, samples) and over
     (channels) of the channels ``read`` (the source among them; scope_shot); returns
     (status, the trigger crossing from the impact s, the first sample after it s)."""
     n_pad = z_rest.shape[1]
@@ -176,8 +183,8 @@ def one_shot(force, h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wi
         conditioned = condition(v, probe[c], ac[c], lowpass[c])
         for k in range(conditioned.shape[0]):  # element by element: numba's row assignment compiles its error message
             analog[c, k] = conditioned[k]
-    st, t_cross, x_zero = scope_shot(analog, h, source, level, rising, phase, n_pre, dt, offset, ymult, yoff, sd,
-                                     z_scope, lo, hi, codes, over, read)
+    st, t_cross, x_zero = scope_shot(analog, h, source, level, rising, forced + n_pad * h, phase, n_pre, dt, offset,
+                                     ymult, yoff, sd, z_scope, lo, hi, codes, over, read)
     return st, t_cross - n_pad * h, x_zero
 
 
@@ -226,10 +233,13 @@ def shots(first, last, seeds, forces, h, speed, fixed, gauges, scope, reads, dra
     their turn (the gauges ``rested``) and the record again. gauges: (calibration errors,
     misalignment sds, noisy, sensitivities, delayed, high-pass coefficients, noise sds);
     scope: (wired, probe, ac, lowpass, source, level, rising, n_pre, dt, offset, ymult,
-    yoff, noise sd, lowest code, highest code, scope noise on). Fills codes, over, status,
-    times (the trigger crossing, the first sample) and drawn (gain factor, position error)."""
+    yoff, noise sd, lowest code, highest code, scope noise on, AUTO mode: a shot that does
+    not trigger is taken untriggered, its trigger point at the impact). Fills codes, over,
+    status, times (the trigger point, the first sample) and drawn (gain factor, position
+    error)."""
     cal, mis, noisy, sens, delayed, gauge_filter, noise_sd = gauges
-    wired, probe, ac, lowpass, source, level, rising, n_pre, dt, offset, ymult, yoff, sd, lo, hi, noisy_scope = scope
+    wired, probe, ac, lowpass, source, level, rising, n_pre, dt, offset, ymult, yoff, sd, lo, hi, noisy_scope, \
+        auto = scope
     G, n_in = forces.shape[1], forces.shape[2]
     C, L = codes.shape[1], codes.shape[2]
     z_gauge = np.zeros((G, n_in))  # a noise-free gauge's row stays 0
@@ -240,12 +250,15 @@ def shots(first, last, seeds, forces, h, speed, fixed, gauges, scope, reads, dra
         st = pcg64.seeded(seeds[s])
         phase = shot_draws(st, cal, mis, noisy, drawn[s], z_gauge, dt, noisy_scope, z_scope[:drawn_rows])
         shot_settings(drawn[s], fixed[s], sens, delayed, speed[s], shift, scale)
-        z_rest = z_none
-        for attempt in range(2):
+        z_rest, forced = z_none, math.nan
+        for _ in range(3):
             done, t_cross, x_zero = one_shot(forces[s], h, shift, scale, gauge_filter, noise_sd, z_gauge, z_rest, wired,
-                                             probe, ac, lowpass, source, level, rising, phase, n_pre, dt, offset, ymult,
-                                             yoff, sd, z_scope, lo, hi, codes[s], over[s], reads)
-            n_pad = samples_before_input(done, t_cross, x_zero, h) if attempt == 0 else 0
+                                             probe, ac, lowpass, source, level, rising, forced, phase, n_pre, dt,
+                                             offset, ymult, yoff, sd, z_scope, lo, hi, codes[s], over[s], reads)
+            if done == NO_TRIGGER and auto:  # AUTO: taken untriggered, its trigger point at the impact
+                forced = 0.0
+                continue
+            n_pad = samples_before_input(done, t_cross, x_zero, h) if z_rest.shape[1] == 0 else 0
             if not n_pad:
                 break
             if noisy_scope:  # the noise of the channels not read, in its turn
