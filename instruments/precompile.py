@@ -27,7 +27,8 @@ LEADING = {f"{ANALYSIS}.pulses.leading_pair": f"({F1}, {F1}, {F1}, float64, floa
 SHOT = {**LEADING, f"{ANALYSIS}.pulses.candidates": f"({F1}, float64, float64, int64, float64)"}
 # the others a shot calls from Python, small (about 2.3 s in all), compiled aside after the analysis: the
 # solver's compile (about 11 s) outlasts both
-SHOT_SMALL = {f"{DEVICES}.acquisition.scope_shot": f"({F2}, float64, int64, float64, boolean, float64, int64, float64, "
+SHOT_SMALL = {f"{DEVICES}.acquisition.scope_shot": f"({F2}, float64, int64, float64, boolean, float64, float64, int64, "
+                                                   f"float64, "
                                                    f"{F1}, {F1}, {F1}, {F1}, {F2}, float64, float64, int8[:, ::1], "
                                                    f"boolean[::1], boolean[::1])",
               f"{DEVICES}.acquisition.gauge_signal": f"({F1}, float64, float64, float64, float64, float64, float64, "
@@ -43,8 +44,8 @@ F3 = "float64[:, :, ::1]"
 STUDY = {f"{DEVICES}.acquisition.shots": f"(int64, int64, {I1}, {F3}, float64, {F1}, {F3}, "
                                          f"Tuple(({F1}, {F1}, {B1}, {F1}, {B1}, {F2}, {F1})), "
                                          f"Tuple(({I1}, {F1}, {F2}, {F2}, int64, float64, boolean, int64, float64, "
-                                         f"{F1}, {F1}, {F1}, {F1}, float64, float64, boolean)), {B1}, int64, {I1}, "
-                                         f"{I8}, boolean[:, ::1], {I1}, {F2}, {F3})",
+                                         f"{F1}, {F1}, {F1}, {F1}, float64, float64, boolean, boolean)), {B1}, int64, "
+                                         f"{I1}, {I8}, boolean[:, ::1], {I1}, {F2}, {F3})",
          f"{ANALYSIS}.batch_analysis.analyse_range": f"(int64, int64, {I8}, {I1}, {F2}, float64, int64, {F1}, {F1}, "
                                                    f"{F1}, {I1}, {I1}, "
                                                    f"{F1}, {F1}, UniTuple(float64, 7), {F2}, {F2}, {B1}, "

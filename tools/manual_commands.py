@@ -8,7 +8,10 @@ Run with tm_devices installed (it is not a dependency of the project):
     python tools/manual_commands.py
 
 The conformance test (tests/lab/test_manual_conformance.py) and the coverage table
-(docs/reference/scpi-coverage.md) read these files; the TDS2000 has no tree there.
+(docs/reference/scpi-coverage.md) read these files. The TDS2000 has no tree there: its list,
+manuals/tds2000.txt, is transcribed by hand from its programmer manual (071-1075-04), not
+generated. This tool writes only the files of MODELS, so running it leaves that one as it is;
+edit it against the manual.
 """
 from __future__ import annotations
 
@@ -17,7 +20,7 @@ import inspect
 import re
 from pathlib import Path
 
-MODELS = {"mdo3000": "mdo3k_commands", "mso4": "mso4_commands"}
+MODELS = {"mdo3000": "mdo3k_commands", "mso4": "mso4_commands"}  # not tds2000: transcribed, see above
 GROUPS = {
     "waveform transfer": ("curve", "curvestream", "data", "wfmoutpre", "wavfrm"),
     "horizontal": ("horizontal",),

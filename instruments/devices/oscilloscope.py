@@ -192,7 +192,7 @@ class Oscilloscope:
                 continue
             if n_pad:
                 break
-            n_pad = samples_before_input(status, t_cross, x_zero, h)
+            n_pad = samples_before_input(int(status), t_cross, x_zero, h)  # an int: the kernel's one signature
             if not n_pad:
                 break
             read = self._at_rest_before(inputs, rest or {}, n_pad, rng)

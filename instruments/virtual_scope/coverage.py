@@ -1,14 +1,14 @@
 """How much of each model's programmer manual the emulated scope answers.
 
-The manuals' commands (instruments/virtual_scope/manuals/, written by
-tools/manual_commands.py from the command trees of tm_devices, which Tektronix generates
-from the programmer manuals) are sent to an emulated scope one by one, <x> taken as 1: a
+The manuals' commands (instruments/virtual_scope/manuals/: the MDO3000's and the 4 Series'
+written by tools/manual_commands.py from the command trees of tm_devices, which Tektronix
+generates from the programmer manuals; the TDS2000's, which has no such tree, transcribed by
+hand from its manual, 071-1075) are sent to an emulated scope one by one, <x> taken as 1: a
 header the scope answers (or takes) is *implemented*; an enumerated value of it the scope
 refuses with 221 "Settings conflict" is *refused by design* (a setting not emulated, such
 as GND coupling); a header the scope does not know (113 "Undefined header") is *not
 emulated*. ``python -m instruments.virtual_scope.coverage`` prints the table of
-docs/reference/scpi-coverage.md. The TDS2000 has no such tree; its commands are those of
-the emulation's own tests."""
+docs/reference/scpi-coverage.md."""
 from __future__ import annotations
 
 import re

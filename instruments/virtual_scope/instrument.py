@@ -7,7 +7,8 @@ so other sessions are answered during a shot. The scope starts from the scene's 
 (``instruments.devices.oscilloscope.Oscilloscope``), its record length and s/div snapped to the
 personality's (those count as overrides); ``*RST`` returns there. ``rig_port()`` serves the
 RIG: commands alone, on the same state, for a separate port. No command reads or writes a
-file (FILESystem and SAVe are undefined headers). Replies start with HEADer OFF (what
+file (FILESystem and SAVe:WAVEform are undefined headers; the TDS2000's SAVe:SETUp and
+RECAll:SETUp take set-up locations, a file path is -221). Replies start with HEADer OFF (what
 TDS2000-family scripts and qcodes' TPS2012 driver read without asking) and VERBose ON;
 ``*RST`` leaves both as they are."""
 from __future__ import annotations
@@ -23,7 +24,7 @@ from ..scpi.engine import Engine, ReplyForm
 from ..scpi.status import OPC, ScpiError, StatusModel
 from ..scpi.tree import CommandTree
 from ..transports.device import InstrumentLock
-from . import commands, common, display, measurements, rig_commands, setup, stream, waveform_commands
+from . import commands, common, display, measurements, rig_commands, setup, stream, tds_commands, waveform_commands
 from .acquisition import Acquisition, ShotSource
 from .manual import in_manual
 from .measurements import default_slots
@@ -94,6 +95,7 @@ class VirtualScope:
         stream.register(tree, self)
         measurements.register(tree, self)
         setup.register(tree, self)
+        tds_commands.register(tree, self)  # the TDS2000's other names for the commands above
         display.register(tree, self)  # after the modelled display commands: the manual's others, kept
         in_model_manual = partial(in_manual, self.personality.name)
         self.engine = Engine(tree, self.status, self.form, in_model_manual)

@@ -1,7 +1,8 @@
-"""The command lists of the emulated models' programmer manuals (manuals/, written by
-tools/manual_commands.py from the command trees of tm_devices, which Tektronix generates
-from the manuals): each header with its query and set forms and the words its set form
-takes. The scope refuses a word of its manual that it does not emulate as a setting it does
+"""The command lists of the emulated models' programmer manuals (manuals/: the MDO3000's and
+the 4 Series' written by tools/manual_commands.py from the command trees of tm_devices, which
+Tektronix generates from the manuals; the TDS2000's, which has no such tree, transcribed by
+hand from its manual, 071-1075): each header with its query and set forms and the words its
+set form takes. The scope refuses a word of its manual that it does not emulate as a setting it does
 not model (221 "Settings conflict"), not as one it has never heard of (224); coverage.py
 measures the emulation against these lists."""
 from __future__ import annotations
@@ -14,7 +15,7 @@ from importlib import resources
 from ..errors import InstrumentError
 from ..scpi.tree import Mnemonic
 
-MODELS = ("mdo3000", "mso4")
+MODELS = ("tds2000", "mdo3000", "mso4")
 ENUM = re.compile(r"\{([^{}]*)\}")
 WORD = re.compile(r"[A-Za-z0-9_]+(<x>[A-Za-z0-9_]*)?")  # a word of an enumeration (CH<x>: a numbered one)
 
@@ -72,7 +73,7 @@ def normal(header: str) -> str:
 @cache
 def words_of(model: str) -> dict:
     """{normal(header): the words of its set form, as the manual prints them} of a model
-    ({} for a model without a list here, the TDS2000)."""
+    ({} for a model without a list here)."""
     if model not in MODELS:
         return {}
     return {normal(c.header): c.words for c in manual(model) if c.words}

@@ -23,6 +23,17 @@ WAVEFORM_FIELDS = ("WFId", "NR_Pt", "PT_Fmt", "XINcr", "PT_Off", "XZEro", "XUNit
 """The preamble fields that describe one waveform (TDS2000 manual, WFMPre:<wfm>?), in its order."""
 
 
+REFERENCE_FIELDS = ("PT_Fmt", "XINcr", "XUNit", "XZEro", "YMUlt", "YOFf", "YUNit", "YZEro")
+"""The WFMPre fields whose set forms (TDS2000 manual) describe the reference waveform
+DATa:DESTination names: -221 here, where no reference waveform is emulated."""
+
+
+def reference(c: Call):
+    """The set form of a REFERENCE_FIELDS field: -221, reference waveforms are not emulated."""
+    raise ScpiError(-221, f"{c.header}: sets the preamble of the reference waveform DATa:DESTination names; "
+                          f"reference waveforms are not emulated")
+
+
 def source_waveform(scope, ch: str, header: str, *, off_too: bool = False):
     """(codes or None, Preamble, WFID) of channel ``ch``: the last record's, or where there
     is none yet (or the channel is off and ``off_too``) the preamble its settings give
@@ -141,10 +152,11 @@ def register(tree, scope) -> None:
     tree.add("DATa", write=data_init, read=lambda c: Fields((
         ("DESTination", destination), ("ENCdg", Word(scope.data.encoding)), ("SOUrce", Word(scope.data.source)),
         ("STARt", str(scope.data.start)), ("STOP", str(scope.data.stop)), ("WIDth", str(scope.data.sent_width)))))
+
     def set_sources(c: Call):
         """DATa:SOUrce <wfm>[,<wfm>...] (the MDO3000's and 4 Series' manuals: a list; the
         TDS2000 takes one): the first is the source of the preamble and CURVe?."""
-        names = [c.word(CHANNEL_WORDS, i) for i in range(len(c.args) if p.name != "tds2000" else 1)]
+        names = [c.word(CHANNEL_WORDS, i) for i in range(max(len(c.args), 1) if p.name != "tds2000" else 1)]
         data(source=names[0], sources=tuple(names) if len(names) > 1 else ())
 
     tree.add("DATa:SOUrce", write=set_sources,
@@ -161,7 +173,9 @@ def register(tree, scope) -> None:
         scope.data = scope.data.formatted(floating=True) if fmt == "FP" else scope.data.formatted(signed=fmt == "RI")
 
     def set_encoding(c: Call):
-        scope.data = scope.data.encoded("ASCIi" if c.word(("ASCIi", "BINary")) == "ASCIi" else scope.data.binary)
+        """ENCdg's words as the model's manual prints them: ASCii or BINary; the TDS's ASC or BIN."""
+        words = ("ASCIi", "BINary") if p.engineering else ("ASC", "BIN")
+        scope.data = scope.data.encoded("ASCIi" if c.word(words) == words[0] else scope.data.binary)
 
     def bits(c: Call):
         """BIT_Nr 8 or 16: the bits a point is sent in, with BYT_Nr (the 4/5/6 Series way to
@@ -172,6 +186,8 @@ def register(tree, scope) -> None:
                "BN_Fmt": set_format,
                "BYT_Or": lambda c: setattr(scope, "data",
                                            scope.data.formatted(msb_first=c.word(("MSB", "LSB")) == "MSB"))}
+    if p.name == "tds2000":  # its manual's set forms of the fields that describe a waveform write a reference one
+        setters.update({name: reference for name in REFERENCE_FIELDS})
     for name in p.preamble_fields:
         tree.add(f"{p.preamble}:{name}", read=preamble_field(name), write=setters.get(name))
     def channel_preamble(c: Call) -> Fields:
