@@ -47,9 +47,11 @@ def cmd_fit(args) -> dict:
                        if not sources else f"give one kind of data, not {' and '.join('--' + s for s in sources)}")
     if args.shot is not None and not args.archive:
         raise invalid("--shot", args.shot, f"picks one shot of --archive A.h5, not of --{sources[0]}")
-    for option, value in (("--walkers", args.walkers), ("--seed", args.seed)):
-        if value is not None and not args.posterior:
-            raise invalid(option, value, "needs --posterior STEPS (it is the MCMC sampler's)")
+    if args.walkers is not None and not args.posterior:
+        raise invalid("--walkers", args.walkers, "needs --posterior STEPS (it is the MCMC sampler's)")
+    if args.seed is not None and not (args.posterior or args.global_search):
+        raise invalid("--seed", args.seed,
+                      "needs --posterior STEPS or --global-search GENERATIONS (the draws it seeds)")
     params = parse_parameters(args.param)
     if args.posterior:
         from rig.fit.posterior import check
@@ -95,7 +97,7 @@ def cmd_fit(args) -> dict:
     progress = None if args.quiet else stderr_progress
     with writing_to(args.out):
         block = run_fit(args.scene, objective, args.out, progress, args.max_evaluations, args.posterior,
-                        args.walkers, args.seed or 0, args.starts)
+                        args.walkers, args.seed or 0, args.starts, args.global_search)
     if not args.json:
         for k, p in block["parameters"].items():
             unit = "" if p["unit"] == "1" else f" {p['unit']}"
@@ -104,6 +106,10 @@ def cmd_fit(args) -> dict:
         goodness = ("chi2/dof undefined (no degrees of freedom)" if block["chi2_reduced"] is None else
                     f"chi2/dof {block['chi2_reduced']:.3f} (p = {block['p_value']:.3g})")
         print(f"{goodness}, BIC {block['bic']:.2f}, residual rms {block['residual_rms_relative']:.2%}")
+        gs = block.get("global_search")
+        if gs:
+            print(f"global search: {gs['generations']} generations of {gs['population']} members (seed {gs['seed']}), "
+                  f"{gs['candidates']} candidates, best chi2 {gs['best_chi2']:.6g}")
         for o in block.get("optima", [])[1:]:
             print("another optimum: " + ", ".join(f"{k} {v:.6g}{'' if o['unit'][k] == '1' else ' ' + o['unit'][k]}"
                                                    for k, v in o["estimate"].items())
@@ -160,6 +166,22 @@ def starts_arg(text: str) -> int:
     return whole_number(text, 1, 100, "a whole number of starts from 1 to 100")
 
 
+def generations_arg(text: str) -> int:
+    """--global-search: a whole number of generations 1..1000."""
+    from rig.cli.common import whole_number
+
+    return whole_number(text, 1, 1000, "a whole number of generations from 1 to 1000")
+
+
+def global_search_arg(parser) -> None:
+    """--global-search GENERATIONS (rig fit, rig reproduce --fitted)."""
+    parser.add_argument("--global-search", type=generations_arg, default=0, metavar="GENERATIONS",
+                        help="first search the bounds globally: differential evolution for at most GENERATIONS "
+                             "generations (10 members per fitted key, drawn from --seed), the local fits then "
+                             "starting from its best members too; every candidate cached in the evaluations "
+                             "folder, so the same command run again resumes")
+
+
 def add_fit(sub) -> None:
     """The parser of ``rig fit``."""
     fi = command(sub, "fit", "fit scene keys to measured points, scope records or observations", cmd_fit)
@@ -185,9 +207,11 @@ def add_fit(sub) -> None:
                          "then points spread over the bounds) and "
                          "keep the best: a narrow window or a second minimum is found; every distinct optimum is in "
                          "fit.json's \"optima\" (default 1)")
+    global_search_arg(fi)
     fi.add_argument("--posterior", type=count_arg, default=0, metavar="STEPS",
                     help="then sample the posterior by MCMC for STEPS steps (needs the extra: "
                          "pip install 'sonic-rig[posterior]'); resumes in DIR/posterior.h5")
     fi.add_argument("--walkers", type=count_arg, help="with --posterior: walkers (default 4 per parameter, at least 8)")
-    fi.add_argument("--seed", type=seed_arg, help="with --posterior: the walkers' seed (default 0)")
+    fi.add_argument("--seed", type=seed_arg, help="with --posterior: the walkers' seed; with --global-search: its "
+                                                  "population's (default 0)")
     fi.add_argument("--quiet", action="store_true", help="no progress lines")

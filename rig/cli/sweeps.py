@@ -17,6 +17,7 @@ from rig.cli.common import (
     seed_arg,
     writing_to,
 )
+from rig.cli.fitting import global_search_arg, starts_arg
 from rig.cli.shots import shot_summary
 from rig.errors import Interrupted, RigError, invalid
 
@@ -106,9 +107,15 @@ def print_sweep(key: str, points: list):
 
 
 def cmd_reproduce(args) -> dict:
-    for flag, value in (("--draws", args.draws), ("--seed", args.seed), ("--allow-large", args.allow_large or None)):
+    for flag, value in (("--draws", args.draws), ("--allow-large", args.allow_large or None)):
         if value is not None and not args.identifiability:
             raise invalid(flag, value, "only with --identifiability (the published study draws no noise)")
+    if args.seed is not None and not (args.identifiability or args.global_search):
+        raise invalid("--seed", args.seed, "only with --identifiability or --fitted --global-search (the published "
+                                           "study draws no noise)")
+    for flag, value, default in (("--starts", args.starts, 1), ("--global-search", args.global_search, 0)):
+        if value != default and not args.fitted:
+            raise invalid(flag, value, "only with --fitted (each family's joint fit)")
     args.draws = 20 if args.draws is None else args.draws
     args.seed = 0 if args.seed is None else args.seed
     if args.family and not args.fitted:
@@ -135,14 +142,15 @@ def cmd_reproduce(args) -> dict:
     if args.fitted:
         from rig.study.reproduce_fitted import DASHPOTS, reproduce_fitted
 
-        steps = 3 * len(families) + len(DASHPOTS) + 1  # each family's fits and shots, the scan, steel
+        steps = 3 * len(families) + len(DASHPOTS) + 3  # each family's fits and shots, the scan, steel, the kept set
         with progress_bar(args.quiet, total=steps, desc="fitted models", unit="step") as bar:
             def progress(what):
                 bar.set_postfix_str(what[:40])
                 bar.update()
 
             with writing_to(args.out):
-                block["fitted"] = reproduce_fitted(args.out, progress, families)
+                block["fitted"] = reproduce_fitted(args.out, progress, families, args.starts, args.global_search,
+                                                   args.seed, lambda what: bar.set_postfix_str(what[:60]))
     if not args.json:
         print((Path(args.out) / "table1.md").read_text())
         if args.fitted:
@@ -174,6 +182,10 @@ def add_reproduce(sub) -> None:
                     help="also fit the PTFE model to the published experiment (Table 1) and compare its shots")
     rp.add_argument("--family", action="append", metavar="NAME",
                     help="with --fitted: fit only this model family (repeat for more; default: every one)")
+    rp.add_argument("--starts", type=starts_arg, default=1, metavar="N",
+                    help="with --fitted: start each family's joint fit from N points (rig fit --starts); every "
+                         "distinct optimum is in its row's \"optima\" (default 1)")
+    global_search_arg(rp)
     rp.add_argument("--identifiability", action="store_true",
                     help="instead: fit each new contact parameter to noisy virtual Fig. 3 observations (20 data "
                          "sets each) and count the 95%% intervals that hold the truth (identifiability.json, .md)")
@@ -188,7 +200,8 @@ def add_reproduce(sub) -> None:
                     help="with --param: its truth, a quantity in the key's unit (one per --param, in order)")
     rp.add_argument("--draws", type=count_arg,
                     help="with --identifiability: data sets per key (default 20)")
-    rp.add_argument("--seed", type=seed_arg, help="with --identifiability: the noise's seed (default 0)")
+    rp.add_argument("--seed", type=seed_arg, help="with --identifiability: the noise's seed; with --fitted "
+                                                  "--global-search: its population's (default 0)")
     rp.add_argument("--allow-large", action="store_true",
                     help="with --identifiability: run even when its estimate passes a day")
     rp.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -9,13 +9,13 @@ from instruments.files import atomic_write, folder_lock, left_as_found, write_te
 from rig.errors import Interrupted, RigError
 from rig.experiment import scene as scene_io
 from rig.fit import report
-from rig.fit.multistart import multistart
+from rig.fit.globalsearch import optima_block, searched_fit
 
 LOCK = "fit.lock"  # held in the --out folder while a fit writes it: a second fit into it is refused
 
 
 def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 400, posterior_steps: int = 0,
-            walkers: int | None = None, seed: int = 0, starts: int = 1) -> dict:
+            walkers: int | None = None, seed: int = 0, starts: int = 1, generations: int = 0) -> dict:
     """Fit ``objective`` and write the folder ``out`` (rig.fit.report); returns the JSON
     block. Evaluations are cached in out/evaluations/: the same command run again after an
     interruption replays them instead of solving them again. A fit that did not converge
@@ -30,22 +30,25 @@ def run_fit(scene: str, objective, out, progress=None, max_evaluations: int = 40
     is held (LOCK) while the fit runs: a second fit into it is refused in one line, naming
     the run that holds it, rather than the two overwriting each other. ``starts`` > 1: the fit
     starts from that many points (rig.fit.fitting.multistart), keeps the best and lists every
-    distinct optimum in the block's "optima"."""
+    distinct optimum in the block's "optima"; ``generations`` > 0: a global search first
+    (rig.fit.globalsearch, drawn from ``seed``; the block's "global_search"), the local fits
+    then starting from its best members too."""
     kept = (OSError, Interrupted)  # a full disk, Ctrl-C: what was cached stays, for the same command to resume from
     with left_as_found(out, (RigError, OSError, InstrumentError), keep=lambda exc: isinstance(exc, kept)), \
             folder_lock(out, LOCK, "wait for it to end, or give another --out", keep=lambda: False):
         return _fit_into(scene, objective, Path(out), progress, max_evaluations, posterior_steps, walkers, seed,
-                         starts)
+                         starts, generations)
 
 
 def _fit_into(scene, objective, out: Path, progress, max_evaluations, posterior_steps, walkers, seed,
-              starts) -> dict:
+              starts, generations) -> dict:
     """run_fit's work, writing into ``out``."""
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise RigError(f"--out {out}: cannot create ({exc.strerror})") from None
-    result, optima = multistart(objective, starts, out / "evaluations", max_evaluations, progress)
+    result, optima, found = searched_fit(objective, starts, generations, seed, out / "evaluations", max_evaluations,
+                                         progress)
     fitted = None
     stale = out / "fitted.toml"
     if stale.exists():
@@ -59,11 +62,10 @@ def _fit_into(scene, objective, out: Path, progress, max_evaluations, posterior_
 
         fitted = atomic_write(stale, write)
     block = report.summary(result, objective, fitted)
-    if starts > 1:
-        units = dict(zip(result.keys, result.units))
-        block["optima"] = [{"estimate": dict(zip(result.keys, o.estimate)), "unit": units,
-                            "chi2": o.chi2, "converged": o.converged,
-                            "starts": [dict(zip(result.keys, s)) for s in o.starts]} for o in optima]
+    if starts > 1 or found is not None:
+        block["optima"] = optima_block(result, optima)
+    if found is not None:
+        block["global_search"] = found.as_dict(result.keys)
     if posterior_steps and result.converged:
         from rig.fit import posterior
 

@@ -31,6 +31,7 @@ _ENTRIES = (
     {"kind": "ratio", "of": "peak", "value": 2.0, "sd": 0.25, "scene": MAGNETIC, "over_scene": GRAVITY,
      "gauge": "upper"},
     {"kind": "tail", "value": 0.0, "sd": 0.05, "scene": MAGNETIC, "gauge": "lower"},
+    {"kind": "pulses", "value": 2, "sd": 0.5, "limit": "at least", "scene": GRAVITY, "gauge": "lower"},
 )
 
 
@@ -58,7 +59,7 @@ class Target:
 
 def _figure(kind: str, unit: str, scene: str, gauge: str = "", of: str = "", over: str = "") -> Observation:
     return Observation(kind, math.nan, math.nan, unit, Shot(scene), gauge, of, None if not over else Shot(over),
-                       f"Fig. 3 target {kind}{' of ' + of if of else ''} {scene} {gauge}".rstrip())
+                       label=f"Fig. 3 target {kind}{' of ' + of if of else ''} {scene} {gauge}".rstrip())
 
 
 TARGETS = (

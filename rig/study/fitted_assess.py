@@ -14,8 +14,11 @@ whose sum of the two is lowest.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -23,6 +26,8 @@ from rig.errors import RigError
 from rig.fit.checks import unusable
 from rig.fit.crossval import leverages
 from rig.fit.fitting import FitResult, fit
+from rig.fit.globalsearch import optima_block, searched_fit
+from rig.study.fitted_bounds import SOURCES
 from rig.study.fitted_families import (
     Family,
     fitted_overrides,
@@ -37,6 +42,25 @@ FTOL, XTOL = 1e-2, 1e-3
 of 1 that moves an interval, for any chi2 below 100) or the parameters by less than 1e-3 of their bounds'
 span (a tenth of the Jacobian's step): tighter, they spend solves on the solver's
 noise (rig.fit.fitting's defaults are 1e-8 and 1e-6)."""
+
+
+@dataclass(frozen=True)
+class SearchPlan:
+    """How each family's joint fit looks for its optimum: ``starts`` local fits
+    (rig.fit.multistart), after a global search of ``generations`` generations drawn from
+    ``seed`` where > 0 (rig.fit.globalsearch); every evaluation cached under ``folder`` (a
+    family's own folder in it: a run stopped and started again replays them; None: in memory);
+    ``detail`` told each fit's and search's progress lines."""
+
+    starts: int = 1
+    generations: int = 0
+    seed: int = 0
+    folder: Path | None = None
+    detail: Callable | None = None
+
+    def cache(self, family: Family) -> Path | None:
+        """The family's evaluation cache folder."""
+        return None if self.folder is None else self.folder / "".join(c if c.isalnum() else "_" for c in family.name)
 
 
 @dataclass(frozen=True)
@@ -99,15 +123,17 @@ def estimates(result: FitResult) -> dict:
 
 def magnetic_from_gravity(family: Family, points, observations, joint: FitResult) -> dict:
     """The family fitted to the gravity-only data (starting at its ``joint`` fit's values),
-    predicting the magnetic data (module doc); its magnetic-only keys, and any the
-    gravity-only data do not see, at the law's defaults ("at_defaults")."""
+    predicting the magnetic data (module doc): its magnetic-only keys at the law's defaults
+    ("at_defaults"); a key the gravity-only data do not see (rig.fit.checks.unseen) held at
+    the joint fit's value ("held_at_joint": the law may need it, a yield pressure)."""
     mag_p = magnetic_points(points)
     mag_o = [magnetic_observation(o) for o in observations]
     gravity = family.without(family.magnetic_only)  # keys only the magnet's shots see: at the law's defaults
-    unseen = []
-    while True:  # and the keys the gravity-only data do not see (rig.fit.checks.unseen) too
+    joint_values = estimates(joint)
+    held: dict = {}
+    while True:  # and the keys the gravity-only data do not see, held at the joint fit's values
         g_obj = objective(gravity, points.subset(np.flatnonzero(~mag_p)),
-                          tuple(o for o, m in zip(observations, mag_o) if not m), estimates(joint))
+                          tuple(o for o, m in zip(observations, mag_o) if not m), joint_values)
         try:
             g = fit(g_obj, ftol=FTOL, xtol=XTOL)
             break
@@ -115,23 +141,28 @@ def magnetic_from_gravity(family: Family, points, observations, joint: FitResult
             key = next((p.split("=")[0] for p in gravity.params if f"'{p.split('=')[0]}'" in str(exc)), None)
             if "do not see it" not in str(exc) or key is None or len(gravity.params) == 1:
                 raise
-            unseen.append(key)
-            gravity = gravity.without((key,))
+            held[key] = joint_values[key]
+            gravity = dataclasses.replace(gravity.without((key,)),
+                                          fixed=gravity.fixed + (f"{key}={joint_values[key]!r}",))
     m_obj = objective(gravity, points.subset(np.flatnonzero(mag_p)),
                       tuple(o for o, m in zip(observations, mag_o) if m))
     (model,) = m_obj.evaluate([g.estimate])
     r = m_obj.residuals(model, np.zeros(0))
-    return {"parameters": parameters(g), "at_defaults": list(family.magnetic_only) + unseen, "converged": g.converged,
-            "chi2": float(r @ r), "n": int(r.size),
+    return {"parameters": parameters(g), "at_defaults": list(family.magnetic_only), "held_at_joint": held,
+            "converged": g.converged, "chi2": float(r @ r), "n": int(r.size),
             "chi2_per_point": float(r @ r) / r.size, "rms_relative": m_obj.relative_rms(model, np.zeros(0))}
 
 
-def assess(family: Family, points, observations, tell, done=()) -> Assessment:
+def assess(family: Family, points, observations, tell, done=(), search: SearchPlan | None = None) -> Assessment:
     """The family's joint fit and held-out prediction (module doc), its fit starting where
-    the Assessment in ``done`` of the family it starts from ended; a family this version
-    cannot fit is skipped, one whose fit the rig refuses is failed, each with the reason."""
+    the Assessment in ``done`` of the family it starts from ended (else at the family's own
+    start), through ``search`` (the starts, the global search, the cache); a family this
+    version cannot fit is skipped, one whose fit the rig refuses is failed, each with the
+    reason."""
+    search = search or SearchPlan()
     row: dict = {"note": family.note, "fitted_keys": list(family.params), "fixed": list(family.fixed),
-           "magnetic_only": list(family.magnetic), "skipped": unavailable(family) or None, "failed": None}
+           "magnetic_only": list(family.magnetic), "skipped": unavailable(family) or None, "failed": None,
+           "bounds_sources": {p.split("=")[0]: SOURCES.get(p.split("=")[0]) for p in family.params}}
     if row["skipped"]:
         tell(f"{family.name}: skipped")
         return Assessment(family, row)
@@ -139,15 +170,19 @@ def assess(family: Family, points, observations, tell, done=()) -> Assessment:
         parent = next((a.result for a in done if a.family.name == family.starts_from and a.result), None)
         start = dict(family.start) | ({} if parent is None else estimates(parent))
         obj = objective(family, points, observations, start)
-        r = fit(obj, ftol=FTOL, xtol=XTOL)
+        r, optima, found = searched_fit(obj, search.starts, search.generations, search.seed, search.cache(family),
+                                        progress=search.detail, ftol=FTOL, xtol=XTOL)
     except RigError as exc:
         row["failed"] = f"joint fit: {exc}"
         tell(f"{family.name}: failed")
         return Assessment(family, row)
     row.update({"parameters": parameters(r), "chi2": r.chi2, "dof": r.dof, "bic": r.bic, "converged": r.converged,
-                "candidates_solved": r.evaluations,
+                "candidates_solved": r.evaluations, "candidates_replayed": r.replayed,
+                "optima": optima_block(r, optima),
                 "at_bound": list(r.at_bound), "unusable": unusable(r) or None,
                 "fig3_chi2": float(np.sum(r.residuals[obj.slices[1]] ** 2)), **table1_figures(obj, r)})
+    if found is not None:
+        row["global_search"] = found.as_dict(r.keys)
     tell(f"{family.name}: joint fit")
     try:
         row["magnetic_from_gravity"] = magnetic_from_gravity(family, points, observations, r)

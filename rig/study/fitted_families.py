@@ -23,21 +23,37 @@ from rig.fit.joint import JointObjective
 from rig.fit.observations.objective import ObservationObjective
 from rig.fit.observations.reading import read_observations
 from rig.fit.parameters import law_overrides, parse_parameters
-from rig.fit.points import PointObjective
+from rig.fit.points import PointObjective, start_values
+from rig.study import fitted_bounds as bounds
 
 SCENE = "ptfe52_gravity"
 MAGNETIC_SCENE = "ptfe52_magnetic"
-E_BOUNDS = "chain.youngs_modulus=0.2 GPa:4 GPa"
-N_BOUNDS = "chain.contact_exponent=1.05:2.6"
-MU_BOUNDS = "chain.contact_damping=0.001 kg/s:3 kg/s"
-YIELD_BOUNDS = "chain.yield_force=0.05 N:10 N"
-RATE_BOUNDS = "chain.yield_rate_exponent=0:0.15"
-RATIO_BOUNDS = "chain.static_yield_ratio=0.2:1"
-WEAK_MU_BOUNDS = "chain.contact_damping=0.001 kg/s:0.1 kg/s"
-EP_START = (("chain.youngs_modulus", 1.0225e9), ("chain.yield_force", 0.627), ("chain.yield_rate_exponent", 0.110),
+E_BOUNDS, N_BOUNDS, MU_BOUNDS = bounds.E.text, bounds.EXPONENT.text, bounds.DASHPOT.text
+YIELD_BOUNDS, RATE_BOUNDS, RATIO_BOUNDS = bounds.YIELD_PRESSURE.text, bounds.RATE.text, bounds.RATIO.text
+"""The fitted keys' bounds, each from the literature (rig.study.fitted_bounds: the sources)."""
+EP_START = (("chain.youngs_modulus", 1.0225e9), ("chain.yield_pressure", 33.0e6), ("chain.yield_rate_exponent", 0.110),
             ("chain.static_yield_ratio", 0.708), ("chain.contact_damping", 0.0999))
 """Where the elastic-plastic families' fits start: a joint fit of the rate-dependent one to
-Table 1 and Fig. 3 (rig reproduce daraio2006 --fitted, this version)."""
+Table 1 and Fig. 3 (rig reproduce daraio2006 --fitted, an earlier version: its yield force
+0.627 N at the reference rate is this yield pressure at its modulus)."""
+
+
+EPD_START = (("chain.youngs_modulus", 0.868743e9), ("chain.yield_pressure", 59.5432e6),
+             ("chain.static_yield_ratio", 0.242588), ("chain.contact_damping", 0.21831))
+"""Where the elastic-plastic + dashpot family's fit starts: a set that meets every Table 1 and
+Fig. 3 target, where its joint fit (rig reproduce daraio2006 --fitted) stops. How it was
+found: 256 Sobol points over E 0.75-1.05 GPa, p_y 40-75 MPa, static ratio 0.2-0.5 and dashpot
+0.1-0.45 kg/s (scipy.stats.qmc.Sobol, seed 2), each judged on every target; the one that met
+them all (E 0.832 GPa, p_y 69.3 MPa, ratio 0.201, 0.179 kg/s, chi2 8.2) started the family's
+joint fit, which ended at E 0.868745 GPa, p_y 59.5434 MPa, ratio 0.242584, 0.217932 kg/s (chi2
+6.685, 37 candidates, 19 s); --fitted from there ended here (the dashpot 0.17% higher), and
+from here stays here (11 candidates, 6-10 s): its steps towards a single pulse at the lower
+gauge cost the train's 4 in chi2. The set sits on two edges of its targets
+(rig.study.fitted_windows): the train (E less than 0.2% lower or the dashpot less than 0.2% higher leaves a
+single pulse) and the gravity speed (E 0.18% higher passes 142 m/s). The global search
+(--global-search 40 --starts 4 --seed 0, started at EP_START: 1638 candidates) ends in the same
+basin at chi2 6.585, E 0.881 GPa, whose gravity speed, 142.8 m/s, lies 0.8 m/s beyond its
+window: the data pull the set to that edge."""
 
 
 @dataclass(frozen=True)
@@ -73,27 +89,28 @@ FAMILIES = (
            starts_from="hertz"),
     Family("dashpot", (E_BOUNDS, N_BOUNDS, MU_BOUNDS), note="the power law with a linear dashpot in the contacts",
            starts_from="elastic power law"),
-    Family("power-law dashpot", (E_BOUNDS, N_BOUNDS, "chain.dashpot_gamma=0.001:3", "chain.dashpot_exponent=0.5:2"),
+    Family("power-law dashpot", (E_BOUNDS, N_BOUNDS, bounds.GAMMA.text, bounds.ALPHA.text),
            note="the power law with a dashpot gamma v^alpha in the contacts", starts_from="elastic power law"),
-    Family("holder friction", (E_BOUNDS, N_BOUNDS, "holder.friction=0 N:0.1 N"),
+    Family("holder friction", (E_BOUNDS, N_BOUNDS, bounds.FRICTION.text),
            note="the power law with Coulomb friction of every bead on the holder's wall",
            starts_from="elastic power law"),
     # The elastic-plastic contact law with memory (chain.contact_law = thornton): the beads'
-    # contacts yield above chain.yield_force; the magnet's load, resting on the chain before
-    # the shot (magnet.hold, 600 s unless given: the paper does not say), flattens them at
-    # chain.static_yield_ratio x the dynamic yield pressure. Their fits start at the values a
-    # fit of the richest of them found (rig.study.fitted_families.EP_START).
+    # contacts yield at chain.yield_pressure (each contact at its own force); the magnet's load,
+    # resting on the chain before the shot (magnet.hold, 600 s unless given: the paper does not
+    # say), flattens them at
+    # chain.static_yield_ratio x the dynamic yield pressure. Their fits start at EP_START,
+    # the dashpot's at EPD_START.
     Family("elastic-plastic", (E_BOUNDS, YIELD_BOUNDS, RATIO_BOUNDS), fixed=("chain.contact_law=thornton",),
            note="elastic-plastic contacts with memory (Thornton), the magnet's hold flattening them",
            start=EP_START, magnetic_only=("chain.static_yield_ratio",)),
-    Family("elastic-plastic + dashpot", (E_BOUNDS, YIELD_BOUNDS, RATIO_BOUNDS, WEAK_MU_BOUNDS),
-           fixed=("chain.contact_law=thornton",), note="elastic-plastic contacts with memory and a weak linear dashpot",
-           start=EP_START, magnetic_only=("chain.static_yield_ratio",)),
+    Family("elastic-plastic + dashpot", (E_BOUNDS, YIELD_BOUNDS, RATIO_BOUNDS, MU_BOUNDS),
+           fixed=("chain.contact_law=thornton",), note="elastic-plastic contacts with memory and a linear dashpot",
+           start=EPD_START, magnetic_only=("chain.static_yield_ratio",)),
     Family("elastic-plastic, rate-dependent + dashpot", (E_BOUNDS, YIELD_BOUNDS, RATE_BOUNDS, RATIO_BOUNDS,
-                                                         WEAK_MU_BOUNDS),
+                                                         MU_BOUNDS),
            fixed=("chain.contact_law=thornton",),
            note="elastic-plastic contacts whose yield rises with the closing rate (above 0.01 m/s, the law's "
-                "reference rate), and a weak linear dashpot",
+                "reference rate), and a linear dashpot",
            start=EP_START, magnetic_only=("chain.static_yield_ratio",)),
 )
 """The families, in the order they are reported."""
@@ -166,19 +183,20 @@ def with_magnetic(family: Family, points: Points, observations: tuple) -> tuple:
 
 def objective(family: Family, points: Points, observations: tuple, start: dict | None = None) -> JointObjective:
     """The family's joint objective on these points and observations (either may be empty),
-    its fit starting at ``start`` ({key: SI value}) for the keys it gives, at the scene's
-    values for the others."""
+    its fit starting, and its pilot calibrated, at ``start`` ({key: SI value}, each cut at its
+    bounds) for the keys it gives, at the scene's values (else the bounds' middle) for the
+    others."""
     params = parse_parameters(family.params)
     points, observations = with_magnetic(family, points, observations)
-    parts: list[PointObjective | ObservationObjective] = []
-    if points.n:
-        parts.append(PointObjective(SCENE, params, points, family.fixed))
-    if observations:
-        parts.append(ObservationObjective(SCENE, params, observations, family.fixed, "Fig. 3"))
-    theta0 = parts[0].start().copy()
+    theta0 = start_values(SCENE, list(family.fixed) + law_overrides(params, family.fixed), params)
     for k, p in enumerate(params):
         if start and p.key in start:
             theta0[k] = min(max(start[p.key], p.lo), p.hi)
+    parts: list[PointObjective | ObservationObjective] = []
+    if points.n:
+        parts.append(PointObjective(SCENE, params, points, family.fixed, theta0))
+    if observations:
+        parts.append(ObservationObjective(SCENE, params, observations, family.fixed, "Fig. 3", theta0))
     return JointObjective(parts, theta0)
 
 

@@ -145,6 +145,7 @@ def markdown(f: dict) -> str:
     scene = f.get("fitted_scene")
     lines += ["", f"Fitted scene: {scene} (`rig shot` fires it)." if scene
               else f"No fitted scene written: {f.get('no_fitted_scene')}."]
+    lines += _windows(f.get("windows")) + _history(f) + _drops(f.get("table1_striker_drops")) + _sources(models)
     lines += ["", "Dashpot scan on the elastic power law's fitted E and n:", "",
               SCAN_HEADER, "|---|---|---|---|---|---|"]
     for s in f["dashpot_scan"]:
@@ -166,6 +167,61 @@ def markdown(f: dict) -> str:
                  f"{st['magnetic_speed_m_per_s']:.0f} m/s against 580 and 688 m/s.")
     lines += ["", steel]
     return "\n".join(lines) + "\n"
+
+
+def _windows(windows) -> list:
+    """The kept set's windows (rig.study.fitted_windows), one row a parameter."""
+    if not windows:
+        return []
+    out = ["", "Each parameter's window in which the kept set still meets every target (the others held; a scan "
+               "over its bounds, edges bisected to 0.2%):", "",
+           "| parameter | value | window | relative | fails below | fails above |", "|---|---|---|---|---|---|"]
+    for key, w in windows.items():
+        if w["window"] is None:
+            out.append(f"| {key} | {w['value']:.6g} | none: the set misses a target here | | | |")
+            continue
+        lo, hi = (("<= " if w["open"][0] else "") + f"{w['window'][0]:.6g}",
+                  (">= " if w["open"][1] else "") + f"{w['window'][1]:.6g}")
+        unit = "" if w["unit"] == "1" else " " + w["unit"]
+        out.append(f"| {key} | {w['value']:.6g}{unit} | {lo} .. {hi} | {w['relative'][0]:+.2%} .. "
+                   f"{w['relative'][1]:+.2%} | {'; '.join(w['failing_below']) or '-'} | "
+                   f"{'; '.join(w['failing_above']) or '-'} |")
+    return out
+
+
+def _history(f: dict) -> list:
+    """Which shot is compared, and the kept set's shots on one chain."""
+    out = ["", f"Compared: {f.get('compared_shot')}."]
+    history = f.get("shot_history")
+    if not history:
+        return out
+    out += ["", "| shot on one chain | " + " | ".join(what for _, what, _, _ in FIG3) + " |",
+            "|---|" + "---|" * len(FIG3)]
+    for h in history:
+        out.append(f"| {h['shot']} | " + " | ".join(_f(h["fig3"].get(key), ".4g") for key, _, _, _ in FIG3) + " |")
+    missed = f.get("settled_fig3_misses") or []
+    out += ["", "The last of them misses: " + ("; ".join(f"{m['target']} ({_shown(m['value'])})" for m in missed)
+                                            if missed else "nothing") + "."]
+    return out
+
+
+def _drops(drops) -> list:
+    """The Table 1 curves' striker velocities, each with its drop and where it is released."""
+    if not drops or not drops["drops"]:
+        return []
+    speeds = ", ".join(f"{d['velocity_m_per_s']:.3g}" for d in drops["drops"])
+    heights = ", ".join(f"{100 * d['drop_height_m']:.3g}" for d in drops["drops"])
+    return ["", f"Table 1's curves strike at {speeds} m/s: drops of {heights} cm (h = v^2 / 2g, no loss on the "
+                f"way); the {1000 * drops['holder_length_m']:.0f} mm tube leaves {100 * drops['free_length_m']:.3g} "
+                "cm above the chain, so the higher drops release the striker above its open top."]
+
+
+def _sources(models: dict) -> list:
+    """Where each fitted key's bounds come from (once a key)."""
+    sources: dict = {}
+    for b in models.values():
+        sources.update({k: v for k, v in (b.get("bounds_sources") or {}).items() if v})
+    return ["", "Bounds and their sources:", ""] + [f"- {k}: {v}" for k, v in sources.items()] if sources else []
 
 
 def _us(seconds) -> str:

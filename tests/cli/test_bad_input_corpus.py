@@ -219,6 +219,14 @@ def _flag_cases():
               (["reproduce", "daraio2006", "--out", out, "--draws", "5"], "--draws = 5: only with --identifiability"),
               (["reproduce", "daraio2006", "--out", out, "--identifiability", "--draws", "1000000"],
                "--draws = 1000000: the identifiability study would take 5000000 fits")]
+    # the fitted families' search: a flag of --fitted without it, a seed that seeds nothing, no generations
+    cases += [(["reproduce", "daraio2006", "--out", out, "--starts", "3"], "--starts = 3: only with --fitted"),
+              (["reproduce", "daraio2006", "--out", out, "--global-search", "5"],
+               "--global-search = 5: only with --fitted"),
+              (["reproduce", "daraio2006", "--out", out, "--fitted", "--global-search", "0"],
+               "a whole number of generations from 1 to 1000"),
+              (["fit", S, "--param", YM, "--points", "p.csv", "--out", out, "--seed", "3"],
+               "--seed = 3: needs --posterior STEPS or --global-search GENERATIONS")]
     # an empty path: rig mc had written into the current folder, rig shot had archived nothing with exit 0
     cases += [(["shot", S, "--out", ""], "--out = '': an empty path"),
               (["shot", S, "--export", " "], "--export = ' ': an empty path"),

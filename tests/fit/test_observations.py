@@ -200,6 +200,7 @@ GOOD = {"kind": "speed", "value": "129 m/s", "sd": "13 m/s"}
     ({**GOOD, "set": ["magnet.forse=2 N"]}, ["observation 1", "magnet.forse", "unknown key"]),
     ({**GOOD, "scene": "ptfe99"}, ["observation 1", "ptfe99", "known scenes"]),
     ({**GOOD, "set": ["chain.youngs_modulus=1 GPa"]}, ["chain.youngs_modulus", "fitted --param"]),
+    ({**GOOD, "limit": "at leest"}, ["observation 1.limit", "at leest", "'at least', 'at most'"]),
 ])
 def test_bad_observations_are_one_line_exit_2(tmp_path, capsys, entry, words):
     code, _, err, folder = _run(tmp_path, capsys, _toml([GOOD, entry]),
@@ -234,3 +235,24 @@ def test_a_missing_observations_file_is_one_line_exit_2(tmp_path, capsys):
                  "--out", str(tmp_path / "fit")])
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and "--observations" in err and "cannot read" in err, err
+
+
+def test_a_one_sided_observation_costs_nothing_on_its_side(tmp_path):
+    """limit = "at least": a figure at or above the value has residual 0, one below it
+    (figure - value) / sd; "at most" the mirror; a measured value both ways. Read from a
+    file by the reader, the residuals by the objective a fit uses."""
+    from rig.fit.observations.objective import ObservationObjective
+    from rig.fit.observations.reading import read_observations
+    from rig.fit.parameters import parse_parameters
+
+    train = {"kind": "pulses", "value": 2, "sd": 0.5, "gauge": "lower"}
+    path = tmp_path / "o.toml"
+    path.write_text(_toml([{**train, "limit": "at least"}, {**train, "limit": "at most"}, train]))
+    obs = read_observations(path, SCENE)
+    assert [o.limit for o in obs] == ["at least", "at most", ""]
+    objective = ObservationObjective(SCENE, parse_parameters(["chain.youngs_modulus=0.5 GPa:3 GPa"]), obs)
+    for count, expected in ((1.0, [-2.0, 0.0, -2.0]), (2.0, [0.0, 0.0, 0.0]), (4.0, [0.0, 4.0, 4.0])):
+        r = objective.residuals(np.full(3, count), np.zeros(0))
+        assert r.tolist() == expected, count
+    assert objective.residuals(np.full(3, np.nan), np.zeros(0)).tolist() == [1e3] * 3  # no figure: as before
+    assert objective.rows(np.full(3, 1.0), np.zeros(3))[0][1] == "pulses (at least)"

@@ -56,7 +56,8 @@ def test_window_open_where_the_scan_holds_and_none_where_the_centre_fails():
     assert window(lambda xs: [x > 4.0 for x in xs], 3.0, 1.0, 9.0) is None
 
 
-GRAVITY_SPEED_AND_DURATION = tuple(o for o in fig3.observations() if o.shot.scene == fig3.GRAVITY)
+GRAVITY_SPEED_AND_DURATION = tuple(o for o in fig3.observations()
+                                   if o.shot.scene == fig3.GRAVITY and o.kind in ("speed", "duration"))
 
 
 def test_coverage_counts_the_intervals_and_the_seed_repeats_the_data():

@@ -42,7 +42,10 @@ class Observation:
     uncertainty ``sd`` in the kind's SI unit ``unit``, of ``shot``, at ``gauge`` (a gauge's
     name in the scene, or "wall"; "" for a speed or the wall's peak). A ratio also has
     ``of`` (the kind whose figures it divides) and ``over`` (the shot of its denominator,
-    at the same gauge). ``label``: where it was read (file and entry), for messages."""
+    at the same gauge). ``label``: where it was read (file and entry), for messages.
+    ``limit``: "" for a measured value; "at least" or "at most" where the observation says
+    only that the figure is at least or at most ``value`` (a train "seen"): a model's figure
+    on the allowed side then costs nothing, one beyond it (figure - value) / sd (LIMITS)."""
 
     kind: str
     value: float
@@ -52,10 +55,16 @@ class Observation:
     gauge: str = ""
     of: str = ""
     over: Shot | None = None
+    limit: str = ""
     label: str = ""
 
     def shots(self) -> tuple:
         return (self.shot,) if self.over is None else (self.shot, self.over)
+
+
+LIMITS = {"at least": (-math.inf, 0.0), "at most": (0.0, math.inf)}
+"""The one-sided observations: the range of (figure - value) / sd that counts as one
+standard deviation's residual; on the allowed side the residual is 0."""
 
 
 def signal(truth, where: str) -> tuple[np.ndarray, np.ndarray]:

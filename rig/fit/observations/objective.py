@@ -21,7 +21,7 @@ from rig.errors import RigError, invalid
 from rig.experiment.shot import Rig
 from rig.fit.checks import at_values, check_bounds
 from rig.fit.evaluate import Pilot, calibrate, numerics, solve_rigs
-from rig.fit.observations.kinds import measure
+from rig.fit.observations.kinds import LIMITS, measure
 from rig.fit.parameters import law_overrides
 from rig.fit.points import start_values
 
@@ -30,11 +30,13 @@ NO_FIGURE = 1e3
 
 
 class ObservationObjective:
-    """Residuals of observations against the model's figures (module doc)."""
+    """Residuals of observations against the model's figures (module doc); ``start``: where
+    the fit starts and its pilot is calibrated (SI; None: start_values)."""
 
     central_differences = False  # the figures move smoothly with the parameters: forward, half the solves
 
-    def __init__(self, scene: str, params: tuple, observations: tuple, overrides=(), source: str = ""):
+    def __init__(self, scene: str, params: tuple, observations: tuple, overrides=(), source: str = "",
+                 start=None):
         self.scene, self.params, self.observations, self.source = scene, tuple(params), tuple(observations), source
         self.overrides = list(overrides) + law_overrides(params, overrides)
         keys = {p.key for p in self.params}
@@ -46,7 +48,10 @@ class ObservationObjective:
         self.shot_list = list(dict.fromkeys(s for obs in self.observations for s in obs.shots()))
         self.value = np.array([o.value for o in self.observations])
         self.sd = np.array([o.sd for o in self.observations])
-        self._start = start_values(scene, self.overrides, params)
+        sides = [LIMITS.get(o.limit, (-math.inf, math.inf)) for o in self.observations]
+        self.residual_lo = np.array([lo for lo, _ in sides])  # one-sided observations: their residual's range
+        self.residual_hi = np.array([hi for _, hi in sides])
+        self._start = start_values(scene, self.overrides, params) if start is None else np.asarray(start, float)
         check_bounds(scene, self.overrides, self.params, self._start)
 
     def rigs_of(self, theta) -> list:
@@ -118,7 +123,9 @@ class ObservationObjective:
         return z["figures"]
 
     def residuals(self, model, eta) -> np.ndarray:
+        """(figure - value) / sd; a one-sided observation's 0 on its allowed side (LIMITS)."""
         r = (model - self.value) / self.sd
+        r = np.clip(r, self.residual_lo, self.residual_hi)
         return np.where(np.isfinite(r), r, NO_FIGURE)
 
     def relative_residuals(self, model) -> np.ndarray:
@@ -134,9 +141,11 @@ class ObservationObjective:
         return float(np.sqrt(np.mean(rel ** 2))) if rel.size else math.nan
 
     def rows(self, model, residuals) -> list:
-        """One row per observation for residuals.csv: what, where, observed, sd, model, residual."""
-        return [[o.label, o.kind + (f" of {o.of}" if o.of else ""), o.gauge, o.shot.label()
-                 + ("" if o.over is None else f" / {o.over.label()}"), o.unit, o.value, o.sd, float(m), float(r)]
+        """One row per observation for residuals.csv: what (a one-sided one's limit beside its
+        kind), where, observed, sd, model, residual."""
+        return [[o.label, o.kind + (f" of {o.of}" if o.of else "") + (f" ({o.limit})" if o.limit else ""), o.gauge,
+                 o.shot.label() + ("" if o.over is None else f" / {o.over.label()}"), o.unit, o.value, o.sd, float(m),
+                 float(r)]
                 for o, m, r in zip(self.observations, model, residuals)]
 
     def figures(self, model, residuals) -> list:

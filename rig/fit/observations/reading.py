@@ -7,6 +7,8 @@
     scene = "ptfe52_gravity"    # optional: the command's SCENE (a name, or a file beside this one)
     set = ["magnet.force=2.38 N"]   # optional: the shot's scene overrides
     gauge = "upper"             # where the kind is taken at a gauge: a gauge of the scene, or "wall"
+    limit = "at least"          # optional: the observation says only that the figure is at least
+                                #   (or "at most") the value; 0 residual on that side
 
     [[observation]]             # a ratio: the figure `of` of this shot over that of the `over_` shot
     kind = "ratio"
@@ -28,7 +30,7 @@ from pathlib import Path
 
 from rig.errors import RigError, invalid, lookup
 from rig.experiment import scene as scene_io
-from rig.fit.observations.kinds import KINDS, WALL, Kind, Observation, Shot
+from rig.fit.observations.kinds import KINDS, LIMITS, WALL, Kind, Observation, Shot
 from rig.units import number, quantity
 
 if sys.version_info >= (3, 11):
@@ -37,7 +39,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 SD_FLOOR = 1e-9  # the smallest sd an observation may have, relative to its value
-FIELDS = ("kind", "value", "sd", "unit", "scene", "set", "gauge", "of", "over_scene", "over_set")
+FIELDS = ("kind", "value", "sd", "unit", "scene", "set", "gauge", "of", "over_scene", "over_set", "limit")
 
 
 def _figure(entry: dict, name: str, kind: Kind, field: str) -> float:
@@ -126,7 +128,11 @@ def observation(entry, default_scene: str, folder: Path, field: str) -> Observat
         raise invalid(f"{field}.value", entry["value"], "at least 1 (the leading pulse)")
     if not (value >= 0 if name == "tail" else value > 0):
         raise invalid(f"{field}.value", entry["value"], ">= 0" if name == "tail" else "> 0")
-    return Observation(name, value, sd, kind.unit, shot, gauge, of, over, field)
+    limit = entry.get("limit", "")
+    if limit != "" and limit not in LIMITS:
+        raise invalid(f"{field}.limit", limit, f"one of {', '.join(repr(k) for k in LIMITS)} (or leave it out: a "
+                                                "measured value)")
+    return Observation(name, value, sd, kind.unit, shot, gauge, of, over, str(limit), field)
 
 
 def read_observations(path, default_scene: str) -> tuple:
