@@ -183,6 +183,21 @@ def test_measurements_on_the_last_record(make_scope, slot):
     assert v.max() == pytest.approx(0.2, abs=0.005)  # the pulse's peak, within 2 codes and the noise
 
 
+@pytest.mark.parametrize("personality", ["mdo3000", "mso4"])
+def test_a_measurements_second_source_is_its_own(make_scope, personality):
+    """MEASUrement:MEAS<x>:SOUrce1 (MDO3000 manual): SOUrce1 is the source of single-channel
+    measurements ("SOUrce is equivalent to SOURCE1"), SOUrce2 the waveform a delay or phase
+    measurement goes "to": setting the second leaves the first, and the value is SOUrce1's."""
+    scope, s, _ = make_scope(personality)
+    fire(s)
+    s.handle(b"MEASU:MEAS1:SOU1 CH1;:MEASU:MEAS1:SOU2 CH2;:MEASU:MEAS1:TYPE MAX;:MEASU:IMM:SOURCE2 CH2")
+    assert ask(s, "MEASU:MEAS1:SOU1?;SOU2?;SOURCE?;:MEASU:IMM:SOU1?;SOU2?") == "CH1;CH2;CH1;CH1;CH2"
+    value = float(ask(s, "MEASU:MEAS1:VAL?"))
+    assert value == pytest.approx(scope.acq.last.record["CH1"].volts().max(), rel=1e-12)
+    assert scope.acq.last.record["CH2"].volts().max() - value > 0.05  # not CH2's larger pulse (0.3 V)
+    assert s.handle(b"MEASU:MEAS1:SOURCE3?") == b"" and ask(s, "EVENT?") == "113"
+
+
 def test_a_scene_scope_no_model_can_take_is_refused():
     with pytest.raises(InstrumentError, match="personality"):
         VirtualScope(scene_scope(), lambda o, s: None, personality_name="tds9999")
