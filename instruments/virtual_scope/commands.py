@@ -250,7 +250,6 @@ def register(tree, scope) -> None:
     # acquisition goes on either way (programs turn it off to transfer faster)
     tree.add("DISplay:WAVEform", write=lambda c: setattr(scope, "display_waveform", c.boolean()),
              read=lambda c: "1" if scope.display_waveform else "0")
-    tree.add("CONFIGuration:ANALOg:NUMCHANnels", read=lambda c: str(len(CHANNEL_WORDS)))
     tree.add("AUTOSet", write=lambda c: c.word(("EXECute", "UNDo")) and None)
 
 

@@ -24,7 +24,18 @@ from ..scpi.engine import Engine, ReplyForm
 from ..scpi.status import OPC, ScpiError, StatusModel
 from ..scpi.tree import CommandTree
 from ..transports.device import InstrumentLock
-from . import commands, common, display, measurements, rig_commands, setup, stream, tds_commands, waveform_commands
+from . import (
+    commands,
+    common,
+    configuration,
+    display,
+    measurements,
+    rig_commands,
+    setup,
+    stream,
+    tds_commands,
+    waveform_commands,
+)
 from .acquisition import Acquisition, ShotSource
 from .manual import in_manual
 from .measurements import default_slots
@@ -95,6 +106,7 @@ class VirtualScope:
         stream.register(tree, self)
         measurements.register(tree, self)
         setup.register(tree, self)
+        configuration.register(tree, self)
         tds_commands.register(tree, self)  # the TDS2000's other names for the commands above
         display.register(tree, self)  # after the modelled display commands: the manual's others, kept
         in_model_manual = partial(in_manual, self.personality.name)
@@ -161,7 +173,7 @@ class VirtualScope:
             return self.overrides_locked()
 
     def _set_opc(self) -> None:
-        self.status.esr |= OPC
+        self.status.set_bits(OPC)
 
     def wait_idle(self, session) -> None:
         """Wait (the lock released) until no shot is pending; -410 when the session was
