@@ -65,6 +65,12 @@ class Personality:
     the MDO3000's)."""
 
     @property
+    def combined_offset(self) -> bool:
+        """Whether WFMOutpre:YZEro holds the vertical position and offset and YOFf is always 0
+        (the MDO3000's and 4 Series' manuals); the TDS2000's YOFf is the position in codes."""
+        return self.preamble == "WFMOutpre"
+
+    @property
     def floats(self) -> bool:
         """Whether the model sends 4-byte floats (DATa:ENCdg FPBinary, BN_Fmt FP)."""
         return "FPBinary" in self.encodings
