@@ -29,6 +29,7 @@ from . import (
     common,
     configuration,
     display,
+    horizontal,
     measurements,
     rig_commands,
     setup,
@@ -102,6 +103,7 @@ class VirtualScope:
             common.register(t, self)
             rig_commands.register(t, self)
         commands.register(tree, self)
+        horizontal.register(tree, self)
         waveform_commands.register(tree, self)
         stream.register(tree, self)
         measurements.register(tree, self)
@@ -133,7 +135,8 @@ class VirtualScope:
         self.shown = set(self.scene.channels)
         self.rig_values: dict = {}  # RIG: settings, scene key -> value text
         self.data = DataSelection(stop=self.initial["scope.record_length"])
-        self.horizontal_mode = "MANual"
+        self.horizontal_mode = "AUTO"  # HORizontal:MODe (4 Series), and in MANual what a new rate moves
+        self.manual_configure = "HORIZontalscale"
         self.measurements = default_slots(next(iter(self.scene.channels)), self.personality.name)
         self.numavg = self.scene.averages if self.scene.mode == "average" else 16
         self.trigger_levels: dict = {}  # TRIGger:A:LEVel:CH<x>: each channel's own level (V), set by a client

@@ -162,9 +162,14 @@ def test_data_start_and_stop_are_clamped_as_the_scopes_clamp_them(make_scope):
 
 
 def test_horizontal_mode_forms_are_the_same_settings(make_scope):
+    """HORizontal:MODe:SCAle and :RECOrdlength are HORizontal:SCAle and :RECOrdlength; in MANual
+    (4 Series manual, HORizontal:MODe: "when you change record length then the horizontal
+    scale also changes") the sample rate of 10,000 points at 200 us/div, 5 MS/s, is kept."""
     _scope, s, _ = make_scope("mso4")
     s.handle(b"HOR:MODE MAN;:HOR:MODE:SCALE 1E-4;RECORDLENGTH 20000")
-    assert ask(s, "HOR:SCALE?;RECO?;:HOR:MODE:SAMPLERATE?;:HOR:MODE?") == "100.0000E-6;20000;20.0000E+6;MANUAL"
+    assert ask(s, "HOR:SCALE?;RECO?;:HOR:MODE:SAMPLERATE?;:HOR:MODE?") == "400.0000E-6;20000;5.0000E+6;MANUAL"
+    s.handle(b"HOR:MODE AUTO;:HOR:MODE:SCALE 1E-4;RECORDLENGTH 20000")  # AUTO: the scale kept
+    assert ask(s, "HOR:SCALE?;RECO?;:HOR:MODE:SAMPLERATE?;:HOR:MODE?") == "100.0000E-6;20000;20.0000E+6;AUTO"
 
 
 @pytest.mark.parametrize("slot", ["IMM", "MEAS3"])
