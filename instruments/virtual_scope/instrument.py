@@ -61,7 +61,8 @@ class VirtualScope:
     max_message_bytes (program message), max_reply_bytes (one message's replies),
     max_record_length (points; None: the model's longest record); opc_timeout_s: the longest *OPC? wait; fire_period_s /
     on_command: how an armed scope gets shots (acquisition.py): every so many seconds, or
-    only from TRIGger FORCe, *TRG and RIG:FIRE; neither: at once. rig_scene: the scene's
+    only from TRIGger FORCe, *TRG and RIG:FIRE; neither: at once; on_shot is called for the
+    shots that give a record. rig_scene: the scene's
     values of the RIG: settings as text ({"striker.velocity": "0.89 m/s", ...}), what their
     queries answer until a client sets them. record_cost: asked when a horizontal setting
     changes (HORIZONTAL); a record past the shot source's limits is refused there (-221).
@@ -142,8 +143,7 @@ class VirtualScope:
         self.trigger_levels: dict = {}  # TRIGger:A:LEVel:CH<x>: each channel's own level (V), set by a client
         self.display_waveform = True  # DISplay:WAVEform: the screen only, the records are the same
         self.b_trigger = {"source": "CH1", "slope": "RISe", "level": 0.0}  # TRIGger:B:EDGE, kept; B is off
-        self.acq.stop_after, self.acq.pending = "RUNSTop", 0
-        self.acq.run(False)
+        self.acq.reset()
 
     def channels(self) -> tuple:
         return acquired(self.scene, self.shown)
@@ -166,8 +166,11 @@ class VirtualScope:
                 raise ScpiError(-221, refusal)
         self.settings, self.shown = settings, set(shown)
 
-    def overrides_locked(self) -> dict:
-        return {**overrides(self.scene, self.settings, self.channels()), **self.rig_values}
+    def overrides_locked(self, forced: bool = False) -> dict:
+        """overrides() holding the condition; ``forced``: a forced trigger's shot, taken in
+        AUTO (scope.trigger.mode auto: acquisition.py)."""
+        settings = {**self.settings, "scope.trigger.mode": "auto"} if forced else self.settings
+        return {**overrides(self.scene, settings, self.channels()), **self.rig_values}
 
     def overrides(self) -> dict:
         """The settings that differ from the scene as loaded, {scene key: value text}: what
