@@ -76,6 +76,7 @@ class Acquisition:
         self.pending: deque[bool] = deque()  # shots fired by command, not yet begun: forced (True) or impacts
         self.spent = False  # on-arm: the armed scope's impact came and did not trigger
         self.busy = False
+        self.commanded = False  # the shot under way was fired by a command (not by arming)
         self.opc_armed = False
         self.count = 0
         self.finished = 0  # shots ended with a record or refused: a stream waits for the next
@@ -158,15 +159,16 @@ class Acquisition:
             self.pending.clear()
             self.cond.notify_all()
 
-    def _wait_for_a_shot(self) -> bool | None:
-        """Wait (holding ``cond``) until a shot is due: whether it is forced, or None once
-        closed. Due: a fired or forced shot, or while armed (ACQuire:STATE ON; while a stream
-        is on, only when it asked for a record) at once unless its impact is spent, or at the
-        next tick of the period, or never (on_command: only fired shots, an armed scope waits
-        for them). The stream's record stays asked for until a shot gives one."""
+    def _wait_for_a_shot(self) -> str | None:
+        """Wait (holding ``cond``) until a shot is due: "forced", "fired" (an impact by
+        command) or "armed", or None once closed. Due: a fired or forced shot, or while armed
+        (ACQuire:STATE ON; while a stream is on, only when it asked for a record) at once
+        unless its impact is spent, or at the next tick of the period, or never (on_command:
+        only fired shots, an armed scope waits for them). The stream's record stays asked for
+        until a shot gives one."""
         while not self.closed:
             if self.pending:
-                return self.pending.popleft()
+                return "forced" if self.pending.popleft() else "fired"
             armed = (self.wanted if self.streaming else self.running) and not self.on_command
             due = armed and self.period_s is None and not self.spent
             now = time.monotonic()
@@ -174,7 +176,7 @@ class Acquisition:
                 self.next_tick += self.period_s * (1 + math.floor((now - self.next_tick) / self.period_s))
                 due = True
             if due:
-                return False
+                return "armed"
             self.cond.wait(self.next_tick - now if armed and self.period_s is not None else None)
         return None
 
@@ -184,26 +186,27 @@ class Acquisition:
         the first shot (seed N, counted, ``on_shot`` called); InstrumentError with the
         rig's reason when it fails (one that does not trigger is kept, as later ones)."""
         with self.cond:
-            overrides, seed = self._take_seed(False)
+            overrides, seed = self._take_seed("fired")
         shot, error = self._shoot(overrides, seed)
         if shot is None:
             raise InstrumentError(f"the first shot, at seed {seed}: {error}")
         return shot
 
-    def _take_seed(self, forced: bool) -> tuple:
-        """(overrides, seed) of the shot that starts now (holding ``cond``)."""
-        overrides, seed = dict(self.snapshot(forced)), self.next_seed
+    def _take_seed(self, kind: str) -> tuple:
+        """(overrides, seed) of the shot of ``kind`` (_wait_for_a_shot's) that starts now
+        (holding ``cond``)."""
+        overrides, seed = dict(self.snapshot(kind == "forced")), self.next_seed
         self.next_seed += 1
-        self.busy = True
+        self.busy, self.commanded = True, kind != "armed"
         return overrides, seed
 
     def _work(self) -> None:
         while True:
             with self.cond:
-                forced = self._wait_for_a_shot()
-                if forced is None:
+                kind = self._wait_for_a_shot()
+                if kind is None:
                     return
-                overrides, seed = self._take_seed(forced)
+                overrides, seed = self._take_seed(kind)
             self._shoot(overrides, seed)
 
     def _shoot(self, overrides: dict, seed: int) -> tuple:
@@ -234,7 +237,7 @@ class Acquisition:
         if shot is not None and not shot.record.waveforms:  # NORMal, no trigger: no record
             if self.running or self.streaming:
                 self.spent = True  # armed still, the last record kept: it waits for a trigger
-            else:
+            elif self.commanded:  # fired on a stopped scope (RIG:FIRE, the first acquisition): said
                 self.post(-200, f"the shot of seed {seed} did not trigger: {shot.record.reason}; "
                                 "no record, the last one kept")
         else:
