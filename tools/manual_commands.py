@@ -32,6 +32,7 @@ GROUPS = {
     "display": ("display",),
     "status and events": ("status_and_error", "allev", "busy", "dese", "event", "evmsg", "evqty"),
     "miscellaneous": ("miscellaneous", "header", "verbose", "id", "lock", "unlock", "rem"),
+    "configuration": ("configuration",),
 }
 TRIGGER_KEPT = ("TRIGger", "TRIGger:A", "TRIGger:STATE", "TRIGger:A:EDGE", "TRIGger:A:LEVel", "TRIGger:A:MODe",
                 "TRIGger:A:TYPe", "TRIGger:A:HOLDoff")

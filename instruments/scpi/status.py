@@ -81,19 +81,37 @@ class Event:
 
 
 class StatusModel:
-    """ESR, ESE, SRE and the event queue of one instrument (not thread-safe: its owner
-    serialises access). The ESR starts with PON set, as after power-on."""
+    """ESR, ESE, SRE, DESER and the event queue of one instrument (not thread-safe: its owner
+    serialises access). It starts as a Tek scope powers on with ``*PSC`` 1 (the MDO3000 and
+    4 Series manuals, *PSC: "the DESER register is set to 255 and the SRER and ESER registers
+    are set to 0 at power-on"), the ESR with PON set. ``psc`` is that flag, kept and answered:
+    nothing here outlives the instrument, so each start is a power-on with it true.
+
+    DESER (``DESE``): "the mask that determines whether events are reported to the Standard
+    Event Status Register (SESR), and entered into the Event Queue" (the manuals, DESE): an
+    event whose ESR bit it clears neither sets that bit nor is queued. ``*CLS`` and ``*RST``
+    leave the enable registers (ESER, SRER, DESER) as they are (IEEE 488.2 10.3, 10.32)."""
 
     def __init__(self, capacity: int = QUEUE_SIZE) -> None:
-        self.esr = PON
+        self.dese = 0xFF
         self.ese = 0
         self.sre = 0
+        self.psc = True
+        self.esr = PON
         self.capacity = capacity
         self.events: deque[Event] = deque()
 
+    def set_bits(self, bits: int) -> None:
+        """Set ESR bits (OPC when an operation completes), those DESER lets through."""
+        self.esr |= bits & self.dese
+
     def post(self, code: int, detail: str = "") -> None:
-        """Queue an event and set its ESR bit; a full queue's last entry becomes -350."""
-        self.esr |= esr_bit(code)
+        """Queue an event and set its ESR bit, unless DESER masks that bit (then neither);
+        a full queue's last entry becomes -350. An event of no ESR bit is always queued."""
+        bit = esr_bit(code)
+        if bit and not bit & self.dese:
+            return
+        self.esr |= bit
         if len(self.events) >= self.capacity:
             self.events[-1] = Event(-350)
         elif len(self.events) == self.capacity - 1:

@@ -1,23 +1,40 @@
-"""The emulated scope's acquisition system: run/stop, single sequence, forced shots, seeds.
+"""The emulated scope's acquisition system: run/stop, single sequence, fired and forced shots, seeds.
 
 Shots run in one worker thread, outside the instrument's message lock, so every session
 keeps being answered while the rig computes a shot. ``ACQuire:STOPAfter SEQuence`` with
-``ACQuire:STATE ON`` fires one shot and stops; ``RUNSTop`` fires shots back to back until
-``ACQuire:STATE OFF``; ``TRIGger FORCe``, ``*TRG`` and ``RIG:FIRE`` fire one now. How an
-armed scope gets its shots is the rig's (``rig serve scope --fire``): at once (on-arm), at
-the ticks of a period (every=SECONDS, as a rig that drops its striker periodically), or
-only from those fire commands (on-command: the armed scope waits for the impact). A shot
-takes the settings as they are when it starts (a change during a shot applies to the
-next) and the next seed: the k-th shot fired uses seed N + k - 1 (a refused shot uses
-none). ``*OPC?``/``*WAI`` wait while a single sequence or a forced shot is pending. While
-a curve stream is on (``stream``: CURVEStream?) the stream paces the acquisition: a shot
-is due only when the stream asks for its next record (``want``), at once, at the next
-tick or on a fire command as above, so that no record is made that no client asked for."""
+``ACQuire:STATE ON`` arms the scope for one record; ``RUNSTop`` for records back to back
+until ``ACQuire:STATE OFF``. How an armed scope gets its shots is the rig's (``rig serve
+scope --fire``): at once (on-arm: one impact each time the scope is armed, and in run mode
+after each record), at the ticks of a period (every=SECONDS, as a rig that drops its
+striker periodically), or only from the fire commands (on-command: the armed scope waits for
+the impact). ``RIG:FIRE`` fires a shot now (an impact, in the trigger's mode); ``TRIGger
+FORCe``, ``*TRG`` and the transports' device trigger force one (programmer manuals, TRIGger:
+"FORCe creates a trigger event"): the shot is taken as TRIGger:A:MODe AUTO takes it, with
+the shot item scope.trigger.mode=auto, so a shot whose input never crosses the level gives
+the untriggered record AUTO gives (oscilloscope.Trigger).
+
+In NORMal (the manuals, TRIGger:A:MODe: "NORMal waits for a valid trigger event") a shot
+that does not trigger makes no record and the armed scope stays armed, the last record kept
+("If no trigger occurs, the last waveform record acquired remains on the display", 4 Series
+Quick Start): ``ACQuire:STATE?`` 1, ``TRIGger:STATE?`` READY, and in a single sequence
+``BUSY?`` 1 and ``*OPC?`` waiting, until a shot that triggers (the next tick; ``RIG:FIRE``),
+a forced trigger, ``ACQuire:STATE OFF``, ``*RST`` or, for the waiting query, a device clear.
+On-arm, its impact spent, it waits for these (no impact is fired again until it is armed
+again). Such a shot takes its seed (the striker fell) and is no acquisition (ACQuire:NUMACq);
+a ``RIG:FIRE`` on a stopped scope that does not trigger queues an execution error saying so.
+
+A shot takes the settings as they are when it starts (a change during a shot applies to the
+next) and the next seed: the k-th shot fired uses seed N + k - 1 (a refused shot uses none).
+``*OPC?``/``*WAI`` wait while a single sequence or a fired shot is pending. While a curve
+stream is on (``stream``: CURVEStream?) the stream paces the acquisition: a shot is due only
+when the stream asks for its next record (``want``), at once, at the next tick or on a fire
+command as above, so that no record is made that no client asked for."""
 from __future__ import annotations
 
 import math
 import threading
 import time
+from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
@@ -40,9 +57,10 @@ class Shot:
 class Acquisition:
     """The acquisition state (guarded by ``cond``, the instrument's condition) and its worker.
 
-    snapshot() -> the overrides of the next shot (called holding ``cond``); post(code,
-    detail) queues an event (holding ``cond``); done_opc() sets ESR's OPC bit; on_shot(Shot)
-    is called after each finished shot, outside the lock."""
+    snapshot(forced) -> the overrides of the next shot (called holding ``cond``; ``forced``:
+    a forced trigger's, taken in AUTO); post(code, detail) queues an event (holding
+    ``cond``); done_opc() sets ESR's OPC bit; on_shot(Shot) is called after each finished
+    shot with a record, outside the lock."""
 
     def __init__(self, cond: threading.Condition, source: ShotSource, snapshot, post, done_opc,
                  seed: int = 0, on_shot=None, *, period_s: float | None = None, on_command: bool = False) -> None:
@@ -55,11 +73,13 @@ class Acquisition:
         self.next_seed = int(seed)
         self.stop_after = "RUNSTop"
         self.running = False
-        self.pending = 0
+        self.pending: deque[bool] = deque()  # shots fired by command, not yet begun: forced (True) or impacts
+        self.spent = False  # on-arm: the armed scope's impact came and did not trigger
         self.busy = False
+        self.commanded = False  # the shot under way was fired by a command (not by arming)
         self.opc_armed = False
         self.count = 0
-        self.finished = 0  # shots ended, refused ones too: a stream waits for the next
+        self.finished = 0  # shots ended with a record or refused: a stream waits for the next
         self.streaming = False  # a curve stream paces the shots (CURVEStream?)
         self.wanted = False  # the stream asked for its next record
         self.last: Shot | None = None
@@ -70,7 +90,8 @@ class Acquisition:
 
     @property
     def awaiting(self) -> bool:
-        """A shot that *OPC? waits for is pending or running (BUSY? 1)."""
+        """A shot that *OPC? waits for is pending or running, or a single sequence waits for
+        its trigger (BUSY? 1)."""
         return bool(self.pending or (self.running and self.stop_after == "SEQuence")
                     or (self.busy and not self.running))
 
@@ -79,10 +100,18 @@ class Acquisition:
         """ACQuire:STATE? 1: running, streaming, or a shot on its way."""
         return bool(self.running or self.streaming or self.busy or self.pending)
 
+    def reset(self) -> None:
+        """*RST: run mode (RUNSTop), stopped, no fired shot pending."""
+        self.stop_after = "RUNSTop"
+        self.pending.clear()
+        self.run(False)
+
     def run(self, on: bool) -> None:
-        """ACQuire:STATE: armed or stopped; once armed, the first tick is the next one."""
+        """ACQuire:STATE: armed or stopped; once armed, the first tick is the next one (and
+        on-arm, an impact)."""
         if on and not self.running:
             self._next_tick()
+            self.spent = False
         self.running = on
         self.cond.notify_all()
 
@@ -97,17 +126,24 @@ class Acquisition:
         record asked for and not begun is not made)."""
         if on and not self.streaming:
             self._next_tick()
+            self.spent = False
         self.streaming, self.wanted = on, False
         self.cond.notify_all()
 
     def want(self) -> None:
-        """The stream asks for the next record."""
-        self.wanted = True
+        """The stream asks for the next record (on-arm: an impact for it)."""
+        self.wanted, self.spent = True, False
+        self.cond.notify_all()
+
+    def fire(self, forced: bool = False) -> None:
+        """A shot now: an impact (RIG:FIRE), or ``forced``, a forced trigger (TRIGger FORCe,
+        *TRG): taken as AUTO takes it."""
+        self.pending.append(forced)
         self.cond.notify_all()
 
     def force(self) -> None:
-        self.pending += 1
-        self.cond.notify_all()
+        """TRIGger FORCe, *TRG, the transports' device trigger: a forced shot now."""
+        self.fire(forced=True)
 
     def opc(self) -> None:
         """*OPC: OPC set now, or when the pending shot is in."""
@@ -119,30 +155,30 @@ class Acquisition:
     def close(self) -> None:
         with self.cond:
             self.closed = True
-            self.running, self.pending = False, 0
+            self.running = False
+            self.pending.clear()
             self.cond.notify_all()
 
-    def _wait_for_a_shot(self) -> bool:
-        """Wait (holding ``cond``) until a shot is due; False once closed. Due: a forced shot,
-        or while armed (ACQuire:STATE ON; while a stream is on, only when it asked for a
-        record) at once, or at the next tick of the period, or never (on_command: only
-        forced shots fire, an armed scope waits for them)."""
+    def _wait_for_a_shot(self) -> str | None:
+        """Wait (holding ``cond``) until a shot is due: "forced", "fired" (an impact by
+        command) or "armed", or None once closed. Due: a fired or forced shot, or while armed
+        (ACQuire:STATE ON; while a stream is on, only when it asked for a record) at once
+        unless its impact is spent, or at the next tick of the period, or never (on_command:
+        only fired shots, an armed scope waits for them). The stream's record stays asked for
+        until a shot gives one."""
         while not self.closed:
             if self.pending:
-                self.pending -= 1
-                self.wanted = False  # the stream's next record is this one
-                return True
+                return "forced" if self.pending.popleft() else "fired"
             armed = (self.wanted if self.streaming else self.running) and not self.on_command
-            due = armed and self.period_s is None
+            due = armed and self.period_s is None and not self.spent
             now = time.monotonic()
             if armed and self.period_s is not None and now >= self.next_tick:
                 self.next_tick += self.period_s * (1 + math.floor((now - self.next_tick) / self.period_s))
                 due = True
             if due:
-                self.wanted = False
-                return True
-            self.cond.wait(self.next_tick - now if armed else None)
-        return False
+                return "armed"
+            self.cond.wait(self.next_tick - now if armed and self.period_s is not None else None)
+        return None
 
     def first_acquisition(self) -> Shot:
         """Fire one shot now in the caller's thread, before any client is served: the record
@@ -150,25 +186,27 @@ class Acquisition:
         the first shot (seed N, counted, ``on_shot`` called); InstrumentError with the
         rig's reason when it fails (one that does not trigger is kept, as later ones)."""
         with self.cond:
-            overrides, seed = self._take_seed()
+            overrides, seed = self._take_seed("fired")
         shot, error = self._shoot(overrides, seed)
         if shot is None:
             raise InstrumentError(f"the first shot, at seed {seed}: {error}")
         return shot
 
-    def _take_seed(self) -> tuple:
-        """(overrides, seed) of the shot that starts now (holding ``cond``)."""
-        overrides, seed = dict(self.snapshot()), self.next_seed
+    def _take_seed(self, kind: str) -> tuple:
+        """(overrides, seed) of the shot of ``kind`` (_wait_for_a_shot's) that starts now
+        (holding ``cond``)."""
+        overrides, seed = dict(self.snapshot(kind == "forced")), self.next_seed
         self.next_seed += 1
-        self.busy = True
+        self.busy, self.commanded = True, kind != "armed"
         return overrides, seed
 
     def _work(self) -> None:
         while True:
             with self.cond:
-                if not self._wait_for_a_shot():
+                kind = self._wait_for_a_shot()
+                if kind is None:
                     return
-                overrides, seed = self._take_seed()
+                overrides, seed = self._take_seed(kind)
             self._shoot(overrides, seed)
 
     def _shoot(self, overrides: dict, seed: int) -> tuple:
@@ -178,7 +216,7 @@ class Acquisition:
         shot = None if record is None else Shot(overrides, seed, record)
         with self.cond:
             self._finish(shot, seed, error)
-        if shot is not None and self.on_shot is not None:
+        if shot is not None and shot.record.waveforms and self.on_shot is not None:
             try:
                 self.on_shot(shot)
             except Exception as e:  # noqa: BLE001 - the instrument keeps serving; the client is told
@@ -195,7 +233,24 @@ class Acquisition:
             return None, f"the shot failed: {type(e).__name__}: {e}"
 
     def _finish(self, shot: Shot | None, seed: int, error: str | None) -> None:
-        self.busy, self.finished = False, self.finished + 1
+        self.busy = False
+        if shot is not None and not shot.record.waveforms:  # NORMal, no trigger: no record
+            if self.running or self.streaming:
+                self.spent = True  # armed still, the last record kept: it waits for a trigger
+            elif self.commanded:  # fired on a stopped scope (RIG:FIRE, the first acquisition): said
+                self.post(-200, f"the shot of seed {seed} did not trigger: {shot.record.reason}; "
+                                "no record, the last one kept")
+        else:
+            self._ended(shot, seed, error)
+        if self.opc_armed and not self.awaiting:
+            self.opc_armed = False
+            self.done_opc()
+        self.cond.notify_all()
+
+    def _ended(self, shot: Shot | None, seed: int, error: str | None) -> None:
+        """A shot ended with a record, or refused (``shot`` None, ``error`` why): the
+        sequence done, the stream's record in."""
+        self.finished, self.wanted, self.spent = self.finished + 1, False, False
         if shot is None:  # no stale record may pass for this shot's: the last one is dropped
             self.post(-200, error)
             self.last, self.failure = None, error
@@ -204,11 +259,5 @@ class Acquisition:
             self.running = False
         else:
             self.last, self.failure, self.count = shot, None, self.count + 1
-            if not shot.record.waveforms:  # NORMal: no trigger, no record (AUTO took one untriggered)
-                self.post(-200, f"the shot of seed {seed} did not trigger: {shot.record.reason}")
         if self.stop_after == "SEQuence":
             self.running = False
-        if self.opc_armed and not self.awaiting:
-            self.opc_armed = False
-            self.done_opc()
-        self.cond.notify_all()

@@ -6,8 +6,7 @@ length it cannot take is an execution error), and a value the oscilloscope refus
 -222 (data out of range) or -221 (settings conflict) with its reason. Not emulated, and
 refused with -221: GND coupling, trigger couplings other than DC, acquisition modes other
 than sample and average, roll mode. ``AUTOSet`` is a documented no-op (the scene sets the
-scope), and so is ``HORizontal:MODE`` (kept and answered: scale and record length are always
-both set here, as in MANual)."""
+scope). The horizontal group is horizontal.py's."""
 from __future__ import annotations
 
 import math
@@ -15,7 +14,7 @@ import math
 from ..devices.oscilloscope import LEVEL_LIMIT_V
 from ..scpi.engine import Call, Fields, Word
 from ..scpi.status import ScpiError
-from .personalities import snap_record_length, snap_to_steps
+from .personalities import snap_to_steps
 from .settings import channel_key
 
 CHANNEL_WORDS = ("CH1", "CH2", "CH3", "CH4")
@@ -51,7 +50,7 @@ def register(tree, scope) -> None:
         return lambda c: scope.change({channel(c, field): convert(c)}, code=-222)
 
     def volts_per_div(c: Call) -> float:
-        return snap_to_steps(_positive(c, c.number("V")), p.volt_steps)
+        return snap_to_steps(positive(c, c.number("V")), p.volt_steps)
 
     def coupling(c: Call) -> str:
         word = c.word(("DC", "AC", "GND"))
@@ -62,7 +61,7 @@ def register(tree, scope) -> None:
     def bandwidth(c: Call):
         a = c.arg()
         if a.kind == "number":
-            return _positive(c, c.number("HZ"))
+            return positive(c, c.number("HZ"))
         return {"ON": TWENTY_MHZ, "TWEnty": TWENTY_MHZ, "OFF": None, "FULl": None}[
             c.word(("ON", "OFF", "TWEnty", "FULl"))]
 
@@ -80,7 +79,7 @@ def register(tree, scope) -> None:
         read = {"coupling": lambda c: Word(scope.settings[channel(c, "coupling")]),
                 "bandwidth": read_bandwidth}.get(field, lambda c, f=field: p.number(scope.settings[channel(c, f)]))
         tree.add(f"CH<n>:{name}", write=set_channel(field, convert), read=read)
-    tree.add("CH<n>:PRObe:GAIN", write=set_channel("probe", lambda c: 1.0 / _positive(c, c.number())),
+    tree.add("CH<n>:PRObe:GAIN", write=set_channel("probe", lambda c: 1.0 / positive(c, c.number())),
              read=lambda c: p.number(1.0 / scope.settings[channel(c, "probe")]))  # MDO form: gain = 1 / attenuation
 
     def refuse_but(allowed: str):
@@ -90,58 +89,6 @@ def register(tree, scope) -> None:
                 raise ScpiError(-221, f"{c.header} {c.arg().text}: only {allowed} is emulated")
         return write
 
-    # --- horizontal -------------------------------------------------------------------
-    def s_div() -> float:
-        return scope.settings["scope.sample_interval"] * scope.settings["scope.record_length"] / 10
-
-    def set_scale(c: Call):
-        snapped = snap_to_steps(_positive(c, c.number("S")), p.time_steps)
-        scope.change({"scope.sample_interval": snapped * 10 / scope.settings["scope.record_length"]}, code=-222)
-
-    def set_length(c: Call):
-        n = snap_record_length(_positive(c, c.number()), p.record_lengths)
-        if n is None:
-            raise ScpiError(-222, f"{c.header} {c.arg().text}: the {p.name} takes "
-                                  f"{', '.join(str(x) for x in p.record_lengths)}")
-        if n > scope.max_record_length:
-            raise ScpiError(-221, f"{c.header} {c.arg().text}: this virtual scope keeps records of at most "
-                                  f"{scope.max_record_length} points (max_record_length)")
-        scope.change({"scope.record_length": n, "scope.sample_interval": s_div() * 10 / n}, code=-222)
-
-    def sample_rate() -> float:
-        """S/s, to 12 digits (1 / 5e-10 s is 2 GS/s, not 1.9999999999999998E+9)."""
-        return float(f"{1.0 / scope.settings['scope.sample_interval']:.12g}")
-
-    def record_span() -> float:
-        return scope.settings["scope.sample_interval"] * scope.settings["scope.record_length"]
-
-    def set_position(c: Call):
-        # the TDS2000 gives seconds from the trigger to the screen's centre, the others the
-        # percent of the record before the trigger
-        pre = 0.5 - c.number("S") / record_span() if p.name == "tds2000" else c.number() / 100
-        scope.change({"scope.trigger.pre_trigger": pre}, code=-222)
-
-    def read_position(c: Call) -> str:
-        pre = scope.settings["scope.trigger.pre_trigger"]
-        return p.number((0.5 - pre) * record_span() if p.name == "tds2000" else pre * 100)
-
-    def set_mode(c: Call):
-        scope.horizontal_mode = c.word(("AUTO", "CONStant", "MANual"))
-
-    for head in ("HORizontal", "HORizontal:MAIn", "HORizontal:MODe"):
-        tree.add(f"{head}:SCAle", write=set_scale, read=lambda c: p.number(s_div()))
-    for head in ("HORizontal", "HORizontal:MAIn"):
-        tree.add(f"{head}:POSition", write=set_position, read=read_position)
-    def set_rate(c: Call):
-        """HORizontal:MODe:SAMPLERate (manual mode): the sample interval 1/rate, the record
-        length kept (the time per division follows)."""
-        scope.change({"scope.sample_interval": 1.0 / _positive(c, c.number("HZ"))}, code=-222)
-
-    for head in ("HORizontal", "HORizontal:MODe"):
-        tree.add(f"{head}:RECOrdlength", write=set_length, read=lambda c: str(scope.settings["scope.record_length"]))
-        tree.add(f"{head}:SAMPLERate", read=lambda c: p.number(sample_rate()),
-                 write=set_rate if p.name != "tds2000" else None)
-    tree.add("HORizontal:MODe", write=set_mode, read=lambda c: Word(scope.horizontal_mode))
     tree.add("HORizontal:MAIn:UNIts", read=lambda c: '"s"')
     tree.add("HORizontal:ROLL", write=refuse_but("OFF"), read=lambda c: Word("OFF"))
 
@@ -250,7 +197,6 @@ def register(tree, scope) -> None:
     # acquisition goes on either way (programs turn it off to transfer faster)
     tree.add("DISplay:WAVEform", write=lambda c: setattr(scope, "display_waveform", c.boolean()),
              read=lambda c: "1" if scope.display_waveform else "0")
-    tree.add("CONFIGuration:ANALOg:NUMCHANnels", read=lambda c: str(len(CHANNEL_WORDS)))
     tree.add("AUTOSet", write=lambda c: c.word(("EXECute", "UNDo")) and None)
 
 
@@ -287,7 +233,8 @@ def register_b_trigger(tree, scope) -> None:
     tree.add("TRIGger:B:STATE", write=state, read=lambda c: "0")
 
 
-def _positive(c: Call, x: float) -> float:
+def positive(c: Call, x: float) -> float:
+    """x, or -222 naming the header where it is not > 0."""
     if not x > 0:
         raise ScpiError(-222, f"{c.header} {c.arg().text}: a value > 0")
     return x

@@ -1,10 +1,10 @@
 """IEEE 488.2 common commands and the status, event and reply-form commands of a Tek scope
 (TDS2000 and MDO3000 programmer manuals, "Status and Events", "Miscellaneous"):
-``*IDN? *RST *CLS *OPC[?] *WAI *ESR? *ESE *SRE *STB? *TRG *TST?``, ``ALLEv? EVENT? EVMsg?
-EVQty? SYSTem:ERRor? BUSY? HEADer VERBose``. Every queue read takes the event off the queue;
-``ALLEv?`` takes them all (``0,"No events to report - queue empty"`` when none). The event
-queries give Tek's unsigned codes (113 "Undefined header"), ``SYSTem:ERRor?`` SCPI's
-(-113)."""
+``*IDN? *RST *CLS *OPC[?] *WAI *ESR? *ESE *SRE *PSC *STB? *TRG *TST?``, ``DESE ALLEv? EVENT?
+EVMsg? EVQty? SYSTem:ERRor? BUSY? HEADer VERBose`` (DESE and *PSC: StatusModel). Every queue
+read takes the event off the queue; ``ALLEv?`` takes them all (``0,"No events to report -
+queue empty"`` when none). The event queries give Tek's unsigned codes (113 "Undefined
+header"), ``SYSTem:ERRor?`` SCPI's (-113)."""
 from __future__ import annotations
 
 from ..scpi.engine import Call
@@ -41,6 +41,9 @@ def register(tree, scope) -> None:
     tree.add("*ESR", read=lambda c: str(status.read_esr()), bare=True)
     tree.add("*ESE", write=register_byte("ese"), read=lambda c: str(status.ese), bare=True)
     tree.add("*SRE", write=register_byte("sre"), read=lambda c: str(status.sre), bare=True)
+    tree.add("DESE", write=register_byte("dese"), read=lambda c: str(status.dese))
+    tree.add("*PSC", write=lambda c: setattr(status, "psc", c.boolean()), read=lambda c: "1" if status.psc else "0",
+             bare=True)
     tree.add("*STB", read=lambda c: str(status.status_byte(False)), bare=True)
     tree.add("*TRG", write=lambda c: acq.force())
     tree.add("*TST", read=lambda c: "0", bare=True)

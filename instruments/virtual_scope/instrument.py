@@ -24,7 +24,19 @@ from ..scpi.engine import Engine, ReplyForm
 from ..scpi.status import OPC, ScpiError, StatusModel
 from ..scpi.tree import CommandTree
 from ..transports.device import InstrumentLock
-from . import commands, common, display, measurements, rig_commands, setup, stream, tds_commands, waveform_commands
+from . import (
+    commands,
+    common,
+    configuration,
+    display,
+    horizontal,
+    measurements,
+    rig_commands,
+    setup,
+    stream,
+    tds_commands,
+    waveform_commands,
+)
 from .acquisition import Acquisition, ShotSource
 from .manual import in_manual
 from .measurements import default_slots
@@ -49,7 +61,8 @@ class VirtualScope:
     max_message_bytes (program message), max_reply_bytes (one message's replies),
     max_record_length (points; None: the model's longest record); opc_timeout_s: the longest *OPC? wait; fire_period_s /
     on_command: how an armed scope gets shots (acquisition.py): every so many seconds, or
-    only from TRIGger FORCe, *TRG and RIG:FIRE; neither: at once. rig_scene: the scene's
+    only from TRIGger FORCe, *TRG and RIG:FIRE; neither: at once; on_shot is called for the
+    shots that give a record. rig_scene: the scene's
     values of the RIG: settings as text ({"striker.velocity": "0.89 m/s", ...}), what their
     queries answer until a client sets them. record_cost: asked when a horizontal setting
     changes (HORIZONTAL); a record past the shot source's limits is refused there (-221).
@@ -91,10 +104,12 @@ class VirtualScope:
             common.register(t, self)
             rig_commands.register(t, self)
         commands.register(tree, self)
+        horizontal.register(tree, self)
         waveform_commands.register(tree, self)
         stream.register(tree, self)
         measurements.register(tree, self)
         setup.register(tree, self)
+        configuration.register(tree, self)
         tds_commands.register(tree, self)  # the TDS2000's other names for the commands above
         display.register(tree, self)  # after the modelled display commands: the manual's others, kept
         in_model_manual = partial(in_manual, self.personality.name)
@@ -121,14 +136,14 @@ class VirtualScope:
         self.shown = set(self.scene.channels)
         self.rig_values: dict = {}  # RIG: settings, scene key -> value text
         self.data = DataSelection(stop=self.initial["scope.record_length"])
-        self.horizontal_mode = "MANual"
+        self.horizontal_mode = "AUTO"  # HORizontal:MODe (4 Series), and in MANual what a new rate moves
+        self.manual_configure = "HORIZontalscale"
         self.measurements = default_slots(next(iter(self.scene.channels)), self.personality.name)
         self.numavg = self.scene.averages if self.scene.mode == "average" else 16
         self.trigger_levels: dict = {}  # TRIGger:A:LEVel:CH<x>: each channel's own level (V), set by a client
         self.display_waveform = True  # DISplay:WAVEform: the screen only, the records are the same
         self.b_trigger = {"source": "CH1", "slope": "RISe", "level": 0.0}  # TRIGger:B:EDGE, kept; B is off
-        self.acq.stop_after, self.acq.pending = "RUNSTop", 0
-        self.acq.run(False)
+        self.acq.reset()
 
     def channels(self) -> tuple:
         return acquired(self.scene, self.shown)
@@ -151,8 +166,11 @@ class VirtualScope:
                 raise ScpiError(-221, refusal)
         self.settings, self.shown = settings, set(shown)
 
-    def overrides_locked(self) -> dict:
-        return {**overrides(self.scene, self.settings, self.channels()), **self.rig_values}
+    def overrides_locked(self, forced: bool = False) -> dict:
+        """overrides() holding the condition; ``forced``: a forced trigger's shot, taken in
+        AUTO (scope.trigger.mode auto: acquisition.py)."""
+        settings = {**self.settings, "scope.trigger.mode": "auto"} if forced else self.settings
+        return {**overrides(self.scene, settings, self.channels()), **self.rig_values}
 
     def overrides(self) -> dict:
         """The settings that differ from the scene as loaded, {scene key: value text}: what
@@ -161,7 +179,7 @@ class VirtualScope:
             return self.overrides_locked()
 
     def _set_opc(self) -> None:
-        self.status.esr |= OPC
+        self.status.set_bits(OPC)
 
     def wait_idle(self, session) -> None:
         """Wait (the lock released) until no shot is pending; -410 when the session was

@@ -1,6 +1,8 @@
 """Measurements on the last record (programmer manuals, "Measurement" command group):
 the immediate one, ``MEASUrement:IMMed:TYPe/SOUrce/VALue?/UNIts?``, and the numbered slots
-``MEASUrement:MEAS<n>:TYPe/SOUrce/STATE/VALue?/UNIts?`` (n = 1..8), each model with its
+``MEASUrement:MEAS<n>:TYPe/SOUrce/STATE/VALue?/UNIts?`` (n = 1..8; ``SOUrce`` is ``SOUrce1``, the
+waveform measured, ``SOUrce2`` the second waveform of a delay or phase measurement, kept
+apart and read by none of the measurements emulated), each model with its
 manual's words (MEASUREMENTS, SPELLINGS): AMPlitude and PK2pk (max - min: the min-max
 method of HIGH and LOW), MAXimum, MINimum, HIGH, LOW, MEAN, RMS in volts; FREQuency,
 PERIod (the first cycle: two rising crossings of the 50% mid reference), PWIdth, NWIdth,
@@ -154,12 +156,29 @@ def words_of(personality: str) -> dict:
     return SPELLINGS.get(personality, {k: k for k in MEASUREMENTS})
 
 
+SECOND_SOURCE = "CH2"
+"""SOUrce2 of every slot until set: the waveform a delay or phase measurement would measure
+"to" (none of the emulated measurements reads it)."""
+
+
 def default_slots(channel: str, personality: str = "") -> dict:
-    """{slot: {"type", "source", "state"}}: "IMMed" and 1..8, of ``channel``: PK2pk on the
-    TDS2000 (whose manual has no AMPlitude), AMPlitude on the others; only IMMed on."""
+    """{slot: {"type", "source", "source2", "state"}}: "IMMed" and 1..8, of ``channel``:
+    PK2pk on the TDS2000 (whose manual has no AMPlitude), AMPlitude on the others; only
+    IMMed on. ``source`` is SOUrce1 (SOUrce), the one the measurements read; ``source2``
+    SOUrce2, kept apart (the MDO3000 manual, MEASUrement:MEAS<x>:SOUrce1: "For SOUrce2: ...
+    the waveform to measure 'to' when taking a delay measurement or phase measurement")."""
     kind = "PK2pk" if personality == "tds2000" else "AMPlitude"
-    return {slot: {"type": kind, "source": channel, "state": slot == "IMMed"}
+    return {slot: {"type": kind, "source": channel, "source2": SECOND_SOURCE, "state": slot == "IMMed"}
             for slot in ("IMMed", *range(1, SLOTS + 1))}
+
+
+def source_field(c: Call) -> str:
+    """The slot's field a MEASUrement:...:SOUrce<n> header names: SOUrce and SOUrce1 the
+    measured waveform, SOUrce2 the second one; another number is an undefined header."""
+    n = c.suffixes[-1]
+    if n not in (None, 1, 2):
+        raise ScpiError(-113, f"{c.header}: SOUrce1 or SOUrce2")
+    return "source2" if n == 2 else "source"
 
 
 def register(tree, scope) -> None:
@@ -175,10 +194,8 @@ def register(tree, scope) -> None:
 
     words = words_of(p.name)
 
-    def setter(field: str, choices):
-        def write(c: Call):
-            slot(c)[field] = c.word(choices)
-        return write
+    def set_source(c: Call):
+        slot(c)[source_field(c)] = c.word(CHANNEL_WORDS)
 
     def set_type(c: Call):
         slot(c)["type"] = words[c.word(tuple(words))]
@@ -211,8 +228,7 @@ def register(tree, scope) -> None:
 
     for node in ("IMMed", "MEAS<n>"):
         tree.add(f"MEASUrement:{node}:TYPe", write=set_type, read=read_type)
-        tree.add(f"MEASUrement:{node}:SOUrce<n>", write=setter("source", CHANNEL_WORDS),
-                 read=lambda c: Word(slot(c)["source"]))
+        tree.add(f"MEASUrement:{node}:SOUrce<n>", write=set_source, read=lambda c: Word(slot(c)[source_field(c)]))
         tree.add(f"MEASUrement:{node}:VALue", read=value)
         tree.add(f"MEASUrement:{node}:UNIts", read=lambda c: f'"{UNITS.get(slot(c)["type"], "V")}"')
     tree.add("MEASUrement:MEAS<n>:STATE", write=set_state, read=lambda c: "1" if slot(c)["state"] else "0")
@@ -235,7 +251,8 @@ def register_results(tree, scope, slot, value) -> None:
         free = next((n for n in range(1, SLOTS + 1) if not scope.measurements[n]["state"]), None)
         if free is None:
             raise ScpiError(-221, f"{c.header} {c.arg().text}: all {SLOTS} measurements are on")
-        scope.measurements[free] = {"type": kind, "source": scope.data.source, "state": True}
+        scope.measurements[free] = {**scope.measurements[free], "type": kind, "source": scope.data.source,
+                                    "state": True}
 
     def result(c: Call) -> str:
         """A slot's value, if the slot is on: one that is off has no results (9.91E37, 2225)."""

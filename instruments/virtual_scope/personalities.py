@@ -63,6 +63,18 @@ class Personality:
     streams: bool = False
     """Whether the model's manual has CURVEStream? (the 4 Series'; not the TDS2000's nor
     the MDO3000's)."""
+    horizontal_modes: bool = False
+    """Whether the model's manual has HORizontal:MODe {AUTO|MANual} (the 4 Series'): see
+    horizontal.py."""
+    max_sample_rate: float | None = None
+    """The highest real-time sample rate (S/s) its horizontal modes keep to (the 4 Series:
+    6.25 GS/s on every channel, 4 Series MSO datasheet); None: not bounded here."""
+
+    @property
+    def combined_offset(self) -> bool:
+        """Whether WFMOutpre:YZEro holds the vertical position and offset and YOFf is always 0
+        (the MDO3000's and 4 Series' manuals); the TDS2000's YOFf is the position in codes."""
+        return self.preamble == "WFMOutpre"
 
     @property
     def floats(self) -> bool:
@@ -107,7 +119,8 @@ PERSONALITIES = {
                          10000000, 20000000, 31250000),
                         (1.0, 2.0, 5.0), "WFMOutpre", WFMOUTPRE_4SERIES, "V", True, 4,
                         encodings=("ASCIi", "RIBinary", "RPBinary", "FPBinary", "SRIbinary", "SRPbinary", "SFPbinary"),
-                        models=r"MSO4[4-8]B?", model_names="MSO44, MSO46, MSO48 (B too)", streams=True),
+                        models=r"MSO4[4-8]B?", model_names="MSO44, MSO46, MSO48 (B too)", streams=True,
+                        horizontal_modes=True, max_sample_rate=6.25e9),
 }
 
 

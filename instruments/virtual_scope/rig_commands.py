@@ -1,4 +1,4 @@
-"""The rest of the rig over SCPI, the ``RIG:`` subsystem: ``RIG:FIRE`` (a shot now),
+"""The rest of the rig over SCPI, the ``RIG:`` subsystem: ``RIG:FIRE`` (a shot now, an impact in the trigger's mode),
 ``RIG:STRiker:VELocity``, ``RIG:MAGnet:FORCe``, ``RIG:MAGnet:POSition`` (scene keys
 striker.velocity, magnet.force, magnet.position; values as in scene files, a number and
 its unit: ``RIG:STR:VEL 0.9 m/s``, or a quoted string; the query answers the text set, or
@@ -40,7 +40,7 @@ def register(tree, scope) -> None:
 
     for pattern, key in RIG_KEYS.items():
         tree.add(f"RIG:{pattern}", write=setter(key), read=reader(key))
-    tree.add("RIG:FIRE", write=lambda c: c.only(0) or scope.acq.force())
+    tree.add("RIG:FIRE", write=lambda c: c.only(0) or scope.acq.fire())
     tree.add("RIG:SEED", write=set_seed, read=lambda c: str(scope.acq.next_seed))
     tree.add("RIG:SCENe", read=lambda c: _quoted(scope.scene_name))
     tree.add("RIG:OVERrides", read=lambda c: _quoted(",".join(f"{k}={v}" for k, v in scope.overrides_locked().items())))

@@ -7,8 +7,9 @@ forms (``:CH1:SCALE 5.0E-2;:CH1:POSITION -1.0E0;...``), whatever HEADer and VERB
 manuals: "SET? always returns command headers"), so that a program can send it back to
 restore the set-up. Every setting the emulation keeps is in it: per channel scale,
 position, offset, coupling, bandwidth and probe; horizontal scale, position and (where the
-model has it) record length; the edge trigger; the acquisition; the channels shown; the
-DATa selection. The rig's own RIG: settings are not (``RIG:OVERRIDES?`` gives them).
+model has them) record length, mode, MANual:CONFIGure and sample rate; the edge trigger;
+the acquisition; the channels shown; the DATa selection. The rig's own RIG: settings are
+not (``RIG:OVERRIDES?`` gives them).
 
 On the TDS2000 (its manual's Save and Recall group) a set-up location, 1 to 10, keeps those
 same settings from ``*SAV n`` or ``SAVe:SETUp n`` until the scope is closed (``*RST`` leaves
@@ -44,12 +45,14 @@ class Saved:
     stop_after: str
 
 
-def setup_queries(record_length: bool) -> str:
+def setup_queries(record_length: bool, modes: bool = False) -> str:
     """The program message whose answers are the set-up (``record_length``: the model sets
-    HORizontal:RECOrdlength)."""
+    HORizontal:RECOrdlength; ``modes``: it has HORizontal:MODe, whose mode and sample rate come
+    first, so that a set-up of either mode is restored in it: horizontal.py)."""
     per_channel = [f"{ch}:{name}" for ch in CHANNEL_WORDS for name in CHANNEL_SETTINGS]
     shown = [f"SELect:{ch}" for ch in CHANNEL_WORDS]
-    horizontal = ["HORizontal:RECOrdlength"] if record_length else []
+    horizontal = (["HORizontal:MODe", "HORizontal:MODe:MANual:CONFIGure", "HORizontal:MODe:SAMPLERate"]
+                  if modes else []) + (["HORizontal:RECOrdlength"] if record_length else [])
     return ";:".join(f"{q}?" for q in horizontal + per_channel + shown + list(SETTINGS))
 
 
@@ -57,7 +60,7 @@ def register(tree, scope) -> None:
     """Add ``SET?``, ``*LRN?`` and the set-up locations of ``scope`` (a VirtualScope)."""
     form = ReplyForm(header=True, verbose=True)
     engine = Engine(tree, StatusModel(), form)  # its own reply form and queue: the client's are untouched
-    queries = setup_queries(len(scope.personality.record_lengths) > 1).encode()
+    queries = setup_queries(len(scope.personality.record_lengths) > 1, scope.personality.horizontal_modes).encode()
 
     def setup(c) -> bytes:
         return engine.execute(queries, c.context).rstrip(b"\n")

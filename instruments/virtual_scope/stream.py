@@ -11,9 +11,10 @@ the last block has left the connection, transports/stream.py), so that the clien
 pace the acquisition (the manual: "the trigger rate is slowed to allow each waveform to be
 sent sequentially") and nothing piles up where the client does not read. Each block is a
 new shot at the next seed, the record ``rig shot`` gives at that seed with the scope's
-settings, as a repeated single sequence and CURVe? would have it. A shot that gives no
-record (refused, or untriggered in NORMal) answers CURVe?'s empty block, the reason in the
-queue, and ends the stream. One stream at a time: a second client's is refused (-200)."""
+settings, as a repeated single sequence and CURVe? would have it. A shot the rig refuses
+answers CURVe?'s empty block, the reason in the queue, and ends the stream; one that does not
+trigger in NORMal sends nothing: the stream waits for a trigger (acquisition.py), until the
+client ends it. One stream at a time: a second client's is refused (-200)."""
 from __future__ import annotations
 
 from typing import Protocol, cast

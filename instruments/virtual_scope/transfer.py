@@ -7,7 +7,8 @@ MSB or LSB first: BYT_NR 4, BN_FMT FP; the 8-bit codes as floats, YMULT and YOFF
 1-byte codes) and FAStest (the MDO3000's "fastest": RIBinary). ``DATa:WIDth 2`` sends the
 8-bit converter's code in the high byte (code x 256), as the scopes do, so YMULT is
 V/div / 25 / 256. An unsigned encoding adds 2^(8 width - 1)
-to every code and to YOFF. The preamble (``WFMPre?``/``WFMOutpre?``) always describes the
+to every code and to YOFF (on the MDO3000 and 4 Series, whose YOFF is always 0, YZERO takes
+it with the position: ``scaled``). The preamble (``WFMPre?``/``WFMOutpre?``) always describes the
 bytes ``CURVe?`` sends with the current DATa settings: NR_PT the points from STARt to STOP
 (clipped to the record), XZERO the time of the first point sent (s from the trigger),
 PT_OFF 0, so volts = YZERO + YMULT (code - YOFF) and t = XZERO + XINCR n."""
@@ -103,11 +104,20 @@ def curve_bytes(codes: np.ndarray, sel: DataSelection) -> bytes:
     return definite_block(values.astype(f"{order}{kind}{sel.sent_width}").tobytes())
 
 
-def scaled(pre: Preamble, sel: DataSelection) -> tuple:
-    """(YMULT, YOFF, YZERO) of the codes as sent."""
+def scaled(pre: Preamble, sel: DataSelection, combined: bool = False) -> tuple:
+    """(YMULT, YOFF, YZERO) of the codes as sent, volts = YZERO + YMULT (code - YOFF).
+
+    The TDS2000's definition (``combined`` False): YOFF the vertical position in digitizing
+    levels (with the unsigned encodings' 2^(8 width - 1)), YZERO the offset. The MDO3000's and
+    the 4 Series' (``combined``; their manuals, WFMOutpre:YZEro: "the combined vertical
+    position and offset ... For this instrument family, the value of :YOFf is always 0.0"):
+    YOFF 0 and YZERO = offset - YMULT x that YOFF, the same volts for every code."""
     factor = 256 if sel.width == 2 and not sel.floating else 1
+    ymult = pre.y_multiplier / factor
     yoff = pre.y_offset * factor + ((1 << (8 * sel.width - 1)) if sel.unsigned else 0)
-    return pre.y_multiplier / factor, yoff, pre.y_zero
+    if combined:
+        return ymult, 0.0, pre.y_zero - ymult * yoff
+    return ymult, yoff, pre.y_zero
 
 
 def waveform_id(channel: str, pre: Preamble, coupling: str, volts_per_div: float, mode: str,
@@ -121,7 +131,7 @@ def waveform_id(channel: str, pre: Preamble, coupling: str, volts_per_div: float
 def preamble_fields(pre: Preamble, sel: DataSelection, wfid: str, p: Personality) -> Fields:
     """The model's preamble (``WFMPre?`` 16 fields, ``WFMOutpre?`` 22) for the bytes sent."""
     first, end = sel.span(pre.points)
-    ymult, yoff, yzero = scaled(pre, sel)
+    ymult, yoff, yzero = scaled(pre, sel, p.combined_offset)
     binary = sel.encoding != "ASCIi"
     values = {
         "BYT_Nr": str(sel.sent_width), "BIT_Nr": str(8 * sel.sent_width),

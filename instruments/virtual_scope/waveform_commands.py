@@ -61,8 +61,9 @@ def source_waveform(scope, ch: str, header: str, *, off_too: bool = False):
 
 def curve_answer(scope, header: str) -> tuple:
     """(CURVe?'s answer without its header, whether it holds the record): the last record's
-    codes of DATa:SOUrce as DATa sets them; where there is none (no shot yet, the last one
-    failed or, in NORMal, did not trigger, the source is off) an empty answer (``#10``, or an
+    codes of DATa:SOUrce as DATa sets them (in NORMal, a shot that did not trigger leaves the
+    last record); where there is none (no record yet, the last shot failed, the source is
+    off) an empty answer (``#10``, or an
     empty line in ASCIi) with the reason in the queue, so that a client reads the error
     instead of waiting out its timeout."""
     empty = curve_bytes(np.zeros(0, np.int8), scope.data)
@@ -76,9 +77,7 @@ def curve_answer(scope, header: str) -> tuple:
         scope.status.post(off.code, off.detail)
         return empty, False
     if codes is None:
-        last = scope.acq.last
         why = (f"the last shot failed ({scope.acq.failure})" if scope.acq.failure else
-               f"the last shot did not trigger ({last.record.reason})" if last and not last.record.waveforms else
                "no record yet; fire a shot (ACQuire:STATE ON, TRIGger FORCe or RIG:FIRE)")
         scope.status.post(-200, f"{scope.data.source} has no record: {why}; {header}")
         return empty, False

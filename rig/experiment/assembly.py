@@ -224,10 +224,11 @@ class Assembly:
             raise invalid("scope.trigger.source", src,
                           f"triggers on an unconnected channel (connected: {', '.join(used) or 'none'})")
 
-    def check_record(self):
+    def check_record(self, trigger: bool = True):
         """Refuse scope settings that can give no record of this rig's solve (RigError naming
         them), before it runs: a shot fires only after this (a fit's windowed solves, which
-        read no scope, do not ask)."""
+        read no scope, do not ask). ``trigger``: a trigger that never fires too
+        (``trigger_never_fires``)."""
         tb, tr, s = self.scope.timebase, self.scope.trigger, self.solver
         span = tb.record_length * tb.sample_interval
         after = (1 - tr.pre_trigger) * span
@@ -250,9 +251,20 @@ class Assembly:
             reach = st.gap / st.velocity if g == 0 else (math.sqrt(st.velocity**2 + 2 * g * st.gap) - st.velocity) / g
             raise RigError(f"striker.gap = {st.gap:g} m at striker.velocity = {st.velocity:g} m/s: the striker "
                            f"reaches the top bead after {reach:.4g} s, not within solver.duration = {s.duration:g} s")
-        if tr.slope == "rising" and tr.level <= 0 and tr.mode == "normal":  # in AUTO a record comes all the same
-            raise invalid("scope.trigger.level", f"{tr.level:g} V", "a rising trigger needs a level above the "
-                                                                   "gauges' rest at 0 V, e.g. '30 mV'")
+        never = self.trigger_never_fires() if trigger else None
+        if never is not None:
+            raise never
+
+    def trigger_never_fires(self) -> RigError | None:
+        """The refusal of a trigger that cannot fire on this rig's gauges, or None: in NORMal
+        mode (in AUTO a record comes all the same), a rising edge at or below the gauges' rest
+        at 0 V. ``check_record`` raises it; a served scope waits for the trigger instead (a
+        real scope armed in NORMal waits for a valid trigger event: rig/lab/shots.py)."""
+        tr = self.scope.trigger
+        if tr.slope == "rising" and tr.level <= 0 and tr.mode == "normal":
+            return invalid("scope.trigger.level", f"{tr.level:g} V", "a rising trigger needs a level above the "
+                                                                    "gauges' rest at 0 V, e.g. '30 mV'")
+        return None
 
     def wiring(self) -> dict:
         """{scope channel: what is connected to it ("gauges.NAME" or "wall_sensor")}."""

@@ -81,9 +81,11 @@ class InProcessBench:
         with self._lock:
             wanted = {**self.overrides, key: text}
             try:
-                self.shots.rig(wanted)  # the scene read and its parts built with it, or the rig's refusal
+                never = self.shots.rig(wanted).trigger_never_fires()  # the scene read, its parts built
             except RigError as exc:
                 raise InstrumentError(str(exc)) from None
+            if never is not None:  # refused, as rig shot refuses it
+                raise InstrumentError(str(never))
             self.overrides = wanted
 
     def value(self, key: str) -> float:

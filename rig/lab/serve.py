@@ -17,9 +17,10 @@ a share of the connections per address, eviction of a quiet connection for a new
 address other than loopback is warned of in one line, and the resources printed are ones a
 remote client can open. ``--log`` gets one line per listener, connection, disconnect (and
 why), refusal, protocol violation, refused command (with the event it left in the queue),
-shot and refused shot. A second ``--vxi11`` server on loopback whose portmapper maps another
-server's VXI-11 moves its VXI-11 channels to a loopback address of its own (127.0.0.2, ...),
-with a portmapper there, so that both are found and neither unregisters the other.
+shot, shot that did not trigger and refused shot. A second ``--vxi11`` server on loopback
+whose portmapper maps another server's VXI-11 moves its VXI-11 channels to a loopback address
+of its own (127.0.0.2, ...), with a portmapper there, so that both are found and neither
+unregisters the other.
 """
 from __future__ import annotations
 
@@ -296,14 +297,18 @@ class ScopeServer:
 
     def _fire(self, overrides: Mapping[str, str], seed: int) -> ScopeRecord:
         """The scope's shot source: the scene's shot, a refusal logged (then raised, for the
-        scope to queue)."""
+        scope to queue), a shot that did not trigger logged (the scope, armed, waits)."""
+        settings = " ".join(f"{k}={v}" for k, v in overrides.items()) or "the scene as loaded"
         try:
-            return self.shots(overrides, seed)
+            record = self.shots(overrides, seed)
         except Exception as e:
-            settings = " ".join(f"{k}={v}" for k, v in overrides.items()) or "the scene as loaded"
             self.refusals.shot_refused(str(e))
             self.log.warning("refused shot at seed %d (%s): %s", seed, printable(settings), printable(str(e)))
             raise
+        if not record.waveforms:
+            self.log.info("shot at seed %d (%s) did not trigger: %s", seed, printable(settings),
+                          printable(record.reason or ""))
+        return record
 
     def _record(self, shot: ShotRecord) -> None:
         """A served shot finished: log it, archive it (``--out``)."""

@@ -12,6 +12,10 @@ The rigs built are kept per distinct set of overrides (a small LRU), so repeated
 one fire each; a rig whose settings differ from a kept one only in ``scope.*`` keys takes
 that rig's solved chain (the scope does not change what the chain does).
 
+A scope whose trigger can never fire (NORMal, a rising level at or below the gauges' rest,
+which ``rig shot`` refuses) gets the record of a shot that did not trigger, with the
+refusal as its reason: the served scope waits for a trigger, as a real one armed in NORMal.
+
 Every record the scope's settings describe is given (``record_solver``): where a record
 lasts longer after its trigger than the scene's solve, the chain is solved for longer (past
 its pulses it rings down and settles under the magnet and gravity, the striker bouncing off
@@ -182,7 +186,7 @@ class SceneShots:
         record needs (``record_solver``), refused (RigError) where it could give no record or
         passes the size limits, before anything is solved."""
         rig = self._recording(items)
-        rig.check_record()
+        rig.check_record(trigger=False)  # a trigger that never fires: the scope waits (__call__)
         rig.estimate().refuse_unless(self.allow_large, "this shot")
         return rig
 
@@ -237,7 +241,17 @@ class SceneShots:
             return shot
 
     def __call__(self, overrides: Mapping[str, str], seed: int) -> ScopeRecord:
-        """The ShotSource: the scope record of ``shot(overrides, seed)``."""
+        """The ShotSource: the scope record of ``shot(overrides, seed)``; where the scope's
+        trigger can never fire (Rig.trigger_never_fires: NORMal, a rising level at or below
+        the gauges' rest), the record of a shot that did not trigger, with that reason and
+        nothing solved or fired (``rig shot`` refuses such a shot: the served scope, armed in
+        NORMal, waits for a trigger that never comes)."""
+        try:
+            never = self.rig(overrides).trigger_never_fires()
+        except RigError as exc:
+            raise InstrumentError(str(exc)) from None
+        if never is not None:
+            return ScopeRecord({}, False, f"the trigger never fires: {never}")
         return self.shot(overrides, seed).scope
 
     def record_cost(self, overrides: Mapping[str, str]) -> str | None:

@@ -29,6 +29,8 @@ def test_a_setting_reads_back_in_si_and_a_refusal_changes_nothing():
         bench.set("magnet.position", "5 cm")  # the scene gives the force
     with pytest.raises(InstrumentError, match="magnet.position: not set"):
         bench.value("magnet.position")
+    with pytest.raises(InstrumentError, match="a rising trigger needs a level above the gauges' rest"):
+        bench.set("scope.trigger.level", "-0.1 V")  # NORMal: refused, as rig shot refuses it
     assert bench.overrides == {"magnet.force": "2700 mN", "striker.velocity": "1.1"}
 
 

@@ -98,6 +98,7 @@ def test_served_in_auto_an_untriggered_shot_is_the_rig_shot_of_its_items_and_see
         scope.write("*RST;:HEADER OFF")
         assert scope.query("TRIG:A:MODE?").strip() == "AUTO"
         scope.write("TRIG:A:EDGE:SLOPE RISE;:TRIG:A:LEVEL -0.4")
+        assert float(scope.query("TRIG:A:LEVEL?")) == -0.4  # taken before another connection fires
         codes, overrides, seed = shot_codes(rm, served.resource("SOCKET"))
         assert scope.query("ALLEV?").strip().startswith("0,")  # no event: the record came
     finally:

@@ -162,9 +162,14 @@ def test_data_start_and_stop_are_clamped_as_the_scopes_clamp_them(make_scope):
 
 
 def test_horizontal_mode_forms_are_the_same_settings(make_scope):
+    """HORizontal:MODe:SCAle and :RECOrdlength are HORizontal:SCAle and :RECOrdlength; in MANual
+    (4 Series manual, HORizontal:MODe: "when you change record length then the horizontal
+    scale also changes") the sample rate of 10,000 points at 200 us/div, 5 MS/s, is kept."""
     _scope, s, _ = make_scope("mso4")
     s.handle(b"HOR:MODE MAN;:HOR:MODE:SCALE 1E-4;RECORDLENGTH 20000")
-    assert ask(s, "HOR:SCALE?;RECO?;:HOR:MODE:SAMPLERATE?;:HOR:MODE?") == "100.0000E-6;20000;20.0000E+6;MANUAL"
+    assert ask(s, "HOR:SCALE?;RECO?;:HOR:MODE:SAMPLERATE?;:HOR:MODE?") == "400.0000E-6;20000;5.0000E+6;MANUAL"
+    s.handle(b"HOR:MODE AUTO;:HOR:MODE:SCALE 1E-4;RECORDLENGTH 20000")  # AUTO: the scale kept
+    assert ask(s, "HOR:SCALE?;RECO?;:HOR:MODE:SAMPLERATE?;:HOR:MODE?") == "100.0000E-6;20000;20.0000E+6;AUTO"
 
 
 @pytest.mark.parametrize("slot", ["IMM", "MEAS3"])
@@ -181,6 +186,21 @@ def test_measurements_on_the_last_record(make_scope, slot):
     s.handle(f"MEASU:{slot}:SOURCE CH2;:SEL:CH2 OFF".encode())
     assert s.handle(f"MEASU:{slot}:VAL?".encode()) == b"" and ask(s, "EVENT?") == "2244"
     assert v.max() == pytest.approx(0.2, abs=0.005)  # the pulse's peak, within 2 codes and the noise
+
+
+@pytest.mark.parametrize("personality", ["mdo3000", "mso4"])
+def test_a_measurements_second_source_is_its_own(make_scope, personality):
+    """MEASUrement:MEAS<x>:SOUrce1 (MDO3000 manual): SOUrce1 is the source of single-channel
+    measurements ("SOUrce is equivalent to SOURCE1"), SOUrce2 the waveform a delay or phase
+    measurement goes "to": setting the second leaves the first, and the value is SOUrce1's."""
+    scope, s, _ = make_scope(personality)
+    fire(s)
+    s.handle(b"MEASU:MEAS1:SOU1 CH1;:MEASU:MEAS1:SOU2 CH2;:MEASU:MEAS1:TYPE MAX;:MEASU:IMM:SOURCE2 CH2")
+    assert ask(s, "MEASU:MEAS1:SOU1?;SOU2?;SOURCE?;:MEASU:IMM:SOU1?;SOU2?") == "CH1;CH2;CH1;CH1;CH2"
+    value = float(ask(s, "MEASU:MEAS1:VAL?"))
+    assert value == pytest.approx(scope.acq.last.record["CH1"].volts().max(), rel=1e-12)
+    assert scope.acq.last.record["CH2"].volts().max() - value > 0.05  # not CH2's larger pulse (0.3 V)
+    assert s.handle(b"MEASU:MEAS1:SOURCE3?") == b"" and ask(s, "EVENT?") == "113"
 
 
 def test_a_scene_scope_no_model_can_take_is_refused():

@@ -60,6 +60,35 @@ def test_bytes_and_preamble_give_the_records_volts(make_scope, personality, name
     assert np.allclose(w.time(), record.time()[100:1600], rtol=0, atol=1e-15)
 
 
+@pytest.mark.parametrize("personality", ["tds2000", "mdo3000", "mso4"])
+@pytest.mark.parametrize("encoding, width", [("RIBinary", 1), ("SRPbinary", 1), ("RPBinary", 2), ("ASCIi", 2)])
+def test_yoff_and_yzero_are_each_models_own(make_scope, personality, encoding, width):
+    """WFMOutpre:YOFf (MDO3000 and 4 Series manuals): "For this instrument family, the value
+    returned is always 0.0 as the offset is combined with the :YZEro value"; YZEro "returns
+    the combined vertical position and offset". The TDS2000 keeps its own: YOFf the position
+    in digitizing levels (-1 div: -25 codes, x 256 at width 2, + 2^(8 width - 1) unsigned),
+    YZEro the offset. Either way YZERO + YMULT (code - YOFF) is the record's volts, and the
+    whole preamble says the same as its fields."""
+    scope, s, _ = make_scope(personality, seed=2)
+    s.handle(b"CH1:POSITION -1;OFFSET 0.02")  # -1 div at 50 mV/div, 20 mV offset
+    fire(s)
+    s.handle(f"DATA:SOURCE CH1;ENCDG {encoding};WIDTH {width};START 1;STOP 100000".encode())
+    name = "WFMPre" if personality == "tds2000" else "WFMOutpre"
+    pre = preamble(s, name)
+    assert (pre["YOFF"], pre["YZERO"]) == tuple(ask(s, f"{name}:YOFF?;YZERO?").split(";"))
+    factor = 256 if width == 2 else 1
+    unsigned = 128 * factor if encoding in ("RPBinary", "SRPbinary") else 0
+    if personality == "tds2000":
+        assert float(pre["YOFF"]) == -25 * factor + unsigned and float(pre["YZERO"]) == pytest.approx(0.02, rel=1e-12)
+    else:
+        assert pre["YOFF"] == "0.0E+0"
+        code_zero = 0.02 + 0.05 - unsigned * 0.002 / factor  # the volts of the code 0 as sent
+        assert float(pre["YZERO"]) == pytest.approx(code_zero, rel=1e-12)
+    codes = decode(s.handle(b"CURVE?"), pre)
+    volts = float(pre["YZERO"]) + float(pre["YMULT"]) * (codes - float(pre["YOFF"]))
+    assert np.allclose(volts, scope.acq.last.record["CH1"].volts(), rtol=0, atol=1e-12)
+
+
 def test_wavfrm_is_the_preamble_then_the_curve(make_scope):
     _scope, s, _ = make_scope("tds2000", seed=1)
     fire(s)

@@ -1,0 +1,84 @@
+"""The horizontal couplings of the 4 Series manual (HORizontal:MODe, MODe:RECOrdlength,
+MODe:SAMPLERate, MODe:SCAle, MODe:MANual:CONFIGure): AUTO after *RST keeps the scale, MANual
+keeps the sample rate, the rate never past the MSO44's 6.25 GS/s; the MDO3000's and TDS2000's
+manuals have no HORizontal:MODe (113)."""
+import pytest
+
+from lab.lab_scope import ask
+
+MSO44_RATE = "6.2500E+9"
+
+
+def test_manual_mode_keeps_the_sample_rate_and_a_record_length_moves_the_scale(make_scope):
+    """HORizontal:MODe MANual "lets you change the sample rate, horizontal scale, and record
+    length. These values interact. For example, when you change record length then the
+    horizontal scale also changes": 1,000 points at 6.25 GS/s span 160 ns, 16 ns/div."""
+    _scope, s, _ = make_scope("mso4")
+    s.handle(b"HORizontal:MODe MANual;:HORizontal:MODe:SAMPLERate 6.25e9;:HORizontal:RECOrdlength 1000")
+    assert ask(s, "HORizontal:MODe:SAMPLERate?;:HORizontal:SCAle?;:HORizontal:RECOrdlength?") == \
+        f"{MSO44_RATE};16.0000E-9;1000"
+    s.handle(b"HORizontal:SCAle 1E-6")  # the rate kept: 62,500 points, the model's nearest 50,000
+    assert ask(s, "HOR:SAMPLER?;:HOR:RECO?;:HOR:SCA?") == f"{MSO44_RATE};50000;800.0000E-9"
+    assert ask(s, "ALLEV?") == '0,"No events to report - queue empty"'
+
+
+def test_a_sample_rate_past_the_models_is_its_maximum(make_scope):
+    """The MSO44 samples at most 6.25 GS/s in real time (4 Series MSO datasheet): a higher
+    rate asked is that one, in either mode."""
+    _scope, s, _ = make_scope("mso4")
+    s.handle(b"HOR:MODE MANUAL;:HOR:MODE:SAMPLERATE 1E11")
+    assert ask(s, "HOR:MODE:SAMPLERATE?;:ALLEV?") == f'{MSO44_RATE};0,"No events to report - queue empty"'
+    s.handle(b"HOR:MODE AUTO;:HOR:SCALE 2E-8;:HOR:MODE:SAMPLERATE 1E11")
+    assert ask(s, "HOR:SCALE?;:HOR:RECO?;:HOR:SAMPLERATE?") == "20.0000E-9;1000;5.0000E+9"
+
+
+def test_auto_mode_after_rst_keeps_the_scale_and_the_rate_within_the_models(make_scope):
+    """AUTO, the 4 Series' mode after *RST, "automatically adjusts the sample rate and record
+    length": the scale is the client's; a record the rate cannot fill at it (10,000 points at
+    20 ns/div: 50 GS/s) is the longest that fits (1,000 points, 5 GS/s); below 16 ns/div even
+    1,000 points need more (the real scope interpolates): the shortest record."""
+    _scope, s, _ = make_scope("mso4")
+    s.handle(b"HOR:MODE MANUAL;:HOR:MODE:MANUAL:CONFIGURE RECORDLENGTH;*RST")
+    assert ask(s, "HOR:MODE?;:HOR:MODE:MANUAL:CONFIGURE?") == "AUTO;HORIZONTALSCALE"
+    s.handle(b"HOR:SCALE 2E-8;:HOR:RECO 10000")
+    assert ask(s, "HOR:SCALE?;:HOR:RECO?;:HOR:SAMPLERATE?") == "20.0000E-9;1000;5.0000E+9"
+    s.handle(b"HOR:SCALE 1E-4;:HOR:RECO 20000")  # within the rate: the record set, the scale kept
+    assert ask(s, "HOR:SCALE?;:HOR:RECO?;:HOR:SAMPLERATE?") == "100.0000E-6;20000;20.0000E+6"
+    s.handle(b"HOR:SCALE 1E-9")
+    assert ask(s, "HOR:SCALE?;:HOR:RECO?") == "1.0000E-9;1000"
+
+
+def test_manual_configure_names_what_a_new_sample_rate_moves(make_scope):
+    """HORizontal:MODe:MANual:CONFIGure: "which horizontal control (scale or record length)
+    will primarily change when the sample rate is changed in Manual mode"."""
+    _scope, s, _ = make_scope("mso4")
+    s.handle(b"HOR:MODE MANUAL;:HOR:MODE:SAMPLERATE 5E6")  # 10,000 points: 200 us/div
+    assert ask(s, "HOR:SCALE?;:HOR:RECO?") == "200.0000E-6;10000"
+    s.handle(b"HOR:MODE:SAMPLERATE 10E6")  # HORIZontalscale: the scale moves
+    assert ask(s, "HOR:SCALE?;:HOR:RECO?") == "100.0000E-6;10000"
+    s.handle(b"HOR:MODE:MANUAL:CONFIGURE RECORDL;:HOR:MODE:SAMPLERATE 20E6")  # RECORDLength: the record
+    assert ask(s, "HOR:SCALE?;:HOR:RECO?;:HOR:SAMPLERATE?") == "100.0000E-6;20000;20.0000E+6"
+
+
+@pytest.mark.parametrize("personality", ["tds2000", "mdo3000"])
+def test_models_without_horizontal_modes_answer_113(make_scope, personality):
+    """The MDO3000's and TDS2000's manuals have no HORizontal:MODe: scale and record length
+    are set alone, each keeping the other."""
+    _scope, s, _ = make_scope(personality)
+    for query in (b"HORIZONTAL:MODE?", b"HORIZONTAL:MODE:SCALE?", b"HORIZONTAL:MODE:RECORDLENGTH?"):
+        assert s.handle(query) == b"" and ask(s, "EVENT?") == "113"
+
+
+def test_set_query_restores_a_manual_mode_setup(make_scope):
+    """SET? of the 4 Series holds the mode, what a new rate moves and the sample rate before
+    the record length and scale: sent back after *RST (AUTO), the set-up is the same."""
+    _scope, s, _ = make_scope("mso4")
+    s.handle(b"HOR:MODE MANUAL;:HOR:MODE:MANUAL:CONFIGURE RECORDL;:HOR:MODE:SAMPLERATE 6.25E9;:HOR:RECO 1000")
+    state = "HOR:MODE?;:HOR:MODE:MANUAL:CONFIGURE?;:HOR:SAMPLERATE?;:HOR:RECO?;:HOR:SCALE?"
+    before = ask(s, state)
+    setup = s.handle(b"SET?").rstrip(b"\n")
+    s.handle(b"*RST")
+    assert ask(s, state) != before
+    s.handle(setup)
+    assert ask(s, state) == before == f"MANUAL;RECORDLENGTH;{MSO44_RATE};1000;16.0000E-9"
+    assert ask(s, "ALLEV?") == '0,"No events to report - queue empty"'
