@@ -26,8 +26,10 @@ from doc_blocks import ROOT, blocks, pages
 
 PAGES = [page for page in pages() if blocks(page)]
 TIMEOUT = 120  # s per command: the first run of a command compiles numba kernels
-SETUP = (("pip", "install"), ("python", "-m", "pytest"), ("mkdocs", "build"), ("mkdocs", "serve"))
-"""Commands a page may show without the test running them: installing, the test suite, the site."""
+SETUP = (("pip", "install"), ("python", "-m", "pytest"), ("coverage", "combine"), ("coverage", "report"),
+         ("mkdocs", "build"), ("mkdocs", "serve"))
+"""Commands a page may show without the test running them: installing, the test suite and its
+coverage, the site."""
 
 
 def _env() -> dict:
