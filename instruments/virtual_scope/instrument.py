@@ -25,6 +25,7 @@ from ..scpi.status import OPC, ScpiError, StatusModel
 from ..scpi.tree import CommandTree
 from ..transports.device import InstrumentLock
 from . import (
+    clock,
     commands,
     common,
     configuration,
@@ -104,6 +105,7 @@ class VirtualScope:
             common.register(t, self)
             rig_commands.register(t, self)
         commands.register(tree, self)
+        clock.register(tree)
         horizontal.register(tree, self)
         waveform_commands.register(tree, self)
         stream.register(tree, self)

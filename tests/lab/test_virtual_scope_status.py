@@ -79,3 +79,21 @@ def test_the_bandwidth_follows_the_mdo3000_model_number_and_the_4_series_has_its
     _scope, s, _ = make_scope("mso4")
     assert ask(s, "CONFIG:ANALOG:BANDWIDTH?") == "1.5000E+9"
     assert s.handle(b"CONFIG:ADVMATH?") == b"" and ask(s, "EVENT?") == "113"  # not in the 4 Series' tree
+
+
+@pytest.mark.parametrize("personality", ["tds2000", "mdo3000"])
+def test_the_clock_answers_and_takes_the_manuals_quoted_date_and_time(make_scope, personality):
+    """DATE and TIME (miscellaneous group): "yyyy-mm-dd" and "hh:mm:ss", quoted both ways;
+    a date not of the calendar is 222, another form 224; *RST leaves the clock."""
+    import re
+
+    _scope, s, _ = make_scope(personality)
+    assert re.fullmatch(r'"\d{4}-\d{2}-\d{2}";"\d{2}:\d{2}:\d{2}"', ask(s, "DATE?;:TIME?"))
+    s.handle(b'DATE "2031-02-28";:TIME "23:59:58";*RST')
+    date, time = ask(s, "DATE?;:TIME?").split(";")
+    assert date in ('"2031-02-28"', '"2031-03-01"') and time[:6] in ('"23:59', '"00:00')
+    s.handle(b'DATE "2031-02-30"')
+    assert ask(s, "EVENT?") == "222"
+    for bad in (b"DATE 20310228", b'TIME "7:05"'):
+        s.handle(bad)
+        assert ask(s, "EVENT?") == "224", bad
