@@ -167,26 +167,55 @@ def test_sigterm_stops_it_cleanly_and_out_has_archived_the_warm_up_shot(tmp_path
     ([SCENE, "--stall-timeout", "0"], "--stall-timeout"),
     ([SCENE, "--max-clients", "4", "--per-address", "9"], "--per-address"),
 ])
-def test_bad_input_is_one_line_and_exit_2(args, field):
-    r = subprocess.run([*RIG, "serve", "scope", *args, "--port", "0"] if "--port" not in args else
-                       [*RIG, "serve", "scope", *args], check=False, capture_output=True, text=True, timeout=300)
-    assert r.returncode == 2, r.stdout + r.stderr
-    lines = r.stderr.strip().splitlines()
-    assert len(lines) == 1 and field in lines[0], r.stderr
-    assert lines[0].startswith("rig serve scope: error: ") and "Traceback" not in r.stderr
+def test_bad_input_is_one_line_and_exit_2(args, field, capsys):
+    code, _, err = serve_in_process([*args, "--port", "0"] if "--port" not in args else args, capsys)
+    assert code == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and field in lines[0], err
+    assert lines[0].startswith("rig serve scope: error: ") and "Traceback" not in err
 
 
-def test_a_port_in_use_is_one_line_naming_the_option():
+def test_a_port_in_use_is_one_line_naming_the_option(capsys):
     taken = socket.create_server(("127.0.0.1", 0))
     try:
         port = taken.getsockname()[1]
-        r = subprocess.run([*RIG, "serve", "scope", SCENE, "--port", str(port)], check=False, capture_output=True,
-                           text=True, timeout=300)
+        code, _, err = serve_in_process([SCENE, "--port", str(port)], capsys)
     finally:
         taken.close()
-    assert r.returncode == 2, r.stdout + r.stderr
-    assert r.stderr.strip() == (f"rig serve scope: error: --port = {port}: a port free on 127.0.0.1 "
-                                "(Address already in use), or 0 for any")
+    assert code == 2, err
+    assert err.strip() == (f"rig serve scope: error: --port = {port}: a port free on 127.0.0.1 "
+                           "(Address already in use), or 0 for any")
+
+
+def serve_in_process(args: list, capsys, limit_s: float = 120.0) -> tuple:
+    """(exit code, stdout, stderr) of ``rig serve scope ARGS`` refused in this process: what
+    the command line's exit status and its one line say is what ``main`` returns (or the
+    parser's SystemExit) and writes, without a process's start-up of a second or more. Run in
+    a thread with a time limit, so that input the command wrongly accepts fails the test
+    (a server is started: it cannot install its signal handlers off the main thread)
+    instead of serving for ever."""
+    import threading
+
+    from rig.cli import main
+
+    done: list = []
+
+    def run():
+        try:
+            done.append(main(["serve", "scope", *args]))
+        except SystemExit as exc:
+            done.append(exc.code)
+        except BaseException as exc:  # reported below, as the test's failure
+            done.append(exc)
+
+    worker = threading.Thread(target=run, daemon=True)
+    worker.start()
+    worker.join(limit_s)
+    out, err = capsys.readouterr()
+    assert done, f"rig serve scope {' '.join(args)}: still running after {limit_s} s; stdout: {out[-500:]}"
+    if isinstance(done[0], BaseException):
+        raise done[0]
+    return done[0], out, err
 
 
 def test_the_parsers_personalities_are_the_scopes():
@@ -202,11 +231,10 @@ def test_the_parsers_personalities_are_the_scopes():
 
 
 @pytest.mark.parametrize("host", ["192.0.2.1", "no-such-host.invalid"])
-def test_a_bad_host_is_refused_before_the_warm_up_shot(host):
-    r = subprocess.run([*RIG, "serve", "scope", SCENE, "--host", host, "--port", "0"], check=False,
-                       capture_output=True, text=True, timeout=300)
-    assert r.returncode == 2 and "--host" in r.stderr
-    assert "warm-up shot" not in r.stdout  # refused before seconds of compiling, not after
+def test_a_bad_host_is_refused_before_the_warm_up_shot(host, capsys):
+    code, out, err = serve_in_process([SCENE, "--host", host, "--port", "0"], capsys)
+    assert code == 2 and "--host" in err
+    assert "warm-up shot" not in out  # refused before seconds of compiling, not after
 
 
 def test_the_parsers_wire_defaults_are_the_limits():
