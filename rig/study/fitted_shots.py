@@ -13,7 +13,8 @@ import numpy as np
 from rig.experiment import scene as scene_io
 from rig.experiment.shot import Rig
 from rig.fit.evaluate import calibrate, solve_rigs
-from rig.fit.observations.kinds import KINDS, WALL
+from rig.fit.observations import measures
+from rig.fit.observations.kinds import KINDS, WALL, look_until, signal
 from rig.study.fitted_families import MAGNETIC_SCENE, SCENE
 
 SHOTS = 3
@@ -26,7 +27,9 @@ def fig3_figures(truths: dict) -> dict:
     (10% rise to 10% fall or first real dip), the pulses at the lower gauge (bead 29) above
     10% of the leading one, the ratio of the upper gauge READINGS' peaks (not F_d), the
     wall's peaks, and the magnetic shot's tail at the lower gauge relative to its leading
-    pulse."""
+    pulse: its oscillation alone ("magnetic_tail_relative", the tail kind) and, beside it,
+    its slow shoulder ("magnetic_tail_shoulder_relative", rig.fit.observations.measures.
+    tail_shoulder: the mean over the tail's first period)."""
     g, m = truths[SCENE], truths[MAGNETIC_SCENE]
 
     def of(kind, truth, where=""):
@@ -41,7 +44,9 @@ def fig3_figures(truths: dict) -> dict:
             "gravity_pulses_lower_gauge": of("pulses", g, "lower"), "magnetic_speed_m_per_s": of("speed", m),
             "gauge_ratio_magnetic_to_gravity": peaks[0] / peaks[1] if None not in peaks and peaks[1] else None,
             "wall_peak_gravity_N": of("wall_peak", g, WALL), "wall_peak_magnetic_N": of("wall_peak", m, WALL),
-            "magnetic_tail_relative": of("tail", m, "lower")}
+            "magnetic_tail_relative": of("tail", m, "lower"),
+            "magnetic_tail_shoulder_relative": _finite(measures.tail_shoulder(*signal(m, "lower"),
+                                                                              until=look_until(m, "lower")))}
 
 
 def _finite(x):

@@ -136,7 +136,8 @@ def test_reproduce_fitted_keeps_no_family_that_misses_a_target_and_names_what_it
     assert json.loads((out / "fitted.json").read_text()) == f
     for key in ("model", "table1_rms_relative", "table1_max_relative", "gravity_fit_predicts_magnetic_rms_relative",
                 "ptfe52_gravity_speed_m_per_s", "ptfe52_magnetic_speed_m_per_s", "ptfe52_gravity_duration_s",
-                "amplitude_ratio_magnetic_to_gravity", "wall_peak_gravity_N", "wall_peak_magnetic_N",
+                "amplitude_ratio_magnetic_to_gravity", "contact_force_ratio_magnetic_to_gravity",
+                "wall_peak_gravity_N", "wall_peak_magnetic_N",
                 "pulses_gravity", "pulses_magnetic", "parameters", "models", "gravity_only_fit", "power_law_shots",
                 "dashpot_scan", "steel", "published", "table1_chi2_per_dof", "table1_max_sigma", "fig3",
                 "targets", "fitted_scene"):
@@ -144,7 +145,7 @@ def test_reproduce_fitted_keeps_no_family_that_misses_a_target_and_names_what_it
     row = f["models"]["hertz"]
     assert set(row["fig3"]) == {"gravity_speed_m_per_s", "gravity_duration_us", "gravity_pulses_lower_gauge",
                                 "magnetic_speed_m_per_s", "gauge_ratio_magnetic_to_gravity", "wall_peak_gravity_N",
-                                "wall_peak_magnetic_N", "magnetic_tail_relative"}
+                                "wall_peak_magnetic_N", "magnetic_tail_relative", "magnetic_tail_shoulder_relative"}
     assert {"gravity_speed_m_per_s", "magnetic_speed_m_per_s"} <= set(f["steel"])
     assert all({"estimate", "std", "ci95", "unit"} <= set(p) for p in row["parameters"].values())
     assert row["loo_chi2"] >= row["table1_chi2"] and row["magnetic_from_gravity"]["chi2"] > 0  # held out: no better

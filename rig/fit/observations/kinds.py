@@ -127,8 +127,9 @@ KINDS = {
     "wall_peak": Kind("N", False, lambda tr, w: measures.peak(*signal(tr, WALL)),
                       "the wall's peak force (its leading pulse)"),
     "tail": Kind("1", True, lambda tr, w: measures.tail_excursion(*signal(tr, w), until=look_until(tr, w)),
-                 "the oscillating tail after the leading pulse: half its peak-to-peak excursion about a "
-                 "100 us running mean, over the leading pulse's peak"),
+                 "the oscillating tail after the leading pulse (from 1.5 FWHM after its peak, 400 us): half "
+                 "its peak-to-peak excursion about its slow part (a running mean over the tail's own period, "
+                 "its curvature bias removed), over the leading pulse's peak"),
     "ratio": Kind("1", True, None, "a figure (of = KIND) of one shot over the same figure of another (over_scene, "
                                    "over_set), at the same gauge"),
 }

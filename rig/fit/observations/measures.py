@@ -28,11 +28,18 @@ again from it by at least this fraction of the pulse's amplitude before the next
 FLAT_TOP = 0.6
 """A leading pulse is flat-topped or shock-like where its time above 90% of its amplitude
 is more than this fraction of its FWHM (a Gaussian: 0.39; a sech^2 solitary wave: 0.37)."""
-TAIL_LEVEL = 0.01
-"""The tail begins where the leading pulse has fallen to this fraction of its amplitude
-(or at its first minimum, where that comes first): the pipeline's base level."""
+TAIL_AFTER = 1.5
+"""The tail begins this many FWHMs of the leading pulse after its peak: a sech^2 solitary
+wave has fallen to 2% there, a Gaussian to 0.2%. A fixed multiple of the pulse's own width
+moves continuously with the trace; a start at a minimum or a level does not (a minimum
+vanishes where the ripple's slope falls below the shoulder's, and the start then jumps past
+the shoulder)."""
 TAIL_WINDOW = 100e-6
-"""s: the running mean that the tail's excursion is measured about."""
+"""s: the first pass's running mean, whose residual's crossings give the tail's period (and
+the period where the tail has fewer than three crossings)."""
+TAIL_CROSSING = 1e-3
+"""A crossing of the first pass's residual counts once it passes this fraction of the
+leading pulse's amplitude on the other side (rounding noise on a smooth shoulder is none)."""
 TAIL_SPAN = 400e-6
 """s: how long after the leading pulse's end the tail is examined."""
 
@@ -151,29 +158,80 @@ def pulses_in_train(t: np.ndarray, f: np.ndarray, until: float = math.inf, heigh
     return float(count)
 
 
-def tail_excursion(t: np.ndarray, f: np.ndarray, until: float = math.inf, window: float = TAIL_WINDOW,
-                   span: float = TAIL_SPAN) -> float:
-    """The oscillating tail after the leading pulse, relative to that pulse: over the
-    ``span`` (400 us) after the pulse's end (pulse_span at TAIL_LEVEL, 1%: the earlier of its
-    fall to 1% and its first minimum; at most to ``until``, s), half the
-    peak-to-peak excursion of f about its centred running mean over ``window`` (100 us),
-    divided by the leading pulse's amplitude. A sine of amplitude a on a slow drift gives
-    a / amplitude (the mean follows a drift that is linear over the window). nan where the
-    tail is shorter than the window or there is no pulse."""
+def _tail_start(t: np.ndarray, p: Pulse, after: float) -> int:
+    """The tail's first sample: ``after`` FWHMs after the leading pulse's peak."""
+    return int(np.searchsorted(t, p.time + after * p.fwhm))
+
+
+def _running_mean(x: np.ndarray, n: int) -> np.ndarray:
+    """The mean of x over n samples; element j is centred on sample j + n // 2."""
+    c = np.concatenate(([0.0], np.cumsum(x)))
+    return (c[n:] - c[:-n]) / n
+
+
+def _odd(samples: float) -> int:
+    return 2 * int(round(0.5 * samples)) + 1
+
+
+def _period(seg: np.ndarray, h: float, window: float, noise: float) -> float:
+    """The tail's oscillation period (s): twice the median spacing of the crossings of the
+    residual about the running mean over ``window`` (a crossing counted once the residual
+    passes ``noise`` on the other side); ``window`` where there are fewer than three."""
+    n = _odd(window / h)
+    if seg.size <= n:
+        return window
+    r = seg[n // 2: n // 2 + seg.size - n + 1] - _running_mean(seg, n)
+    out = np.flatnonzero(np.abs(r) > noise)
+    turn = out[1:][np.sign(r[out[1:]]) != np.sign(r[out[:-1]])]
+    return float(2.0 * np.median(np.diff(turn)) * h) if turn.size >= 3 else window
+
+
+def tail_parts(t: np.ndarray, f: np.ndarray, until: float = math.inf, window: float = TAIL_WINDOW,
+               span: float = TAIL_SPAN) -> tuple[float, float]:
+    """(oscillation, shoulder) of the tail after the leading pulse, each over the leading
+    pulse's amplitude. The tail: the ``span`` (400 us, at most to ``until``, s) from its
+    start (the earlier of the pulse's first minimum below half its amplitude, TAIL_HALF, and
+    its fall to 1%, TAIL_LEVEL). Its period P: twice the median spacing of its crossings of
+    a first running mean over ``window`` (100 us; ``window`` where it crosses fewer than 3
+    times). Its slow part S: the running mean over P with the mean's curvature bias taken
+    out, S = M - (P^2 / 24) M'' (M'' a second difference over P/4), which removes a sine of
+    period P and passes a cubic unchanged (a running mean alone is off by P^2 f'' / 24: on a
+    shoulder of 0.25 decaying over one period that is 0.01, as large as the ripple).
+    oscillation: half the peak-to-peak of f - S where S's support (3P/4 each side) lies in
+    the tail; shoulder: the mean of f over the tail's first period (the slow, non-oscillating
+    level the tail starts at). (nan, nan) where the tail is shorter than 2 P or there is no
+    pulse."""
     t, f = np.asarray(t, dtype=float), np.asarray(f, dtype=float)
     p = leading_pulse(t, f)
-    _, end = pulse_span(t, f, TAIL_LEVEL)
-    if p is None or not math.isfinite(end):
-        return math.nan
-    h = t[1] - t[0]
-    seg = f[(t >= end) & (t <= min(end + span, until))]
-    n = 2 * int(round(0.5 * window / h)) + 1
-    if seg.size <= n:
-        return math.nan
-    c = np.concatenate(([0.0], np.cumsum(seg)))
-    mean = (c[n:] - c[:-n]) / n
-    r = seg[n // 2: n // 2 + mean.size] - mean
-    return float(0.5 * (np.max(r) - np.min(r)) / p.amplitude)
+    if p is None or not p.fwhm > 0:
+        return math.nan, math.nan
+    k0, h = _tail_start(t, p, TAIL_AFTER), t[1] - t[0]
+    seg = f[k0:][t[k0:] <= min(t[k0] + span, until)]
+    n = _odd(_period(seg, h, window, TAIL_CROSSING * p.amplitude) / h)
+    q = max(n // 4, 1)  # P/4: the second difference's step
+    if seg.size < 2 * n:
+        return math.nan, math.nan
+    m = _running_mean(seg, n)
+    slow = m[q:m.size - q] - (n * n / 24.0) * (m[2 * q:] - 2.0 * m[q:m.size - q] + m[:m.size - 2 * q]) / (q * q)
+    r = seg[n // 2 + q: n // 2 + q + slow.size] - slow
+    return float(0.5 * (np.max(r) - np.min(r)) / p.amplitude), float(np.mean(seg[:n]) / p.amplitude)
+
+
+def tail_excursion(t: np.ndarray, f: np.ndarray, until: float = math.inf, window: float = TAIL_WINDOW,
+                   span: float = TAIL_SPAN) -> float:
+    """The oscillating tail after the leading pulse, relative to that pulse: half the
+    peak-to-peak excursion of f about its slow part (tail_parts), so a slow shoulder does not
+    count. A sine of amplitude a on a slow drift or shoulder gives a / amplitude. nan where
+    the tail is too short or there is no pulse."""
+    return tail_parts(t, f, until, window, span)[0]
+
+
+def tail_shoulder(t: np.ndarray, f: np.ndarray, until: float = math.inf, window: float = TAIL_WINDOW,
+                  span: float = TAIL_SPAN) -> float:
+    """The tail's slow shoulder relative to the leading pulse: the mean of f over the tail's
+    first oscillation period (tail_parts), which a sine of that period leaves unchanged. nan
+    where the tail is too short or there is no pulse."""
+    return tail_parts(t, f, until, window, span)[1]
 
 
 def pulse_speed(t: np.ndarray, f_from: np.ndarray, f_to: np.ndarray, distance: float) -> float:
