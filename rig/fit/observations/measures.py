@@ -190,17 +190,16 @@ def tail_parts(t: np.ndarray, f: np.ndarray, until: float = math.inf, window: fl
                span: float = TAIL_SPAN) -> tuple[float, float]:
     """(oscillation, shoulder) of the tail after the leading pulse, each over the leading
     pulse's amplitude. The tail: the ``span`` (400 us, at most to ``until``, s) from its
-    start (the earlier of the pulse's first minimum below half its amplitude, TAIL_HALF, and
-    its fall to 1%, TAIL_LEVEL). Its period P: twice the median spacing of its crossings of
-    a first running mean over ``window`` (100 us; ``window`` where it crosses fewer than 3
-    times). Its slow part S: the running mean over P with the mean's curvature bias taken
-    out, S = M - (P^2 / 24) M'' (M'' a second difference over P/4), which removes a sine of
-    period P and passes a cubic unchanged (a running mean alone is off by P^2 f'' / 24: on a
-    shoulder of 0.25 decaying over one period that is 0.01, as large as the ripple).
-    oscillation: half the peak-to-peak of f - S where S's support (3P/4 each side) lies in
-    the tail; shoulder: the mean of f over the tail's first period (the slow, non-oscillating
-    level the tail starts at). (nan, nan) where the tail is shorter than 2 P or there is no
-    pulse."""
+    start, TAIL_AFTER (1.5) FWHMs of the leading pulse after its peak. Its period P: twice
+    the median spacing of its crossings of a first running mean over ``window`` (100 us;
+    ``window`` where it crosses fewer than 3 times). Its slow part S: the running mean over
+    P with the mean's curvature bias taken out, S = M - (P^2 / 24) M'' (M'' a second
+    difference over P/4), which removes a sine of period P and passes a cubic unchanged (a
+    running mean alone is off by P^2 f'' / 24: on a shoulder of 0.25 decaying over one
+    period that is 0.01, as large as the ripple). oscillation: half the peak-to-peak of f -
+    S where S's support (3P/4 each side) lies in the tail; shoulder: the mean of f over the
+    tail's first period (the slow, non-oscillating level the tail starts at). (nan, nan)
+    where the tail is shorter than 2 P or there is no pulse."""
     t, f = np.asarray(t, dtype=float), np.asarray(f, dtype=float)
     p = leading_pulse(t, f)
     if p is None or not p.fwhm > 0:
