@@ -100,6 +100,7 @@ class VirtualScope:
                                seed, on_shot, period_s=fire_period_s, on_command=on_command)
         with self.cond:
             self.reset()
+            self.acq.run(False)  # power-on: stopped (a real scope runs; acquisition.py)
         tree, rig_tree = CommandTree(truncation=True), CommandTree(truncation=True)  # DATA:SOUR as on a Tek
         for t in (tree, rig_tree):
             common.register(t, self)
@@ -133,7 +134,7 @@ class VirtualScope:
     # --- state, all under self.cond ------------------------------------------------
     def reset(self) -> None:
         """*RST: the scene's settings as loaded (the personality's snapping kept), the
-        default DATa and acquisition (stopped); the seed sequence goes on."""
+        default DATa and acquisition (running, idle: acquisition.py); the seed sequence goes on."""
         self.settings = dict(self.initial)
         self.shown = set(self.scene.channels)
         self.rig_values: dict = {}  # RIG: settings, scene key -> value text
