@@ -11,11 +11,11 @@ the impact). ``RIG:FIRE`` fires a shot now (an impact, in the trigger's mode); `
 FORCe``, ``*TRG`` and the transports' device trigger force one (programmer manuals, TRIGger:
 "FORCe creates a trigger event"): the shot is taken as TRIGger:A:MODe AUTO takes it, with
 the shot item scope.trigger.mode=auto, so a shot whose input never crosses the level gives
-the untriggered record AUTO gives (oscilloscope.Trigger). Not yet as the manuals have it: a
-forced trigger on a stopped scope fires a shot too ("If TRIGger:STATE is set to READy, the
-acquisition will complete. Otherwise, this command will be ignored").
+the untriggered record AUTO gives (oscilloscope.Trigger). On a stopped scope a forced trigger
+is ignored, no shot and no seed ("If TRIGger:STATE is set to READy, the acquisition will
+complete. Otherwise, this command will be ignored").
 
-``*RST`` leaves the scope running (the manuals' default setup: ACQuire:STATE ON,
+Power-on and ``*RST`` leave the scope running (the manuals' default setup: ACQuire:STATE ON,
 ACQuire:STOPAfter RUNSTop; ACQuire:STATE: "When state is set to ON or RUN, a new acquisition
 will be started"), as a scope on a bench whose rig is at rest: it waits for an impact. The
 rig strikes on its own (on-arm, every=SECONDS) only once a client has armed the scope
@@ -24,8 +24,7 @@ rig strikes on its own (on-arm, every=SECONDS) only once a client has armed the 
 long a client takes to configure the scope. Such a record, in run mode, leaves the scope
 running and waiting again; in a single sequence (STOPAfter SEQuence set meanwhile) it ends
 it. The idle running scope has nothing pending (``BUSY?`` 0, ``*OPC?`` at once); the
-untriggered records a real scope in AUTO would take between impacts are not made. At power-on
-the emulated scope is stopped (VirtualScope), holding its first acquisition: a real one runs.
+untriggered records a real scope in AUTO would take between impacts are not made.
 
 In NORMal (the manuals, TRIGger:A:MODe: "NORMal waits for a valid trigger event") a shot
 that does not trigger makes no record and the armed scope stays armed, the last record kept
@@ -116,7 +115,7 @@ class Acquisition:
         return bool(self.running or self.streaming or self.busy or self.pending)
 
     def reset(self) -> None:
-        """*RST: run mode (RUNSTop), running, idle (waiting for an impact: the
+        """Power-on and *RST: run mode (RUNSTop), running, idle (waiting for an impact: the
         rig does not strike until a client arms the scope), no fired shot pending."""
         self.stop_after = "RUNSTop"
         self.pending.clear()
@@ -160,8 +159,12 @@ class Acquisition:
         self.cond.notify_all()
 
     def force(self) -> None:
-        """TRIGger FORCe, *TRG, the transports' device trigger: a forced shot now."""
-        self.fire(forced=True)
+        """TRIGger FORCe, *TRG, the transports' device trigger: a forced shot now on an
+        acquiring scope (running, or a curve stream on); ignored on a stopped one: "If
+        TRIGger:STATE is set to READy, the acquisition will complete. Otherwise, this command
+        will be ignored" (programmer manuals, TRIGger)."""
+        if self.running or self.streaming:
+            self.fire(forced=True)
 
     def opc(self) -> None:
         """*OPC: OPC set now, or when the pending shot is in."""

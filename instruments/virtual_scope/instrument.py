@@ -100,7 +100,6 @@ class VirtualScope:
                                seed, on_shot, period_s=fire_period_s, on_command=on_command)
         with self.cond:
             self.reset()
-            self.acq.run(False)  # power-on: stopped (a real scope runs; acquisition.py)
         tree, rig_tree = CommandTree(truncation=True), CommandTree(truncation=True)  # DATA:SOUR as on a Tek
         for t in (tree, rig_tree):
             common.register(t, self)

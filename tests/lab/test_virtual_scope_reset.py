@@ -63,3 +63,29 @@ def test_every_period_the_ticks_pass_by_the_idle_scope_until_it_is_armed(make_sc
     assert source.calls == [] and ask(s, "ACQ:STATE?") == "1"
     s.handle(b"ACQ:STOPA SEQ;STATE ON")
     assert ask(s, "*OPC?") == "1" and len(source.calls) == 1 and ask(s, "ACQ:STATE?") == "0"
+
+
+@pytest.mark.parametrize("command", [b"TRIGGER FORCE", b"*TRG", None])
+def test_a_forced_trigger_on_a_stopped_scope_is_ignored(make_scope, command):
+    """TRIGger FORCe (and *TRG, the transports' device trigger): "If TRIGger:STATE is set
+    to READy, the acquisition will complete. Otherwise, this command will be ignored": on a
+    stopped scope (TRIGger:STATE? SAVE) no shot, no seed, no event; on the running scope
+    one record, taken as AUTO takes it."""
+    scope, s, source = make_scope("mso4", seed=8)
+    fire(s)  # a single sequence: stopped after it
+    assert ask(s, "ACQ:STATE?;:TRIG:STATE?") == "0;SAVE"
+    s.handle(command) if command else s.trigger()
+    assert ask(s, "*OPC?") == "1" and len(source.calls) == 1
+    assert ask(s, "RIG:SEED?;:ACQ:NUMACQ?;:ALLEV?") == '9;1;0,"No events to report - queue empty"'
+    s.handle(b"*RST")
+    s.handle(command) if command else s.trigger()
+    assert ask(s, "*OPC?") == "1" and [seed for _, seed in source.calls] == [8, 9]
+    assert scope.acq.last.overrides["scope.trigger.mode"] == "auto" and ask(s, "ACQ:STATE?") == "1"
+
+
+def test_power_on_is_the_reset_state_and_the_first_acquisition_leaves_it_waiting(make_scope):
+    scope, s, source = make_scope("tds2000", seed=2)
+    assert ask(s, "ACQ:STATE?;STOPAFTER?;:BUSY?") == "1;RUNSTOP;0"
+    scope.acq.first_acquisition()
+    time.sleep(0.2)
+    assert [seed for _, seed in source.calls] == [2] and ask(s, "ACQ:STATE?;NUMACQ?;:BUSY?") == "1;1;0"
