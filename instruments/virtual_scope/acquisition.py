@@ -11,7 +11,20 @@ the impact). ``RIG:FIRE`` fires a shot now (an impact, in the trigger's mode); `
 FORCe``, ``*TRG`` and the transports' device trigger force one (programmer manuals, TRIGger:
 "FORCe creates a trigger event"): the shot is taken as TRIGger:A:MODe AUTO takes it, with
 the shot item scope.trigger.mode=auto, so a shot whose input never crosses the level gives
-the untriggered record AUTO gives (oscilloscope.Trigger).
+the untriggered record AUTO gives (oscilloscope.Trigger). On a stopped scope a forced trigger
+is ignored, no shot and no seed ("If TRIGger:STATE is set to READy, the acquisition will
+complete. Otherwise, this command will be ignored").
+
+Power-on and ``*RST`` leave the scope running (the manuals' default setup: ACQuire:STATE ON,
+ACQuire:STOPAfter RUNSTop; ACQuire:STATE: "When state is set to ON or RUN, a new acquisition
+will be started"), as a scope on a bench whose rig is at rest: it waits for an impact. The
+rig strikes on its own (on-arm, every=SECONDS) only once a client has armed the scope
+(ACQuire:STATE ON|RUN, or a curve stream); until then no seed is taken but by a client's
+``RIG:FIRE`` or forced trigger, so that the k-th shot fired still uses seed N + k - 1 however
+long a client takes to configure the scope. Such a record, in run mode, leaves the scope
+running and waiting again; in a single sequence (STOPAfter SEQuence set meanwhile) it ends
+it. The idle running scope has nothing pending (``BUSY?`` 0, ``*OPC?`` at once); the
+untriggered records a real scope in AUTO would take between impacts are not made.
 
 In NORMal (the manuals, TRIGger:A:MODe: "NORMal waits for a valid trigger event") a shot
 that does not trigger makes no record and the armed scope stays armed, the last record kept
@@ -73,6 +86,7 @@ class Acquisition:
         self.next_seed = int(seed)
         self.stop_after = "RUNSTop"
         self.running = False
+        self.idle = False  # running as *RST leaves it: the rig strikes only once a client arms it
         self.pending: deque[bool] = deque()  # shots fired by command, not yet begun: forced (True) or impacts
         self.spent = False  # on-arm: the armed scope's impact came and did not trigger
         self.busy = False
@@ -92,7 +106,7 @@ class Acquisition:
     def awaiting(self) -> bool:
         """A shot that *OPC? waits for is pending or running, or a single sequence waits for
         its trigger (BUSY? 1)."""
-        return bool(self.pending or (self.running and self.stop_after == "SEQuence")
+        return bool(self.pending or (self.running and not self.idle and self.stop_after == "SEQuence")
                     or (self.busy and not self.running))
 
     @property
@@ -101,18 +115,21 @@ class Acquisition:
         return bool(self.running or self.streaming or self.busy or self.pending)
 
     def reset(self) -> None:
-        """*RST: run mode (RUNSTop), stopped, no fired shot pending."""
+        """Power-on and *RST: run mode (RUNSTop), running, idle (waiting for an impact: the
+        rig does not strike until a client arms the scope), no fired shot pending."""
         self.stop_after = "RUNSTop"
         self.pending.clear()
-        self.run(False)
+        self.running, self.idle, self.spent = True, True, False
+        self.cond.notify_all()
 
     def run(self, on: bool) -> None:
-        """ACQuire:STATE: armed or stopped; once armed, the first tick is the next one (and
-        on-arm, an impact)."""
-        if on and not self.running:
+        """ACQuire:STATE: armed (a new acquisition, "When state is set to ON or RUN, a new
+        acquisition will be started", also on a running scope: the first tick is the next one,
+        and on-arm an impact) or stopped."""
+        if on:
             self._next_tick()
             self.spent = False
-        self.running = on
+        self.running, self.idle = on, False
         self.cond.notify_all()
 
     def _next_tick(self) -> None:
@@ -142,8 +159,12 @@ class Acquisition:
         self.cond.notify_all()
 
     def force(self) -> None:
-        """TRIGger FORCe, *TRG, the transports' device trigger: a forced shot now."""
-        self.fire(forced=True)
+        """TRIGger FORCe, *TRG, the transports' device trigger: a forced shot now on an
+        acquiring scope (running, or a curve stream on); ignored on a stopped one: "If
+        TRIGger:STATE is set to READy, the acquisition will complete. Otherwise, this command
+        will be ignored" (programmer manuals, TRIGger)."""
+        if self.running or self.streaming:
+            self.fire(forced=True)
 
     def opc(self) -> None:
         """*OPC: OPC set now, or when the pending shot is in."""
@@ -162,14 +183,15 @@ class Acquisition:
     def _wait_for_a_shot(self) -> str | None:
         """Wait (holding ``cond``) until a shot is due: "forced", "fired" (an impact by
         command) or "armed", or None once closed. Due: a fired or forced shot, or while armed
-        (ACQuire:STATE ON; while a stream is on, only when it asked for a record) at once
+        (ACQuire:STATE ON by a client, not idle; while a stream is on, only when it asked for
+        a record) at once
         unless its impact is spent, or at the next tick of the period, or never (on_command:
         only fired shots, an armed scope waits for them). The stream's record stays asked for
         until a shot gives one."""
         while not self.closed:
             if self.pending:
                 return "forced" if self.pending.popleft() else "fired"
-            armed = (self.wanted if self.streaming else self.running) and not self.on_command
+            armed = (self.wanted if self.streaming else self.running and not self.idle) and not self.on_command
             due = armed and self.period_s is None and not self.spent
             now = time.monotonic()
             if armed and self.period_s is not None and now >= self.next_tick:

@@ -60,6 +60,21 @@ def analog_bandwidth(model: str) -> float:
     return MDO3000_BANDWIDTH_HZ.get(code, int(code) * 100e6 if code.isdigit() else 1e9)
 
 
+def analog_sample_rate(model: str) -> float:
+    """S/s, an MDO3000's real-time sample rate (MDO3000 Series datasheet: 5 GS/s on the 500 MHz
+    and 1 GHz models, 2.5 GS/s on the others)."""
+    return 5e9 if analog_bandwidth(model) >= 500e6 else 2.5e9
+
+
+def max_sample_rate(personality) -> float | None:
+    """The highest sample rate the horizontal settings keep to on the model ``*IDN?`` names
+    (horizontal.py), S/s: the MDO3000's by its bandwidth, the 4 Series' one
+    (Personality.max_sample_rate); None on the TDS2000, whose one record length cannot shrink."""
+    if personality.name == "mdo3000":
+        return analog_sample_rate(model_of(personality.idn))
+    return personality.max_sample_rate
+
+
 def figures(scope) -> dict:
     """{normal header: its answer} of the queries that are not 0 (module doc)."""
     p = scope.personality
@@ -69,7 +84,7 @@ def figures(scope) -> dict:
         "CONFIGURATION:ANALOG:NUMCHANNELS": str(analog_channels(model)),
         "CONFIGURATION:ANALOG:BANDWIDTH": bandwidth,
         "CONFIGURATION:ANALOG:MAXBANDWIDTH": bandwidth,
-        "CONFIGURATION:ANALOG:MAXSAMPLERATE": p.number(5e9 if analog_bandwidth(model) >= 500e6 else 2.5e9),
+        "CONFIGURATION:ANALOG:MAXSAMPLERATE": p.number(analog_sample_rate(model)),
         "CONFIGURATION:ANALOG:RECLENS": ",".join(str(n) for n in p.record_lengths if n <= scope.max_record_length),
         "CONFIGURATION:NUMMEAS": str(SLOTS),
         **{name: p.number(0.0) for name in NUMBERS},

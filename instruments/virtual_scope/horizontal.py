@@ -5,7 +5,14 @@ model's steps (scene key scope.sample_interval follows), the record length to it
 
 - TDS2000 and MDO3000 (no HORizontal:MODe in their manuals: 113 there): ``HORizontal:SCAle``
   keeps the record length, ``HORizontal:RECOrdlength`` keeps the scale; the sample rate
-  follows (the MDO3000's ``HORizontal:SAMPLERate``, set, keeps the record length).
+  follows. On the MDO3000 it follows up to the model's real-time rate
+  (configuration.analog_sample_rate: MDO3012 to MDO3034 2.5 GS/s, MDO3052 to MDO3104 5 GS/s):
+  a record that would need more is the longest of the model's within it, the shortest (1,000
+  points) where even that needs more (below 40 ns/div at 2.5 GS/s: a real scope
+  interpolates there, the emulated one samples its input that finely); its
+  ``HORizontal:SAMPLERate`` "The command form is ignored. The query returns the sample rate
+  for analog channels in samples per second" (MDO3000 manual). The TDS2000's one record
+  length, 2,500 points, cannot shrink: its rate is not bounded here.
 - 4 Series, ``HORizontal:MODe {AUTO|MANual}``, AUTO after ``*RST``. AUTO "automatically
   adjusts the sample rate and record length" (its manual): the scale is the client's and is
   kept; ``RECOrdlength`` and ``SAMPLERate`` set the record length at that scale; the rate
@@ -28,6 +35,7 @@ import math
 from ..scpi.engine import Call, Word
 from ..scpi.status import ScpiError
 from .commands import positive
+from .configuration import max_sample_rate
 from .personalities import snap_record_length, snap_to_steps
 
 MODES = ("AUTO", "MANual")
@@ -37,7 +45,8 @@ CONFIGURE = ("HORIZontalscale", "RECORDLength")
 def register(tree, scope) -> None:
     """Add the horizontal commands of ``scope`` (a VirtualScope) to a command tree."""
     p = scope.personality
-    top_rate = p.max_sample_rate or math.inf
+    top = max_sample_rate(p)
+    top_rate = math.inf if top is None else top
 
     def lengths() -> list:
         return [n for n in p.record_lengths if n <= scope.max_record_length]
@@ -66,8 +75,9 @@ def register(tree, scope) -> None:
         scope.change({"scope.record_length": n, "scope.sample_interval": dt}, code=-222)
 
     def at_scale(n: int, s: float) -> None:
-        """n points over ten divisions of s (AUTO and the models without modes)."""
-        if p.horizontal_modes:
+        """n points over ten divisions of s (AUTO and the models without modes), at most the
+        model's rate."""
+        if top is not None:
             n = min(n, longest(top_rate, s))
         set_time(n, s * 10 / n)
 
@@ -93,6 +103,8 @@ def register(tree, scope) -> None:
 
     def set_rate(c: Call):
         rate = min(positive(c, c.number("HZ")), top_rate)
+        if p.name == "mdo3000":  # its manual: "The command form is ignored"
+            return
         if p.horizontal_modes and not manual():
             at_scale(longest(rate, s_div()), s_div())
         elif manual() and scope.manual_configure == "RECORDLength":

@@ -133,7 +133,7 @@ class VirtualScope:
     # --- state, all under self.cond ------------------------------------------------
     def reset(self) -> None:
         """*RST: the scene's settings as loaded (the personality's snapping kept), the
-        default DATa and acquisition (stopped); the seed sequence goes on."""
+        default DATa and acquisition (running, idle: acquisition.py); the seed sequence goes on."""
         self.settings = dict(self.initial)
         self.shown = set(self.scene.channels)
         self.rig_values: dict = {}  # RIG: settings, scene key -> value text

@@ -66,6 +66,9 @@ class Personality:
     horizontal_modes: bool = False
     """Whether the model's manual has HORizontal:MODe {AUTO|MANual} (the 4 Series'): see
     horizontal.py."""
+    source_list: bool = False
+    """Whether DATa:SOUrce takes a list, ``<wfm>[<,><wfm>]`` (the 4 Series' manual); the
+    TDS2000's and MDO3000's take one source (``{CH<x>|MATH|...}``)."""
     max_sample_rate: float | None = None
     """The highest real-time sample rate (S/s) its horizontal modes keep to (the 4 Series:
     6.25 GS/s on every channel, 4 Series MSO datasheet); None: not bounded here."""
@@ -120,7 +123,7 @@ PERSONALITIES = {
                         (1.0, 2.0, 5.0), "WFMOutpre", WFMOUTPRE_4SERIES, "V", True, 4,
                         encodings=("ASCIi", "RIBinary", "RPBinary", "FPBinary", "SRIbinary", "SRPbinary", "SFPbinary"),
                         models=r"MSO4[4-8]B?", model_names="MSO44, MSO46, MSO48 (B too)", streams=True,
-                        horizontal_modes=True, max_sample_rate=6.25e9),
+                        source_list=True, horizontal_modes=True, max_sample_rate=6.25e9),
 }
 
 

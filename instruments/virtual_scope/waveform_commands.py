@@ -153,9 +153,10 @@ def register(tree, scope) -> None:
         ("STARt", str(scope.data.start)), ("STOP", str(scope.data.stop)), ("WIDth", str(scope.data.sent_width)))))
 
     def set_sources(c: Call):
-        """DATa:SOUrce <wfm>[,<wfm>...] (the MDO3000's and 4 Series' manuals: a list; the
-        TDS2000 takes one): the first is the source of the preamble and CURVe?."""
-        names = [c.word(CHANNEL_WORDS, i) for i in range(max(len(c.args), 1) if p.name != "tds2000" else 1)]
+        """DATa:SOUrce <wfm>[<,><wfm>] (the 4 Series' manual: a list, the first the source of
+        the preamble and CURVe?); the TDS2000's and MDO3000's manuals take one source
+        (``DATa:SOUrce {CH<x>|MATH|REF<x>|...}``): a list there is 108, "Parameter not allowed"."""
+        names = [c.word(CHANNEL_WORDS, i) for i in range(max(len(c.args), 1) if p.source_list else 1)]
         data(source=names[0], sources=tuple(names) if len(names) > 1 else ())
 
     tree.add("DATa:SOUrce", write=set_sources,

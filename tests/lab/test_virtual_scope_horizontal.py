@@ -82,3 +82,25 @@ def test_set_query_restores_a_manual_mode_setup(make_scope):
     s.handle(setup)
     assert ask(s, state) == before == f"MANUAL;RECORDLENGTH;{MSO44_RATE};1000;16.0000E-9"
     assert ask(s, "ALLEV?") == '0,"No events to report - queue empty"'
+
+
+@pytest.mark.parametrize("idn, rate", [("TEKTRONIX,MDO3024,C010001,CF:91.1CT FV:v1.30", "2.5000E+9"),
+                                       ("TEKTRONIX,MDO3054,C010001,CF:91.1CT FV:v1.30", "5.0000E+9")])
+def test_the_mdo3000_keeps_to_its_models_sample_rate(make_scope, idn, rate):
+    """MDO3000 datasheet: 2.5 GS/s on the 100 to 350 MHz models, 5 GS/s on the 500 MHz and
+    1 GHz ones. 10,000 points at 400 ns/div need 2.5 GS/s: kept on both; at 200 ns/div they
+    need 5 GS/s: kept on the MDO3054, the MDO3024's longest record within 2.5 GS/s (1,000
+    points) on it; RECOrdlength 10000 there stays within it too; at 20 ns/div even 1,000
+    points need 5 GS/s: the shortest record. HORizontal:SAMPLERate's "command form is
+    ignored" (MDO3000 manual)."""
+    _scope, s, _ = make_scope("mdo3000", idn=idn)
+    state = "HOR:SCALE?;:HOR:RECO?;:HOR:SAMPLERATE?"
+    s.handle(b"HOR:RECO 10000;:HOR:SCALE 4E-7")
+    assert ask(s, state) == "400.0000E-9;10000;2.5000E+9"
+    s.handle(b"HOR:SCALE 2E-7;:HOR:RECO 10000")
+    assert ask(s, state) == ("200.0000E-9;10000;5.0000E+9" if rate == "5.0000E+9" else "200.0000E-9;1000;500.0000E+6")
+    assert ask(s, "CONFIG:ANALOG:MAXSAMPLERATE?") == rate
+    s.handle(b"HOR:SCALE 2E-8")
+    assert ask(s, state) == "20.0000E-9;1000;5.0000E+9"
+    s.handle(b"HOR:SCALE 1E-3;:HOR:RECO 10000;:HOR:SAMPLERATE 1E9")
+    assert ask(s, state + ";:ALLEV?") == '1.0000E-3;10000;1.0000E+6;0,"No events to report - queue empty"'

@@ -184,3 +184,14 @@ def test_a_list_of_sources_is_taken_where_the_manual_has_one(make_scope):
     _scope, tds, _ = make_scope("tds2000")
     tds.handle(b"DATA:SOURCE CH2,CH1")
     assert ask(tds, "DATA:SOURCE?;:EVENT?") == "CH2;108"
+
+
+@pytest.mark.parametrize("personality", ["mdo3000", "tds2000"])
+def test_a_model_whose_manual_takes_one_source_refuses_a_list(make_scope, personality):
+    """The MDO3000's and TDS2000's manuals: ``DATa:SOUrce {CH<x>|MATH|REF<x>|...}``, one
+    source: a list is 108 "Parameter not allowed", the first source taken; CURVe? sends it."""
+    _scope, s, _ = make_scope(personality)
+    fire(s)
+    s.handle(b"DATA:SOURCE CH2,CH1")
+    assert ask(s, "DATA:SOURCE?;:EVENT?;:EVENT?") == "CH2;108;0"
+    assert len(block_payload(s.handle(b"CURVE?").rstrip(b"\n"))) > 0 and ask(s, "EVENT?") == "0"
