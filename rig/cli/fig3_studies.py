@@ -17,11 +17,25 @@ def parameter_set(args) -> tuple:
     from rig.study import fig3
 
     given = scene_overrides(args)
-    keys = {item.split("=", 1)[0].strip() for item in given}
-    merged = tuple(o for o in fig3.PARAMETER_SET if o.split("=", 1)[0].strip() not in keys) + given
+    merged = replaced(fig3.PARAMETER_SET, given)
     for scene in (fig3.GRAVITY, fig3.MAGNETIC):
         load(scene, list(merged))
     return merged
+
+
+SAME_QUANTITY = ({"chain.yield_force", "chain.yield_pressure"},)
+"""Keys that set one quantity in two ways (the contacts' yield: a force, converted, or a
+pressure): a --set item of one replaces the parameter set's other."""
+
+
+def replaced(overrides: tuple, given: tuple) -> tuple:
+    """``overrides`` less the items whose key ``given`` sets (itself, or another key of the
+    same quantity, SAME_QUANTITY), then ``given``."""
+    keys = {item.split("=", 1)[0].strip() for item in given}
+    for group in SAME_QUANTITY:
+        if keys & group:
+            keys |= group
+    return tuple(o for o in overrides if o.split("=", 1)[0].strip() not in keys) + tuple(given)
 
 
 def questions(args, overrides: tuple) -> tuple:
@@ -35,9 +49,7 @@ def questions(args, overrides: tuple) -> tuple:
         raise invalid("--truth", truths, f"one truth per --param ({len(params)} --param, {len(truths)} --truth)")
     if not params:
         given = scene_overrides(args)
-        keys = {item.split("=", 1)[0].strip() for item in given}
-        return tuple(Question(q.bounds, q.truth, tuple(o for o in q.overrides if o.split("=", 1)[0].strip() not in keys)
-                              + given, q.why) for q in QUESTIONS)
+        return tuple(Question(q.bounds, q.truth, replaced(q.overrides, given), q.why) for q in QUESTIONS)
     out = []
     for text, truth in zip(params, truths):
         truth_value(parse_parameter(text), truth)  # a bad key, bounds or truth: one line before any solve

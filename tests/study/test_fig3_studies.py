@@ -110,3 +110,17 @@ def test_a_parameter_the_observations_do_not_see_is_reported_not_fitted():
                  GRAVITY_SPEED_AND_DURATION, n=2, seed=0)
     assert "do not see it" in c.refused and c.n == 0 and c.count == 0
     assert c.as_dict()["refused"] == c.refused and c.as_dict()["mean_estimate"] is None
+
+
+def test_a_yield_pressure_given_replaces_the_sets_yield_force():
+    """The kept set gives the contacts' yield as a pressure, Fig. 3's set as a force: a --set
+    of either replaces the set's other (a scene takes one of the two), so the kept set can be
+    asked about (rig reproduce daraio2006 --identifiability --set chain.yield_pressure=...)."""
+    from rig.cli import build_parser
+    from rig.cli.fig3_studies import parameter_set
+
+    args = build_parser().parse_args(["reproduce", "daraio2006", "--sensitivity", "--out", "unused",
+                                      "--set", "chain.yield_pressure=59.5 MPa"])
+    merged = parameter_set(args)
+    assert "chain.yield_pressure=59.5 MPa" in merged and not any(o.startswith("chain.yield_force") for o in merged)
+    assert len(merged) == len(fig3.PARAMETER_SET)
