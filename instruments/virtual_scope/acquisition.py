@@ -5,15 +5,19 @@ keeps being answered while the rig computes a shot. ``ACQuire:STOPAfter SEQuence
 ``ACQuire:STATE ON`` arms the scope for one record; ``RUNSTop`` for records back to back
 until ``ACQuire:STATE OFF``. How an armed scope gets its shots is the rig's (``rig serve
 scope --fire``): at once (on-arm: one impact each time the scope is armed, and in run mode
-after each record), at the ticks of a period (every=SECONDS, as a rig that drops its
-striker periodically), or only from the fire commands (on-command: the armed scope waits for
-the impact). ``RIG:FIRE`` fires a shot now (an impact, in the trigger's mode); ``TRIGger
-FORCe``, ``*TRG`` and the transports' device trigger force one (programmer manuals, TRIGger:
-"FORCe creates a trigger event"): the shot is taken as TRIGger:A:MODe AUTO takes it, with
-the shot item scope.trigger.mode=auto, so a shot whose input never crosses the level gives
-the untriggered record AUTO gives (oscilloscope.Trigger). On a stopped scope a forced trigger
-is ignored, no shot and no seed ("If TRIGger:STATE is set to READy, the acquisition will
-complete. Otherwise, this command will be ignored").
+one more at the first client message after each record: the rig strikes again when a program
+next talks to the scope, not back to back while nobody asks, so that a program that leaves
+the scope running, as one that restores the state it found does, leaves no rig firing and
+archiving records that nobody reads until the server stops), at the ticks of a period
+(every=SECONDS, as a rig that drops its striker periodically), or only from the fire
+commands (on-command: the armed scope waits for the impact). ``RIG:FIRE`` fires a shot now
+(an impact, in the trigger's mode); ``TRIGger FORCe``, ``*TRG`` and the transports' device
+trigger force one (programmer manuals, TRIGger: "FORCe creates a trigger event"): the shot
+is taken as TRIGger:A:MODe AUTO takes it, with the shot item scope.trigger.mode=auto, so a
+shot whose input never crosses the level gives the untriggered record AUTO gives
+(oscilloscope.Trigger). On a stopped scope a forced trigger is ignored, no shot and no seed
+("If TRIGger:STATE is set to READy, the acquisition will complete. Otherwise, this command
+will be ignored").
 
 Power-on and ``*RST`` leave the scope running (the manuals' default setup: ACQuire:STATE ON,
 ACQuire:STOPAfter RUNSTop; ACQuire:STATE: "When state is set to ON or RUN, a new acquisition
@@ -89,6 +93,7 @@ class Acquisition:
         self.idle = False  # running as *RST leaves it: the rig strikes only once a client arms it
         self.pending: deque[bool] = deque()  # shots fired by command, not yet begun: forced (True) or impacts
         self.spent = False  # on-arm: the armed scope's impact came and did not trigger
+        self.resting = False  # on-arm, run mode: a record is in; the next impact waits for a client's message
         self.busy = False
         self.commanded = False  # the shot under way was fired by a command (not by arming)
         self.opc_armed = False
@@ -128,7 +133,7 @@ class Acquisition:
         and on-arm an impact) or stopped."""
         if on:
             self._next_tick()
-            self.spent = False
+            self.spent = self.resting = False
         self.running, self.idle = on, False
         self.cond.notify_all()
 
@@ -151,6 +156,13 @@ class Acquisition:
         """The stream asks for the next record (on-arm: an impact for it)."""
         self.wanted, self.spent = True, False
         self.cond.notify_all()
+
+    def poke(self) -> None:
+        """A client's message was handled: on-arm in run mode, a scope whose record is in
+        gets its next impact now (``resting``)."""
+        if self.resting:
+            self.resting = False
+            self.cond.notify_all()
 
     def fire(self, forced: bool = False) -> None:
         """A shot now: an impact (RIG:FIRE), or ``forced``, a forced trigger (TRIGger FORCe,
@@ -192,7 +204,7 @@ class Acquisition:
             if self.pending:
                 return "forced" if self.pending.popleft() else "fired"
             armed = (self.wanted if self.streaming else self.running and not self.idle) and not self.on_command
-            due = armed and self.period_s is None and not self.spent
+            due = armed and self.period_s is None and not self.spent and not self.resting
             now = time.monotonic()
             if armed and self.period_s is not None and now >= self.next_tick:
                 self.next_tick += self.period_s * (1 + math.floor((now - self.next_tick) / self.period_s))
@@ -283,3 +295,4 @@ class Acquisition:
             self.last, self.failure, self.count = shot, None, self.count + 1
         if self.stop_after == "SEQuence":
             self.running = False
+        self.resting = self.running and not self.streaming

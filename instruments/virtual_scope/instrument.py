@@ -251,6 +251,7 @@ class ScopeSession:
                 scope.status.post(-363, f"a message of {len(message)} bytes (at most {scope.max_message_bytes})")
                 return b""
             reply = self.engine.execute(message, self)
+            scope.acq.poke()  # on-arm in run mode: the rig strikes again when a client talks to the scope
             if len(reply) > scope.max_reply_bytes:
                 scope.status.post(-350, f"a reply of {len(reply)} bytes exceeds the output queue's "
                                         f"{scope.max_reply_bytes}; nothing sent")

@@ -44,8 +44,9 @@ def test_rst_ends_run_mode_shots_back_to_back_and_the_scope_keeps_running(make_s
     scope, s, source = make_scope("tds2000")
     s.handle(b"ACQ:STOPAFTER RUNSTOP;STATE RUN")
     deadline = time.monotonic() + 30
-    while scope.acq.count < 2:
+    while scope.acq.count < 2:  # a client polling: each message after a record brings the next impact
         assert time.monotonic() < deadline
+        ask(s, "ACQ:NUMACQ?")
         time.sleep(0.005)
     s.handle(b"*RST")
     while scope.acq.busy:
@@ -89,3 +90,22 @@ def test_power_on_is_the_reset_state_and_the_first_acquisition_leaves_it_waiting
     scope.acq.first_acquisition()
     time.sleep(0.2)
     assert [seed for _, seed in source.calls] == [2] and ask(s, "ACQ:STATE?;NUMACQ?;:BUSY?") == "1;1;0"
+
+
+def test_on_arm_in_run_mode_the_rig_strikes_again_when_a_client_next_talks_to_the_scope(make_scope):
+    """--fire on-arm in run mode: one impact when armed, then one more at the first client
+    message after each record; a client that leaves the scope running and goes (a program
+    restoring the state it found) leaves no rig firing records nobody asks for."""
+    scope, s, source = make_scope("mso4", seed=5)
+    s.handle(b"ACQ:STOPAFTER RUNSTOP;STATE RUN")
+    deadline = time.monotonic() + 30
+    while scope.acq.count < 1 or scope.acq.busy:
+        assert time.monotonic() < deadline
+        time.sleep(0.005)
+    time.sleep(0.3)
+    assert len(source.calls) == 1 and ask(s, "ACQ:STATE?;:BUSY?") == "1;0"  # running, the rig at rest
+    while scope.acq.count < 2 or scope.acq.busy:  # that query was a message: the next impact
+        assert time.monotonic() < deadline
+        time.sleep(0.005)
+    time.sleep(0.3)
+    assert [seed for _, seed in source.calls] == [5, 6] and scope.acq.count == 2

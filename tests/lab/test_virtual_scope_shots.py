@@ -60,11 +60,13 @@ def test_opc_waits_for_the_record_and_busy_reads_1_from_another_session_meanwhil
     assert source.calls[1] == ({"scope.channels.CH1.volts_per_div": "0.1 V"}, 6)
 
 
-def test_run_mode_fires_back_to_back_until_stopped(make_scope):
+def test_run_mode_fires_again_at_each_poll_until_stopped(make_scope):
+    """Run mode, --fire on-arm: a record, then the next impact at the client's next message
+    (acquisition.py): a client polling gets records one after the other until it stops."""
     scope, s, source = make_scope("tds2000")
     s.handle(b"ACQ:STOPAFTER RUNSTOP;STATE ON")
     assert ask(s, "*OPC?") == "1"  # run mode has nothing pending
-    wait_for(lambda: scope.acq.count >= 3)
+    wait_for(lambda: ask(s, "ACQ:NUMACQ?") and scope.acq.count >= 3)
     s.handle(b"ACQ:STATE STOP")
     wait_for(lambda: not scope.acq.busy)
     count = scope.acq.count
@@ -291,7 +293,7 @@ def test_auto_takes_a_record_without_a_trigger_and_the_trigger_state_says_auto(m
     assert np.array_equal(record["CH1"].codes, source.record(*source.calls[-1])["CH1"].codes)
     assert ask(s, "TRIG:STATE?") == "SAVE"
     s.handle(b"ACQ:STOPAFTER RUNSTOP;STATE RUN")
-    wait_for(lambda: scope.acq.count >= 3)
+    wait_for(lambda: ask(s, "ACQ:NUMACQ?") and scope.acq.count >= 3)  # a client polling: a shot per poll
     assert ask(s, "TRIG:STATE?") == "AUTO"
     s.handle(b"ACQ:STATE STOP")
     wait_for(lambda: not scope.acq.busy)
