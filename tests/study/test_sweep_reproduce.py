@@ -140,9 +140,15 @@ def test_reproduce_fitted_keeps_no_family_that_misses_a_target_and_names_what_it
                 "wall_peak_gravity_N", "wall_peak_magnetic_N",
                 "pulses_gravity", "pulses_magnetic", "parameters", "models", "gravity_only_fit", "power_law_shots",
                 "dashpot_scan", "steel", "published", "table1_chi2_per_dof", "table1_max_sigma", "fig3",
-                "targets", "fitted_scene"):
+                "targets", "fitted_scene", "table1_points_both_conversions"):
         assert key in f, key
     row = f["models"]["hertz"]
+    both = row["table1_points_both_conversions"]  # the elastic law's readings convert to its contact forces
+    assert both["chi2_contact_force"] == pytest.approx(row["table1_chi2"], rel=1e-12) and len(both["points"]) == 10
+    assert {"F_d_N", "V_s_m_per_s", "model_V_s_contact_force_m_per_s", "model_V_s_elastic_conversion_m_per_s",
+            "residual_contact_force_sd", "residual_elastic_conversion_sd"} <= set(both["points"][0])
+    assert all(abs(e / c - 1) < 0.02 for cv in both["curves"]
+               for c, e in zip(cv["contact_force_N"], cv["elastic_conversion_N"]) if c and e)
     assert set(row["fig3"]) == {"gravity_speed_m_per_s", "gravity_duration_us", "gravity_pulses_lower_gauge",
                                 "magnetic_speed_m_per_s", "gauge_ratio_magnetic_to_gravity", "wall_peak_gravity_N",
                                 "wall_peak_magnetic_N", "magnetic_tail_relative", "magnetic_tail_shoulder_relative"}
