@@ -167,11 +167,17 @@ def estimates(rigs: list, pilot: Pilot) -> list:
 class Curve:
     """The leading pulse's dynamic contact force F_d (N) and speed V_s (m/s) between the
     gauges (the truth analysis, as the published numerics) at each striker velocity (m/s);
-    nan where a shot gave no pulse."""
+    nan where a shot gave no pulse. ``reading``: the same shots' gauge readings F_m,e (N,
+    the truth analysis's averaged amplitude: the peak of the mean of a gauge bead's two
+    dynamic contact forces, averaged over the two gauges) and ``static_force`` the
+    precompression F_0 (N, at the contact midway between the gauges), where the shots gave
+    them (None: a curve read back from a store that did not keep them)."""
 
     velocity: np.ndarray
     force: np.ndarray
     speed: np.ndarray
+    reading: np.ndarray | None = None
+    static_force: np.ndarray | None = None
 
     def reach(self) -> tuple:
         """(F_d, V_s) of the curve's largest leading pulse (nan, nan where it has none): no
@@ -245,8 +251,7 @@ def curves(scene: str, overrides: list, velocities, pilot: Pilot | None = None) 
     scene's duration; without: at the a-priori step). A candidate the scene refuses (a
     value out of a part's range) has no points; RigError if the scene refuses them all."""
     v = np.asarray(velocities, dtype=float)
-    F = np.full((len(overrides), v.size), math.nan)
-    V = np.full((len(overrides), v.size), math.nan)
+    F, V, R, F0 = (np.full((len(overrides), v.size), math.nan) for _ in range(4))
     window = math.inf if pilot is None else pilot.window_s
     rigs, where, refused = shot_rigs(scene, overrides, v, window)
     if not rigs:
@@ -261,4 +266,5 @@ def curves(scene: str, overrides: list, velocities, pilot: Pilot | None = None) 
     for (c, k), rep in zip(where, reports):
         if rep is not None and rep.speed_m_per_s is not None and rep.amplitude_N is not None:
             F[c, k], V[c, k] = rep.amplitude_N, rep.speed_m_per_s
-    return [Curve(v, F[c], V[c]) for c in range(len(overrides))]
+            R[c, k], F0[c, k] = rep.averaged_amplitude_N, rep.static_force_N
+    return [Curve(v, F[c], V[c], R[c], F0[c]) for c in range(len(overrides))]

@@ -146,12 +146,21 @@ class PointObjective:
 
     @staticmethod
     def pack(model) -> dict:
-        return {"velocity": model[0].velocity, "force": np.array([c.force for c in model]),
-                "speed": np.array([c.speed for c in model])}
+        """The curves' arrays; their gauge readings and F_0 where every curve has them."""
+        out = {"velocity": model[0].velocity, "force": np.array([c.force for c in model]),
+               "speed": np.array([c.speed for c in model])}
+        if all(c.reading is not None and c.static_force is not None for c in model):
+            out.update({"reading": np.array([c.reading for c in model]),
+                        "static_force": np.array([c.static_force for c in model])})
+        return out
 
     @staticmethod
     def unpack(z: dict):
-        return tuple(Curve(z["velocity"], f, v) for f, v in zip(z["force"], z["speed"]))
+        """The curves of ``pack``'s arrays (readings None where they were not kept)."""
+        n = len(z["force"])
+        reading, static = z.get("reading", [None] * n), z.get("static_force", [None] * n)
+        return tuple(Curve(z["velocity"], f, v, r, f0)
+                     for f, v, r, f0 in zip(z["force"], z["speed"], reading, static))
 
     def model_speeds(self, model) -> tuple:
         """(V_s at each point's F_d, dlnV/dlnF there); nan where its curve is missing."""

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from rig.errors import RigError
+from rig.fit.amplitudes import both_conversions
 from rig.fit.checks import unusable
 from rig.fit.crossval import leverages
 from rig.fit.fitting import FitResult, fit
@@ -96,8 +97,10 @@ def _rms(x) -> float:
 def table1_figures(obj, result: FitResult) -> dict:
     """Table 1's share of a joint fit (its first part): chi2 per (points - fitted parameters),
     relative RMS and worst point, the largest |residual| in sd, the points no striker velocity
-    of the model's curve reaches (rig.fit.points), and the linearised leave-one-out
-    (rig.fit.crossval)."""
+    of the model's curve reaches (rig.fit.points), the linearised leave-one-out
+    (rig.fit.crossval), and the points against the model's F_d both ways, its contact forces
+    (what the fit compares) and the paper's elastic conversion of its gauge readings
+    (rig.fit.amplitudes: "table1_points_both_conversions")."""
     rows = obj.slices[0]
     r = result.residuals[rows]
     rel = obj.parts[0].relative_residuals(result.model[0])
@@ -113,7 +116,19 @@ def table1_figures(obj, result: FitResult) -> dict:
             "relative_residuals": rel.tolist(), "normalised_residuals": r.tolist(),
             "loo_method": "linearised (PRESS: r_i / (1 - h_ii) at the joint optimum)",
             "loo_chi2": float(loo_r @ loo_r), "loo_rms_relative": _rms(loo_rel),
-            "loo_relative_residuals": loo_rel.tolist()}
+            "loo_relative_residuals": loo_rel.tolist(),
+            "table1_points_both_conversions": both_conversions(obj.parts[0], _with_readings(obj, result),
+                                                               len(result.keys))}
+
+
+def _with_readings(obj, result: FitResult) -> tuple:
+    """Table 1's curves at the fit's estimate with their gauge readings: the fit's own, or,
+    where they were read back from a store that did not keep the readings, its Table 1
+    shots solved again."""
+    model = result.model[0]
+    if all(c.reading is not None for c in model):
+        return model
+    return obj.parts[0].evaluate([result.estimate])[0]
 
 
 def estimates(result: FitResult) -> dict:

@@ -148,6 +148,7 @@ def markdown(f: dict) -> str:
     scene = f.get("fitted_scene")
     lines += ["", f"Fitted scene: {scene} (`rig shot` fires it)." if scene
               else f"No fitted scene written: {f.get('no_fitted_scene')}."]
+    lines += _conversions(f.get("table1_points_both_conversions"))
     lines += _windows(f.get("windows")) + _history(f) + _drops(f.get("table1_striker_drops")) + _sources(models)
     lines += ["", "Dashpot scan on the elastic power law's fitted E and n:", "",
               SCAN_HEADER, "|---|---|---|---|---|---|"]
@@ -170,6 +171,34 @@ def markdown(f: dict) -> str:
                  f"{st['magnetic_speed_m_per_s']:.0f} m/s against 580 and 688 m/s.")
     lines += ["", steel]
     return "\n".join(lines) + "\n"
+
+
+CONVERSIONS = ("Table 1's points against the kept set's F_d two ways: (1) its largest dynamic contact force at the "
+               "gauge beads (the truth analysis; what the fit compares), (2) its gauge readings F_m,e converted as the "
+               "paper converted the experiment's, F_d = beta(F_m/F_0) F_m,e of the elastic (Hertz) chain, from the "
+               "same shots. Model V_s at each point's F_d, residual in sd (effective variance):")
+
+
+def _conversions(both) -> list:
+    """Table 1's points against the kept set's F_d both ways (rig.fit.amplitudes)."""
+    if not both:
+        return []
+    out = ["", CONVERSIONS, "", "| magnet.force | F_d (N) | V_s (m/s) | model V_s, (1) contact force (m/s) "
+                                "| (1) residual (sd) | model V_s, (2) elastic conversion (m/s) | (2) residual (sd) |",
+           "|---|---|---|---|---|---|---|"]
+    for p in both["points"]:
+        magnet = next((o.split("=", 1)[1] for o in p["configuration"] if o.startswith("magnet.force=")), "-")
+        cells = (_f(p["model_V_s_contact_force_m_per_s"], ".1f"), _f(p["residual_contact_force_sd"], "+.2f"),
+                 _f(p["model_V_s_elastic_conversion_m_per_s"], ".1f"), _f(p["residual_elastic_conversion_sd"], "+.2f"))
+        out.append(f"| {magnet} | {p['F_d_N']:.3g} | {p['V_s_m_per_s']:.0f} | " + " | ".join(cells) + " |")
+    ratios = [e / c for cv in both["curves"] for c, e in zip(cv["contact_force_N"], cv["elastic_conversion_N"])
+              if c and e]
+    spread = f"; (2)'s F_d over (1)'s on the curves' shots: {min(ratios):.3f} to {max(ratios):.3f}" if ratios else ""
+    rms = (_f(both["rms_relative_contact_force"], ".1%"), _f(both["rms_relative_elastic_conversion"], ".1%"))
+    out += ["", f"chi2/dof ({both['dof']} dof): (1) {_f(both['chi2_per_dof_contact_force'], '.3f')}, "
+                f"(2) {_f(both['chi2_per_dof_elastic_conversion'], '.3f')}; relative RMS: (1) {rms[0]}, (2) {rms[1]}"
+                f"{spread}. The fit uses (1)."]
+    return out
 
 
 def _windows(windows) -> list:

@@ -164,3 +164,33 @@ def beta(force_ratio: float, n: float = 1.5) -> float:
     if math.isinf(force_ratio):
         return solitary_wave(1.0, 1.0, 1.0, 1.0, n=n).beta
     return solitary_wave(1.0, 1.0, 1.0, force_ratio, 1.0, n=n).beta
+
+
+def elastic_amplitude(reading: float, F0: float, n: float = 1.5, rtol: float = 1e-10) -> float:
+    """F_d (N) from a rigid gauge bead's reading F_m,e (N, the peak of the mean of its two
+    dynamic contact forces), as Daraio et al. (2006) converted their gauges: F_d = beta
+    F_m,e with beta = beta(F_m/F_0) of the elastic chain (``beta``), F_m = F_d + F_0 the
+    total contact force on the precompression F0 (N; 0: the sonic vacuum, beta(inf)).
+
+    F_m is not known before F_d, so F_d is the fixed point of x -> beta(1 + x/F_0) F_m,e,
+    iterated from x = F_m,e until a step changes x by less than ``rtol`` of it: beta >= 1
+    rises with F_m/F_0, so the iterates rise to the fixed point, and the map's slope
+    (dbeta/dln f_r (f_r - 1)/(f_r beta), about 0.1 at most) makes each step about ten times
+    smaller than the last. RigError (invalid) for a reading that is not > 0 or whose
+    F_m/F_0 stays below MIN_FORCE_RATIO (beta is computed from there up)."""
+    if not 0 < reading < math.inf:
+        raise invalid("reading", reading, "a gauge reading F_m,e must be > 0 N and finite")
+    if not 0 <= F0 < math.inf:
+        raise invalid("F0", F0, "precompression must be >= 0 N")
+    if F0 == 0:
+        return beta(math.inf, n) * reading
+    if 1.0 + reading / F0 < MIN_FORCE_RATIO:
+        raise invalid("reading", reading, f"F_m/F_0 below {MIN_FORCE_RATIO} on F_0 = {F0:.4g} N: beta is "
+                                          f"computed from F_m/F_0 = {MIN_FORCE_RATIO} up")
+    x = reading
+    for _ in range(100):
+        new = beta(1.0 + x / F0, n) * reading
+        if abs(new - x) <= rtol * new:
+            return new
+        x = new
+    raise RigError(f"the elastic conversion of the reading {reading:.4g} N on F_0 = {F0:.4g} N did not converge")
