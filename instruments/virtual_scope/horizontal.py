@@ -12,7 +12,11 @@ model's steps (scene key scope.sample_interval follows), the record length to it
   interpolates there, the emulated one samples its input that finely); its
   ``HORizontal:SAMPLERate`` "The command form is ignored. The query returns the sample rate
   for analog channels in samples per second" (MDO3000 manual). The TDS2000's one record
-  length, 2,500 points, cannot shrink: its rate is not bounded here.
+  length, 2,500 points, cannot shrink: its rate is not bounded here; its time base runs
+  from 5 ns/div to 50 s/div (Personality.scale_range), a scale beyond taken at the nearer
+  end. Below 100 ns/div a real TDS2000 interpolates (sin x / x) between samples taken at its
+  real-time rate (500 MS/s to 2 GS/s by model); the emulated one samples its input at the
+  record's interval, so its noise is not correlated between those points.
 - 4 Series, ``HORizontal:MODe {AUTO|MANual}``, AUTO after ``*RST``. AUTO "automatically
   adjusts the sample rate and record length" (its manual): the scale is the client's and is
   kept; ``RECOrdlength`` and ``SAMPLERate`` set the record length at that scale; the rate
@@ -82,7 +86,10 @@ def register(tree, scope) -> None:
         set_time(n, s * 10 / n)
 
     def set_scale(c: Call):
-        s = snap_to_steps(positive(c, c.number("S")), p.time_steps)
+        s = positive(c, c.number("S"))
+        if p.scale_range is not None:  # forced to the time base's range (Personality.scale_range)
+            s = min(max(s, p.scale_range[0]), p.scale_range[1])
+        s = snap_to_steps(s, p.time_steps)
         if manual():
             set_time(nearest(s * 10 / interval()), interval())
         else:

@@ -72,6 +72,11 @@ class Personality:
     max_sample_rate: float | None = None
     """The highest real-time sample rate (S/s) its horizontal modes keep to (the 4 Series:
     6.25 GS/s on every channel, 4 Series MSO datasheet); None: not bounded here."""
+    scale_range: tuple | None = None
+    """(fastest, slowest) s/div its time base takes; a scale beyond is taken at the nearer end,
+    as the manuals force a numeric argument "to a valid setting" (the TDS2000C's "5 ns/div to
+    50 s/div, in a 1, 2.5, 5 sequence", its user manual's horizontal specifications); None:
+    not bounded here."""
 
     @property
     def combined_offset(self) -> bool:
@@ -110,7 +115,8 @@ PERSONALITIES = {
     "tds2000": Personality("tds2000", "TEKTRONIX,TDS 2024C,C010001,CF:91.1CT FV:v24.26", (2500,),
                            (1.0, 2.5, 5.0), "WFMPre", WFMPRE_16, "Volts", False, 3,
                            models=r"TDS ?(2[0-9]{2}|1[0-9]{3}[A-Z]?|2[0-9]{3}[A-Z]?)(-EDU)?|TPS ?20[0-9]{2}[A-Z]?",
-                           model_names="TDS 210 to TDS 224, TDS 1001 to TDS 2024 (B, C), TPS 2012 to TPS 2024"),
+                           model_names="TDS 210 to TDS 224, TDS 1001 to TDS 2024 (B, C), TPS 2012 to TPS 2024",
+                           scale_range=(5e-9, 50.0)),
     "mdo3000": Personality("mdo3000", "TEKTRONIX,MDO3024,C010001,CF:91.1CT FV:v1.30", (1000, 10000, 100000, 1000000,
                                                                                       5000000, 10000000),
                            (1.0, 2.0, 4.0), "WFMOutpre", WFMOUTPRE_22, "V", True, 4,

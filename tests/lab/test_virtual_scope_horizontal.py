@@ -104,3 +104,16 @@ def test_the_mdo3000_keeps_to_its_models_sample_rate(make_scope, idn, rate):
     assert ask(s, state) == "20.0000E-9;1000;5.0000E+9"
     s.handle(b"HOR:SCALE 1E-3;:HOR:RECO 10000;:HOR:SAMPLERATE 1E9")
     assert ask(s, state + ";:ALLEV?") == '1.0000E-3;10000;1.0000E+6;0,"No events to report - queue empty"'
+
+
+@pytest.mark.parametrize("asked, taken", [("1E-9", "5.0E-9"), ("2.6E-9", "5.0E-9"), ("5E-9", "5.0E-9"),
+                                          ("7E-9", "5.0E-9"), ("1E3", "5.0E1")])
+def test_a_tds2000_scale_beyond_its_time_base_is_taken_at_the_nearer_end(make_scope, asked, taken):
+    """The TDS2000C's time base runs "5 ns/div to 50 s/div, in a 1, 2.5, 5 sequence" (its user
+    manual's horizontal specifications); a numeric argument is "forced to a valid setting":
+    beyond the range, the nearer end, without an error; 2,500 points over ten divisions."""
+    _scope, s, _ = make_scope("tds2000")
+    s.handle(f"HORIZONTAL:MAIN:SCALE {asked}".encode())
+    assert ask(s, "HORIZONTAL:MAIN:SCALE?") == taken
+    assert ask(s, "WFMPRE:XINCR?") == _scope.personality.number(float(taken) * 10 / 2500)
+    assert ask(s, "ALLEV?") == '0,"No events to report - queue empty"'
