@@ -2,10 +2,10 @@
 exactly one line on stderr naming the field or path, exit 2, never a traceback.
 
 Each case is (argv, needle): ``{d}`` in an argument is the case's scratch folder (holding
-the files of ``_files``); the one error line must contain ``needle``."""
+the files of ``_files``); the one error line must contain ``needle``. A full disk under
+each command that writes: tests/cli/test_full_disk.py."""
 from __future__ import annotations
 
-import json
 import os
 import subprocess
 import sys
@@ -249,33 +249,6 @@ def test_the_real_entry_point(tmp_path, argv, needle):
                        text=True, cwd=tmp_path, env={**os.environ}, timeout=300)
     assert r.returncode == 2
     assert needle in one_line(r.stderr)
-
-
-DISK_FULL = """
-import resource, signal, sys
-signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
-limit = int(sys.argv[1])
-resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
-from rig.cli import main
-sys.exit(main(sys.argv[2:]))
-"""
-
-
-@pytest.mark.parametrize("limit,argv,folder", [
-    (1000, ["shot", S, "--seed", "1", "--export", "{d}/shots"], "shots"),
-    (3000, ["mc", S, "--shots", "8", "--batch", "4", "--vary", VEL, "--out", "{d}/study", "--quiet"], "study"),
-])
-def test_a_full_disk_is_one_line_naming_the_path(tmp_path, limit, argv, folder):
-    """A file-size limit makes every write past ``limit`` bytes fail (EFBIG), as a full disk
-    does; a study's study.json is whole or absent (so the folder can resume)."""
-    r = subprocess.run([sys.executable, "-c", DISK_FULL, str(limit), *_argv(argv, tmp_path)],
-                       capture_output=True, text=True, cwd=tmp_path, timeout=300)
-    assert r.returncode == 2, r.stderr
-    line = one_line(r.stderr)
-    assert str(tmp_path / folder) in line and "too large" in line.lower()
-    meta = tmp_path / folder / "study.json"
-    if meta.exists():
-        assert json.loads(meta.read_text())["shots"] == 8
 
 
 def test_a_value_that_starts_with_a_dash_says_how_to_give_it(capsys):

@@ -2,12 +2,14 @@
 exit 2, no traceback, nothing truncated or empty left behind, and the same command run
 again once there is room succeeds.
 
-The disk is made full the way tests/cli/test_bad_inputs.py does it: a file-size limit on
-the command's process (RLIMIT_FSIZE), which makes every write past the limit fail with
-EFBIG ("File too large") as ENOSPC would. Each limit is below the size of what the
-command writes, so the failure comes from a real write in the middle of it. A failed run
-leaves nothing new but whole files: no folder it created empty, no 0-byte file, no lock
-file."""
+The disk is made full by a file-size limit on the command's process (RLIMIT_FSIZE, DISK_FULL),
+which makes every write past the limit fail with EFBIG ("File too large") as ENOSPC would.
+Each limit is below the size of what the command writes, so the failure comes from a real
+write in the middle of it. A failed run leaves nothing new but whole files: no folder it
+created empty, no 0-byte file, no lock file. Only the failing run needs a process of its
+own (the limit, its exit status, its stderr); the runs with room (a fit that fills its
+cache first, the run again) are rig.cli.main in this process, its exit status and stderr
+checked the same way (an exception it lets out fails the test, as a traceback would)."""
 from __future__ import annotations
 
 import json
@@ -19,10 +21,11 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from test_bad_inputs import DISK_FULL, VEL, S, one_line
+from test_bad_inputs import VEL, S, one_line
 
 from instruments.archive import Archive
 from instruments.formats.isf import read_isf
+from rig.cli import main
 
 LAYOUT1 = Path(__file__).parents[1] / "instruments" / "data" / "layout1.h5"
 POINTS = "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n0.5,0.05,130,4\n0.9,0.09,150,4.5\n1.6,0.16,175,5\n"
@@ -48,17 +51,55 @@ CASES = {
     "upgrade": (LAYOUT1.stat().st_size + 2000, ["upgrade", "{d}/old.h5"]),
     "fit, the cache": (300, FIT),
     "fit, the report": (8000, FIT),
-    "fit --posterior, the chain": (3000, [*FIT, "--posterior", "40", "--walkers", "4"]),
+    # 24 steps (a 154 kB chain): by then (not by 20) walkers have had moves refused and met a candidate
+    # whose figure is refused (its pulse never falls to 1%), as they did in 40
+    "fit --posterior, the chain": (3000, [*FIT, "--posterior", "24", "--walkers", "4"]),
     "reproduce --out": (3000, ["reproduce", "daraio2006", "--out", "{d}/r", "--quiet"]),
     "animate --out": (2000, ["animate", S, *SMALL, "--frames", "4", "--out", "{d}/a.gif", "--quiet"]),
 }
 
 
+# a rig command in a process whose files cannot grow past argv[1] bytes (SIGXFSZ ignored: the
+# write fails with EFBIG instead of the signal ending the process)
+DISK_FULL = """
+import resource, signal, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+limit = int(sys.argv[1])
+resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+from rig.cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def expand(argv, d: Path, realdata) -> list:
+    return [a.replace("{d}", str(d)).replace("{realdata}", str(realdata)) for a in argv]
+
+
 def run_case(argv, d: Path, realdata, limit=None):
-    argv = [a.replace("{d}", str(d)).replace("{realdata}", str(realdata)) for a in argv]
+    """``argv`` in a process of its own in folder ``d``, its files limited to ``limit``
+    bytes (DISK_FULL) where one is given."""
     code = DISK_FULL if limit else "import sys\nfrom rig.cli import main\nsys.exit(main(sys.argv[2:]))\n"
-    return subprocess.run([sys.executable, "-c", code, str(limit or 0), *argv], check=False, capture_output=True,
-                          text=True, cwd=d, timeout=600)
+    return subprocess.run([sys.executable, "-c", code, str(limit or 0), *expand(argv, d, realdata)], check=False,
+                          capture_output=True, text=True, cwd=d, timeout=600)
+
+
+def run_here(argv, d: Path, realdata, monkeypatch, capsys) -> tuple:
+    """``argv`` by rig.cli.main in this process, in folder ``d`` (a run with room):
+    (exit status, stderr)."""
+    capsys.readouterr()
+    with monkeypatch.context() as m:
+        m.chdir(d)
+        try:
+            code = main(expand(argv, d, realdata))
+        except SystemExit as exc:
+            code = exc.code
+    return code, capsys.readouterr().err
+
+
+def target(argv) -> str:
+    """The path ``argv`` writes: its --out, --export or --into, else (upgrade) its file."""
+    flag = next((f for f in ("--out", "--export", "--into") if f in argv), None)
+    return argv[argv.index(flag) + 1] if flag else argv[1]
 
 
 def whole(path: Path):
@@ -104,13 +145,15 @@ STUDIES = ("reproduce --out", "mc --out, two workers", "mc --traces", "mc --out"
 
 
 @pytest.mark.parametrize("case", [c for c in CASES if c not in STUDIES])
-def test_a_full_disk_is_one_line_leaves_nothing_broken_and_a_second_run_succeeds(tmp_path, realdata, case):
-    check_full_disk(tmp_path, realdata, case)
+def test_a_full_disk_is_one_line_leaves_nothing_broken_and_a_second_run_succeeds(tmp_path, realdata, case,
+                                                                                    monkeypatch, capsys):
+    check_full_disk(tmp_path, realdata, case, monkeypatch, capsys)
 
 
-def check_full_disk(tmp_path: Path, realdata, case: str):
-    """Case ``case`` of CASES under its file-size limit: one line naming the path and the
-    cause, exit 2, nothing broken left; then run again with room, it succeeds."""
+def check_full_disk(tmp_path: Path, realdata, case: str, monkeypatch, capsys):
+    """Case ``case`` of CASES under its file-size limit: one line naming the path it was
+    told to write and the cause, exit 2, nothing broken left; then run again with room
+    (in this process), it succeeds."""
     limit, argv = CASES[case]
     if argv[0] == "animate":
         pytest.importorskip("pyvista")
@@ -119,19 +162,23 @@ def check_full_disk(tmp_path: Path, realdata, case: str):
     if argv[0] == "fit":
         (tmp_path / "points.csv").write_text(POINTS)
         if case != "fit, the cache":  # the cache filled by a first run: this one writes the scene and report first
-            assert run_case(FIT, tmp_path, realdata).returncode in (0, 1)
+            code, err = run_here(FIT, tmp_path, realdata, monkeypatch, capsys)
+            assert code in (0, 1), err
     before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file() and p.suffix != ".lock"}
     there = set(tmp_path.rglob("*"))
     r = run_case(argv, tmp_path, realdata, limit)
     assert r.returncode == 2, r.stderr
     line = one_line(r.stderr)
-    assert line.startswith(f"rig {argv[0]}: error: {tmp_path}") and line.endswith(": File too large"), line
+    written = expand([target(argv)], tmp_path, realdata)[0]
+    assert line.startswith(f"rig {argv[0]}: error: {written}") and line.endswith(": File too large"), line
     check_left(tmp_path, there)
+    if argv[0] == "mc" and (tmp_path / "study" / "study.json").exists():  # whole: the study can resume
+        assert json.loads((tmp_path / "study" / "study.json").read_text())["shots"] == 8
     if argv[0] == "shot" and "--export" in argv:  # several files: all of them or none, and no new empty folder
         assert not list(tmp_path.rglob("*.isf")) and not list(tmp_path.rglob("*.csv"))
     for p in (p for p in before if p.suffix == ".h5"):
         assert p.read_bytes() == before[p], f"{p}: changed by a failed write"
-    again = run_case(argv, tmp_path, realdata)
-    assert again.returncode in ((0, 1) if argv[0] == "fit" else (0,)), again.stderr
-    assert "Traceback" not in again.stderr
+    code, err = run_here(argv, tmp_path, realdata, monkeypatch, capsys)
+    assert code in ((0, 1) if argv[0] == "fit" else (0,)), err
+    assert "Traceback" not in err
     check_left(tmp_path)
