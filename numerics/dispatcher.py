@@ -17,11 +17,13 @@ values are dropped before numba types them, so the kernels they call are never c
 Hertz chain compiles no Thornton code). One copy per value used, the same operations on
 the branch taken (the same bits).
 """
+import logging
 import os
 import time
 from dataclasses import dataclass
 
 from numba.core import ir, types
+from numba.core.caching import FunctionCache
 from numba.core.compiler import CompilerBase, DefaultPassBuilder
 from numba.core.compiler_machinery import FunctionPass, register_pass
 from numba.core.ir_utils import get_definition, guard
@@ -122,6 +124,9 @@ class OneTypePerArgument(CPUDispatcher):
             return types.NamedTuple([self.typeof_pyval(x) for x in val], type(val))
         return super().typeof_pyval(val)
 
+    def enable_caching(self):
+        self._cache = SavedIfRoom(self.py_func)
+
     def compile(self, sig):
         """Compile (or load from numba's cache) the copy for ``sig``, called from Python or
         from a kernel being compiled. If a side process compiles this kernel
@@ -131,6 +136,23 @@ class OneTypePerArgument(CPUDispatcher):
         while side is not None and side.poll() is None and not has_machine_code(self):
             time.sleep(POLL_S)
         return super().compile(sig)
+
+
+class SavedIfRoom(FunctionCache):
+    """numba's on-disk cache of a kernel, whose machine code is saved where the disk takes it:
+    a save that fails (a full disk, a file-size limit, a read-only cache folder) leaves the
+    compiled kernel running and the command going on, as if the cache were off (numba lets
+    the OSError end the command; its temporary file is removed either way). The next
+    command compiles that kernel again; the failure is logged (numerics.dispatcher, INFO)."""
+
+    def save_overload(self, sig, data):
+        try:
+            super().save_overload(sig, data)
+        except OSError as e:
+            LOG.info("numba's cache kept no machine code of %s%s: %s", self._name, sig, e)
+
+
+LOG = logging.getLogger(__name__)
 
 
 def _plain(ty, name):

@@ -51,3 +51,31 @@ def test_the_checker_finds_a_planted_kernel(tmp_path):
         "@jit(parallel=True)\ndef loose(x):\n    return x\n\n@numba.njit\ndef other(x):\n    return x\n")
     (tmp_path / "rig").mkdir()
     assert unguarded(tmp_path) == ["instruments/batch.py: loose", "instruments/batch.py: other"]
+
+
+SAVE_ON_A_FULL_DISK = """
+import logging, resource, signal, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+resource.setrlimit(resource.RLIMIT_FSIZE, (200, 200))  # no cache file fits: each save fails with EFBIG
+logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s")
+import numpy as np
+from instruments._kernels import pcg64
+state = pcg64.seeded(7)
+print(int(state[0]) == int(np.random.default_rng(7).bit_generator.state["state"]["state"] >> 64))
+"""
+
+
+def test_a_kernel_whose_machine_code_the_disk_cannot_keep_still_runs(tmp_path):
+    """numba's cache on a full disk (here a file-size limit, EFBIG as ENOSPC): the kernel is
+    compiled, runs and gives its result; the save's failure is logged, not raised (numba
+    itself ends the command with the OSError, numerics.dispatcher.SavedIfRoom), and no
+    temporary file is left in the cache folder."""
+    import os
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", SAVE_ON_A_FULL_DISK], capture_output=True, text=True, timeout=300,
+                          env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path)), cwd=ROOT, check=False)
+    assert done.returncode == 0 and done.stdout.strip() == "True", done.stderr[-2000:]
+    assert "numba's cache kept no machine code of" in done.stderr and "File too large" in done.stderr
+    assert not [p for p in tmp_path.rglob("*") if ".tmp." in p.name]
