@@ -56,6 +56,7 @@ def test_the_checker_finds_a_planted_kernel(tmp_path):
 SAVE_ON_A_FULL_DISK = """
 import logging, resource, signal, sys
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+sys.dont_write_bytecode = True  # a .pyc written past the limit would be truncated (tests/cli/test_full_disk.py)
 resource.setrlimit(resource.RLIMIT_FSIZE, (200, 200))  # no cache file fits: each save fails with EFBIG
 logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s")
 import numpy as np

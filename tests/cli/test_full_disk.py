@@ -64,6 +64,9 @@ CASES = {
 DISK_FULL = """
 import resource, signal, sys
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+# no .pyc written past the limit: the import system writes one in a single write(), and a short write
+# under the limit is renamed into place, a truncated .pyc for every later process ("marshal data too short")
+sys.dont_write_bytecode = True
 limit = int(sys.argv[1])
 resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 from rig.cli import main
