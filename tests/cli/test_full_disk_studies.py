@@ -1,10 +1,42 @@
 """The study commands of tests/cli/test_full_disk.py under a full disk (the same checks;
-kept apart so the suite's workers share these, the longest runs)."""
+kept apart so the suite's workers share these, the longest runs), and rig reproduce: what
+it writes, its figures, and its run again after a full disk repeating a clean run's results
+exactly (three runs of the published study, where the full-disk case and a repeat of its
+own took four)."""
+import json
+
 import pytest
 from test_full_disk import STUDIES, check_full_disk
 
+from rig.cli import main
 
-@pytest.mark.parametrize("case", STUDIES)
+
+@pytest.mark.parametrize("case", [c for c in STUDIES if c != "reproduce --out"])
 def test_a_full_disk_is_one_line_leaves_nothing_broken_and_a_second_run_succeeds(tmp_path, realdata, case,
                                                                                     monkeypatch, capsys):
     check_full_disk(tmp_path, realdata, case, monkeypatch, capsys)
+
+
+def test_reproduce_writes_everything_and_after_a_full_disk_repeats_exactly(tmp_path, realdata, monkeypatch,
+                                                                            capsys):
+    a = tmp_path / "clean"
+    assert main(["reproduce", "daraio2006", "--out", str(a), "--quiet", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    for name in ("table1.md", "table1.csv", "summary.md", "results.json", "beta.png",
+                 "speed_vs_force_ptfe.png", "speed_vs_force_steel.png", "traces_ptfe.png",
+                 "traces_steel.png", "leading_pulse_vs_solitary_ptfe52_gravity.png"):
+        assert (a / name).stat().st_size > 0
+    rows = {(r["chain"], r["precompression"]): r for r in result["table1"]}
+    for r in rows.values():  # c0 against the published values (PHYSICS.md): the F_0 differs, see the notes
+        assert r["Vs_numerics_m_per_s"] > r["c0_eq2_m_per_s"]
+        assert r["Vs_eq1_m_per_s"] == pytest.approx(r["Vs_numerics_m_per_s"], rel=0.05)
+    assert rows[("PTFE", "2.38 N")]["c0_eq2_m_per_s"] == pytest.approx(211.2, rel=0.005)
+    assert rows[("steel", "2.38 N")]["c0_eq2_m_per_s"] == pytest.approx(539.6, rel=0.005)
+    s = result["summary"]
+    assert 4.0 < s["ptfe52_gravity_leading_width_1pct_diameters"] < 6.0  # about five diameters
+    mass = json.loads((a / "results.json").read_text())["mass_ratio"]
+    assert [m["pulses_lower_gauge"] for m in mass][:3] == [1, 2, 3]  # about the mass ratio
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    check_full_disk(disk, realdata, "reproduce --out", monkeypatch, capsys)  # into disk/r, then again
+    assert (disk / "r" / "results.json").read_text() == (a / "results.json").read_text()
