@@ -51,11 +51,10 @@ def _num(x) -> float | None:
 
 
 def _way(part, model) -> tuple:
-    """(V_s compared at each point, residuals in sd, reachable) of one way: the speed the
-    residual compares (the curve's end speed where the point lies beyond it)."""
-    reach = part.reachable(model)
-    V = np.where(reach, part.model_speeds(model)[0], part.reach(model)[1])
-    return V, part.residuals(model, np.zeros(0)), reach
+    """(V_s compared at each point, residuals in sd, reachable, relative RMS) of one way, as
+    the fit counts them (rig.fit.points.PointObjective)."""
+    return (part.compared_speeds(model), part.residuals(model, np.zeros(0)), part.reachable(model),
+            part.relative_rms(model, np.zeros(0)))
 
 
 def both_conversions(part, model, fitted: int) -> dict:
@@ -74,17 +73,15 @@ def both_conversions(part, model, fitted: int) -> dict:
     for i in range(p.n):
         row = {"F_d_N": float(p.force[i]), "F_d_sd_N": float(p.force_sd[i]), "V_s_m_per_s": float(p.speed[i]),
                "V_s_sd_m_per_s": float(p.speed_sd[i]), "configuration": list(p.configs[i])}
-        for name, (V, r, reach) in ways.items():
+        for name, (V, r, reach, _) in ways.items():
             row.update({f"model_V_s_{name}_m_per_s": _num(V[i]), f"residual_{name}_sd": _num(r[i]),
                         f"reachable_{name}": bool(reach[i])})
         points.append(row)
     out: dict = {"fit_uses": CONTACT, "elastic_exponent": ELASTIC_EXPONENT, "dof": dof, "points": points}
-    for name, (V, r, _) in ways.items():
+    for name, (_, r, _, rms) in ways.items():
         chi2 = float(r @ r)
-        rel = V / p.speed - 1.0
-        rel = rel[np.isfinite(rel)]
         out.update({f"chi2_{name}": chi2, f"chi2_per_dof_{name}": chi2 / dof if dof > 0 else None,
-                    f"rms_relative_{name}": float(np.sqrt(np.mean(rel ** 2))) if rel.size else None})
+                    f"rms_relative_{name}": _num(rms)})
     out["curves"] = [{"configuration": list(cfg), "velocity_m_per_s": [float(v) for v in c.velocity],
                       "contact_force_N": [_num(x) for x in c.force], "reading_N": [_num(x) for x in c.reading],
                       "static_force_N": [_num(x) for x in c.static_force],

@@ -195,10 +195,14 @@ class PointObjective:
         r = np.where(beyond, np.where(r >= 0, 1.0, -1.0) * np.hypot(r, gap), r)
         return np.where(np.isfinite(r), r, NO_CURVE)
 
+    def compared_speeds(self, model) -> np.ndarray:
+        """The model's V_s (m/s) each point is compared with: the curve's at the point's F_d,
+        or, for a point beyond the curve's largest pulse, the curve's end speed."""
+        return np.where(self.reachable(model), self.model_speeds(model)[0], self.reach(model)[1])
+
     def relative_residuals(self, model) -> np.ndarray:
         """V_model(F_i) / V_i - 1 at each point (an unreachable one: the curve's end speed's)."""
-        V = np.where(self.reachable(model), self.model_speeds(model)[0], self.reach(model)[1])
-        return V / self.points.speed - 1.0
+        return self.compared_speeds(model) / self.points.speed - 1.0
 
     def relative_rms(self, model, eta) -> float:
         """RMS of the relative speed residuals (points without a model curve left out)."""
