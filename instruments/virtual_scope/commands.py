@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-from ..devices.oscilloscope import LEVEL_LIMIT_V
+from ..devices.scope_settings import LEVEL_LIMIT_V
 from ..scpi.engine import Call, Fields, Word
 from ..scpi.status import ScpiError
 from .personalities import snap_to_steps
