@@ -67,6 +67,37 @@ def pytest_sessionstart(session):
 
 COMPILED: list = []  # what pytest_sessionstart compiled, said in the summary
 
+# The test files that take longest, seconds summed over their tests (fresh clone, 2 cores):
+# dealt out to the workers first. pytest-xdist hands out whole files (--dist loadfile), by
+# default the files with the most tests first, which left the few long single tests (the
+# 10,000-shot archive, the cold shot, mypy) for the end, one worker running them while the
+# other idled (about 12 s of a run's wall time).
+LONGEST_FIRST = {"tests/fit/test_fit.py": 46, "tests/cli/test_full_disk_studies.py": 44, "tests/docs/test_docs.py": 38,
+                 "tests/instruments/test_archive_scale.py": 28, "tests/solver/test_models.py": 27,
+                 "tests/cli/test_full_disk.py": 25, "tests/instruments/test_archive_flips.py": 24,
+                 "tests/cli/test_cold_start.py": 21, "tests/study/test_fig3_studies.py": 18,
+                 "tests/instruments/test_archive.py": 17, "tests/study/test_mc.py": 15, "tests/test_typing.py": 15,
+                 "tests/cli/test_small_disk.py": 14, "tests/bench/test_models_bench.py": 12,
+                 "tests/fit/test_joint.py": 11, "tests/study/test_failures.py": 10,
+                 "tests/bench/test_modules_import.py": 10}
+
+
+def pytest_configure(config):
+    """The controller deals the files out in the order the workers collected them
+    (pytest_collection_modifyitems), not reordered by their number of tests."""
+    if hasattr(config.option, "loadscopereorder"):
+        config.option.loadscopereorder = False
+
+
+def pytest_collection_modifyitems(items):
+    """The files of LONGEST_FIRST first, longest first; then the others, those with the
+    most tests first (pytest-xdist's own order); the tests of a file in their order."""
+    counts: dict = {}
+    for item in items:
+        counts[item.nodeid.split("::")[0]] = counts.get(item.nodeid.split("::")[0], 0) + 1
+    order = {f: k for k, f in enumerate(sorted(counts, key=lambda f: (-LONGEST_FIRST.get(f, 0), -counts[f])))}
+    items.sort(key=lambda item: order[item.nodeid.split("::")[0]])
+
 
 def pytest_terminal_summary(terminalreporter):
     for line in COMPILED:
