@@ -31,6 +31,7 @@ from . import (
     configuration,
     display,
     horizontal,
+    manual_settings,
     measurements,
     rig_commands,
     setup,
@@ -114,6 +115,7 @@ class VirtualScope:
         configuration.register(tree, self)
         tds_commands.register(tree, self)  # the TDS2000's other names for the commands above
         display.register(tree, self)  # after the modelled display commands: the manual's others, kept
+        manual_settings.register(tree, self)  # last: its group queries answer the settings registered above
         in_model_manual = partial(in_manual, self.personality.name)
         self.engine = Engine(tree, self.status, self.form, in_model_manual)
         self.rig_engine = Engine(rig_tree, self.status, self.form, in_model_manual)

@@ -16,6 +16,7 @@ from ..errors import InstrumentError
 from ..scpi.tree import Mnemonic
 
 MODELS = ("tds2000", "mdo3000", "mso4")
+LETTERED = {"tds2000"}  # models whose reference waveforms are REFA to REFD (the manual's REF<x>), not REF1 to REF4
 ENUM = re.compile(r"\{([^{}]*)\}")
 WORD = re.compile(r"[A-Za-z0-9_]+(<x>[A-Za-z0-9_]*)?")  # a word of an enumeration (CH<x>: a numbered one)
 
@@ -30,11 +31,14 @@ class ManualCommand:
     query: bool
     write: bool
     args: str = ""
+    lettered: bool = False  # REF<x> is REFA to REFD (LETTERED)
 
     @property
     def concrete(self) -> str:
-        """The header with every <x> taken as 1 and every {A|B} choice as its first."""
-        return ENUM.sub(lambda m: m.group(1).split("|")[0], self.header.replace("<x>", "1"))
+        """The header with every <x> taken as 1 (REF<x> as REFA where ``lettered``) and every
+        {A|B} choice as its first."""
+        header = self.header.replace("REF<x>", "REFA") if self.lettered else self.header
+        return ENUM.sub(lambda m: m.group(1).split("|")[0], header.replace("<x>", "1"))
 
     @property
     def words(self) -> tuple:
@@ -59,7 +63,7 @@ def manual(model: str) -> tuple:
         head = head.rstrip("?")
         old = heads.get(head, ManualCommand(group, head, False, False))
         heads[head] = ManualCommand(group, head, old.query or query, old.write or not query,
-                                    old.args or ("" if query else args))
+                                    old.args or ("" if query else args), model in LETTERED)
     return tuple(heads.values())
 
 
