@@ -20,7 +20,7 @@ why), refusal, protocol violation, refused command (with the event it left in th
 shot, shot that did not trigger and refused shot. A second ``--vxi11`` server on loopback
 whose portmapper maps another server's VXI-11 moves its VXI-11 channels to a loopback address
 of its own (127.0.0.2, ...), with a portmapper there, so that both are found and neither
-unregisters the other.
+unregisters the other (rig/lab/serve_vxi11.py).
 """
 from __future__ import annotations
 
@@ -36,10 +36,10 @@ from typing import TypeVar
 
 from instruments.errors import InstrumentError
 from instruments.records import ScopeRecord
-from instruments.transports.addresses import LOOPBACK_V4, is_loopback, is_wildcard, machine_addresses
+from instruments.transports.addresses import is_loopback, is_wildcard, machine_addresses
 from instruments.transports.device import MessageInstrument
 from instruments.transports.hislip import HislipServer
-from instruments.transports.portmap import PMAP_PORT, MappingTaken
+from instruments.transports.portmap import PMAP_PORT
 from instruments.transports.socket import SocketServer
 from instruments.transports.vxi11 import Vxi11Server
 from instruments.transports.wire import ConnectionEvent, EventKind, Limits, printable
@@ -47,6 +47,7 @@ from instruments.virtual_scope.instrument import VirtualScope
 from rig.errors import invalid
 from rig.experiment.shot import ShotRecord, fresh_seed
 from rig.lab.serve_log import LoggedInstrument, Refusals, server_log
+from rig.lab.serve_vxi11 import announce
 from rig.lab.shots import SceneShots, append_shot
 
 
@@ -113,8 +114,6 @@ def _port(name: str, port: int | None) -> None:
 
 
 _Server = TypeVar("_Server", SocketServer, HislipServer, Vxi11Server)
-VXI11_ADDRESSES = 8
-"""Loopback addresses (127.0.0.2 on) a second VXI-11 server tries for a portmapper of its own."""
 
 
 class ScopeServer:
@@ -215,7 +214,11 @@ class ScopeServer:
             self._listening(self._names[id(server)], server)
             if isinstance(server, Vxi11Server):
                 self._tell(f"VXI-11 abort channel on {server.host} port {server.abort_port}")
-                self._vxi11 = self._announce(server, s)
+                self._vxi11 = announce(server, s.portmapper_port, self._tell, self._vxi11_at)
+                if self._vxi11 is not server:  # moved to a loopback address of its own
+                    self.servers[self.servers.index(server)] = self._vxi11
+                    self._names[id(self._vxi11)] = "VXI-11 core channel"
+                    server.close()
         self.resources += [self._socket.resource_at(a) for a in self._addresses(self._socket.host)]
         if self._hislip is not None:
             self.resources += [self._hislip.resource_at(a) for a in self._addresses(self._hislip.host)]
@@ -234,59 +237,16 @@ class ScopeServer:
         self.say(line)
         self.log.info("%s", line)
 
+    def _vxi11_at(self, address: str) -> Vxi11Server:
+        """The scope's VXI-11 server on ``address``, started."""
+        return Vxi11Server(LoggedInstrument(self.scope, self.refusals, "VXI-11"), address, 0,
+                           limits=self.settings.limits, on_event=self._on_event).start()
+
     @staticmethod
     def _addresses(host: str) -> list[str]:
         """The addresses a client opens a server listening on ``host`` at: this machine's
         own for a wildcard (0.0.0.0, ::), which no remote client can open."""
         return machine_addresses(host) if is_wildcard(host) else [host]
-
-    def _announce(self, vx: Vxi11Server, s: ServeSettings) -> Vxi11Server:
-        """Make VXI-11 findable through the portmapper; where another server's VXI-11 holds the
-        loopback portmapper, on a loopback address of its own. The server that serves it."""
-        try:
-            self._tell(f"VXI-11: {vx.announce(portmapper_port=s.portmapper_port)}")
-            return vx
-        except MappingTaken as e:
-            moved = self._vxi11_elsewhere(e.port, s) if vx.host == LOOPBACK_V4 else None
-            if moved is None:
-                self._tell(f"VXI-11: {e}")
-                return vx
-        except InstrumentError as e:  # no portmapper: clients name the core port
-            self._tell(f"VXI-11: {e}")
-            return vx
-        self.servers[self.servers.index(vx)] = moved
-        vx.close()
-        return moved
-
-    def _vxi11_elsewhere(self, taken: int, s: ServeSettings) -> Vxi11Server | None:
-        """VXI-11 on 127.0.0.2, 127.0.0.3, ... with a portmapper there; None when no loopback
-        address of this machine takes it (one portmapper answering on all of them, or no
-        such address, as off Linux)."""
-        for last in range(2, 2 + VXI11_ADDRESSES):
-            address = f"127.0.0.{last}"
-            try:
-                vx = Vxi11Server(LoggedInstrument(self.scope, self.refusals, "VXI-11"), address, 0,
-                                 limits=s.limits, on_event=self._on_event).start()
-            except (InstrumentError, OSError):
-                return None
-            try:
-                how = vx.announce(portmapper_port=s.portmapper_port)
-            except MappingTaken as e:
-                vx.close()
-                if e.port == taken:  # the same portmapper answers there: no address of its own helps
-                    return None
-                continue
-            except InstrumentError:
-                vx.close()
-                continue
-            self._tell(f"VXI-11: the portmapper on {LOOPBACK_V4} port {s.portmapper_port} maps another server's "
-                       f"VXI-11 (core port {taken}): this one moves to {address}, a loopback address of its own")
-            self._names[id(vx)] = "VXI-11 core channel"
-            self._listening("VXI-11 core channel", vx)
-            self._tell(f"VXI-11 abort channel on {vx.host} port {vx.abort_port}")
-            self._tell(f"VXI-11: {how}")
-            return vx
-        return None
 
     # ---- what the log says ---------------------------------------------------------------
 
