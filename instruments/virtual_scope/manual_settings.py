@@ -16,12 +16,17 @@ the model's manual (manual.py) lists it:
 - ``FACtory``: the factory set-up, as ``*RST`` and ``RECAll:SETUp FACtory`` give it.
 - ``ACQuire:MAXSamplerate?`` (MDO3000): the model's real-time rate, as
   ``CONFIGuration:ANALOg:MAXSAMPLERate?`` answers it.
+- ``TRIGger:A:HOLDoff:TIMe`` (0 to 10 s, the manuals' range; 0 s until set, the manuals
+  giving no factory value): kept and answered. The holdoff keeps the trigger from re-arming
+  for that long after a trigger; an emulated acquisition ends at its first trigger, so it
+  changes no record.
 - Settings taken at the one value that is emulated, any other of the manual's values
   refused with 221 "not modelled" (never taken and then ignored): ``CH<x>:INVert OFF``,
   ``CH<x>:YUNit "V"`` (the gauges are read in volts; current probes are not modelled),
   ``CH<x>:IMPedance MEG`` (1 MOhm, the input the gauges' RC filter is computed for),
   ``SELect:MATH OFF`` and ``SELect:REF<x> OFF`` (no math or reference waveforms),
-  ``HORizontal:VIEW MAIn`` (no zoom window)."""
+  ``HORizontal:VIEW MAIn`` (no zoom window), ``CH<x>:PROBEFunc:EXTAtten 1`` (no external
+  attenuator: the probe's own attenuation is ``CH<x>:PRObe``)."""
 from __future__ import annotations
 
 from ..scpi.engine import Call, Fields, Word
@@ -30,11 +35,14 @@ from ..scpi.tree import Mnemonic
 from .configuration import max_sample_rate
 from .manual import MODELS, manual, normal
 
-ONE_VALUE = {  # header: (the emulated value's word or string, how the manual's syntax writes the set form)
+ONE_VALUE = {  # header: (the emulated value's word, string or number, how the manual's syntax writes the set form)
     "CH<x>:INVert": ("OFF", "word"), "CH<x>:YUNit": ('"V"', "string"), "CH<x>:IMPedance": ("MEG", "word"),
     "SELect:MATH": ("0", "switch"), "SELect:REF<x>": ("0", "switch"), "HORizontal:VIEW": ("MAIn", "word"),
+    "CH<x>:PROBEFunc:EXTAtten": ("1.0", "number"),
 }
 IMPEDANCE_OHM = 1e6
+EXTERNAL_ATTENUATION = (1e-10, 1e10)  # CH<x>:PROBEFunc:EXTAtten's range (4 Series manual), a multiplier
+HOLDOFF_S = (0.0, 10.0)  # TRIGger:A:HOLDoff:TIMe's range (MDO3000 and 4 Series manuals), s
 UNITS = ("V", "A")  # CH<x>:YUNit's strings (TDS1000B/2000B: volts, or amperes with a current probe)
 
 
@@ -71,12 +79,23 @@ def register(tree, scope) -> None:
     add("UNLock", write=unlock)
     add("REM", write=comment)
     add("FACtory", write=lambda c: scope.reset())
+    holdoff = {"s": HOLDOFF_S[0]}
+
+    def set_holdoff(c: Call):
+        t = c.number("S")
+        if not HOLDOFF_S[0] <= t <= HOLDOFF_S[1]:
+            raise ScpiError(-222, f"{c.header} {t:g} s: allowed 0 to 10 s")
+        holdoff["s"] = t
+
+    add("TRIGger:A:HOLDoff:TIMe", write=set_holdoff, read=lambda c: scope.personality.number(holdoff["s"]))
     rate = max_sample_rate(scope.personality)
     if rate is not None:
         add("ACQuire:MAXSamplerate", read=lambda c: scope.personality.number(rate))
     for header, (value, form) in ONE_VALUE.items():
         words = listed[normal(header)].words if normal(header) in listed else ()
-        add(header, write=one_value(words, value, form), read=lambda c, v=value, f=form: Word(v) if f == "word" else v)
+        add(header, write=one_value(words, value, form),
+            read=lambda c, v=value, f=form: Word(v) if f == "word" else scope.personality.number(float(v))
+            if f == "number" else v)
     for command in manual(model):  # the group queries, once their settings are in the tree
         if command.query and not command.write and not command.args and "{" not in command.header:
             node = group_node(tree, command.header)
@@ -107,6 +126,11 @@ def one_value(words: tuple, value: str, form: str):
             if unit not in UNITS:
                 raise ScpiError(-224, f"{c.header} {a.text[:40]}: allowed {', '.join(UNITS)}")
             taken = unit == value.strip('"')
+        elif form == "number":  # CH<x>:PROBEFunc:EXTAtten <NR3>
+            x = c.number()
+            if not EXTERNAL_ATTENUATION[0] <= x <= EXTERNAL_ATTENUATION[1]:
+                raise ScpiError(-222, f"{c.header} {x:g}: allowed 1E-10 to 1E10")
+            taken = x == float(value)
         elif a.kind == "number":  # CH<x>:IMPedance <NR3>: ohms
             taken = c.number("OHM") == IMPEDANCE_OHM
         else:

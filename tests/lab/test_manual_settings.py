@@ -111,3 +111,26 @@ def test_a_command_of_another_models_manual_stays_undefined(make_scope, personal
 def test_the_mdo3000s_max_sample_rate_is_its_models(make_scope, idn, rate):
     scope, s, _ = make_scope("mdo3000", idn=idn)
     assert ask(s, "ACQUIRE:MAXSAMPLERATE?") == ask(s, "CONFIGURATION:ANALOG:MAXSAMPLERATE?") == rate
+
+
+@pytest.mark.parametrize("personality", ["mdo3000", "mso4"])
+def test_the_trigger_holdoff_is_kept_within_the_manuals_range(make_scope, personality):
+    """An unseen program waited 5 s on TRIGger:A:HOLDoff:TIMe? (113, no answer)."""
+    scope, s, _ = make_scope(personality)
+    assert float(ask(s, "TRIGGER:A:HOLDOFF:TIME?")) == 0.0
+    s.handle(b"TRIGGER:A:HOLDOFF:TIME 250ms")
+    assert float(ask(s, "TRIG:A:HOLD:TIM?")) == 0.25 and events(s) == []
+    for bad in (b"TRIGGER:A:HOLDOFF:TIME 10.5", b"TRIGGER:A:HOLDOFF:TIME -1E-9"):
+        s.handle(bad)
+        assert events(s) == [222] and float(ask(s, "TRIGGER:A:HOLDOFF:TIME?")) == 0.25
+
+
+def test_the_4_series_external_attenuation_is_one_and_refuses_others(make_scope):
+    scope, s, _ = make_scope("mso4")
+    assert float(ask(s, "CH2:PROBEFUNC:EXTATTEN?")) == 1.0
+    s.handle(b"CH2:PROBEFUNC:EXTATTEN 1")
+    assert events(s) == []
+    s.handle(b"CH2:PROBEFUNC:EXTATTEN 10")  # would scale the channel's volts: not modelled, not taken
+    assert events(s) == [221] and float(ask(s, "CH2:PROBEFUNC:EXTATTEN?")) == 1.0
+    s.handle(b"CH2:PROBEFUNC:EXTATTEN 1E11")
+    assert events(s) == [222]
