@@ -153,14 +153,15 @@ def test_trace_fit_recovers_modulus_and_damping_from_one_shot(tmp_path):
 def test_trace_fit_of_a_csv_export_is_the_fit_of_its_record(tmp_path):
     """A CSV export gives volts, not the scope's codes: the fit finds the ADC's rounding from
     the grid the volts lie on (2 mV here; without it the wall channel's 0.5 mV noise alone
-    made chi2/dof 2.3), so the export fits as its record does, to the CSV's printed digits."""
+    made chi2/dof 2.3), so the export fits as its record does, to the CSV's printed digits.
+    The record is the scene's first half (HALF)."""
     from instruments.formats import read_record
     from instruments.formats.tek_csv import write_csv
 
-    shot = Rig.from_scene(SCENE).fire(seed=3)
+    shot = Rig.from_scene(SCENE, HALF).fire(seed=3)
     paths = write_csv(shot.scope.waveforms, tmp_path, "shot")  # one file per channel
     params = parse_parameters(["chain.youngs_modulus=0.5 GPa:3 GPa"])
-    direct, exported = (fit(TraceObjective(SCENE, params, [rec])) for rec in (shot.scope, read_record(paths)))
+    direct, exported = (fit(TraceObjective(SCENE, params, [rec], HALF)) for rec in (shot.scope, read_record(paths)))
     assert exported.chi2_reduced == pytest.approx(direct.chi2_reduced, rel=1e-3)
     assert abs(exported.estimate[0] - direct.estimate[0]) < 0.01 * direct.std[0]
     assert exported.std[0] == pytest.approx(direct.std[0], rel=1e-3)
