@@ -1,9 +1,11 @@
 """The documentation matches the program: the site builds with warnings as errors, and the
 code blocks of README.md and docs/**/*.md run.
 
-- ```bash blocks: each ``rig ...`` command runs as a subprocess (``python -m rig.cli``) in
-  a fresh folder per page, blocks in page order, and must exit 0 (or the block's
-  ``<!-- exit: N -->``); ``python docs/...`` scripts run too. Installing, the test suite
+- ```bash blocks: each ``rig ...`` command runs as the ``rig`` console script does
+  (``rig.cli.main``, in this process: the command line's own process is tested by
+  tests/cli/test_startup.py) in a fresh folder per page, blocks in page order, and must
+  exit 0 (or the block's ``<!-- exit: N -->``); ``python docs/...`` scripts run as
+  subprocesses. Installing, the test suite
   and building the site (SETUP) are listed as not run; any other command fails the test.
   A block marked ``<!-- slow: WHY -->`` or ``<!-- needs: WHAT -->`` is checked by the
   command line's parser only (the command and its flags exist). What is not run is listed
@@ -13,7 +15,9 @@ code blocks of README.md and docs/**/*.md run.
 """
 from __future__ import annotations
 
+import contextlib
 import glob
+import io
 import json
 import os
 import subprocess
@@ -68,7 +72,24 @@ def _run(argv: list, folder: Path, where: str, expected: int) -> str:
     return done.stdout
 
 
-def _bash(block, folder: Path, report: list):
+def _rig(argv: list, folder: Path, where: str, expected: int, monkeypatch) -> str:
+    """``rig`` + ``argv`` run in ``folder``; its stdout."""
+    from rig.cli import main
+
+    monkeypatch.chdir(folder)
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(argv)
+        except SystemExit as exc:  # the parser's own exit (--help, a refused flag)
+            code = exc.code
+    assert code == expected, (
+        f"{where}: rig {' '.join(argv)} exited {code}, the page says {expected}\n"
+        f"stdout: {out.getvalue()[-2000:]}\nstderr: {err.getvalue()[-2000:]}")
+    return out.getvalue()
+
+
+def _bash(block, folder: Path, report: list, monkeypatch):
     expected = int(block.marker("exit") or 0)
     last_json = None
     for words in block.commands():
@@ -78,7 +99,7 @@ def _bash(block, folder: Path, report: list):
                 _parse_only(words[1:], block.where)
                 report.append(f"{block.where}: parsed only ({block.not_run}): {line[:100]}")
                 continue
-            last_json = _run(["-m", "rig.cli", *_expand(words[1:], folder)], folder, block.where, expected)
+            last_json = _rig(_expand(words[1:], folder), folder, block.where, expected, monkeypatch)
         elif words[0] == "python" and len(words) > 1 and words[1].startswith("docs/"):
             _run([str(ROOT / words[1]), *words[2:]], folder, block.where, 0)
         else:
@@ -107,7 +128,7 @@ def test_code_blocks_run(page, tmp_path, monkeypatch):
     report, namespace = [], {"__name__": "__docs__"}
     for block in blocks(page):
         if block.language == "bash":
-            _bash(block, tmp_path, report)
+            _bash(block, tmp_path, report, monkeypatch)
         else:
             _python(block, tmp_path, namespace, report, monkeypatch)
     if report:

@@ -37,7 +37,10 @@ def entry(seed: int, truth=True) -> Entry:
 
 
 # a writer appending one shot at a time, which stops at each point of a transaction (it
-# prints the point's name) until it reads "go", and prints "commit ID" after each append
+# prints the point's name) until it reads "go", and prints "commit ID" after each append.
+# Writers are forked from one process that has imported the archive and the scope once: a
+# line "START" forks a writer (it prints "pid PID") appending shots START, START + 1, ...;
+# when that writer ends, its parent prints "exit CODE" (negative: the signal that ended it)
 WRITER = r"""
 import os, shutil, sys
 sys.path[:0] = {paths!r}
@@ -48,7 +51,7 @@ from instruments.archive import Archive
 def pause(event):
     print(event, flush=True)
     if sys.stdin.readline().strip() != "go":
-        sys.exit(0)
+        os._exit(0)
 
 def after(event, function, when=lambda *a: True):
     def hooked(*args, **kw):
@@ -58,24 +61,45 @@ def after(event, function, when=lambda *a: True):
         return out
     return hooked
 
+def write(path, i):
+    print("pid", os.getpid(), flush=True)
+    a = Archive(path)
+    while True:
+        ids = a.append([entry(i)])
+        print("commit", ids[0], flush=True)
+        i += 1
+
 archive.shutil.copyfile = after("copied", shutil.copyfile)
 archive._fsync = after("written", archive._fsync, lambda p: str(p).endswith(".tmp"))
 archive.os.replace = after("replaced", os.replace)
 append = Archive.append
 Archive.append = lambda self, entries: (pause("idle"), append(self, entries))[1]
-a = Archive(sys.argv[1])
-i = int(sys.argv[2])
-while True:
-    ids = a.append([entry(i)])
-    print("commit", ids[0], flush=True)
-    i += 1
+entry(0)  # the scope's kernel is loaded before the first fork, not in every writer
+for line in iter(sys.stdin.readline, ""):
+    pid = os.fork()
+    if pid == 0:
+        try:
+            write(sys.argv[1], int(line))
+        finally:
+            os._exit(1)  # a writer never goes on as the forking process
+    print("exit", os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]), flush=True)
 """
 
 
-def _writer(path, start):
+def _writers(path):
+    """The process that forks the writers on `path` (its own process group: killpg ends all)."""
     code = WRITER.format(paths=[os.path.dirname(__file__), os.getcwd()])
-    return subprocess.Popen([sys.executable, "-c", code, str(path), str(start)],
+    return subprocess.Popen([sys.executable, "-c", code, str(path)], start_new_session=True,
                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+
+
+def _fork_writer(writers, start) -> int:
+    """Fork a writer appending shots `start`, `start` + 1, ...; returns its process id."""
+    writers.stdin.write(f"{start}\n")
+    writers.stdin.flush()
+    event = writers.stdout.readline().split()
+    assert event[0] == "pid", event
+    return int(event[1])
 
 
 def test_round_trip_is_bit_identical(tmp_path):
@@ -114,32 +138,36 @@ def test_sigkill_at_every_point_of_an_append_never_loses_a_committed_shot(tmp_pa
     plan = [(int(n), KILL_POINTS[k % len(KILL_POINTS)])
             for k, n in enumerate(np.random.default_rng(2024).integers(0, 3, 20))]
     committed, start, mid_transaction = [1], 1, 0
-    for n_commits, point in plan:
-        proc = _writer(path, start + 1)
-        watchdog = threading.Timer(120, proc.kill)  # a safety net only: a hung writer fails, not hangs
-        watchdog.start()
-        done = []
-        for line in proc.stdout:
-            event = line.split()
-            if event[0] == "commit":
-                done.append(int(event[1]))
-            elif len(done) == n_commits and event[0] == point:
-                proc.send_signal(signal.SIGKILL)
-                mid_transaction += point != "idle"
-                break
-            else:
-                proc.stdin.write("go\n")
-                proc.stdin.flush()
-        proc.communicate()
+    writers = _writers(path)
+    watchdog = threading.Timer(120, os.killpg, (writers.pid, signal.SIGKILL))  # a hung writer fails, not hangs
+    watchdog.start()
+    try:
+        for n_commits, point in plan:
+            pid = _fork_writer(writers, start + 1)
+            done = []
+            for line in writers.stdout:
+                event = line.split()
+                if event[0] == "commit":
+                    done.append(int(event[1]))
+                elif len(done) == n_commits and event[0] == point:
+                    os.kill(pid, signal.SIGKILL)
+                    mid_transaction += point != "idle"
+                    break
+                else:
+                    writers.stdin.write("go\n")
+                    writers.stdin.flush()
+            assert writers.stdout.readline().split() == ["exit", str(-signal.SIGKILL)] and len(done) == n_commits
+            committed += done
+            start += len(done) + 1
+            a = Archive(path)
+            ids = a.ids()
+            assert set(committed) <= set(ids)  # every shot reported committed is there
+            report = a.verify()
+            assert report["bad"] == [] and report["shots"] == len(ids)
+    finally:
         watchdog.cancel()
-        assert proc.returncode == -signal.SIGKILL and len(done) == n_commits
-        committed += done
-        start += len(done) + 1
-        a = Archive(path)
-        ids = a.ids()
-        assert set(committed) <= set(ids)  # every shot reported committed is there
-        report = a.verify()
-        assert report["bad"] == [] and report["shots"] == len(ids)
+        os.killpg(writers.pid, signal.SIGKILL)
+        writers.communicate()
     assert len(committed) == 1 + sum(n for n, _ in plan) and mid_transaction == 15
     n = len(Archive(path).ids())
     assert Archive(path).append([entry(99999)]) == [n + 1]  # the next append works
@@ -186,10 +214,11 @@ def test_reader_sees_only_complete_shots_while_a_writer_appends(tmp_path):
     # the reader opens the archive at every point of the writer's transactions
     path = tmp_path / "live.h5"
     Archive(path).append([entry(0)])
-    proc = _writer(path, 1)
+    writers = _writers(path)
     seen = []
     try:
-        for line in proc.stdout:
+        _fork_writer(writers, 1)
+        for line in writers.stdout:
             a = Archive(path)
             ids = a.ids()
             assert a.read(ids[-1]).shot_id == ids[-1]  # sha256 checked: complete, consistent data
@@ -197,11 +226,11 @@ def test_reader_sees_only_complete_shots_while_a_writer_appends(tmp_path):
             if len(ids) == 6:
                 break
             if not line.startswith("commit"):
-                proc.stdin.write("go\n")
-                proc.stdin.flush()
+                writers.stdin.write("go\n")
+                writers.stdin.flush()
     finally:
-        proc.kill()
-        proc.communicate()
+        os.killpg(writers.pid, signal.SIGKILL)
+        writers.communicate()
     assert seen[0] == 1 and seen[-1] == 6 and len(seen) > 5 * 4  # read before, inside and after appends
     assert Archive(path).verify()["bad"] == []
 
