@@ -126,7 +126,9 @@ def test_round_trip_is_bit_identical(tmp_path):
         assert np.allclose(t[()] * t.attrs["scale_factor"] + t.attrs["add_offset"], w.time(), rtol=1e-12, atol=1e-18)
 
 
-KILL_POINTS = ("idle", "copied", "written", "replaced")  # between appends, then inside one
+# (point, its occurrence within one append): between appends, then inside one, where an
+# append writes and renames its part file, then copies, writes and renames the archive's
+KILL_POINTS = (("idle", 1), ("copied", 1), ("written", 1), ("replaced", 1), ("written", 2), ("replaced", 2))
 
 
 @pytest.mark.slow
@@ -135,21 +137,21 @@ def test_sigkill_at_every_point_of_an_append_never_loses_a_committed_shot(tmp_pa
     # it at a chosen point after a chosen number of commits: events, not wall-clock windows
     path = tmp_path / "crash.h5"
     Archive(path).append([entry(0)])  # every append copies the archive: each point is reached
-    plan = [(int(n), KILL_POINTS[k % len(KILL_POINTS)])
+    plan = [(int(n), *KILL_POINTS[k % len(KILL_POINTS)])
             for k, n in enumerate(np.random.default_rng(2024).integers(0, 3, 20))]
     committed, start, mid_transaction = [1], 1, 0
     writers = _writers(path)
     watchdog = threading.Timer(120, os.killpg, (writers.pid, signal.SIGKILL))  # a hung writer fails, not hangs
     watchdog.start()
     try:
-        for n_commits, point in plan:
+        for n_commits, point, occurrence in plan:
             pid = _fork_writer(writers, start + 1)
-            done = []
+            done, reached = [], 0
             for line in writers.stdout:
                 event = line.split()
                 if event[0] == "commit":
                     done.append(int(event[1]))
-                elif len(done) == n_commits and event[0] == point:
+                elif len(done) == n_commits and event[0] == point and (reached := reached + 1) == occurrence:
                     os.kill(pid, signal.SIGKILL)
                     mid_transaction += point != "idle"
                     break
@@ -168,7 +170,7 @@ def test_sigkill_at_every_point_of_an_append_never_loses_a_committed_shot(tmp_pa
         watchdog.cancel()
         os.killpg(writers.pid, signal.SIGKILL)
         writers.communicate()
-    assert len(committed) == 1 + sum(n for n, _ in plan) and mid_transaction == 15
+    assert len(committed) == 1 + sum(n for n, _, _ in plan) and mid_transaction == 16
     n = len(Archive(path).ids())
     assert Archive(path).append([entry(99999)]) == [n + 1]  # the next append works
     assert not list(tmp_path.glob(".crash.h5.*.tmp"))  # stale temporaries were cleaned
