@@ -13,6 +13,7 @@ checked the same way (an exception it lets out fails the test, as a traceback wo
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -82,8 +83,10 @@ def run_case(argv, d: Path, realdata, limit=None):
     """``argv`` in a process of its own in folder ``d``, its files limited to ``limit``
     bytes (DISK_FULL) where one is given."""
     code = DISK_FULL if limit else "import sys\nfrom rig.cli import main\nsys.exit(main(sys.argv[2:]))\n"
+    # and none by the processes it starts (rig mc --workers: spawned interpreters, the limit inherited)
+    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1") if limit else None
     return subprocess.run([sys.executable, "-c", code, str(limit or 0), *expand(argv, d, realdata)], check=False,
-                          capture_output=True, text=True, cwd=d, timeout=600)
+                          capture_output=True, text=True, cwd=d, timeout=600, env=env)
 
 
 def run_here(argv, d: Path, realdata, monkeypatch, capsys) -> tuple:
