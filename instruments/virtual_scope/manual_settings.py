@@ -93,14 +93,12 @@ def register(tree, scope) -> None:
         add("ACQuire:MAXSamplerate", read=lambda c: scope.personality.number(rate))
     for header, (value, form) in ONE_VALUE.items():
         words = listed[normal(header)].words if normal(header) in listed else ()
-        add(header, write=one_value(words, value, form),
-            read=lambda c, v=value, f=form: Word(v) if f == "word" else scope.personality.number(float(v))
-            if f == "number" else v)
+        add(header, write=one_value(words, value, form), read=lambda c, v=value, f=form: answer(scope, v, f))
     for command in manual(model):  # the group queries, once their settings are in the tree
         if command.query and not command.write and not command.args and "{" not in command.header:
             node = group_node(tree, command.header)
             if node is not None and tree.find(tokens(command.header)) is None:
-                tree.add(command.header.replace("<x>", "<n>"), read=group_query(tree, command.header, node))
+                tree.add(command.header.replace("<x>", "<n>"), read=group_query(node))
 
 
 def tokens(header: str) -> tuple:
@@ -112,6 +110,14 @@ def tokens(header: str) -> tuple:
 def comment(c: Call) -> None:
     """REM: a comment in a program, its string read and nothing done."""
     c.taken[0] = len(c.args)
+
+
+def answer(scope, value: str, form: str):
+    """A one-value setting's query answer: a word in the reply form, a number in the
+    model's NR3, a string or a switch as it is."""
+    if form == "word":
+        return Word(value)
+    return scope.personality.number(float(value)) if form == "number" else value
 
 
 def one_value(words: tuple, value: str, form: str):
@@ -158,7 +164,7 @@ def leaf(node) -> bool:
     return c is not None and c.read is not None and c.write is not None and not node.mnemonic.numbered
 
 
-def group_query(tree, header: str, node):
+def group_query(node):
     """The read handler of a group query: Fields of the settings beneath ``node``."""
     def read(c: Call):
         pairs, seen = [], set()
