@@ -22,15 +22,18 @@ import os
 import time
 from dataclasses import dataclass
 
-from numba.core import ir, types
+from numba.core import ir, sigutils, types
 from numba.core.caching import FunctionCache
 from numba.core.compiler import CompilerBase, DefaultPassBuilder
 from numba.core.compiler_machinery import FunctionPass, register_pass
 from numba.core.ir_utils import get_definition, guard
 from numba.core.registry import CPUDispatcher
+from numba.core.typed_passes import NopythonTypeInference
 from numba.core.types import unliteral
 from numba.core.untyped_passes import IRProcessing
 from numba.extending import typeof_impl
+
+from numerics.callees import DEPTH, KernelLibraries, is_callee
 
 PER_VALUE = frozenset({"law", "flows", "multirate"})  # the parameters compiled per value (module doc)
 
@@ -99,11 +102,13 @@ def _read_type(func_ir, expr, args, arguments):
 
 
 class ConstantPipeline(CompilerBase):
-    """numba's nopython pipeline with ConstantArguments before its dead-branch pruning."""
+    """numba's nopython pipeline with ConstantArguments before its dead-branch pruning, and
+    the kernels' libraries (numerics/callees.py) before lowering."""
 
     def define_pipelines(self):
         passes = DefaultPassBuilder.define_nopython_pipeline(self.state)
         passes.add_pass_after(ConstantArguments, IRProcessing)
+        passes.add_pass_after(KernelLibraries, NopythonTypeInference)
         passes.finalize()
         return [passes]
 
@@ -124,18 +129,33 @@ class OneTypePerArgument(CPUDispatcher):
             return types.NamedTuple([self.typeof_pyval(x) for x in val], type(val))
         return super().typeof_pyval(val)
 
-    def enable_caching(self):
-        self._cache = SavedIfRoom(self.py_func)
-
     def compile(self, sig):
         """Compile (or load from numba's cache) the copy for ``sig``, called from Python or
-        from a kernel being compiled. If a side process compiles this kernel
-        (instruments/precompile.py), first wait until the cache holds its machine code (or
-        that process has ended)."""
+        from a kernel being compiled (then a callee's copy, numerics/callees.py; called from
+        Python, a kernel compiled as a callee only is compiled again, as a kernel of its
+        own). If a side process compiles this kernel (instruments/precompile.py), first
+        wait until the cache holds its machine code (or that process has ended)."""
         side = SIDE_COMPILES.get(f"{self.py_func.__module__}.{self.py_func.__qualname__}")
         while side is not None and side.poll() is None and not has_machine_code(self):
             time.sleep(POLL_S)
-        return super().compile(sig)
+        args, _ = sigutils.normalize_signature(sig)
+        if DEPTH[0] == 0 and is_callee(self.overloads.get(tuple(args))):
+            del self.overloads[tuple(args)]
+        DEPTH[0] += 1
+        try:
+            return super().compile(sig)
+        finally:
+            DEPTH[0] -= 1
+
+    def add_overload(self, cres):
+        """numba's, but a callee's copy is not entered in the table of calls from Python."""
+        if is_callee(cres):
+            self.overloads[tuple(cres.signature.args)] = cres
+        else:
+            super().add_overload(cres)
+
+    def enable_caching(self):
+        self._cache = SavedIfRoom(self.py_func)
 
 
 class SavedIfRoom(FunctionCache):
@@ -143,9 +163,12 @@ class SavedIfRoom(FunctionCache):
     a save that fails (a full disk, a file-size limit, a read-only cache folder) leaves the
     compiled kernel running and the command going on, as if the cache were off (numba lets
     the OSError end the command; its temporary file is removed either way). The next
-    command compiles that kernel again; the failure is logged (numerics.dispatcher, INFO)."""
+    command compiles that kernel again; the failure is logged (numerics.dispatcher, INFO).
+    A callee's copy is not kept (it has no machine code of its own: its callers' holds it)."""
 
     def save_overload(self, sig, data):
+        if is_callee(data):
+            return
         try:
             super().save_overload(sig, data)
         except OSError as e:

@@ -7,7 +7,8 @@ and the analysis' loops in the instruments' kernel packages) is declared with ``
 kept on disk), ``fastmath=False`` (IEEE arithmetic: results bit-identical to numpy's) and
 no C-callable wrapper (``no_cfunc_wrapper``: numba builds one for every function by
 default, for a function passed as a value, which no kernel does; 4% of the solver's
-compile time).
+compile time). A kernel compiled as another kernel's callee is optimised and turned into
+machine code once, in its callers' (numerics/callees.py), not in a library of its own too.
 A loop that divides and must vectorise takes ``error_model="numpy"`` (a division by zero
 gives inf, as in numpy; numba's default checks every divisor, a branch per element).
 A kernel package calls ``drop_stale_cache(__name__)`` in its ``__init__``.
