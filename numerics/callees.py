@@ -22,7 +22,7 @@ from numba.core.codegen import JITCodeLibrary
 from numba.core.compiler_machinery import FunctionPass, register_pass
 
 DEPTH = [0]  # kernels being compiled, nested (the dispatcher's compile counts them)
-TESTED = ((0, 58), (0, 69))
+TESTED = ((0, 68), (0, 69))
 """numba releases (from, before) whose code libraries this module was tested with: it uses
 their private parts (the modules linked, the final module); on another release numba
 compiles each callee in a library of its own, as numba does (the same machine code, a

@@ -9,10 +9,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
+from numerics.callees import ACTIVE, TESTED
 from numerics.jit import jit
 
 ROOT = Path(__file__).resolve().parents[1]
+pytestmark = pytest.mark.skipif(not ACTIVE, reason=f"numba releases {TESTED} only: others compile as numba does")
 
 
 @jit
