@@ -31,7 +31,6 @@ from __future__ import annotations
 
 from ..scpi.engine import Call, Fields, Word
 from ..scpi.status import ScpiError
-from ..scpi.tree import Mnemonic
 from .configuration import max_sample_rate
 from .manual import MODELS, manual, normal
 
@@ -102,9 +101,8 @@ def register(tree, scope) -> None:
 
 
 def tokens(header: str) -> tuple:
-    """A manual header as the tree's find() takes it: its long forms, <x> as 1."""
-    return tuple(Mnemonic(part.replace("<x>", "")).long + ("1" if "<x>" in part else "")
-                 for part in header.split(":"))
+    """A manual header as the tree's find() takes it: its long forms (capitals), <x> as 1."""
+    return tuple(part.replace("<x>", "1").upper() for part in header.split(":"))
 
 
 def comment(c: Call) -> None:

@@ -17,6 +17,7 @@ from ..records import Preamble
 from ..scpi.engine import Call, Fields, Word
 from ..scpi.status import ScpiError
 from .commands import CHANNEL_WORDS
+from .manual import LETTERED
 from .transfer import DataSelection, curve_bytes, preamble_fields, waveform_id
 
 WAVEFORM_FIELDS = ("WFId", "NR_Pt", "PT_Fmt", "XINcr", "PT_Off", "XZEro", "XUNit", "YMUlt", "YZEro", "YOFf", "YUNit")
@@ -147,7 +148,7 @@ def register(tree, scope) -> None:
         c.word(("INIT",))
         scope.data = DataSelection(stop=scope.initial["scope.record_length"])
 
-    destination = Word("REFA" if p.name == "tds2000" else "REF1")  # where DATa:DESTination would write (no refs)
+    destination = Word("REFA" if p.name in LETTERED else "REF1")  # where DATa:DESTination would write (no refs)
     tree.add("DATa", write=data_init, read=lambda c: Fields((
         ("DESTination", destination), ("ENCdg", Word(scope.data.encoding)), ("SOUrce", Word(scope.data.source)),
         ("STARt", str(scope.data.start)), ("STOP", str(scope.data.stop)), ("WIDth", str(scope.data.sent_width)))))
