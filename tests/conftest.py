@@ -91,9 +91,9 @@ def pytest_configure(config):
 def pytest_collection_modifyitems(items):
     """The files of LONGEST_FIRST first, longest first; then the others, those with the
     most tests first (pytest-xdist's own order); the tests of a file in their order."""
-    counts: dict = {}
-    for item in items:
-        counts[item.nodeid.split("::")[0]] = counts.get(item.nodeid.split("::")[0], 0) + 1
+    from collections import Counter
+
+    counts = Counter(item.nodeid.split("::")[0] for item in items)
     order = {f: k for k, f in enumerate(sorted(counts, key=lambda f: (-LONGEST_FIRST.get(f, 0), -counts[f])))}
     items.sort(key=lambda item: order[item.nodeid.split("::")[0]])
 

@@ -75,25 +75,23 @@ def test_lock_unlock_rem_and_factory(make_scope, personality):
     assert ask(s, "SET?") == factory and events(s) == []
 
 
-@pytest.mark.parametrize("personality, command, query, emulated", [
-    ("tds2000", "CH1:INVERT ON", "CH1:INVERT?", "OFF"),
-    ("tds2000", 'CH1:YUNIT "A"', "CH1:YUNIT?", '"V"'),
-    ("tds2000", "SELECT:MATH ON", "SELECT:MATH?", "0"),
-    ("tds2000", "SELECT:REFB 1", "SELECT:REFB?", "0"),
-    ("tds2000", "HORIZONTAL:VIEW WINDOW", "HORIZONTAL:VIEW?", "MAIN"),
-    ("mdo3000", "CH2:IMPEDANCE FIFTY", "CH2:IMPEDANCE?", "MEG"),
-    ("mdo3000", "CH2:IMPEDANCE 50", "CH2:IMPEDANCE?", "MEG"),
-    ("mso4", "CH3:INVERT 1", "CH3:INVERT?", "OFF"),
+@pytest.mark.parametrize("personality, header, taken, refused, answer", [
+    ("tds2000", "CH1:INVERT", "OFF", "ON", "OFF"),
+    ("tds2000", "CH1:YUNIT", '"V"', '"A"', '"V"'),
+    ("tds2000", "SELECT:MATH", "OFF", "ON", "0"),
+    ("tds2000", "SELECT:REFB", "OFF", "1", "0"),
+    ("tds2000", "HORIZONTAL:VIEW", "MAIN", "WINDOW", "MAIN"),
+    ("mdo3000", "CH2:IMPEDANCE", "MEG", "FIFTY", "MEG"),
+    ("mdo3000", "CH2:IMPEDANCE", "MEG", "50", "MEG"),
+    ("mso4", "CH3:INVERT", "OFF", "1", "OFF"),
 ])
 def test_a_setting_emulated_at_one_value_refuses_the_manuals_others_and_never_takes_them(
-        make_scope, personality, command, query, emulated):
+        make_scope, personality, header, taken, refused, answer):
     scope, s, _ = make_scope(personality)
-    header = command.split(" ")[0]
-    value = {"OFF": "OFF", '"V"': '"V"', "0": "OFF", "MAIN": "MAIN", "MEG": "MEG"}[emulated]
-    s.handle(f"{header} {value}".encode())
-    assert events(s) == [] and ask(s, query) == emulated
-    s.handle(command.encode())
-    assert events(s) == [221] and ask(s, query) == emulated
+    s.handle(f"{header} {taken}".encode())
+    assert events(s) == [] and ask(s, f"{header}?") == answer
+    s.handle(f"{header} {refused}".encode())
+    assert events(s) == [221] and ask(s, f"{header}?") == answer
     s.handle(f"{header} NOSUCHWORD".encode())
     assert events(s) == [224]
 
