@@ -8,6 +8,11 @@ jobs below, shared out over as many processes as there will be workers, fill the
 and the workers load from it. Nothing here is asserted; a job that fails is reported in one
 line and its kernels are compiled by the tests that need them (which then show the real
 error).
+
+``python tests/compile_once.py`` runs ``compile_all`` on every core and says what it did
+in one line; it needs only the rig's own dependencies (no pytest), so .ci/run starts it
+while pip is still installing the test extras, and the tests then find the kernels
+compiled (RIG_KERNELS_COMPILED set: conftest.py compiles nothing before the workers).
 """
 from __future__ import annotations
 
@@ -35,7 +40,7 @@ def run_job(name: str) -> None:
 
         compile_now({**SHOT, **SHOT_SMALL, **STUDY, **STUDY_SMALL})
         return
-    from conftest import PTFE
+    from chains import PTFE
 
     from rig import Bead, Chain, ChainProblem, MagneticBead, SaveAt, Striker, Wall, solve
     from rig.solver.ensemble import solve_ensemble
@@ -65,8 +70,20 @@ def compile_all(processes: int) -> tuple[float, list[str]]:
     return time.perf_counter() - t0, failed
 
 
+def said(wall: float, processes: int, failed: list[str], when: str) -> str:
+    """The one line that says what compile_all did, and ``when``."""
+    return (f"compiled the shared kernels once in {wall:.0f} s ({processes} processes) {when}"
+            + "".join(f"; failed: {f}" for f in failed))
+
+
 if __name__ == "__main__":
-    sys.path.insert(0, str(Path(__file__).parent))  # conftest's chain parts
+    sys.path.insert(0, str(Path(__file__).parent))  # the chains' parts (tests/chains.py)
+    if len(sys.argv) == 1:  # every job, on every core (.ci/run, while the test extras install)
+        import os
+
+        processes = os.cpu_count() or 1
+        wall, failed = compile_all(processes)
+        print(said(wall, processes, failed, "while pip installed the test extras"))
     for job in sys.argv[1:]:
         try:
             run_job(job)

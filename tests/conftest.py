@@ -1,27 +1,7 @@
-"""Shared chain builders for the tests (small chains keep the suite fast)."""
+"""The suite's fixtures and its order: the kernels compiled once before the workers start,
+the longest files dealt out first."""
 import pytest
-
-from rig import Bead, Chain, MagneticBead, SaveAt, Striker, Wall
-
-STEEL = dict(material="steel316", diameter="4.76 mm", mass="0.4501 g")
-PTFE = dict(material="ptfe", diameter="4.76 mm", mass="0.1226 g")
-
-
-def steel_sonic_vacuum(n=60, velocity="0.44 m/s", wall=False):
-    """Horizontal steel chain (no gravity, no precompression) struck by one bead mass."""
-    return Chain([Bead(**STEEL)] * n, striker=Striker("steel316", "0.4501 g", velocity),
-                 wall=Wall() if wall else None, gravity=0)
-
-
-def ptfe_rig(n=52, top_force=2.38, striker=True, velocity="0.89 m/s"):
-    """The published PTFE set-up: magnetic bead on n PTFE beads, wall, gravity."""
-    beads = [MagneticBead()] + [Bead(**PTFE)] * n
-    st = Striker("alumina", "0.47 g", velocity) if striker else None
-    return Chain(beads, striker=st, wall=Wall(), top_force=top_force)
-
-
-def record_contacts(chain, *contacts, **kw):
-    return SaveAt({f"c{k}": chain.contact_probe(k) for k in contacts}, **kw)
+from chains import steel_sonic_vacuum
 
 
 @pytest.fixture
@@ -53,16 +33,21 @@ def realdata():
 def pytest_sessionstart(session):
     """Before pytest-xdist starts its workers on a cold numba cache, compile the kernels
     most test files need once, in as many processes as there will be workers
-    (tests/compile_once.py), rather than once in every worker."""
+    (tests/compile_once.py), rather than once in every worker; not where RIG_KERNELS_COMPILED
+    says it was done before (.ci/run does it while pip installs the test extras)."""
+    import os
+
     config = session.config
     workers = getattr(config.option, "numprocesses", None)
     if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 2:
         return
-    from compile_once import compile_all
+    if os.environ.get("RIG_KERNELS_COMPILED"):
+        COMPILED.append(os.environ["RIG_KERNELS_COMPILED"])
+        return
+    from compile_once import compile_all, said
 
     wall, failed = compile_all(workers)
-    COMPILED.append(f"compiled the shared kernels once in {wall:.0f} s ({workers} processes) before the workers "
-                    "started" + "".join(f"; failed: {f}" for f in failed))
+    COMPILED.append(said(wall, workers, failed, "before the workers started"))
 
 
 COMPILED: list = []  # what pytest_sessionstart compiled, said in the summary

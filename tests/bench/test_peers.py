@@ -8,7 +8,7 @@ import importlib
 
 import numpy as np
 import pytest
-from conftest import STEEL, ptfe_rig, record_contacts, steel_sonic_vacuum
+from chains import STEEL, ptfe_rig, record_contacts, steel_sonic_vacuum
 
 from rig import Bead, Chain, ChainProblem, RigError, Wall, solve
 from rig.bench import lammps, peers

@@ -1,7 +1,7 @@
 """Energy and momentum of conservative shots."""
 import numpy as np
 import pytest
-from conftest import ptfe_rig, record_contacts
+from chains import ptfe_rig, record_contacts
 
 from rig import METHODS, ChainProblem, solve
 

@@ -7,7 +7,7 @@ where each method must still reach its declared ``contact_order``.
 """
 import numpy as np
 import pytest
-from conftest import STEEL, record_contacts, steel_sonic_vacuum
+from chains import STEEL, record_contacts, steel_sonic_vacuum
 
 from rig import METHODS, Bead, Chain, ChainProblem, Wall, solve
 from rig.solver.stepsize import contact_time_scale

@@ -1,7 +1,7 @@
 """The batched kernel against single shots: same step, same numbers."""
 import numpy as np
 import pytest
-from conftest import ptfe_rig, record_contacts
+from chains import ptfe_rig, record_contacts
 
 from rig import ChainProblem, RigError, solve
 from rig.solver.ensemble import solve_ensemble

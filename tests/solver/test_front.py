@@ -2,7 +2,7 @@
 bit of anything recorded (rig/solver/kernels/integrators.py)."""
 import numpy as np
 import pytest
-from conftest import ptfe_rig, record_contacts, steel_sonic_vacuum
+from chains import ptfe_rig, record_contacts, steel_sonic_vacuum
 
 from rig import Bead, Chain, ChainProblem, ForceSchedule, SaveAt, Striker, Wall
 from rig.solver.ensemble import solve_ensemble

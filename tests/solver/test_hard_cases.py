@@ -3,7 +3,7 @@ import importlib
 
 import numpy as np
 import pytest
-from conftest import PTFE, STEEL, ptfe_rig, record_contacts, steel_sonic_vacuum
+from chains import PTFE, STEEL, ptfe_rig, record_contacts, steel_sonic_vacuum
 
 from rig import Bead, Chain, ChainProblem, RigError, SaveAt, Striker, Wall, solve
 from rig.solver.methods import METHODS

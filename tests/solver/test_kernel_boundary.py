@@ -5,7 +5,7 @@ import re
 from pathlib import Path
 
 import numpy as np
-from conftest import ptfe_rig, record_contacts
+from chains import ptfe_rig, record_contacts
 
 from rig import ChainProblem
 from rig.model.laws.thornton import STATE_ROWS

@@ -2,7 +2,7 @@
 cache lines, at fixed offsets in a 4 KiB page, and no bit of a solve depends on it."""
 import numpy as np
 import pytest
-from conftest import ptfe_rig
+from chains import ptfe_rig
 
 import rig.solver.run as run
 from rig import Bead, Chain, ChainProblem, SaveAt, Striker, Wall

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import PTFE, STEEL, record_contacts, steel_sonic_vacuum
+from chains import PTFE, STEEL, record_contacts, steel_sonic_vacuum
 
 from rig import Bead, Chain, ChainProblem, Striker, Wall, solve
 from rig.errors import RigError

@@ -1,7 +1,7 @@
 """The multirate head: a stiff striker contact substepped, the chain at its own step."""
 import numpy as np
 import pytest
-from conftest import ptfe_rig, record_contacts, steel_sonic_vacuum
+from chains import ptfe_rig, record_contacts, steel_sonic_vacuum
 
 from rig import ChainProblem, solve
 from rig.solver.methods import method
@@ -23,7 +23,7 @@ def _reference(p, t_end, save):
 
 
 def test_the_head_is_the_striker_and_the_contacts_that_open_at_speed():
-    from conftest import STEEL
+    from chains import STEEL
 
     from rig import Bead, Chain, Striker, Wall
 

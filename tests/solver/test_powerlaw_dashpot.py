@@ -6,7 +6,7 @@ balance closes. (Order, energy balance and batched shots at alpha 0.5 and 1.5:
 tests/solver/test_models.py.)"""
 import numpy as np
 import pytest
-from conftest import PTFE, record_contacts
+from chains import PTFE, record_contacts
 from test_models import _forces, _slope, ptfe_chain
 
 from rig import Bead, Chain, ChainProblem, Wall

@@ -1,7 +1,7 @@
 """What a solve records and refuses."""
 import numpy as np
 import pytest
-from conftest import ptfe_rig, steel_sonic_vacuum
+from chains import ptfe_rig, steel_sonic_vacuum
 
 from rig import Chain, ChainProblem, ForceSchedule, RigError, SaveAt, solve
 
@@ -52,7 +52,7 @@ def test_scheduled_magnet_force_balances_energy_and_momentum():
 
 def test_dissipative_law_loses_energy_and_is_off_by_default():
     assert steel_sonic_vacuum(n=5).law.name == "hertz"
-    from conftest import STEEL
+    from chains import STEEL
 
     from rig import Bead, Striker
     lossy = Chain([Bead(**STEEL)] * 30, striker=Striker("steel316", "0.4501 g", "0.44 m/s"),

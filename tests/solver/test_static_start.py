@@ -1,6 +1,6 @@
 """The rig starts from exact static equilibrium: nothing moves before impact."""
 import numpy as np
-from conftest import ptfe_rig
+from chains import ptfe_rig
 
 from rig import ChainProblem, SaveAt, solve
 from rig.solver.solution import relative_error

@@ -7,7 +7,7 @@ import re
 
 import numpy as np
 import pytest
-from conftest import PTFE, record_contacts
+from chains import PTFE, record_contacts
 
 from rig import ChainProblem, RigError, solve
 from rig.model.chain import Chain

@@ -1,6 +1,6 @@
 """A struck sonic-vacuum chain forms the exact discrete solitary wave, not Eq (4)'s."""
 import numpy as np
-from conftest import record_contacts, steel_sonic_vacuum
+from chains import record_contacts, steel_sonic_vacuum
 
 from rig import solve
 from rig.theory.longwave import sonic_vacuum_speed
