@@ -61,13 +61,14 @@ GRAVITY_SPEED_AND_DURATION = tuple(o for o in fig3.observations()
 
 
 def test_coverage_counts_the_intervals_and_the_seed_repeats_the_data():
-    """Youngs modulus from the gravity shot's speed and duration (a cheap set: one scene, Hertz's law)."""
+    """Youngs modulus from the gravity shot's speed and duration (a cheap set: one scene, Hertz's law).
+    Another seed needs one data set only to show that its data differ (its first fit's estimate)."""
     param = parse_parameter("chain.youngs_modulus=0.4 GPa:2 GPa")
     a = coverage(param, 0.84e9, (), GRAVITY_SPEED_AND_DURATION, n=3, seed=7)
     b = coverage(param, 0.84e9, (), GRAVITY_SPEED_AND_DURATION, n=3, seed=7)
-    c = coverage(param, 0.84e9, (), GRAVITY_SPEED_AND_DURATION, n=3, seed=8)
+    c = coverage(param, 0.84e9, (), GRAVITY_SPEED_AND_DURATION, n=1, seed=8)
     assert a.estimates == b.estimates and a.stds == b.stds and a.seed == 7
-    assert a.estimates != c.estimates
+    assert c.n == 1 and a.estimates[0] != c.estimates[0]
     est, sd = np.array(a.estimates), np.array(a.stds)
     by_hand = [bool(ok and e - 1.96 * s <= 0.84e9 <= e + 1.96 * s) for ok, e, s in zip(a.converged, est, sd)]
     assert list(a.holds) == by_hand and a.count == sum(by_hand)
@@ -91,10 +92,12 @@ def test_sensitivity_is_the_hand_computed_central_difference():
     fig = Figures(fig3.PARAMETER_SET)
     result = sensitivities(fig)
     assert all(result["holds"].values())  # the parameter set meets Fig. 3
-    # by hand: the gravity speed alone, its own objective, E at 0.84 GPa e^(+-STEP)
+    # by hand: the gravity speed alone, its own objective, E at 0.84 GPa e^(+-STEP); its shots
+    # at the study's numerics (the step calibrated once at the set, as a study's fits share it)
     speed = fig3.TARGETS[0].figure
     obj = ObservationObjective(fig3.GRAVITY, (parse_parameter("chain.youngs_modulus=0.2 GPa:3 GPa"),), (speed,),
                                fig3.PARAMETER_SET)
+    obj.pilot = fig.objective.pilot
     (down,), (up,) = obj.evaluate([np.array([0.84e9 * math.exp(-STEP)]), np.array([0.84e9 * math.exp(STEP)])])
     by_hand = (math.log(up) - math.log(down)) / (2 * STEP)
     assert result["d_ln_figure_d_ln_p"]["gravity_speed"]["chain.youngs_modulus"] == pytest.approx(by_hand, rel=1e-3)
