@@ -20,7 +20,8 @@ from .verify import root_seal
 
 TEXTS = {LAYOUT3: PARTS_TEXT.format(version=3, groups=2) + "\n\n" + LAYOUT,
          LAYOUT4: PARTS_TEXT.format(version=4, groups=4) + "\n\n" + LAYOUT4_TEXT}
-WRITERS: dict[int, Callable[..., None]] = {LAYOUT3: write_entry, LAYOUT4: write_compact_entry}
+# a shot's writer, by layout: layout 4's returns the text of the shot's table (layout 3's, None)
+WRITERS: dict[int, Callable[..., str | None]] = {LAYOUT3: write_entry, LAYOUT4: write_compact_entry}
 
 
 def commit_parts(path: Path, entries: list, transaction, master=None, ids=None, part: str = "") -> list:
@@ -54,10 +55,10 @@ def commit_parts(path: Path, entries: list, transaction, master=None, ids=None, 
     extra = (axes,) if layout == LAYOUT4 else ()  # layout 4: the time axes shared inside the part
 
     def fill(f):
-        for shot_id, e in zip(ids, entries):
-            WRITERS[layout](f, shot_id, e, checked, stored, *extra)
+        tables = {f"/shot_{shot_id:06d}": WRITERS[layout](f, shot_id, e, checked, stored, *extra)
+                  for shot_id, e in zip(ids, entries)}  # the tables' texts as written (layout 4), not read back
         f.attrs.update({"NX_class": "NXroot", "layout_version": layout, "part_of": path.name})
-        return (sorted(f["shared"]) if "shared" in f else []), part_digest(part_tables(f))
+        return (sorted(f["shared"]) if "shared" in f else []), part_digest(part_tables(f, tables))
 
     try:
         where.mkdir(exist_ok=True)

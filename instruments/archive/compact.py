@@ -51,13 +51,14 @@ CODES = {"fletcher32": True}  # chunked (fletcher32 needs chunks), not compresse
 INDEX = {"compression": "gzip", "compression_opts": 1, "shuffle": True, "fletcher32": True}
 
 
-def write_compact_entry(f, shot_id: int, e: Entry, checked: dict, stored: dict, axes: dict):
+def write_compact_entry(f, shot_id: int, e: Entry, checked: dict, stored: dict, axes: dict) -> str:
     """Write one NXentry of layout 4 into a part file, then seal its table of checksums (an
     attribute); ``checked`` and ``stored`` as for instruments.archive.layout.write_entry;
     ``axes``: the time axes this transaction wrote ({(time base, name): (dataset, its rows)}),
     which a later shot of the same time base hard-links to rather than writing its own. The
     table's rows are those the writer gives each item as it writes it (digest.table's rows,
-    from the values written): the shot is not walked nor read back."""
+    from the values written): the shot is not walked nor read back. Returns the table's
+    text as written (the part's digest is made of it: part_digests.part_tables)."""
     written: dict = {}  # digests of a scene's shared group this call writes, by address (digest.table)
     rows: dict = {}  # the shot's table, by path (digest.table)
     where = f"shot {shot_id}"
@@ -92,7 +93,7 @@ def write_compact_entry(f, shot_id: int, e: Entry, checked: dict, stored: dict, 
         rows["truth/"] = member_row(["forces"])
         names.append("truth")
     rows["/"] = member_row(names)
-    seal_rows(g, rows, attribute=True)
+    return seal_rows(g, rows, attribute=True)
 
 
 def link(g, name: str, target) -> str:

@@ -61,15 +61,19 @@ def _enter(g, prefix: str, out: dict, linked: dict):
             _enter(obj, prefix + name + "/", out, linked)
 
 
-def table(group: h5py.Group, linked: dict, written: dict | None = None) -> dict:
+def table(group: h5py.Group, linked: dict, written: dict | None = None, hashed: dict | None = None) -> dict:
     """The rows of ``group``'s table as the file reads now. An item that cannot be read
     gets the row ``unreadable: <cause>`` (never an exception). ``written`` ({address: the
     value_digest of the values a writer has just given a dataset}, and {(address, name):
     the attribute_digest of an attribute's}) spares reading those back: the writer hashes
-    what it wrote, in one pass."""
+    what it wrote, in one pass. ``hashed`` (one check of many groups in the same open
+    files: rig verify) keeps the rows of each dataset with more than one hard link (a
+    part's time axis, shared by its shots of one time base) from the first group that
+    reads it, for the others: its values and attributes read and hashed once, not once per
+    shot."""
     rows: dict[str, str] = {}
     a = address(group)
-    _walk(group, a, "", _Tree(group, {a: "."}, {}, linked, rows, written or {}))
+    _walk(group, a, "", _Tree(group, {a: "."}, {}, linked, rows, written or {}, hashed))
     return rows
 
 
@@ -79,7 +83,9 @@ class _Tree:
     the objects met so far (the walk and paths() go in one order: the first path met is
     the first in sorted order), {address: path} of every object inside it and of the linked
     ones (filled by names(), for the dimension scales' references only), the linked
-    objects, the rows, the digests of datasets just written (not read back)."""
+    objects, the rows, the digests of datasets just written (not read back), the rows of
+    datasets with several hard links that an earlier group of the same check hashed
+    (table's ``hashed``; None: none kept)."""
 
     group: object
     where: dict
@@ -87,14 +93,38 @@ class _Tree:
     linked: dict
     rows: dict
     written: dict
+    hashed: dict | None = None
 
 
-def _attrs(obj, a, path: str, t: _Tree):
+def _attrs(obj, a, path: str, t: _Tree, into: dict | None = None):
+    """The rows of ``obj``'s attributes (``path@name``), into ``t.rows`` (or ``into``)."""
+    rows = t.rows if into is None else into
     for key in sorted(attribute_names(obj)):
         if obj is t.group and key in (DIGEST, TABLE):
             continue
         refs = names(t) if key in _REFERENCE_ATTRS else {}
-        t.rows[f"{path}@{key}"] = t.written.get((a, key)) or _guard(functools.partial(_attr_digest, obj, key, refs))
+        rows[f"{path}@{key}"] = t.written.get((a, key)) or _guard(functools.partial(_attr_digest, obj, key, refs))
+
+
+def _dataset_rows(obj, a, path: str, t: _Tree):
+    """A dataset's rows, its values' (``path``) and its attributes' (``path@name``), into
+    ``t.rows``. Where ``t.hashed`` keeps rows and the dataset has more than one hard link,
+    they are computed once per object of an open file (HDF5's file number and the object's
+    address) and kept; rows of dimension-scale references (paths inside the sealed group)
+    are not kept."""
+    import h5py
+
+    held = None
+    if t.hashed is not None:  # the object's info was read once already (its address): it reads
+        info = h5py.h5o.get_info(obj)
+        held = (info.fileno, info.addr) if info.rc > 1 else None
+    kept = t.hashed.get(held) if t.hashed is not None and held is not None else None
+    if kept is None:
+        kept = {"": t.written.get(a) or _guard(functools.partial(_dataset_digest, obj))}
+        _attrs(obj, a, "", t, kept)
+        if t.hashed is not None and held is not None and not any(k[1:] in _REFERENCE_ATTRS for k in kept):
+            t.hashed[held] = kept
+    t.rows.update({path + k: row for k, row in kept.items()})
 
 
 def names(t) -> dict:
@@ -132,8 +162,7 @@ def _walk(g, a, prefix: str, t: _Tree):
             _walk(h5py.Group(obj), a, path + "/", t)
         else:
             t.where[a] = path
-            t.rows[path] = t.written.get(a) or _guard(functools.partial(_dataset_digest, obj))
-            _attrs(obj, a, path, t)
+            _dataset_rows(obj, a, path, t)
 
 
 def seal(group: h5py.Group, linked: dict, written: dict | None = None, attribute: bool = False):
@@ -143,15 +172,16 @@ def seal(group: h5py.Group, linked: dict, written: dict | None = None, attribute
     seal_rows(group, table(group, linked, written), attribute)
 
 
-def seal_rows(group: h5py.Group, rows: dict, attribute: bool = False):
+def seal_rows(group: h5py.Group, rows: dict, attribute: bool = False) -> str:
     """Write ``rows`` as ``group``'s table, and its digest (seal, for a writer that has
-    made every row of the group itself)."""
+    made every row of the group itself); returns the table's text as written."""
     text = json.dumps(rows, sort_keys=True, indent=0)
     if attribute:
         group.attrs[TABLE] = text
     else:
         group.create_dataset(TABLE, data=text)
     group.attrs[DIGEST] = sha(text.encode())
+    return text
 
 
 def member_row(names) -> str:
@@ -160,14 +190,16 @@ def member_row(names) -> str:
     return sha(json.dumps(sorted(names)).encode())
 
 
-def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None, text: str | None = None) -> list:
+def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None, text: str | None = None,
+           hashed: dict | None = None) -> list:
     """What differs between ``group``'s stored table and the file: a list of
     "path: what is wrong" lines, empty when every item matches. ``read`` (a test of a row's
     key, e.g. ``lambda key: not key.startswith("data/")``): only the rows a reader reads are
     computed, item by item, without walking the rest (``known``: {row key: its row} that a
     reader computed from the values it read, not read again); where one differs, the whole
     table is compared and the lines about those rows given. ``text``: the stored table's
-    text where the caller has read it (stored_table), not read again."""
+    text where the caller has read it (stored_table), not read again. ``hashed``: as for
+    table(), where the whole table is compared."""
     try:
         text = stored_table(group) if text is None else text
         if sha(text.encode()) != _sealed_digest(group):
@@ -180,9 +212,9 @@ def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None
         if rows(group, [k for k in keys if k not in (known or {})], linked, stored, known) == \
                 {k: stored[k] for k in keys}:
             return []
-        found = _differences(stored, table(group, linked))
+        found = _differences(stored, table(group, linked, hashed=hashed))
         return [p for p in found if read(p.removeprefix("attribute ").split(": ", 1)[0])] or found
-    return _differences(stored, table(group, linked))
+    return _differences(stored, table(group, linked, hashed=hashed))
 
 
 def _sealed_digest(group) -> str:

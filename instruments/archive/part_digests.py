@@ -34,12 +34,16 @@ def recorded_digests(f) -> dict:
     return out if isinstance(out, dict) else {}
 
 
-def part_tables(f) -> dict:
+def part_tables(f, written: dict | None = None) -> dict:
     """{path ("/shot_000002", "/shared/scene_x"): its table's text} of every shot and shared
-    group in a part file ``f`` (open), as part_digest takes them."""
+    group in a part file ``f`` (open), as part_digest takes them; ``written``: {path: the
+    text} of the shots' tables a writer has just written into ``f`` (None: read it), not
+    read back."""
     from .stored import table_text
 
-    out = {f"/{name}": table_text(f[name]) for name in f if name.startswith("shot_")}
+    given = written or {}
+    out = {f"/{name}": table_text(f[name]) if given.get(f"/{name}") is None else given[f"/{name}"]
+           for name in f if name.startswith("shot_")}
     if "shared" in f:
         out.update({f"/shared/{key}": table_text(f["shared"][key]) for key in f["shared"]})
     return out

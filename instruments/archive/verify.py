@@ -171,13 +171,14 @@ def check(f: h5py.File) -> dict:
         bad.append(_row(_shot_id(path), path, f"missing: {path}"))
     shared, problems, linked = _shared_groups(f, bad, added)
     users: dict = {}
+    hashed: dict = {}  # rows of the datasets that several shots share (a part's time axis): read once (digest.table)
     with OpenParts() as parts:  # each part opened once, directly
         for name in names:
             shot_id = int(name.split("_", 1)[1])
             try:
                 g = parts.group(f, name)
                 text = table_text(g)
-                found = named(damage(g, linked, text=text), f"/{name}")
+                found = named(damage(g, linked, text=text, hashed=hashed), f"/{name}")
                 for key in linked_groups(g, "/shared/", text):
                     users.setdefault(key, []).append(shot_id)
             except Exception as exc:  # noqa: BLE001

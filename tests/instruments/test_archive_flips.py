@@ -224,3 +224,26 @@ def test_a_read_checks_what_it_returns_and_verify_checks_the_rest(tmp_path, item
     else:
         with pytest.raises(InstrumentError, match=f"shot 2: {'attribute ' if attr else ''}{item}: damaged"):
             Archive(path).read(2)
+
+
+@pytest.mark.parametrize("damaged", [1, 2])
+def test_a_time_axis_its_part_s_shots_share_is_judged_in_each_part(tmp_path, damaged):
+    # verify reads a dataset that several shots link to (a part's time axis) once per part
+    # file, not once per shot: damage in one part's axis names that part's shots and only
+    # those, though the two parts are alike and their axes lie at the same address
+    import h5py
+
+    path = tmp_path / "a.h5"
+    a = Archive(path)
+    a.append([tiny_entry(1, truth=False), tiny_entry(2, truth=False)])
+    a.append([tiny_entry(5, truth=False), tiny_entry(6, truth=False)])
+    with h5py.File(path, "r+") as f:
+        first, second = f["shot_000001/data/time"], f["shot_000003/data/time"]
+        assert h5py.h5o.get_info(first.id).addr == h5py.h5o.get_info(second.id).addr  # in two part files
+        assert first.file.filename != second.file.filename
+        axis = first if damaged == 1 else second
+        axis[5] = axis[5] + 1
+    report = a.verify()
+    shots = [1, 2] if damaged == 1 else [3, 4]
+    assert [b["shot"] for b in report["bad"]] == shots and report["ok"] == 2
+    assert {b["where"] for b in report["bad"]} == {f"/shot_{i:06d}/data/time" for i in shots}
