@@ -1,7 +1,10 @@
 """rig fit: parameters with units, data tables, fits that recover known values (points and
 scope records), resume from the evaluation cache, and clear lines for bad input."""
+import contextlib
+import io
 import json
 import math
+import shutil
 from dataclasses import replace
 
 import numpy as np
@@ -19,6 +22,8 @@ from rig.fit.traces import TraceObjective
 
 SCENE = "ptfe20_gravity"
 HALF = ["solver.duration=1.5e-3", "scope.record_length=3125"]  # the scene's first 1.25 ms of record (of 2.5 ms)
+E = "chain.youngs_modulus=0.5 GPa:3 GPa"
+POSTERIOR = ["--posterior", "4", "--walkers", "4", "--seed", "3"]
 
 
 def test_parameters_carry_units():
@@ -52,11 +57,49 @@ def _write(tmp_path, text):
     return p
 
 
-def _virtual_points(tmp_path):
+@pytest.fixture(scope="module")
+def virtual_points(tmp_path_factory):
     """A points table on the model's own curve at E = 1.1 GPa (10% / 3% uncertainties)."""
     (c,) = curves(SCENE, [["chain.youngs_modulus=1.1e9"]], [0.5, 0.9, 1.6])
     rows = "\n".join(f"{F},{0.1 * F},{V},{0.03 * V}" for F, V in zip(c.force, c.speed))
-    return _write(tmp_path, "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n" + rows + "\n")
+    return _write(tmp_path_factory.mktemp("points"), "F_d [N],F_d_sd [N],V_s [m/s],V_s_sd [m/s]\n" + rows + "\n")
+
+
+@pytest.fixture(scope="module")
+def point_objective(virtual_points):
+    """The points' objective for E, its pilot calibrated once for the tests that fit it."""
+    return PointObjective(SCENE, parse_parameters([E]), read_points(virtual_points))
+
+
+def _fit_argv(points, out, *extra):
+    return ["fit", SCENE, "--points", str(points), "--param", E, "--out", str(out), "--json", "--quiet", *extra]
+
+
+def _main(argv):
+    """(exit code, stdout) of rig ``argv`` (for the module's fixtures: capsys is a test's)."""
+    with contextlib.redirect_stdout(io.StringIO()) as out:
+        code = main(argv)
+    return code, out.getvalue()
+
+
+@pytest.fixture(scope="module")
+def cli_fit(tmp_path_factory, virtual_points):
+    """`rig fit --json --quiet` of the virtual points for E, run once: (exit code, --out
+    folder, JSON block). A test that runs the same fit again copies the folder, or its
+    evaluations/ (the fit replays them instead of solving)."""
+    out = tmp_path_factory.mktemp("cli_fit") / "fit"
+    code, text = _main(_fit_argv(virtual_points, out))
+    return code, out, json.loads(text)
+
+
+@pytest.fixture(scope="module")
+def cli_posterior(tmp_path_factory, virtual_points, cli_fit):
+    """The same command with POSTERIOR, run once (the fit replayed from cli_fit's
+    evaluations): (exit code, --out folder, its posterior block)."""
+    out = tmp_path_factory.mktemp("cli_posterior") / "fit"
+    shutil.copytree(cli_fit[1] / "evaluations", out / "evaluations")
+    code, text = _main(_fit_argv(virtual_points, out, *POSTERIOR))
+    return code, out, json.loads(text)["posterior"] if code == 0 else None
 
 
 @pytest.mark.parametrize("text,match", [
@@ -71,26 +114,24 @@ def test_bad_point_tables_name_the_problem(tmp_path, text, match):
         read_points(_write(tmp_path, text))
 
 
-def test_point_fit_recovers_the_modulus_of_virtual_points(tmp_path):
+def test_point_fit_recovers_the_modulus_of_virtual_points(point_objective):
     """Points on the model's own curve at E = 1.1 GPa, with 3% / 10% uncertainties: the fit
     finds E within its interval, and the interval is as wide as the uncertainties allow."""
-    pts = read_points(_virtual_points(tmp_path))
-    r = fit(PointObjective(SCENE, parse_parameters(["chain.youngs_modulus=0.5 GPa:3 GPa"]), pts))
+    r = fit(point_objective)
     assert r.converged
     assert r.ci95[0, 0] <= 1.1e9 <= r.ci95[0, 1]
     assert abs(r.estimate[0] / 1.1e9 - 1) < 0.01  # exact data: only the curve's interpolation
     assert 0.01 < r.std[0] / 1.1e9 < 0.2
 
 
-def test_a_point_fit_calibrates_its_step_once_and_its_curves_keep_the_accuracy(tmp_path):
+def test_a_point_fit_calibrates_its_step_once_and_its_curves_keep_the_accuracy(point_objective):
     """The pilot: the accuracy control on the start values' shots, over their leading
     window, sets the ratio of the step to the a-priori rule's; every candidate's shots then
     take that ratio without companions and carry the pilot's estimate. A softer candidate's
     curve agrees with a reference solved 100x tighter within the accuracy setting (its
     amplitudes are peaks of recorded forces); a candidate whose pulse ends after the window
     is solved again over the scene's whole duration."""
-    obj = PointObjective(SCENE, parse_parameters(["chain.youngs_modulus=0.5 GPa:3 GPa"]),
-                         read_points(_virtual_points(tmp_path)))
+    obj = point_objective
     pilot = obj.pilot
     scene_duration = Rig.from_scene(SCENE).solver.duration
     assert pilot.accuracy == 1e-4 and pilot.shots == len(obj.velocities)
@@ -167,7 +208,7 @@ def test_trace_fit_of_a_csv_export_is_the_fit_of_its_record(tmp_path):
     assert exported.std[0] == pytest.approx(direct.std[0], rel=1e-3)
 
 
-def test_leave_one_out_predicts_each_point_from_the_others(tmp_path):
+def test_leave_one_out_predicts_each_point_from_the_others(point_objective):
     """Points on the model's own curve are predicted from the others to the curve's
     interpolation (< 1%); a point moved 20% up is predicted where the others put it, about
     20% / 1.2 = 17% below its value, further than the full fit's residual there. The
@@ -177,17 +218,19 @@ def test_leave_one_out_predicts_each_point_from_the_others(tmp_path):
     chi2; on the elastic Hertz chain the paper's elastic conversion of the gauge readings
     gives the contact F_d to within 1.5% (0.6% measured: the leading pulse at the gauges is
     close to the stationary solitary wave beta is computed from; a constant sonic-vacuum beta
-    would be 6% off at the lowest shot)."""
+    would be 6% off at the lowest shot). The moved points' objective takes the pilot of the
+    points' (calibrated on the start values' shots, not the data: the same Pilot)."""
     from rig.fit.joint import JointObjective
     from rig.study.fitted_assess import table1_figures
 
-    def leave_one_out(points):
-        obj = JointObjective([PointObjective(SCENE, parse_parameters(bounds), points)])
-        return table1_figures(obj, fit(obj))
+    def leave_one_out(part):
+        """The figures and the fit of ``part`` (a PointObjective) as a joint fit's one part."""
+        obj = JointObjective([part])
+        r = fit(obj)
+        return table1_figures(obj, r), r
 
-    pts = read_points(_virtual_points(tmp_path))
-    bounds = ["chain.youngs_modulus=0.5 GPa:3 GPa"]
-    exact = leave_one_out(pts)
+    pts = point_objective.points
+    exact, _ = leave_one_out(point_objective)
     assert max(abs(r) for r in exact["loo_relative_residuals"]) < 0.01
     both = exact["table1_points_both_conversions"]
     assert both["chi2_contact_force"] == pytest.approx(exact["table1_chi2"], rel=1e-12) and both["dof"] == pts.n - 1
@@ -196,20 +239,17 @@ def test_leave_one_out_predicts_each_point_from_the_others(tmp_path):
     assert len(both["points"]) == pts.n and all(p["model_V_s_elastic_conversion_m_per_s"] for p in both["points"])
     moved = pts.subset(range(pts.n))
     moved.speed[1] *= 1.2
-    cv = leave_one_out(moved)
-    full = PointObjective(SCENE, parse_parameters(bounds), moved)
-    r = fit(full)
+    full = PointObjective(SCENE, parse_parameters([E]), moved)
+    full.pilot = point_objective.pilot
+    cv, r = leave_one_out(full)  # r: the full fit, to every point
     assert cv["loo_relative_residuals"][1] == pytest.approx(-0.2 / 1.2, abs=0.01)
-    assert abs(full.relative_residuals(r.model)[1]) < abs(cv["loo_relative_residuals"][1])
+    assert abs(full.relative_residuals(r.model[0])[1]) < abs(cv["loo_relative_residuals"][1])
     assert cv["loo_chi2"] > r.chi2
 
 
-def test_cli_fit_writes_a_scene_that_fires(tmp_path, capsys):
-    pts = _virtual_points(tmp_path)
-    out = tmp_path / "fit"
-    assert main(["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
-                 "--out", str(out), "--json", "--quiet"]) == 0
-    block = json.loads(capsys.readouterr().out)
+def test_cli_fit_writes_a_scene_that_fires(cli_fit):
+    code, out, block = cli_fit
+    assert code == 0
     assert set(block) >= {"parameters", "correlation", "residual_rms_relative", "converged", "fitted_scene"}
     assert set(block["parameters"]["chain.youngs_modulus"]) >= {"estimate", "std", "ci95"}
     num = block["numerics"]
@@ -238,10 +278,10 @@ def test_cli_fit_warns_when_the_model_does_not_describe_the_data(tmp_path, capsy
     assert "numerics: the model's error estimate" in out and "against the accuracy 0.0001" in out
 
 
-def test_cli_fit_warns_of_parameters_the_data_do_not_determine(tmp_path, capsys):
+def test_cli_fit_warns_of_parameters_the_data_do_not_determine(tmp_path, capsys, virtual_points):
     """E and Poisson's ratio enter the Hertz contact only as E / (1 - nu^2): their sds pass
     their bounds' spans, and the fit says so for each."""
-    main(["fit", SCENE, "--points", str(_virtual_points(tmp_path)), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
+    main(["fit", SCENE, "--points", str(virtual_points), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
           "--param", "chain.poisson_ratio=0.1:0.45", "--out", str(tmp_path / "fit"), "--quiet"])
     out = capsys.readouterr().out
     for key in ("chain.youngs_modulus", "chain.poisson_ratio"):
@@ -249,10 +289,12 @@ def test_cli_fit_warns_of_parameters_the_data_do_not_determine(tmp_path, capsys)
 
 
 def test_cli_fit_reads_the_shots_of_an_archive(tmp_path, capsys):
-    """--archive: the shot that `rig shot --out` archived is fitted from its stored record;
-    a missing archive is one line, exit 2."""
+    """--archive: the shot that `rig shot --out` archived is fitted from its stored record,
+    modelled with the overrides it was fired with (the scene's first half, HALF); a missing
+    archive is one line, exit 2."""
     archive = tmp_path / "A.h5"
-    assert main(["shot", SCENE, "--seed", "3", "--out", str(archive), "--json"]) == 0
+    half = [arg for key in HALF for arg in ("--set", key)]
+    assert main(["shot", SCENE, *half, "--seed", "3", "--out", str(archive), "--json"]) == 0
     capsys.readouterr()
     argv = ["fit", SCENE, "--param", "chain.youngs_modulus=0.5 GPa:3 GPa", "--json", "--quiet"]
     assert main(argv + ["--archive", str(archive), "--shot", "1", "--out", str(tmp_path / "fit")]) == 0
@@ -265,22 +307,21 @@ def test_cli_fit_reads_the_shots_of_an_archive(tmp_path, capsys):
     assert "no such archive" in err and len(err.splitlines()) == 1
 
 
-def test_cli_fit_samples_the_posterior_and_resumes_it(tmp_path, capsys):
-    pts = _virtual_points(tmp_path)
-    argv = ["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
-            "--out", str(tmp_path / "fit"), "--json", "--quiet", "--posterior", "4", "--walkers", "4", "--seed", "3"]
-    assert main(argv) == 0
-    post = json.loads(capsys.readouterr().out)["posterior"]
+def test_cli_fit_samples_the_posterior_and_resumes_it(tmp_path, capsys, virtual_points, cli_posterior):
+    code, folder, post = cli_posterior
+    assert code == 0
     assert post["steps"] == 4 and post["walkers"] == 4 and post["seed"] == 3
     lo, hi = post["parameters"]["chain.youngs_modulus"]["ci95"]
     assert 0.5e9 <= lo <= post["parameters"]["chain.youngs_modulus"]["median"] <= hi <= 3e9
-    assert (tmp_path / "fit" / "posterior.png").stat().st_size > 0
-    assert main(argv) == 0  # the same command again: the chain read back from posterior.h5
+    assert (folder / "posterior.png").stat().st_size > 0
+    shutil.copytree(folder, tmp_path / "fit")
+    # the same command again (on a copy of its folder): the chain read back from posterior.h5
+    assert main(_fit_argv(virtual_points, tmp_path / "fit", *POSTERIOR)) == 0
     assert json.loads(capsys.readouterr().out)["posterior"] == post
 
 
-def test_cli_fit_that_does_not_converge_writes_no_scene(tmp_path, capsys):
-    pts = _virtual_points(tmp_path)
+def test_cli_fit_that_does_not_converge_writes_no_scene(tmp_path, capsys, virtual_points):
+    pts = virtual_points
     out = tmp_path / "fit"
     assert main(["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
                  "--param", "chain.contact_exponent=1.2:2.2", "--out", str(out), "--max-evaluations", "1",
@@ -302,13 +343,13 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, argv, match):
     assert match in err and len(err.splitlines()) == 1
 
 
-def test_a_cache_entry_that_cannot_be_read_is_dropped_and_solved_again(tmp_path, capsys):
+def test_a_cache_entry_that_cannot_be_read_is_dropped_and_solved_again(tmp_path, capsys, virtual_points,
+                                                                       cli_fit):
     # a full disk once left a 0-byte entry, and every later run of the command died with EOFError
-    pts = _virtual_points(tmp_path)
-    argv = ["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
-            "--out", str(tmp_path / "fit"), "--json", "--quiet"]
-    assert main(argv) == 0
-    first = json.loads(capsys.readouterr().out)
+    code, folder, first = cli_fit
+    assert code == 0
+    shutil.copytree(folder, tmp_path / "fit")  # the first run's folder
+    argv = _fit_argv(virtual_points, tmp_path / "fit")
     entries = sorted((tmp_path / "fit" / "evaluations").glob("*.npz"))
     assert len(entries) == first["evaluations"] >= 3
     entries[0].write_bytes(b"")  # as a full disk left it
@@ -326,7 +367,7 @@ def test_a_cache_entry_that_cannot_be_read_is_dropped_and_solved_again(tmp_path,
             assert z.files
 
 
-def test_ctrl_c_while_the_posterior_samples_is_one_line_and_keeps_the_chain(tmp_path):
+def test_ctrl_c_while_the_posterior_samples_is_one_line_and_keeps_the_chain(tmp_path, virtual_points, cli_fit):
     # Ctrl-C inside emcee's call of the likelihood once printed emcee's traceback first
     import os
     import signal
@@ -334,15 +375,15 @@ def test_ctrl_c_while_the_posterior_samples_is_one_line_and_keeps_the_chain(tmp_
     import sys
 
     pytest.importorskip("emcee")
-    pts = _virtual_points(tmp_path)
-    argv = ["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
-            "--out", str(tmp_path / "fit"), "--posterior", "100000", "--walkers", "4", "--seed", "3"]
+    shutil.copytree(cli_fit[1] / "evaluations", tmp_path / "fit" / "evaluations")  # the fit replays: no solve
+    argv = ["fit", SCENE, "--points", str(virtual_points), "--param", E, "--out", str(tmp_path / "fit"),
+            "--posterior", "100000", "--walkers", "2", "--seed", "3"]  # the fewest walkers: 2 candidates a step
     p = subprocess.Popen([sys.executable, "-m", "rig.cli", *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                          text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
     err = []
-    for line in p.stderr:  # the progress lines, until the chain has taken 20 steps
+    for line in p.stderr:  # the progress lines, until the chain has taken 10 steps (the first line)
         err.append(line)
-        if line.startswith("posterior: step 20/"):
+        if line.startswith("posterior: step 10/"):
             p.send_signal(signal.SIGINT)
             break
     rest, tail = p.communicate(timeout=300)
@@ -356,16 +397,16 @@ def test_ctrl_c_while_the_posterior_samples_is_one_line_and_keeps_the_chain(tmp_
 
     with h5py.File(tmp_path / "fit" / "posterior.h5", "r") as f:
         (chain,) = f.values()
-        assert int(chain.attrs["iteration"]) == kept >= 20  # every step it says it kept is stored
+        assert int(chain.attrs["iteration"]) == kept >= 10  # every step it says it kept is stored
 
 
-def test_a_chain_file_that_cannot_be_read_is_dropped_and_sampled_again(tmp_path, capsys):
+def test_a_chain_file_that_cannot_be_read_is_dropped_and_sampled_again(tmp_path, capsys, virtual_points,
+                                                                       cli_posterior):
     pytest.importorskip("emcee")
-    pts = _virtual_points(tmp_path)
-    argv = ["fit", SCENE, "--points", str(pts), "--param", "chain.youngs_modulus=0.5 GPa:3 GPa",
-            "--out", str(tmp_path / "fit"), "--json", "--quiet", "--posterior", "4", "--walkers", "4", "--seed", "3"]
-    assert main(argv) == 0
-    first = json.loads(capsys.readouterr().out)["posterior"]
+    code, folder, first = cli_posterior
+    assert code == 0
+    shutil.copytree(folder, tmp_path / "fit")  # the first run's folder
+    argv = _fit_argv(virtual_points, tmp_path / "fit", *POSTERIOR)
     chain = tmp_path / "fit" / "posterior.h5"
     chain.write_bytes(chain.read_bytes()[:1000])  # cut short
     assert main(argv) == 0

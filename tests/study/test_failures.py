@@ -104,8 +104,8 @@ def test_a_dask_study_without_workers_stops_and_resumes(tmp_path):
         cluster.scale(0)
         while client.scheduler_info()["workers"]:
             time.sleep(0.05)
-        with pytest.raises(RigError, match="--worker-timeout"):
-            run_study(_study(), store, scheduler=cluster.scheduler_address, worker_timeout=2.0)
+        with pytest.raises(RigError, match="--worker-timeout"):  # 0.5 s: it stops at the poll after the first
+            run_study(_study(), store, scheduler=cluster.scheduler_address, worker_timeout=0.5)  # that found none
         cluster.scale(1)
         client.wait_for_workers(1)
         assert run_study(_study(), store, scheduler=cluster.scheduler_address, worker_timeout=2.0) == 4
