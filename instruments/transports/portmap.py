@@ -216,6 +216,8 @@ class PortMapper:
                 continue
             except OSError:
                 return
+            if self._stop.is_set():  # woken by close()'s shutdown
+                return
             peer = peer_text(addr)
             reply = oncrpc.answer(datagram, self._programs(f"udp {peer}", peer, str(addr[0]), self._tcp.report))
             if reply is not None:
@@ -225,6 +227,8 @@ class PortMapper:
     def close(self) -> None:
         self._stop.set()
         self._tcp.close()
+        with contextlib.suppress(OSError):  # wakes a recvfrom() that waits (ENOTCONN all the same)
+            self._udp.shutdown(socket.SHUT_RDWR)
         self._udp.close()
         if self._udp_thread.is_alive():
             self._udp_thread.join(timeout=2.0)
