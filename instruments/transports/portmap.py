@@ -216,8 +216,6 @@ class PortMapper:
                 continue
             except OSError:
                 return
-            if self._stop.is_set():  # woken by close()'s shutdown
-                return
             peer = peer_text(addr)
             reply = oncrpc.answer(datagram, self._programs(f"udp {peer}", peer, str(addr[0]), self._tcp.report))
             if reply is not None:
@@ -227,7 +225,7 @@ class PortMapper:
     def close(self) -> None:
         self._stop.set()
         self._tcp.close()
-        with contextlib.suppress(OSError):  # wakes a recvfrom() that waits (ENOTCONN all the same)
+        with contextlib.suppress(OSError):  # ENOTCONN, yet it wakes the recvfrom() that waits: it ends on the close
             self._udp.shutdown(socket.SHUT_RDWR)
         self._udp.close()
         if self._udp_thread.is_alive():
