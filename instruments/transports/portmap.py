@@ -225,6 +225,8 @@ class PortMapper:
     def close(self) -> None:
         self._stop.set()
         self._tcp.close()
+        with contextlib.suppress(OSError):  # ENOTCONN, yet it wakes the recvfrom() that waits: it ends on the close
+            self._udp.shutdown(socket.SHUT_RDWR)
         self._udp.close()
         if self._udp_thread.is_alive():
             self._udp_thread.join(timeout=2.0)

@@ -184,6 +184,8 @@ class TcpService:
     def close(self) -> None:
         """Stop listening and shut every connection down (their handlers then return)."""
         self._stop.set()
+        with contextlib.suppress(OSError):  # wakes an accept() that waits, instead of its 0.2 s poll
+            self._listener.shutdown(socket.SHUT_RDWR)
         self._listener.close()
         with self._guard:
             clients = list(self._clients.values())

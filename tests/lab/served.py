@@ -1,6 +1,6 @@
-"""What the tests of ``rig serve scope`` share: the server as a subprocess (``Served``), a
-pyvisa client of one of its resources (``open_scope``) and a tap that records what a
-client library sends over a raw socket (``Tap``)."""
+"""What the tests of ``rig serve scope`` share: the server as a subprocess (``Served``), the
+resource of a transport among a server's (``resource``), a pyvisa client of one
+(``open_scope``) and a tap that records what a client library sends over a raw socket (``Tap``)."""
 import os
 import signal
 import socket
@@ -29,7 +29,7 @@ class Served:
         self.resources = self.lines[-1].split(": ", 1)[1].split("  ")
 
     def resource(self, kind: str) -> str:
-        return next(r for r in self.resources if kind in r)
+        return resource(self.resources, kind)
 
     def port(self) -> int:
         """The raw socket's port (the next to last field: an IPv6 address holds '::' too)."""
@@ -39,6 +39,11 @@ class Served:
         self.proc.send_signal(signal.SIGTERM)
         rest, _ = self.proc.communicate(timeout=30)
         return self.proc.returncode, rest
+
+
+def resource(resources: list, kind: str) -> str:
+    """The first of a server's ``resources`` naming ``kind`` ("SOCKET", "hislip0", ...)."""
+    return next(r for r in resources if kind in r)
 
 
 def open_scope(rm, resource: str):

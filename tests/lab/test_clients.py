@@ -1,4 +1,6 @@
-"""Lab client libraries, unchanged, against ``rig serve scope``: tm_devices (raw socket, the
+"""Lab client libraries, unchanged, against the scope ``rig serve scope`` serves (built in
+this process as the command builds it, ``ScopeServer``: what is tested is the wire between
+a client and the server, not the server's process): tm_devices (raw socket, the
 server claiming an MSO44), qcodes' Tektronix drivers ``TPS2012`` (a TDS2024C over VXI-11:
 its ``WAVFrm?`` parser needs the reply's closing newline, which a raw socket's read
 strips) and ``DPO7200xx`` (the mso4 personality, raw socket), and three of Tektronix's own
@@ -18,7 +20,8 @@ import pytest
 
 pyvisa = pytest.importorskip("pyvisa")
 
-from lab.served import Served, Tap, open_scope
+from lab.served import Tap, open_scope, resource
+from rig.lab.serve import ScopeServer, ServeSettings
 from rig.lab.shots import SceneShots
 
 SCENE = "ptfe52_magnetic"
@@ -28,20 +31,23 @@ GET_EXAMPLES = ("RIG_TEK_EXAMPLES unset: git clone https://github.com/tektronix/
                 "and set RIG_TEK_EXAMPLES to the clone (the folder holding Examples/Oscilloscopes)")
 
 
+def served(**settings):
+    """``rig serve scope SCENE --port 0 --hislip 0`` with ``settings`` (ServeSettings' fields)."""
+    server = ScopeServer(ServeSettings(scene=SCENE, port=0, hislip=0, **settings), say=lambda line: None)
+    yield server
+    server.close()
+
+
 @pytest.fixture(scope="module")
 def tds(port111):
     """A TDS2024C (2,500 points, 8 bit) on a raw socket, HiSLIP and VXI-11."""
-    s = Served(SCENE, "--port", "0", "--hislip", "0", "--vxi11", "--personality", "tds2000", "--seed", "21")
-    yield s
-    s.stop()
+    yield from served(vxi11=True, personality="tds2000", seed=21)
 
 
 @pytest.fixture(scope="module")
 def mso():
     """A 4 Series MSO (10,000 points) that says it is an MSO44, on a raw socket and HiSLIP."""
-    s = Served(SCENE, "--port", "0", "--hislip", "0", "--personality", "mso4", "--idn", MSO44, "--seed", "31")
-    yield s
-    s.stop()
+    yield from served(personality="mso4", idn=MSO44, seed=31)
 
 
 @pytest.fixture(scope="module")
@@ -49,11 +55,11 @@ def rig_shots():
     return SceneShots(SCENE)
 
 
-def held_record(rm, served: Served, rig_shots: SceneShots, channel: str = "CH1"):
+def held_record(rm, server: ScopeServer, rig_shots: SceneShots, channel: str = "CH1"):
     """(the waveform of ``channel`` in the record the served scope holds, as the rig
     computes it here: the shot at the seed before ``RIG:SEED?`` with ``RIG:OVERRIDES?``;
     the server's event queue, read out)."""
-    scope = open_scope(rm, served.resource("SOCKET"))
+    scope = open_scope(rm, resource(server.resources, "SOCKET"))
     try:
         scope.write("HEADER OFF")
         seed = int(scope.query("RIG:SEED?")) - 1
@@ -88,7 +94,7 @@ def test_tm_devices_knows_the_mso44_and_its_curve_query_is_the_record(mso, rm, r
     configure_logging(log_console_level=LoggingLevels.NONE, log_file_level=LoggingLevels.NONE,
                       log_uncaught_exceptions=False)
 
-    tap = Tap(mso.port())
+    tap = Tap(mso._socket.port)
     try:
         with DeviceManager(verbose=False) as dm:
             dm.setup_cleanup_enabled = False
@@ -146,7 +152,7 @@ def test_a_tektronix_example_runs_unchanged_and_ends_with_the_record(name, tek_e
     path, variable, server, transport = EXAMPLES[name]
     served = request.getfixturevalue(server)
     script = tmp_path / "example.py"
-    script.write_text(with_resource(tek_examples / path, variable, served.resource(transport)))
+    script.write_text(with_resource(tek_examples / path, variable, resource(served.resources, transport)))
     paths = [str(OLD_NAMES), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
     env = os.environ | {"PYTHONPATH": os.pathsep.join(paths),
                         "PYVISA_LIBRARY": "@py", "MPLBACKEND": "Agg"}
@@ -173,7 +179,7 @@ def test_qcodes_dpo7200xx_trace_is_the_record_in_volts(mso, rm, rig_shots):
     format its WFMOutpre parameters read, ``(code - YOFF) * YMULT + YZERO``."""
     from qcodes.instrument_drivers.tektronix.DPO7200xx import TektronixDPO7000xx
 
-    dpo = TektronixDPO7000xx("rig_dpo", mso.resource("SOCKET"), visalib="@py")
+    dpo = TektronixDPO7000xx("rig_dpo", resource(mso.resources, "SOCKET"), visalib="@py")
     try:
         assert dpo.get_idn()["model"] == "MSO44"
         dpo.acquisition.stop_after("SEQUENCE")
@@ -196,7 +202,7 @@ def test_qcodes_tps2012_curvedata_is_the_record_in_volts(tds, rm, rig_shots):
     ``YMULT (code - YOFF)``: the driver leaves YZERO (the channel's offset) out."""
     from qcodes.instrument_drivers.tektronix.TPS2012 import TektronixTPS2012
 
-    tps = TektronixTPS2012("rig_tps", tds.resource("127.0.0.1::INSTR"), visalib="@py")
+    tps = TektronixTPS2012("rig_tps", resource(tds.resources, "127.0.0.1::INSTR"), visalib="@py")
     try:
         assert tps.get_idn()["model"] == "TDS 2024C"
         tps.ch1.curvedata.prepare_curvedata()
@@ -213,7 +219,7 @@ def test_a_curvestream_program_reads_the_next_shots_of_the_rig_block_by_block(ms
     """A lab program's stream, its address alone changed: CURVESTREAM? written, then a
     binary block read per acquisition; each block is the rig's shot at the next seed, code
     for code, and a command ends the stream (the socket drained, as VISA's clear does)."""
-    scope = open_scope(rm, mso.resource("SOCKET"))
+    scope = open_scope(rm, resource(mso.resources, "SOCKET"))
     try:
         scope.write("*CLS;:HEADER OFF;:DATA:SOURCE CH1;:DATA:ENCDG SRIBINARY;:DATA:WIDTH 2;:DATA:START 1;"
                     ":DATA:STOP 100000")

@@ -91,8 +91,10 @@ def test_exclusive_lock_holds_others_out_until_released(rm, server, instrument):
     assert lb.async_lock_request(timeout=0.3) == "failure"
     assert 0.25 < time.monotonic() - started < 2.0  # it waited its timeout, not less, not forever
     b.write("ECHO? held")
+    b.timeout = 200  # unlocked, the echo comes within milliseconds
     with pytest.raises(VisaIOError, match="[Tt]imeout"):
         b.read()  # the message waits while a holds the lock
+    b.timeout = 500
     assert a.query("ECHO? holder") == "holder"  # the holder goes on
     assert la.async_lock_release() == "success"
     assert b.read() == "held"

@@ -2,7 +2,6 @@
 pyvisa-py) on each transport, the records compared bit for bit with ``rig shot`` at the
 same settings and seed, SIGTERM ending it cleanly, bad input refused in one line."""
 import socket
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +10,7 @@ import pytest
 pyvisa = pytest.importorskip("pyvisa")
 
 from instruments.formats import read_waveforms
-from lab.served import RIG, Served, open_scope
+from lab.served import Served, open_scope
 
 SCENE = "ptfe52_magnetic"
 FIRST_SEED = 11
@@ -45,10 +44,15 @@ def shot_codes(rm, resource: str, channel: str = "CH1") -> tuple:
 
 
 def rig_shot_codes(tmp_path: Path, overrides: list, seed: int, channel: str = "CH1") -> np.ndarray:
+    """The codes of ``channel`` that ``rig shot SCENE --seed SEED --set ... --export DIR``
+    writes, read back from its files. The command runs in this process (its ``main``: the
+    same parsing, shot and export, without a process's start-up of a second or more); the
+    served shot it is compared with comes from the server's own process."""
+    from rig.cli import main
+
     out = tmp_path / f"shot{seed}"
     sets = [a for o in overrides for a in ("--set", o)]
-    subprocess.run([*RIG, "shot", SCENE, "--seed", str(seed), *sets, "--export", str(out)], check=True,
-                   capture_output=True, text=True)
+    assert main(["shot", SCENE, "--seed", str(seed), *sets, "--export", str(out)]) == 0
     (w,) = [w for f in sorted(out.iterdir()) for w in read_waveforms(f) if w.channel == channel]
     return w.codes
 
@@ -251,24 +255,28 @@ def test_the_parsers_wire_defaults_are_the_limits():
 
 
 def test_ipv6_loopback_is_served_and_its_resources_name_it_in_brackets():
+    """In this process (``ScopeServer``, as ``rig serve scope --host ::1`` builds it: the
+    resources are those its "listening" line prints)."""
+    from rig.lab.serve import ScopeServer, ServeSettings
+
     if not socket.has_ipv6:
         pytest.skip("no IPv6 here")
     try:
         socket.create_server(("::1", 0), family=socket.AF_INET6).close()
     except OSError as e:
         pytest.skip(f"::1 cannot be listened on here ({e.strerror})")
-    s = Served(SCENE, "--host", "::1", "--port", "0", "--hislip", "0", "--seed", "2")
+    said: list = []
+    server = ScopeServer(ServeSettings(scene=SCENE, host="::1", port=0, hislip=0, seed=2), say=said.append)
     try:
-        assert not any("exposed" in line for line in s.lines)  # ::1 is loopback
-        port = s.port()
-        assert s.resources[0] == f"TCPIP::[::1]::{port}::SOCKET"
-        assert s.resource("hislip0").startswith("TCPIP::[::1]::hislip0,")
+        assert not any("exposed" in line for line in said)  # ::1 is loopback
+        port = server._socket.port
+        assert server.resources[0] == f"TCPIP::[::1]::{port}::SOCKET"
+        assert next(r for r in server.resources if "hislip0" in r).startswith("TCPIP::[::1]::hislip0,")
         with socket.create_connection(("::1", port), timeout=10) as c:
             c.sendall(b"*IDN?\n")
             assert c.recv(100).startswith(b"TEKTRONIX,TDS 2024C")
     finally:
-        code, rest = s.stop()
-    assert code == 0, rest
+        server.close()
 
 
 def test_another_address_than_loopback_is_warned_of_and_named_as_remote_clients_open_it(tmp_path):

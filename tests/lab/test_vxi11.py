@@ -377,8 +377,9 @@ def test_close_stops_both_channels_ends_links_and_unregisters():
         for port in (server.port, server.abort_port):
             with pytest.raises(ConnectionRefusedError):
                 socket.create_connection((HOST, port), timeout=2.0)
-        # the client's connection was shut down: its call fails (pyvisa-py reports an I/O error)
-        assert client.device_write(link, 500, 0, v.OP_FLAG_END, b"*IDN?")[0] == v.ErrorCodes.io_error
+        # the client's connection was shut down: its call fails (pyvisa-py reports an I/O error
+        # after io_timeout and a second of its own: an io_timeout of 0 leaves its second)
+        assert client.device_write(link, 0, 0, v.OP_FLAG_END, b"*IDN?")[0] == v.ErrorCodes.io_error
         client.close()
     finally:
         server.close()
