@@ -3,6 +3,7 @@ leading pulse against the exact solitary wave); rig.viz.figures only draws them.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -15,10 +16,11 @@ from rig.theory.solitary import solitary_wave
 from rig.viz.figures import FigureSpec
 
 
-def figure_specs(results, rigs) -> list:
+def figure_specs(results, rigs) -> Iterator[FigureSpec]:
     """The published study's figures as data: theory curves, virtual and numerical traces,
-    beta against F_m/F_0 and the leading pulse against the exact solitary wave."""
-    specs = []
+    beta against F_m/F_0 and the leading pulse against the exact solitary wave, each
+    computed when it is asked for (a figure that cannot be drawn, on a full disk, leaves the
+    later ones uncomputed)."""
     for mat, scenes in (("PTFE", ("ptfe52_gravity", "ptfe52_magnetic")),
                         ("steel", ("steel21_gravity", "steel21_magnetic"))):
         rig = rigs[scenes[0]]
@@ -41,9 +43,9 @@ def figure_specs(results, rigs) -> list:
             meas = [(p["measured_Fm"], p["measured_speed"]) for p in pts if p["measured_speed"] is not None]
             series.append((f"virtual experiment, {pre}", [x for x, _ in meas], [y for _, y in meas], style + "x"))
         curves.append(("Eq (4), sonic vacuum", sonic_vacuum_speed(m.E, m.nu, m.rho, bead.diameter, F), "k--"))
-        specs.append(FigureSpec("speed_vs_force", f"speed_vs_force_{mat.lower()}.png",
-                                (f"{mat}: solitary wave speed against force", series,
-                                 {"F_m": F, "curves": curves, "sound": sound})))
+        yield FigureSpec("speed_vs_force", f"speed_vs_force_{mat.lower()}.png",
+                         (f"{mat}: solitary wave speed against force", series,
+                          {"F_m": F, "curves": curves, "sound": sound}))
         panels = {}
         for scene in scenes:
             r = rigs[scene]
@@ -59,8 +61,8 @@ def figure_specs(results, rigs) -> list:
             panels[(pre, "numerics (time from impact)")] = [
                 (f"gauge bead {g.bead}", tt, g.average_force - g.average_force[0]) for g in gs] + [
                 ("wall", tt, tr.wall_force - tr.wall_force[0])]
-        specs.append(FigureSpec("traces", f"traces_{mat.lower()}.png",
-                                (f"{mat}: gauges (top two) and wall, gravity only vs 2.38 N", panels)))
+        yield FigureSpec("traces", f"traces_{mat.lower()}.png",
+                         (f"{mat}: gauges (top two) and wall, gravity only vs 2.38 N", panels))
     fr = np.logspace(math.log10(1.06), 3, 40)
     pts = []
     for scene, style in (("ptfe52_gravity", "C0o"), ("ptfe52_magnetic", "C3o"),
@@ -68,7 +70,7 @@ def figure_specs(results, rigs) -> list:
         sw = results["sweeps"][scene]
         pts.append((f"virtual shots, {scene}", [p["truth_Fm"] / p["F0"] for p in sw], [p["truth_beta"] for p in sw],
                     style))
-    specs.append(FigureSpec("beta_curve", "beta.png", (fr, [beta_of(x) for x in fr], pts)))
+    yield FigureSpec("beta_curve", "beta.png", (fr, [beta_of(x) for x in fr], pts))
     for scene in ("ptfe52_gravity", "ptfe52_magnetic"):
         r = rigs[scene]
         tr = r.truth()
@@ -83,9 +85,8 @@ def figure_specs(results, rigs) -> list:
         j = int(np.argmax(wave.force))
         tw = -(wave.xi - wave.xi[j]) / wave.contacts_per_s
         window = np.abs(t - t[i]) < 4 * (tw.max() - tw.min()) / 10
-        specs.append(FigureSpec("pulse_vs_solitary", f"leading_pulse_vs_solitary_{scene}.png", (
+        yield FigureSpec("pulse_vs_solitary", f"leading_pulse_vs_solitary_{scene}.png", (
             f"{scene}: leading pulse at contact {low.bead + 1}\\nvs the stationary solitary wave "
             f"of the same amplitude ({F0 + f[i]:.2f} N on F_0 = {F0:.3f} N)",
             [("virtual shot (numerics)", (t[window] - t[i]) * 1e6, f[window], "C0-"),
-             ("exact discrete solitary wave", tw * 1e6, wave.force - F0, "k--")])))
-    return specs
+             ("exact discrete solitary wave", tw * 1e6, wave.force - F0, "k--")]))

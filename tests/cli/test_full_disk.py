@@ -9,7 +9,9 @@ write in the middle of it. A failed run leaves nothing new but whole files: no f
 created empty, no 0-byte file, no lock file. Only the failing run needs a process of its
 own (the limit, its exit status, its stderr); the runs with room (a fit that fills its
 cache first, the run again) are rig.cli.main in this process, its exit status and stderr
-checked the same way (an exception it lets out fails the test, as a traceback would)."""
+checked the same way (an exception it lets out fails the test, as a traceback would). The
+fit that fills the cache runs once for the file (``fitted``); the cases that start from it
+start from a copy of its folder."""
 from __future__ import annotations
 
 import json
@@ -55,8 +57,11 @@ CASES = {
     # 24 steps (a 154 kB chain): by then (not by 20) walkers have had moves refused and met a candidate
     # whose figure is refused (its pulse never falls to 1%), as they did in 40
     "fit --posterior, the chain": (3000, [*FIT, "--posterior", "24", "--walkers", "4"]),
-    "reproduce --out": (3000, ["reproduce", "daraio2006", "--out", "{d}/r", "--quiet"]),
-    "animate --out": (2000, ["animate", S, *SMALL, "--frames", "4", "--out", "{d}/a.gif", "--quiet"]),
+    # the tables and results.json (18 kB) fit, each figure (48 to 140 kB; the first drawn 84 kB) does not:
+    # the failed run leaves the study's numbers whole (tests/cli/test_full_disk_studies.py)
+    "reproduce --out": (40000, ["reproduce", "daraio2006", "--out", "{d}/r", "--quiet", "--json"]),
+    # two frames (the fewest): a movie written whole or not at all; more frames only render longer
+    "animate --out": (2000, ["animate", S, *SMALL, "--frames", "2", "--out", "{d}/a.gif", "--quiet"]),
 }
 
 
@@ -91,7 +96,7 @@ def run_case(argv, d: Path, realdata, limit=None):
 
 def run_here(argv, d: Path, realdata, monkeypatch, capsys) -> tuple:
     """``argv`` by rig.cli.main in this process, in folder ``d`` (a run with room):
-    (exit status, stderr)."""
+    (exit status, stderr, stdout)."""
     capsys.readouterr()
     with monkeypatch.context() as m:
         m.chdir(d)
@@ -99,7 +104,8 @@ def run_here(argv, d: Path, realdata, monkeypatch, capsys) -> tuple:
             code = main(expand(argv, d, realdata))
         except SystemExit as exc:
             code = exc.code
-    return code, capsys.readouterr().err
+    out, err = capsys.readouterr()
+    return code, err, out
 
 
 def target(argv) -> str:
@@ -150,26 +156,46 @@ def check_left(d: Path, before: set | None = None):
 STUDIES = ("reproduce --out", "mc --out, two workers", "mc --traces", "mc --out")
 
 
+@pytest.fixture(scope="module")
+def fitted(tmp_path_factory):
+    """A folder with points.csv and FIT's folder, its evaluations cached: run once, each
+    case that starts from a filled cache starts from a copy of it."""
+    d = tmp_path_factory.mktemp("fitted")
+    (d / "points.csv").write_text(POINTS)
+    with pytest.MonkeyPatch.context() as m:
+        m.chdir(d)
+        assert main(expand(FIT, d, None)) in (0, 1)
+    return d
+
+
 @pytest.mark.parametrize("case", [c for c in CASES if c not in STUDIES])
 def test_a_full_disk_is_one_line_leaves_nothing_broken_and_a_second_run_succeeds(tmp_path, realdata, case,
-                                                                                    monkeypatch, capsys):
-    check_full_disk(tmp_path, realdata, case, monkeypatch, capsys)
+                                                                                    monkeypatch, capsys, request):
+    check_full_disk(tmp_path, realdata, case, monkeypatch, capsys, request)
 
 
-def check_full_disk(tmp_path: Path, realdata, case: str, monkeypatch, capsys):
+def check_full_disk(tmp_path: Path, realdata, case: str, monkeypatch, capsys, request=None):
+    """Case ``case`` of CASES under its file-size limit (fill_disk), then run again with
+    room (run_again)."""
+    argv = fill_disk(tmp_path, realdata, case, request)
+    run_again(argv, tmp_path, realdata, monkeypatch, capsys)
+
+
+def fill_disk(tmp_path: Path, realdata, case: str, request=None) -> list:
     """Case ``case`` of CASES under its file-size limit: one line naming the path it was
-    told to write and the cause, exit 2, nothing broken left; then run again with room
-    (in this process), it succeeds."""
+    told to write and the cause, exit 2, nothing broken left; returns its argv. A fit case
+    other than the cache's starts from the module's ``fitted`` folder (``request``: the
+    test's, to get it)."""
     limit, argv = CASES[case]
     if argv[0] == "animate":
         pytest.importorskip("pyvista")
     if argv[0] == "upgrade":
         shutil.copyfile(LAYOUT1, tmp_path / "old.h5")
     if argv[0] == "fit":
-        (tmp_path / "points.csv").write_text(POINTS)
-        if case != "fit, the cache":  # the cache filled by a first run: this one writes the scene and report first
-            code, err = run_here(FIT, tmp_path, realdata, monkeypatch, capsys)
-            assert code in (0, 1), err
+        if case == "fit, the cache":
+            (tmp_path / "points.csv").write_text(POINTS)
+        else:  # the cache filled by a first run: this one writes the scene and report first
+            shutil.copytree(request.getfixturevalue("fitted"), tmp_path, dirs_exist_ok=True)
     before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file() and p.suffix != ".lock"}
     there = set(tmp_path.rglob("*"))
     r = run_case(argv, tmp_path, realdata, limit)
@@ -184,7 +210,14 @@ def check_full_disk(tmp_path: Path, realdata, case: str, monkeypatch, capsys):
         assert not list(tmp_path.rglob("*.isf")) and not list(tmp_path.rglob("*.csv"))
     for p in (p for p in before if p.suffix == ".h5"):
         assert p.read_bytes() == before[p], f"{p}: changed by a failed write"
-    code, err = run_here(argv, tmp_path, realdata, monkeypatch, capsys)
+    return argv
+
+
+def run_again(argv, d: Path, realdata, monkeypatch, capsys) -> str:
+    """``argv`` run again in folder ``d`` once there is room (in this process): it
+    succeeds, says nothing of a traceback, and leaves every file whole; its stdout."""
+    code, err, out = run_here(argv, d, realdata, monkeypatch, capsys)
     assert code in ((0, 1) if argv[0] == "fit" else (0,)), err
     assert "Traceback" not in err
-    check_left(tmp_path)
+    check_left(d)
+    return out
