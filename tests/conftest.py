@@ -57,13 +57,14 @@ COMPILED: list = []  # what pytest_sessionstart compiled, said in the summary
 # default the files with the most tests first, which left the few long single tests (the
 # 10,000-shot archive, the cold shot, mypy) for the end, one worker running them while the
 # other idled (about 12 s of a run's wall time).
-LONGEST_FIRST = {"tests/cli/test_full_disk_studies.py": 44, "tests/instruments/test_archive_scale.py": 28,
-                 "tests/fit/test_fit.py": 27, "tests/solver/test_models.py": 27, "tests/cli/test_full_disk.py": 25,
-                 "tests/instruments/test_archive_flips.py": 24, "tests/docs/test_docs.py": 23,
-                 "tests/cli/test_cold_start.py": 21, "tests/study/test_fig3_studies.py": 18,
-                 "tests/study/test_mc.py": 15, "tests/test_typing.py": 15, "tests/cli/test_small_disk.py": 14,
-                 "tests/bench/test_models_bench.py": 12, "tests/fit/test_joint.py": 11,
-                 "tests/study/test_failures.py": 10, "tests/bench/test_modules_import.py": 10}
+LONGEST_FIRST = {"tests/solver/test_models.py": 38, "tests/cli/test_full_disk_studies.py": 34,
+                 "tests/study/test_fig3_studies.py": 32, "tests/instruments/test_archive_scale.py": 30,
+                 "tests/instruments/test_archive_flips.py": 28, "tests/cli/test_full_disk.py": 26,
+                 "tests/fit/test_fit.py": 22, "tests/bench/test_models_bench.py": 21,
+                 "tests/cli/test_cold_start.py": 21, "tests/test_typing.py": 20, "tests/cli/test_small_disk.py": 19,
+                 "tests/study/test_mc.py": 16, "tests/cli/test_bad_input_corpus.py": 15,
+                 "tests/lab/test_clients.py": 12, "tests/solver/test_vectorised.py": 12, "tests/docs/test_docs.py": 12,
+                 "tests/bench/test_modules_import.py": 11, "tests/cli/test_analyze.py": 10}
 
 
 def pytest_configure(config):
