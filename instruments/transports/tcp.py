@@ -62,6 +62,7 @@ class TcpService:
         self._listener.settimeout(0.2)
         self.host, self.port = self._listener.getsockname()[:2]
         self._clients: dict[socket.socket, Connection] = {}
+        self._serving: set[threading.Thread] = set()  # the connections' handlers, until each has said its end
         self._guard = threading.Lock()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._accept, name=f"{name}-accept", daemon=True)
@@ -110,7 +111,10 @@ class TcpService:
                 continue
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             self.report(EventKind.CONNECTED, c.peer)
-            threading.Thread(target=self._serve, args=(c,), name=f"{self.name}-{c.peer}", daemon=True).start()
+            handler = threading.Thread(target=self._serve, args=(c,), name=f"{self.name}-{c.peer}", daemon=True)
+            with self._guard:
+                self._serving.add(handler)
+            handler.start()
 
     def _admit(self, c: Connection) -> str | None:
         """Make room for ``c`` (holding the guard): None when it may come in, evicting a quiet
@@ -180,9 +184,12 @@ class TcpService:
                 self._clients.pop(c.sock, None)
             c.sock.close()
             self.report(EventKind.DISCONNECTED, c.peer, c.reason or why)
+            with self._guard:
+                self._serving.discard(threading.current_thread())
 
     def close(self) -> None:
-        """Stop listening and shut every connection down (their handlers then return)."""
+        """Stop listening and shut every connection down; return once each handler has said
+        its end (the log whole), or after 2 s for those held inside the instrument."""
         self._stop.set()
         with contextlib.suppress(OSError):  # wakes an accept() that waits, instead of its 0.2 s poll
             self._listener.shutdown(socket.SHUT_RDWR)
@@ -194,6 +201,11 @@ class TcpService:
         for thread in (self._thread, self._watch):
             if thread.is_alive():
                 thread.join(timeout=2.0)
+        with self._guard:
+            serving = list(self._serving)
+        deadline = time.monotonic() + 2.0
+        for thread in serving:
+            thread.join(timeout=max(0.0, deadline - time.monotonic()))
 
 
 def recv_exact(conn: socket.socket, n: int) -> bytes:

@@ -77,6 +77,27 @@ def test_an_idle_connection_is_closed_but_not_one_waiting_on_its_own_query(instr
     assert len(idle_ends) == 1 and idle_ends[0].endswith("disconnected: idle: nothing from the client for 0.4 s")
 
 
+def test_close_returns_once_every_connection_has_said_its_end(instrument):
+    """A handler says a connection's end after its socket is closed, so the client may see
+    the close first; the server's close() waits for those lines (a log read after it is
+    whole), even where the handler is slow to say it."""
+    class Slow(Events):
+        def __call__(self, event):
+            if event.kind == EventKind.DISCONNECTED:
+                time.sleep(0.3)
+            super().__call__(event)
+
+    events = Slow()
+    server = SocketServer(instrument, limits=Limits(idle_timeout_s=5), on_event=events).start()
+    clients = [socket.create_connection(("127.0.0.1", server.port), timeout=3) for _ in range(2)]
+    assert query(clients[0], b"ECHO? here\n") == b"here\n"
+    clients[0].close()  # its end, said by its handler at leisure
+    server.close()  # the other's, the server's own
+    assert sorted(line.rsplit(": ", 1)[-1] for line in events.lines(EventKind.DISCONNECTED)) == [
+        "closed by the client", "the server is closing"]
+    clients[1].close()
+
+
 def test_a_vxi11_read_waiting_longer_than_the_idle_timeout_is_served(instrument):
     server = Vxi11Server(instrument, limits=Limits(idle_timeout_s=0.3)).start()
     client = Vxi11CoreClient("127.0.0.1", server.port)
