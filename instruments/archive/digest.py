@@ -114,11 +114,11 @@ def _dataset_rows(obj, a, path: str, t: _Tree):
     are not kept."""
     import h5py
 
-    held = None
-    if t.hashed is not None:  # the object's info was read once already (its address): it reads
+    held = kept = None
+    if t.hashed is not None:  # a dataset with several hard links: keyed by its file and address
         info = h5py.h5o.get_info(obj)
         held = (info.fileno, info.addr) if info.rc > 1 else None
-    kept = t.hashed.get(held) if t.hashed is not None and held is not None else None
+        kept = t.hashed.get(held) if held is not None else None
     if kept is None:
         kept = {"": t.written.get(a) or _guard(functools.partial(_dataset_digest, obj))}
         _attrs(obj, a, "", t, kept)
