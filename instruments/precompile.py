@@ -82,6 +82,17 @@ def start(kernels: dict, then: dict | None = None) -> bool:
     return True
 
 
+def stop() -> None:
+    """Stop every side process ``start`` started (the command refused its input: nothing
+    will wait for their kernels); numba's cache stays whole (``finish``)."""
+    from numerics.dispatcher import SIDE_COMPILES
+
+    for side in set(SIDE_COMPILES.values()):
+        side.kill()
+        side.wait()
+    SIDE_COMPILES.clear()
+
+
 def finish(side: subprocess.Popen, wait_s: float = 30.0) -> None:
     """At the command's exit: let the side process end its compiles (``then``'s may outlast
     the command) for up to ``wait_s`` seconds, then stop it, so none outlives the command (a

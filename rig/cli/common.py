@@ -259,7 +259,17 @@ def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     compiles the chain solver, and say so in one line on stderr unless ``quiet``, a
     terminal or not (a log or a pipe had sat silent for the whole compile, tens of
     seconds). Nothing on a warm cache."""
-    from instruments.precompile import LEADING, SHOT, SHOT_SMALL, STUDY, start
+    with compiling_cold(command, task, quiet):
+        pass
+
+
+@contextlib.contextmanager
+def compiling_cold(command: str, task: str, quiet: bool = False):
+    """compile_cold with the side process started before the block and the line said after
+    it: the block's own compiles (a chain's statics, about 0.7 s of a cold shot) run while the
+    side process compiles, and a refusal in the block stops the side process and is the
+    command's one line (no word of a compile that will not happen)."""
+    from instruments.precompile import LEADING, SHOT, SHOT_SMALL, STUDY, start, stop
     from numerics.dispatcher import has_machine_code
     from rig.solver.kernels.ensemble import integrate_chunks
     from rig.solver.kernels.integrators import integrate
@@ -271,6 +281,11 @@ def compile_cold(command: str, task: str, quiet: bool = False) -> None:
     kernels = {**LEADING, **STUDY} if task == "study" else {**SHOT, **SHOT_SMALL}
     cold_solver = not (has_machine_code(integrate) and (task == "shot" or has_machine_code(integrate_chunks)))
     aside = start(kernels, then=SHOT_SMALL if task == "study" else None)  # so a shot after it compiles nothing
+    try:
+        yield
+    except BaseException:
+        stop()
+        raise
     parts = (["the chain solver"] if cold_solver else []) + (["the instruments"] if aside else [])
     if parts and not quiet:
         print(f"rig {command}: numba is compiling {' and '.join(parts)}{' (in two processes)' if aside else ''}, "

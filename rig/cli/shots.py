@@ -7,7 +7,7 @@ from rig.cli.common import (
     check_export_folder,
     check_size,
     command,
-    compile_cold,
+    compiling_cold,
     flag_lines,
     missing_lines,
     plain,
@@ -40,9 +40,9 @@ def cmd_shot(args) -> dict:
         if args.export:
             raise invalid("--export", args.export, "one shot's scope files; with --repeat archive the shots (--out)")
         return repeat_shots(args, scene)
-    rig = Rig(scene)
-    check_size(rig.estimate(), args, "this shot")
-    compile_cold("shot", "shot")  # after the refusals that need no kernel: a refused shot leaves no side process
+    with compiling_cold("shot", "shot"):  # a refused shot leaves no side process
+        rig = Rig(scene)
+        check_size(rig.estimate(), args, "this shot")
     shot = rig.fire(seed=args.seed)
     out = shot_summary(rig, shot)
     out.update(shot_blocks(rig, shot))
@@ -80,9 +80,9 @@ def repeat_shots(args, scene) -> dict:
     from rig.experiment.shot import Rig, fresh_seed
 
     seed = fresh_seed() if args.seed is None else args.seed
-    first = Rig(scene)
-    check_size(first.estimate(), args, "each shot")
-    compile_cold("shot", "shot")
+    with compiling_cold("shot", "shot"):
+        first = Rig(scene)
+        check_size(first.estimate(), args, "each shot")
     rows, rig = [], first
     for k in range(args.repeat):
         if k:

@@ -135,3 +135,27 @@ def test_a_cold_start_says_so_in_a_log_too(monkeypatch, capsys):
                    "its cache\n"), err
     compile_cold("mc", "study", quiet=True)
     assert capsys.readouterr().err == ""
+
+
+def test_a_shot_refused_on_a_cold_cache_stops_its_side_process_and_says_one_line(monkeypatch, capsys):
+    """The side process starts before the chain is built (its statics compile meanwhile);
+    a shot refused there (too large, no --allow-large) stops it at once, and the refusal is
+    the command's only line (no word of a compile that will not happen)."""
+    import instruments.precompile
+    import numerics.dispatcher
+
+    started = []
+
+    def start(kernels, then=None):  # the real start, its process kept to look at
+        on = real_start(kernels, then)
+        started.extend(set(numerics.dispatcher.SIDE_COMPILES.values()))
+        return on
+
+    real_start = instruments.precompile.start
+    monkeypatch.setattr(numerics.dispatcher, "has_machine_code", lambda kernel: False)  # a cold cache
+    monkeypatch.setattr(instruments.precompile, "start", start)
+    assert main(["shot", "ptfe52_magnetic", "--set", "solver.duration=1000 s", "--seed", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--allow-large" in err and "compiling" not in err, err
+    assert len(started) == 1 and started[0].returncode is not None  # started, and ended before the command
+    assert numerics.dispatcher.SIDE_COMPILES == {}
