@@ -20,11 +20,13 @@ slower beside them.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib
 import inspect
 import os
 import pkgutil
+import types
 from pathlib import Path
 
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # before numba loads its OpenMP layer
@@ -57,6 +59,23 @@ def _declare(function, options: dict):
     if OPTIONS["cache"]:
         dispatcher.enable_caching()
     return dispatcher
+
+
+@functools.cache
+def interpreted(kernel):
+    """``kernel`` (a ``jit`` function) run by the Python interpreter, the kernels it calls
+    interpreted too: the same float64 operations in the same order as its machine code
+    (IEEE arithmetic, no fastmath, libm's pow and sqrt), so the same bits, and nothing to
+    compile; for a call too small to pay for a compile (rig.solver.problem.balance_at_rest
+    of one short chain: 0.7 s of a cold shot's compile, milliseconds interpreted)."""
+    from numba.core.dispatcher import Dispatcher
+
+    f = kernel.py_func
+    names = dict(f.__globals__)
+    for name in f.__code__.co_names:
+        if isinstance(names.get(name), Dispatcher):
+            names[name] = interpreted(names[name])
+    return types.FunctionType(f.__code__, names, f.__name__, f.__defaults__, f.__closure__)
 
 
 def kernel(function=None, **options):

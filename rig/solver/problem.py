@@ -230,10 +230,20 @@ def balance_at_rest(load, A, d0, expo, invm):
     for chains under 1e4 beads), so that the slots below can carry it exactly. The change
     is otherwise a few parts in 1e16; the kernels integrate the bodies ahead of a pulse
     only where they are at rest bit for bit (rig/solver/kernels/integrators.py)."""
-    from numerics.threads import over_threads
     from rig.solver.kernels.forces import balance_at_rest as balance  # numba: loaded when a problem is built
 
+    if A.shape[0] == 1 and A.shape[1] <= INTERPRETED_BODIES:  # one short chain: no compile (the same bits)
+        from numerics.jit import interpreted
+
+        interpreted(balance)(0, 1, load, A, d0, expo, invm, REST_TOLERANCE, NUDGES)
+        return
+    from numerics.threads import over_threads
+
     over_threads(A.shape[0], balance, load, A, d0, expo, invm, REST_TOLERANCE, NUDGES)
+
+
+INTERPRETED_BODIES = 2000  # a single shot's chain up to this many bodies is balanced by the interpreter (about
+# 1 ms a thousand bodies), not the compiled kernel (0.7 s of compile on a cold cache)
 
 
 @dataclass(frozen=True, eq=False)

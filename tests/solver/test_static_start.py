@@ -45,3 +45,37 @@ def test_a_record_where_nothing_moves_is_not_refined_down_to_rounding():
     # a pulse a billionth of the static force high is still a pulse, measured against itself
     moved = dict(sol.forces, wall=wall + 2e-9 * wall[0] * (np.arange(wall.size) > wall.size // 2))
     assert relative_error(sol.forces, moved) > 0.4
+
+
+def test_a_short_chain_is_balanced_by_the_interpreter_to_the_compiled_kernels_bits(monkeypatch):
+    """One short chain's rest balance runs interpreted (numerics.jit.interpreted: no compile
+    on a cold cache), a batch's compiled: the same loads and overlaps to the last bit, on
+    chains whose balance moves numbers (the nudges run) and whose exponents are not all 3/2."""
+    from chains import PTFE, STEEL, steel_sonic_vacuum
+
+    import rig.solver.problem as problem
+    from numerics.jit import interpreted
+    from numerics.threads import over_threads
+    from rig import Bead, Chain, MagneticBead, Striker, Wall
+    from rig.solver.kernels.forces import balance_at_rest
+
+    seen = []
+    monkeypatch.setattr(problem, "balance_at_rest", lambda *arrays: seen.append([a.copy() for a in arrays]))
+    chains = [ptfe_rig(), ptfe_rig(n=300, striker=False), steel_sonic_vacuum(n=40, wall=True),
+              Chain([MagneticBead()] + [Bead(**PTFE)] * 30, striker=Striker("alumina", "0.47 g", "0.89 m/s"),
+                    wall=Wall(), top_force=2.38, contact_exponent=1.75),
+              Chain([Bead(**STEEL)] * 50, striker=Striker("steel316", "0.4501 g", "0.5 m/s"), wall=Wall())]
+    for chain in chains:
+        ChainProblem.from_chain(chain)
+    moved = np.zeros(2, dtype=int)
+    for load, A, d0, expo, invm in seen:
+        assert A.shape[0] == 1 and A.shape[1] <= problem.INTERPRETED_BODIES  # the interpreter's case
+        by_hand = [a.copy() for a in (load, d0)]
+        interpreted(balance_at_rest)(0, 1, by_hand[0], A, by_hand[1], expo, invm, problem.REST_TOLERANCE,
+                                     problem.NUDGES)
+        compiled = [a.copy() for a in (load, d0)]
+        over_threads(1, balance_at_rest, compiled[0], A, compiled[1], expo, invm, problem.REST_TOLERANCE,
+                     problem.NUDGES)
+        assert all(np.array_equal(x, y) for x, y in zip(by_hand, compiled))
+        moved += [np.count_nonzero(compiled[0] != load), np.count_nonzero(compiled[1] != d0)]
+    assert np.all(moved > 0)  # loads and overlaps moved: the rounding and the nudges ran, in both
