@@ -88,8 +88,11 @@ def run_case(argv, d: Path, realdata, limit=None):
     """``argv`` in a process of its own in folder ``d``, its files limited to ``limit``
     bytes (DISK_FULL) where one is given."""
     code = DISK_FULL if limit else "import sys\nfrom rig.cli import main\nsys.exit(main(sys.argv[2:]))\n"
-    # and none by the processes it starts (rig mc --workers: spawned interpreters, the limit inherited)
-    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1") if limit else None
+    # and none by the processes it starts (rig mc --workers: spawned interpreters, the limit inherited); under
+    # coverage (docs/how-to/contributing.md) such a process is not measured: it could not save coverage's data,
+    # and coverage's complaint would be a second line on its stderr
+    env = dict({k: v for k, v in os.environ.items() if not k.startswith("COVERAGE_")},
+               PYTHONDONTWRITEBYTECODE="1") if limit else None
     return subprocess.run([sys.executable, "-c", code, str(limit or 0), *expand(argv, d, realdata)], check=False,
                           capture_output=True, text=True, cwd=d, timeout=600, env=env)
 
