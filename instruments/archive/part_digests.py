@@ -42,8 +42,7 @@ def part_tables(f, written: dict | None = None) -> dict:
     from .stored import table_text
 
     given = written or {}
-    out = {f"/{name}": table_text(f[name]) if given.get(f"/{name}") is None else given[f"/{name}"]
-           for name in f if name.startswith("shot_")}
+    out = {f"/{name}": given.get(f"/{name}") or table_text(f[name]) for name in f if name.startswith("shot_")}
     if "shared" in f:
         out.update({f"/shared/{key}": table_text(f["shared"][key]) for key in f["shared"]})
     return out

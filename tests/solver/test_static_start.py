@@ -54,6 +54,7 @@ def test_a_short_chain_is_balanced_by_the_interpreter_to_the_compiled_kernels_bi
     from chains import PTFE, STEEL, steel_sonic_vacuum
 
     import rig.solver.problem as problem
+    import rig.solver.rest as rest
     from numerics.jit import interpreted
     from numerics.threads import over_threads
     from rig import Bead, Chain, MagneticBead, Striker, Wall
@@ -69,13 +70,13 @@ def test_a_short_chain_is_balanced_by_the_interpreter_to_the_compiled_kernels_bi
         ChainProblem.from_chain(chain)
     moved = np.zeros(2, dtype=int)
     for load, A, d0, expo, invm in seen:
-        assert A.shape[0] == 1 and A.shape[1] <= problem.INTERPRETED_BODIES  # the interpreter's case
+        assert A.shape[0] == 1 and A.shape[1] <= rest.INTERPRETED_BODIES  # the interpreter's case
         by_hand = [a.copy() for a in (load, d0)]
-        interpreted(balance_at_rest)(0, 1, by_hand[0], A, by_hand[1], expo, invm, problem.REST_TOLERANCE,
-                                     problem.NUDGES)
+        interpreted(balance_at_rest)(0, 1, by_hand[0], A, by_hand[1], expo, invm, rest.REST_TOLERANCE,
+                                     rest.NUDGES)
         compiled = [a.copy() for a in (load, d0)]
-        over_threads(1, balance_at_rest, compiled[0], A, compiled[1], expo, invm, problem.REST_TOLERANCE,
-                     problem.NUDGES)
+        over_threads(1, balance_at_rest, compiled[0], A, compiled[1], expo, invm, rest.REST_TOLERANCE,
+                     rest.NUDGES)
         assert all(np.array_equal(x, y) for x, y in zip(by_hand, compiled))
         moved += [np.count_nonzero(compiled[0] != load), np.count_nonzero(compiled[1] != d0)]
     assert np.all(moved > 0)  # loads and overlaps moved: the rounding and the nudges ran, in both
