@@ -39,16 +39,21 @@ def undo_highpass(y, h, tau):
 @jit
 def undo_highpass_into(y, level, h, tau, scale, out):
     """out[n] = x[n] / scale, x undo_highpass's input of the RC high-pass (tau s; 0: none,
-    x = y - level) whose output is y - level: one pass, with undo_highpass's operations in
-    its order. out may be y itself."""
-    acc = 0.0
-    before = 0.0
-    for k in range(y.shape[0]):
-        yk = y[k] - level
-        if tau > 0.0:
-            if k:
-                acc = acc + h * (yk + before) / 2.0
-            out[k] = (yk + acc / tau) / scale
-        else:
-            out[k] = yk / scale
-        before = yk
+    x = y - level) whose output is y - level, with undo_highpass's operations in its order.
+    out may be y itself. The integral's running sum is a chain of additions; the two
+    divisions of each sample, which do not wait on it, run in a second pass that
+    vectorises (a scalar division's throughput had bounded the loop)."""
+    n = y.shape[0]
+    if not tau > 0.0:
+        for k in range(n):
+            out[k] = (y[k] - level) / scale
+        return
+    shifted, acc = np.empty(n), np.empty(n)  # y - level, and the running sum before sample k's division by tau
+    total = 0.0
+    for k in range(n):
+        shifted[k] = y[k] - level
+        if k:
+            total = total + h * (shifted[k] + shifted[k - 1]) / 2.0
+        acc[k] = total
+    for k in range(n):  # reads neither y nor out: a vector loop where out is y
+        out[k] = (shifted[k] + acc[k] / tau) / scale

@@ -212,6 +212,59 @@ def test_correlation_adds_each_lag_in_order():
             assert _same_bits(c, ref)
 
 
+def test_the_correlation_peak_is_every_lags_peak_from_the_lags_that_can_hold_it():
+    # correlation_peak sums only the lags whose Cauchy-Schwarz bound reaches a value the
+    # correlation takes, and their neighbours: its peak (np.argmax's) and parabola shift are
+    # those of every lag's sums (correlate's, in order), bit for bit, for pulse pairs clean,
+    # noisy, 8-bit-like and upside down, pure noise, amplitudes whose sums of squares would
+    # underflow or overflow (the full correlation) and a nan; and b holding a's very samples
+    # (its lag's bound is its value: a bound a hair too low drops the peak) beside a plateau
+    # whose bound is higher and whose correlation is lower (so the lags are not all dropped)
+    from instruments.analysis._kernels.pulses import correlate, correlation_peak
+
+    rng = np.random.default_rng(29)
+    for case in range(840):
+        m = int(rng.integers(3, 400))
+        nb = m + int(rng.integers(1, 500))
+
+        def sech2(n, centre, width):
+            return rng.uniform(0.1, 10.0) / np.cosh(np.clip((np.arange(n) - centre) / width, -300, 300)) ** 2
+
+        width = rng.uniform(2.0, 120.0)
+        a, b = sech2(m, m / 2, width), sech2(nb, rng.uniform(0, nb), width)
+        kind = case % 7
+        if kind == 1:
+            a, b = a + rng.normal(0, 0.3, m), b + rng.normal(0, 0.3, nb)
+        elif kind == 2:
+            a, b = np.round(a * 20) / 20, np.round(b * 20) / 20
+        elif kind == 3:
+            a = -a
+        elif kind == 4:
+            a, b = rng.standard_normal(m), rng.standard_normal(nb)
+        elif kind == 5:
+            scale = 10.0 ** rng.choice([-170, 170])
+            a, b = a * scale, b * scale
+            if case % 4 == 1:
+                b[rng.integers(nb)] = np.nan
+        elif kind == 6:
+            a = rng.uniform(0.1, 10.0) / np.cosh((np.arange(m) - m / 2) / rng.uniform(0.05, 0.2) / m) ** 2
+            norm, total = math.sqrt(np.sum(a * a)), np.sum(a)  # total < 0.9 sqrt(m) norm: a narrow pulse
+            level = 0.5 * (norm / math.sqrt(m) + norm * norm / total)  # a plateau: a higher bound, a lower value
+            b = np.concatenate([np.zeros(int(rng.integers(0, 50))), a, np.zeros(int(rng.integers(0, 50))),
+                                np.full(m + int(rng.integers(0, 50)), level)])[::1 if case % 2 else -1].copy()
+            a = a[::1 if case % 2 else -1].copy()
+            nb = b.size
+        c = np.zeros(nb - m + 1)
+        correlate(a, b, c)
+        k = int(np.argmax(c))
+        shift = 0.0
+        if 0 < k < c.size - 1 and c[k - 1] - 2.0 * c[k] + c[k + 1] != 0.0:
+            shift = 0.5 * (c[k - 1] - c[k + 1]) / (c[k - 1] - 2.0 * c[k] + c[k + 1])
+        got_k, got_shift = correlation_peak(a, b)
+        assert got_k == k, case
+        assert got_shift == shift or (math.isnan(got_shift) and math.isnan(shift)), case
+
+
 def test_median_of_many_records_is_numpys():
     # sorted, tied and noisy inputs of every length parity: the selection's pivots and
     # buffers give numpy's value exactly; a nan gives nan, as np.median does

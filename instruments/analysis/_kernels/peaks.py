@@ -14,23 +14,28 @@ def local_maxima(x, floor=-np.inf):
     left neighbour and than the first different sample on their right; a flat top counts
     once, at its middle ((first + last) // 2), as scipy.signal's _local_maxima_1d. The
     floor (find_peaks' height rule) gives the maxima that filtering all of them by it
-    gives, and a sample below it costs one comparison (a noisy baseline's signs are a
-    coin toss for the branch predictor)."""
-    out = np.empty(x.shape[0] // 2 + 1, np.int64)
+    gives. A first pass notes, without a branch, every sample at or above the floor that
+    rises from its left neighbour and does not fall short of its right one (a noisy
+    pulse's rises and falls are a coin toss for the branch predictor); the second walks
+    those few, each flat top to its end."""
+    n = x.shape[0]
+    rising = np.empty(max(n, 2) // 2 + 1, np.int64)  # two such samples are never neighbours
     m = 0
-    i = 1
-    last = x.shape[0] - 1
-    while i < last:
-        if x[i] >= floor and x[i - 1] < x[i]:
-            ahead = i + 1
-            while ahead < last and x[ahead] == x[i]:
-                ahead += 1
-            if x[ahead] < x[i]:
-                out[m] = (i + ahead - 1) // 2
-                m += 1
-                i = ahead
-        i += 1
-    return out[:m]
+    for i in range(1, n - 1):
+        rising[m] = i
+        m += (x[i] >= floor) & (x[i - 1] < x[i]) & (x[i + 1] <= x[i])
+    out = np.empty(m, np.int64)
+    found = 0
+    last = n - 1
+    for r in range(m):
+        i = rising[r]
+        ahead = i + 1
+        while ahead < last and x[ahead] == x[i]:
+            ahead += 1
+        if x[ahead] < x[i]:
+            out[found] = (i + ahead - 1) // 2
+            found += 1
+    return out[:found]
 
 
 @jit
