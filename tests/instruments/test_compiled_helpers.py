@@ -223,7 +223,7 @@ def test_the_correlation_peak_is_every_lags_peak_from_the_lags_that_can_hold_it(
     from instruments.analysis._kernels.pulses import correlate, correlation_peak
 
     rng = np.random.default_rng(29)
-    for case in range(840):
+    for case in range(420):
         m = int(rng.integers(3, 400))
         nb = m + int(rng.integers(1, 500))
 
