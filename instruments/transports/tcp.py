@@ -12,6 +12,7 @@ connection down."""
 from __future__ import annotations
 
 import contextlib
+import select
 import socket
 import threading
 import time
@@ -189,23 +190,43 @@ class TcpService:
 
     def close(self) -> None:
         """Stop listening and shut every connection down; return once each handler has said
-        its end (the log whole), or after 2 s for those held inside the instrument."""
+        its end (the log whole), or after 2 s for those held inside the instrument. A
+        connection the kernel completed that no accept() has taken yet is taken here, said
+        and ended (the client had connected: shutting the listener would drop it unsaid)."""
         self._stop.set()
+        self._end_waiting()
         with contextlib.suppress(OSError):  # wakes an accept() that waits, instead of its 0.2 s poll
             self._listener.shutdown(socket.SHUT_RDWR)
         self._listener.close()
+        if self._thread.is_alive():  # what it took meanwhile is among the clients once it has ended
+            self._thread.join(timeout=2.0)
         with self._guard:
             clients = list(self._clients.values())
         for c in clients:
             c.close("the server is closing")
-        for thread in (self._thread, self._watch):
-            if thread.is_alive():
-                thread.join(timeout=2.0)
+        if self._watch.is_alive():
+            self._watch.join(timeout=2.0)
         with self._guard:
             serving = list(self._serving)
         deadline = time.monotonic() + 2.0
         for thread in serving:
             thread.join(timeout=max(0.0, deadline - time.monotonic()))
+
+    def _end_waiting(self) -> None:
+        """Take each connection the kernel has queued for the listener (the accept thread
+        may take some of them too, and serves those), say it and end it: "the server is
+        closing"."""
+        while True:
+            try:
+                if not select.select([self._listener], [], [], 0)[0]:
+                    return
+                sock, addr = self._listener.accept()
+            except (OSError, ValueError):  # the accept thread took it first (a timeout), or the listener is closed
+                return
+            peer = peer_text(addr)
+            sock.close()
+            self.report(EventKind.CONNECTED, peer)
+            self.report(EventKind.DISCONNECTED, peer, "the server is closing")
 
 
 def recv_exact(conn: socket.socket, n: int) -> bytes:
