@@ -10,9 +10,9 @@ whose scene was stored by an earlier transaction, in another part file) is the r
 xarray and netCDF) are hashed as the paths they point to. The group's attribute ``sha256``
 is the SHA-256 of the table's text, so a damaged table is found too.
 
-Comparing a table with the file as it now reads names each damaged dataset or attribute.
 HDF5's own fletcher32 checks (every array dataset) raise while the values are read; each
-such error is caught and reported against the item that raised.
+such error is caught and its row says so ("unreadable: ..."). Comparing a table with the
+file as it now reads: compare.py.
 """
 from __future__ import annotations
 
@@ -23,8 +23,8 @@ from typing import TYPE_CHECKING
 
 from .addresses import address, external, member_address
 from .hashes import attribute_digest, sha, value_digest
-from .stored import TABLE, stored_table
-from .values import attribute_names, attribute_or, attribute_value, dataset_value, h5py_object, hdf5_id
+from .stored import TABLE
+from .values import attribute_names, attribute_value, dataset_value, h5py_object, hdf5_id
 
 if TYPE_CHECKING:
     import h5py
@@ -151,7 +151,7 @@ def _walk(g, a, prefix: str, t: _Tree):
             obj = h5py.h5o.open(g.id, name.encode())  # as g[name] does, without its h5py object
             a = address(obj)
         except Exception as exc:  # noqa: BLE001 - a damaged link or header is a finding
-            t.rows[path] = f"unreadable: {_first_line(exc)}"
+            t.rows[path] = f"unreadable: {first_line(exc)}"
             continue
         if a in t.linked:
             t.rows[path] = "link:" + t.linked[a]
@@ -190,52 +190,6 @@ def member_row(names) -> str:
     return sha(json.dumps(sorted(names)).encode())
 
 
-def damage(group: h5py.Group, linked: dict, read=None, known: dict | None = None, text: str | None = None,
-           hashed: dict | None = None) -> list:
-    """What differs between ``group``'s stored table and the file: a list of
-    "path: what is wrong" lines, empty when every item matches. ``read`` (a test of a row's
-    key, e.g. ``lambda key: not key.startswith("data/")``): only the rows a reader reads are
-    computed, item by item, without walking the rest (``known``: {row key: its row} that a
-    reader computed from the values it read, not read again); where one differs, the whole
-    table is compared and the lines about those rows given. ``text``: the stored table's
-    text where the caller has read it (stored_table), not read again. ``hashed``: as for
-    table(), where the whole table is compared."""
-    try:
-        text = stored_table(group) if text is None else text
-        if sha(text.encode()) != _sealed_digest(group):
-            return [f"{TABLE}: the table of checksums (or the attribute {DIGEST}) is damaged"]
-        stored = json.loads(text)
-    except Exception as exc:  # noqa: BLE001
-        return [f"{TABLE}: unreadable ({_first_line(exc)})"]
-    if read is not None:
-        keys = [k for k in stored if read(k)]
-        if rows(group, [k for k in keys if k not in (known or {})], linked, stored, known) == \
-                {k: stored[k] for k in keys}:
-            return []
-        found = _differences(stored, table(group, linked, hashed=hashed))
-        return [p for p in found if read(p.removeprefix("attribute ").split(": ", 1)[0])] or found
-    return _differences(stored, table(group, linked, hashed=hashed))
-
-
-def _sealed_digest(group) -> str:
-    """The group's attribute ``sha256`` ("" where it has none)."""
-    return str(attribute_or(group, DIGEST, ""))
-
-
-def _differences(stored: dict, now: dict) -> list:
-    out = []
-    for key in sorted(set(stored) | set(now)):
-        kind = "attribute " if "@" in key else ""
-        if key not in now:
-            out.append(f"{kind}{key}: missing")
-        elif key not in stored:
-            out.append(f"{kind}{key}: not in the table of checksums (added or renamed)")
-        elif now[key] != stored[key]:
-            cause = now[key][len("unreadable: "):] if now[key].startswith("unreadable") else "SHA-256 differs"
-            out.append(f"{kind}{key}: damaged ({cause})")
-    return out
-
-
 def rows(group: h5py.Group, keys: list, linked: dict, stored: dict, known: dict | None = None) -> dict:
     """The rows ``keys`` of ``group``'s table as the file reads now, each computed alone (no
     walk over the rest of the group), and those of ``known`` (rows a reader computed) that the
@@ -256,7 +210,7 @@ def rows(group: h5py.Group, keys: list, linked: dict, stored: dict, known: dict 
         try:
             out[key] = _row(at, key, stored.get(key, ""), t)
         except Exception as exc:  # noqa: BLE001 - damage is reported, never raised
-            out[key] = f"unreadable: {_first_line(exc)}"
+            out[key] = f"unreadable: {first_line(exc)}"
     return out
 
 
@@ -304,8 +258,9 @@ def _guard(compute) -> str:
     try:
         return compute()
     except Exception as exc:  # noqa: BLE001 - damage is reported, never raised
-        return f"unreadable: {_first_line(exc)}"
+        return f"unreadable: {first_line(exc)}"
 
 
-def _first_line(exc) -> str:
+def first_line(exc) -> str:
+    """An exception's first line of text (its type's name where it has none)."""
     return (str(exc).splitlines() or [type(exc).__name__])[0] or type(exc).__name__

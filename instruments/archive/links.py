@@ -82,7 +82,7 @@ def returned_by_read(layout):
 
 
 def truth_item(problem: str) -> bool:
-    """Whether a line of digest.damage names the truth's forces (the "forces" group,
+    """Whether a line of compare.damage names the truth's forces (the "forces" group,
     its datasets or attributes) of a shared group: what a read without the truth skips."""
     key = problem.removeprefix("attribute ").split(":", 1)[0]
     return key.split("@", 1)[0].split("/", 1)[0] == "forces"

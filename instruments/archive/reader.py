@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 from ..errors import InstrumentError
 from ..records import Preamble, ScopeRecord, Waveform
 from .compact import LAYOUT4
-from .digest import damage
+from .compare import damage
 from .entry import Entry, raw_digest
 from .facts import ShotFacts
 from .hashes import attribute_digest, value_digest

@@ -23,7 +23,7 @@ import contextlib
 from dataclasses import dataclass
 
 from ..errors import InstrumentError
-from .digest import damage
+from .compare import damage
 from .hashes import value_digest
 from .links import file_identity, truth_item
 from .stored import links_below, stored_rows, table_text

@@ -1,4 +1,4 @@
-"""A group's table of checksums as stored (digest.py computes and compares them): its
+"""A group's table of checksums as stored (digest.py computes them, compare.py compares them): its
 text, its rows, and the shared groups it links to, each read once by a caller that needs
 several of them."""
 from __future__ import annotations

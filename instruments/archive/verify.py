@@ -20,7 +20,8 @@ import re
 from typing import TYPE_CHECKING
 
 from .addresses import address
-from .digest import damage, sha
+from .compare import damage
+from .digest import sha
 from .links import OpenParts
 from .members import expanded
 from .part_digests import swapped_parts
@@ -31,7 +32,7 @@ if TYPE_CHECKING:
 
 ROOT_TABLE = "checksums"  # root attribute: {attribute: SHA-256} of the root's other attributes
 MEMBERS = "members"  # root attribute (version 2): {"/": root's member names, "/shared": shared's}
-_ADDED = "not in the table of checksums"  # how digest.damage words an added item
+_ADDED = "not in the table of checksums"  # how compare.damage words an added item
 SHARED_ATTRS_SINCE = 4  # the layout from which the root's table covers /shared's attributes
 
 
@@ -210,7 +211,7 @@ def check(f: h5py.File) -> dict:
 
 
 def named(problems: list, prefix: str) -> list:
-    """digest.damage's lines for the group at ``prefix``, with each object added or
+    """compare.damage's lines for the group at ``prefix``, with each object added or
     deleted (a dataset, or a group: its member-list row "X/") named once by its path
     ("missing: /shot_000003/data/CH2") and the lines it alone explains left out: the member
     list of its group, its own attributes and members."""
