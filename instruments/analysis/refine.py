@@ -3,12 +3,12 @@ within ``rules.top`` of its maximum (accurate on 8-bit records whose tops are pl
 equal codes), its widths where it crosses 50% (FWHM) and 1% (base) of its amplitude,
 interpolated linearly; and the delay between two pulses by cross-correlation, with a
 parabola through the correlation peak. The loops are compiled in _kernels/pulses.py
-(refine, xcorr_lag)."""
+(refine) and _kernels/correlation.py (xcorr_lag)."""
 from __future__ import annotations
 
 import numpy as np
 
-from ._kernels import pulses
+from ._kernels import correlation, pulses
 from .pulse import DEFAULT_RULES, PeakRules, Pulse
 
 
@@ -24,7 +24,7 @@ def xcorr_delay(t, fa, pa: Pulse, fb, pb: Pulse) -> float:
 
     The window of a spans one FWHM either side of its maximum (the main lobe, clear of the
     next pulse of a train); b is searched within a window twice as wide around its own
-    maximum; parabola through the correlation peak (compiled: _kernels/pulses.py)."""
+    maximum; parabola through the correlation peak (compiled: _kernels/correlation.py)."""
     c = np.ascontiguousarray
-    return float(pulses.xcorr_lag(c(t, dtype=float), c(fa, dtype=float), pa.time, pa.fwhm, c(fb, dtype=float),
+    return float(correlation.xcorr_lag(c(t, dtype=float), c(fa, dtype=float), pa.time, pa.fwhm, c(fb, dtype=float),
                                   pb.time))

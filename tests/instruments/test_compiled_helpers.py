@@ -198,7 +198,7 @@ def test_correlation_adds_each_lag_in_order():
     # the cross-correlation's sums, four terms at a time, are the plain sums over j in
     # order (numpy adds a[j] b[j:j + K] to c one j after another), bit for bit, for
     # windows that are and are not multiples of four
-    from instruments.analysis._kernels.pulses import correlate
+    from instruments.analysis._kernels.correlation import correlate
 
     rng = np.random.default_rng(13)
     for m in (1, 3, 4, 5, 8, 611, 614):
@@ -220,7 +220,7 @@ def test_the_correlation_peak_is_every_lags_peak_from_the_lags_that_can_hold_it(
     # underflow or overflow (the full correlation) and a nan; and b holding a's very samples
     # (its lag's bound is its value: a bound a hair too low drops the peak) beside a plateau
     # whose bound is higher and whose correlation is lower (so the lags are not all dropped)
-    from instruments.analysis._kernels.pulses import correlate, correlation_peak
+    from instruments.analysis._kernels.correlation import correlate, correlation_peak
 
     rng = np.random.default_rng(29)
     for case in range(420):

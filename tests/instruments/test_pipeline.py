@@ -76,7 +76,7 @@ def test_the_delay_of_a_finely_sampled_pair_is_the_full_correlations_at_a_bounde
     sample's fraction (the coarse search alone would be off by up to 85/2 samples, 8 ns);
     a window just past XCORR_POINTS (every 2nd sample first) gives the full correlation's
     peak and parabola, computed here with numpy."""
-    from instruments.analysis._kernels.pulses import XCORR_POINTS
+    from instruments.analysis._kernels.correlation import XCORR_POINTS
 
     h = 2e-10
     t = np.arange(int(0.32e-3 / h)) * h

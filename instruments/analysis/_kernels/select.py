@@ -1,10 +1,11 @@
 """numpy's array selections and searches as plain loops (numba): ``a[keep]`` for a boolean
 mask, ``a[idx]`` for an index array, a strided slice's copy, np.max, np.argmax,
-np.searchsorted and a stable argsort. numba lowers each selection written with numpy's indexing into its caller, a large
-block of code for every one (candidates' six took 1.9 s of its compile), and compiles its own
-np.max, np.argmax and np.searchsorted in every process for every caller's types (about 0.6 s
-of a cold shot), never cached; as calls of these, each element type compiles once. The same
-elements, in the same order, numpy's results (NaN included)."""
+np.searchsorted and a stable argsort. numba lowers each selection written with numpy's
+indexing into its caller, a large block of code for every one (candidates' six took 1.9 s
+of its compile), and compiles its own np.max, np.argmax and np.searchsorted in every
+process for every caller's types (about 0.6 s of a cold shot), never cached; as calls of
+these, each element type compiles once. The same elements, in the same order, numpy's
+results (NaN included)."""
 import numpy as np
 
 from numerics.jit import jit
